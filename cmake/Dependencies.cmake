@@ -1,0 +1,37 @@
+# Finds every dependency in one place. All come from Debian packages listed in
+# scripts/debian-packages.txt; nothing is downloaded at configure or build time.
+
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(tinyobjloader REQUIRED)
+find_package(OpenSSL REQUIRED)            # SHA-256 of inputs for provenance
+find_package(Threads REQUIRED)
+
+# OpenImageIO writes PNG/EXR images; it is optional so that GPU machines without it can
+# still build and run the samplers (images are then written as PFM/PPM).
+find_package(OpenImageIO CONFIG QUIET)
+set(SDF_HAVE_OIIO ${OpenImageIO_FOUND})
+
+if(SDF_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(SDF_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()
+
+# CUDA: enabled automatically when nvcc is found (SDF_ENABLE_CUDA=AUTO), switchable off.
+set(SDF_HAVE_CUDA OFF)
+if(NOT SDF_ENABLE_CUDA STREQUAL "OFF")
+  include(CheckLanguage)
+  check_language(CUDA)
+  if(CMAKE_CUDA_COMPILER)
+    if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+      set(CMAKE_CUDA_ARCHITECTURES 90 CACHE STRING "CUDA architectures (90 = H100/H200)")
+    endif()
+    enable_language(CUDA)
+    find_package(CUDAToolkit REQUIRED)
+    set(SDF_HAVE_CUDA ON)
+  elseif(SDF_ENABLE_CUDA STREQUAL "ON")
+    message(FATAL_ERROR "SDF_ENABLE_CUDA=ON but no CUDA compiler (nvcc) was found")
+  endif()
+endif()

@@ -1,0 +1,16 @@
+/// @file load_obj.h
+/// @brief Wavefront OBJ loading through tinyobjloader (double precision, polygons triangulated).
+#pragma once
+
+#include <string>
+
+#include "cpu_reference/mesh/triangle_mesh.h"
+
+namespace sdf {
+
+/// Loads every face of every shape in file order; polygons become fans of triangles.
+/// Throws std::runtime_error naming the file (and the line where known) when the file is
+/// missing, unparsable, holds no triangles, or has non-finite coordinates.
+TriangleMesh load_obj(const std::string& path);
+
+}  // namespace sdf

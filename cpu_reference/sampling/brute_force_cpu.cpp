@@ -1,0 +1,129 @@
+#include "cpu_reference/sampling/brute_force_cpu.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "cpu_reference/parallel/parallel_for.h"
+#include "cpu_reference/parallel/progress.h"
+#include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "kernels/distance/signed_distance.h"
+
+namespace sdf {
+namespace {
+
+enum class CpuKernel { Vectorized, Eberly };
+
+/// Evaluates n points: pos(i) gives the position, emit(i, sample) receives the result.
+template <typename T, typename PositionFn, typename EmitFn>
+void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bool progress, int64_t n,
+                     PositionFn pos, EmitFn emit) {
+    const MeshBuffers<T>& buffers = mesh.buffers<T>();
+    const MeshView<T> view = buffers.view();
+    const TriangleSoA<T> soa(buffers.packed);
+    ProgressReporter reporter("sampling " + mesh.name, n, progress);
+    parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
+        const int count = int(end - begin);
+        T px[kPointTile], py[kPointTile], pz[kPointTile], best_q[kPointTile];
+        int best[kPointTile];
+        for (int k = 0; k < count; ++k) {
+            const Vec3<T> p(pos(begin + k));
+            px[k] = p.x; py[k] = p.y; pz[k] = p.z;
+        }
+        if (kernel == CpuKernel::Vectorized) {
+            nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q);
+        } else {
+            for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
+        }
+        for (int k = 0; k < count; ++k)
+            emit(begin + k, signed_distance_to_triangle(view, Vec3<T>(px[k], py[k], pz[k]), best[k]));
+        reporter.advance(count);
+    });
+}
+
+class CpuBruteForceSampler final : public Sampler {
+public:
+    explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options) {
+        if (options.kernel.empty() || options.kernel == "vectorized") kernel_ = CpuKernel::Vectorized;
+        else if (options.kernel == "eberly") kernel_ = CpuKernel::Eberly;
+        else
+            throw std::invalid_argument("sampler.kernel: unknown CPU kernel '" + options.kernel +
+                                        "'; expected \"vectorized\" or \"eberly\"");
+    }
+
+    std::string name() const override {
+        return std::string("cpu/brute_force/") + (kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly");
+    }
+
+    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
+        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice)
+                                                      : sample_as<double>(mesh, lattice);
+    }
+
+    std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        std::vector<PointSample> out(points.size());
+        auto run = [&](auto zero) {
+            using T = decltype(zero);
+            evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, int64_t(points.size()),
+                               [&](int64_t i) { return points[size_t(i)]; },
+                               [&](int64_t i, const SignedDistanceSample<T>& s) {
+                                   out[size_t(i)] = {double(s.distance), Vec3d(s.gradient),
+                                                     mesh.source_triangle[size_t(s.triangle)]};
+                               });
+        };
+        if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
+        return out;
+    }
+
+private:
+    template <typename T>
+    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
+        const auto start = std::chrono::steady_clock::now();
+        SampledField field;
+        field.lattice = lattice;
+        field.precision = options_.precision;
+        field.resize(lattice.num_points());
+        GridBlock blocks[2];
+        const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
+        int64_t computed = 0;
+        for (int b = 0; b < nblocks; ++b) {
+            const GridBlock block = blocks[b];
+            evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, block.count(),
+                               [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
+                               [&](int64_t i, const SignedDistanceSample<T>& s) {
+                                   const int64_t out = block.output_index(lattice, i);
+                                   if (out < 0) return;  // strategy A: not a BCC point
+                                   field.distance[size_t(out)] = double(s.distance);
+                                   field.gradient[size_t(out)] = Vec3d(s.gradient);
+                                   field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
+                               });
+            computed += block.count();
+        }
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        field.timings.total = seconds;
+        field.timings.kernel = seconds;
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
+        field.sampler = {{"backend", "cpu"},
+                         {"method", "brute_force"},
+                         {"kernel", kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly"},
+                         {"threads", resolve_thread_count(options_.threads)},
+                         {"precision", precision_name(options_.precision)},
+                         {"points_computed", computed}};
+        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        return field;
+    }
+
+    SamplerOptions options_;
+    CpuKernel kernel_ = CpuKernel::Vectorized;
+};
+
+}  // namespace
+
+const char* bcc_strategy_name(BccStrategy s) {
+    return s == BccStrategy::TwoGrids ? "two_grids" : "double_resolution";
+}
+
+std::unique_ptr<Sampler> make_cpu_brute_force_sampler(const SamplerOptions& options) {
+    return std::make_unique<CpuBruteForceSampler>(options);
+}
+
+}  // namespace sdf

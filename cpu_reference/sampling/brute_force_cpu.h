@@ -1,0 +1,18 @@
+/// @file brute_force_cpu.h
+/// @brief The CPU reference sampler (thesis section 3.1): for every point, the minimum over
+/// all triangles. Multithreaded; with 1 thread it is the thesis's single-core reference.
+///
+/// Kernels: "vectorized" (default) finds the nearest triangle with the branch-free
+/// squared_distance() over triangles stored as arrays, then re-evaluates the winner with
+/// Eberly's algorithm; "eberly" runs Eberly's algorithm on every pair, as the thesis did.
+#pragma once
+
+#include <memory>
+
+#include "cpu_reference/sampling/sampler.h"
+
+namespace sdf {
+
+std::unique_ptr<Sampler> make_cpu_brute_force_sampler(const SamplerOptions& options);
+
+}  // namespace sdf

@@ -1,0 +1,58 @@
+/// @file nearest_triangle_cpu.h
+/// @brief The vectorised CPU search for the nearest triangle of a small tile of points.
+#pragma once
+
+#include <algorithm>
+#include <limits>
+
+#include "cpu_reference/sampling/triangle_soa.h"
+
+namespace sdf {
+
+/// Triangles per block: the block's 28 arrays (28 KiB in float) stay in the L1 cache while
+/// every point of the tile runs over them.
+constexpr int kTriangleBlock = 256;
+/// Points that share one pass over the triangle blocks.
+constexpr int kPointTile = 16;
+
+/// For each of the `count` points (at most kPointTile), the index of the triangle with the
+/// smallest squared distance (lowest index on ties) and that squared distance.
+template <typename T>
+void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T* px, const T* py, const T* pz,
+                                  int* best_index, T* best_q) {
+    const T* __restrict f[TriangleSoA<T>::kFields];
+    for (int k = 0; k < TriangleSoA<T>::kFields; ++k) f[k] = soa.field(k);
+    for (int p = 0; p < count; ++p) {
+        best_index[p] = -1;
+        best_q[p] = std::numeric_limits<T>::infinity();
+    }
+    alignas(64) T q[kTriangleBlock];
+    const int n = soa.size();
+    for (int start = 0; start < n; start += kTriangleBlock) {
+        const int len = std::min(kTriangleBlock, n - start);
+        for (int p = 0; p < count; ++p) {
+            const T x = px[p], y = py[p], z = pz[p];
+            T block_min = std::numeric_limits<T>::infinity();
+#pragma omp simd reduction(min : block_min)
+            for (int i = 0; i < len; ++i) {
+                const int j = start + i;
+                const PackedTriangle<T> t{f[0][j],  f[1][j],  f[2][j],  f[3][j],  f[4][j],  f[5][j],
+                                          f[6][j],  f[7][j],  f[8][j],  f[9][j],  f[10][j], f[11][j],
+                                          f[12][j], f[13][j], f[14][j], f[15][j], f[16][j], f[17][j],
+                                          f[18][j], f[19][j], f[20][j], f[21][j], f[22][j], f[23][j],
+                                          f[24][j], f[25][j], f[26][j], f[27][j]};
+                const T d = squared_distance(t, x, y, z);
+                q[i] = d;
+                block_min = d < block_min ? d : block_min;
+            }
+            if (block_min < best_q[p]) {
+                int i = 0;
+                while (q[i] != block_min) ++i;
+                best_q[p] = block_min;
+                best_index[p] = start + i;
+            }
+        }
+    }
+}
+
+}  // namespace sdf

@@ -1,0 +1,48 @@
+/// @file sampled_field.h
+/// @brief The output of every sampler: signed distance, exact gradient and closest triangle
+/// at every lattice point, with the provenance of how they were computed.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "kernels/lattice/lattice.h"
+
+namespace sdf {
+
+enum class Precision { Float, Double };
+
+inline const char* precision_name(Precision p) { return p == Precision::Float ? "float" : "double"; }
+
+/// Wall-clock and device timings of one sampling run, in seconds.
+struct SamplingTimings {
+    double total = 0;        ///< everything, host preparation included
+    double kernel = 0;       ///< the distance computation itself (GPU: CUDA events)
+    double upload = 0;       ///< host -> device transfers (GPU only)
+    double download = 0;     ///< device -> host transfers (GPU only)
+    double point_triangle_pairs = 0;  ///< points evaluated x triangles
+    double pairs_per_second() const { return kernel > 0 ? point_triangle_pairs / kernel : 0.0; }
+};
+
+struct SampledField {
+    Lattice lattice;
+    std::vector<double> distance;       ///< signed, negative inside
+    std::vector<Vec3d> gradient;        ///< unit length
+    std::vector<int32_t> closest_triangle;  ///< 0-based, in the mesh file's face order
+    Precision precision = Precision::Float;
+    SamplingTimings timings;
+    nlohmann::json sampler;             ///< backend, method, kernel, threads, strategy, device
+    nlohmann::json mesh;                ///< name, source, sha256, counts, report
+
+    int64_t size() const { return int64_t(distance.size()); }
+    void resize(int64_t n) {
+        distance.assign(size_t(n), 0.0);
+        gradient.assign(size_t(n), Vec3d(0.0));
+        closest_triangle.assign(size_t(n), -1);
+    }
+};
+
+}  // namespace sdf

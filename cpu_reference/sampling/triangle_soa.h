@@ -1,0 +1,41 @@
+/// @file triangle_soa.h
+/// @brief PackedTriangle constants stored field by field (structure of arrays), so that the
+/// CPU loop over triangles loads one SIMD register per field and vectorises.
+#pragma once
+
+#include <vector>
+
+#include "kernels/distance/packed_triangle.h"
+
+namespace sdf {
+
+template <typename T>
+class TriangleSoA {
+public:
+    static constexpr int kFields = int(sizeof(PackedTriangle<T>) / sizeof(T));
+
+    explicit TriangleSoA(const std::vector<PackedTriangle<T>>& packed) : size_(int(packed.size())) {
+        for (int f = 0; f < kFields; ++f) fields_[f].resize(packed.size());
+        for (size_t i = 0; i < packed.size(); ++i) {
+            const T* src = reinterpret_cast<const T*>(&packed[i]);
+            for (int f = 0; f < kFields; ++f) fields_[f][i] = src[f];
+        }
+    }
+
+    int size() const { return size_; }
+    const T* field(int f) const { return fields_[f].data(); }
+
+    /// Reassembles triangle i; inside a loop the compiler keeps each field in a register.
+    SDF_INLINE PackedTriangle<T> operator[](int i) const {
+        PackedTriangle<T> t;
+        T* dst = reinterpret_cast<T*>(&t);
+        for (int f = 0; f < kFields; ++f) dst[f] = fields_[f][size_t(i)];
+        return t;
+    }
+
+private:
+    int size_;
+    std::vector<T> fields_[kFields];
+};
+
+}  // namespace sdf
