@@ -1,0 +1,32 @@
+#include <stdexcept>
+
+#include "experiments/experiment.h"
+
+namespace sdf {
+
+// One line per kind. Each factory is defined in the kind's own file.
+std::unique_ptr<Experiment> make_sampling_experiment();
+
+namespace {
+struct Registration {
+    const char* kind;
+    std::unique_ptr<Experiment> (*make)();
+};
+const Registration kRegistry[] = {
+    {"sampling", make_sampling_experiment},
+};
+}  // namespace
+
+std::vector<std::string> experiment_kinds() {
+    std::vector<std::string> kinds;
+    for (const Registration& r : kRegistry) kinds.push_back(r.kind);
+    return kinds;
+}
+
+std::unique_ptr<Experiment> make_experiment(const std::string& kind) {
+    for (const Registration& r : kRegistry)
+        if (kind == r.kind) return r.make();
+    throw std::invalid_argument("unknown experiment kind '" + kind + "'");
+}
+
+}  // namespace sdf

@@ -1,0 +1,125 @@
+#include "harness/config/json_reader.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace sdf {
+
+nlohmann::json read_json_file(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw ConfigError(path + ": cannot open config file");
+    std::stringstream text;
+    text << in.rdbuf();
+    try {
+        return nlohmann::json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
+    } catch (const nlohmann::json::parse_error& e) {
+        // Translate the byte offset into line:column.
+        const std::string s = text.str();
+        const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, s.size());
+        const size_t line = size_t(std::count(s.begin(), s.begin() + long(at), '\n')) + 1;
+        const size_t last_nl = s.rfind('\n', at == 0 ? 0 : at - 1);
+        const size_t column = last_nl == std::string::npos ? at + 1 : at - last_nl;
+        std::string what = e.what();
+        const size_t colon = what.find(": ", what.find("parse error"));
+        throw ConfigError(path + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                          ": malformed JSON: " + (colon == std::string::npos ? what : what.substr(colon + 2)));
+    }
+}
+
+JsonReader::JsonReader(const nlohmann::json& value, std::string file, std::string path)
+    : value_(value), file_(std::move(file)), path_(std::move(path)) {
+    if (!value_.is_object())
+        throw ConfigError(file_ + ": " + (path_.empty() ? std::string("the config") : "key '" + path_ + "'") +
+                          ": expected a JSON object, got " + value_.dump());
+}
+
+bool JsonReader::has(const std::string& key) const {
+    // Every key asked about is a valid key here, present or not (for "did you mean").
+    if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
+    return value_.contains(key);
+}
+
+const nlohmann::json& JsonReader::raw(const std::string& key) {
+    if (!has(key)) fail(key, "missing");
+    return value_.at(key);
+}
+
+std::string JsonReader::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+void JsonReader::fail(const std::string& key, const std::string& message) const {
+    throw ConfigError(file_ + ": key '" + key_path(key) + "': " + message);
+}
+
+std::string JsonReader::choice(const std::string& key, const std::vector<std::string>& choices,
+                               const std::string& fallback) {
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "\"" : ", \"") + c + "\"";
+    const std::string value = optional<std::string>(key, fallback, "one of " + list);
+    if (std::find(choices.begin(), choices.end(), value) == choices.end()) {
+        const std::string near = nearest_match(value, choices);
+        fail(key, "unknown value \"" + value + "\"; expected one of " + list +
+                      (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+    }
+    return value;
+}
+
+JsonReader JsonReader::object(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    if (!v.is_object()) fail(key, "expected a JSON object, got " + v.dump());
+    return JsonReader(v, file_, key_path(key));
+}
+
+std::vector<JsonReader> JsonReader::objects(const std::string& key) {
+    const nlohmann::json& v = raw(key);
+    if (!v.is_array()) fail(key, "expected an array of objects, got " + v.dump());
+    std::vector<JsonReader> out;
+    for (size_t i = 0; i < v.size(); ++i) {
+        const std::string p = key_path(key) + "[" + std::to_string(i) + "]";
+        if (!v[i].is_object()) throw ConfigError(file_ + ": key '" + p + "': expected an object, got " + v[i].dump());
+        out.emplace_back(v[i], file_, p);
+    }
+    return out;
+}
+
+void JsonReader::finish(const std::vector<std::string>& also_allowed) const {
+    std::vector<std::string> known = known_;
+    known.insert(known.end(), also_allowed.begin(), also_allowed.end());
+    for (const auto& [key, v] : value_.items()) {
+        if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+        const std::string near = nearest_match(key, known);
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        throw ConfigError(file_ + ": unknown key '" + key_path(key) + "'" +
+                          (near.empty() ? "" : "; did you mean '" + near + "'?") +
+                          (list.empty() ? "" : " (valid here: " + list + ")"));
+    }
+}
+
+int edit_distance(const std::string& a, const std::string& b) {
+    std::vector<int> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = int(j);
+    for (size_t i = 1; i <= a.size(); ++i) {
+        int diag = row[0];
+        row[0] = int(i);
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const int up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+std::string nearest_match(const std::string& word, const std::vector<std::string>& candidates) {
+    std::string best;
+    int best_d = 1 << 30;
+    for (const auto& c : candidates) {
+        const int d = edit_distance(word, c);
+        if (d < best_d) { best_d = d; best = c; }
+    }
+    // A typo changes a few characters; beyond that a suggestion would only confuse.
+    return best_d <= std::max<int>(2, int(word.size()) / 3) ? best : "";
+}
+
+}  // namespace sdf

@@ -1,0 +1,218 @@
+#include "harness/io/field_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "harness/config/json_reader.h"
+
+namespace sdf {
+namespace fs = std::filesystem;
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "field files are little-endian; add byte swapping");
+
+namespace {
+
+std::string stem_of_header(const std::string& header_path) {
+    const std::string suffix = ".json";
+    if (header_path.size() > suffix.size() && header_path.compare(header_path.size() - suffix.size(), suffix.size(), suffix) == 0)
+        return header_path.substr(0, header_path.size() - suffix.size());
+    return header_path;
+}
+
+template <typename Out, typename In>
+std::vector<Out> convert_all(const In* in, size_t n) {
+    std::vector<Out> out(n);
+    for (size_t i = 0; i < n; ++i) out[i] = Out(in[i]);
+    return out;
+}
+
+/// Writes one channel; returns its header entry.
+nlohmann::json write_channel(const std::string& stem, const std::string& name, const double* values, size_t count,
+                             int components, FieldDtype dtype, Overwrite overwrite) {
+    const std::string file = stem + "." + name + ".raw";
+    const size_t n = count * size_t(components);
+    if (dtype == FieldDtype::Float32) {
+        const auto data = convert_all<float>(values, n);
+        write_file_atomically(file, data.data(), n * sizeof(float), overwrite);
+    } else {
+        write_file_atomically(file, values, n * sizeof(double), overwrite);
+    }
+    return {{"file", fs::path(file).filename().string()},
+            {"dtype", dtype == FieldDtype::Float32 ? "float32" : "float64"},
+            {"components", components}};
+}
+
+std::vector<char> read_bytes(const std::string& path, size_t expected, const std::string& header) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(header + ": channel file " + path + " not found");
+    in.seekg(0, std::ios::end);
+    const size_t size = size_t(in.tellg());
+    if (size != expected)
+        throw std::runtime_error(header + ": channel file " + path + " holds " + std::to_string(size) +
+                                 " bytes; the header's lattice and dtype need " + std::to_string(expected));
+    in.seekg(0);
+    std::vector<char> bytes(size);
+    in.read(bytes.data(), std::streamsize(size));
+    return bytes;
+}
+
+/// Reads a channel as doubles (float32, float64 or int32 on disk).
+std::vector<double> read_channel(const std::string& header_path, JsonReader& channels, const std::string& name,
+                                 int64_t points, int components) {
+    JsonReader ch = channels.object(name);
+    const std::string file = ch.required<std::string>("file", "a file name relative to the header");
+    const std::string dtype = ch.choice("dtype", {"float32", "float64", "int32"}, "float32");
+    const int comps = ch.optional<int>("components", 1, "the number of components (1 or 3)");
+    ch.finish({"description", "units"});
+    if (comps != components)
+        ch.fail("components", "expected " + std::to_string(components) + " for channel '" + name + "', got " +
+                                  std::to_string(comps));
+    const size_t n = size_t(points) * size_t(components);
+    const size_t width = dtype == "float64" ? 8 : 4;
+    const fs::path path = fs::path(header_path).parent_path() / file;
+    const std::vector<char> bytes = read_bytes(path.string(), n * width, header_path);
+    if (dtype == "float32") return convert_all<double>(reinterpret_cast<const float*>(bytes.data()), n);
+    if (dtype == "int32") return convert_all<double>(reinterpret_cast<const int32_t*>(bytes.data()), n);
+    return convert_all<double>(reinterpret_cast<const double*>(bytes.data()), n);
+}
+
+}  // namespace
+
+nlohmann::json lattice_to_json(const Lattice& l) {
+    const int z = l.type == LatticeType::BCC ? 2 * l.resolution.z : l.resolution.z;
+    return {{"type", l.type == LatticeType::CC ? "cc" : "bcc"},
+            {"origin", {l.origin.x, l.origin.y, l.origin.z}},
+            {"spacing", l.spacing},
+            {"resolution", {l.resolution.x, l.resolution.y, z}},
+            {"notation", lattice_notation(l)},
+            {"points", l.num_points()}};
+}
+
+Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
+    JsonReader r(j, file, "lattice");
+    Lattice l;
+    l.type = r.choice("type", {"cc", "bcc"}, "cc") == "cc" ? LatticeType::CC : LatticeType::BCC;
+    const auto origin = r.required<std::vector<double>>("origin", "an array of 3 numbers");
+    l.spacing = r.required<double>("spacing", "a positive number");
+    const auto res = r.required<std::vector<int>>("resolution", "an array of 3 positive integers");
+    if (origin.size() != 3) r.fail("origin", "expected 3 numbers");
+    if (res.size() != 3 || *std::min_element(res.begin(), res.end()) < 1)
+        r.fail("resolution", "expected 3 positive integers");
+    if (!(l.spacing > 0) || !std::isfinite(l.spacing)) r.fail("spacing", "expected a positive number");
+    l.origin = {origin[0], origin[1], origin[2]};
+    l.resolution = {res[0], res[1], res[2]};
+    if (l.type == LatticeType::BCC) {
+        if (res[2] % 2 != 0) r.fail("resolution", "BCC resolution is [Rx, Ry, 2Rz]; the third entry must be even");
+        l.resolution.z = res[2] / 2;
+    }
+    r.finish({"notation", "points"});
+    return l;
+}
+
+void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
+    const std::string stem = stem_of_header(header_path);
+    const size_t n = size_t(field.size());
+    if (options.overwrite == Overwrite::Forbid && fs::exists(stem + ".json"))
+        throw std::runtime_error(stem + ".json: already exists; refusing to overwrite a field");
+    nlohmann::json channels;
+    channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
+    if (field.gradient.size() == n)
+        channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
+    if (options.closest_triangle && field.closest_triangle.size() == n) {
+        const std::string file = stem + ".closest_triangle.raw";
+        write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
+        channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
+    }
+    nlohmann::json header = {{"format", "sdf-lattice-field"},
+                             {"version", 1},
+                             {"lattice", lattice_to_json(field.lattice)},
+                             {"channels", channels},
+                             {"value_channel", "distance"},
+                             {"units", "mesh units; distance negative inside"},
+                             {"precision", precision_name(field.precision)},
+                             {"mesh", field.mesh},
+                             {"sampler", field.sampler},
+                             {"timings_seconds", {{"total", field.timings.total},
+                                                  {"kernel", field.timings.kernel},
+                                                  {"upload", field.timings.upload},
+                                                  {"download", field.timings.download}}},
+                             {"point_triangle_pairs", field.timings.point_triangle_pairs}};
+    if (channels.contains("gradient")) header["gradient_channel"] = "gradient";
+    write_text_atomically(stem + ".json", header.dump(2) + "\n", options.overwrite);
+}
+
+SampledField read_field(const std::string& header_path) {
+    const nlohmann::json j = read_json_file(header_path);
+    JsonReader r(j, header_path);
+    if (r.required<std::string>("format", "\"sdf-lattice-field\"") != "sdf-lattice-field")
+        r.fail("format", "expected \"sdf-lattice-field\"");
+    if (r.required<int>("version", "the format version 1") != 1) r.fail("version", "only version 1 is known");
+    SampledField field;
+    field.lattice = lattice_from_json(r.raw("lattice"), header_path);
+    const int64_t points = field.lattice.num_points();
+    JsonReader channels = r.object("channels");
+    const std::string value = r.optional<std::string>("value_channel", "value", "the name of the scalar channel");
+    if (!channels.has(value)) r.fail("value_channel", "names channel '" + value + "', which 'channels' lacks");
+    field.distance = read_channel(header_path, channels, value, points, 1);
+    if (r.has("gradient_channel")) {
+        const std::string g = r.required<std::string>("gradient_channel", "the name of a 3-component channel");
+        const std::vector<double> grad = read_channel(header_path, channels, g, points, 3);
+        field.gradient.resize(size_t(points));
+        for (size_t i = 0; i < field.gradient.size(); ++i)
+            field.gradient[i] = {grad[3 * i], grad[3 * i + 1], grad[3 * i + 2]};
+    }
+    if (channels.has("closest_triangle")) {
+        const std::vector<double> tri = read_channel(header_path, channels, "closest_triangle", points, 1);
+        field.closest_triangle = convert_all<int32_t>(tri.data(), tri.size());
+    }
+    if (r.has("precision")) field.precision = r.raw("precision") == "double" ? Precision::Double : Precision::Float;
+    if (r.has("mesh")) field.mesh = r.raw("mesh");
+    if (r.has("sampler")) field.sampler = r.raw("sampler");
+    // Provenance keys are free-form; other channels are allowed and ignored.
+    return field;
+}
+
+void export_nrrd(const std::string& path, const SampledField& field, bool with_gradient, Overwrite overwrite) {
+    const Lattice& l = field.lattice;
+    if (l.type != LatticeType::CC)
+        throw std::invalid_argument(path + ": NRRD export needs a CC lattice (BCC has no NRRD layout)");
+    auto write_volume = [&](const std::string& file, const std::vector<float>& data, int components) {
+        std::ostringstream h;
+        h << "NRRD0004\n# exported by sdf_lattices\ntype: float\n";
+        h << "dimension: " << (components == 1 ? 3 : 4) << "\nspace: 3D-right-handed\nsizes: ";
+        if (components > 1) h << components << " ";
+        h << l.resolution.x << " " << l.resolution.y << " " << l.resolution.z << "\n";
+        h.precision(17);
+        h << "space directions: " << (components > 1 ? "none " : "") << "(" << l.spacing << ",0,0) (0," << l.spacing
+          << ",0) (0,0," << l.spacing << ")\n";
+        if (components > 1) h << "kinds: vector domain domain domain\n";
+        h << "space origin: (" << l.origin.x << "," << l.origin.y << "," << l.origin.z << ")\n";
+        h << "endian: little\nencoding: raw\n\n";
+        std::string bytes = h.str();
+        bytes.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
+        write_file_atomically(file, bytes.data(), bytes.size(), overwrite);
+    };
+    write_volume(path, convert_all<float>(field.distance.data(), field.distance.size()), 1);
+    if (with_gradient && !field.gradient.empty()) {
+        const std::string stem = path.size() > 5 && path.substr(path.size() - 5) == ".nrrd" ? path.substr(0, path.size() - 5) : path;
+        write_volume(stem + ".gradient.nrrd", convert_all<float>(&field.gradient[0].x, 3 * field.gradient.size()), 3);
+    }
+}
+
+double export_uint8(const std::string& path, const SampledField& field, Overwrite overwrite) {
+    double max_abs = 0;
+    for (double d : field.distance) max_abs = std::max(max_abs, std::abs(d));
+    const double scale = max_abs > 0 ? 127.0 / max_abs : 1.0;
+    std::vector<uint8_t> bytes(field.distance.size());
+    for (size_t i = 0; i < bytes.size(); ++i)
+        bytes[i] = uint8_t(std::clamp(std::lround(127.0 - field.distance[i] * scale), 0L, 255L));
+    write_file_atomically(path, bytes.data(), bytes.size(), overwrite);
+    return scale;
+}
+
+}  // namespace sdf

@@ -1,0 +1,54 @@
+/// @file field_file.h
+/// @brief The project's field file: a JSON header plus one raw little-endian array per
+/// channel. Any scalar volume on a CC or BCC lattice can be stored this way, not only
+/// distance fields (docs/field-format.md has the full description).
+///
+/// Header `NAME.json`:
+///   { "format": "sdf-lattice-field", "version": 1,
+///     "lattice": { "type": "cc" | "bcc", "origin": [x,y,z], "spacing": h,
+///                  "resolution": [nx,ny,nz] (BCC: thesis notation [Rx,Ry,2Rz]) },
+///     "channels": { "value": {"file": "NAME.value.raw", "dtype": "float32", "components": 1},
+///                   "gradient": {...components 3...}, ... },
+///     "value_channel": "value", "gradient_channel": "gradient" (optional), ...provenance }
+/// Points are stored x fastest, then y, then z; BCC stores the primary grid, then the
+/// secondary one (see kernels/lattice/lattice.h).
+#pragma once
+
+#include <string>
+
+#include "cpu_reference/sampling/sampled_field.h"
+#include "harness/io/atomic_file.h"
+
+namespace sdf {
+
+enum class FieldDtype { Float32, Float64 };
+
+struct FieldWriteOptions {
+    FieldDtype dtype = FieldDtype::Float32;
+    Overwrite overwrite = Overwrite::Forbid;
+    bool closest_triangle = true;  ///< write the closest-triangle channel when present
+};
+
+/// Writes NAME.json and its channel files next to it (NAME = header path without ".json").
+/// Channel files are written first and the header last, each atomically, so a header
+/// always describes complete data.
+void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options = {});
+
+/// Reads a field written by write_field or by a user. The value channel becomes
+/// `distance`; the gradient channel, if any, `gradient`. Errors name the file and key.
+SampledField read_field(const std::string& header_path);
+
+/// NRRD (detached-free, raw encoding) of a CC field: the value volume, and the gradient as
+/// a 4-D "vector domain domain domain" volume when `with_gradient`.
+void export_nrrd(const std::string& path, const SampledField& field, bool with_gradient,
+                 Overwrite overwrite = Overwrite::Forbid);
+
+/// The thesis's 8-bit export (section 3.3): 127 on the surface, lower outside, higher
+/// inside; byte = clamp(round(127 - d * 127 / max|d|), 0, 255). Returns the scale used.
+double export_uint8(const std::string& path, const SampledField& field, Overwrite overwrite = Overwrite::Forbid);
+
+/// JSON description of a lattice as stored in headers and manifests.
+nlohmann::json lattice_to_json(const Lattice& lattice);
+Lattice lattice_from_json(const nlohmann::json& j, const std::string& file);
+
+}  // namespace sdf

@@ -1,0 +1,97 @@
+#include "harness/provenance/provenance.h"
+
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <memory>
+
+#include "cpu_reference/parallel/parallel_for.h"
+#include "harness/sampling/make_sampler.h"
+#if SDF_HAVE_CUDA
+#include "kernels/cuda/cuda_device.h"
+#endif
+
+#include "harness/build_config.h"
+
+namespace sdf {
+namespace {
+
+std::string run_command(const std::string& cmd, bool* ok) {
+    std::array<char, 256> buf{};
+    std::string out;
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+    if (!pipe) { *ok = false; return ""; }
+    while (fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
+    const int status = pclose(pipe.release());
+    *ok = status == 0;
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    return out;
+}
+
+}  // namespace
+
+GitState git_state() {
+    GitState g;
+    bool ok = false;
+    const std::string dir = std::string("git -C '") + SDF_SOURCE_DIR + "' ";
+    const std::string commit = run_command(dir + "rev-parse HEAD 2>/dev/null", &ok);
+    if (!ok || commit.empty()) return g;
+    g.commit = commit;
+    const std::string status = run_command(dir + "status --porcelain --untracked-files=no 2>/dev/null", &ok);
+    g.dirty = !ok || !status.empty();
+    return g;
+}
+
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown";
+}
+
+nlohmann::json build_info() {
+    return {{"build_type", SDF_BUILD_TYPE},
+            {"cxx_compiler", SDF_CXX_COMPILER},
+            {"cxx_flags", SDF_CXX_FLAGS},
+            {"cuda_flags", SDF_HAVE_CUDA ? SDF_CUDA_FLAGS : ""},
+            {"cuda", SDF_HAVE_CUDA ? true : false},
+            {"fast_math", false}};
+}
+
+nlohmann::json gpu_info() {
+#if SDF_HAVE_CUDA
+    if (cuda::device_count() > 0) return cuda::describe_device(0);
+#endif
+    return nullptr;
+}
+
+std::string utc_timestamp() {
+    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+    return buf;
+}
+
+std::string compact_utc_timestamp() {
+    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", std::gmtime(&t));
+    return buf;
+}
+
+nlohmann::json machine_and_build() {
+    char host[256] = "unknown";
+    gethostname(host, sizeof host - 1);
+    const GitState g = git_state();
+    return {{"host", host},
+            {"cpu", {{"model", cpu_model()}, {"hardware_threads", hardware_threads()}}},
+            {"gpu", gpu_info()},
+            {"build", build_info()},
+            {"git", {{"commit", g.commit}, {"dirty", g.dirty}}}};
+}
+
+}  // namespace sdf

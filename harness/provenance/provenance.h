@@ -1,0 +1,30 @@
+/// @file provenance.h
+/// @brief Everything needed to say how a result was made (STYLE.md, "Measuring"): git commit
+/// and dirty flag, build type and flags, CPU and GPU model, driver and CUDA versions, time.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace sdf {
+
+struct GitState {
+    std::string commit = "unknown";
+    bool dirty = true;  ///< unknown counts as dirty: such a run never becomes a baseline
+};
+
+GitState git_state();
+std::string cpu_model();
+/// Build type, compiler and flags baked in at configure time.
+nlohmann::json build_info();
+/// The GPU (name, driver, runtime) when the CUDA backend and a device are present, else null.
+nlohmann::json gpu_info();
+/// "2026-11-21T13:45:01Z"
+std::string utc_timestamp();
+/// "20261121T134501Z" (for run ids)
+std::string compact_utc_timestamp();
+/// Host name, CPU model and hardware threads, GPU; build; git.
+nlohmann::json machine_and_build();
+
+}  // namespace sdf
