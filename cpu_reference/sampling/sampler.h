@@ -22,6 +22,10 @@ struct SamplerOptions {
     BccStrategy bcc_strategy = BccStrategy::TwoGrids;
     bool progress = true;
     int device = 0;                     ///< CUDA device ordinal
+    // GPU work sizes; 0 = chosen from the device's memory and multiprocessor count.
+    int64_t max_points_per_piece = 0;   ///< lattice points per GPU piece (memory split)
+    int max_triangles_per_chunk = 0;    ///< triangles resident on the GPU at a time
+    int points_per_thread = 0;          ///< tuned kernel: points per thread (1, 2, 4, 8)
 };
 
 /// Result for one arbitrary query point.

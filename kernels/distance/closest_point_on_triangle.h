@@ -54,6 +54,20 @@ SDF_CPU_GPU SDF_INLINE T clamp_on_edge12(T numer, T denom, TriangleFeature& feat
 
 }  // namespace detail
 
+/// T(s,t) = V0 + s E0 + t E1; vertex features return the vertex itself, so a closest point
+/// at a vertex is exactly on the mesh. Shared by Eberly's algorithm and the thesis kernel's
+/// "sign and gradient after" step, which rebuilds the point from the stored (s, t).
+template <typename T>
+SDF_CPU_GPU SDF_INLINE Vec3<T> point_on_triangle(const Vec3<T>& v0, const Vec3<T>& v1, const Vec3<T>& v2, T s, T t,
+                                                 TriangleFeature feature) {
+    switch (feature) {
+        case TriangleFeature::Vertex0: return v0;
+        case TriangleFeature::Vertex1: return v1;
+        case TriangleFeature::Vertex2: return v2;
+        default: return v0 + (v1 - v0) * s + (v2 - v0) * t;
+    }
+}
+
 /// Closest point on triangle (v0, v1, v2) to p, with Eberly's region classification.
 /// Degenerate triangles (zero area) are handled by taking the nearest of the three edges.
 template <typename T>
@@ -149,13 +163,7 @@ SDF_CPU_GPU TriangleClosestPoint<T> closest_point_on_triangle(const Vec3<T>& p, 
     r.s = s;
     r.t = t;
     r.feature = feature;
-    // Exact vertex positions for vertex features keep the closest point on the mesh.
-    switch (feature) {
-        case TriangleFeature::Vertex0: r.point = v0; break;
-        case TriangleFeature::Vertex1: r.point = v1; break;
-        case TriangleFeature::Vertex2: r.point = v2; break;
-        default: r.point = v0 + e0 * s + e1 * t; break;
-    }
+    r.point = point_on_triangle(v0, v1, v2, s, t, feature);
     r.distance_squared = length_squared(p - r.point);
     return r;
 }

@@ -31,25 +31,32 @@ SDF_CPU_GPU Vec3<T> feature_pseudonormal(const MeshView<T>& mesh, int triangle, 
     return mesh.vertex_normals[mesh.triangles[triangle][vertex_index(f)]];
 }
 
-/// Full evaluation of p against one triangle: Eberly's closest point, sign and gradient.
+/// Sign and gradient of p given its closest point on `triangle` and that point's feature.
 template <typename T>
-SDF_CPU_GPU SignedDistanceSample<T> signed_distance_to_triangle(const MeshView<T>& mesh,
-                                                                const Vec3<T>& p, int triangle) {
-    const Int3 tri = mesh.triangles[triangle];
-    const TriangleClosestPoint<T> cp =
-        closest_point_on_triangle(p, mesh.vertices[tri.x], mesh.vertices[tri.y], mesh.vertices[tri.z]);
-    const Vec3<T> n = feature_pseudonormal(mesh, triangle, cp.feature);
-    const Vec3<T> away = p - cp.point;
-    const T dist = std::sqrt(cp.distance_squared);
+SDF_CPU_GPU SignedDistanceSample<T> signed_sample(const MeshView<T>& mesh, const Vec3<T>& p, int triangle,
+                                                  const Vec3<T>& closest, TriangleFeature feature) {
+    const Vec3<T> n = feature_pseudonormal(mesh, triangle, feature);
+    const Vec3<T> away = p - closest;
+    const T dist = std::sqrt(length_squared(away));
     const bool inside = dot(away, n) < T(0);
 
     SignedDistanceSample<T> r;
     r.distance = inside ? -dist : dist;
     r.gradient = dist > T(0) ? away * ((inside ? T(-1) : T(1)) / dist) : n;
-    r.closest_point = cp.point;
+    r.closest_point = closest;
     r.triangle = triangle;
-    r.feature = cp.feature;
+    r.feature = feature;
     return r;
+}
+
+/// Full evaluation of p against one triangle: Eberly's closest point, sign and gradient.
+template <typename T>
+SDF_CPU_GPU SignedDistanceSample<T> signed_distance_to_triangle(const MeshView<T>& mesh, const Vec3<T>& p,
+                                                                int triangle) {
+    const Int3 tri = mesh.triangles[triangle];
+    const TriangleClosestPoint<T> cp =
+        closest_point_on_triangle(p, mesh.vertices[tri.x], mesh.vertices[tri.y], mesh.vertices[tri.z]);
+    return signed_sample(mesh, p, triangle, cp.point, cp.feature);
 }
 
 /// Reference brute force over all triangles with Eberly's algorithm per pair (the thesis's
