@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -13,16 +14,36 @@
 namespace sdf {
 namespace {
 
-/// 1-based line number of the n-th (0-based) `v` line, for error messages.
-int line_of_vertex(const std::string& path, size_t n) {
+/// tinyobjloader reads unparsable numbers ("nan", "abc") as 0 without a word, so every
+/// `v` line is checked here first: three finite numbers, or an error naming the line.
+void check_vertex_lines(const std::string& path) {
     std::ifstream in(path);
     std::string line;
-    size_t seen = 0;
     for (int number = 1; std::getline(in, line); ++number) {
-        size_t p = line.find_first_not_of(" \t");
-        if (p != std::string::npos && line.compare(p, 2, "v ") == 0 && seen++ == n) return number;
+        std::istringstream ss(line);
+        std::string tag;
+        if (!(ss >> tag) || tag != "v") continue;
+        for (int k = 0; k < 3; ++k) {
+            std::string token;
+            char* end = nullptr;
+            const bool present = bool(ss >> token);
+            const double value = present ? std::strtod(token.c_str(), &end) : 0.0;
+            if (!present || end != token.c_str() + token.size() || !std::isfinite(value))
+                throw std::runtime_error(path + ":" + std::to_string(number) + ": " +
+                                         (present ? "non-finite or malformed vertex coordinate '" + token + "'"
+                                                  : std::string("missing vertex coordinate")) +
+                                         "; expected three finite numbers after 'v'");
+        }
     }
-    return -1;
+}
+
+/// tinyobjloader skips faces with fewer than 3 vertices or with invalid indices and only
+/// warns; for distance fields a silently missing face changes the answer, so it is an error.
+void reject_dropped_faces(const std::string& path, const std::string& warnings) {
+    for (const char* fatal : {"Face with invalid vertex index", "Degenerated face"})
+        if (warnings.find(fatal) != std::string::npos)
+            throw std::runtime_error(path + ": " + fatal +
+                                     " found (a face refers to a missing vertex or has fewer than 3 vertices)");
 }
 
 std::string stem_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
@@ -33,12 +54,14 @@ TriangleMesh load_obj(const std::string& path) {
     if (!std::filesystem::is_regular_file(path))
         throw std::runtime_error(path + ": mesh file not found");
 
+    check_vertex_lines(path);
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;
     tinyobj::ObjReader reader;
     if (!reader.ParseFromFile(path, config))
         throw std::runtime_error(path + ": cannot parse OBJ: " + reader.Error());
+    reject_dropped_faces(path, reader.Warning());
 
     TriangleMesh mesh;
     mesh.name = stem_of(path);
@@ -47,13 +70,6 @@ TriangleMesh load_obj(const std::string& path) {
     mesh.vertices.reserve(v.size() / 3);
     for (size_t i = 0; i + 2 < v.size(); i += 3) {
         const Vec3d p{double(v[i]), double(v[i + 1]), double(v[i + 2])};
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            std::ostringstream msg;
-            msg << path << ":" << line_of_vertex(path, i / 3) << ": vertex " << i / 3
-                << " has a non-finite coordinate (" << p.x << " " << p.y << " " << p.z
-                << "); expected three finite numbers";
-            throw std::runtime_error(msg.str());
-        }
         mesh.vertices.push_back(p);
     }
 

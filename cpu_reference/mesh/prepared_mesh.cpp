@@ -23,18 +23,35 @@ struct PositionHash {
     }
 };
 
-/// Maps every input vertex to a welded vertex id (exact, or on a grid of cell `tolerance`).
+/// Maps every input vertex to a welded vertex id. With tolerance 0 only bit-identical
+/// positions merge; otherwise a vertex merges into the first kept vertex within `tolerance`
+/// (searched in the 27 grid cells of size `tolerance` around it), so closeness and not
+/// grid alignment decides.
 std::vector<int> weld_vertices(const std::vector<Vec3d>& in, double tolerance, std::vector<Vec3d>& out) {
     std::vector<int> remap(in.size());
-    std::unordered_map<PositionKey, int, PositionHash> seen;
+    std::unordered_map<PositionKey, std::vector<int>, PositionHash> cells;
+    auto cell_of = [&](const Vec3d& p) {
+        return tolerance > 0 ? PositionKey{std::floor(p.x / tolerance), std::floor(p.y / tolerance), std::floor(p.z / tolerance)}
+                             : PositionKey{p.x, p.y, p.z};
+    };
     for (size_t i = 0; i < in.size(); ++i) {
-        PositionKey key{in[i].x, in[i].y, in[i].z};
-        if (tolerance > 0)
-            key = {std::round(in[i].x / tolerance), std::round(in[i].y / tolerance),
-                   std::round(in[i].z / tolerance)};
-        auto [it, inserted] = seen.emplace(key, int(out.size()));
-        if (inserted) out.push_back(in[i]);
-        remap[i] = it->second;
+        const PositionKey c = cell_of(in[i]);
+        int found = -1;
+        const int reach = tolerance > 0 ? 1 : 0;
+        for (int dz = -reach; dz <= reach && found < 0; ++dz)
+            for (int dy = -reach; dy <= reach && found < 0; ++dy)
+                for (int dx = -reach; dx <= reach && found < 0; ++dx) {
+                    auto it = cells.find({c.x + dx, c.y + dy, c.z + dz});
+                    if (it == cells.end()) continue;
+                    for (int id : it->second)
+                        if (tolerance > 0 ? length(out[size_t(id)] - in[i]) <= tolerance : true) { found = id; break; }
+                }
+        if (found < 0) {
+            found = int(out.size());
+            out.push_back(in[i]);
+            cells[c].push_back(found);
+        }
+        remap[i] = found;
     }
     return remap;
 }

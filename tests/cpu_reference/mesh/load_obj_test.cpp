@@ -1,10 +1,9 @@
 // load_obj(): small OBJ files written here (triangulation order, 1-based indices, the errors
 // and their messages), then the real bunny meshes when the data directory is present.
 //
-// tinyobjloader (2.0.0rc10) parses numbers itself and turns a token it cannot read, such as
-// "nan" or "inf", into 0 without a word, so load_obj() never sees a NaN. A non-finite value
-// is still reachable through overflow: "1e999" parses to +inf, which is what the non-finite
-// test below uses. The "nan" case is kept as a disabled test that states the wanted behaviour.
+// tinyobjloader (2.0.0rc10) turns a token it cannot read, such as "nan" or "inf", into 0
+// without a word, so load_obj() checks the `v` lines itself; both "nan" and an overflowing
+// "1e999" are tested.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -128,9 +127,8 @@ TEST_F(LoadObj, NonFiniteCoordinateThrowsWithFileAndLine) {
     EXPECT_NE(error.find("non-finite"), std::string::npos) << error;
 }
 
-// Disabled: tinyobjloader reads "nan" as 0 (see the top of this file), so load_obj() returns a
-// mesh with a vertex at the origin instead of throwing.
-TEST_F(LoadObj, DISABLED_NanCoordinateThrowsWithFileAndLine) {
+// tinyobjloader alone would read "nan" as 0; load_obj() checks every `v` line itself.
+TEST_F(LoadObj, NanCoordinateThrowsWithFileAndLine) {
     const std::string path = write("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
     const std::string error = error_of(path);
     EXPECT_NE(error.find(path + ":3:"), std::string::npos) << error;
@@ -143,9 +141,8 @@ TEST_F(LoadObj, FaceIndexOutOfRangeThrows) {
     EXPECT_NE(error.find("vertex 9"), std::string::npos) << error;
 }
 
-// Disabled: tinyobjloader drops a quad with an out-of-range index, leaving only a warning
-// that load_obj() does not read, so the file loads with the face silently missing.
-TEST_F(LoadObj, DISABLED_QuadIndexOutOfRangeThrows) {
+// tinyobjloader alone would drop such a quad with a warning; load_obj() makes it an error.
+TEST_F(LoadObj, QuadIndexOutOfRangeThrows) {
     const std::string path = write("bad-quad.obj", std::string(kSquareVertices) + "f 1 2 3\nf 1 2 3 9\n");
     error_of(path);
 }

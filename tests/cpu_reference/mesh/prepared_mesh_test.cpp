@@ -233,12 +233,9 @@ TEST(PreparedMesh, WeldsWithinATolerance) {
     EXPECT_NEAR(m.report.signed_volume, 8.0, 1e-6);
 }
 
-// Known defect in prepared_mesh.cpp, disabled until fixed (run with
-// --gtest_also_run_disabled_tests): welding with a tolerance snaps positions to a grid of
-// that cell size, so two copies of a vertex 1e-7 apart but on either side of a cell boundary
-// (here x = 0.75 = 1.5 cells of 0.5) are not merged, although weld_tolerance promises to merge
-// vertices closer than the tolerance.
-TEST(PreparedMesh, DISABLED_WeldsVerticesCloserThanTheToleranceAcrossGridCells) {
+// Two copies of a vertex 1e-7 apart but on either side of a grid-cell boundary (x = 0.75 =
+// 1.5 cells of 0.5) must merge: closeness, not grid alignment, decides.
+TEST(PreparedMesh, WeldsVerticesCloserThanTheToleranceAcrossGridCells) {
     TriangleMesh soup = as_separate_triangles(make_box({0.75, 0.75, 0.75}));
     for (Vec3d& v : soup.vertices)
         if (v == Vec3d{0.75, 0.75, 0.75}) {
