@@ -6,6 +6,7 @@ namespace sdf {
 
 // One line per kind. Each factory is defined in the kind's own file.
 std::unique_ptr<Experiment> make_sampling_experiment();
+std::unique_ptr<Experiment> make_speedup_experiment();
 
 namespace {
 struct Registration {
@@ -14,6 +15,7 @@ struct Registration {
 };
 const Registration kRegistry[] = {
     {"sampling", make_sampling_experiment},
+    {"speedup", make_speedup_experiment},
 };
 }  // namespace
 

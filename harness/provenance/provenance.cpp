@@ -10,12 +10,11 @@
 #include <memory>
 
 #include "cpu_reference/parallel/parallel_for.h"
+#include "harness/build_config.h"
 #include "harness/sampling/make_sampler.h"
 #if SDF_HAVE_CUDA
 #include "kernels/cuda/cuda_device.h"
 #endif
-
-#include "harness/build_config.h"
 
 namespace sdf {
 namespace {

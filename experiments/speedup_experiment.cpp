@@ -1,0 +1,258 @@
+/// @file speedup_experiment.cpp
+/// @brief Kind "speedup": thesis Tables 3-1 and 3-2. For each mesh and sample count, the
+/// time of every configured sampler (CPU 1 thread, CPU all threads, GPU thesis kernel, GPU
+/// tuned kernel), repeated, with median and spread; speedups are ratios of medians measured
+/// in the same run (end-to-end times, transfers included), printed beside the thesis's
+/// figures; pairs per second use the computation time alone.
+///
+///   "cases": [{"label": "dragon", "mesh": "dragon-legacy.obj", "samples": [32768, 262144]}],
+///   "lattice_types": ["cc"],
+///   "backends": [{"name": "cpu_1", "backend": "cpu", "threads": 1, "max_points": 2048}, ...],
+///   "reference": "cpu_1", "repetitions": 5
+/// A CPU backend with "max_points" below the lattice size is timed on that many lattice
+/// points (evenly strided) and its time scaled by N / n: brute force costs exactly the same
+/// per point, and this keeps a 1-thread 2-million-point run from taking an hour.
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <cstdio>
+#include <ostream>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "experiments/common/study_inputs.h"
+#include "experiments/common/thesis_tables.h"
+#include "experiments/experiment.h"
+#include "harness/config/sampler_spec.h"
+#include "harness/sampling/make_sampler.h"
+
+namespace sdf {
+namespace {
+
+struct BackendSpec {
+    std::string name;
+    SamplerOptions options;
+    int64_t max_points = 0;  ///< 0 = the whole lattice
+};
+
+struct CaseSpec {
+    std::string label;
+    MeshSpec mesh;
+    std::vector<int64_t> samples;
+};
+
+double median_of(std::vector<double> s) {
+    std::sort(s.begin(), s.end());
+    const size_t n = s.size();
+    return n == 0 ? 0 : (n % 2 ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]));
+}
+
+struct Timing {
+    std::vector<double> seconds;  ///< computation per repetition (scaled to the lattice if subset)
+    std::vector<double> total;    ///< end to end per repetition: transfers and host work included
+    int64_t points_timed = 0;
+    double median() const { return median_of(seconds); }
+    double median_total() const { return median_of(total); }
+};
+
+class SpeedupExperiment final : public Experiment {
+public:
+    void configure(JsonReader& config, const RunContext& context) override {
+        const auto data_path = config.optional<std::vector<std::string>>("data_path", {}, "an array of directories");
+        search_path_ = data_search_path(data_path, context.config_dir);
+        if (config.has("domain")) {
+            JsonReader d = config.object("domain");
+            margin_ = d.optional<double>("margin", 0.1, "a non-negative fraction");
+            d.finish();
+        }
+        for (JsonReader& c : config.objects("cases")) {
+            CaseSpec spec;
+            spec.label = c.required<std::string>("label", "a mesh label such as \"dragon\"");
+            spec.mesh = parse_mesh_spec(c, "mesh");
+            spec.samples = c.required<std::vector<int64_t>>("samples", "an array of sample counts");
+            c.finish();
+            cases_.push_back(spec);
+        }
+        for (const std::string& t : config.optional<std::vector<std::string>>("lattice_types", {"cc"}, "[\"cc\"], [\"bcc\"] or both")) {
+            if (t != "cc" && t != "bcc") config.fail("lattice_types", "expected \"cc\" or \"bcc\", got \"" + t + "\"");
+            lattice_types_.push_back(t == "cc" ? LatticeType::CC : LatticeType::BCC);
+        }
+        for (JsonReader& b : config.objects("backends")) {
+            BackendSpec spec;
+            spec.name = b.required<std::string>("name", "a short name such as \"gpu_tuned\"");
+            spec.max_points = b.optional<int64_t>("max_points", 0, "a number of points to time (0 = all)");
+            spec.options = parse_sampler_options_except(b, {"name", "max_points"});
+            spec.options.progress = false;
+            backends_.push_back(spec);
+        }
+        reference_ = config.optional<std::string>("reference", backends_.empty() ? "" : backends_[0].name,
+                                                  "the name of the backend speedups are relative to");
+        repetitions_ = config.optional<int>("repetitions", 3, "a positive count");
+        if (repetitions_ < 1) config.fail("repetitions", "expected at least 1");
+    }
+
+    std::vector<std::string> plan() const override {
+        std::vector<std::string> lines;
+        for (const CaseSpec& c : cases_)
+            for (int64_t n : c.samples)
+                for (LatticeType t : lattice_types_)
+                    for (const BackendSpec& b : backends_)
+                        lines.push_back(c.label + " " + std::to_string(n) + " samples " + lattice_type_name(t) + ": " +
+                                        b.name + " x" + std::to_string(repetitions_));
+        return lines;
+    }
+
+    void run(RunContext& ctx) override {
+        std::ostream& log = *ctx.log;
+        for (const CaseSpec& c : cases_) {
+            StudyInputs in;
+            in.mesh = c.mesh;
+            in.search_path = search_path_;
+            const PreparedMesh mesh = load_prepared_mesh(in, log);
+            ctx.metrics["meshes"][c.label] = describe_mesh(mesh);
+            for (int64_t samples : c.samples)
+                for (LatticeType type : lattice_types_) run_row(ctx, c, mesh, samples, type);
+        }
+    }
+
+private:
+    static SamplerOptions parse_sampler_options_except(JsonReader& b, const std::vector<std::string>& skip) {
+        // The backend object is a sampler object plus the keys in `skip`.
+        nlohmann::json rest = b.json();
+        for (const auto& k : skip) rest.erase(k);
+        JsonReader r(rest, b.file(), b.path());
+        return parse_sampler_options(r);
+    }
+
+    Timing time_backend(const BackendSpec& b, const PreparedMesh& mesh, const Lattice& lattice,
+                        std::vector<double>& subset_distance, const std::vector<Vec3d>& subset) {
+        Timing t;
+        auto sampler = make_sampler(b.options);
+        const int64_t n = lattice.num_points();
+        const bool whole = b.max_points <= 0 || b.max_points >= n;
+        if (!whole) {
+            // Strided subset: same cost per point as the whole lattice.
+            t.points_timed = int64_t(subset.size());
+            for (int r = 0; r < repetitions_; ++r) {
+                const auto start = std::chrono::steady_clock::now();
+                const auto res = sampler->query(mesh, subset);
+                const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                t.seconds.push_back(s * double(n) / double(subset.size()));
+                t.total.push_back(t.seconds.back());
+                if (r == 0) for (const auto& q : res) subset_distance.push_back(q.distance);
+            }
+            return t;
+        }
+        t.points_timed = n;
+        if (b.options.backend == "cuda") sampler->sample(mesh, lattice);  // warm-up: module load, first allocations
+        for (int r = 0; r < repetitions_; ++r) {
+            const SampledField f = sampler->sample(mesh, lattice);
+            t.seconds.push_back(f.timings.kernel);
+            t.total.push_back(f.timings.total);
+            if (r == 0) {
+                const int64_t stride = std::max<int64_t>(1, n / int64_t(subset.size()));
+                for (size_t k = 0; k < subset.size(); ++k) subset_distance.push_back(f.distance[size_t(int64_t(k) * stride)]);
+            }
+        }
+        return t;
+    }
+
+    void run_row(RunContext& ctx, const CaseSpec& c, const PreparedMesh& mesh, int64_t samples, LatticeType type) {
+        const int r = cubic_resolution_for_samples(type, samples);
+        const Lattice lattice = fit_lattice(type, {r, r, r}, mesh.bounds, margin_);
+        const int64_t n = lattice.num_points();
+        // The subset every backend reports distances on, for a cross-check of the results.
+        int64_t subset_size = n;
+        for (const BackendSpec& b : backends_)
+            if (b.max_points > 0) subset_size = std::min(subset_size, b.max_points);
+        const int64_t stride = std::max<int64_t>(1, n / subset_size);
+        std::vector<Vec3d> subset;
+        for (int64_t i = 0; i < n && int64_t(subset.size()) < subset_size; i += stride) subset.push_back(lattice.position(i));
+
+        nlohmann::json row = {{"mesh", c.label},
+                              {"samples_requested", samples},
+                              {"lattice", lattice_type_name(type)},
+                              {"resolution", lattice_notation(lattice)},
+                              {"points", n},
+                              {"triangles", mesh.triangles.size()}};
+        std::map<std::string, double> medians;
+        std::vector<double> reference_distance;
+        for (const BackendSpec& b : backends_) {
+            nlohmann::json entry = {{"name", b.name}, {"sampler", sampler_options_to_json(b.options)}};
+            if (b.options.backend == "cuda" && !cuda_backend_available()) {
+                entry["status"] = "unavailable (no CUDA device or no CUDA backend in this build)";
+                row["backends"].push_back(entry);
+                continue;
+            }
+            std::vector<double> dist;
+            const Timing t = time_backend(b, mesh, lattice, dist, subset);
+            const double med = t.median();
+            medians[b.name] = t.median_total();
+            entry["status"] = "ok";
+            entry["total_seconds_median"] = t.median_total();
+            entry["seconds_median"] = med;
+            entry["seconds_min"] = *std::min_element(t.seconds.begin(), t.seconds.end());
+            entry["seconds_max"] = *std::max_element(t.seconds.begin(), t.seconds.end());
+            entry["seconds_all"] = t.seconds;
+            entry["points_timed"] = t.points_timed;
+            entry["extrapolated"] = t.points_timed < n;
+            entry["pairs_per_second"] = double(n) * double(mesh.triangles.size()) / med;
+            if (b.name == reference_) reference_distance = dist;
+            if (!reference_distance.empty() && dist.size() == reference_distance.size()) {
+                double worst = 0;
+                for (size_t k = 0; k < dist.size(); ++k) worst = std::max(worst, std::abs(dist[k] - reference_distance[k]));
+                entry["max_abs_distance_vs_reference"] = worst;
+            }
+            row["backends"].push_back(entry);
+        }
+        if (medians.count(reference_))
+            for (auto& e : row["backends"])
+                if (e.contains("total_seconds_median"))
+                    e["speedup_vs_reference"] = medians[reference_] / e["total_seconds_median"].get<double>();
+        if (const ThesisTiming* th = thesis_timing(c.label, samples))
+            row["thesis"] = {{"gpu_seconds", th->gpu_seconds}, {"cpu_seconds", th->cpu_seconds}, {"speedup", th->speedup},
+                             {"gpu", "GeForce GTX 465"}};
+        print_row(*ctx.log, row);
+        ctx.metrics["rows"].push_back(row);
+        ctx.metrics["reference"] = reference_;
+    }
+
+    static void print_row(std::ostream& log, const nlohmann::json& row) {
+        char line[512];
+        std::snprintf(line, sizeof line, "%s %s %s (%lld points x %lld triangles):\n", row["mesh"].get<std::string>().c_str(),
+                      row["lattice"].get<std::string>().c_str(), row["resolution"].get<std::string>().c_str(),
+                      (long long)row["points"].get<int64_t>(), (long long)row["triangles"].get<int64_t>());
+        log << line;
+        for (const auto& e : row["backends"]) {
+            if (e["status"] != "ok") {
+                log << "    " << e["name"].get<std::string>() << ": " << e["status"].get<std::string>() << "\n";
+                continue;
+            }
+            std::snprintf(line, sizeof line, "    %-12s %10.4f s end to end, %.4f s computing [%.4f, %.4f]%s  %.3g pairs/s  speedup %.1f\n",
+                          e["name"].get<std::string>().c_str(), e["total_seconds_median"].get<double>(), e["seconds_median"].get<double>(),
+                          e["seconds_min"].get<double>(), e["seconds_max"].get<double>(),
+                          e["extrapolated"].get<bool>() ? " (extrapolated)" : "", e["pairs_per_second"].get<double>(),
+                          e.value("speedup_vs_reference", 0.0));
+            log << line;
+        }
+        if (row.contains("thesis")) {
+            std::snprintf(line, sizeof line, "    thesis (GTX 465 vs 1 CPU core): GPU %.4f s, CPU %.1f s, speedup %.0f\n",
+                          row["thesis"]["gpu_seconds"].get<double>(), row["thesis"]["cpu_seconds"].get<double>(),
+                          row["thesis"]["speedup"].get<double>());
+            log << line;
+        }
+    }
+
+    std::vector<std::string> search_path_;
+    double margin_ = 0.1;
+    std::vector<CaseSpec> cases_;
+    std::vector<LatticeType> lattice_types_;
+    std::vector<BackendSpec> backends_;
+    std::string reference_;
+    int repetitions_ = 3;
+};
+
+}  // namespace
+
+std::unique_ptr<Experiment> make_speedup_experiment() { return std::make_unique<SpeedupExperiment>(); }
+
+}  // namespace sdf

@@ -1,0 +1,190 @@
+// Both CUDA kernels against the CPU reference, on every test mesh, CC and BCC (both
+// strategies): max |dd| <= 1e-5 of the bounding-box diagonal, the same sign and triangle
+// except at ties, gradients within 1e-4.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "harness/config/mesh_spec.h"
+#include "harness/sampling/make_sampler.h"
+#include "kernels/distance/closest_point_on_triangle.h"
+
+namespace sdf {
+namespace {
+
+struct NamedMesh {
+    std::string name;
+    PreparedMesh mesh;
+};
+
+/// The procedural shapes always; the real meshes when the data path has them.
+const std::vector<NamedMesh>& test_meshes() {
+    static const std::vector<NamedMesh> meshes = [] {
+        std::vector<NamedMesh> m;
+        m.push_back({"sphere", prepare_mesh(make_icosphere(4))});
+        m.push_back({"box", prepare_mesh(make_box({1, 0.5, 0.75}))});
+        m.push_back({"torus", prepare_mesh(make_torus())});
+        m.push_back({"pawn", prepare_mesh(make_pawn())});
+        m.push_back({"soccer_ball", prepare_mesh(make_soccer_ball())});
+        for (const char* file : {"bunny.obj", "dragon.obj"}) {
+            try {
+                m.push_back({file, prepare_mesh(load_mesh(mesh_spec_from_argument(file), data_search_path()))});
+            } catch (const std::exception& e) {
+                std::printf("note: %s not available (%s)\n", file, e.what());
+            }
+        }
+        return m;
+    }();
+    return meshes;
+}
+
+/// Prepared-mesh index of each file-order triangle index.
+std::vector<int> prepared_index(const PreparedMesh& m) {
+    std::vector<int> inverse(size_t(m.report.input_triangles), -1);
+    for (size_t i = 0; i < m.source_triangle.size(); ++i) inverse[size_t(m.source_triangle[i])] = int(i);
+    return inverse;
+}
+
+double distance_to(const PreparedMesh& m, const Vec3d& p, int prepared) {
+    const Int3 t = m.triangles[size_t(prepared)];
+    return std::sqrt(closest_point_on_triangle(p, m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
+                                               m.vertices[size_t(t.z)]).distance_squared);
+}
+
+struct Agreement {
+    double max_abs_distance = 0;
+    int triangle_ties = 0, sign_ties = 0;
+};
+
+/// Compares a GPU field with the CPU reference point by point.
+Agreement compare(const PreparedMesh& mesh, const SampledField& cpu, const SampledField& gpu, const std::string& what) {
+    const double diag = mesh.bounds.diagonal(), tol = 1e-5 * diag;
+    const std::vector<int> index = prepared_index(mesh);
+    Agreement a;
+    EXPECT_EQ(cpu.size(), gpu.size()) << what;
+    for (int64_t i = 0; i < cpu.size(); ++i) {
+        const double dc = cpu.distance[size_t(i)], dg = gpu.distance[size_t(i)];
+        a.max_abs_distance = std::max(a.max_abs_distance, std::abs(dc - dg));
+        EXPECT_LE(std::abs(dc - dg), tol) << what << " point " << i;
+        const int tc = cpu.closest_triangle[size_t(i)], tg = gpu.closest_triangle[size_t(i)];
+        bool tie = false;
+        if (tc != tg) {
+            // Allowed only when the GPU's triangle is exactly as near (a shared edge or vertex,
+            // or a float near-tie).
+            const Vec3d p = cpu.lattice.position(i);
+            EXPECT_NEAR(distance_to(mesh, p, index[size_t(tg)]), distance_to(mesh, p, index[size_t(tc)]), tol)
+                << what << " point " << i;
+            tie = true;
+            ++a.triangle_ties;
+        }
+        if ((dc < 0) != (dg < 0)) {
+            ++a.sign_ties;
+            EXPECT_TRUE(tie || std::abs(dc) <= tol) << what << " sign differs at point " << i << " d=" << dc;
+        }
+        if (!tie) {
+            const double scale = std::max(std::abs(dc), 0.01 * diag);
+            EXPECT_LE(length(cpu.gradient[size_t(i)] - gpu.gradient[size_t(i)]), 1e-4 * scale / std::max(std::abs(dc), 1e-30))
+                << what << " point " << i;
+        }
+    }
+    return a;
+}
+
+SampledField sample(const PreparedMesh& mesh, const Lattice& lattice, const std::string& backend, const std::string& kernel,
+                    BccStrategy strategy = BccStrategy::TwoGrids, Precision precision = Precision::Float) {
+    SamplerOptions o;
+    o.backend = backend;
+    o.kernel = kernel;
+    o.bcc_strategy = strategy;
+    o.precision = precision;
+    o.progress = false;
+    return make_sampler(o)->sample(mesh, lattice);
+}
+
+TEST(CudaSampler, BothKernelsAgreeWithTheCpuReferenceOnEveryMesh) {
+    for (const NamedMesh& m : test_meshes()) {
+        const bool big = m.mesh.triangles.size() > 50000;
+        const Lattice cc = fit_lattice(LatticeType::CC, big ? Int3{32, 32, 32} : Int3{40, 36, 33}, m.mesh.bounds, 0.1);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, big ? Int3{26, 26, 26} : Int3{31, 29, 27}, m.mesh.bounds, 0.1);
+        for (const Lattice& lattice : {cc, bcc}) {
+            const SampledField cpu = sample(m.mesh, lattice, "cpu", "vectorized");
+            for (const char* kernel : {"thesis", "tuned"})
+                for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
+                    if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
+                    const std::string what = m.name + " " + lattice_notation(lattice) + " " + kernel + " " + bcc_strategy_name(s);
+                    const SampledField gpu = sample(m.mesh, lattice, "cuda", kernel, s);
+                    const Agreement a = compare(m.mesh, cpu, gpu, what);
+                    std::printf("%-44s max|dd| = %.3g (%.2g of diag), triangle ties %d, sign ties %d, %.3g pairs/s\n",
+                                what.c_str(), a.max_abs_distance, a.max_abs_distance / m.mesh.bounds.diagonal(),
+                                a.triangle_ties, a.sign_ties, gpu.timings.pairs_per_second());
+                }
+        }
+    }
+}
+
+TEST(CudaSampler, DoublePrecisionMatchesTheCpuInDouble) {
+    const PreparedMesh& mesh = test_meshes()[4].mesh;  // soccer ball
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {20, 21, 22}, mesh.bounds, 0.1);
+    const SampledField cpu = sample(mesh, lattice, "cpu", "", BccStrategy::TwoGrids, Precision::Double);
+    for (const char* kernel : {"thesis", "tuned"}) {
+        const SampledField gpu = sample(mesh, lattice, "cuda", kernel, BccStrategy::TwoGrids, Precision::Double);
+        for (int64_t i = 0; i < cpu.size(); ++i)
+            ASSERT_NEAR(gpu.distance[size_t(i)], cpu.distance[size_t(i)], 1e-12 * mesh.bounds.diagonal()) << kernel << " " << i;
+    }
+}
+
+TEST(CudaSampler, SplittingLatticesAndMeshesDoesNotChangeTheResult) {
+    const PreparedMesh& mesh = test_meshes()[4].mesh;
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 24, 24}, mesh.bounds, 0.1);
+    for (const char* kernel : {"thesis", "tuned"}) {
+        const SampledField whole = sample(mesh, lattice, "cuda", kernel);
+        SamplerOptions o;
+        o.backend = "cuda";
+        o.kernel = kernel;
+        o.progress = false;
+        o.max_points_per_piece = 1000;       // many pieces (thesis: one 32^3 region per piece)
+        o.max_triangles_per_chunk = 700;     // several triangle chunks per piece
+        const SampledField split = make_sampler(o)->sample(mesh, lattice);
+        EXPECT_GT(split.sampler["plan"]["pieces"].get<int>(), 1) << kernel;
+        EXPECT_GT(split.sampler["plan"]["triangle_chunks"].get<int>(), 1) << kernel;
+        EXPECT_EQ(whole.distance, split.distance) << kernel;
+        EXPECT_EQ(whole.closest_triangle, split.closest_triangle) << kernel;
+    }
+}
+
+TEST(CudaSampler, PointQueriesMatchTheCpu) {
+    const PreparedMesh& mesh = test_meshes()[3].mesh;  // pawn
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-0.8, 0.8);
+    std::vector<Vec3d> pts(5001);
+    for (auto& p : pts) p = mesh.bounds.center() + Vec3d{u(rng), u(rng), u(rng)};
+    SamplerOptions o;
+    o.progress = false;
+    const auto cpu = make_sampler(o)->query(mesh, pts);
+    o.backend = "cuda";
+    for (const char* kernel : {"thesis", "tuned"}) {
+        o.kernel = kernel;
+        const auto gpu = make_sampler(o)->query(mesh, pts);
+        ASSERT_EQ(gpu.size(), pts.size());
+        for (size_t i = 0; i < pts.size(); ++i)
+            ASSERT_NEAR(gpu[i].distance, cpu[i].distance, 1e-5 * mesh.bounds.diagonal()) << kernel << " " << i;
+    }
+}
+
+TEST(CudaSampler, ErrorsNameTheKernel) {
+    SamplerOptions o;
+    o.backend = "cuda";
+    o.kernel = "fastest";
+    try {
+        make_sampler(o);
+        FAIL() << "an unknown kernel must be rejected";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("fastest"), std::string::npos);
+    }
+}
+
+}  // namespace
+}  // namespace sdf
