@@ -14,11 +14,15 @@ namespace {
 enum class CpuKernel { Vectorized, Eberly };
 
 /// Evaluates n points: pos(i) gives the position, emit(i, sample) receives the result.
+/// The nearest triangle is searched in precision T; the winner is then evaluated in double
+/// (closest point, sign, gradient) at the exact double position, so a float run differs
+/// from a double run only where the float search resolved a near-tie differently.
 template <typename T, typename PositionFn, typename EmitFn>
 void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bool progress, int64_t n,
                      PositionFn pos, EmitFn emit) {
     const MeshBuffers<T>& buffers = mesh.buffers<T>();
     const MeshView<T> view = buffers.view();
+    const MeshView<double> exact = mesh.buffers<double>().view();
     const TriangleSoA<T> soa(buffers.packed);
     ProgressReporter reporter("sampling " + mesh.name, n, progress);
     parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
@@ -34,8 +38,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bo
         } else {
             for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
-        for (int k = 0; k < count; ++k)
-            emit(begin + k, signed_distance_to_triangle(view, Vec3<T>(px[k], py[k], pz[k]), best[k]));
+        for (int k = 0; k < count; ++k) emit(begin + k, signed_distance_to_triangle(exact, pos(begin + k), best[k]));
         reporter.advance(count);
     });
 }
@@ -65,9 +68,8 @@ public:
             using T = decltype(zero);
             evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, int64_t(points.size()),
                                [&](int64_t i) { return points[size_t(i)]; },
-                               [&](int64_t i, const SignedDistanceSample<T>& s) {
-                                   out[size_t(i)] = {double(s.distance), Vec3d(s.gradient),
-                                                     mesh.source_triangle[size_t(s.triangle)]};
+                               [&](int64_t i, const SignedDistanceSample<double>& s) {
+                                   out[size_t(i)] = {s.distance, s.gradient, mesh.source_triangle[size_t(s.triangle)]};
                                });
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
@@ -89,11 +91,11 @@ private:
             const GridBlock block = blocks[b];
             evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, block.count(),
                                [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
-                               [&](int64_t i, const SignedDistanceSample<T>& s) {
+                               [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    const int64_t out = block.output_index(lattice, i);
                                    if (out < 0) return;  // strategy A: not a BCC point
-                                   field.distance[size_t(out)] = double(s.distance);
-                                   field.gradient[size_t(out)] = Vec3d(s.gradient);
+                                   field.distance[size_t(out)] = s.distance;
+                                   field.gradient[size_t(out)] = s.gradient;
                                    field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
                                });
             computed += block.count();

@@ -26,25 +26,23 @@ constexpr int kFinalizeThreads = 256;
 int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
 
 /// Results of one piece, on the host, before they are scattered.
-template <typename T>
 struct HostPiece {
-    std::vector<T> distance;
-    std::vector<Vec3<T>> gradient;
+    std::vector<double> distance;
+    std::vector<Vec3d> gradient;
     std::vector<int> triangle;
     std::vector<int64_t> output_index;
 };
 
 /// Per-piece output buffers on the device.
-template <typename T>
 struct DevicePieceOutputs {
-    DeviceBuffer<T> distance;
-    DeviceBuffer<Vec3<T>> gradient;
+    DeviceBuffer<double> distance;
+    DeviceBuffer<Vec3d> gradient;
     DeviceBuffer<int> triangle;
     DeviceBuffer<int64_t> output_index;
     explicit DevicePieceOutputs(int64_t n) : distance{size_t(n)}, gradient{size_t(n)}, triangle{size_t(n)}, output_index{size_t(n)} {}
-    PieceOutputs<T> view() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
-    HostPiece<T> download(int64_t n) const {
-        HostPiece<T> h;
+    PieceOutputs view() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
+    HostPiece download(int64_t n) const {
+        HostPiece h;
         h.distance.resize(size_t(n));
         h.gradient.resize(size_t(n));
         h.triangle.resize(size_t(n));
@@ -56,24 +54,24 @@ struct DevicePieceOutputs {
         CUDA_CHECK(cudaStreamSynchronize(0));
         return h;
     }
-    static size_t bytes_per_point() { return 4 * sizeof(T) + sizeof(int) + sizeof(int64_t); }
+    static size_t bytes_per_point() { return 4 * sizeof(double) + sizeof(int) + sizeof(int64_t); }
 };
 
 /// Everything one sampling call needs on the device, and its timers.
 template <typename T>
 class Engine {
 public:
-    using Sink = std::function<void(const HostPiece<T>&)>;
+    using Sink = std::function<void(const HostPiece&)>;
 
     Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel)
-        : host_(mesh.buffers<T>()), options_(options), kernel_(kernel) {
+        : host_(mesh.buffers<T>()), exact_host_(mesh.buffers<double>()), options_(options), kernel_(kernel) {
         CUDA_CHECK(cudaSetDevice(options.device));
         cudaDeviceProp prop{};
         CUDA_CHECK(cudaGetDeviceProperties(&prop, options.device));
         sms_ = prop.multiProcessorCount;
         max_threads_per_sm_ = prop.maxThreadsPerMultiProcessor;
         upload_.begin();
-        mesh_ = std::make_unique<DeviceMesh<T>>(host_);
+        mesh_ = std::make_unique<DeviceMesh<double>>(exact_host_);
         upload_.end();
         size_t free_bytes = 0, total = 0;
         CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
@@ -104,7 +102,7 @@ public:
         const int64_t resident = int64_t(sms_) * max_threads_per_sm_;
         int64_t regions = std::max<int64_t>(1, resident / GridRegionPiece::kRegionPoints);
         const size_t per_region = size_t(GridRegionPiece::kRegionPoints) * (3 * sizeof(T) + 2 * sizeof(int) +
-                                                                           DevicePieceOutputs<T>::bytes_per_point());
+                                                                           DevicePieceOutputs::bytes_per_point());
         regions = std::min<int64_t>(regions, std::max<size_t>(1, budget_ / per_region));
         if (options_.max_points_per_piece > 0)
             regions = std::max<int64_t>(1, std::min<int64_t>(regions, options_.max_points_per_piece / GridRegionPiece::kRegionPoints));
@@ -167,7 +165,7 @@ private:
     int64_t tuned_piece_points(int64_t total) {
         points_per_thread_ = choose_points_per_thread(total);
         splits_ = choose_splits(total, points_per_thread_);
-        const size_t per_point = (sizeof(T) + sizeof(int)) * size_t(1 + splits_) + DevicePieceOutputs<T>::bytes_per_point();
+        const size_t per_point = (sizeof(T) + sizeof(int)) * size_t(1 + splits_) + DevicePieceOutputs::bytes_per_point();
         const size_t chunk_bytes = size_t(chunk_size_) * sizeof(PackedTriangle<T>);
         const size_t left = budget_ > chunk_bytes ? budget_ - chunk_bytes : 0;
         int64_t step = std::min<int64_t>(total, int64_t(left / per_point));
@@ -190,11 +188,11 @@ private:
     }
 
     template <typename Piece>
-    HostPiece<T> tuned_piece(const Piece& piece) {
+    HostPiece tuned_piece(const Piece& piece) {
         const int64_t n = piece.size();
         DeviceBuffer<T> best_q{size_t(n)}, partial_q{size_t(n) * size_t(splits_)};
         DeviceBuffer<int> best_i{size_t(n)}, partial_i{size_t(n) * size_t(splits_)};
-        DevicePieceOutputs<T> out(n);
+        DevicePieceOutputs out(n);
         for (int chunk = 0; chunk < chunk_count(); ++chunk) {
             if (chunk != resident_chunk_) upload_chunk(chunk);
             compute_.begin();
@@ -220,7 +218,7 @@ private:
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
         download_.begin();
-        HostPiece<T> h = out.download(n);
+        HostPiece h = out.download(n);
         download_.end();
         return h;
     }
@@ -241,12 +239,12 @@ private:
     }
 
     template <typename Piece>
-    HostPiece<T> thesis_piece(const Piece& piece) {
+    HostPiece thesis_piece(const Piece& piece) {
         const int64_t n = piece.size();
         DeviceBuffer<T> d2{size_t(n)}, s{size_t(n)}, t{size_t(n)};
         DeviceBuffer<int> tri{size_t(n)}, feature{size_t(n)};
         const ThesisMinima<T> minima{d2.get(), tri.get(), s.get(), t.get(), feature.get()};
-        DevicePieceOutputs<T> out(n);
+        DevicePieceOutputs out(n);
         compute_.begin();
         fill_thesis_minima<<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(n, minima);
         CUDA_CHECK_LAUNCH("fill_thesis_minima");
@@ -262,15 +260,16 @@ private:
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
         download_.begin();
-        HostPiece<T> h = out.download(n);
+        HostPiece h = out.download(n);
         download_.end();
         return h;
     }
 
-    const MeshBuffers<T>& host_;
+    const MeshBuffers<T>& host_;          ///< search data in precision T
+    const MeshBuffers<double>& exact_host_;  ///< for the final evaluation
     SamplerOptions options_;
     CudaKernel kernel_;
-    std::unique_ptr<DeviceMesh<T>> mesh_;
+    std::unique_ptr<DeviceMesh<double>> mesh_;
     DeviceBuffer<PackedTriangle<T>> packed_;
     std::vector<T> thesis_triangles_;
     EventTimer upload_, compute_, download_;
@@ -312,12 +311,12 @@ private:
         field.precision = options_.precision;
         field.resize(lattice.num_points());
         Engine<T> engine(mesh, options_, kernel_);
-        auto sink = [&](const HostPiece<T>& h) {
+        auto sink = [&](const HostPiece& h) {
             for (size_t i = 0; i < h.output_index.size(); ++i) {
                 const int64_t o = h.output_index[i];
                 if (o < 0) continue;
-                field.distance[size_t(o)] = double(h.distance[i]);
-                field.gradient[size_t(o)] = Vec3d(h.gradient[i]);
+                field.distance[size_t(o)] = h.distance[i];
+                field.gradient[size_t(o)] = h.gradient[i];
                 field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
             }
         };
@@ -370,11 +369,11 @@ private:
         Engine<T> engine(mesh, options_, kernel_);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
-        auto sink = [&](const HostPiece<T>& h) {
+        auto sink = [&](const HostPiece& h) {
             for (size_t i = 0; i < h.output_index.size(); ++i) {
                 const int64_t o = h.output_index[i];
                 if (o < 0) continue;
-                out[size_t(o)] = {double(h.distance[i]), Vec3d(h.gradient[i]), mesh.source_triangle[size_t(h.triangle[i])]};
+                out[size_t(o)] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
             }
         };
         const int64_t n = int64_t(points.size());

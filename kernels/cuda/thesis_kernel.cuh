@@ -92,10 +92,10 @@ __global__ void fill_thesis_minima(int64_t n, ThesisMinima<T> m) {
 }
 
 /// "Sign computations, gradient computations" of thesis Figure 3-2: the closest point from
-/// the stored (s, t), then the pseudonormal sign and the gradient.
+/// the stored (s, t) and feature, then the pseudonormal sign and the gradient (in double, on
+/// the double mesh, at the exact lattice position).
 template <typename T, typename Piece>
-__global__ void finalize_thesis_samples(MeshView<T> mesh, Piece piece, ThesisMinima<T> minima,
-                                        PieceOutputs<T> out) {
+__global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, ThesisMinima<T> minima, PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
     const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
@@ -104,9 +104,9 @@ __global__ void finalize_thesis_samples(MeshView<T> mesh, Piece piece, ThesisMin
     const int tri = minima.triangle[i];
     const Int3 v = mesh.triangles[tri];
     const TriangleFeature feature = TriangleFeature(minima.feature[i]);
-    const Vec3<T> closest = point_on_triangle(mesh.vertices[v.x], mesh.vertices[v.y], mesh.vertices[v.z],
-                                              minima.s[i], minima.t[i], feature);
-    const SignedDistanceSample<T> s = signed_sample(mesh, Vec3<T>(piece.position(i)), tri, closest, feature);
+    const Vec3d closest = point_on_triangle(mesh.vertices[v.x], mesh.vertices[v.y], mesh.vertices[v.z],
+                                            double(minima.s[i]), double(minima.t[i]), feature);
+    const SignedDistanceSample<double> s = signed_sample(mesh, piece.position(i), tri, closest, feature);
     out.distance[i] = s.distance;
     out.gradient[i] = s.gradient;
     out.triangle[i] = s.triangle;

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include "kernels/core/vec3.h"
 
@@ -67,8 +68,13 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     return t;
 }
 
+/// Clamps to [0, 1]. On the GPU a float saturate is a free modifier of the multiply or FMA
+/// that produces x (FMUL.SAT / FFMA.SAT), so it costs no instruction.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE T saturate(T x) {
+#if SDF_IS_GPU_CODE
+    if constexpr (std::is_same_v<T, float>) return __saturatef(x);
+#endif
     return x < T(0) ? T(0) : (x > T(1) ? T(1) : x);
 }
 
