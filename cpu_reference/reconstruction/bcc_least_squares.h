@@ -1,0 +1,60 @@
+/// @file bcc_least_squares.h
+/// @brief The 27-point least-squares cubic fit on the BCC lattice (thesis section 4.1.3,
+/// eqs. 4-12 to 4-15), solved once with Eigen: the matrix K of eq. 4-13 for the kernels
+/// (kernels/reconstruction/bcc_stencils.h) and the derivative stencils of eq. 4-14.
+///
+/// Gaussian weights (eq. 4-15): w_i = exp(-|x_i|^2 / sigma^2). sigma is measured in one of
+/// two units, because the thesis does not say which: SigmaUnits::LatticeUnits are the
+/// integer units of Figure 4-2 (h/2; neighbours at distance sqrt(3), 2 and 2 sqrt(2)), and
+/// SigmaUnits::Spacing are units of h (the same neighbours at sqrt(3)/2, 1 and sqrt(2)).
+/// sigma^2 = 0.5 h^2 equals sigma^2 = 2 in lattice units. docs/reconstruction.md explains the
+/// default (lattice units, as the thesis's figure) and measures both.
+///
+/// Only the fit's even part depends on the weights: the 26 neighbours form 13 antipodal
+/// pairs and the odd monomials of degree <= 3 are 13, so the odd part (first and third
+/// derivatives) interpolates the pair differences whatever symmetric weights are used.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "kernels/reconstruction/bcc_stencils.h"
+
+namespace sdf {
+
+enum class SigmaUnits { LatticeUnits, Spacing };
+
+struct StencilWeighting {
+    bool gaussian = false;       ///< false: W = I (plain least squares)
+    double sigma2 = 0.5;         ///< sigma^2 of eq. 4-15, in `units`^2
+    SigmaUnits units = SigmaUnits::LatticeUnits;
+};
+
+const char* sigma_units_name(SigmaUnits u);
+
+/// sigma^2 expressed in lattice units (h/2)^2.
+double sigma2_in_lattice_units(const StencilWeighting& w);
+
+/// Weight of neighbour n (bcc_neighbour_offset order).
+double stencil_weight(const StencilWeighting& w, int n);
+
+using BccFitMatrix = Eigen::Matrix<double, kCubicMonomials, kBccNeighbourhood>;
+
+/// K = (Phi^T W Phi)^-1 Phi^T W, computed as the pseudo-inverse of W^1/2 Phi (a stable
+/// route for the strongly decaying Gaussian weights).
+BccFitMatrix bcc_least_squares_matrix(const StencilWeighting& w);
+
+/// The same matrix for the kernels, in T.
+template <typename T>
+BccLeastSquaresFit<T> bcc_least_squares_fit(const StencilWeighting& w) {
+    const BccFitMatrix k = bcc_least_squares_matrix(w);
+    BccLeastSquaresFit<T> fit;
+    for (int m = 0; m < kCubicMonomials; ++m)
+        for (int n = 0; n < kBccNeighbourhood; ++n) fit.k[m][n] = T(k(m, n));
+    return fit;
+}
+
+/// The stencil of d^(dx+dy+dz) f / dx^dx dy^dy dz^dz at the centre (eq. 4-14), per lattice
+/// unit h/2: weights over the 27 neighbours.
+Eigen::Matrix<double, kBccNeighbourhood, 1> bcc_derivative_stencil(const StencilWeighting& w, int dx, int dy, int dz);
+
+}  // namespace sdf
