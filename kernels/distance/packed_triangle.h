@@ -78,8 +78,15 @@ SDF_CPU_GPU SDF_INLINE T saturate(T x) {
     return x < T(0) ? T(0) : (x > T(1) ? T(1) : x);
 }
 
+/// Minimum; one FMNMX on the GPU (a plain a < b ? a : b costs a compare and a select there,
+/// while on the CPU it is exactly what vminps computes).
 template <typename T>
-SDF_CPU_GPU SDF_INLINE T min_of(T a, T b) { return a < b ? a : b; }
+SDF_CPU_GPU SDF_INLINE T min_of(T a, T b) {
+#if SDF_IS_GPU_CODE
+    if constexpr (std::is_same_v<T, float>) return fminf(a, b);
+#endif
+    return a < b ? a : b;
+}
 
 /// Squared distance from p to the triangle, branch-free (see the file comment).
 template <typename T>

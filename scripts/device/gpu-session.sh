@@ -44,8 +44,15 @@ run_step() {
         cpubench) log "bench_cpu_sampler"; "$BUILD/tests/benchmarks/bench_cpu_sampler" --benchmark_counters_tabular=true 2>&1 | tail -8 ;;
         sanitize) log "compute-sanitizer"; compute-sanitizer --tool memcheck --error-exitcode 3 "$BUILD/tests/gpu/cuda_sampler_test" \
                       --gtest_filter='*Splitting*:*PointQueries*' 2>&1 | tee "$OUT/compute-sanitizer.txt" | tail -15 ;;
+        sass) log "SASS of the CUDA sampler"; cuobjdump -sass "$BUILD/kernels/cuda/CMakeFiles/sdf_cuda.dir/cuda_sampler.cu.o" > "$OUT/sampler.sass" 2>&1;
+              cuobjdump -res-usage "$BUILD/kernels/cuda/CMakeFiles/sdf_cuda.dir/cuda_sampler.cu.o" 2>&1 | grep -A1 tuned | head -20 ;;
+        profile) log "ncu: tuned kernel on the dragon 64^3";
+                 ncu --clock-control none -k regex:nearest_triangle_tuned -c 2 --section SchedulerStats --section WarpStateStats \
+                     --section InstructionStats --section Occupancy --section ComputeWorkloadAnalysis \
+                     "$BUILD/tests/benchmarks/bench_cuda_sampler" --benchmark_filter='^tuned/dragon_legacy/64x64x64cc' \
+                     --benchmark_min_time=0.01 > "$OUT/ncu.txt" 2>&1; grep -E "Issue|Executed Ipc|Warp Cycles|Stall|Occupancy|Registers|Instructions" "$OUT/ncu.txt" | head -40 ;;
         experiment\ *) local cfg=${1#experiment }; log "run-experiment $cfg";
-                       "$BUILD/harness/runner/run-experiment" "$cfg" --output-root "$OUT/results" --quiet 2>&1 | tee -a "$OUT/experiments.log" ;;
+                       "$BUILD/harness/runner/run-experiment" "$cfg" --output-root "$OUT" --quiet 2>&1 | tee -a "$OUT/experiments.log" ;;
         *) echo "unknown step: $1"; return 2 ;;
     esac
 }
