@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <functional>
 #include <string>
 
@@ -77,6 +78,7 @@ public:
         CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
         budget_ = size_t(0.8 * double(free_bytes));
         num_triangles_ = int(host_.triangles.size());
+        if (const char* mode = std::getenv("SDF_TUNED_TILE_MODE")) tile_mode_ = std::atoi(mode);  // for benchmarks
         if (kernel_ == CudaKernel::Tuned) plan_triangle_chunks();
         else prepare_thesis_chunks();
     }
@@ -148,10 +150,11 @@ private:
 
     int choose_points_per_thread(int64_t n) const {
         if (options_.points_per_thread > 0) return options_.points_per_thread;
-        // Enough threads to fill every SM, then as many points per thread as that allows.
-        const int64_t target_threads = int64_t(sms_) * 1024;
+        // As many points per thread as still give every SM a few blocks, counting the
+        // triangle splits that multiply the blocks (more points per thread = fewer loads).
+        const int64_t max_splits = std::clamp(std::min(chunk_size_, num_triangles_) / (4 * kTunedTile), 1, 64);
         for (int k : {8, 4, 2})
-            if (n / k >= target_threads / 4) return k;
+            if ((n + int64_t(kTunedThreads) * k - 1) / (int64_t(kTunedThreads) * k) * max_splits >= 4 * int64_t(sms_)) return k;
         return 1;
     }
 
@@ -178,13 +181,24 @@ private:
         return std::max<int64_t>(step, 1);
     }
 
-    template <int K, typename Piece>
-    void launch_tuned(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
+    template <int K, TileMode Mode, typename Piece>
+    void launch_tuned_mode(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
         const int64_t n = piece.size();
         const dim3 grid(unsigned((n + int64_t(kTunedThreads) * K - 1) / (int64_t(kTunedThreads) * K)), unsigned(splits));
         const int per_split = (count + splits - 1) / splits;
-        nearest_triangle_tuned<T, K><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset, per_split, pq, pi);
+        nearest_triangle_tuned<T, K, Mode><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset, per_split, pq, pi);
         CUDA_CHECK_LAUNCH("nearest_triangle_tuned");
+    }
+
+    template <int K, typename Piece>
+    void launch_tuned(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
+        // Two float tiles fit the 48 KiB of static shared memory; two double tiles do not.
+        constexpr TileMode kDouble = sizeof(T) == 4 ? TileMode::DoubleBuffered : TileMode::Shared;
+        switch (tile_mode_) {
+            case 1: launch_tuned_mode<K, TileMode::Shared>(piece, count, offset, pq, pi, splits); break;
+            case 2: launch_tuned_mode<K, TileMode::Global>(piece, count, offset, pq, pi, splits); break;
+            default: launch_tuned_mode<K, kDouble>(piece, count, offset, pq, pi, splits); break;
+        }
     }
 
     template <typename Piece>
@@ -277,6 +291,7 @@ private:
     size_t budget_ = 0;
     int num_triangles_ = 0, chunk_size_ = 0, resident_chunk_ = -1;
     int points_per_thread_ = 0, splits_ = 1;
+    int tile_mode_ = 0;  ///< 0: double-buffered shared tiles, 1: single shared tile, 2: global broadcast loads
     int64_t pieces_ = 0;
 };
 
