@@ -9,7 +9,7 @@
 
 namespace sdf {
 
-/// Triangles per block: the block's 28 arrays (28 KiB in float) stay in the L1 cache while
+/// Triangles per block: the block's 24 arrays (24 KiB in float) stay in the L1 cache while
 /// every point of the tile runs over them.
 constexpr int kTriangleBlock = 256;
 /// Points that share one pass over the triangle blocks.
@@ -39,8 +39,7 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
                 const PackedTriangle<T> t{f[0][j],  f[1][j],  f[2][j],  f[3][j],  f[4][j],  f[5][j],
                                           f[6][j],  f[7][j],  f[8][j],  f[9][j],  f[10][j], f[11][j],
                                           f[12][j], f[13][j], f[14][j], f[15][j], f[16][j], f[17][j],
-                                          f[18][j], f[19][j], f[20][j], f[21][j], f[22][j], f[23][j],
-                                          f[24][j], f[25][j], f[26][j], f[27][j]};
+                                          f[18][j], f[19][j], f[20][j], f[21][j], f[22][j], f[23][j]};
                 const T d = squared_distance(t, x, y, z);
                 q[i] = d;
                 block_min = d < block_min ? d : block_min;

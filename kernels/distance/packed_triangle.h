@@ -5,34 +5,44 @@
 /// It minimises the same quadratic Q(s,t) as Eberly's algorithm (thesis section 3.2), but
 /// with the 7 regions folded into "inside the triangle, or on one of its 3 clamped edges":
 ///   Q = inside ? (n . (B - P))^2 : min(Q_edge01, Q_edge20, Q_edge12),
-/// where each edge minimum is a clamped 1-D quadratic. Every branch becomes a select, so the
-/// loop vectorises on the CPU and does not diverge on the GPU (about 45 instructions a pair).
+/// where each edge minimum is a clamped 1-D quadratic and "inside" tests Eberly's
+/// unconstrained minimiser (s, t) (region 0). Every branch becomes a select, so the loop
+/// vectorises on the CPU and does not diverge on the GPU: 42 instructions a pair on sm_90.
 /// Only the minimum search uses this form; the winning triangle is re-evaluated with
-/// closest_point_on_triangle() for the closest point, (s,t), feature and exact distance.
+/// closest_point_on_triangle() in double for the closest point, feature and exact distance.
+///
+/// Precision. In float the edge terms expand |B - P|^2, so Q carries a rounding error of
+/// about 1e-7 |B - P|^2: two triangles closer than that may be ranked either way (a float
+/// near-tie; the exact re-evaluation then reports the chosen one's true distance). Slivers
+/// (smallest angle below ~0.6 degrees, sin^2 < kSliverSin2) are searched by their edges only,
+/// because (s, t) loses all accuracy there; their interior lies within the inradius of an
+/// edge, so Q over-estimates by at most the squared inradius.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <type_traits>
 
 #include "kernels/core/vec3.h"
 
 namespace sdf {
 
-/// 28 scalars (112 bytes in float): seven 16-byte loads on the GPU.
+/// Triangles with sin^2 of an angle below this are searched by their edges only.
+constexpr double kSliverSin2 = 1e-4;
+
+/// 24 scalars (96 bytes in float): six 16-byte loads on the GPU.
 template <typename T>
 struct alignas(16) PackedTriangle {
     T bx, by, bz;        ///< B = V0
     T e0x, e0y, e0z;     ///< 2 E0 = 2 (V1 - V0)
     T e1x, e1y, e1z;     ///< 2 E1 = 2 (V2 - V0)
-    T nx, ny, nz;        ///< unit normal, or 0 for a zero-area triangle
-    T ux, uy, uz;        ///< (E1 x N) / |N|^2: s of the plane projection is -(B - P) . u
-    T vx, vy, vz;        ///< (N x E0) / |N|^2: t of the plane projection is -(B - P) . v
+    T nx, ny, nz;        ///< unit normal
+    T sa, sb, ta, tb;    ///< s = sa 2d + sb 2e, t = ta 2d + tb 2e (Eberly's region-0 minimiser); NaN = never inside
     T a, c;              ///< E0.E0, E1.E1
     T k01, k20;          ///< -1 / (2a), -1 / (2c): edge parameters from 2d and 2e
     T k12, m12;          ///< 1 / (2g), (c - b) / g with g = a - 2b + c, b = E0.E1: edge V2 -> V1
     T g, w12;            ///< g and 2 (b - c)
-    T inside_limit;      ///< 1, or -1 for a zero-area triangle (never "inside")
-    T pad;
 };
 
 template <typename T>
@@ -43,20 +53,21 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     const double g = a - 2.0 * b + c;
     const double det = a * c - b * b;
     const Vec3d n = normalize_or_zero(cross(e0, e1));
-    const Vec3d nn = cross(e0, e1);
-    const double nn2 = length_squared(nn);
-    const bool flat = !(det > 0.0) || nn2 == 0.0;
-    // In-plane barycentric directions, formed in double: accurate even for slivers, where
-    // the float cancellation in Eberly's b e - c d would misjudge "inside".
-    const Vec3d u = flat ? Vec3d(0.0) : cross(e1, nn) / nn2;
-    const Vec3d v = flat ? Vec3d(0.0) : cross(nn, e0) / nn2;
+    // sin^2 of the angle at V0 is det / (a c); the smallest angle matters, and with the
+    // edge lengths it is at most that one's, so test all three corners.
+    const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
+    const bool interior = det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= kSliverSin2;
+    const T nan = std::numeric_limits<T>::quiet_NaN();  // NaN >= 0 is false: never inside
     PackedTriangle<T> t{};
     t.bx = T(v0.x); t.by = T(v0.y); t.bz = T(v0.z);
     t.e0x = T(2 * e0.x); t.e0y = T(2 * e0.y); t.e0z = T(2 * e0.z);
     t.e1x = T(2 * e1.x); t.e1y = T(2 * e1.y); t.e1z = T(2 * e1.z);
-    t.nx = T(flat ? 0.0 : n.x); t.ny = T(flat ? 0.0 : n.y); t.nz = T(flat ? 0.0 : n.z);
-    t.ux = T(u.x); t.uy = T(u.y); t.uz = T(u.z);
-    t.vx = T(v.x); t.vy = T(v.y); t.vz = T(v.z);
+    t.nx = T(n.x); t.ny = T(n.y); t.nz = T(n.z);
+    // s = (b e - c d) / det, t = (b d - a e) / det with d = 2d / 2, e = 2e / 2.
+    t.sa = interior ? T(-c / (2 * det)) : nan;
+    t.sb = interior ? T(b / (2 * det)) : nan;
+    t.ta = interior ? T(b / (2 * det)) : nan;
+    t.tb = interior ? T(-a / (2 * det)) : nan;
     t.a = T(a); t.c = T(c);
     t.k01 = T(a > 0 ? -1.0 / (2 * a) : 0.0);
     t.k20 = T(c > 0 ? -1.0 / (2 * c) : 0.0);
@@ -64,12 +75,9 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     t.m12 = T(g > 0 ? (c - b) / g : 0.0);
     t.g = T(g);
     t.w12 = T(2 * (b - c));
-    t.inside_limit = T(flat ? -1.0 : 1.0);
     return t;
 }
 
-/// Clamps to [0, 1]. On the GPU a float saturate is a free modifier of the multiply or FMA
-/// that produces x (FMUL.SAT / FFMA.SAT), so it costs no instruction.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE T saturate(T x) {
 #if SDF_IS_GPU_CODE
@@ -97,10 +105,10 @@ SDF_CPU_GPU SDF_INLINE T squared_distance(const PackedTriangle<T>& tri, T px, T 
     const T f = dx * dx + dy * dy + dz * dz;
     const T h = tri.nx * dx + tri.ny * dy + tri.nz * dz;
 
-    // Region 0: the barycentrics (s, t) of the plane projection.
-    const T s = -(tri.ux * dx + tri.uy * dy + tri.uz * dz);
-    const T t = -(tri.vx * dx + tri.vy * dy + tri.vz * dz);
-    const bool inside = (s >= T(0)) & (t >= T(0)) & (s + t <= tri.inside_limit);  // no branches
+    // Region 0: Eberly's unconstrained minimiser (s, t) lies in the triangle.
+    const T s = tri.sa * d2 + tri.sb * e2;
+    const T t = tri.ta * d2 + tri.tb * e2;
+    const bool inside = (s >= T(0)) & (t >= T(0)) & (s + t <= T(1));  // no branches
 
     // Edge V0 -> V1 (t = 0) and edge V0 -> V2 (s = 0).
     const T s01 = saturate(d2 * tri.k01);
