@@ -54,6 +54,12 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     r.lattice = lattice_notation(lattice);
     r.lattice_points = lattice.num_points();
     r.probe_box = recon.domain();
+    const Vec3d inset(spec.margin * lattice.spacing);
+    r.probe_box = {r.probe_box.lo + inset, r.probe_box.hi - inset};
+    for (int a = 0; a < 3; ++a)
+        if (!(r.probe_box.lo[a] < r.probe_box.hi[a]))
+            throw std::invalid_argument("analytic study: margin " + std::to_string(spec.margin) +
+                                        " h leaves no probe box on this lattice");
     const int n = spec.probes_per_axis;
     r.probes = int64_t(n) * n * n;
     const int64_t chunk = int64_t(n) * n;  // one z slice

@@ -9,6 +9,8 @@
 /// Error figures: e = reconstructed - exact at every probe, in the function's own units
 /// (ML values lie in [0,1]). Reported: RMS, max |e|, mean |e|, the L2 norm sqrt(sum e^2),
 /// and RMS and L2 norm scaled by 255 (8-bit data units, as the thesis's volume datasets).
+/// A margin of 2h keeps the probes where every vertex of the containing tetrahedron has a
+/// complete, centred 27-point neighbourhood (no boundary extrapolation in the derivatives).
 #pragma once
 
 #include <string>
@@ -50,7 +52,8 @@ struct AnalyticStudySpec {
     Int3 resolution{111, 111, 111};
     Vec3d domain_min{-1, -1, -1}, domain_max{1, 1, 1};
     ReconstructionSpec reconstruction{InterpolatorKind::BccCubic, DerivativeSource::FiniteDifferences};
-    int probes_per_axis = 256;  ///< probes at the cell centres of a regular grid over domain()
+    int probes_per_axis = 256;  ///< probes at the cell centres of a regular grid over the box:
+    double margin = 0;          ///< the interpolator's domain() shrunk by margin * h per side
     int threads = 0;
 };
 

@@ -15,6 +15,8 @@
 /// derivatives) interpolates the pair differences whatever symmetric weights are used.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "kernels/reconstruction/bcc_stencils.h"
@@ -34,23 +36,33 @@ const char* sigma_units_name(SigmaUnits u);
 /// sigma^2 expressed in lattice units (h/2)^2.
 double sigma2_in_lattice_units(const StencilWeighting& w);
 
-/// Weight of neighbour n (bcc_neighbour_offset order).
-double stencil_weight(const StencilWeighting& w, int n);
+/// Gaussian weights are raised to this floor so that the fit stays well conditioned: it only
+/// acts where exp(-r^2 / sigma^2) < 1e-12, i.e. for sigma^2 < 0.5 (lattice units) or for the
+/// off-centre fits of boundary points.
+constexpr double kMinStencilWeight = 1e-12;
+
+/// Weight of neighbour n (bcc_neighbour_offset order) for the fit evaluated at offset
+/// `at` from the centre (0 except for boundary points, bcc_stencils.h).
+double stencil_weight(const StencilWeighting& w, int n, const Int3& at = {0, 0, 0});
 
 using BccFitMatrix = Eigen::Matrix<double, kCubicMonomials, kBccNeighbourhood>;
 
 /// K = (Phi^T W Phi)^-1 Phi^T W, computed as the pseudo-inverse of W^1/2 Phi (a stable
 /// route for the strongly decaying Gaussian weights).
-BccFitMatrix bcc_least_squares_matrix(const StencilWeighting& w);
+BccFitMatrix bcc_least_squares_matrix(const StencilWeighting& w, const Int3& at = {0, 0, 0});
 
-/// The same matrix for the kernels, in T.
+/// The 27 matrices for the kernels, in T, indexed by bcc_stencil_shift_index: entry i has
+/// its weights centred at offset ((i % 3 - 1) * 2, (i / 3 % 3 - 1) * 2, (i / 9 - 1) * 2).
 template <typename T>
-BccLeastSquaresFit<T> bcc_least_squares_fit(const StencilWeighting& w) {
-    const BccFitMatrix k = bcc_least_squares_matrix(w);
-    BccLeastSquaresFit<T> fit;
-    for (int m = 0; m < kCubicMonomials; ++m)
-        for (int n = 0; n < kBccNeighbourhood; ++n) fit.k[m][n] = T(k(m, n));
-    return fit;
+std::vector<BccLeastSquaresFit<T>> bcc_least_squares_fits(const StencilWeighting& w) {
+    std::vector<BccLeastSquaresFit<T>> fits(kBccNeighbourhood);
+    for (int i = 0; i < kBccNeighbourhood; ++i) {
+        const Int3 at{(i % 3 - 1) * 2, (i / 3 % 3 - 1) * 2, (i / 9 - 1) * 2};
+        const BccFitMatrix k = bcc_least_squares_matrix(w, at);
+        for (int m = 0; m < kCubicMonomials; ++m)
+            for (int n = 0; n < kBccNeighbourhood; ++n) fits[size_t(i)].k[m][n] = T(k(m, n));
+    }
+    return fits;
 }
 
 /// The stencil of d^(dx+dy+dz) f / dx^dx dy^dy dz^dz at the centre (eq. 4-14), per lattice

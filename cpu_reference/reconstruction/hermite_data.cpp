@@ -49,12 +49,12 @@ void build_cc_tricubic(HermiteData<double>& d, const SampledField& field, const 
 void build_bcc_cubic(HermiteData<double>& d, const SampledField& field, const ReconstructionSpec& spec, double unit) {
     const int64_t n = field.size();
     const bool true_first = spec.derivatives == DerivativeSource::True;
-    const BccLeastSquaresFit<double> fit = bcc_least_squares_fit<double>(stencil_weighting(spec));
+    const std::vector<BccLeastSquaresFit<double>> fits = bcc_least_squares_fits<double>(stencil_weighting(spec));
     const int stride = d.higher_stride;
     d.first.resize(size_t(n));
     d.higher.resize(size_t(n) * size_t(stride));
     for_each_point(n, spec.threads, [&](int64_t i) {
-        const CubicJet<double> jet = bcc_least_squares_jet(fit, d.lattice, d.values.data(), d.lattice.coords_of(i));
+        const CubicJet<double> jet = bcc_least_squares_jet(fits.data(), d.lattice, d.values.data(), d.lattice.coords_of(i));
         d.first[size_t(i)] = true_first ? field.gradient[size_t(i)] * unit : jet.gradient;
         double* h = d.higher.data() + size_t(i) * size_t(stride);
         h[kBccDxy] = jet.hessian.xy;

@@ -11,9 +11,10 @@
 /// per h/2, the unit LatticeFieldView stores.
 ///
 /// Boundary: a point whose 27-point neighbourhood leaves the lattice uses the nearest
-/// complete neighbourhood (its centre moved inward by an even step, so it stays a lattice
-/// point of the same kind) and differentiates that fit at its own offset. This stays exact
-/// for cubics; it needs R >= 4 points per axis.
+/// complete neighbourhood (its centre moved inward by 2 units per axis at most, so it stays a
+/// lattice point of the same kind) and differentiates that fit at its own offset. Gaussian
+/// weights stay centred on the point itself, so each of the 27 possible offsets has its own
+/// K (bcc_stencil_shift_index). This stays exact for cubics; it needs R >= 4 per axis.
 #pragma once
 
 #include "kernels/reconstruction/cubic_monomials.h"
@@ -40,11 +41,20 @@ SDF_CPU_GPU inline Int3 bcc_stencil_centre(const Lattice& l, const Int3& c) {
     return centre;
 }
 
+/// Which of the 27 fits lattice point c uses: 13 for an interior point (offset 0), else
+/// sum over axes of (offset / 2 + 1) * 3^axis, offset = c - centre in {-2, 0, 2}.
+SDF_CPU_GPU inline int bcc_stencil_shift_index(const Lattice& l, const Int3& c) {
+    const Int3 centre = bcc_stencil_centre(l, c);
+    return ((c.x - centre.x) / 2 + 1) + 3 * ((c.y - centre.y) / 2 + 1) + 9 * ((c.z - centre.z) / 2 + 1);
+}
+
 /// Value, gradient and Hessian of the least-squares cubic at lattice point c, per h/2.
+/// `fits` holds the 27 fits indexed by bcc_stencil_shift_index (all equal when unweighted).
 template <typename T>
-SDF_CPU_GPU CubicJet<T> bcc_least_squares_jet(const BccLeastSquaresFit<T>& fit, const Lattice& l, const T* values,
+SDF_CPU_GPU CubicJet<T> bcc_least_squares_jet(const BccLeastSquaresFit<T>* fits, const Lattice& l, const T* values,
                                               const Int3& c) {
     const Int3 centre = bcc_stencil_centre(l, c);
+    const BccLeastSquaresFit<T>& fit = fits[bcc_stencil_shift_index(l, c)];
     T y[kBccNeighbourhood];
     for (int n = 0; n < kBccNeighbourhood; ++n) {
         const Int3 o = bcc_neighbour_offset(n);

@@ -113,10 +113,10 @@ TEST(BccLeastSquares, EveryLatticePointIncludingTheBoundaryIsExactForCubics) {
     const SampledField field = sample_analytic_field(l, p);
     const double u = l.half_spacing();
     for (const StencilWeighting& w : {kPlain, kGaussLattice}) {
-        const BccLeastSquaresFit<double> fit = bcc_least_squares_fit<double>(w);
+        const std::vector<BccLeastSquaresFit<double>> fits = bcc_least_squares_fits<double>(w);
         double worst = 0;
         for (int64_t i = 0; i < l.num_points(); ++i) {
-            const CubicJet<double> jet = bcc_least_squares_jet(fit, l, field.distance.data(), l.coords_of(i));
+            const CubicJet<double> jet = bcc_least_squares_jet(fits.data(), l, field.distance.data(), l.coords_of(i));
             const AnalyticSample<double> want = p(l.position(i));
             worst = std::max(worst, std::abs(jet.value - want.value));
             worst = std::max(worst, length(jet.gradient - want.gradient * u));

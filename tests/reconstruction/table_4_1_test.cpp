@@ -1,0 +1,46 @@
+// Thesis Table 4-1, ML row (label `slow`, about 30 s on 2 cores): the Marschner-Lobb
+// function (f_M = 6, alpha = 0.25) sampled on a 111 x 111 x 222 BCC lattice spanning
+// [-1,1]^3, reconstructed with bcc_cubic from plain ("fd") and Gaussian-weighted
+// ("fd_weighted", sigma^2 = 0.5) least-squares derivatives, errors at 256^3 probes.
+// The thesis reports 8.939 (plain) vs 8.725 (weighted) without defining the norm; the
+// normalisation-free comparison is the ratio weighted / plain (thesis: 0.976).
+// Prints every normalisation (docs/reconstruction.md discusses them) and checks that the
+// weighting helps in the interior, as the thesis found.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "cpu_reference/reconstruction/analytic_study.h"
+
+namespace sdf {
+namespace {
+
+AnalyticStudyResult run(DerivativeSource source, SigmaUnits units, double margin) {
+    AnalyticStudySpec spec;  // marschner_lobb, BCC {111, 111, 111} over [-1,1]^3, 256^3 probes
+    spec.reconstruction.interpolator = InterpolatorKind::BccCubic;
+    spec.reconstruction.derivatives = source;
+    spec.reconstruction.sigma2 = 0.5;
+    spec.reconstruction.sigma_units = units;
+    spec.margin = margin;
+    const AnalyticStudyResult r = run_analytic_study(spec);
+    std::printf("%-62s margin %gh: RMS %.5e  max %.4e  L2 %.5e  RMSx255 %.5f  L2x255 %.4f  grad RMS %.4e\n",
+                r.description.c_str(), margin, r.rms, r.max_abs, r.l2_norm, r.rms_255, r.l2_norm_255, r.gradient_rms);
+    return r;
+}
+
+TEST(Table41, MarschnerLobbPlainVersusWeightedLeastSquares) {
+    for (double margin : {0.0, 2.0}) {
+        const AnalyticStudyResult plain = run(DerivativeSource::FiniteDifferences, SigmaUnits::LatticeUnits, margin);
+        const AnalyticStudyResult lattice = run(DerivativeSource::FiniteDifferencesWeighted, SigmaUnits::LatticeUnits, margin);
+        const AnalyticStudyResult spacing = run(DerivativeSource::FiniteDifferencesWeighted, SigmaUnits::Spacing, margin);
+        run(DerivativeSource::True, SigmaUnits::LatticeUnits, margin);
+        std::printf("  ratio weighted / plain (RMS): sigma^2 = 0.5 (h/2)^2: %.4f, sigma^2 = 0.5 h^2: %.4f (thesis 0.976)\n",
+                    lattice.rms / plain.rms, spacing.rms / plain.rms);
+        EXPECT_EQ(plain.lattice, "111x111x222");
+        EXPECT_LT(lattice.rms, plain.rms);
+        EXPECT_LT(spacing.rms, plain.rms);
+    }
+}
+
+}  // namespace
+}  // namespace sdf
