@@ -78,7 +78,7 @@ public:
         CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
         budget_ = size_t(0.8 * double(free_bytes));
         num_triangles_ = int(host_.triangles.size());
-        if (const char* mode = std::getenv("SDF_TUNED_TILE_MODE")) tile_mode_ = std::atoi(mode);  // for benchmarks
+        if (const char* v = std::getenv("SDF_TUNED_VARIANT")) variant_ = std::atoi(v);  // benchmarks only
         if (kernel_ == CudaKernel::Tuned) plan_triangle_chunks();
         else prepare_thesis_chunks();
     }
@@ -181,24 +181,29 @@ private:
         return std::max<int64_t>(step, 1);
     }
 
-    template <int K, TileMode Mode, typename Piece>
-    void launch_tuned_mode(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
+    template <int K, int Tile, int MinBlocks, typename Piece>
+    void launch_tuned_variant(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
         const int64_t n = piece.size();
         const dim3 grid(unsigned((n + int64_t(kTunedThreads) * K - 1) / (int64_t(kTunedThreads) * K)), unsigned(splits));
         const int per_split = (count + splits - 1) / splits;
-        nearest_triangle_tuned<T, K, Mode><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset, per_split, pq, pi);
+        nearest_triangle_tuned<T, K, Tile, MinBlocks><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset,
+                                                                               per_split, pq, pi);
         CUDA_CHECK_LAUNCH("nearest_triangle_tuned");
     }
 
     template <int K, typename Piece>
     void launch_tuned(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
-        // Two float tiles fit the 48 KiB of static shared memory; two double tiles do not.
-        constexpr TileMode kDouble = sizeof(T) == 4 ? TileMode::DoubleBuffered : TileMode::Shared;
-        switch (tile_mode_) {
-            case 1: launch_tuned_mode<K, TileMode::Shared>(piece, count, offset, pq, pi, splits); break;
-            case 2: launch_tuned_mode<K, TileMode::Global>(piece, count, offset, pq, pi, splits); break;
-            default: launch_tuned_mode<K, kDouble>(piece, count, offset, pq, pi, splits); break;
+        if constexpr (K == 8 && sizeof(T) == 4) {
+            // Variants for the occupancy experiment (SDF_TUNED_VARIANT), see docs/gpu-notes.md.
+            switch (variant_) {
+                case 1: return launch_tuned_variant<K, kTunedTile, 5>(piece, count, offset, pq, pi, splits);
+                case 2: return launch_tuned_variant<K, kTunedTile, 4>(piece, count, offset, pq, pi, splits);
+                case 3: return launch_tuned_variant<K, 256, 1>(piece, count, offset, pq, pi, splits);
+                case 4: return launch_tuned_variant<K, 256, 5>(piece, count, offset, pq, pi, splits);
+                default: break;
+            }
         }
+        launch_tuned_variant<K, kTunedTile, 1>(piece, count, offset, pq, pi, splits);
     }
 
     template <typename Piece>
@@ -291,7 +296,7 @@ private:
     size_t budget_ = 0;
     int num_triangles_ = 0, chunk_size_ = 0, resident_chunk_ = -1;
     int points_per_thread_ = 0, splits_ = 1;
-    int tile_mode_ = 0;  ///< 0: double-buffered shared tiles, 1: single shared tile, 2: global broadcast loads
+    int variant_ = 0;  ///< tuned-kernel variant under test (0 = default)
     int64_t pieces_ = 0;
 };
 

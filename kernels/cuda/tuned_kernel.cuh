@@ -8,19 +8,12 @@
 /// and the splits' minima are merged afterwards (lowest index wins ties, like the CPU).
 #pragma once
 
-#include <cuda_pipeline.h>
-
 #include "kernels/distance/packed_triangle.h"
 
 namespace sdf::cuda {
 
 constexpr int kTunedThreads = 128;
-constexpr int kTunedTile = 128;  ///< triangles per shared tile (14 KiB in float)
-
-/// How a block gets its triangles: one shared tile at a time; two shared tiles, the next
-/// one copied asynchronously (cp.async) while the current one is used; or no shared memory,
-/// each warp reading the same triangle straight from global memory (a broadcast L1 load).
-enum class TileMode { Shared, DoubleBuffered, Global };
+constexpr int kTunedTile = 128;  ///< triangles per shared tile (12 KiB in float)
 
 /// Triangles per group: the inner loop keeps only each point's minimum (one FMNMX a pair);
 /// after every group it notes which group improved the minimum, and at the end the winning
@@ -67,25 +60,21 @@ __device__ int nearest_in_group(const PackedTriangle<T>* triangles, int group, i
     return index;
 }
 
-/// Copies `count` packed triangles to shared memory with 16-byte words, asynchronously
-/// (cp.async) when `async`; the caller commits, waits and synchronises.
+/// Copies `count` packed triangles to shared memory with 16-byte words.
 template <typename T>
-__device__ void stage_tile(PackedTriangle<T>* tile, const PackedTriangle<T>* src, int count, bool async) {
+__device__ void stage_tile(PackedTriangle<T>* tile, const PackedTriangle<T>* src, int count) {
     const int words = count * int(sizeof(PackedTriangle<T>) / sizeof(int4));
     int4* dst = reinterpret_cast<int4*>(tile);
     const int4* from = reinterpret_cast<const int4*>(src);
-    for (int w = threadIdx.x; w < words; w += kTunedThreads) {
-        if (async) __pipeline_memcpy_async(dst + w, from + w, sizeof(int4));
-        else dst[w] = from[w];
-    }
+    for (int w = threadIdx.x; w < words; w += kTunedThreads) dst[w] = from[w];
 }
 
-template <typename T, int K, TileMode Mode, typename Piece>
-__global__ void __launch_bounds__(kTunedThreads)
+/// Tile: triangles per shared tile; MinBlocks: blocks per SM the register budget must allow.
+template <typename T, int K, int Tile, int MinBlocks, typename Piece>
+__global__ void __launch_bounds__(kTunedThreads, MinBlocks)
     nearest_triangle_tuned(Piece piece, const PackedTriangle<T>* __restrict__ triangles, int num_triangles,
                            int triangle_offset, int triangles_per_split, T* partial_q, int* partial_index) {
-    constexpr int kBuffers = Mode == TileMode::DoubleBuffered ? 2 : (Mode == TileMode::Shared ? 1 : 0);
-    __shared__ PackedTriangle<T> tiles[kBuffers > 0 ? kBuffers : 1][kTunedTile];
+    __shared__ PackedTriangle<T> tile[Tile];
     const int64_t n = piece.size();
     const int64_t first = int64_t(blockIdx.x) * (kTunedThreads * K) + threadIdx.x;
 
@@ -99,34 +88,17 @@ __global__ void __launch_bounds__(kTunedThreads)
         pts.group[k] = -1;
     }
 
+    // Stage a tile, evaluate it against the K points, repeat. (Double buffering with cp.async
+    // and reading triangles straight from global memory were both measured slower on an
+    // H200: the barriers cost little next to 128 x 8 x 42 instructions per tile.)
     const int split_begin = int(blockIdx.y) * triangles_per_split;
     const int split_end = min(num_triangles, split_begin + triangles_per_split);
-    if constexpr (Mode == TileMode::Global) {
-        // Every lane reads the same triangle: one broadcast load per 16 bytes, no barriers.
-        pts.visit_tile(triangles + split_begin, split_end - split_begin, split_begin);
-    } else if constexpr (Mode == TileMode::Shared) {
-        for (int t0 = split_begin; t0 < split_end; t0 += kTunedTile) {
-            const int count = min(kTunedTile, split_end - t0);
-            __syncthreads();
-            stage_tile(tiles[0], triangles + t0, count, false);
-            __syncthreads();
-            pts.visit_tile(tiles[0], count, t0);
-        }
-    } else {
-        // Double buffering: the copy of tile i+1 runs while tile i is evaluated.
-        if (split_begin < split_end) stage_tile(tiles[0], triangles + split_begin, min(kTunedTile, split_end - split_begin), true);
-        __pipeline_commit();
-        int buffer = 0;
-        for (int t0 = split_begin; t0 < split_end; t0 += kTunedTile, buffer ^= 1) {
-            const int count = min(kTunedTile, split_end - t0);
-            const int next = t0 + kTunedTile;
-            if (next < split_end) stage_tile(tiles[buffer ^ 1], triangles + next, min(kTunedTile, split_end - next), true);
-            __pipeline_commit();
-            __pipeline_wait_prior(1);  // the current tile has landed
-            __syncthreads();
-            pts.visit_tile(tiles[buffer], count, t0);
-            __syncthreads();  // everyone is done with this buffer before it is refilled
-        }
+    for (int t0 = split_begin; t0 < split_end; t0 += Tile) {
+        const int count = min(Tile, split_end - t0);
+        __syncthreads();
+        stage_tile(tile, triangles + t0, count);
+        __syncthreads();
+        pts.visit_tile(tile, count, t0);
     }
 
     // Recover each point's triangle from its winning group (global memory, once per point).
