@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <functional>
 #include <string>
 
@@ -78,7 +77,6 @@ public:
         CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
         budget_ = size_t(0.8 * double(free_bytes));
         num_triangles_ = int(host_.triangles.size());
-        if (const char* v = std::getenv("SDF_TUNED_VARIANT")) variant_ = std::atoi(v);  // benchmarks only
         if (kernel_ == CudaKernel::Tuned) plan_triangle_chunks();
         else prepare_thesis_chunks();
     }
@@ -181,29 +179,13 @@ private:
         return std::max<int64_t>(step, 1);
     }
 
-    template <int K, int Tile, int MinBlocks, typename Piece>
-    void launch_tuned_variant(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
+    template <int K, typename Piece>
+    void launch_tuned(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
         const int64_t n = piece.size();
         const dim3 grid(unsigned((n + int64_t(kTunedThreads) * K - 1) / (int64_t(kTunedThreads) * K)), unsigned(splits));
         const int per_split = (count + splits - 1) / splits;
-        nearest_triangle_tuned<T, K, Tile, MinBlocks><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset,
-                                                                               per_split, pq, pi);
+        nearest_triangle_tuned<T, K><<<grid, kTunedThreads>>>(piece, packed_.get(), count, offset, per_split, pq, pi);
         CUDA_CHECK_LAUNCH("nearest_triangle_tuned");
-    }
-
-    template <int K, typename Piece>
-    void launch_tuned(const Piece& piece, int count, int offset, T* pq, int* pi, int splits) {
-        if constexpr (K == 8 && sizeof(T) == 4) {
-            // Variants for the occupancy experiment (SDF_TUNED_VARIANT), see docs/gpu-notes.md.
-            switch (variant_) {
-                case 1: return launch_tuned_variant<K, kTunedTile, 5>(piece, count, offset, pq, pi, splits);
-                case 2: return launch_tuned_variant<K, kTunedTile, 4>(piece, count, offset, pq, pi, splits);
-                case 3: return launch_tuned_variant<K, 256, 1>(piece, count, offset, pq, pi, splits);
-                case 4: return launch_tuned_variant<K, 256, 5>(piece, count, offset, pq, pi, splits);
-                default: break;
-            }
-        }
-        launch_tuned_variant<K, kTunedTile, 1>(piece, count, offset, pq, pi, splits);
     }
 
     template <typename Piece>
@@ -296,7 +278,6 @@ private:
     size_t budget_ = 0;
     int num_triangles_ = 0, chunk_size_ = 0, resident_chunk_ = -1;
     int points_per_thread_ = 0, splits_ = 1;
-    int variant_ = 0;  ///< tuned-kernel variant under test (0 = default)
     int64_t pieces_ = 0;
 };
 

@@ -69,12 +69,11 @@ __device__ void stage_tile(PackedTriangle<T>* tile, const PackedTriangle<T>* src
     for (int w = threadIdx.x; w < words; w += kTunedThreads) dst[w] = from[w];
 }
 
-/// Tile: triangles per shared tile; MinBlocks: blocks per SM the register budget must allow.
-template <typename T, int K, int Tile, int MinBlocks, typename Piece>
-__global__ void __launch_bounds__(kTunedThreads, MinBlocks)
+template <typename T, int K, typename Piece>
+__global__ void __launch_bounds__(kTunedThreads, 1)  // 1: let it use ~155 registers (measured fastest)
     nearest_triangle_tuned(Piece piece, const PackedTriangle<T>* __restrict__ triangles, int num_triangles,
                            int triangle_offset, int triangles_per_split, T* partial_q, int* partial_index) {
-    __shared__ PackedTriangle<T> tile[Tile];
+    __shared__ PackedTriangle<T> tile[kTunedTile];
     const int64_t n = piece.size();
     const int64_t first = int64_t(blockIdx.x) * (kTunedThreads * K) + threadIdx.x;
 
@@ -88,13 +87,14 @@ __global__ void __launch_bounds__(kTunedThreads, MinBlocks)
         pts.group[k] = -1;
     }
 
-    // Stage a tile, evaluate it against the K points, repeat. (Double buffering with cp.async
-    // and reading triangles straight from global memory were both measured slower on an
-    // H200: the barriers cost little next to 128 x 8 x 42 instructions per tile.)
+    // Stage a tile, evaluate it against the K points, repeat. (Double buffering with cp.async,
+    // reading triangles straight from global memory, 256-triangle tiles and capping the
+    // registers for more resident blocks were all measured no faster on an H200: see
+    // docs/gpu-notes.md.)
     const int split_begin = int(blockIdx.y) * triangles_per_split;
     const int split_end = min(num_triangles, split_begin + triangles_per_split);
-    for (int t0 = split_begin; t0 < split_end; t0 += Tile) {
-        const int count = min(Tile, split_end - t0);
+    for (int t0 = split_begin; t0 < split_end; t0 += kTunedTile) {
+        const int count = min(kTunedTile, split_end - t0);
         __syncthreads();
         stage_tile(tile, triangles + t0, count);
         __syncthreads();
