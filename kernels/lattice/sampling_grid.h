@@ -5,8 +5,9 @@
 ///   - CC: one block, the lattice itself.
 ///   - BCC strategy B (Figure 3-3 B): two blocks, the primary grid and the secondary grid
 ///     shifted by h/2.
-///   - BCC strategy A (Figure 3-3 A): one CC block of twice the resolution at spacing h/2;
-///     points that are not BCC points are computed and then discarded.
+///   - BCC strategy A (Figure 3-3 A): one CC block of twice the resolution (2Rx x 2Ry x 2Rz, as
+///     the thesis writes it; 2R-1 per axis would suffice, so its last planes lie h/2 beyond
+///     the domain) at spacing h/2; points that are not BCC points are computed and discarded.
 /// Positions come from Lattice::position_of_coords, so every strategy and backend sees the
 /// same positions bit for bit.
 #pragma once

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/mesh/shapes/stitch_rings.h"
 
 namespace sdf {
 namespace {
@@ -64,26 +65,6 @@ std::vector<int> add_ring(const ProfilePoint& p, int slices, std::vector<Vec3d>&
     return ring;
 }
 
-/// Joins two consecutive rings by a strip, walking both around the axis and always advancing
-/// the ring whose next vertex comes first (compared exactly, in integers). A one-vertex ring
-/// (a pole) never advances, so the strip becomes a fan. Rings of m and n > 1 vertices give
-/// m + n triangles.
-void stitch(const std::vector<int>& lo, const std::vector<int>& hi, std::vector<Int3>& triangles) {
-    const int m = int(lo.size()), n = int(hi.size());
-    const int lo_steps = m > 1 ? m : 0, hi_steps = n > 1 ? n : 0;
-    for (int i = 0, j = 0; i < lo_steps || j < hi_steps;) {
-        const bool advance_lo = j == hi_steps || (i < lo_steps && (i + 1) * n <= (j + 1) * m);
-        const int a = lo[size_t(i % m)], b = hi[size_t(j % n)];
-        if (advance_lo) {
-            ++i;
-            triangles.push_back({a, b, lo[size_t(i % m)]});
-        } else {
-            ++j;
-            triangles.push_back({a, b, hi[size_t(j % n)]});
-        }
-    }
-}
-
 }  // namespace
 
 TriangleMesh make_pawn(int segments) {
@@ -101,7 +82,7 @@ TriangleMesh make_pawn(int segments) {
     std::vector<std::vector<int>> rings;
     for (size_t i = 0; i < profile.size(); ++i)
         rings.push_back(add_ring(profile[i], slices_at(profile, i, segments), mesh.vertices));
-    for (size_t i = 0; i + 1 < rings.size(); ++i) stitch(rings[i], rings[i + 1], mesh.triangles);
+    for (size_t i = 0; i + 1 < rings.size(); ++i) stitch_rings(rings[i], rings[i + 1], mesh.triangles);
     mesh.content_sha256 = geometry_sha256(mesh);
     return mesh;
 }

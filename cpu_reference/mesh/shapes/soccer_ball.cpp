@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/mesh/shapes/stitch_rings.h"
 
 namespace sdf {
 namespace {
@@ -132,26 +133,6 @@ double ring_scale(const Vec3d& center, const Vec3d& corner, const Vec3d& seam_no
     return inside;
 }
 
-/// Joins two nested rings by a strip, walking both around the panel and always advancing the
-/// ring whose next vertex comes first (compared exactly, in integers). A one-vertex ring (the
-/// centre) never advances, so the strip becomes a fan. Rings of m and n > 1 vertices give
-/// m + n triangles.
-void stitch(const std::vector<int>& lo, const std::vector<int>& hi, std::vector<Int3>& triangles) {
-    const int m = int(lo.size()), n = int(hi.size());
-    const int lo_steps = m > 1 ? m : 0, hi_steps = n > 1 ? n : 0;
-    for (int i = 0, j = 0; i < lo_steps || j < hi_steps;) {
-        const bool advance_lo = j == hi_steps || (i < lo_steps && (i + 1) * n <= (j + 1) * m);
-        const int a = lo[size_t(i % m)], b = hi[size_t(j % n)];
-        if (advance_lo) {
-            ++i;
-            triangles.push_back({a, b, lo[size_t(i % m)]});
-        } else {
-            ++j;
-            triangles.push_back({a, b, hi[size_t(j % n)]});
-        }
-    }
-}
-
 /// Centre, fan grid up to the groove's edge, flank ring, outline; stitched inside out.
 void triangulate_panel(const Polyhedron& p, const std::vector<int>& panel, const EdgeVertices& edges, int n,
                        double half_width, TriangleMesh& mesh) {
@@ -171,7 +152,7 @@ void triangulate_panel(const Polyhedron& p, const std::vector<int>& panel, const
         rings.push_back(inner_ring(outline, center, edge_scale * level / n, level, mesh.vertices));
     rings.push_back(inner_ring(outline, center, flank_scale, n, mesh.vertices));
     rings.push_back(outline_ring(panel, edges));
-    for (size_t r = 0; r + 1 < rings.size(); ++r) stitch(rings[r], rings[r + 1], mesh.triangles);
+    for (size_t r = 0; r + 1 < rings.size(); ++r) stitch_rings(rings[r], rings[r + 1], mesh.triangles);
 }
 
 /// A seam: the great-circle arc between two corners, with the unit normal of its plane.
