@@ -51,7 +51,7 @@ BccFaceTable<T> to_face_table(const BccFaceWeights& w) {
     BccFaceTable<T> t;
     for (int l = 0; l < 4; ++l)
         for (int v = 0; v < 4; ++v)
-            for (int k = 0; k < kBccData; ++k) t.w[l][v][k] = T(w(l, kBccData * v + k));
+            for (int k = 0; k < kBccData; ++k) t.w[v][k][l] = T(w(l, kBccData * v + k));
     return t;
 }
 

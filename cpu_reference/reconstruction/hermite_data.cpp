@@ -119,7 +119,7 @@ HermiteData<T> convert_hermite_data(const HermiteData<double>& d) {
     out.higher_stride = d.higher_stride;
     for (int l = 0; l < 4; ++l)
         for (int v = 0; v < 4; ++v)
-            for (int k = 0; k < kBccData; ++k) out.faces.w[l][v][k] = T(d.faces.w[l][v][k]);
+            for (int k = 0; k < kBccData; ++k) out.faces.w[v][k][l] = T(d.faces.w[v][k][l]);
     return out;
 }
 

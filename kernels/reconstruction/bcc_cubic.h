@@ -61,16 +61,14 @@ SDF_CPU_GPU BccCubicNet<T> bcc_cubic_net(const T data[4][kBccData], const BccFac
             T step = T(0);  // grad f_i . (v_j - v_i)
             for (int a = 0; a < 3; ++a)
                 step += data[i][kDx + a] * T(bcc_reference_vertex(j, a) - bcc_reference_vertex(i, a));
-            net.edge[i][j] = data[i][kDf] + step / T(3);
+            net.edge[i][j] = data[i][kDf] + step * (T(1) / T(3));
         }
     }
     // Face centres: linear in all vertex data through the precomputed table
-    for (int l = 0; l < 4; ++l) {
-        T c = T(0);
-        for (int k = 0; k < 4; ++k)
-            for (int m = 0; m < kBccData; ++m) c += table.w[l][k][m] * data[k][m];
-        net.face[l] = c;
-    }
+    for (int l = 0; l < 4; ++l) net.face[l] = T(0);
+    for (int k = 0; k < 4; ++k)
+        for (int m = 0; m < kBccData; ++m)
+            for (int l = 0; l < 4; ++l) net.face[l] += table.w[k][m][l] * data[k][m];
     return net;
 }
 

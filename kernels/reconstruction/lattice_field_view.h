@@ -31,12 +31,13 @@ enum BccDatum : int { kDf = 0, kDx = 1, kDy = 2, kDz = 3, kDxy = 4, kDxz = 5, kD
 
 /// Weights that give the 4 face-centre Bernstein-Bezier coefficients of the BCC cubic on the
 /// reference tetrahedron as linear combinations of its vertex data:
-///   c_face[l] = sum_v sum_k w[l][v][k] * data[v][k]   (face l is opposite vertex l).
+///   c_face[l] = sum_v sum_k w[v][k][l] * data[v][k]   (face l is opposite vertex l).
 /// Filled on the host (bcc_cubic_tables.h): thesis eq. 4-9 for bcc_cubic, a face-local
-/// least-squares fit for bcc_cubic_c0. POD, passed by value (1.3 KB in double).
+/// least-squares fit for bcc_cubic_c0. POD, passed by value (1.3 KB in double). The face
+/// index runs fastest so the 4 sums advance together (one SIMD lane each).
 template <typename T>
 struct BccFaceTable {
-    T w[4][4][kBccData];
+    T w[4][kBccData][4];  ///< [vertex][datum][face]
 };
 
 template <typename T>
