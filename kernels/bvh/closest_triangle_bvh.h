@@ -1,0 +1,125 @@
+/// @file closest_triangle_bvh.h
+/// @brief The exact nearest-triangle query over a BVH, written once for host and device.
+///
+/// Ordered depth-first traversal with a shrinking radius, the closest-point form of the
+/// nearest-neighbour search of Friedman, Bentley & Finkel, "An Algorithm for Finding Best
+/// Matches in Logarithmic Expected Time" (ACM TOMS 1977) on the node layout of Aila & Laine
+/// (2009): at every node both child boxes are measured, the nearer child is entered first,
+/// the farther one is kept on a small fixed stack with its box distance, and an entry is
+/// dropped when it is popped if the best squared distance found so far (the radius) has
+/// shrunk below it. Leaves are scanned with the same branch-free squared_distance() as the
+/// brute-force samplers.
+///
+/// Exactness. A subtree is skipped only when its box, which contains every one of its
+/// triangles, is at least as far as the best triangle so far, so no triangle that could be
+/// strictly nearer is skipped: the result is the brute-force minimum of squared_distance()
+/// (up to ties, and in float up to the rounding of the box and triangle distances, which
+/// brute force shares). A query may be seeded with any triangle (e.g. the winner of a
+/// neighbouring lattice point): its distance is a true upper bound, so the seed only
+/// shrinks the initial radius and never changes which distance is found.
+#pragma once
+
+#include <limits>
+
+#include "kernels/bvh/aabb_distance.h"
+#include "kernels/bvh/bvh_view.h"
+
+namespace sdf {
+
+/// The nearest triangle found so far: its BVH slot and squared_distance().
+template <typename T>
+struct BvhHit {
+    int32_t slot = -1;
+    T distance_squared = std::numeric_limits<T>::infinity();
+};
+
+/// Counting hooks for the CPU statistics; the default counts nothing and compiles away.
+struct NoBvhStats {
+    SDF_CPU_GPU void visit_node() {}
+    SDF_CPU_GPU void test_triangles(int) {}
+};
+
+struct BvhStats {
+    int64_t nodes = 0, triangles = 0;
+    SDF_CPU_GPU void visit_node() { ++nodes; }
+    SDF_CPU_GPU void test_triangles(int n) { triangles += n; }
+};
+
+/// A starting hit from triangle `slot` (BVH order), e.g. a neighbour's winner.
+template <typename T>
+SDF_CPU_GPU SDF_INLINE BvhHit<T> seed_hit(const BvhView<T>& bvh, int32_t slot, const Vec3<T>& p) {
+    BvhHit<T> h;
+    if (slot >= 0) {
+        h.slot = slot;
+        h.distance_squared = squared_distance(bvh.packed[slot], p);
+    }
+    return h;
+}
+
+/// Scans leaf triangles [first, first + count) and keeps the nearest in `best`.
+template <typename T>
+SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int32_t count, const Vec3<T>& p,
+                                      BvhHit<T>& best) {
+    for (int32_t j = first; j < first + count; ++j) {
+        const T q = squared_distance(bvh.packed[j], p);
+        if (q < best.distance_squared) {
+            best.distance_squared = q;
+            best.slot = j;
+        }
+    }
+}
+
+/// Nearest triangle to p, starting from `best` (an empty hit or a seed).
+template <typename T, typename Stats>
+SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats) {
+    int32_t stack_node[kBvhMaxDepth];
+    T stack_d2[kBvhMaxDepth];
+    int top = 0;
+    int32_t node = 0;
+    while (node >= 0) {
+        stats.visit_node();
+        const BvhNode n = bvh.nodes[node];
+        const T d0 = child_box_distance_squared(n, 0, p), d1 = child_box_distance_squared(n, 1, p);
+        const int near = d1 < d0 ? 1 : 0;
+        const T d_near = near ? d1 : d0, d_far = near ? d0 : d1;
+        int32_t next = -1;
+        // Nearer child first: scanning a leaf shrinks the radius before the farther test.
+        if (d_near < best.distance_squared) {
+            if (bvh_child_is_leaf(n, near)) {
+                stats.test_triangles(n.count[near]);
+                scan_leaf(bvh, n.ref[near], n.count[near], p, best);
+            } else {
+                next = n.ref[near];
+            }
+        }
+        if (d_far < best.distance_squared) {
+            const int far = 1 - near;
+            if (bvh_child_is_leaf(n, far)) {
+                stats.test_triangles(n.count[far]);
+                scan_leaf(bvh, n.ref[far], n.count[far], p, best);
+            } else if (next < 0) {
+                next = n.ref[far];
+            } else {
+                SDF_DCHECK(top < kBvhMaxDepth);
+                stack_node[top] = n.ref[far];
+                stack_d2[top] = d_far;
+                ++top;
+            }
+        }
+        // Pop the next subtree still inside the (shrunken) radius.
+        while (next < 0 && top > 0) {
+            --top;
+            if (stack_d2[top] < best.distance_squared) next = stack_node[top];
+        }
+        node = next;
+    }
+    return best;
+}
+
+template <typename T>
+SDF_CPU_GPU SDF_INLINE BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best = {}) {
+    NoBvhStats none;
+    return closest_triangle_bvh(bvh, p, best, none);
+}
+
+}  // namespace sdf

@@ -1,0 +1,122 @@
+// The CPU BVH sampler equals the CPU brute-force sampler on every test mesh (sphere, box,
+// torus, pawn, soccer ball, a sphere of tiny and sliver triangles, a slab of large flat
+// faces, bunny and dragon when present), on CC and BCC lattices and random points, in float
+// and double: the same triangle gives the same distance, sign and gradient to 1e-12; any
+// other triangle must be a tie (checked with the exact distances to both).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+
+namespace sdf {
+namespace {
+
+SamplerOptions options(Precision precision, const std::string& kernel = "", int threads = 0,
+                       BccStrategy strategy = BccStrategy::TwoGrids) {
+    SamplerOptions o;
+    o.precision = precision;
+    o.kernel = kernel;
+    o.threads = threads;
+    o.bcc_strategy = strategy;
+    o.progress = false;
+    return o;
+}
+
+std::vector<Vec3d> random_points_around(const PreparedMesh& mesh, int n, unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-0.75, 0.75);
+    const Vec3d c = mesh.bounds.center(), e = mesh.bounds.extent();
+    std::vector<Vec3d> pts(static_cast<size_t>(n));
+    for (auto& p : pts) p = c + component_mul(e, Vec3d{u(rng), u(rng), u(rng)});
+    return pts;
+}
+
+void print(const std::string& what, const test::Agreement& a, const PreparedMesh& mesh) {
+    std::printf("%-40s %7lld points: max|dd| = %.3g (%.2g of diag), triangle ties %lld, sign ties %lld\n", what.c_str(),
+                (long long)a.points, a.max_abs_distance, a.max_abs_distance / mesh.bounds.diagonal(),
+                (long long)a.triangle_ties, (long long)a.sign_ties);
+}
+
+TEST(CpuBvh, EqualsBruteForceOnLatticesOfEveryMesh) {
+    for (const test::NamedMesh& m : test::bvh_test_meshes()) {
+        const bool big = m.mesh.triangles.size() > 20000;
+        for (Precision precision : {Precision::Float, Precision::Double}) {
+            // Brute force in double on 100k triangles is the slow part: smaller lattices there.
+            const int r = big ? (precision == Precision::Double ? 10 : 14) : 24;
+            const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds, 0.1);
+            const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds, 0.1);
+            for (const Lattice& lattice : {cc, bcc}) {
+                const SampledField brute = make_cpu_brute_force_sampler(options(precision))->sample(m.mesh, lattice);
+                const SampledField bvh = make_cpu_bvh_sampler(options(precision))->sample(m.mesh, lattice);
+                test::FieldComparer cmp(m.mesh, test::epsilon_of(precision));
+                const std::string what = m.name + " " + lattice_notation(lattice) + " " + precision_name(precision);
+                cmp.fields(brute, bvh, what);
+                if (HasFatalFailure()) return;
+                print(what, cmp.agreement(), m.mesh);
+                EXPECT_EQ(bvh.sampler["method"], "bvh");
+            }
+        }
+    }
+}
+
+TEST(CpuBvh, EqualsBruteForceOnRandomPoints) {
+    for (const test::NamedMesh& m : test::bvh_test_meshes()) {
+        const bool big = m.mesh.triangles.size() > 20000;
+        const auto pts = random_points_around(m.mesh, big ? 1500 : 5000, 17);
+        for (Precision precision : {Precision::Float, Precision::Double}) {
+            if (big && precision == Precision::Double) continue;  // covered on lattices above
+            const auto brute = make_cpu_brute_force_sampler(options(precision))->query(m.mesh, pts);
+            for (const char* kernel : {"seeded", "unseeded"}) {
+                const auto bvh = make_cpu_bvh_sampler(options(precision, kernel))->query(m.mesh, pts);
+                test::FieldComparer cmp(m.mesh, test::epsilon_of(precision));
+                const std::string what = m.name + " random " + precision_name(precision) + " " + kernel;
+                cmp.samples(pts, brute, bvh, what);
+                if (HasFatalFailure()) return;
+                print(what, cmp.agreement(), m.mesh);
+            }
+        }
+    }
+}
+
+TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
+    const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {17, 18, 19}, mesh.bounds, 0.1);
+    const SampledField two = make_cpu_bvh_sampler(options(Precision::Float, "", 1))->sample(mesh, lattice);
+    const SampledField two_threads = make_cpu_bvh_sampler(options(Precision::Float, "", 2))->sample(mesh, lattice);
+    const SampledField doubled =
+        make_cpu_bvh_sampler(options(Precision::Float, "", 0, BccStrategy::DoubleResolution))->sample(mesh, lattice);
+    EXPECT_EQ(two.distance, two_threads.distance);
+    EXPECT_EQ(two.closest_triangle, two_threads.closest_triangle);
+    // Strategy A sees the same points in another order (other seeds): equal up to ties.
+    test::FieldComparer cmp(mesh, test::epsilon_of(Precision::Float));
+    cmp.fields(two, doubled, "soccer ball BCC strategies");
+}
+
+TEST(CpuBvh, SeededAndUnseededAgreeAndSeedingSavesWork) {
+    const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
+    const Lattice lattice = fit_lattice(LatticeType::CC, {32, 32, 32}, mesh.bounds, 0.1);
+    const SampledField seeded = make_cpu_bvh_sampler(options(Precision::Float, "seeded"))->sample(mesh, lattice);
+    const SampledField unseeded = make_cpu_bvh_sampler(options(Precision::Float, "unseeded"))->sample(mesh, lattice);
+    test::FieldComparer cmp(mesh, test::epsilon_of(Precision::Float));
+    cmp.fields(unseeded, seeded, "pawn seeded vs unseeded");
+    const double work_seeded = seeded.sampler["bvh"]["node_visits_per_point"].get<double>();
+    const double work_unseeded = unseeded.sampler["bvh"]["node_visits_per_point"].get<double>();
+    std::printf("pawn 32^3: node visits per point %.2f seeded, %.2f unseeded\n", work_seeded, work_unseeded);
+    EXPECT_LT(work_seeded, work_unseeded);
+}
+
+TEST(CpuBvh, RejectsUnknownKernelsByName) {
+    try {
+        make_cpu_bvh_sampler(options(Precision::Float, "vectorized"));
+        FAIL() << "a brute-force kernel name must be rejected";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("vectorized"), std::string::npos);
+    }
+}
+
+}  // namespace
+}  // namespace sdf

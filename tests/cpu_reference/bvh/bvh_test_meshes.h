@@ -1,0 +1,225 @@
+/// @file bvh_test_meshes.h
+/// @brief The meshes the BVH is checked on (CPU and GPU tests) and the comparison of a BVH
+/// field with the brute-force field: the procedural shapes, a sphere full of tiny and
+/// sliver triangles, a slab with large flat faces, and bunny/dragon when SDF_DATA_PATH has
+/// them.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "cpu_reference/mesh/load_obj.h"
+#include "cpu_reference/mesh/prepared_mesh.h"
+#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/sampling/sampler.h"
+#include "kernels/distance/closest_point_on_triangle.h"
+
+namespace sdf::test {
+
+/// Icosphere whose every triangle is split at a point very near one of its vertices (one
+/// tiny triangle and two slivers) or very near an edge (two slivers of almost zero area).
+/// Stays closed and manifold: the new vertex is inside the old triangle.
+inline TriangleMesh make_sliver_sphere(int subdivisions = 3) {
+    TriangleMesh m = make_icosphere(subdivisions);
+    std::vector<Int3> out;
+    const double e = 1e-4;
+    for (size_t i = 0; i < m.triangles.size(); ++i) {
+        const Int3 t = m.triangles[i];
+        const Vec3d a = m.vertices[size_t(t.x)], b = m.vertices[size_t(t.y)], c = m.vertices[size_t(t.z)];
+        const Vec3d p = i % 2 == 0 ? a * (1 - 2 * e) + b * e + c * e                  // near a vertex
+                                   : a * (0.5 - e) + b * (0.5 - e) + c * (2 * e);  // near an edge
+        const int v = int(m.vertices.size());
+        m.vertices.push_back(p);
+        out.push_back({t.x, t.y, v});
+        out.push_back({t.y, t.z, v});
+        out.push_back({t.z, t.x, v});
+    }
+    m.triangles = out;
+    m.name = "sliver_sphere";
+    return m;
+}
+
+/// Box of half extents `half` with every face cut into a grid of squares of side about
+/// `cell` (2 triangles each): large coplanar regions, many equal box distances.
+inline TriangleMesh make_flat_slab(Vec3d half = {4.0, 4.0, 0.5}, double cell = 0.25) {
+    TriangleMesh m;
+    m.name = "flat_slab";
+    std::map<std::tuple<long, long, long>, int> ids;  // vertices shared along the box edges
+    const int n[3] = {int(std::lround(2 * half.x / cell)), int(std::lround(2 * half.y / cell)),
+                      int(std::lround(2 * half.z / cell))};
+    auto vertex = [&](int i, int j, int k) {
+        const auto key = std::make_tuple(long(i), long(j), long(k));
+        auto it = ids.find(key);
+        if (it != ids.end()) return it->second;
+        const Vec3d p{-half.x + 2 * half.x * i / n[0], -half.y + 2 * half.y * j / n[1], -half.z + 2 * half.z * k / n[2]};
+        m.vertices.push_back(p);
+        return ids[key] = int(m.vertices.size()) - 1;
+    };
+    // Face with normal +-axis a; (u, v) run over the other two axes, ordered so that the
+    // triangles are counter-clockwise seen from outside.
+    for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+            const int u = (a + 1) % 3, v = (a + 2) % 3;
+            for (int i = 0; i < n[u]; ++i)
+                for (int j = 0; j < n[v]; ++j) {
+                    int c[4][3];
+                    const int corner[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+                    for (int q = 0; q < 4; ++q) {
+                        c[q][a] = side * n[a];
+                        c[q][u] = corner[q][0];
+                        c[q][v] = corner[q][1];
+                    }
+                    int id[4];
+                    for (int q = 0; q < 4; ++q) id[q] = vertex(c[q][0], c[q][1], c[q][2]);
+                    if (side == 1) {
+                        m.triangles.push_back({id[0], id[1], id[2]});
+                        m.triangles.push_back({id[0], id[2], id[3]});
+                    } else {
+                        m.triangles.push_back({id[0], id[2], id[1]});
+                        m.triangles.push_back({id[0], id[3], id[2]});
+                    }
+                }
+        }
+    return m;
+}
+
+/// Finds `file` in the colon-separated SDF_DATA_PATH (set by ctest); empty if absent.
+inline std::string find_data_file(const std::string& file) {
+    const char* env = std::getenv("SDF_DATA_PATH");
+    std::stringstream dirs(env ? env : "");
+    for (std::string dir; std::getline(dirs, dir, ':');)
+        if (!dir.empty() && std::ifstream(dir + "/" + file).good()) return dir + "/" + file;
+    return {};
+}
+
+struct NamedMesh {
+    std::string name;
+    PreparedMesh mesh;
+};
+
+/// Every BVH test mesh, prepared once; bunny and dragon only when the data path has them.
+inline const std::vector<NamedMesh>& bvh_test_meshes() {
+    static const std::vector<NamedMesh> meshes = [] {
+        std::vector<NamedMesh> m;
+        m.push_back({"sphere", prepare_mesh(make_icosphere(4))});
+        m.push_back({"box", prepare_mesh(make_box({1, 0.5, 0.75}))});
+        m.push_back({"torus", prepare_mesh(make_torus())});
+        m.push_back({"pawn", prepare_mesh(make_pawn())});
+        m.push_back({"soccer_ball", prepare_mesh(make_soccer_ball())});
+        m.push_back({"sliver_sphere", prepare_mesh(make_sliver_sphere())});
+        m.push_back({"flat_slab", prepare_mesh(make_flat_slab())});
+        for (const char* file : {"bunny.obj", "dragon.obj"}) {
+            const std::string path = find_data_file(file);
+            if (path.empty()) std::printf("note: %s not in SDF_DATA_PATH: skipped\n", file);
+            else m.push_back({file, prepare_mesh(load_obj(path))});
+        }
+        return m;
+    }();
+    return meshes;
+}
+
+/// Prepared-mesh index of each file-order triangle index.
+inline std::vector<int> prepared_index(const PreparedMesh& m) {
+    std::vector<int> inverse(size_t(m.report.input_triangles), -1);
+    for (size_t i = 0; i < m.source_triangle.size(); ++i) inverse[size_t(m.source_triangle[i])] = int(i);
+    return inverse;
+}
+
+inline double exact_distance_to(const PreparedMesh& m, const Vec3d& p, int prepared) {
+    const Int3 t = m.triangles[size_t(prepared)];
+    return std::sqrt(closest_point_on_triangle(p, m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
+                                               m.vertices[size_t(t.z)]).distance_squared);
+}
+
+inline double longest_edge(const PreparedMesh& m) {
+    double e = 0;
+    for (const Int3& t : m.triangles)
+        for (int k = 0; k < 3; ++k)
+            e = std::max(e, length(m.vertices[size_t(t[k])] - m.vertices[size_t(t[(k + 1) % 3])]));
+    return e;
+}
+
+struct Agreement {
+    int64_t points = 0, triangle_ties = 0, sign_ties = 0;
+    double max_abs_distance = 0;
+};
+
+/// Compares a BVH result with the brute-force result point by point. Where both found the
+/// same triangle, the final double evaluation is the same code on the same input: distance,
+/// sign and gradient must agree to double rounding (`rel` relative). Where they differ, it
+/// must be a tie: the two triangles' exact distances agree within the search rounding of
+/// precision `eps` (squared distances carry about eps (|d| + longest edge)^2, see
+/// packed_triangle.h), and a sign may differ only on the surface.
+class FieldComparer {
+public:
+    FieldComparer(const PreparedMesh& mesh, double eps, double rel = 1e-12)
+        : mesh_(mesh), index_(prepared_index(mesh)), edge_(longest_edge(mesh)), eps_(eps), rel_(rel) {}
+
+    void point(const Vec3d& p, double d_brute, double d_bvh, const Vec3d& g_brute, const Vec3d& g_bvh, int t_brute,
+               int t_bvh, const std::string& what) {
+        ++a_.points;
+        a_.max_abs_distance = std::max(a_.max_abs_distance, std::abs(d_brute - d_bvh));
+        const double scale = std::abs(d_brute) + edge_;
+        // Float positions move both candidates by up to eps |p|: add that to the bound.
+        const double tol_q = 64 * eps_ * scale * (scale + length(p));
+        if (t_brute == t_bvh) {
+            ASSERT_NEAR(d_bvh, d_brute, rel_ * std::max(std::abs(d_brute), 1e-300)) << what;
+            ASSERT_LE(length(g_bvh - g_brute), 1e-12 * (1 + length(p) / std::max(std::abs(d_brute), 1e-300))) << what;
+            return;
+        }
+        ++a_.triangle_ties;
+        const double e_brute = exact_distance_to(mesh_, p, index_[size_t(t_brute)]);
+        const double e_bvh = exact_distance_to(mesh_, p, index_[size_t(t_bvh)]);
+        ASSERT_LE(std::abs(e_bvh * e_bvh - e_brute * e_brute), tol_q)
+            << what << ": triangles " << t_brute << " (brute) and " << t_bvh << " (bvh) are no tie";
+        ASSERT_NEAR(std::abs(d_bvh), e_bvh, 1e-12 * scale) << what;
+        if ((d_brute < 0) != (d_bvh < 0)) {
+            ++a_.sign_ties;
+            ASSERT_LE(std::abs(d_brute), std::sqrt(tol_q)) << what << ": sign differs off the surface";
+        }
+    }
+
+    void fields(const SampledField& brute, const SampledField& bvh, const std::string& what) {
+        ASSERT_EQ(brute.size(), bvh.size()) << what;
+        for (int64_t i = 0; i < brute.size(); ++i) {
+            const size_t k = size_t(i);
+            point(brute.lattice.position(i), brute.distance[k], bvh.distance[k], brute.gradient[k], bvh.gradient[k],
+                  brute.closest_triangle[k], bvh.closest_triangle[k], what + " point " + std::to_string(i));
+            if (::testing::Test::HasFatalFailure()) return;
+        }
+    }
+
+    void samples(const std::vector<Vec3d>& pts, const std::vector<PointSample>& brute, const std::vector<PointSample>& bvh,
+                 const std::string& what) {
+        ASSERT_EQ(brute.size(), bvh.size()) << what;
+        for (size_t i = 0; i < pts.size(); ++i) {
+            point(pts[i], brute[i].distance, bvh[i].distance, brute[i].gradient, bvh[i].gradient, brute[i].triangle,
+                  bvh[i].triangle, what + " point " + std::to_string(i));
+            if (::testing::Test::HasFatalFailure()) return;
+        }
+    }
+
+    const Agreement& agreement() const { return a_; }
+
+private:
+    const PreparedMesh& mesh_;
+    std::vector<int> index_;
+    double edge_, eps_, rel_;
+    Agreement a_;
+};
+
+inline double epsilon_of(Precision p) {
+    return p == Precision::Float ? double(std::numeric_limits<float>::epsilon()) : std::numeric_limits<double>::epsilon();
+}
+
+}  // namespace sdf::test
