@@ -1,0 +1,144 @@
+#include "cpu_reference/raycast/views.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace sdf {
+namespace {
+
+struct NamedView {
+    const char* name;
+    Vec3d direction;  ///< from the target towards the eye
+    Vec3d up;
+};
+
+// Directions need not be unit length; they are normalised when used.
+const NamedView kNamedViews[] = {
+    {"front", {0, 0, 1}, {0, 1, 0}},
+    {"back", {0, 0, -1}, {0, 1, 0}},
+    {"side", {1, 0, 0}, {0, 1, 0}},
+    {"right", {1, 0, 0}, {0, 1, 0}},
+    {"left", {-1, 0, 0}, {0, 1, 0}},
+    {"top", {0, 1, 0}, {0, 0, -1}},
+    {"bottom", {0, -1, 0}, {0, 0, 1}},
+    {"three_quarter", {0.61237243569579, 0.5, 0.61237243569579}, {0, 1, 0}},  // az 45, el 30
+    {"dragon_side", {0, 0, 1}, {0, 1, 0}},
+    {"dragon_front", {0.93, 0.26, 0.26}, {0, 1, 0}},
+};
+
+const NamedView& find_named_view(const std::string& name) {
+    for (const NamedView& v : kNamedViews)
+        if (name == v.name) return v;
+    std::string known;
+    for (const NamedView& v : kNamedViews) known += std::string(known.empty() ? "" : ", ") + v.name;
+    throw std::invalid_argument("view '" + name + "': unknown view name; expected one of " + known +
+                                " or an explicit camera (eye, target, up, fov)");
+}
+
+std::string vec_text(const Vec3d& v) {
+    std::ostringstream s;
+    s << "[" << v.x << ", " << v.y << ", " << v.z << "]";
+    return s.str();
+}
+
+void check_size_and_fov(const std::string& view, int width, int height, double fov) {
+    if (width < 1 || height < 1)
+        throw std::invalid_argument("view '" + view + "': image size " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " is not positive");
+    if (!(fov > 0 && fov < 180))
+        throw std::invalid_argument("view '" + view + "': fov " + std::to_string(fov) +
+                                    " degrees is outside (0, 180)");
+}
+
+/// Distance from the centre of `bounds` along `direction` at which its corners fit the image.
+double fitted_distance(const Bounds3& bounds, const Vec3d& direction, const Vec3d& up, double fov_y_degrees,
+                       double aspect, double margin) {
+    const Vec3d back = normalize_or_zero(direction);
+    const Vec3d right = normalize_or_zero(cross(-back, up));
+    const Vec3d true_up = cross(right, -back);
+    const double fill = std::max(1e-3, 1.0 - 2.0 * margin);
+    const double tan_y = std::tan(fov_y_degrees * M_PI / 360.0) * fill;
+    const double tan_x = tan_y * aspect;
+    const Vec3d centre = bounds.center();
+    double distance = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3d c{corner & 1 ? bounds.max.x : bounds.min.x, corner & 2 ? bounds.max.y : bounds.min.y,
+                      corner & 4 ? bounds.max.z : bounds.min.z};
+        const Vec3d q = c - centre;
+        const double z = dot(q, back);  // towards the eye
+        distance = std::max({distance, z + std::abs(dot(q, right)) / tan_x, z + std::abs(dot(q, true_up)) / tan_y});
+    }
+    // A flat or point-like box still needs a positive distance
+    return std::max(distance, 1e-6 * std::max(1.0, bounds.diagonal()));
+}
+
+}  // namespace
+
+std::vector<std::string> named_view_names() {
+    std::vector<std::string> names;
+    for (const NamedView& v : kNamedViews) names.emplace_back(v.name);
+    return names;
+}
+
+bool is_named_view(const std::string& name) {
+    for (const NamedView& v : kNamedViews)
+        if (name == v.name) return true;
+    return false;
+}
+
+ViewRequest named_view(const std::string& name) {
+    find_named_view(name);  // throws for unknown names
+    ViewRequest r;
+    r.name = name;
+    return r;
+}
+
+CameraSpec resolve_view(const ViewRequest& request, const Bounds3& bounds, int width, int height) {
+    check_size_and_fov(request.name, width, height, request.fov_y_degrees);
+    CameraSpec c;
+    c.name = request.name;
+    c.fov_y_degrees = request.fov_y_degrees;
+    c.width = width;
+    c.height = height;
+    if (request.explicit_camera) {
+        c.eye = request.eye;
+        c.target = request.target;
+        c.up = request.up;
+    } else {
+        if (bounds.empty()) throw std::invalid_argument("view '" + request.name + "': the bounds to fit are empty");
+        if (!(request.margin >= 0 && request.margin < 0.5))
+            throw std::invalid_argument("view '" + request.name + "': margin " + std::to_string(request.margin) +
+                                        " is outside [0, 0.5)");
+        const NamedView& v = find_named_view(request.name);
+        const double d = fitted_distance(bounds, v.direction, v.up, request.fov_y_degrees, double(width) / height,
+                                         request.margin);
+        c.target = bounds.center();
+        c.eye = c.target + normalize_or_zero(v.direction) * d;
+        c.up = v.up;
+    }
+    make_camera(c);  // validates
+    return c;
+}
+
+PinholeCamera<double> make_camera(const CameraSpec& spec) {
+    check_size_and_fov(spec.name, spec.width, spec.height, spec.fov_y_degrees);
+    const Vec3d forward = spec.target - spec.eye;
+    if (!(length(forward) > 0))
+        throw std::invalid_argument("view '" + spec.name + "': eye " + vec_text(spec.eye) + " equals target " +
+                                    vec_text(spec.target));
+    if (!(length(cross(normalize_or_zero(forward), normalize_or_zero(spec.up))) > 1e-6))
+        throw std::invalid_argument("view '" + spec.name + "': up " + vec_text(spec.up) +
+                                    " is zero or parallel to the view direction " + vec_text(forward));
+    return make_look_at_camera(spec.eye, spec.target, spec.up, spec.fov_y_degrees, spec.width, spec.height);
+}
+
+nlohmann::json camera_to_json(const CameraSpec& spec) {
+    auto v = [](const Vec3d& p) { return nlohmann::json::array({p.x, p.y, p.z}); };
+    return {{"name", spec.name},          {"eye", v(spec.eye)},
+            {"target", v(spec.target)},   {"up", v(spec.up)},
+            {"fov_y_degrees", spec.fov_y_degrees}, {"size", {spec.width, spec.height}}};
+}
+
+}  // namespace sdf
