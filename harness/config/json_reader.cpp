@@ -28,7 +28,11 @@ nlohmann::json read_json_file(const std::string& path) {
 }
 
 JsonReader::JsonReader(const nlohmann::json& value, std::string file, std::string path)
-    : value_(value), file_(std::move(file)), path_(std::move(path)) {
+    : JsonReader(value, std::move(file), std::move(path), nullptr, nlohmann::json::json_pointer()) {}
+
+JsonReader::JsonReader(const nlohmann::json& value, std::string file, std::string path,
+                       std::shared_ptr<nlohmann::json> resolved, nlohmann::json::json_pointer where)
+    : value_(value), file_(std::move(file)), path_(std::move(path)), resolved_(std::move(resolved)), where_(std::move(where)) {
     if (!value_.is_object())
         throw ConfigError(file_ + ": " + (path_.empty() ? std::string("the config") : "key '" + path_ + "'") +
                           ": expected a JSON object, got " + value_.dump());
@@ -36,12 +40,16 @@ JsonReader::JsonReader(const nlohmann::json& value, std::string file, std::strin
 
 bool JsonReader::has(const std::string& key) const {
     // Every key asked about is a valid key here, present or not (for "did you mean").
-    if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
+    accept(key);
     return value_.contains(key);
 }
 
+void JsonReader::accept(const std::string& key) const {
+    if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
+}
+
 const nlohmann::json& JsonReader::raw(const std::string& key) {
-    if (!has(key)) fail(key, "missing");
+    if (!has(key)) fail_missing(key, "");
     return value_.at(key);
 }
 
@@ -49,6 +57,29 @@ std::string JsonReader::key_path(const std::string& key) const { return path_.em
 
 void JsonReader::fail(const std::string& key, const std::string& message) const {
     throw ConfigError(file_ + ": key '" + key_path(key) + "': " + message);
+}
+
+void JsonReader::fail_missing(const std::string& key, const std::string& expected) const {
+    // A present key nobody has asked about that is close to `key` is most likely a typo of it.
+    std::vector<std::string> unknown;
+    for (const auto& [k, v] : value_.items())
+        if (std::find(known_.begin(), known_.end(), k) == known_.end()) unknown.push_back(k);
+    std::string hint;
+    for (const auto& k : unknown)
+        if (nearest_match(k, {key}) == key) {
+            hint = "; the config has an unknown key '" + key_path(k) + "': did you mean '" + key + "'?";
+            break;
+        }
+    fail(key, "missing" + (expected.empty() ? std::string() : "; expected " + expected) + hint);
+}
+
+void JsonReader::record(const std::string& key, const nlohmann::json& value) const {
+    if (resolved_) (*resolved_)[where_ / key] = value;
+}
+
+JsonReader JsonReader::child(const nlohmann::json& v, const std::string& path,
+                             const nlohmann::json::json_pointer& where) const {
+    return JsonReader(v, file_, path, resolved_, where);
 }
 
 std::string JsonReader::choice(const std::string& key, const std::vector<std::string>& choices,
@@ -65,19 +96,30 @@ std::string JsonReader::choice(const std::string& key, const std::vector<std::st
 }
 
 JsonReader JsonReader::object(const std::string& key) {
+    if (!has(key)) fail_missing(key, "a JSON object");
     const nlohmann::json& v = raw(key);
     if (!v.is_object()) fail(key, "expected a JSON object, got " + v.dump());
-    return JsonReader(v, file_, key_path(key));
+    if (resolved_ && !resolved_->contains(where_ / key)) (*resolved_)[where_ / key] = v;
+    return child(v, key_path(key), where_ / key);
+}
+
+JsonReader JsonReader::optional_object(const std::string& key) {
+    static const nlohmann::json empty = nlohmann::json::object();
+    if (has(key)) return object(key);
+    if (resolved_ && !resolved_->contains(where_ / key)) (*resolved_)[where_ / key] = nlohmann::json::object();
+    return child(empty, key_path(key), where_ / key);
 }
 
 std::vector<JsonReader> JsonReader::objects(const std::string& key) {
+    if (!has(key)) fail_missing(key, "an array of objects");
     const nlohmann::json& v = raw(key);
     if (!v.is_array()) fail(key, "expected an array of objects, got " + v.dump());
+    if (resolved_ && !resolved_->contains(where_ / key)) (*resolved_)[where_ / key] = v;
     std::vector<JsonReader> out;
     for (size_t i = 0; i < v.size(); ++i) {
         const std::string p = key_path(key) + "[" + std::to_string(i) + "]";
         if (!v[i].is_object()) throw ConfigError(file_ + ": key '" + p + "': expected an object, got " + v[i].dump());
-        out.emplace_back(v[i], file_, p);
+        out.push_back(child(v[i], p, where_ / key / i));
     }
     return out;
 }
