@@ -1,22 +1,51 @@
 #include "harness/config/sampler_spec.h"
 
+#include <algorithm>
+
+#include "harness/sampling/make_sampler.h"
+
 namespace sdf {
+
+std::vector<std::string> sampler_kernel_names(const std::string& backend) {
+    if (backend == "cpu") return {"vectorized", "eberly"};
+    if (backend == "cuda") return {"tuned", "thesis"};
+    return {};
+}
 
 SamplerOptions parse_sampler_options(JsonReader& r) {
     SamplerOptions o;
-    o.backend = r.choice("backend", {"cpu", "cuda"}, "cpu");
-    o.method = r.choice("method", {"brute_force", "bvh"}, "brute_force");
-    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: thesis, tuned)");
+    const std::string backend = r.choice("backend", {"cpu", "cuda", "auto"}, "cpu");
+    o.backend = backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : backend;
+    // "bvh" is not implemented yet; the BVH work adds it back here.
+    o.method = r.choice("method", {"brute_force"}, "brute_force");
+    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis)");
+    const std::vector<std::string> kernels = sampler_kernel_names(o.backend);
+    if (backend == "auto" && !o.kernel.empty())
+        r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +
+                             "\": name the backend to choose a kernel");
+    if (!o.kernel.empty() && std::find(kernels.begin(), kernels.end(), o.kernel) == kernels.end()) {
+        std::string list;
+        for (const auto& k : kernels) list += (list.empty() ? "\"" : ", \"") + k + "\"";
+        const std::string near = nearest_match(o.kernel, kernels);
+        r.fail("kernel", "unknown " + o.backend + " kernel \"" + o.kernel + "\"; expected one of " + list +
+                             (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+    }
     o.threads = r.optional<int>("threads", 0, "a thread count (0 = all cores)");
-    if (o.threads < 0) r.fail("threads", "expected 0 (all cores) or a positive count");
+    if (o.threads < 0) r.fail("threads", "expected 0 (all cores) or a positive count, got " + std::to_string(o.threads));
     o.precision = r.choice("precision", {"float", "double"}, "float") == "float" ? Precision::Float : Precision::Double;
     o.bcc_strategy = r.choice("bcc_strategy", {"two_grids", "double_resolution"}, "two_grids") == "two_grids"
                          ? BccStrategy::TwoGrids
                          : BccStrategy::DoubleResolution;
     o.progress = r.optional<bool>("progress", true, "true or false");
     o.device = r.optional<int>("device", 0, "a CUDA device ordinal");
+    if (o.device < 0) r.fail("device", "expected a CUDA device ordinal >= 0, got " + std::to_string(o.device));
     o.max_points_per_piece = r.optional<int64_t>("max_points_per_piece", 0, "a point count (0 = automatic)");
+    if (o.max_points_per_piece < 0)
+        r.fail("max_points_per_piece", "expected 0 (automatic) or a positive count, got " + std::to_string(o.max_points_per_piece));
     o.max_triangles_per_chunk = r.optional<int>("max_triangles_per_chunk", 0, "a triangle count (0 = automatic)");
+    if (o.max_triangles_per_chunk < 0)
+        r.fail("max_triangles_per_chunk",
+               "expected 0 (automatic) or a positive count, got " + std::to_string(o.max_triangles_per_chunk));
     o.points_per_thread = r.optional<int>("points_per_thread", 0, "1, 2, 4 or 8 (0 = automatic)");
     if (o.points_per_thread != 0 && o.points_per_thread != 1 && o.points_per_thread != 2 && o.points_per_thread != 4 &&
         o.points_per_thread != 8)

@@ -1,15 +1,28 @@
 /// @file sampler_spec.h
 /// @brief The "sampler" object of a config:
-///   {"backend": "cpu" | "cuda", "method": "brute_force", "kernel": "...",
-///    "threads": 0, "precision": "float" | "double", "bcc_strategy": "two_grids" | "double_resolution"}
+///   {"backend": "cpu" | "cuda" | "auto", "method": "brute_force", "kernel": "...",
+///    "threads": 0, "precision": "float" | "double", "bcc_strategy": "two_grids" | "double_resolution",
+///    "progress": true, "device": 0, "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
+///    "points_per_thread": 0}
+/// Kernels per backend: cpu "vectorized" (default) | "eberly"; cuda "tuned" (default) |
+/// "thesis". "auto" is cuda when this build has the CUDA backend and a GPU is present, else
+/// cpu (it takes no "kernel"); the choice is made when the config is read.
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include "cpu_reference/sampling/sampler.h"
 #include "harness/config/json_reader.h"
 
 namespace sdf {
 
+/// Reads and validates the sampler object (kernel names per backend included) and calls
+/// r.finish(). "auto" is resolved here.
 SamplerOptions parse_sampler_options(JsonReader& r);
 nlohmann::json sampler_options_to_json(const SamplerOptions& o);
+
+/// The kernels a backend accepts ("" = its default is always accepted too).
+std::vector<std::string> sampler_kernel_names(const std::string& backend);
 
 }  // namespace sdf

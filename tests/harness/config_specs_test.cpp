@@ -115,15 +115,14 @@ TEST(LatticeSpec, BadResolutionsRejected) {
 }
 
 TEST(LatticeSpec, FractionalResolutionEntryRejected) {
-    std::optional<LatticeSpec> s;
-    try {
-        s = lattice({{"type", "cc"}, {"resolution", {80, 80.5, 80}}});
-    } catch (const ConfigError& e) {
-        EXPECT_TRUE(Contains(e.what(), "'lattices[0].resolution'"));
-    }
-    if (s)
-        GTEST_SKIP() << "BUG: parse_lattice_spec accepts \"resolution\": [80, 80.5, 80] as " << s->resolution.x << "x"
-                     << s->resolution.y << "x" << s->resolution.z << " (entries truncated, not rejected)";
+    const std::string msg = error_of([] { lattice({{"type", "cc"}, {"resolution", {80, 80.5, 80}}}); });
+    EXPECT_TRUE(Contains(msg, "'lattices[0].resolution'"));
+    EXPECT_TRUE(Contains(msg, "80.5"));
+}
+
+TEST(LatticeSpec, BadResolutionQuotesTheValueSeen) {
+    const std::string msg = error_of([] { lattice({{"type", "cc"}, {"resolution", {4, 4}}}); });
+    EXPECT_TRUE(Contains(msg, "expected an array of 3 integers >= 2, got [4,4]"));
 }
 
 TEST(LatticeSpec, UnknownTypeSuggestsNearest) {
@@ -182,18 +181,26 @@ TEST(LatticeSpec, MarginOverrideAndUnknownKeys) {
     EXPECT_TRUE(Contains(msg, "did you mean 'margin'?"));
 }
 
-// A negative per-lattice margin silently means "the config's margin" (internal sentinel),
-// whereas "domain": {"margin": -0.3} is rejected.
+// A negative per-lattice margin is rejected (as "domain": {"margin": -0.3} is), quoting it.
 TEST(LatticeSpec, NegativeMarginRejected) {
-    std::optional<LatticeSpec> s;
-    try {
-        s = lattice({{"resolution", {4, 4, 4}}, {"margin", -0.3}});
-    } catch (const ConfigError& e) {
-        EXPECT_TRUE(Contains(e.what(), "'lattices[0].margin'"));
-    }
-    if (s)
-        GTEST_SKIP() << "BUG: parse_lattice_spec accepts \"margin\": -0.3 and build_lattice then silently uses the "
-                        "config's domain margin instead (negative = internal 'unset' sentinel)";
+    const std::string msg = error_of([] { lattice({{"resolution", {4, 4, 4}}, {"margin", -0.3}}); });
+    EXPECT_TRUE(Contains(msg, "'lattices[0].margin'"));
+    EXPECT_TRUE(Contains(msg, "-0.3"));
+    EXPECT_DOUBLE_EQ(lattice({{"resolution", {4, 4, 4}}, {"margin", 0.0}}).margin, 0.0);
+}
+
+TEST(LatticeSpec, LabelsAreUniqueAndGivenNamesChecked) {
+    const json cfg = json::object();
+    JsonReader r(cfg, "cfg.json");
+    const LatticeSpec cc = lattice({{"type", "cc"}, {"resolution", {4, 4, 4}}});
+    const LatticeSpec bcc = lattice({{"type", "bcc"}, {"samples", 100}});
+    EXPECT_EQ(lattice_spec_labels({cc, bcc, cc}, r), (std::vector<std::string>{"cc-4x4x4", "bcc-4x4x8", "cc-4x4x4-2"}));
+    const LatticeSpec named = lattice({{"type", "cc"}, {"resolution", {4, 4, 4}}, {"name", "coarse"}});
+    EXPECT_EQ(lattice_spec_labels({named, cc}, r), (std::vector<std::string>{"coarse", "cc-4x4x4"}));
+    const std::string msg = error_of([&] { lattice_spec_labels({named, cc, named}, r); });
+    EXPECT_TRUE(Contains(msg, "'lattices[2].name'"));
+    EXPECT_TRUE(Contains(msg, "\"coarse\""));
+    EXPECT_TRUE(Contains(error_of([] { lattice({{"resolution", {4, 4, 4}}, {"name", ".."}}); }), "'lattices[0].name'"));
 }
 
 // ---- build_lattice / fit_lattice ----------------------------------------------------------
@@ -371,23 +378,23 @@ TEST(MeshSpec, BadSpecsNameTheKey) {
     EXPECT_TRUE(Contains(missing, "cfg.json: key 'mesh': missing"));
 }
 
-// {"file": ..., "shape": ...}: the file wins and "shape" is called an unknown key, with
-// "valid here: file" -- misleading, since "shape" is valid; it should say "give either".
+// {"file": ..., "shape": ...}: exclusive, said so.
 TEST(MeshSpec, FileAndShapeTogetherAreReportedAsExclusive) {
     const std::string msg = error_of([] { mesh_spec({{"file", "x.obj"}, {"shape", "box"}}); });
-    EXPECT_TRUE(Contains(msg, "cfg.json"));
-    EXPECT_TRUE(Contains(msg, "shape"));
-    if (Contains(msg, "unknown key"))
-        GTEST_SKIP() << "BUG (weak message): mesh with both \"file\" and \"shape\" gives \"" << msg << "\"";
-    EXPECT_TRUE(Contains(msg, "file"));
+    EXPECT_TRUE(Contains(msg, "cfg.json: key 'mesh'"));
+    EXPECT_TRUE(Contains(msg, "give either 'file' or 'shape', not both"));
+    EXPECT_FALSE(Contains(msg, "unknown key"));
+    EXPECT_TRUE(Contains(error_of([] { mesh_spec(json::object()); }), "expected {\"file\": NAME}"));
+    EXPECT_TRUE(Contains(error_of([] { mesh_spec({{"file", ""}}); }), "'mesh.file'"));
+    EXPECT_TRUE(Contains(error_of([] { mesh_spec(""); }), "'mesh'"));
 }
 
-// "shape:" with no name becomes a file mesh named "" and is reported as "mesh '' not found".
+// "shape:" with no name is an error about the shape, not a file named "".
 TEST(LoadMesh, EmptyShapeNameIsReportedAsSuch) {
     const std::string msg = error_of([] { load_mesh(mesh_spec_from_argument("shape:"), {"/nonexistent"}); });
-    if (Contains(msg, "mesh '' not found"))
-        GTEST_SKIP() << "BUG (weak message): \"shape:\" is treated as a file named \"\": " << msg;
-    EXPECT_TRUE(Contains(msg, "shape"));
+    EXPECT_TRUE(Contains(msg, "needs a shape name"));
+    EXPECT_FALSE(Contains(msg, "not found"));
+    EXPECT_TRUE(Contains(error_of([] { mesh_spec("shape:"); }), "cfg.json: key 'mesh'"));
 }
 
 TEST(LoadMesh, ProceduralBox) {
@@ -420,31 +427,51 @@ TEST(LoadMesh, ShapeParameterErrorsNameTheParameter) {
     EXPECT_TRUE(Contains(size, "3 numbers"));
 }
 
-// The parameter descriptions promise "a positive number" / "an integer >= 3", but the values
-// are not checked: a negative radius or a 1-segment torus is built (the latter as an empty
-// mesh that fails much later with "cannot fit a lattice to an empty mesh").
+// Every parameter is range-checked; the message names the key and the value seen.
 TEST(LoadMesh, OutOfRangeShapeParametersRejected) {
-    const std::vector<json> bad = {
-        {{"shape", "sphere"}, {"radius", -1.0}},
-        {{"shape", "box"}, {"half_extent", {1, -1, 1}}},
-        {{"shape", "box"}, {"half_extent", {0, 0, 0}}},
-        {{"shape", "torus"}, {"major_segments", 1}},
-        {{"shape", "torus"}, {"minor_radius", 0.0}},
+    struct Case {
+        json spec;
+        std::string key, value;
     };
-    std::vector<std::string> accepted;
-    for (const json& spec : bad) {
-        try {
-            load_mesh(mesh_spec(spec), {});
-            accepted.push_back(spec.dump());
-        } catch (const std::exception& e) {
-            EXPECT_TRUE(Contains(e.what(), "mesh.")) << spec.dump();
-        }
+    const std::vector<Case> bad = {
+        {{{"shape", "sphere"}, {"radius", -1.0}}, "'mesh.radius'", "-1"},
+        {{{"shape", "sphere"}, {"radius", 0}}, "'mesh.radius'", "got 0"},
+        {{{"shape", "box"}, {"half_extent", {1, -1, 1}}}, "'mesh.half_extent'", "[1,-1,1]"},
+        {{{"shape", "box"}, {"half_extent", {0, 0, 0}}}, "'mesh.half_extent'", "[0,0,0]"},
+        {{{"shape", "torus"}, {"major_segments", 1}}, "'mesh.major_segments'", "got 1"},
+        {{{"shape", "torus"}, {"minor_segments", 2}}, "'mesh.minor_segments'", "got 2"},
+        {{{"shape", "torus"}, {"minor_radius", 0.0}}, "'mesh.minor_radius'", "got 0"},
+        {{{"shape", "torus"}, {"minor_radius", 1.5}}, "'mesh.minor_radius'", "1.5"},
+        {{{"shape", "torus"}, {"minor_radius", 1.0}}, "'mesh.minor_radius'", "intersect"},
+        {{{"shape", "torus"}, {"major_radius", -2.0}}, "'mesh.major_radius'", "-2"},
+        {{{"shape", "pawn"}, {"segments", 2}}, "'mesh.segments'", "got 2"},
+        {{{"shape", "soccer_ball"}, {"seam_depth", -0.01}}, "'mesh.seam_depth'", "-0.01"},
+        {{{"shape", "soccer_ball"}, {"seam_depth", 0.5}}, "'mesh.seam_depth'", "0.5"},
+        {{{"shape", "soccer_ball"}, {"seam_width", 0.0}}, "'mesh.seam_width'", "got 0"},
+        {{{"shape", "soccer_ball"}, {"detail", -1}}, "'mesh.detail'", "got -1"},
+    };
+    for (const Case& c : bad) {
+        const std::string msg = error_of([&] { load_mesh(mesh_spec(c.spec), {}); });
+        EXPECT_TRUE(Contains(msg, "cfg.json")) << c.spec.dump();
+        EXPECT_TRUE(Contains(msg, c.key)) << c.spec.dump();
+        EXPECT_TRUE(Contains(msg, c.value)) << c.spec.dump();
     }
-    if (!accepted.empty()) {
-        std::string list;
-        for (const auto& a : accepted) list += " " + a;
-        GTEST_SKIP() << "BUG: load_mesh (make_shape) builds shapes from out-of-range parameters:" << list;
-    }
+    // The edges of the valid ranges build.
+    EXPECT_EQ(load_mesh(mesh_spec({{"shape", "torus"}, {"major_segments", 3}, {"minor_segments", 3}}), {}).triangles.size(), 18u);
+    EXPECT_GT(load_mesh(mesh_spec({{"shape", "soccer_ball"}, {"detail", 0}, {"seam_depth", 0.0}}), {}).triangles.size(), 0u);
+}
+
+// Parameters are checked when the spec is parsed (a dry run sees them), and the errors of the
+// built shape name the config file the spec came from.
+TEST(MeshSpec, ShapeParametersCheckedAtParseTimeNamingTheFile) {
+    EXPECT_TRUE(Contains(error_of([] { mesh_spec({{"shape", "sphere"}, {"radius", -1.0}}); }), "cfg.json: key 'mesh.radius'"));
+    const std::string unknown = error_of([] { mesh_spec("shape:bxo"); });
+    EXPECT_TRUE(Contains(unknown, "cfg.json: key 'mesh'"));
+    EXPECT_TRUE(Contains(unknown, "did you mean 'box'?"));
+    MeshSpec spec = mesh_spec({{"shape", "box"}});
+    spec.parameters["half_extnt"] = {1, 1, 1};  // edited after parsing: caught when building
+    const std::string built = error_of([&] { load_mesh(spec, {}); });
+    EXPECT_TRUE(Contains(built, "cfg.json: unknown key 'mesh.half_extnt'"));
 }
 
 // ---- files: search path, locating, loading ------------------------------------------------
@@ -505,6 +532,35 @@ TEST_F(MeshFiles, LocateFindsFirstMatchOnPath) {
     EXPECT_EQ(fs::path(locate_mesh_file("m.obj", path)), fs::weakly_canonical(first));
     // Absolute names are used as they are.
     EXPECT_EQ(locate_mesh_file(first, {}), first);
+}
+
+// Relative names: the base directory (the config's own, or the working directory for
+// sdf-query) first, then the search path; the result is absolute; "not found" lists all.
+TEST_F(MeshFiles, BaseDirectoryFirstThenSearchPathAbsoluteResult) {
+    write("cfg/m.obj", kTetrahedron);
+    write("path/m.obj", kTetrahedron);
+    write("path/only.obj", kTetrahedron);
+    const std::vector<std::string> path = {(dir_ / "path").string()};
+    EXPECT_EQ(fs::path(locate_mesh_file("m.obj", path, (dir_ / "cfg").string())), fs::weakly_canonical(dir_ / "cfg/m.obj"));
+    EXPECT_EQ(fs::path(locate_mesh_file("only.obj", path, (dir_ / "cfg").string())),
+              fs::weakly_canonical(dir_ / "path/only.obj"));
+    EXPECT_EQ(fs::path(locate_mesh_file("m.obj", path)), fs::weakly_canonical(dir_ / "path/m.obj"));
+    // A relative base directory still gives an absolute path.
+    const fs::path saved = fs::current_path();
+    fs::current_path(dir_);
+    const std::string found = locate_mesh_file("m.obj", {}, "cfg");
+    fs::current_path(saved);
+    EXPECT_TRUE(fs::path(found).is_absolute()) << found;
+    EXPECT_EQ(fs::path(found), fs::weakly_canonical(dir_ / "cfg/m.obj"));
+    const std::string msg = error_of([&] { locate_mesh_file("none.obj", path, (dir_ / "cfg").string()); });
+    EXPECT_TRUE(Contains(msg, (dir_ / "cfg/none.obj").string()));
+    EXPECT_TRUE(Contains(msg, (dir_ / "path/none.obj").string()));
+    // resolve_mesh_file records the path and names the config key on failure.
+    MeshSpec spec = mesh_spec("m.obj");
+    resolve_mesh_file(spec, path, (dir_ / "cfg").string());
+    EXPECT_EQ(fs::path(spec.resolved_file), fs::weakly_canonical(dir_ / "cfg/m.obj"));
+    MeshSpec missing = mesh_spec("none.obj");
+    EXPECT_TRUE(Contains(error_of([&] { resolve_mesh_file(missing, path, ""); }), "cfg.json: key 'mesh'"));
 }
 
 TEST_F(MeshFiles, ConfigRelativeDataPathIsFound) {
