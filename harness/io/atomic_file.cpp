@@ -1,44 +1,145 @@
 #include "harness/io/atomic_file.h"
 
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <signal.h>
 #include <unistd.h>
 
-#include <cstdio>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <regex>
 #include <stdexcept>
 
 namespace sdf {
 namespace fs = std::filesystem;
 
-void write_file_atomically(const std::string& path, const void* data, size_t size, Overwrite overwrite) {
-    if (overwrite == Overwrite::Forbid && fs::exists(path))
-        throw std::runtime_error(path + ": already exists; refusing to overwrite it (choose another output or "
-                                        "remove the file)");
-    const fs::path target(path);
-    if (target.has_parent_path()) fs::create_directories(target.parent_path());
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error(tmp + ": cannot open for writing");
-        out.write(static_cast<const char*>(data), std::streamsize(size));
-        out.flush();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw std::runtime_error(path + ": write failed (disk full?)");
+namespace {
+
+std::string errno_text(int e) { return std::strerror(e); }
+
+/// Writes everything to `fd`, retrying short writes; returns errno or 0.
+int write_all(int fd, const char* data, size_t size) {
+    while (size > 0) {
+        const ssize_t n = ::write(fd, data, size);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        data += n;
+        size -= size_t(n);
+    }
+    return 0;
+}
+
+/// fsync of the directory holding `path`, so a rename into it survives a crash (best effort).
+void sync_parent_directory(const std::string& path) {
+    const fs::path parent = fs::path(path).parent_path();
+    const int fd = ::open(parent.empty() ? "." : parent.c_str(), O_RDONLY | O_DIRECTORY);
+    if (fd < 0) return;
+    ::fsync(fd);
+    ::close(fd);
+}
+
+/// Normalised, without a trailing separator: "runs/r5/" and "runs/./r5" are "runs/r5".
+std::string normalised(const std::string& path) {
+    fs::path p = fs::path(path).lexically_normal();
+    if (p.filename().empty() && p.has_parent_path()) p = p.parent_path();
+    return p.string();
+}
+
+}  // namespace
+
+std::string unique_sibling_name(const std::string& path, const std::string& tag) {
+    static std::atomic<unsigned long> counter{0};
+    const fs::path p(path);
+    const std::string name = "." + p.filename().string() + "." + tag + "." + std::to_string(::getpid()) + "." +
+                             std::to_string(counter.fetch_add(1));
+    return (p.parent_path() / name).string();
+}
+
+int remove_stale_staging(const std::string& dir) {
+    static const std::regex pattern(R"(\..+\.(tmp|partial)\.([0-9]+)\.[0-9]+)");
+    int removed = 0;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) return 0;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        std::smatch m;
+        const std::string name = e.path().filename().string();
+        if (!std::regex_match(name, m, pattern)) continue;
+        const pid_t pid = pid_t(std::stol(m[2].str()));
+        if (::kill(pid, 0) == 0 || errno == EPERM) continue;  // still running
+        std::error_code rm;
+        fs::remove_all(e.path(), rm);
+        if (!rm) ++removed;
+    }
+    return removed;
+}
+
+bool rename_no_replace(const std::string& from, const std::string& to) {
+    if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
+    int e = errno;
+    if (e == EEXIST) return false;
+    if (e == EINVAL || e == ENOSYS || e == ENOTSUP) {
+        // No RENAME_NOREPLACE on this file system: link() refuses an existing target too
+        // (files only; a directory falls back to a checked rename).
+        struct stat st {};
+        if (::stat(from.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+            if (fs::exists(to)) return false;
+            if (::rename(from.c_str(), to.c_str()) == 0) return true;
+            e = errno;
+        } else if (::link(from.c_str(), to.c_str()) == 0) {
+            ::unlink(from.c_str());
+            return true;
+        } else {
+            e = errno;
+            if (e == EEXIST) return false;
         }
     }
-    fs::rename(tmp, path);
+    throw std::runtime_error("cannot rename " + from + " to " + to + ": " + errno_text(e));
+}
+
+void write_file_atomically(const std::string& path, const void* data, size_t size, Overwrite overwrite) {
+    auto refuse = [&] {
+        return std::runtime_error(path + ": already exists; refusing to overwrite it (choose another output or "
+                                         "remove the file)");
+    };
+    if (overwrite == Overwrite::Forbid && fs::exists(path)) throw refuse();
+    const fs::path target(path);
+    if (target.has_parent_path()) fs::create_directories(target.parent_path());
+    const std::string tmp = unique_sibling_name(path, "tmp");
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error(tmp + ": cannot open for writing: " + errno_text(errno));
+    int e = write_all(fd, static_cast<const char*>(data), size);
+    if (e == 0 && ::fsync(fd) != 0) e = errno;
+    if (::close(fd) != 0 && e == 0) e = errno;
+    if (e != 0) {
+        ::unlink(tmp.c_str());
+        throw std::runtime_error(path + ": write failed: " + errno_text(e));
+    }
+    try {
+        if (overwrite == Overwrite::Forbid) {
+            if (!rename_no_replace(tmp, path)) throw refuse();
+        } else if (::rename(tmp.c_str(), path.c_str()) != 0) {
+            throw std::runtime_error(path + ": cannot move the written file into place: " + errno_text(errno));
+        }
+    } catch (...) {
+        ::unlink(tmp.c_str());
+        throw;
+    }
+    sync_parent_directory(path);
 }
 
 void write_text_atomically(const std::string& path, const std::string& text, Overwrite overwrite) {
     write_file_atomically(path, text.data(), text.size(), overwrite);
 }
 
-StagedDirectory::StagedDirectory(std::string final_path) : final_(std::move(final_path)) {
+StagedDirectory::StagedDirectory(std::string final_path) : final_(normalised(final_path)) {
     if (fs::exists(final_))
         throw std::runtime_error(final_ + ": already exists; refusing to overwrite a result directory");
-    const fs::path p(final_);
-    staging_ = (p.parent_path() / ("." + p.filename().string() + ".partial." + std::to_string(::getpid()))).string();
+    staging_ = unique_sibling_name(final_, "partial");
     fs::create_directories(staging_);
 }
 
@@ -50,10 +151,20 @@ StagedDirectory::~StagedDirectory() {
 }
 
 void StagedDirectory::commit() {
-    if (fs::exists(final_))
+    if (!try_commit_as(final_))
         throw std::runtime_error(final_ + ": appeared while this run was writing; refusing to overwrite it");
-    fs::rename(staging_, final_);
+}
+
+bool StagedDirectory::try_commit_as(const std::string& final_path) {
+    if (committed_) throw std::logic_error(final_ + ": StagedDirectory committed twice");
+    const std::string target = normalised(final_path);
+    if (fs::path(target).parent_path() != fs::path(final_).parent_path())
+        throw std::logic_error(target + ": not in the same directory as " + final_);
+    if (!rename_no_replace(staging_, target)) return false;
+    final_ = target;
     committed_ = true;
+    sync_parent_directory(final_);
+    return true;
 }
 
 }  // namespace sdf

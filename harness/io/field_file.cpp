@@ -48,16 +48,20 @@ nlohmann::json write_channel(const std::string& stem, const std::string& name, c
 }
 
 std::vector<char> read_bytes(const std::string& path, size_t expected, const std::string& header) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) throw std::runtime_error(header + ": channel file " + path + " not found");
+    if (fs::is_directory(st)) throw std::runtime_error(header + ": channel file " + path + " is a directory, not a regular file");
+    if (!fs::is_regular_file(st)) throw std::runtime_error(header + ": channel file " + path + " is not a regular file");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(header + ": channel file " + path + " not found");
-    in.seekg(0, std::ios::end);
-    const size_t size = size_t(in.tellg());
+    if (!in) throw std::runtime_error(header + ": channel file " + path + " cannot be opened");
+    const size_t size = size_t(fs::file_size(path));
     if (size != expected)
         throw std::runtime_error(header + ": channel file " + path + " holds " + std::to_string(size) +
                                  " bytes; the header's lattice and dtype need " + std::to_string(expected));
-    in.seekg(0);
     std::vector<char> bytes(size);
     in.read(bytes.data(), std::streamsize(size));
+    if (!in) throw std::runtime_error(header + ": channel file " + path + ": read failed");
     return bytes;
 }
 
@@ -100,14 +104,17 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     const auto origin = r.required<std::vector<double>>("origin", "an array of 3 numbers");
     l.spacing = r.required<double>("spacing", "a positive number");
     const auto res = r.required<std::vector<int>>("resolution", "an array of 3 positive integers");
-    if (origin.size() != 3) r.fail("origin", "expected 3 numbers");
+    if (origin.size() != 3) r.fail("origin", "expected an array of 3 numbers, got " + r.raw("origin").dump());
     if (res.size() != 3 || *std::min_element(res.begin(), res.end()) < 1)
-        r.fail("resolution", "expected 3 positive integers");
-    if (!(l.spacing > 0) || !std::isfinite(l.spacing)) r.fail("spacing", "expected a positive number");
+        r.fail("resolution", "expected an array of 3 positive integers, got " + r.raw("resolution").dump());
+    if (!(l.spacing > 0) || !std::isfinite(l.spacing))
+        r.fail("spacing", "expected a positive number, got " + r.raw("spacing").dump());
     l.origin = {origin[0], origin[1], origin[2]};
     l.resolution = {res[0], res[1], res[2]};
     if (l.type == LatticeType::BCC) {
-        if (res[2] % 2 != 0) r.fail("resolution", "BCC resolution is [Rx, Ry, 2Rz]; the third entry must be even");
+        if (res[2] % 2 != 0)
+            r.fail("resolution", "BCC resolution is [Rx, Ry, 2Rz]; the third entry must be even, got " +
+                                     r.raw("resolution").dump());
         l.resolution.z = res[2] / 2;
     }
     r.finish({"notation", "points"});
@@ -117,16 +124,39 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
 void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
     const std::string stem = stem_of_header(header_path);
     const size_t n = size_t(field.size());
-    if (options.overwrite == Overwrite::Forbid && fs::exists(stem + ".json"))
-        throw std::runtime_error(stem + ".json: already exists; refusing to overwrite a field");
+    const bool gradient = !field.gradient.empty() && field.gradient.size() == n;
+    const bool triangles = options.closest_triangle && field.closest_triangle.size() == n;
+    // Every target is checked before anything is written, so a refusal leaves no orphan
+    // channel behind; a file that appears meanwhile is still refused by the atomic write,
+    // and then what this call wrote is removed again.
+    std::vector<std::string> targets = {stem + ".json", stem + ".distance.raw"};
+    if (gradient) targets.push_back(stem + ".gradient.raw");
+    if (triangles) targets.push_back(stem + ".closest_triangle.raw");
+    if (options.overwrite == Overwrite::Forbid)
+        for (const std::string& t : targets)
+            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
+    std::vector<std::string> written;
     nlohmann::json channels;
-    channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
-    if (field.gradient.size() == n)
-        channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
-    if (options.closest_triangle && field.closest_triangle.size() == n) {
-        const std::string file = stem + ".closest_triangle.raw";
-        write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
-        channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
+    try {
+        channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
+        written.push_back(stem + ".distance.raw");
+        if (gradient) {
+            channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
+            written.push_back(stem + ".gradient.raw");
+        }
+        if (triangles) {
+            const std::string file = stem + ".closest_triangle.raw";
+            write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
+            written.push_back(file);
+            channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
+        }
+    } catch (...) {
+        if (options.overwrite == Overwrite::Forbid)
+            for (const std::string& w : written) {
+                std::error_code ec;
+                fs::remove(w, ec);
+            }
+        throw;
     }
     nlohmann::json header = {{"format", "sdf-lattice-field"},
                              {"version", 1},
@@ -143,15 +173,25 @@ void write_field(const std::string& header_path, const SampledField& field, cons
                                                   {"download", field.timings.download}}},
                              {"point_triangle_pairs", field.timings.point_triangle_pairs}};
     if (channels.contains("gradient")) header["gradient_channel"] = "gradient";
-    write_text_atomically(stem + ".json", header.dump(2) + "\n", options.overwrite);
+    try {
+        write_text_atomically(stem + ".json", header.dump(2) + "\n", options.overwrite);
+    } catch (...) {
+        if (options.overwrite == Overwrite::Forbid)
+            for (const std::string& w : written) {
+                std::error_code ec;
+                fs::remove(w, ec);
+            }
+        throw;
+    }
 }
 
 SampledField read_field(const std::string& header_path) {
     const nlohmann::json j = read_json_file(header_path);
     JsonReader r(j, header_path);
-    if (r.required<std::string>("format", "\"sdf-lattice-field\"") != "sdf-lattice-field")
-        r.fail("format", "expected \"sdf-lattice-field\"");
-    if (r.required<int>("version", "the format version 1") != 1) r.fail("version", "only version 1 is known");
+    const std::string format = r.required<std::string>("format", "\"sdf-lattice-field\"");
+    if (format != "sdf-lattice-field") r.fail("format", "expected \"sdf-lattice-field\", got \"" + format + "\"");
+    const int version = r.required<int>("version", "the format version 1");
+    if (version != 1) r.fail("version", "only version 1 is known, got " + std::to_string(version));
     SampledField field;
     field.lattice = lattice_from_json(r.raw("lattice"), header_path);
     const int64_t points = field.lattice.num_points();
