@@ -7,8 +7,9 @@
 namespace sdf {
 
 double angle_degrees(const Vec3f& a, const Vec3f& b) {
-    const double c = double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z;
-    return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+    // atan2(|a x b|, a.b): accurate for small angles (acos is not) and exactly 0 for a == b
+    const Vec3d u(a), v(b);
+    return std::atan2(length(cross(u, v)), dot(u, v)) * 180.0 / M_PI;
 }
 
 ErrorSummary summarize_errors(std::vector<double>& values) {

@@ -6,7 +6,8 @@
 /// Definitions (both images the same size; normals are the unit, viewer-facing shading
 /// normals of the records):
 ///   both = pixels hit in both images; only_test / only_reference = hit in one only
-///   normal angle error = acos(clamp(n_test . n_ref, -1, 1)) in degrees, over `both`:
+///   normal angle error = the angle between n_test and n_ref in degrees (atan2 of the
+///     cross and dot products: exact for equal vectors, accurate for small angles), over `both`:
 ///     mean, 95th percentile (nearest rank), max
 ///   depth error = |depth_test - depth_ref| in world units, over `both`: mean, 95th
 ///     percentile, max; and the same divided by `length_unit` when one is given (e.g. the
@@ -49,7 +50,7 @@ ErrorSummary summarize_errors(std::vector<double>& values);
 
 nlohmann::json metrics_to_json(const ImageMetrics& m);
 
-/// Angle in degrees between two unit vectors (clamped, so rounding never gives NaN).
+/// Angle in degrees between two vectors, atan2(|a x b|, a . b): 0 for equal vectors.
 double angle_degrees(const Vec3f& a, const Vec3f& b);
 
 }  // namespace sdf
