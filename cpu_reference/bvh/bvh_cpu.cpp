@@ -8,6 +8,7 @@
 #include "cpu_reference/parallel/parallel_for.h"
 #include "cpu_reference/parallel/progress.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
+#include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf {
@@ -15,6 +16,14 @@ namespace {
 
 /// Points per parallel_for chunk: long enough that most seeds come from the x-neighbour.
 constexpr int64_t kBvhChunk = 256;
+
+/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (16 float lanes: one
+/// AVX-512 register, or two AVX2 registers, per coordinate in the leaf loop).
+constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
+/// Bricks per parallel_for chunk.
+constexpr int64_t kBrickChunk = 16;
+
+enum class BvhKernel { Brick, Seeded, Unseeded };
 
 struct QueryCounters {
     std::atomic<int64_t> nodes{0}, triangles{0};
@@ -46,14 +55,78 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, bool seed
     });
 }
 
+/// The points of one brick of `block`: block-local indices and positions; lanes beyond
+/// `count` repeat lane 0.
+struct Brick {
+    int64_t local[kBrick];
+    Vec3d position[kBrick];
+    int count = 0;
+};
+
+Brick brick_points(const Lattice& lattice, const GridBlock& block, const Int3& bricks, int64_t b) {
+    const Int3 r = block.resolution;
+    const int bi = int(b % bricks.x), bj = int((b / bricks.x) % bricks.y), bk = int(b / (int64_t(bricks.x) * bricks.y));
+    Brick out;
+    for (int k = 0; k < kBrick; ++k) {
+        const int i = bi * kBrickX + k % kBrickX, j = bj * kBrickY + (k / kBrickX) % kBrickY, l = bk * kBrickZ + k / (kBrickX * kBrickY);
+        if (i >= r.x || j >= r.y || l >= r.z) continue;
+        out.local[out.count] = i + int64_t(r.x) * (j + int64_t(r.y) * l);
+        out.position[out.count] = lattice.position_of_coords(block.coords(out.local[out.count]));
+        ++out.count;
+    }
+    for (int k = out.count; k < kBrick; ++k) {
+        out.local[k] = out.local[0];
+        out.position[k] = out.position[0];
+    }
+    return out;
+}
+
+/// Evaluates every point of `block` brick by brick (closest_triangles_packet.h); each lane
+/// is seeded with the triangle of the same lane of the previous brick along x.
+template <typename T, typename EmitFn>
+void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lattice& lattice, const GridBlock& block,
+                     int threads, bool progress, QueryCounters& counters, EmitFn emit) {
+    const BvhView<T> view = bvh.view<T>();
+    const MeshView<double> exact = mesh.buffers<double>().view();
+    const Int3 r = block.resolution;
+    const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
+    const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
+    ProgressReporter reporter("sampling " + mesh.name + " (bvh)", block.count(), progress);
+    parallel_for(n, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
+        BvhStats stats;
+        int32_t seed[kBrick];
+        for (int k = 0; k < kBrick; ++k) seed[k] = -1;
+        int64_t done = 0;
+        for (int64_t b = begin; b < end; ++b) {
+            const Brick br = brick_points(lattice, block, bricks, b);
+            BvhPacket<T, kBrick> pk;
+            for (int k = 0; k < kBrick; ++k) {
+                pk.x[k] = T(br.position[k].x);
+                pk.y[k] = T(br.position[k].y);
+                pk.z[k] = T(br.position[k].z);
+            }
+            seed_packet(view, seed, pk);
+            closest_triangles_packet(view, pk, stats);
+            for (int k = 0; k < br.count; ++k)
+                emit(br.local[k], signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]));
+            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
+            done += br.count;
+        }
+        counters.nodes += stats.nodes;
+        counters.triangles += stats.triangles;
+        reporter.advance(done);
+    });
+}
+
 class CpuBvhSampler final : public Sampler {
 public:
     explicit CpuBvhSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "seeded") seeded_ = true;
-        else if (options.kernel == "unseeded") seeded_ = false;
+        if (options.kernel.empty() || options.kernel == "brick") kernel_ = BvhKernel::Brick;
+        else if (options.kernel == "seeded") kernel_ = BvhKernel::Seeded;
+        else if (options.kernel == "unseeded") kernel_ = BvhKernel::Unseeded;
         else
             throw std::invalid_argument("sampler.kernel: unknown CPU BVH kernel '" + options.kernel +
-                                        "'; expected \"seeded\" or \"unseeded\"");
+                                        "'; expected \"brick\", \"seeded\" or \"unseeded\"");
     }
 
     std::string name() const override { return std::string("cpu/bvh/") + kernel_name(); }
@@ -70,7 +143,7 @@ public:
         QueryCounters counters;
         auto run = [&](auto zero) {
             using T = decltype(zero);
-            evaluate_points<T>(mesh, *bvh, seeded_, options_.threads, options_.progress, int64_t(points.size()), counters,
+            evaluate_points<T>(mesh, *bvh, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
                                [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    out[size_t(i)] = {s.distance, s.gradient, mesh.source_triangle[size_t(s.triangle)]};
@@ -81,7 +154,11 @@ public:
     }
 
 private:
-    const char* kernel_name() const { return seeded_ ? "seeded" : "unseeded"; }
+    const char* kernel_name() const {
+        return kernel_ == BvhKernel::Brick ? "brick" : (kernel_ == BvhKernel::Seeded ? "seeded" : "unseeded");
+    }
+    /// Point lists have no bricks: "brick" queries them one by one, seeded.
+    bool seeded() const { return kernel_ != BvhKernel::Unseeded; }
 
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
@@ -99,15 +176,18 @@ private:
         QueryCounters counters;
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];
-            evaluate_points<T>(mesh, *bvh, seeded_, options_.threads, options_.progress, block.count(), counters,
-                               [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
-                               [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   const int64_t out = block.output_index(lattice, i);
-                                   if (out < 0) return;  // strategy A: not a BCC point
-                                   field.distance[size_t(out)] = s.distance;
-                                   field.gradient[size_t(out)] = s.gradient;
-                                   field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
-                               });
+            auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
+                const int64_t out = block.output_index(lattice, i);
+                if (out < 0) return;  // strategy A: not a BCC point
+                field.distance[size_t(out)] = s.distance;
+                field.gradient[size_t(out)] = s.gradient;
+                field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
+            };
+            if (kernel_ == BvhKernel::Brick)
+                evaluate_bricks<T>(mesh, *bvh, lattice, block, options_.threads, options_.progress, counters, emit);
+            else
+                evaluate_points<T>(mesh, *bvh, seeded(), options_.threads, options_.progress, block.count(), counters,
+                                   [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); }, emit);
             computed += block.count();
         }
         const auto now = std::chrono::steady_clock::now();
@@ -118,7 +198,7 @@ private:
         nlohmann::json bvh_info = bvh->stats.to_json();
         bvh_info["built_by_this_call"] = built;
         bvh_info["node_visits_per_point"] = computed > 0 ? double(counters.nodes) / double(computed) : 0.0;
-        bvh_info["triangle_tests_per_point"] = computed > 0 ? double(counters.triangles) / double(computed) : 0.0;
+        bvh_info["point_triangle_tests_per_point"] = computed > 0 ? double(counters.triangles) / double(computed) : 0.0;
         field.sampler = {{"backend", "cpu"},
                          {"method", "bvh"},
                          {"kernel", kernel_name()},
@@ -131,7 +211,7 @@ private:
     }
 
     SamplerOptions options_;
-    bool seeded_ = true;
+    BvhKernel kernel_ = BvhKernel::Brick;
     BvhCache cache_;
 };
 

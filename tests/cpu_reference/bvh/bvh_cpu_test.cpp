@@ -96,13 +96,19 @@ TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
     cmp.fields(two, doubled, "soccer ball BCC strategies");
 }
 
-TEST(CpuBvh, SeededAndUnseededAgreeAndSeedingSavesWork) {
+double work_seeded_or_zero(const SampledField& f) { return f.sampler["bvh"]["node_visits_per_point"].get<double>(); }
+
+TEST(CpuBvh, BrickSeededAndUnseededKernelsAgreeAndCoherenceSavesWork) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
     const Lattice lattice = fit_lattice(LatticeType::CC, {32, 32, 32}, mesh.bounds, 0.1);
     const SampledField seeded = make_cpu_bvh_sampler(options(Precision::Float, "seeded"))->sample(mesh, lattice);
     const SampledField unseeded = make_cpu_bvh_sampler(options(Precision::Float, "unseeded"))->sample(mesh, lattice);
     test::FieldComparer cmp(mesh, test::epsilon_of(Precision::Float));
     cmp.fields(unseeded, seeded, "pawn seeded vs unseeded");
+    const SampledField brick = make_cpu_bvh_sampler(options(Precision::Float, "brick"))->sample(mesh, lattice);
+    test::FieldComparer cmp_brick(mesh, test::epsilon_of(Precision::Float));
+    cmp_brick.fields(unseeded, brick, "pawn brick vs unseeded");
+    EXPECT_LT(brick.sampler["bvh"]["node_visits_per_point"].get<double>(), work_seeded_or_zero(seeded));
     const double work_seeded = seeded.sampler["bvh"]["node_visits_per_point"].get<double>();
     const double work_unseeded = unseeded.sampler["bvh"]["node_visits_per_point"].get<double>();
     std::printf("pawn 32^3: node visits per point %.2f seeded, %.2f unseeded\n", work_seeded, work_unseeded);

@@ -1,0 +1,136 @@
+/// @file closest_triangles_packet.h
+/// @brief The exact nearest triangle of K neighbouring points in one BVH traversal (a
+/// "packet"), written once for host and device: lattice-coherent sampling.
+///
+/// Neighbouring lattice points have nearly the same candidate triangles, so they share one
+/// traversal (packet traversal as in Wald et al., "Interactive Rendering with Coherent Ray
+/// Tracing", EG 2001, applied to the closest-point query of closest_triangle_bvh.h). A
+/// subtree is entered when its box is nearer to at least one lane than that lane's best
+/// squared distance (an active-lane test, K box distances in one vector loop); a subtree
+/// waiting on the stack is dropped when its nearest lane is no nearer than the largest
+/// best of the packet. In both cases no
+/// point of the packet can have a strictly nearer triangle in it, so every point gets the
+/// same minimum as its own query would (up to ties and the rounding of T). Leaves test all
+/// K points against each triangle: on the CPU that loop over points vectorises (K lanes).
+/// Children are entered nearer-first by their nearest lane.
+#pragma once
+
+#include "kernels/bvh/closest_triangle_bvh.h"
+
+namespace sdf {
+
+/// K points in structure-of-arrays form with their current best hits. Lanes beyond the
+/// real points must repeat a real point (they then never widen the packet's bounds).
+template <typename T, int K>
+struct BvhPacket {
+    T x[K], y[K], z[K];
+    T best_q[K];
+    int32_t best_slot[K];
+};
+
+namespace detail {
+
+/// Whether child c's box may hold a nearer triangle for any lane (its distance to that lane
+/// is below the lane's best); `min_d2` receives the smallest distance over the lanes.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacket<T, K>& pk, T& min_d2) {
+    const T lo_x = T(n.min_x[c]), hi_x = T(n.max_x[c]), lo_y = T(n.min_y[c]), hi_y = T(n.max_y[c]);
+    const T lo_z = T(n.min_z[c]), hi_z = T(n.max_z[c]);
+    int wanted = 0;
+    T m = std::numeric_limits<T>::infinity();
+#if !SDF_IS_GPU_CODE
+#pragma omp simd reduction(| : wanted) reduction(min : m)
+#endif
+    for (int k = 0; k < K; ++k) {
+        const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
+        const T d = gx * gx + gy * gy + gz * gz;
+        wanted |= int(d < pk.best_q[k]);
+        m = d < m ? d : m;
+    }
+    min_d2 = m;
+    return wanted != 0;
+}
+
+/// Tests every point of the packet against leaf triangles [first, first + count); returns
+/// the new largest best squared distance of the packet.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk) {
+    for (int32_t j = first; j < first + count; ++j) {
+        const PackedTriangle<T> tri = bvh.packed[j];
+#if !SDF_IS_GPU_CODE
+#pragma omp simd
+#endif
+        for (int k = 0; k < K; ++k) {
+            const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
+            const bool better = q < pk.best_q[k];
+            pk.best_q[k] = better ? q : pk.best_q[k];
+            pk.best_slot[k] = better ? j : pk.best_slot[k];
+        }
+    }
+    T worst = pk.best_q[0];
+    for (int k = 1; k < K; ++k) worst = worst > pk.best_q[k] ? worst : pk.best_q[k];
+    return worst;
+}
+
+}  // namespace detail
+
+/// Seeds lane k with triangle seed[k] (BVH slot, or -1 for none): an exact upper bound.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* seed, BvhPacket<T, K>& pk) {
+    for (int k = 0; k < K; ++k) {
+        pk.best_slot[k] = seed[k];
+        pk.best_q[k] = seed[k] >= 0 ? squared_distance(bvh.packed[seed[k]], pk.x[k], pk.y[k], pk.z[k])
+                                    : std::numeric_limits<T>::infinity();
+    }
+}
+
+/// Completes the nearest triangle of every lane of `pk` (seeded or with infinite radii).
+template <typename T, int K, typename Stats>
+SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats) {
+    T worst = pk.best_q[0];
+    for (int k = 1; k < K; ++k) worst = worst > pk.best_q[k] ? worst : pk.best_q[k];
+    int32_t stack_node[kBvhMaxDepth];
+    T stack_d2[kBvhMaxDepth];
+    int top = 0;
+    int32_t node = 0;
+    while (node >= 0) {
+        stats.visit_node();
+        const BvhNode n = bvh.nodes[node];
+        T d0, d1;
+        const bool want0 = detail::child_wanted(n, 0, pk, d0), want1 = detail::child_wanted(n, 1, pk, d1);
+        const int near = d1 < d0 ? 1 : 0;
+        const bool want_near = near ? want1 : want0, want_far = near ? want0 : want1;
+        int32_t next = -1;
+        if (want_near) {
+            if (bvh_child_is_leaf(n, near)) {
+                stats.test_triangles(n.count[near] * K);
+                worst = detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk);
+            } else {
+                next = n.ref[near];
+            }
+        }
+        if (want_far) {
+            const int far = 1 - near;
+            const T d_far = near ? d0 : d1;
+            if (bvh_child_is_leaf(n, far)) {
+                stats.test_triangles(n.count[far] * K);
+                worst = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk);
+            } else if (next < 0) {
+                next = n.ref[far];
+            } else {
+                SDF_DCHECK(top < kBvhMaxDepth);
+                stack_node[top] = n.ref[far];
+                stack_d2[top] = d_far;  // nearest lane's distance: a lower bound for every lane
+                ++top;
+            }
+        }
+        // A popped subtree is dropped once its nearest lane is beyond every lane's radius.
+        while (next < 0 && top > 0) {
+            --top;
+            if (stack_d2[top] < worst) next = stack_node[top];
+        }
+        node = next;
+    }
+}
+
+}  // namespace sdf

@@ -1,0 +1,128 @@
+// Google Benchmark of the BVH samplers: exact queries per second on the CC lattices of the
+// bunny and the dragon (262k = 64^3 and 2,097k = 128^3 points).
+//   CPU: 1 thread and all threads, seeded (lattice-coherent) and unseeded; the BVH build.
+//   GPU (when a device is present): manual time from the sampler's CUDA events.
+//   SDF_DATA_PATH=... bench_bvh --benchmark_counters_tabular=true --benchmark_filter=Cpu
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/bvh/triangle_bvh.h"
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/mesh/load_obj.h"
+#include "cpu_reference/parallel/parallel_for.h"
+#include "harness/build_config.h"
+#include "harness/sampling/make_sampler.h"
+
+namespace sdf {
+namespace {
+
+/// bunny.obj / dragon.obj from SDF_DATA_PATH or the build's default data directories.
+std::shared_ptr<PreparedMesh> load(const std::string& file) {
+    static std::map<std::string, std::shared_ptr<PreparedMesh>> cache;
+    if (cache.count(file)) return cache[file];
+    std::string dirs = std::getenv("SDF_DATA_PATH") ? std::getenv("SDF_DATA_PATH") : "";
+    dirs += std::string(":") + SDF_DATA_DIR_DEFAULT;
+    for (char& c : dirs) if (c == ';') c = ':';
+    std::stringstream ss(dirs);
+    for (std::string d; std::getline(ss, d, ':');)
+        if (!d.empty() && std::ifstream(d + "/" + file).good())
+            return cache[file] = std::make_shared<PreparedMesh>(prepare_mesh(load_obj(d + "/" + file)));
+    return cache[file] = nullptr;
+}
+
+Lattice cubic_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds, 0.1); }
+
+void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Lattice& lattice, const SampledField& f) {
+    const double points = double(lattice.num_points());
+    state.counters["queries/s"] = benchmark::Counter(points * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["points"] = points;
+    state.counters["triangles"] = double(mesh.triangles.size());
+    if (f.sampler.contains("bvh") && f.sampler["bvh"].contains("node_visits_per_point")) {
+        state.counters["nodes/pt"] = f.sampler["bvh"]["node_visits_per_point"].get<double>();
+        state.counters["tris/pt"] = f.sampler["bvh"]["point_triangle_tests_per_point"].get<double>();
+    }
+}
+
+/// Kernels by argument: 0 brick (packets of 16 lattice points), 1 seeded, 2 unseeded.
+const char* const kKernels[] = {"brick", "seeded", "unseeded"};
+
+/// Args: resolution, threads (0 = all), kernel.
+void BM_CpuBvh(benchmark::State& state, const std::string& file) {
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o;
+    o.method = "bvh";
+    o.threads = int(state.range(1));
+    o.kernel = kKernels[state.range(2)];
+    o.progress = false;
+    auto sampler = make_cpu_bvh_sampler(o);
+    SampledField f = sampler->sample(*mesh, lattice);  // builds and caches the BVH
+    for (auto _ : state) {
+        f = sampler->sample(*mesh, lattice);
+        state.SetIterationTime(f.timings.kernel);
+    }
+    set_counters(state, *mesh, lattice, f);
+    state.counters["threads"] = double(resolve_thread_count(o.threads));
+}
+
+void BM_BvhBuild(benchmark::State& state, const std::string& file) {
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    for (auto _ : state) benchmark::DoNotOptimize(build_triangle_bvh(*mesh).nodes.data());
+    state.counters["triangles"] = double(mesh->triangles.size());
+}
+
+void BM_CudaBvh(benchmark::State& state, const std::string& file) {
+    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o;
+    o.backend = "cuda";
+    o.method = "bvh";
+    o.kernel = state.range(1) ? "seeded" : "unseeded";
+    o.precision = state.range(2) ? Precision::Double : Precision::Float;
+    o.progress = false;
+    auto sampler = make_sampler(o);
+    SampledField f = sampler->sample(*mesh, lattice);  // warm-up: module load, BVH upload
+    for (auto _ : state) {
+        f = sampler->sample(*mesh, lattice);
+        state.SetIterationTime(f.timings.kernel);
+    }
+    set_counters(state, *mesh, lattice, f);
+}
+
+void cpu_args(benchmark::internal::Benchmark* b) {
+    for (int r : {64, 128})
+        for (int threads : {1, 0})
+            for (int kernel : {0, 1, 2}) b->Args({r, threads, kernel});
+    b->ArgNames({"res", "threads", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)
+        ->ReportAggregatesOnly(true);
+}
+
+void cuda_args(benchmark::internal::Benchmark* b) {
+    for (int r : {64, 128})
+        for (int seeded : {1, 0})
+            for (int dbl : {0, 1}) b->Args({r, seeded, dbl});
+    b->ArgNames({"res", "seeded", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
+}
+
+BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
+BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
+BENCHMARK_CAPTURE(BM_CudaBvh, bunny, std::string("bunny.obj"))->Apply(cuda_args);
+BENCHMARK_CAPTURE(BM_CudaBvh, dragon, std::string("dragon.obj"))->Apply(cuda_args);
+
+}  // namespace
+}  // namespace sdf
+
+BENCHMARK_MAIN();
