@@ -10,9 +10,9 @@
 /// sigma^2 = 0.5 h^2 equals sigma^2 = 2 in lattice units. docs/reconstruction.md explains the
 /// default (lattice units, as the thesis's figure) and measures both.
 ///
-/// Only the fit's even part depends on the weights: the 26 neighbours form 13 antipodal
-/// pairs and the odd monomials of degree <= 3 are 13, so the odd part (first and third
-/// derivatives) interpolates the pair differences whatever symmetric weights are used.
+/// Only the centred fit's even part depends on the weights: the 26 neighbours form 13
+/// antipodal pairs and the odd monomials of degree <= 3 are 13, so the odd part (first and
+/// third derivatives) interpolates the pair differences whatever symmetric weights are used.
 #pragma once
 
 #include <vector>

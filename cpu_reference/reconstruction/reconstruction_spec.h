@@ -13,8 +13,8 @@
 ///     "fd_weighted" is rejected: the Gaussian weighting belongs to the BCC least-squares fit.
 ///   bcc_cubic, bcc_cubic_c0: "true" = first derivatives from the sampled gradients, second
 ///     derivatives from the plain 27-point least-squares fit; "fd" = all from the plain fit;
-///     "fd_weighted" = all from the Gaussian-weighted fit (eq. 4-15; the first derivatives are
-///     the same as "fd", only the second ones change).
+///     "fd_weighted" = all from the Gaussian-weighted fit (eq. 4-15; at interior points the
+///     first derivatives are the same as "fd", only the second ones change).
 #pragma once
 
 #include <string>
