@@ -76,10 +76,21 @@ std::string utc_timestamp() {
 }
 
 std::string compact_utc_timestamp() {
-    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", std::gmtime(&t));
-    return buf;
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t t = std::chrono::system_clock::to_time_t(now);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    char buf[32], out[48];
+    std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%S", std::gmtime(&t));
+    std::snprintf(out, sizeof out, "%s.%03dZ", buf, int(ms));
+    return out;
+}
+
+nlohmann::json machine_kind(const nlohmann::json& provenance) {
+    nlohmann::json kind = {{"cpu", "unknown"}, {"gpu", nullptr}};
+    if (provenance.contains("cpu") && provenance["cpu"].contains("model")) kind["cpu"] = provenance["cpu"]["model"];
+    const nlohmann::json gpu = provenance.value("gpu", nlohmann::json());
+    if (gpu.is_object() && gpu.contains("name")) kind["gpu"] = gpu["name"];
+    return kind;
 }
 
 nlohmann::json machine_and_build() {

@@ -22,8 +22,11 @@ nlohmann::json build_info();
 nlohmann::json gpu_info();
 /// "2026-11-21T13:45:01Z"
 std::string utc_timestamp();
-/// "20261121T134501Z" (for run ids)
+/// "20261121T134501.123Z" (for run ids: UTC, milliseconds)
 std::string compact_utc_timestamp();
+/// The machine a result was measured on, from a provenance object (machine_and_build()):
+/// {"cpu": model, "gpu": name or null}. Timings are comparable only between equal kinds.
+nlohmann::json machine_kind(const nlohmann::json& provenance);
 /// Host name, CPU model and hardware threads, GPU; build; git.
 nlohmann::json machine_and_build();
 

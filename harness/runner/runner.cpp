@@ -6,57 +6,246 @@
 
 #include "cpu_reference/mesh/sha256.h"
 #include "experiments/experiment.h"
+#include "harness/build_config.h"
+#include "harness/cache/field_cache.h"
+#include "harness/check/regression_check.h"
+#include "harness/config/config_loader.h"
+#include "harness/config/sweep.h"
 #include "harness/io/atomic_file.h"
 #include "harness/provenance/provenance.h"
 
 namespace sdf {
 namespace fs = std::filesystem;
 
+namespace {
+
+/// One run of the plan (one sweep point), configured.
+struct PlannedRun {
+    SweepPoint point;
+    std::shared_ptr<nlohmann::json> resolved;
+    std::string kind, baseline;
+    std::unique_ptr<Experiment> experiment;
+    RunContext context;
+};
+
+/// Directories created on the way to the run directory; those still empty at the end (a
+/// failed run) are removed again, innermost first.
+class CreatedDirectories {
+public:
+    void create(const fs::path& dir) {
+        std::vector<fs::path> missing;
+        for (fs::path p = dir; !p.empty() && !fs::exists(p); p = p.parent_path()) missing.push_back(p);
+        fs::create_directories(dir);
+        created_.insert(created_.end(), missing.begin(), missing.end());
+    }
+    ~CreatedDirectories() {
+        for (const fs::path& p : created_) {
+            std::error_code ec;
+            if (fs::is_directory(p, ec) && fs::is_empty(p, ec)) fs::remove(p, ec);
+        }
+    }
+
+private:
+    std::vector<fs::path> created_;  ///< innermost first
+};
+
+std::string read_run_name(JsonReader& root) {
+    const std::string name = root.required<std::string>(
+        "name", "a run name of letters, digits, '-', '_' or '.', starting with a letter or digit");
+    if (!std::regex_match(name, std::regex("[A-Za-z0-9][A-Za-z0-9_.-]*")))
+        root.fail("name", "expected letters, digits, '-', '_' or '.', starting with a letter or digit, got \"" + name + "\"");
+    return name;
+}
+
+std::string config_hash(const std::vector<PlannedRun>& runs) {
+    nlohmann::json all = nlohmann::json::array();
+    for (const PlannedRun& r : runs) all.push_back(*r.resolved);
+    const std::string text = runs.size() == 1 ? all[0].dump() : all.dump();
+    return sha256_hex(text.data(), text.size());
+}
+
+std::vector<PlannedRun> configure_runs(const LoadedConfig& config, const RunnerOptions& options, const FieldCache* fields,
+                                       const ContentCache* cache) {
+    const std::string file = config.label();
+    JsonReader top(config.merged, file);
+    const std::string name = read_run_name(top);
+    std::vector<PlannedRun> runs;
+    for (SweepPoint& point : expand_sweep(config.merged, file, name)) {
+        PlannedRun r;
+        r.point = std::move(point);
+        r.resolved = std::make_shared<nlohmann::json>(r.point.config);
+        JsonReader root(r.point.config, file, "", r.resolved, nlohmann::json::json_pointer());
+        read_run_name(root);
+        r.kind = root.choice("kind", experiment_kinds(), "sampling");
+        root.optional<std::string>("description", "", "a string");
+        r.baseline = root.optional<std::string>("baseline", "", "the path of the baseline file (relative to the config)");
+        r.context.config_path = options.config_path;
+        r.context.config_dir = fs::path(config.files.front()).parent_path().string();
+        r.context.run_name = r.point.name;
+        r.context.log = &std::cout;
+        r.context.fields = fields;
+        r.context.cache = cache;
+        r.experiment = make_experiment(r.kind);
+        r.experiment->configure(root, r.context);
+        root.finish();
+        runs.push_back(std::move(r));
+    }
+    return runs;
+}
+
+void print_plan(const LoadedConfig& config, const std::vector<PlannedRun>& runs, const std::string& hash,
+                const RunnerOptions& options, const std::string& cache_root) {
+    std::cout << "plan for " << config.label() << " (kind " << runs[0].kind << ", " << runs.size()
+              << (runs.size() == 1 ? " run" : " runs") << ", config " << hash.substr(0, 12) << "):\n";
+    std::cout << "  cache: " << (options.no_cache ? "off (--no-cache: everything is sampled again)" : cache_root) << "\n";
+    for (size_t i = 0; i < runs.size(); ++i) {
+        const PlannedRun& r = runs[i];
+        if (runs.size() > 1)
+            std::cout << "  [" << i + 1 << "/" << runs.size() << "] " << r.point.name << "  " << r.point.parameters.dump() << "\n";
+        for (const std::string& line : r.experiment->plan(r.context)) std::cout << (runs.size() > 1 ? "      - " : "  - ") << line << "\n";
+    }
+    const std::string name = JsonReader(config.merged, config.label()).raw("name").get<std::string>();
+    std::cout << "  results: " << (fs::path(options.output_root) / name).string()
+              << "/<run-id>/ (manifest.json, metrics.json)" << (options.check ? ", then checked against the baseline" : "")
+              << "\n";
+}
+
+std::string baseline_path_for(const std::string& explicit_path, const std::string& from_config, const std::string& config_dir,
+                              const std::string& name) {
+    if (!explicit_path.empty()) return explicit_path;
+    if (!from_config.empty())
+        return fs::path(from_config).is_absolute() ? from_config : (fs::path(config_dir) / from_config).string();
+    return (fs::path(SDF_SOURCE_DIR) / "results" / "baselines" / (name + ".json")).string();
+}
+
+int report_check(const nlohmann::json& manifest, const nlohmann::json& metrics, const std::string& baseline_path) {
+    if (!fs::is_regular_file(baseline_path))
+        throw std::runtime_error("no baseline at " + baseline_path +
+                                 "; make one from a clean run with: run-experiment --write-baseline RUN_DIR");
+    const CheckResult r = check_run(manifest, metrics, read_json_file(baseline_path), baseline_path);
+    std::cout << r.text();
+    return r.passed() ? 0 : kCheckFailedExitCode;
+}
+
+nlohmann::json combined_metrics(std::vector<PlannedRun>& runs) {
+    if (runs.size() == 1) return runs[0].context.metrics;
+    nlohmann::json m = {{"points", nlohmann::json::array()}, {"regression", nlohmann::json::object()}};
+    for (PlannedRun& r : runs) {
+        nlohmann::json pm = r.context.metrics;
+        if (pm.contains("regression"))
+            for (const auto& [k, v] : pm["regression"].items()) m["regression"][r.point.name + "/" + k] = v;
+        pm.erase("regression");
+        m["points"].push_back({{"name", r.point.name}, {"parameters", r.point.parameters}, {"metrics", pm}});
+    }
+    m["sweep"] = nlohmann::json::array();
+    for (const auto& [k, v] : runs[0].point.parameters.items()) m["sweep"].push_back(k);
+    return m;
+}
+
+nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<PlannedRun>& runs, const std::string& hash,
+                             const std::string& run_id, const std::string& started, const RunnerOptions& options,
+                             const std::string& cache_root) {
+    const PlannedRun& first = runs[0];
+    nlohmann::json manifest = {{"run_id", run_id},
+                               {"name", JsonReader(config.merged, config.label()).raw("name")},
+                               {"kind", first.kind},
+                               {"description", first.resolved->value("description", std::string())},
+                               {"config", {{"path", fs::absolute(config.path).lexically_normal().string()},
+                                           {"files", config.files},
+                                           {"sha256", hash},
+                                           {"as_written", config.as_written}}},
+                               {"started", started},
+                               {"finished", utc_timestamp()},
+                               {"cache", {{"used", !options.no_cache}, {"root", options.no_cache ? "" : cache_root}}},
+                               {"provenance", machine_and_build()}};
+    if (runs.size() == 1) {
+        manifest["config"]["resolved"] = *first.resolved;
+        manifest["inputs"] = first.context.inputs;
+    } else {
+        manifest["config"]["merged"] = config.merged;
+        for (const PlannedRun& r : runs) {
+            const std::string text = r.resolved->dump();
+            manifest["points"].push_back({{"name", r.point.name},
+                                          {"parameters", r.point.parameters},
+                                          {"resolved", *r.resolved},
+                                          {"sha256", sha256_hex(text.data(), text.size())}});
+            manifest["inputs"][r.point.name] = r.context.inputs;
+        }
+    }
+    return manifest;
+}
+
+}  // namespace
+
 int run_experiment(const RunnerOptions& options) {
-    const nlohmann::json config = read_json_file(options.config_path);
-    JsonReader root(config, options.config_path);
-    const std::string name = root.required<std::string>("name", "a run name of letters, digits, '-', '_' or '.'");
-    if (!std::regex_match(name, std::regex("[A-Za-z0-9_.-]+")))
-        root.fail("name", "expected letters, digits, '-', '_' or '.', got \"" + name + "\"");
-    const std::string kind = root.choice("kind", experiment_kinds(), "sampling");
-    root.optional<std::string>("description", "", "a string");
-
-    RunContext ctx;
-    ctx.config_path = options.config_path;
-    ctx.config_dir = fs::path(options.config_path).parent_path().string();
-    ctx.log = &std::cout;
-    std::unique_ptr<Experiment> experiment = make_experiment(kind);
-    experiment->configure(root, ctx);
-    root.finish();
-
-    const std::string config_text = config.dump();
-    const std::string config_hash = sha256_hex(config_text.data(), config_text.size());
+    const LoadedConfig config = load_config(options.config_path);
+    const std::string cache_root = options.cache_dir.empty() ? ContentCache::default_root() : options.cache_dir;
+    const FieldCache fields(cache_root);
+    const ContentCache cache(cache_root);
+    std::vector<PlannedRun> runs =
+        configure_runs(config, options, options.no_cache ? nullptr : &fields, options.no_cache ? nullptr : &cache);
+    const std::string hash = config_hash(runs);
+    const std::string name = JsonReader(config.merged, config.label()).raw("name").get<std::string>();
     if (options.dry_run) {
-        std::cout << "plan for " << options.config_path << " (kind " << kind << ", config " << config_hash.substr(0, 12)
-                  << "):\n";
-        for (const std::string& line : experiment->plan()) std::cout << "  - " << line << "\n";
+        print_plan(config, runs, hash, options, cache_root);
         return 0;
     }
 
     const std::string started = utc_timestamp();
-    const std::string run_id = compact_utc_timestamp() + "-" + config_hash.substr(0, 8);
-    StagedDirectory out((fs::path(options.output_root) / name / run_id).string());
-    ctx.output_dir = out.path();
-    std::cout << "run " << name << "/" << run_id << " (kind " << kind << ")\n";
-    experiment->run(ctx);
+    const fs::path parent = fs::path(options.output_root) / name;
+    CreatedDirectories created;  // declared first: removed (when empty) after the staging directory
+    created.create(parent);
+    remove_stale_staging(parent.string());
+    // Run ids: UTC time to the millisecond and the config hash; a suffix when still taken.
+    const std::string id_base = compact_utc_timestamp() + "-" + hash.substr(0, 8);
+    std::string run_id = id_base;
+    int suffix = 1;
+    while (fs::exists(parent / run_id)) run_id = id_base + "-" + std::to_string(++suffix);
+    StagedDirectory out((parent / run_id).string());
+    std::cout << "run " << name << "/" << run_id << " (kind " << runs[0].kind << (runs.size() > 1 ? ", " + std::to_string(runs.size()) + " sweep points" : std::string()) << ")" << std::endl;
+    for (size_t i = 0; i < runs.size(); ++i) {
+        RunContext& ctx = runs[i].context;
+        ctx.output_dir = runs.size() == 1 ? out.path() : (fs::path(out.path()) / runs[i].point.name).string();
+        if (runs.size() > 1)
+            std::cout << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
+        runs[i].experiment->run(ctx);
+    }
 
-    nlohmann::json manifest = {{"run_id", run_id},
-                               {"name", name},
-                               {"kind", kind},
-                               {"config", {{"path", options.config_path}, {"sha256", config_hash}, {"resolved", config}}},
-                               {"started", started},
-                               {"finished", utc_timestamp()},
-                               {"provenance", machine_and_build()}};
-    if (ctx.metrics.contains("mesh")) manifest["inputs"]["mesh"] = ctx.metrics["mesh"];
-    write_text_atomically(out.path() + "/metrics.json", ctx.metrics.dump(2) + "\n");
+    const nlohmann::json metrics = combined_metrics(runs);
+    nlohmann::json manifest = make_manifest(config, runs, hash, run_id, started, options, cache_root);
+    write_text_atomically(out.path() + "/metrics.json", metrics.dump(2) + "\n");
     write_text_atomically(out.path() + "/manifest.json", manifest.dump(2) + "\n");
-    out.commit();
-    std::cout << "results in " << out.final_path() << "\n";
+    // A run of the same config may have taken this id meanwhile: take the next free one.
+    while (!out.try_commit_as((parent / run_id).string())) {
+        run_id = id_base + "-" + std::to_string(++suffix);
+        manifest["run_id"] = run_id;
+        write_text_atomically(out.path() + "/manifest.json", manifest.dump(2) + "\n", Overwrite::Allow);
+    }
+    std::cout << "results in " << out.final_path() << std::endl;
+    if (!options.check) return 0;
+    return report_check(manifest, metrics,
+                        baseline_path_for(options.baseline, runs[0].baseline, runs[0].context.config_dir, name));
+}
+
+int check_stored_run(const std::string& run_dir, const std::string& baseline_path) {
+    const nlohmann::json manifest = read_json_file((fs::path(run_dir) / "manifest.json").string());
+    const nlohmann::json metrics = read_json_file((fs::path(run_dir) / "metrics.json").string());
+    const nlohmann::json cfg = manifest.at("config");
+    const nlohmann::json resolved = cfg.contains("resolved") ? cfg["resolved"] : cfg.value("merged", nlohmann::json::object());
+    const std::string config_dir = fs::path(cfg.value("path", std::string())).parent_path().string();
+    return report_check(manifest, metrics,
+                        baseline_path_for(baseline_path, resolved.value("baseline", std::string()), config_dir,
+                                          manifest.at("name").get<std::string>()));
+}
+
+int write_baseline(const std::string& run_dir, const std::string& baseline_path, bool force) {
+    const nlohmann::json manifest = read_json_file((fs::path(run_dir) / "manifest.json").string());
+    const nlohmann::json metrics = read_json_file((fs::path(run_dir) / "metrics.json").string());
+    const nlohmann::json baseline = make_baseline(manifest, metrics);
+    const std::string path = baseline_path_for(baseline_path, "", "", manifest.at("name").get<std::string>());
+    write_text_atomically(path, baseline.dump(2) + "\n", force ? Overwrite::Allow : Overwrite::Forbid);
+    std::cout << "baseline " << path << ": " << baseline["metrics"].size() << " metrics from run "
+              << manifest["run_id"].get<std::string>() << "\n";
     return 0;
 }
 

@@ -1,0 +1,47 @@
+/// @file content_cache.h
+/// @brief A content-addressed store of computed results on disk: an entry is a directory
+/// named by the SHA-256 of a JSON key that describes exactly what was computed (inputs,
+/// parameters, code version), so equal keys mean interchangeable results.
+///
+///   <root>/<kind>/<hh>/<sha256>/entry.json     {"key": ..., "info": ..., "created": ...}
+///   <root>/<kind>/<hh>/<sha256>/...            the entry's own files
+///
+/// Entries appear whole or not at all (StagedDirectory) and are never replaced: when two
+/// processes fill the same entry, the first one wins and the second is discarded. The root
+/// is $SDF_CACHE_DIR, else <repo>/cache (git-ignored).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace sdf {
+
+class ContentCache {
+public:
+    explicit ContentCache(std::string root);
+    /// $SDF_CACHE_DIR when set and not empty, else <repo>/cache.
+    static std::string default_root();
+
+    const std::string& root() const { return root_; }
+    static std::string key_hash(const nlohmann::json& key);
+    std::string entry_path(const std::string& kind, const nlohmann::json& key) const;
+
+    /// The entry's directory when it exists (its entry.json present), else nullopt.
+    std::optional<std::string> find(const std::string& kind, const nlohmann::json& key) const;
+    /// The entry's entry.json ("key", "info", "created").
+    nlohmann::json entry_record(const std::string& kind, const nlohmann::json& key) const;
+
+    /// Creates the entry: `write` fills a staging directory, then entry.json is added and
+    /// the directory is moved into place. Returns false (discarding what was written) when
+    /// the entry already exists.
+    bool store(const std::string& kind, const nlohmann::json& key, const nlohmann::json& info,
+               const std::function<void(const std::string& dir)>& write) const;
+
+private:
+    std::string root_;
+};
+
+}  // namespace sdf

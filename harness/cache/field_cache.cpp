@@ -1,0 +1,75 @@
+#include "harness/cache/field_cache.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "harness/config/json_reader.h"
+#include "harness/io/field_file.h"
+#include "harness/provenance/provenance.h"
+
+namespace sdf {
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Exact text of a double ("%a"), so keys never depend on decimal rounding.
+std::string exact(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%a", v);
+    return buf;
+}
+
+}  // namespace
+
+nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l, const SamplerOptions& o) {
+    const bool bcc = l.type == LatticeType::BCC;
+    return {{"what", "sampled_field"},
+            {"code_version", kFieldCodeVersion},
+            {"mesh_sha256", mesh_sha256},
+            {"lattice", {{"type", bcc ? "bcc" : "cc"},
+                         {"origin", {exact(l.origin.x), exact(l.origin.y), exact(l.origin.z)}},
+                         {"spacing", exact(l.spacing)},
+                         {"resolution", {l.resolution.x, l.resolution.y, l.resolution.z}}}},
+            {"sampler", {{"method", o.method},
+                         {"kernel", o.kernel},
+                         {"precision", precision_name(o.precision)},
+                         {"bcc_strategy", bcc ? bcc_strategy_name(o.bcc_strategy) : "-"}}}};
+}
+
+std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {
+    if (!contains(key)) return std::nullopt;
+    const std::string dir = entry_path(key);
+    try {
+        SampledField field = read_field(dir + "/field.json");
+        const nlohmann::json info = read_json_file(dir + "/entry.json").at("info");
+        const nlohmann::json& t = info.at("timings_seconds");
+        field.timings.total = t.at("total");
+        field.timings.kernel = t.at("kernel");
+        field.timings.upload = t.at("upload");
+        field.timings.download = t.at("download");
+        field.timings.point_triangle_pairs = info.at("point_triangle_pairs");
+        field.precision = key.at("sampler").at("precision") == "double" ? Precision::Double : Precision::Float;
+        return field;
+    } catch (const std::exception& e) {
+        throw std::runtime_error("field cache entry " + dir + " is damaged (" + e.what() +
+                                 "); remove that directory or run with --no-cache");
+    }
+}
+
+bool FieldCache::store(const nlohmann::json& key, const SampledField& field) const {
+    const nlohmann::json info = {{"filled_by", field.sampler},
+                                 {"host_cpu", cpu_model()},
+                                 {"timings_seconds", {{"total", field.timings.total},
+                                                      {"kernel", field.timings.kernel},
+                                                      {"upload", field.timings.upload},
+                                                      {"download", field.timings.download}}},
+                                 {"point_triangle_pairs", field.timings.point_triangle_pairs},
+                                 {"git_commit", git_state().commit}};
+    return store_.store("fields", key, info, [&](const std::string& dir) {
+        FieldWriteOptions o;
+        o.dtype = FieldDtype::Float64;
+        write_field(dir + "/field.json", field, o);
+    });
+}
+
+}  // namespace sdf

@@ -1,0 +1,193 @@
+// The content-addressed cache: what the field key holds (and leaves out), exact round trips,
+// entries never replaced, damaged entries reported, stale staging removed, and the default
+// root ($SDF_CACHE_DIR).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "harness/cache/content_cache.h"
+#include "harness/cache/field_cache.h"
+#include "harness/io/atomic_file.h"
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
+}
+
+Lattice lattice(LatticeType type, Int3 res, double h = 0.1) {
+    Lattice l;
+    l.type = type;
+    l.origin = {-1.0, -0.5, 0.25};
+    l.spacing = h;
+    l.resolution = res;
+    return l;
+}
+
+SampledField field(const Lattice& l) {
+    SampledField f;
+    f.lattice = l;
+    f.resize(l.num_points());
+    for (int64_t i = 0; i < f.size(); ++i) {
+        f.distance[size_t(i)] = 0.1 * double(i) - 1.0 / 3.0;  // not representable in float
+        f.gradient[size_t(i)] = {1.0 / 3.0, double(i), -1.0};
+        f.closest_triangle[size_t(i)] = int32_t(i % 7);
+    }
+    f.timings.total = 1.5;
+    f.timings.kernel = 1.25;
+    f.timings.point_triangle_pairs = 1e6;
+    f.sampler = {{"backend", "cpu"}, {"kernel", "vectorized"}, {"threads", 2}};
+    return f;
+}
+
+class Cache : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() / ("sdf_field_cache_test_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    fs::path dir_;
+};
+
+TEST(FieldCacheKey, BackendAndThreadsAreNotPartOfTheKey) {
+    const Lattice l = lattice(LatticeType::BCC, {4, 4, 4});
+    SamplerOptions cpu;
+    cpu.backend = "cpu";
+    cpu.threads = 1;
+    SamplerOptions gpu = cpu;
+    gpu.backend = "cuda";
+    gpu.threads = 0;
+    gpu.device = 1;
+    gpu.points_per_thread = 4;
+    EXPECT_EQ(field_cache_key("abc", l, cpu), field_cache_key("abc", l, gpu));
+}
+
+TEST(FieldCacheKey, EverythingThatChangesTheFieldIsPartOfTheKey) {
+    const Lattice l = lattice(LatticeType::BCC, {4, 4, 4});
+    const SamplerOptions o;
+    const json base = field_cache_key("abc", l, o);
+    auto differs = [&](const json& other) { return ContentCache::key_hash(other) != ContentCache::key_hash(base); };
+    EXPECT_TRUE(differs(field_cache_key("abd", l, o)));
+    Lattice moved = l;
+    moved.origin.x = std::nextafter(moved.origin.x, 1.0);  // one ulp: a different lattice
+    EXPECT_TRUE(differs(field_cache_key("abc", moved, o)));
+    Lattice finer = l;
+    finer.spacing = 0.05;
+    EXPECT_TRUE(differs(field_cache_key("abc", finer, o)));
+    EXPECT_TRUE(differs(field_cache_key("abc", lattice(LatticeType::BCC, {4, 4, 5}), o)));
+    EXPECT_TRUE(differs(field_cache_key("abc", lattice(LatticeType::CC, {4, 4, 4}), o)));
+    SamplerOptions p = o;
+    p.precision = Precision::Double;
+    EXPECT_TRUE(differs(field_cache_key("abc", l, p)));
+    SamplerOptions k = o;
+    k.kernel = "eberly";
+    EXPECT_TRUE(differs(field_cache_key("abc", l, k)));
+    SamplerOptions s = o;
+    s.bcc_strategy = BccStrategy::DoubleResolution;
+    EXPECT_TRUE(differs(field_cache_key("abc", l, s)));
+    EXPECT_EQ(base.at("code_version"), kFieldCodeVersion);
+    // The BCC strategy does not matter for a CC lattice.
+    const Lattice cc = lattice(LatticeType::CC, {4, 4, 4});
+    EXPECT_EQ(field_cache_key("abc", cc, o), field_cache_key("abc", cc, s));
+}
+
+TEST_F(Cache, StoreThenLoadIsExactAndNeverReplaces) {
+    const FieldCache cache(dir_.string());
+    const Lattice l = lattice(LatticeType::BCC, {3, 4, 5});
+    const SampledField f = field(l);
+    const json key = field_cache_key("mesh-hash", l, SamplerOptions{});
+    EXPECT_FALSE(cache.contains(key));
+    EXPECT_FALSE(cache.load(key).has_value());
+    ASSERT_TRUE(cache.store(key, f));
+    EXPECT_TRUE(cache.contains(key));
+    const std::optional<SampledField> back = cache.load(key);
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back->distance, f.distance);  // float64 on disk: bit for bit
+    EXPECT_EQ(back->gradient, f.gradient);
+    EXPECT_EQ(back->closest_triangle, f.closest_triangle);
+    EXPECT_EQ(back->lattice.origin, l.origin);
+    EXPECT_EQ(back->lattice.spacing, l.spacing);
+    EXPECT_EQ(back->lattice.resolution, l.resolution);
+    EXPECT_EQ(back->timings.total, 1.5);
+    EXPECT_EQ(back->timings.kernel, 1.25);
+    // The entry says who filled it.
+    const json entry = ContentCache(dir_.string()).entry_record("fields", key);
+    EXPECT_EQ(entry.at("key"), key);
+    EXPECT_EQ(entry.at("info").at("filled_by").at("backend"), "cpu");
+    // A second store of the same key keeps the first entry.
+    SampledField other = f;
+    other.distance[0] = 42;
+    EXPECT_FALSE(cache.store(key, other));
+    EXPECT_EQ(cache.load(key)->distance[0], f.distance[0]);
+    // Nothing but the entry: no staging leftovers.
+    int entries = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir_)) entries += e.is_directory() && e.path().filename().string()[0] == '.';
+    EXPECT_EQ(entries, 0);
+}
+
+TEST_F(Cache, DamagedEntryIsReportedWithItsDirectory) {
+    const FieldCache cache(dir_.string());
+    const Lattice l = lattice(LatticeType::CC, {2, 2, 2});
+    const json key = field_cache_key("m", l, SamplerOptions{});
+    ASSERT_TRUE(cache.store(key, field(l)));
+    fs::resize_file(fs::path(cache.entry_path(key)) / "field.distance.raw", 3);
+    try {
+        cache.load(key);
+        FAIL() << "a damaged entry loaded";
+    } catch (const std::exception& e) {
+        EXPECT_TRUE(Contains(e.what(), cache.entry_path(key)));
+        EXPECT_TRUE(Contains(e.what(), "damaged"));
+        EXPECT_TRUE(Contains(e.what(), "--no-cache"));
+    }
+}
+
+TEST_F(Cache, ContentCacheStoreRemovesStaleStagingAndWritesEntryRecord) {
+    const ContentCache cache(dir_.string());
+    const json key = {{"what", "test"}, {"n", 1}};
+    const fs::path parent = fs::path(cache.entry_path("things", key)).parent_path();
+    // A staging directory left by a process that no longer exists (pid 2^22 + 1 is above
+    // Linux's default pid_max), and one of this process, which is kept.
+    fs::create_directories(parent / ".x.partial.4194305.0");
+    fs::create_directories(parent / (".y.partial." + std::to_string(::getpid()) + ".99"));
+    EXPECT_TRUE(cache.store("things", key, {{"note", "hi"}}, [](const std::string& d) {
+        write_text_atomically(d + "/payload.txt", "data");
+    }));
+    EXPECT_FALSE(fs::exists(parent / ".x.partial.4194305.0"));
+    EXPECT_TRUE(fs::exists(parent / (".y.partial." + std::to_string(::getpid()) + ".99")));
+    const auto found = cache.find("things", key);
+    ASSERT_TRUE(found.has_value());
+    EXPECT_TRUE(fs::exists(*found + "/payload.txt"));
+    EXPECT_EQ(cache.entry_record("things", key).at("info").at("note"), "hi");
+    EXPECT_FALSE(cache.find("things", {{"what", "test"}, {"n", 2}}).has_value());
+    // A writer that throws leaves no entry.
+    const json other = {{"what", "test"}, {"n", 3}};
+    EXPECT_ANY_THROW(cache.store("things", other, {}, [](const std::string&) { throw std::runtime_error("x"); }));
+    EXPECT_FALSE(cache.find("things", other).has_value());
+    EXPECT_FALSE(fs::exists(cache.entry_path("things", other)));
+}
+
+TEST(ContentCacheRoot, EnvironmentThenRepository) {
+    const char* saved = std::getenv("SDF_CACHE_DIR");
+    const std::string keep = saved ? saved : "";
+    ::setenv("SDF_CACHE_DIR", "/tmp/some/cache", 1);
+    EXPECT_EQ(ContentCache::default_root(), "/tmp/some/cache");
+    ::setenv("SDF_CACHE_DIR", "", 1);
+    EXPECT_EQ(fs::path(ContentCache::default_root()).filename(), "cache");
+    if (saved) ::setenv("SDF_CACHE_DIR", keep.c_str(), 1);
+    else ::unsetenv("SDF_CACHE_DIR");
+}
+
+}  // namespace
+}  // namespace sdf
