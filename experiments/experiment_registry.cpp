@@ -7,6 +7,8 @@ namespace sdf {
 // One line per kind. Each factory is defined in the kind's own file.
 std::unique_ptr<Experiment> make_sampling_experiment();
 std::unique_ptr<Experiment> make_speedup_experiment();
+std::unique_ptr<Experiment> make_reconstruction_experiment();
+std::unique_ptr<Experiment> make_analytic_experiment();
 
 namespace {
 struct Registration {
@@ -16,6 +18,8 @@ struct Registration {
 const Registration kRegistry[] = {
     {"sampling", make_sampling_experiment},
     {"speedup", make_speedup_experiment},
+    {"reconstruction", make_reconstruction_experiment},
+    {"analytic", make_analytic_experiment},
 };
 }  // namespace
 

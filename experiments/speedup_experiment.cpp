@@ -9,6 +9,10 @@
 ///   "lattice_types": ["cc"],
 ///   "backends": [{"name": "cpu_1", "backend": "cpu", "threads": 1, "max_points": 2048}, ...],
 ///   "reference": "cpu_1", "repetitions": 5
+/// Each backend object is a sampler object (sampler_spec.h) plus "name" and "max_points".
+/// CUDA backends on a machine without a GPU are listed as unavailable, never faked. Times
+/// are never taken from the field cache. Meshes whose label is a thesis mesh ("soccer ball",
+/// "bunny", "dragon") get the thesis's Table 3-1 counts beside ours, rows its Table 3-2 times.
 /// A CPU backend with "max_points" below the lattice size is timed on that many lattice
 /// points (evenly strided) and its time scaled by N / n: brute force costs exactly the same
 /// per point, and this keeps a 1-thread 2-million-point run from taking an hour.
@@ -22,6 +26,7 @@
 #include "experiments/common/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
 #include "experiments/experiment.h"
+#include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/sampling/make_sampler.h"
 
@@ -57,47 +62,67 @@ struct Timing {
 class SpeedupExperiment final : public Experiment {
 public:
     void configure(JsonReader& config, const RunContext& context) override {
-        const auto data_path = config.optional<std::vector<std::string>>("data_path", {}, "an array of directories");
-        search_path_ = data_search_path(data_path, context.config_dir);
-        if (config.has("domain")) {
-            JsonReader d = config.object("domain");
-            margin_ = d.optional<double>("margin", 0.1, "a non-negative fraction");
-            d.finish();
-        }
-        for (JsonReader& c : config.objects("cases")) {
+        search_path_ = read_search_path(config, context);
+        base_dir_ = context.config_dir;
+        margin_ = read_domain_margin(config);
+        std::vector<JsonReader> cases = config.objects("cases");
+        if (cases.empty()) config.fail("cases", "expected at least one case, got []");
+        for (JsonReader& c : cases) {
             CaseSpec spec;
             spec.label = c.required<std::string>("label", "a mesh label such as \"dragon\"");
             spec.mesh = parse_mesh_spec(c, "mesh");
+            resolve_mesh_file(spec.mesh, search_path_, base_dir_);
             spec.samples = c.required<std::vector<int64_t>>("samples", "an array of sample counts");
+            if (spec.samples.empty()) c.fail("samples", "expected at least one sample count, got []");
+            for (int64_t n : spec.samples)
+                if (n < 8) c.fail("samples", "expected sample counts of at least 8, got " + std::to_string(n));
             c.finish();
             cases_.push_back(spec);
         }
-        for (const std::string& t : config.optional<std::vector<std::string>>("lattice_types", {"cc"}, "[\"cc\"], [\"bcc\"] or both")) {
+        const auto types = config.optional<std::vector<std::string>>("lattice_types", {"cc"}, "[\"cc\"], [\"bcc\"] or both");
+        if (types.empty()) config.fail("lattice_types", "expected \"cc\", \"bcc\" or both, got []");
+        for (const std::string& t : types) {
             if (t != "cc" && t != "bcc") config.fail("lattice_types", "expected \"cc\" or \"bcc\", got \"" + t + "\"");
             lattice_types_.push_back(t == "cc" ? LatticeType::CC : LatticeType::BCC);
         }
-        for (JsonReader& b : config.objects("backends")) {
+        std::vector<JsonReader> backends = config.objects("backends");
+        if (backends.empty()) config.fail("backends", "expected at least one backend, got []");
+        for (JsonReader& b : backends) {
             BackendSpec spec;
             spec.name = b.required<std::string>("name", "a short name such as \"gpu_tuned\"");
+            for (const BackendSpec& other : backends_)
+                if (other.name == spec.name) b.fail("name", "\"" + spec.name + "\" names two backends");
             spec.max_points = b.optional<int64_t>("max_points", 0, "a number of points to time (0 = all)");
-            spec.options = parse_sampler_options_except(b, {"name", "max_points"});
+            if (spec.max_points < 0) b.fail("max_points", "expected 0 (all) or a positive count, got " + std::to_string(spec.max_points));
+            spec.options = parse_sampler_options(b);  // reads the sampler keys and finishes
             spec.options.progress = false;
             backends_.push_back(spec);
         }
-        reference_ = config.optional<std::string>("reference", backends_.empty() ? "" : backends_[0].name,
+        reference_ = config.optional<std::string>("reference", backends_[0].name,
                                                   "the name of the backend speedups are relative to");
+        if (std::none_of(backends_.begin(), backends_.end(), [&](const BackendSpec& b) { return b.name == reference_; }))
+            config.fail("reference", "names no backend: \"" + reference_ + "\"");
         repetitions_ = config.optional<int>("repetitions", 3, "a positive count");
-        if (repetitions_ < 1) config.fail("repetitions", "expected at least 1");
+        if (repetitions_ < 1) config.fail("repetitions", "expected at least 1, got " + std::to_string(repetitions_));
     }
 
-    std::vector<std::string> plan() const override {
+    std::vector<std::string> plan(const RunContext&) const override {
         std::vector<std::string> lines;
         for (const CaseSpec& c : cases_)
             for (int64_t n : c.samples)
-                for (LatticeType t : lattice_types_)
-                    for (const BackendSpec& b : backends_)
-                        lines.push_back(c.label + " " + std::to_string(n) + " samples " + lattice_type_name(t) + ": " +
-                                        b.name + " x" + std::to_string(repetitions_));
+                for (LatticeType t : lattice_types_) {
+                    const int r = cubic_resolution_for_samples(t, n);
+                    std::string line = c.label + " (" + c.mesh.label() + ") " + with_commas(n) + " samples, " +
+                                       lattice_type_name(t) + " " + std::to_string(r) + "^3" +
+                                       (t == LatticeType::BCC ? " + " + std::to_string(r - 1) + "^3" : "") + ":";
+                    for (const BackendSpec& b : backends_) {
+                        line += " " + b.name + " x" + std::to_string(repetitions_);
+                        if (b.max_points > 0) line += " (on " + with_commas(b.max_points) + " points, scaled)";
+                        if (b.options.backend == "cuda" && !cuda_backend_available()) line += " [unavailable here: reported, not run]";
+                        line += ";";
+                    }
+                    lines.push_back(line + " speedups vs " + reference_ + "; never from the cache");
+                }
         return lines;
     }
 
@@ -107,22 +132,19 @@ public:
             StudyInputs in;
             in.mesh = c.mesh;
             in.search_path = search_path_;
+            in.base_dir = base_dir_;
             const PreparedMesh mesh = load_prepared_mesh(in, log);
-            ctx.metrics["meshes"][c.label] = describe_mesh(mesh);
+            nlohmann::json described = describe_mesh(mesh);
+            ctx.inputs["meshes"][c.label] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
+            for (const ThesisMeshCounts& t : kThesisTable31)
+                if (c.label == t.mesh) described["thesis_table_3_1"] = {{"triangles", t.triangles}, {"vertices", t.vertices}};
+            ctx.metrics["meshes"][c.label] = described;
             for (int64_t samples : c.samples)
                 for (LatticeType type : lattice_types_) run_row(ctx, c, mesh, samples, type);
         }
     }
 
 private:
-    static SamplerOptions parse_sampler_options_except(JsonReader& b, const std::vector<std::string>& skip) {
-        // The backend object is a sampler object plus the keys in `skip`.
-        nlohmann::json rest = b.json();
-        for (const auto& k : skip) rest.erase(k);
-        JsonReader r(rest, b.file(), b.path());
-        return parse_sampler_options(r);
-    }
-
     Timing time_backend(const BackendSpec& b, const PreparedMesh& mesh, const Lattice& lattice,
                         std::vector<double>& subset_distance, const std::vector<Vec3d>& subset) {
         Timing t;
@@ -206,8 +228,14 @@ private:
         }
         if (medians.count(reference_))
             for (auto& e : row["backends"])
-                if (e.contains("total_seconds_median"))
-                    e["speedup_vs_reference"] = medians[reference_] / e["total_seconds_median"].get<double>();
+                if (e.contains("total_seconds_median")) {
+                    const double speedup = medians[reference_] / e["total_seconds_median"].get<double>();
+                    e["speedup_vs_reference"] = speedup;
+                    if (e["name"] != reference_)
+                        ctx.metrics["regression"][c.label + "/" + std::to_string(samples) + "/" + lattice_type_name(type) +
+                                                  "/" + e["name"].get<std::string>() + "/speedup"] = {{"value", speedup},
+                                                                                                      {"kind", "speedup"}};
+                }
         if (const ThesisTiming* th = thesis_timing(c.label, samples))
             row["thesis"] = {{"gpu_seconds", th->gpu_seconds}, {"cpu_seconds", th->cpu_seconds}, {"speedup", th->speedup},
                              {"gpu", "GeForce GTX 465"}};
@@ -243,6 +271,7 @@ private:
     }
 
     std::vector<std::string> search_path_;
+    std::string base_dir_;
     double margin_ = 0.1;
     std::vector<CaseSpec> cases_;
     std::vector<LatticeType> lattice_types_;

@@ -2,30 +2,52 @@
 
 #include <iostream>
 
+#include "harness/build_config.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/sampling/make_sampler.h"
 
 namespace sdf {
+
+std::vector<std::string> read_search_path(JsonReader& config, const RunContext& context) {
+    const auto data_path = config.optional<std::vector<std::string>>("data_path", {}, "an array of directories");
+    return data_search_path(data_path, context.config_dir);
+}
+
+double read_domain_margin(JsonReader& config) {
+    JsonReader domain = config.optional_object("domain");
+    const double margin = domain.optional<double>("margin", 0.1, "a margin as a fraction of the mesh's largest extent");
+    if (!(margin >= 0)) domain.fail("margin", "expected a non-negative fraction, got " + domain.raw("margin").dump());
+    domain.finish();
+    return margin;
+}
+
+void require_backend(const SamplerOptions& options, const JsonReader& config, const std::string& key) {
+    if (options.backend == "cuda" && !cuda_backend_available())
+        config.fail(key + ".backend", std::string("\"cuda\" is not available here: ") +
+                                          (SDF_HAVE_CUDA ? "no CUDA device is present"
+                                                               : "this build has no CUDA backend") +
+                                          " (use \"cpu\", or \"auto\" to take the GPU when there is one)");
+}
 
 StudyInputs read_study_inputs(JsonReader& config, const RunContext& context, bool lattices_required) {
     StudyInputs in;
     in.mesh = parse_mesh_spec(config, "mesh");
-    const auto data_path = config.optional<std::vector<std::string>>("data_path", {}, "an array of directories");
-    in.search_path = data_search_path(data_path, context.config_dir);
-    if (config.has("domain")) {
-        JsonReader domain = config.object("domain");
-        in.margin = domain.optional<double>("margin", 0.1, "a margin as a fraction of the mesh's largest extent");
-        if (in.margin < 0) domain.fail("margin", "expected a non-negative fraction");
-        domain.finish();
-    }
-    if (lattices_required || config.has("lattices"))
-        for (JsonReader& l : config.objects("lattices")) {
+    in.search_path = read_search_path(config, context);
+    in.base_dir = context.config_dir;
+    resolve_mesh_file(in.mesh, in.search_path, in.base_dir);
+    in.margin = read_domain_margin(config);
+    if (lattices_required || config.has("lattices")) {
+        std::vector<JsonReader> lattices = config.objects("lattices");
+        if (lattices.empty()) config.fail("lattices", "expected at least one lattice, got []");
+        for (JsonReader& l : lattices) {
             in.lattices.push_back(parse_lattice_spec(l));
             l.finish();
         }
-    if (config.has("sampler")) {
-        JsonReader s = config.object("sampler");
-        in.sampler = parse_sampler_options(s);
+        in.lattice_labels = lattice_spec_labels(in.lattices, config);
     }
+    JsonReader s = config.optional_object("sampler");
+    in.sampler = parse_sampler_options(s);
+    require_backend(in.sampler, config, "sampler");
     return in;
 }
 
@@ -52,7 +74,7 @@ nlohmann::json describe_mesh(const PreparedMesh& m) {
 }
 
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
-    PreparedMesh mesh = prepare_mesh(load_mesh(inputs.mesh, inputs.search_path));
+    PreparedMesh mesh = prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
     const MeshReport& r = mesh.report;
     log << "mesh " << mesh.name << " (" << mesh.source << "): " << mesh.vertices.size() << " vertices, "
         << mesh.triangles.size() << " triangles, " << r.components << " component(s), "
@@ -60,6 +82,12 @@ PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
         << "\n";
     for (const std::string& w : mesh.warnings()) std::cerr << "warning: " << w << "\n";
     return mesh;
+}
+
+std::string with_commas(int64_t v) {
+    std::string s = std::to_string(v < 0 ? -v : v);
+    for (int i = int(s.size()) - 3; i > 0; i -= 3) s.insert(size_t(i), ",");
+    return v < 0 ? "-" + s : s;
 }
 
 }  // namespace sdf

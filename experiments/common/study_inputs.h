@@ -21,18 +21,32 @@ namespace sdf {
 struct StudyInputs {
     MeshSpec mesh;
     std::vector<std::string> search_path;
-    double margin = 0.1;  ///< fraction of the mesh's largest extent added on every side
+    std::string base_dir;  ///< the config's directory: relative mesh names are looked up there first
+    double margin = 0.1;   ///< fraction of the mesh's largest extent added on every side
     std::vector<LatticeSpec> lattices;
+    std::vector<std::string> lattice_labels;  ///< unique, one per lattice (lattice_spec_labels)
     SamplerOptions sampler;
 };
 
-/// Reads mesh, data_path, domain, lattices and sampler from the root config.
+/// Reads mesh, data_path, domain, lattices and sampler from the root config and validates
+/// what a run would need: the mesh file is located, shape parameters checked, at least one
+/// lattice given and their names unique, and the sampler's backend present on this machine.
 StudyInputs read_study_inputs(JsonReader& config, const RunContext& context, bool lattices_required = true);
+
+/// Reads "data_path" and returns the search path it makes (mesh_spec.h).
+std::vector<std::string> read_search_path(JsonReader& config, const RunContext& context);
+/// Reads the optional "domain" object; returns its margin.
+double read_domain_margin(JsonReader& config);
+/// Throws ConfigError at `key`.backend when `options` name a backend this machine lacks.
+void require_backend(const SamplerOptions& options, const JsonReader& config, const std::string& key);
 
 /// Loads (or generates) and prepares the mesh; prints its summary and warnings to `log`.
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log);
 
 /// Name, source, hash, counts and preparation report, for headers and manifests.
 nlohmann::json describe_mesh(const PreparedMesh& mesh);
+
+/// "512,000"
+std::string with_commas(int64_t v);
 
 }  // namespace sdf

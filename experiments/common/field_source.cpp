@@ -1,0 +1,70 @@
+#include "experiments/common/field_source.h"
+
+#include <cstdio>
+#include <ostream>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "experiments/common/study_inputs.h"
+#include "harness/cache/field_cache.h"
+#include "harness/io/field_file.h"
+#include "harness/sampling/make_sampler.h"
+
+namespace sdf {
+
+nlohmann::json ObtainedField::describe() const {
+    const SamplingTimings& t = field.timings;
+    return {{"lattice", lattice_to_json(field.lattice)},
+            {"cache_key", cache_key},
+            {"from_cache", from_cache},
+            {"sampler", field.sampler},
+            {"seconds", t.total},
+            {"kernel_seconds", t.kernel},
+            {"pairs_per_second", t.pairs_per_second()}};
+}
+
+FieldSource::FieldSource(const RunContext& context, SamplerOptions options)
+    : cache_(context.fields), options_(std::move(options)) {}
+
+FieldSource::~FieldSource() = default;
+
+Sampler& FieldSource::sampler() {
+    if (!sampler_) sampler_ = make_sampler(options_);
+    return *sampler_;
+}
+
+std::string FieldSource::status(const PreparedMesh& mesh, const Lattice& lattice) const {
+    if (!cache_) return "to sample (--no-cache)";
+    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, options_);
+    return cache_->contains(key) ? "cached " + ContentCache::key_hash(key).substr(0, 12) : "to sample";
+}
+
+ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice, const std::string& label,
+                               std::ostream& log) {
+    ObtainedField out;
+    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, options_);
+    out.cache_key = ContentCache::key_hash(key);
+    const std::string what = label + " (" + lattice_notation(lattice) + ", " + with_commas(lattice.num_points()) + " points)";
+    if (cache_) {
+        if (std::optional<SampledField> f = cache_->load(key)) {
+            log << "  " << what << ": from the cache (" << out.cache_key.substr(0, 12) << ")\n";
+            out.field = std::move(*f);
+            out.from_cache = true;
+            return out;
+        }
+    }
+    log << "  " << what << ": sampling with " << sampler().name() << " ..." << std::endl;
+    out.field = sampler().sample(mesh, lattice);
+    char line[160];
+    std::snprintf(line, sizeof line, "  %s: sampled in %.2f s (%.3g pairs/s)", what.c_str(), out.field.timings.total,
+                  out.field.timings.pairs_per_second());
+    log << line;
+    if (cache_) {
+        out.field.mesh = describe_mesh(mesh);
+        const bool stored = cache_->store(key, out.field);
+        log << (stored ? "; cached as " : "; already cached as ") << out.cache_key.substr(0, 12);
+    }
+    log << "\n";
+    return out;
+}
+
+}  // namespace sdf

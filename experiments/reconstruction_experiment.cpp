@@ -1,0 +1,215 @@
+/// @file reconstruction_experiment.cpp
+/// @brief Kind "reconstruction": thesis Figures 5-2..5-11 as numbers. One mesh is sampled on
+/// CC and BCC lattices of matched point counts (through the field cache), the configured
+/// reconstructions are built (cpu_reference/reconstruction), and their errors against the
+/// exact signed distance are measured at probe points (experiments/common/probes.h): RMS,
+/// max and mean |error| over the domain and in a band around the surface, and the angle
+/// between reconstructed and exact gradients in the band.
+///
+///   "metrics": {"domain_probes": 100000, "band_probes": 100000, "band": 1.0, "seed": 1, "threads": 0}
+///     band: half-width of the surface band in units of the coarsest lattice spacing
+///   "render": {"size": [512, 512], "views": ["side", "front"]}
+///     reserved for the ray caster: validated and shown in the plan as a TODO; nothing is rendered
+///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
+/// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/reconstruction/reconstruction.h"
+#include "experiments/common/field_source.h"
+#include "experiments/common/probes.h"
+#include "experiments/common/reconstruction_list.h"
+#include "experiments/common/study_inputs.h"
+#include "experiments/experiment.h"
+#include "harness/io/field_file.h"
+
+namespace sdf {
+namespace {
+
+struct RenderRequest {
+    std::vector<int> size{512, 512};
+    std::vector<std::string> views{"side", "front"};
+};
+
+/// The box every reconstruction covers (probes outside one of them would be clamped there).
+DomainBox<double> common_domain(const std::vector<std::unique_ptr<Reconstruction>>& recons) {
+    DomainBox<double> box = recons.front()->domain();
+    for (const auto& r : recons) {
+        const DomainBox<double> d = r->domain();
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = std::max(box.lo[a], d.lo[a]);
+            box.hi[a] = std::min(box.hi[a], d.hi[a]);
+        }
+    }
+    return box;
+}
+
+class ReconstructionExperiment final : public Experiment {
+public:
+    void configure(JsonReader& config, const RunContext& context) override {
+        inputs_ = read_study_inputs(config, context);
+        recons_ = read_reconstructions(config, inputs_.lattices, inputs_.lattice_labels);
+        JsonReader m = config.optional_object("metrics");
+        probes_.domain_probes = m.optional<int64_t>("domain_probes", 100000, "a number of probes (>= 0)");
+        probes_.band_probes = m.optional<int64_t>("band_probes", 100000, "a number of probes (>= 0)");
+        if (probes_.domain_probes < 0 || probes_.band_probes < 0 || probes_.domain_probes + probes_.band_probes < 1)
+            m.fail("domain_probes", "expected non-negative probe counts, at least one probe in all, got " +
+                                        std::to_string(probes_.domain_probes) + " and " + std::to_string(probes_.band_probes));
+        probes_.band = m.optional<double>("band", 1.0, "the band half-width in lattice spacings (> 0)");
+        if (!(probes_.band > 0)) m.fail("band", "expected a positive number of lattice spacings, got " + std::to_string(probes_.band));
+        probes_.seed = m.optional<uint64_t>("seed", 1, "a random seed (a non-negative integer)");
+        threads_ = m.optional<int>("threads", inputs_.sampler.threads, "a thread count (0 = all cores)");
+        if (threads_ < 0) m.fail("threads", "expected 0 (all cores) or a positive count, got " + std::to_string(threads_));
+        m.finish();
+        JsonReader r = config.optional_object("render");
+        render_.size = r.optional<std::vector<int>>("size", render_.size, "[width, height] in pixels");
+        if (render_.size.size() != 2 || render_.size[0] < 1 || render_.size[1] < 1)
+            r.fail("size", "expected [width, height] with positive entries, got " + nlohmann::json(render_.size).dump());
+        render_.views = r.optional<std::vector<std::string>>("views", render_.views, "an array of view names");
+        if (render_.views.empty()) r.fail("views", "expected at least one view name, got []");
+        r.finish();
+        figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
+    }
+
+    std::vector<std::string> plan(const RunContext& ctx) const override {
+        std::ostringstream quiet;
+        const PreparedMesh mesh = load_prepared_mesh(inputs_, quiet);
+        FieldSource source(ctx, inputs_.sampler);
+        std::vector<std::string> lines = {"mesh " + mesh.name + " (" + mesh.source + ", " +
+                                          with_commas(int64_t(mesh.triangles.size())) + " triangles, sha256 " +
+                                          mesh.content_sha256.substr(0, 12) + ")"};
+        for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
+            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
+            lines.push_back("field " + inputs_.lattice_labels[i] + ": " + lattice_spec_notation(inputs_.lattices[i]) + ", " +
+                            with_commas(l.num_points()) + " points, " + inputs_.sampler.backend + "/" +
+                            inputs_.sampler.method + ": " + source.status(mesh, l));
+        }
+        lines.push_back("probes: " + with_commas(probes_.domain_probes) + " in the common domain + " +
+                        with_commas(probes_.band_probes) + " within " + nlohmann::json(probes_.band).dump() +
+                        " spacing(s) of the surface (seed " + std::to_string(probes_.seed) +
+                        "), exact distances by the sampler's query" + (ctx.cache ? " (or the cache)" : ""));
+        for (const ReconstructionEntry& e : recons_)
+            lines.push_back("reconstruct " + e.id + (e.thesis_panel.empty() ? "" : " (thesis panel " + e.thesis_panel + ")") +
+                            ": errors at the probes");
+        lines.push_back("TODO(ray caster): render views " + join(render_.views) + " at " + std::to_string(render_.size[0]) +
+                        "x" + std::to_string(render_.size[1]) + " for every reconstruction");
+        lines.push_back("TODO(ray caster): image grid (thesis layout: A catmull_rom, B bcc_cubic/true, C bcc_cubic/fd; "
+                        "D tricubic_lm/true, E tricubic_lm/fd) and image metrics");
+        return lines;
+    }
+
+    void run(RunContext& ctx) override {
+        std::ostream& log = *ctx.log;
+        const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
+        ctx.metrics["mesh"] = describe_mesh(mesh);
+        ctx.inputs["mesh"] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
+        FieldSource source(ctx, inputs_.sampler);
+
+        // Fields, then every reconstruction built from them.
+        std::vector<SampledField> fields;
+        double h_ref = 0;
+        for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
+            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
+            ObtainedField got = source.get(mesh, l, inputs_.lattice_labels[i], log);
+            nlohmann::json d = got.describe();
+            d["label"] = inputs_.lattice_labels[i];
+            ctx.metrics["lattices"].push_back(d);
+            ctx.inputs["fields"].push_back({{"label", inputs_.lattice_labels[i]}, {"cache_key", got.cache_key}});
+            ctx.metrics["regression"]["lattices/" + inputs_.lattice_labels[i] + "/points"] = {{"value", l.num_points()},
+                                                                                              {"kind", "exact"}};
+            h_ref = std::max(h_ref, l.spacing);
+            fields.push_back(std::move(got.field));
+        }
+        std::vector<std::unique_ptr<Reconstruction>> recons;
+        for (const ReconstructionEntry& e : recons_) {
+            ReconstructionSpec spec = e.spec;
+            spec.threads = threads_;
+            recons.push_back(std::make_unique<Reconstruction>(fields[e.lattice], spec));
+        }
+
+        // Probes with exact values, then the errors of each reconstruction.
+        const DomainBox<double> box = common_domain(recons);
+        std::string probe_log;
+        const ProbeSet probes = make_probes(mesh, box, probes_.band * h_ref, probes_, source.sampler(), inputs_.sampler,
+                                            ctx.cache, &probe_log);
+        log << "  " << probe_log << "\n";
+        int64_t in_band = 0;
+        for (size_t i = 0; i < probes.points.size(); ++i) in_band += probes.in_band(i);
+        ctx.metrics["probes"] = {{"domain", probes.domain_count},
+                                 {"band_placed", int64_t(probes.points.size()) - probes.domain_count},
+                                 {"in_band", in_band},
+                                 {"band_width", probes.band_width},
+                                 {"band_spacings", probes_.band},
+                                 {"h_ref", h_ref},
+                                 {"seed", probes_.seed},
+                                 {"box", {{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}}}};
+        ctx.metrics["regression"]["probes/in_band"] = {{"value", in_band}, {"kind", "exact"}};
+        print_header(log, h_ref);
+        for (size_t k = 0; k < recons.size(); ++k) measure(ctx, recons_[k], *recons[k], probes, h_ref);
+        ctx.metrics["render"] = {{"status", "TODO: needs the ray caster (not built yet); nothing was rendered"},
+                                 {"size", render_.size},
+                                 {"views", render_.views}};
+        ctx.metrics["thesis_figures"] = figures_;
+    }
+
+private:
+    static std::string join(const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+        return s;
+    }
+
+    static void print_header(std::ostream& log, double h) {
+        char line[256];
+        std::snprintf(line, sizeof line, "  errors in units of h = %.4g (the coarsest spacing):\n  %-44s %10s %10s %10s %10s %8s %8s\n",
+                      h, "reconstruction", "RMS", "max", "band mean", "band RMS", "angle", "p95");
+        log << line;
+    }
+
+    void measure(RunContext& ctx, const ReconstructionEntry& e, const Reconstruction& recon, const ProbeSet& probes,
+                 double h) {
+        const auto got = recon.evaluate(probes.points, threads_);
+        const nlohmann::json err = probe_errors(probes, got);
+        const nlohmann::json& d = err["domain"];
+        const nlohmann::json& b = err["band"];
+        char line[256];
+        std::snprintf(line, sizeof line, "  %-44s %10.4g %10.4g %10.4g %10.4g %7.3g° %7.3g°\n",
+                      (e.id + (e.thesis_panel.empty() ? "" : " (" + e.thesis_panel + ")")).c_str(),
+                      d["rms"].get<double>() / h, err["max_abs"].get<double>() / h, b["mean_abs"].get<double>() / h,
+                      b["rms"].get<double>() / h, b["gradient_angle_mean_deg"].get<double>(),
+                      b["gradient_angle_p95_deg"].get<double>());
+        *ctx.log << line;
+        ctx.metrics["reconstructions"].push_back({{"id", e.id},
+                                                  {"lattice", inputs_.lattice_labels[e.lattice]},
+                                                  {"interpolator", interpolator_name(e.spec.interpolator)},
+                                                  {"derivatives", derivative_source_name(e.spec.derivatives)},
+                                                  {"description", recon.description()},
+                                                  {"thesis_panel", e.thesis_panel},
+                                                  {"errors", err}});
+        nlohmann::json& reg = ctx.metrics["regression"];
+        auto add = [&](const std::string& name, double v) { reg[e.id + "/" + name] = {{"value", v}, {"kind", "error"}}; };
+        add("domain_rms", d["rms"]);
+        add("max_abs", err["max_abs"]);
+        add("band_rms", b["rms"]);
+        add("band_mean_abs", b["mean_abs"]);
+        add("gradient_angle_mean_deg", b["gradient_angle_mean_deg"]);
+        add("gradient_angle_p95_deg", b["gradient_angle_p95_deg"]);
+    }
+
+    StudyInputs inputs_;
+    std::vector<ReconstructionEntry> recons_;
+    ProbeSpec probes_;
+    int threads_ = 0;
+    RenderRequest render_;
+    std::vector<std::string> figures_;
+};
+
+}  // namespace
+
+std::unique_ptr<Experiment> make_reconstruction_experiment() { return std::make_unique<ReconstructionExperiment>(); }
+
+}  // namespace sdf

@@ -1,0 +1,418 @@
+// run-experiment end to end: configs/ci_smoke.json and its committed baseline, a perturbed
+// result failing the check, the field cache across runs and kinds (and --no-cache), sweeps
+// with inheritance, the analytic and speedup kinds at tiny sizes, baselines from clean runs
+// only, and scripts/make-report on a fake results tree.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/build_config.h"
+
+#ifndef RUN_EXPERIMENT_EXE
+#error "RUN_EXPERIMENT_EXE must be defined by CMake"
+#endif
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
+}
+
+std::string read_text(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+struct Result {
+    int code = -1;
+    std::string out, err;
+};
+
+class E2e : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() / ("sdf_e2e_test_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::string at(const std::string& rel) const { return (dir_ / rel).string(); }
+    std::string write(const std::string& rel, const std::string& text) const {
+        const fs::path p = dir_ / rel;
+        fs::create_directories(p.parent_path());
+        std::ofstream(p, std::ios::binary) << text;
+        return p.string();
+    }
+    Result shell(const std::string& command) const {
+        const std::string out = at(".stdout"), err = at(".stderr");
+        const std::string cmd = "cd " + quote(dir_.string()) + " && SDF_CACHE_DIR=" + quote(at("cache")) + " " + command +
+                                " > " + quote(out) + " 2> " + quote(err);
+        const int status = std::system(cmd.c_str());
+        Result r;
+        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.out = read_text(out);
+        r.err = read_text(err);
+        fs::remove(out);
+        fs::remove(err);
+        return r;
+    }
+    Result run(const std::string& args) const { return shell(quote(RUN_EXPERIMENT_EXE) + " " + args); }
+    /// The single run directory under out/<name>/.
+    fs::path only_run(const std::string& name, const std::string& root = "out") const {
+        std::vector<fs::path> runs;
+        for (const auto& e : fs::directory_iterator(dir_ / root / name)) runs.push_back(e.path());
+        EXPECT_EQ(runs.size(), 1u) << name;
+        return runs.empty() ? fs::path() : runs[0];
+    }
+    fs::path dir_;
+};
+
+const std::string kSource = SDF_SOURCE_DIR;
+
+/// A tiny reconstruction config on the procedural box.
+json tiny_study(const std::string& name) {
+    return {{"name", name},
+            {"kind", "reconstruction"},
+            {"mesh", {{"shape", "sphere"}, {"subdivisions", 1}}},
+            {"lattices", {{{"type", "cc"}, {"resolution", {6, 6, 6}}}, {{"type", "bcc"}, {"resolution", {5, 5, 10}}}}},
+            {"sampler", {{"threads", 1}, {"progress", false}}},
+            {"metrics", {{"domain_probes", 200}, {"band_probes", 200}}}};
+}
+
+// ---- the CI-sized config and its committed baseline ----------------------------------------
+
+TEST_F(E2e, CiSmokeRunPassesItsCommittedBaseline) {
+    const Result r = run(quote(kSource + "/configs/ci_smoke.json") + " --output-root out --check --quiet");
+    EXPECT_EQ(r.code, 0) << r.out << r.err;
+    EXPECT_TRUE(Contains(r.out, "check of ci_smoke/"));
+    EXPECT_TRUE(Contains(r.out, "PASSED"));
+    const fs::path run_dir = only_run("ci_smoke");
+    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    EXPECT_EQ(metrics.at("reconstructions").size(), 7u);
+    EXPECT_GE(metrics.at("regression").size(), 40u);
+    const json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    for (const char* key : {"run_id", "config", "provenance", "started", "finished", "inputs"}) EXPECT_TRUE(manifest.contains(key)) << key;
+    EXPECT_TRUE(manifest.at("provenance").at("git").contains("dirty"));
+    EXPECT_TRUE(manifest.at("provenance").at("build").contains("cxx_flags"));
+    EXPECT_TRUE(manifest.at("config").contains("resolved"));
+    EXPECT_EQ(manifest.at("inputs").at("fields").size(), 2u);
+}
+
+TEST_F(E2e, PerturbedResultFailsTheCheckReadably) {
+    ASSERT_EQ(run(quote(kSource + "/configs/ci_smoke.json") + " --output-root out --quiet").code, 0);
+    const fs::path run_dir = only_run("ci_smoke");
+    const std::string baseline = kSource + "/results/baselines/ci_smoke.json";
+    EXPECT_EQ(run("--check-run " + quote(run_dir.string()) + " --baseline " + quote(baseline)).code, 0);
+    // Make one error 50 % worse.
+    json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    const std::string key = "cc-14x14x14/catmull_rom/fd/domain_rms";
+    ASSERT_TRUE(metrics.at("regression").contains(key));
+    const double before = metrics["regression"][key]["value"];
+    metrics["regression"][key]["value"] = before * 1.5;
+    fs::permissions(run_dir / "metrics.json", fs::perms::owner_write, fs::perm_options::add);
+    std::ofstream(run_dir / "metrics.json") << metrics.dump(2);
+    const Result r = run("--check-run " + quote(run_dir.string()));  // the baseline named by the config
+    EXPECT_EQ(r.code, 3) << r.out << r.err;
+    EXPECT_TRUE(Contains(r.out, "FAIL  " + key)) << r.out;
+    EXPECT_TRUE(Contains(r.out, "(+50%)")) << r.out;
+    EXPECT_TRUE(Contains(r.out, "FAILED:")) << r.out;
+    EXPECT_TRUE(Contains(r.out, "1 outside")) << r.out;
+}
+
+// ---- the field cache -------------------------------------------------------------------------
+
+TEST_F(E2e, FieldsAreCachedAcrossRunsAndKindsAndNoCacheResamples) {
+    write("a.json", tiny_study("a").dump());
+    json sampling = tiny_study("s");
+    sampling["kind"] = "sampling";
+    sampling.erase("metrics");
+    sampling["lattices"] = {{{"type", "bcc"}, {"resolution", {5, 5, 10}}}};
+    write("s.json", sampling.dump());
+
+    // The sampling kind fills the BCC entry; the reconstruction kind then finds it.
+    ASSERT_EQ(run("s.json --output-root out --quiet").code, 0);
+    const Result dry = run("a.json --output-root out --dry-run");
+    ASSERT_EQ(dry.code, 0) << dry.err;
+    EXPECT_TRUE(Contains(dry.out, "field cc-6x6x6: cc 6x6x6, 216 points, cpu/brute_force: to sample")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "field bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: cached")) << dry.out;
+    const Result first = run("a.json --output-root out --quiet");
+    ASSERT_EQ(first.code, 0) << first.err;
+    EXPECT_TRUE(Contains(first.out, "cc-6x6x6 (6x6x6, 216 points): sampled")) << first.out;
+    EXPECT_TRUE(Contains(first.out, "bcc-5x5x10 (5x5x10, 189 points): from the cache")) << first.out;
+    EXPECT_TRUE(Contains(first.out, "probes: exact distances computed")) << first.out;
+    // A second run samples nothing and gets the same numbers.
+    const Result second = run("a.json --output-root out2 --quiet");
+    ASSERT_EQ(second.code, 0) << second.err;
+    EXPECT_FALSE(Contains(second.out, "sampled in")) << second.out;
+    EXPECT_TRUE(Contains(second.out, "probes from the cache")) << second.out;
+    const json m1 = json::parse(read_text(only_run("a") / "metrics.json"));
+    const json m2 = json::parse(read_text(only_run("a", "out2") / "metrics.json"));
+    EXPECT_EQ(m1.at("regression"), m2.at("regression"));
+    EXPECT_TRUE(m2.at("lattices")[0].at("from_cache").get<bool>());
+    // --no-cache samples everything again and leaves the cache alone.
+    const Result dry_nc = run("a.json --output-root out3 --dry-run --no-cache");
+    EXPECT_TRUE(Contains(dry_nc.out, "to sample (--no-cache)")) << dry_nc.out;
+    const Result nc = run("a.json --output-root out3 --no-cache --quiet");
+    ASSERT_EQ(nc.code, 0) << nc.err;
+    EXPECT_TRUE(Contains(nc.out, "cc-6x6x6 (6x6x6, 216 points): sampled")) << nc.out;
+    EXPECT_TRUE(Contains(nc.out, "bcc-5x5x10 (5x5x10, 189 points): sampled")) << nc.out;
+    const json m3 = json::parse(read_text(only_run("a", "out3") / "metrics.json"));
+    EXPECT_FALSE(m3.at("lattices")[0].at("from_cache").get<bool>());
+    EXPECT_EQ(m1.at("regression"), m3.at("regression"));
+    EXPECT_FALSE(json::parse(read_text(only_run("a", "out3") / "manifest.json")).at("cache").at("used").get<bool>());
+    // --cache-dir chooses another cache: nothing there yet.
+    EXPECT_TRUE(Contains(run("a.json --dry-run --cache-dir " + quote(at("other"))).out, "bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: to sample"));
+}
+
+// ---- sweeps and inheritance ------------------------------------------------------------------
+
+TEST_F(E2e, SweepWithParentRunsEveryPointInOneRunDirectory) {
+    json parent = tiny_study("unused");
+    parent.erase("name");
+    write("common/base.json", parent.dump());
+    write("cfg/sweep.json", json{{"parent", "../common/base.json"},
+                                 {"name", "sw"},
+                                 {"sweep", {{"lattices[0].resolution", {{5, 5, 5}, {7, 7, 7}}}}},
+                                 {"reconstructions", {{{"lattice", "cc"}, {"interpolator", "catmull_rom"}}}}}
+                                .dump());
+    const Result dry = run("cfg/sweep.json --output-root out --dry-run");
+    ASSERT_EQ(dry.code, 0) << dry.err;
+    EXPECT_TRUE(Contains(dry.out, "2 runs")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "[1/2] sw-resolution_5x5x5")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "[2/2] sw-resolution_7x7x7")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "inheriting from")) << dry.out;
+    const Result r = run("cfg/sweep.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(Contains(r.out, "[2/2] sw-resolution_7x7x7"));
+    const fs::path run_dir = only_run("sw");
+    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    ASSERT_EQ(metrics.at("points").size(), 2u);
+    EXPECT_EQ(metrics["points"][0].at("name"), "sw-resolution_5x5x5");
+    EXPECT_EQ(metrics["points"][1].at("parameters").at("lattices[0].resolution"), json({7, 7, 7}));
+    EXPECT_EQ(metrics["points"][1].at("metrics").at("reconstructions").size(), 1u);
+    EXPECT_TRUE(metrics.at("regression").contains("sw-resolution_7x7x7/cc-7x7x7/catmull_rom/fd/domain_rms"));
+    const json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    ASSERT_EQ(manifest.at("points").size(), 2u);
+    EXPECT_EQ(manifest["points"][1].at("resolved").at("lattices")[0].at("resolution"), json({7, 7, 7}));
+    EXPECT_EQ(manifest["points"][1].at("resolved").at("metrics").at("band"), 1.0);  // a default, filled in
+    EXPECT_EQ(manifest.at("config").at("files").size(), 2u);
+    EXPECT_TRUE(manifest.at("config").at("as_written").contains("parent"));
+    EXPECT_FALSE(manifest.at("config").at("merged").contains("parent"));
+}
+
+// ---- the other kinds at tiny sizes -------------------------------------------------------------
+
+TEST_F(E2e, AnalyticKindTinyTable41AndConvergence) {
+    write("ml.json", json{{"name", "ml_tiny"},
+                          {"kind", "analytic"},
+                          {"threads", 1},
+                          {"table_4_1", {{"resolution", {10, 10, 20}}, {"probes_per_axis", 12}}},
+                          {"convergence", {{"samples", {2000, 4000}}, {"interpolators", {"catmull_rom", "bcc_cubic/fd"}},
+                                           {"probes_per_axis", 8}}}}
+                         .dump());
+    const Result r = run("ml.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(Contains(r.out, "thesis 8.725 / 8.939"));
+    const json m = json::parse(read_text(only_run("ml_tiny") / "metrics.json"));
+    EXPECT_EQ(m.at("table_4_1").at("lattice"), "10x10x20");
+    EXPECT_GT(m.at("table_4_1").at("plain").at("rms").get<double>(), 0.0);
+    EXPECT_EQ(m.at("table_4_1").at("thesis").at("plain"), 8.939);
+    ASSERT_EQ(m.at("convergence").at("curves").size(), 2u);
+    EXPECT_EQ(m["convergence"]["curves"][1].at("id"), "bcc_cubic/fd");
+    EXPECT_EQ(m["convergence"]["curves"][1].at("points").size(), 2u);
+    EXPECT_TRUE(m.at("regression").contains("convergence/catmull_rom/fd/2000/rms"));
+    write("small.json", json{{"name", "s"}, {"kind", "analytic"}, {"convergence", {{"samples", {200}}}}}.dump());
+    const Result small = run("small.json --dry-run");
+    EXPECT_NE(small.code, 0);
+    EXPECT_TRUE(Contains(small.err, "'convergence.samples': 200 samples give trilinear/fd a 6^3 lattice")) << small.err;
+    // Errors name the key.
+    write("bad.json", json{{"name", "b"}, {"kind", "analytic"}, {"convergence", {{"interpolators", {"bcc_cubic/fd_weird"}}}}}.dump());
+    const Result bad = run("bad.json --dry-run");
+    EXPECT_NE(bad.code, 0);
+    EXPECT_TRUE(Contains(bad.err, "'convergence.interpolators'")) << bad.err;
+}
+
+TEST_F(E2e, SpeedupKindReportsGpuBackendsAsUnavailableWithoutAGpu) {
+    write("sp.json", json{{"name", "sp"},
+                          {"kind", "speedup"},
+                          {"cases", {{{"label", "bunny"}, {"mesh", {{"shape", "sphere"}, {"subdivisions", 1}}}, {"samples", {64}}}}},
+                          {"lattice_types", {"cc", "bcc"}},
+                          {"backends", {{{"name", "cpu_1"}, {"backend", "cpu"}, {"threads", 1}, {"max_points", 16}},
+                                        {{"name", "cpu_all"}, {"backend", "cpu"}},
+                                        {{"name", "gpu_tuned"}, {"backend", "cuda"}, {"kernel", "tuned"}}}},
+                          {"repetitions", 1}}
+                         .dump());
+    const Result r = run("sp.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json m = json::parse(read_text(only_run("sp") / "metrics.json"));
+    ASSERT_EQ(m.at("rows").size(), 2u);
+    EXPECT_EQ(m.at("meshes").at("bunny").at("thesis_table_3_1").at("triangles"), 69666);
+    const json& backends = m["rows"][0].at("backends");
+    EXPECT_EQ(backends[0].at("status"), "ok");
+    EXPECT_TRUE(backends[0].at("extrapolated").get<bool>());
+    EXPECT_TRUE(m.at("regression").contains("bunny/64/cc/cpu_all/speedup"));
+#if !SDF_HAVE_CUDA
+    EXPECT_TRUE(Contains(backends[2].at("status").get<std::string>(), "unavailable"));
+    EXPECT_FALSE(backends[2].contains("seconds_median"));
+    EXPECT_FALSE(m.at("regression").contains("bunny/64/cc/gpu_tuned/speedup"));
+#endif
+    write("bad.json", json{{"name", "b"}, {"kind", "speedup"}, {"cases", {{{"label", "x"}, {"mesh", "shape:box"}, {"samples", {64}}}}},
+                           {"backends", {{{"name", "a"}}}}, {"reference", "b"}}
+                          .dump());
+    EXPECT_TRUE(Contains(run("bad.json --dry-run").err, "'reference'"));
+}
+
+// ---- baselines ---------------------------------------------------------------------------------
+
+TEST_F(E2e, BaselinesOnlyFromCleanRuns) {
+    write("a.json", tiny_study("a").dump());
+    ASSERT_EQ(run("a.json --output-root out --quiet").code, 0);
+    const fs::path run_dir = only_run("a");
+    json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    fs::permissions(run_dir / "manifest.json", fs::perms::owner_write, fs::perm_options::add);
+    manifest["provenance"]["git"]["dirty"] = true;
+    std::ofstream(run_dir / "manifest.json") << manifest.dump(2);
+    const Result dirty = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
+    EXPECT_EQ(dirty.code, 1);
+    EXPECT_TRUE(Contains(dirty.err, "dirty work tree")) << dirty.err;
+    EXPECT_FALSE(fs::exists(dir_ / "b/a.json"));
+    manifest["provenance"]["git"] = {{"commit", "0123abcd"}, {"dirty", false}};
+    std::ofstream(run_dir / "manifest.json") << manifest.dump(2);
+    const Result clean = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
+    ASSERT_EQ(clean.code, 0) << clean.err;
+    EXPECT_TRUE(Contains(clean.out, "baseline b/a.json"));
+    EXPECT_EQ(json::parse(read_text(dir_ / "b/a.json")).at("made_from").at("git_commit"), "0123abcd");
+    EXPECT_TRUE(Contains(run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json").err, "already exists"));
+    EXPECT_EQ(run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json --force").code, 0);
+    // A new run checks against it.
+    const Result check = run("a.json --output-root out2 --check --baseline b/a.json --quiet");
+    EXPECT_EQ(check.code, 0) << check.out << check.err;
+    EXPECT_TRUE(Contains(check.out, "PASSED"));
+    // Without a baseline file: a clear error.
+    const Result none = run("a.json --output-root out3 --check --baseline b/none.json --quiet");
+    EXPECT_EQ(none.code, 1);
+    EXPECT_TRUE(Contains(none.err, "no baseline at b/none.json"));
+    EXPECT_TRUE(Contains(none.err, "--write-baseline"));
+    // Modes are exclusive.
+    EXPECT_EQ(run("a.json --check-run " + quote(run_dir.string())).code, 1);
+}
+
+// ---- the report script ------------------------------------------------------------------------------
+
+json fake_manifest(const std::string& name, const std::string& kind, const std::string& finished) {
+    return {{"name", name},
+            {"kind", kind},
+            {"run_id", finished + "-00000000"},
+            {"finished", finished},
+            {"config", {{"resolved", {{"thesis_figures", {"5-3"}}}}}},
+            {"provenance", {{"git", {{"commit", "0123456789ab"}, {"dirty", false}}},
+                            {"cpu", {{"model", "Test CPU"}}},
+                            {"gpu", nullptr},
+                            {"build", {{"build_type", "Release"}}}}}};
+}
+
+json fake_reconstruction_metrics(double scale) {
+    json recs = json::array();
+    for (const auto& [id, panel] : std::vector<std::pair<std::string, std::string>>{{"cc-8x8x8/catmull_rom/fd", "A"},
+                                                                                     {"bcc-6x6x12/bcc_cubic/true", "B"}}) {
+        const std::string interp = id.find("catmull") != std::string::npos ? "catmull_rom" : "bcc_cubic";
+        recs.push_back({{"id", id}, {"interpolator", interp}, {"derivatives", panel == "A" ? "fd" : "true"},
+                        {"lattice", id.substr(0, id.find('/'))}, {"thesis_panel", panel},
+                        {"errors", {{"domain", {{"rms", 0.01 * scale}, {"max_abs", 0.1 * scale}, {"mean_abs", 0.005 * scale}}},
+                                    {"band", {{"rms", 0.02 * scale}, {"max_abs", 0.1 * scale}, {"mean_abs", 0.01 * scale},
+                                              {"gradient_angle_mean_deg", 3.5}, {"gradient_angle_p95_deg", 9.25}}},
+                                    {"max_abs", 0.1 * scale}}}});
+    }
+    return {{"mesh", {{"name", "dragon"}, {"source", "/x/dragon.obj"}, {"triangles", 99902}}},
+            {"lattices", {{{"label", "cc-8x8x8"}, {"lattice", {{"notation", "8x8x8"}, {"points", 512}}}}}},
+            {"probes", {{"h_ref", 0.5}, {"domain", 100}, {"in_band", 80}, {"band_spacings", 1.0}}},
+            {"reconstructions", recs}};
+}
+
+TEST_F(E2e, ReportFromAFakeResultsTree) {
+    if (std::system("python3 --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "python3 is not available";
+    auto put = [&](const std::string& rel, const json& manifest, const json& metrics) {
+        write("res/" + rel + "/manifest.json", manifest.dump());
+        write("res/" + rel + "/metrics.json", metrics.dump());
+    };
+    // Two dragon runs: only the later one is reported.
+    put("dragon/r1", fake_manifest("dragon", "reconstruction", "2026-01-01T00:00:00Z"), fake_reconstruction_metrics(100));
+    put("dragon/r2", fake_manifest("dragon", "reconstruction", "2026-02-01T00:00:00Z"), fake_reconstruction_metrics(1));
+    put("pawn_sweep/r1", fake_manifest("pawn_sweep", "reconstruction", "2026-02-01T00:00:00Z"),
+        {{"points", {{{"name", "pawn_sweep-33k"}, {"parameters", json::object()}, {"metrics", fake_reconstruction_metrics(2)}},
+                     {{"name", "pawn_sweep-200k"}, {"parameters", json::object()}, {"metrics", fake_reconstruction_metrics(1)}}}}});
+    put("ml/r1", fake_manifest("ml", "analytic", "2026-02-01T00:00:00Z"),
+        {{"table_4_1", {{"function", "marschner_lobb"}, {"lattice", "111x111x222"}, {"sigma2", 0.5}, {"sigma_units", "lattice_units"},
+                        {"margin_spacings", 2.0}, {"ratio_rms", 0.98},
+                        {"plain", {{"rms", 0.035}, {"max_abs", 0.2}, {"rms_255", 8.9}, {"l2_norm_255", 9000.0}}},
+                        {"weighted", {{"rms", 0.0343}, {"max_abs", 0.2}, {"rms_255", 8.7}, {"l2_norm_255", 8800.0}}}}},
+         {"convergence", {{"function", "trig"},
+                          {"curves", {{{"id", "bcc_cubic/true"}, {"lattice_type", "bcc"},
+                                       {"points", {{{"lattice", "13x13x26"}, {"lattice_points", 3925}, {"rms", 1e-5}, {"max_abs", 5e-5}, {"gradient_rms", 1e-3}},
+                                                   {{"lattice", "26x26x52"}, {"lattice_points", 33201}, {"rms", 1e-6}, {"max_abs", 5e-6}, {"gradient_rms", 1e-4}}}}}}}}}});
+    put("speedup/r1", fake_manifest("speedup", "speedup", "2026-02-01T00:00:00Z"),
+        {{"reference", "cpu_1"},
+         {"meshes", {{"dragon", {{"source", "/x/dragon-legacy.obj"}, {"triangles", 100000}, {"vertices", 50000}}}}},
+         {"rows", {{{"mesh", "dragon"}, {"samples_requested", 32768}, {"lattice", "cc"}, {"resolution", "32x32x32"}, {"points", 32768},
+                    {"backends", {{{"name", "cpu_1"}, {"status", "ok"}, {"total_seconds_median", 40.0}, {"extrapolated", true},
+                                   {"speedup_vs_reference", 1.0}},
+                                  {{"name", "gpu_tuned"}, {"status", "unavailable (no CUDA device)"}}}}}}}});
+    fs::create_directories(dir_ / "res/dragon/.r3.partial.1.0");  // staging leftovers are ignored
+    const std::string script = quote(kSource + "/scripts/make-report");
+    const Result r = shell(script + " --results res --out report");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    const std::string md = read_text(dir_ / "report/report.md");
+    EXPECT_TRUE(Contains(md, "| dragon | reconstruction | 2026-02-01T00:00:00Z-00000000 |")) << md;
+    EXPECT_FALSE(Contains(md, "2026-01-01T00:00:00Z-00000000"));
+    EXPECT_TRUE(Contains(md, "## Table 3-1: meshes"));
+    EXPECT_TRUE(Contains(md, "| dragon | dragon-legacy.obj | 100,000 | 50,000 | 100,000 | 50,000 |")) << md;
+    EXPECT_TRUE(Contains(md, "| dragon | 32,768 | cc 32x32x32 | 32,768 | 40* | n/a | n/a | 1.232 | 383.6 | 311 |")) << md;
+    EXPECT_TRUE(Contains(md, "## Table 4-1")) << md;
+    EXPECT_TRUE(Contains(md, "| plain | 0.035 | 0.2 | 8.9 | 9000 | 8.939 |")) << md;
+    EXPECT_TRUE(Contains(md, "### dragon (thesis Figures 5-3)")) << md;
+    EXPECT_TRUE(Contains(md, "| cc-8x8x8/catmull_rom/fd | A | 0.02 | 0.2 | 0.02 | 0.04 | 3.5 | 9.25 |")) << md;
+    EXPECT_TRUE(Contains(md, "#### pawn_sweep-200k")) << md;
+    EXPECT_TRUE(Contains(md, "Image grids")) << md;
+    const std::string page = read_text(dir_ / "report/index.html");
+    EXPECT_TRUE(Contains(page, "<table>"));
+    EXPECT_FALSE(Contains(page, "src=\"http"));
+    if (Contains(md, "matplotlib is not available")) GTEST_SKIP() << "matplotlib is not available: plots not checked";
+    for (const char* png : {"speedup_vs_size.png", "analytic_error_vs_samples.png", "pawn_sweep_error_vs_samples.png"}) {
+        EXPECT_TRUE(fs::exists(dir_ / "report" / png)) << png;
+        EXPECT_TRUE(Contains(md, std::string("](") + png + ")")) << png;
+    }
+    EXPECT_TRUE(Contains(page, "data:image/png;base64,"));
+
+    // Sections without results say so; given run directories are used as they are.
+    const Result one = shell(script + " --out report2 res/dragon/r1");
+    ASSERT_EQ(one.code, 0) << one.err;
+    const std::string md2 = read_text(dir_ / "report2/report.md");
+    EXPECT_TRUE(Contains(md2, "No speedup run in the results")) << md2;
+    EXPECT_TRUE(Contains(md2, "No analytic run")) << md2;
+    EXPECT_TRUE(Contains(md2, "| cc-8x8x8/catmull_rom/fd | A | 2 |")) << md2;
+}
+
+}  // namespace
+}  // namespace sdf
