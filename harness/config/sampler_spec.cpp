@@ -6,7 +6,8 @@
 
 namespace sdf {
 
-std::vector<std::string> sampler_kernel_names(const std::string& backend) {
+std::vector<std::string> sampler_kernel_names(const std::string& backend, const std::string& method) {
+    if (method == "bvh") return {"brick", "seeded", "unseeded"};
     if (backend == "cpu") return {"vectorized", "eberly"};
     if (backend == "cuda") return {"tuned", "thesis"};
     return {};
@@ -16,10 +17,9 @@ SamplerOptions parse_sampler_options(JsonReader& r) {
     SamplerOptions o;
     const std::string backend = r.choice("backend", {"cpu", "cuda", "auto"}, "cpu");
     o.backend = backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : backend;
-    // "bvh" is not implemented yet; the BVH work adds it back here.
-    o.method = r.choice("method", {"brute_force"}, "brute_force");
-    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis)");
-    const std::vector<std::string> kernels = sampler_kernel_names(o.backend);
+    o.method = r.choice("method", {"brute_force", "bvh"}, "brute_force");
+    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis; bvh: brick, seeded, unseeded)");
+    const std::vector<std::string> kernels = sampler_kernel_names(o.backend, o.method);
     if (backend == "auto" && !o.kernel.empty())
         r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +
                              "\": name the backend to choose a kernel");
@@ -27,7 +27,7 @@ SamplerOptions parse_sampler_options(JsonReader& r) {
         std::string list;
         for (const auto& k : kernels) list += (list.empty() ? "\"" : ", \"") + k + "\"";
         const std::string near = nearest_match(o.kernel, kernels);
-        r.fail("kernel", "unknown " + o.backend + " kernel \"" + o.kernel + "\"; expected one of " + list +
+        r.fail("kernel", "unknown " + o.backend + (o.method == "bvh" ? " bvh" : "") + " kernel \"" + o.kernel + "\"; expected one of " + list +
                              (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
     }
     o.threads = r.optional<int>("threads", 0, "a thread count (0 = all cores)");

@@ -22,7 +22,7 @@ namespace sdf {
 SamplerOptions parse_sampler_options(JsonReader& r);
 nlohmann::json sampler_options_to_json(const SamplerOptions& o);
 
-/// The kernels a backend accepts ("" = its default is always accepted too).
-std::vector<std::string> sampler_kernel_names(const std::string& backend);
+/// The kernels a backend's method accepts ("" = its default is always accepted too).
+std::vector<std::string> sampler_kernel_names(const std::string& backend, const std::string& method = "brute_force");
 
 }  // namespace sdf

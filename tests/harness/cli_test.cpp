@@ -695,7 +695,7 @@ TEST_F(Cli, DryRunValidatesTheMesh) {
     }
 }
 
-// Kernel names per backend, the unimplemented "bvh", and a CUDA backend on a machine without
+// Kernel names per backend and method, and a CUDA backend on a machine without
 // one are all found by the dry run, naming the file and key.
 TEST_F(Cli, DryRunValidatesTheSampler) {
     struct Case {
@@ -706,7 +706,8 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
                                            {{{"threads", 1}, {"kernel", "tuned"}}, "'sampler.kernel'"},
                                            {{{"backend", "cuda"}, {"kernel", "eberly"}}, "'sampler.kernel'"},
                                            {{{"backend", "auto"}, {"kernel", "eberly"}}, "'sampler.kernel'"},
-                                           {{{"threads", 1}, {"method", "bvh"}}, "'sampler.method'"}}) {
+                                           {{{"threads", 1}, {"method", "bvh"}, {"kernel", "vectorized"}}, "'sampler.kernel'"},
+                                           {{{"threads", 1}, {"method", "octree"}}, "'sampler.method'"}}) {
         config("c.json", {{"sampler", c.sampler}});
         const Result r = experiment("c.json --output-root out --dry-run");
         EXPECT_NE(r.code, 0) << c.sampler.dump();
@@ -714,6 +715,8 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
         EXPECT_TRUE(Contains(r.err, c.key)) << r.err;
     }
     config("c.json", {{"sampler", {{"threads", 1}, {"kernel", "eberly"}}}});
+    EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
+    config("c.json", {{"sampler", {{"threads", 1}, {"method", "bvh"}, {"kernel", "brick"}}}});
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
     config("c.json", {{"sampler", {{"backend", "auto"}, {"threads", 1}}}});
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
