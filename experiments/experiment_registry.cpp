@@ -9,6 +9,7 @@ std::unique_ptr<Experiment> make_sampling_experiment();
 std::unique_ptr<Experiment> make_speedup_experiment();
 std::unique_ptr<Experiment> make_reconstruction_experiment();
 std::unique_ptr<Experiment> make_analytic_experiment();
+std::unique_ptr<Experiment> make_peers_experiment();
 
 namespace {
 struct Registration {
@@ -20,6 +21,7 @@ const Registration kRegistry[] = {
     {"speedup", make_speedup_experiment},
     {"reconstruction", make_reconstruction_experiment},
     {"analytic", make_analytic_experiment},
+    {"peers", make_peers_experiment},
 };
 }  // namespace
 

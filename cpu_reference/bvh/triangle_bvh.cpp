@@ -48,6 +48,9 @@ void write_child(BvhNode& n, int c, const BuiltChild& child) {
     n.count[c] = child.count;
 }
 
+/// Most SAH bins per axis (BvhBuildOptions::bins is checked against it).
+constexpr int kMaxBins = 64;
+
 struct Split {
     int axis = -1;
     int bin = 0;  ///< refs in bins [0, bin) go left
@@ -106,32 +109,32 @@ private:
         const double area = surface_area(box);
         for (int axis = 0; axis < 3; ++axis) {
             if (!(centroids.max[axis] > centroids.min[axis])) continue;
-            std::vector<Bounds3> bin_box(size_t(o_.bins));
-            std::vector<int> bin_count(size_t(o_.bins), 0);
+            Bounds3 bin_box[kMaxBins];
+            int bin_count[kMaxBins] = {};
             for (int i = begin; i < end; ++i) {
                 const int b = bin_of(refs_[size_t(i)].centroid, axis, centroids);
-                bin_box[size_t(b)] = merged(bin_box[size_t(b)], refs_[size_t(i)].box);
-                ++bin_count[size_t(b)];
+                bin_box[b] = merged(bin_box[b], refs_[size_t(i)].box);
+                ++bin_count[b];
             }
             // Right-to-left sweep for the right sides, then left-to-right for the costs.
-            std::vector<double> right_area(size_t(o_.bins), 0.0);
-            std::vector<int> right_count(size_t(o_.bins), 0);
+            double right_area[kMaxBins] = {};
+            int right_count[kMaxBins] = {};
             Bounds3 acc;
             int n = 0;
             for (int b = o_.bins - 1; b > 0; --b) {
-                acc = merged(acc, bin_box[size_t(b)]);
-                n += bin_count[size_t(b)];
-                right_area[size_t(b)] = surface_area(acc);
-                right_count[size_t(b)] = n;
+                acc = merged(acc, bin_box[b]);
+                n += bin_count[b];
+                right_area[b] = surface_area(acc);
+                right_count[b] = n;
             }
             acc = Bounds3{};
             n = 0;
             for (int b = 1; b < o_.bins; ++b) {
-                acc = merged(acc, bin_box[size_t(b - 1)]);
-                n += bin_count[size_t(b - 1)];
-                if (n == 0 || right_count[size_t(b)] == 0) continue;
+                acc = merged(acc, bin_box[b - 1]);
+                n += bin_count[b - 1];
+                if (n == 0 || right_count[b] == 0) continue;
                 const double cost = o_.node_cost +
-                                    (surface_area(acc) * n + right_area[size_t(b)] * right_count[size_t(b)]) / area;
+                                    (surface_area(acc) * n + right_area[b] * right_count[b]) / area;
                 if (cost < best.cost) best = {axis, b, cost};
             }
         }
@@ -225,8 +228,8 @@ BvhView<double> TriangleBvh::view<double>() const {
 
 TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& options) {
     if (mesh.triangles.empty()) throw std::invalid_argument("BVH build: mesh '" + mesh.name + "' has no triangles");
-    if (options.max_leaf_size < 1 || options.bins < 2)
-        throw std::invalid_argument("BVH build: max_leaf_size must be >= 1 and bins >= 2, got " +
+    if (options.max_leaf_size < 1 || options.bins < 2 || options.bins > kMaxBins)
+        throw std::invalid_argument("BVH build: max_leaf_size must be >= 1 and bins in [2, 64], got " +
                                     std::to_string(options.max_leaf_size) + " and " + std::to_string(options.bins));
     const auto start = std::chrono::steady_clock::now();
     TriangleBvh bvh;
