@@ -11,6 +11,22 @@ find_package(Threads REQUIRED)
 # still build and run the samplers (images are then written as PFM/PPM).
 find_package(OpenImageIO CONFIG QUIET)
 set(SDF_HAVE_OIIO ${OpenImageIO_FOUND})
+# Debian 12's OpenImageIO target lists /usr/include/opencv4 even without libopencv-dev, and
+# CMake refuses a target with a missing include directory: keep only the existing ones.
+if(SDF_HAVE_OIIO)
+  foreach(_prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+    get_target_property(_dirs OpenImageIO::OpenImageIO ${_prop})
+    if(_dirs)
+      set(_existing "")
+      foreach(_d IN LISTS _dirs)
+        if(EXISTS "${_d}")
+          list(APPEND _existing "${_d}")
+        endif()
+      endforeach()
+      set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${_prop} "${_existing}")
+    endif()
+  endforeach()
+endif()
 
 if(SDF_BUILD_TESTS)
   find_package(GTest REQUIRED)

@@ -52,26 +52,52 @@ void check_size_and_fov(const std::string& view, int width, int height, double f
                                     " degrees is outside (0, 180)");
 }
 
-/// Distance from the centre of `bounds` along `direction` at which its corners fit the image.
-double fitted_distance(const Bounds3& bounds, const Vec3d& direction, const Vec3d& up, double fov_y_degrees,
-                       double aspect, double margin) {
+/// Distance from `centre` along `direction` at which every point projects inside the image.
+double fitted_distance(const std::vector<Vec3d>& points, const Vec3d& centre, const Vec3d& direction, const Vec3d& up,
+                       double fov_y_degrees, double aspect, double margin) {
     const Vec3d back = normalize_or_zero(direction);
     const Vec3d right = normalize_or_zero(cross(-back, up));
     const Vec3d true_up = cross(right, -back);
     const double fill = std::max(1e-3, 1.0 - 2.0 * margin);
     const double tan_y = std::tan(fov_y_degrees * M_PI / 360.0) * fill;
     const double tan_x = tan_y * aspect;
-    const Vec3d centre = bounds.center();
-    double distance = 0;
-    for (int corner = 0; corner < 8; ++corner) {
-        const Vec3d c{corner & 1 ? bounds.max.x : bounds.min.x, corner & 2 ? bounds.max.y : bounds.min.y,
-                      corner & 4 ? bounds.max.z : bounds.min.z};
-        const Vec3d q = c - centre;
+    double distance = 0, extent = 0;
+    for (const Vec3d& p : points) {
+        const Vec3d q = p - centre;
         const double z = dot(q, back);  // towards the eye
         distance = std::max({distance, z + std::abs(dot(q, right)) / tan_x, z + std::abs(dot(q, true_up)) / tan_y});
+        extent = std::max(extent, length(q));
     }
-    // A flat or point-like box still needs a positive distance
-    return std::max(distance, 1e-6 * std::max(1.0, bounds.diagonal()));
+    // A point-like set still needs a positive distance
+    return std::max(distance, 1e-6 * std::max(1.0, extent));
+}
+
+std::vector<Vec3d> corners(const Bounds3& b) {
+    std::vector<Vec3d> c;
+    for (int k = 0; k < 8; ++k)
+        c.push_back({k & 1 ? b.max.x : b.min.x, k & 2 ? b.max.y : b.min.y, k & 4 ? b.max.z : b.min.z});
+    return c;
+}
+
+CameraSpec fit_named_view(const ViewRequest& request, const std::vector<Vec3d>& points, const Bounds3& bounds,
+                          int width, int height) {
+    check_size_and_fov(request.name, width, height, request.fov_y_degrees);
+    if (bounds.empty()) throw std::invalid_argument("view '" + request.name + "': the bounds to fit are empty");
+    if (!(request.margin >= 0 && request.margin < 0.5))
+        throw std::invalid_argument("view '" + request.name + "': margin " + std::to_string(request.margin) +
+                                    " is outside [0, 0.5)");
+    const NamedView& v = find_named_view(request.name);
+    CameraSpec c;
+    c.name = request.name;
+    c.fov_y_degrees = request.fov_y_degrees;
+    c.width = width;
+    c.height = height;
+    c.target = bounds.center();
+    c.eye = c.target + normalize_or_zero(v.direction) *
+                           fitted_distance(points, c.target, v.direction, v.up, request.fov_y_degrees,
+                                           double(width) / height, request.margin);
+    c.up = v.up;
+    return c;
 }
 
 }  // namespace
@@ -98,27 +124,27 @@ ViewRequest named_view(const std::string& name) {
 CameraSpec resolve_view(const ViewRequest& request, const Bounds3& bounds, int width, int height) {
     check_size_and_fov(request.name, width, height, request.fov_y_degrees);
     CameraSpec c;
-    c.name = request.name;
-    c.fov_y_degrees = request.fov_y_degrees;
-    c.width = width;
-    c.height = height;
     if (request.explicit_camera) {
+        c.name = request.name;
+        c.fov_y_degrees = request.fov_y_degrees;
+        c.width = width;
+        c.height = height;
         c.eye = request.eye;
         c.target = request.target;
         c.up = request.up;
     } else {
-        if (bounds.empty()) throw std::invalid_argument("view '" + request.name + "': the bounds to fit are empty");
-        if (!(request.margin >= 0 && request.margin < 0.5))
-            throw std::invalid_argument("view '" + request.name + "': margin " + std::to_string(request.margin) +
-                                        " is outside [0, 0.5)");
-        const NamedView& v = find_named_view(request.name);
-        const double d = fitted_distance(bounds, v.direction, v.up, request.fov_y_degrees, double(width) / height,
-                                         request.margin);
-        c.target = bounds.center();
-        c.eye = c.target + normalize_or_zero(v.direction) * d;
-        c.up = v.up;
+        c = fit_named_view(request, corners(bounds), bounds, width, height);
     }
     make_camera(c);  // validates
+    return c;
+}
+
+CameraSpec resolve_view(const ViewRequest& request, const std::vector<Vec3d>& points, int width, int height) {
+    if (request.explicit_camera || points.empty()) return resolve_view(request, Bounds3{}, width, height);
+    Bounds3 bounds;
+    for (const Vec3d& p : points) bounds.extend(p);
+    CameraSpec c = fit_named_view(request, points, bounds, width, height);
+    make_camera(c);
     return c;
 }
 

@@ -4,8 +4,9 @@
 ///
 /// A named view is a direction from the target to the eye plus an up vector; the target is
 /// the centre of the bounds and the distance is the smallest at which the 8 corners of the
-/// bounds project inside the image with `margin` (a fraction of the image's width and
-/// height) left free on every side. Directions (mesh axes, y up):
+/// bounds (or, with the points overload, every given point, e.g. the mesh's vertices)
+/// project inside the image with `margin` (a fraction of the image's width and height) left
+/// free on every side. Directions (mesh axes, y up):
 ///
 ///   front  +z        back  -z        side / right  +x        left  -x
 ///   top    +y (up -z)               bottom -y (up +z)
@@ -57,6 +58,10 @@ ViewRequest named_view(const std::string& name);
 /// camera (eye == target, up parallel to the view direction), fov outside (0, 180) or a
 /// non-positive size, naming the view and the value.
 CameraSpec resolve_view(const ViewRequest& request, const Bounds3& bounds, int width, int height);
+
+/// As above, fitted to the projections of `points` (e.g. a mesh's vertices: tighter than
+/// the box's corners for oblique views); the target is the centre of the points' bounds.
+CameraSpec resolve_view(const ViewRequest& request, const std::vector<Vec3d>& points, int width, int height);
 
 /// The kernel camera of a spec (checks it as resolve_view does).
 PinholeCamera<double> make_camera(const CameraSpec& spec);

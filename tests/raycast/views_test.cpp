@@ -63,6 +63,27 @@ TEST(Views, NamedViewsFitEveryCornerWithTheMargin) {
     }
 }
 
+TEST(Views, FittingPointsIsTighterThanTheirBoxAndKeepsThemInside) {
+    std::vector<Vec3d> points;  // a sphere's points: its box corners stick out in oblique views
+    for (int i = 0; i < 400; ++i) {
+        const double t = std::acos(1 - 2 * (i + 0.5) / 400), p = 2.399963 * i;
+        points.push_back(Vec3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)) * 0.5);
+    }
+    Bounds3 b;
+    for (const Vec3d& p : points) b.extend(p);
+    const CameraSpec loose = resolve_view(named_view("three_quarter"), b, 200, 200);
+    const CameraSpec tight = resolve_view(named_view("three_quarter"), points, 200, 200);
+    EXPECT_LT(length(tight.eye - tight.target), 0.8 * length(loose.eye - loose.target));
+    const PinholeCamera<double> c = make_camera(tight);
+    for (const Vec3d& p : points) {
+        const Vec3d q = project(c, p);
+        EXPECT_GE(q.x, 0.04 * 200 - 1e-6);
+        EXPECT_LE(q.x, 200 - 0.04 * 200 + 1e-6);
+        EXPECT_GE(q.y, 0.04 * 200 - 1e-6);
+        EXPECT_LE(q.y, 200 - 0.04 * 200 + 1e-6);
+    }
+}
+
 TEST(Views, DragonPresetsAndExplicitCameras) {
     const Bounds3 b = box({-1, -1, -1}, {1, 1, 1});
     const CameraSpec side = resolve_view(named_view("dragon_side"), b, 100, 100);

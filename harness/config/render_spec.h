@@ -1,0 +1,48 @@
+/// @file render_spec.h
+/// @brief The "render" block of a config: image size, views, reference and error rows,
+/// backend (docs/raycast.md, "Config"). Plain structs plus one parse function, so the
+/// reconstruction experiment and sdf-render read the same thing.
+///
+///   "render": {
+///     "size": [512, 512],              // or one integer for a square image; default 512
+///     "views": ["dragon_side", "dragon_front",          // named views fitted to the mesh
+///               {"name": "closeup", "eye": [0, 0.2, 0.4], "target": [0, 0.12, 0],
+///                "up": [0, 1, 0], "fov": 20},          // an explicit camera
+///               {"view": "front", "fov": 20, "margin": 0.1}],  // a named view, adjusted
+///     "fov": 30,                       // default vertical fov of named views, degrees
+///     "margin": 0.04,                  // default free border of named views (fraction)
+///     "reference": true,               // render the mesh reference (ground truth) and metrics
+///     "error_maps": true,              // heat-map rows in the grid
+///     "heat_max_degrees": 10,          // heat-map scale
+///     "backend": "auto",               // cpu, cuda or auto
+///     "precision": "float",            // cpu casts in float (as the GPU) or double
+///     "grid_downsample": 1             // grid images reduced by this factor
+///   }
+/// Named views: views.h (front, back, side, right, left, top, bottom, three_quarter,
+/// dragon_side, dragon_front). Every key is optional; unknown keys are rejected.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cpu_reference/raycast/views.h"
+#include "harness/config/json_reader.h"
+
+namespace sdf {
+
+struct RenderSpec {
+    int width = 512, height = 512;
+    std::vector<ViewRequest> views{named_view("three_quarter")};
+    bool reference = true;
+    bool error_maps = true;
+    double heat_max_degrees = 10;
+    std::string backend = "auto";
+    std::string precision = "float";
+    int grid_downsample = 1;
+};
+
+/// Reads a "render" object (r reads that object, e.g. config.optional_object("render")) and
+/// calls r.finish(). Errors name the file, the key path, the value and what was expected.
+RenderSpec parse_render_spec(JsonReader& r);
+
+}  // namespace sdf

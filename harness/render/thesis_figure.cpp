@@ -1,0 +1,155 @@
+#include "harness/render/thesis_figure.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "harness/render/heat_map.h"
+#include "harness/render/image_io.h"
+
+namespace sdf {
+namespace {
+
+std::string fixed(double v, int digits) {
+    std::ostringstream s;
+    s.setf(std::ios::fixed);
+    s.precision(digits);
+    s << v;
+    return s.str();
+}
+
+std::string panel_label(const FigurePanelSpec& p, const Lattice& lattice) {
+    return p.letter + "  " + p.caption + " (" + lattice_notation(lattice) + ")";
+}
+
+std::string panel_file_stem(const std::string& name, const FigurePanelSpec& p) {
+    return name + "_" + p.letter + "_" + p.interpolator + "_" + p.derivatives;
+}
+
+ImageRgb reduced(const ImageRgb& image, int factor) { return factor > 1 ? downsample(image, factor) : image; }
+
+/// Rows 1-2 from per-panel images (in panel order A..E).
+void add_thesis_rows(std::vector<GridRow>& rows, const std::vector<GridCell>& cells) {
+    rows.push_back({cells[0], cells[1], cells[2]});
+    rows.push_back({cells[3], cells[4]});
+}
+
+std::vector<GridRow> figure_rows(const ThesisFigure& f, const FigureOptions& o) {
+    std::vector<GridRow> rows;
+    std::vector<GridCell> renders, errors;
+    for (const FigurePanel& p : f.panels) {
+        renders.push_back({reduced(shaded_image(p.image), o.downsample), p.label});
+        if (o.error_rows && f.has_reference)
+            errors.push_back({reduced(normal_error_heat_map(p.image, f.reference, o.heat_max_degrees), o.downsample),
+                              p.spec.letter + "  normal error: mean " + fixed(p.metrics.normal_angle_degrees.mean, 2) +
+                                  ", p95 " + fixed(p.metrics.normal_angle_degrees.p95, 2) + " deg; " +
+                                  std::to_string(p.metrics.coverage_mismatch) + " px coverage"});
+    }
+    add_thesis_rows(rows, renders);
+    if (o.reference_row && f.has_reference) {
+        GridRow r{{reduced(shaded_image(f.reference), o.downsample), "Reference: the mesh, ray-traced"}};
+        if (o.error_rows) {
+            const int w = r[0].image.width;
+            r.push_back({viridis_bar(w, std::max(8, w / 16)),
+                         "normal error 0 - " + fixed(o.heat_max_degrees, 0) + " deg; magenta: coverage differs"});
+        }
+        rows.push_back(r);
+    }
+    if (!errors.empty()) add_thesis_rows(rows, errors);
+    return rows;
+}
+
+nlohmann::json with(const nlohmann::json& base, const nlohmann::json& extra) {
+    nlohmann::json j = base.is_object() ? base : nlohmann::json::object();
+    for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+    return j;
+}
+
+}  // namespace
+
+std::vector<FigurePanelSpec> thesis_figure_panels() {
+    return {{"A", LatticeType::CC, "catmull_rom", "fd", "Catmull-Rom"},
+            {"B", LatticeType::BCC, "bcc_cubic", "true", "BCC cubic, true derivatives"},
+            {"C", LatticeType::BCC, "bcc_cubic", "fd", "BCC cubic, estimated derivatives"},
+            {"D", LatticeType::CC, "tricubic_lm", "true", "CC tricubic, true derivatives"},
+            {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives"}};
+}
+
+ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bcc, const PreparedMesh* mesh,
+                                  const CameraSpec& camera, const FigureOptions& options) {
+    ThesisFigure f;
+    f.camera = camera;
+    f.summary["camera"] = camera_to_json(camera);
+    if (mesh) {
+        f.reference = MeshReferenceRenderer(*mesh).render(camera, options.mesh);
+        f.has_reference = true;
+        f.summary["reference"] = f.reference.info;
+    }
+    for (const FigurePanelSpec& spec : thesis_figure_panels()) {
+        const SampledField& field = spec.lattice == LatticeType::CC ? cc : bcc;
+        if (field.lattice.type != spec.lattice)
+            throw std::invalid_argument("thesis figure: panel " + spec.letter + " needs a " +
+                                        (spec.lattice == LatticeType::CC ? "CC" : "BCC") + " field");
+        FigurePanel p;
+        p.spec = spec;
+        p.label = panel_label(spec, field.lattice);
+        const Reconstruction recon(field, spec.interpolator, spec.derivatives);
+        p.image = render_reconstruction(recon, camera, options.render);
+        p.image.info["lattice"] = lattice_notation(field.lattice);
+        nlohmann::json entry = {{"letter", spec.letter}, {"label", p.label}, {"render", p.image.info}};
+        if (f.has_reference) {
+            p.metrics = compare_images(p.image, f.reference, field.lattice.spacing);
+            p.has_metrics = true;
+            entry["metrics"] = metrics_to_json(p.metrics);
+        }
+        std::fprintf(stderr, "  %s %s: %.2f s%s\n", spec.letter.c_str(), recon.description().c_str(),
+                     p.image.info["seconds"].get<double>(),
+                     p.has_metrics ? (", normal error mean " + fixed(p.metrics.normal_angle_degrees.mean, 2) + " deg")
+                                         .c_str()
+                                   : "");
+        f.summary["panels"].push_back(entry);
+        f.panels.push_back(std::move(p));
+    }
+    f.style.title = options.title;
+    f.rows = figure_rows(f, options);
+    f.grid = make_image_grid(f.rows, f.style);
+    f.summary["grid"] = {{"size", {f.grid.width, f.grid.height}},
+                         {"downsample", options.downsample},
+                         {"heat_max_degrees", options.heat_max_degrees},
+                         {"labels", label_grid_text(f.rows, f.style)}};
+    return f;
+}
+
+std::string write_thesis_figure(const std::string& dir, const std::string& name, const ThesisFigure& figure,
+                                const nlohmann::json& provenance, Overwrite overwrite) {
+    const std::string base = dir + "/" + name;
+    for (const FigurePanel& p : figure.panels) {
+        const std::string stem = dir + "/" + panel_file_stem(name, p.spec);
+        const nlohmann::json attributes =
+            with(provenance, {{"render_seconds", p.image.info.value("seconds", 0.0)},
+                              {"reconstruction", p.image.info.value("reconstruction", std::string())},
+                              {"lattice", p.image.info.value("lattice", std::string())},
+                              {"camera", camera_to_json(figure.camera)},
+                              {"backend", p.image.info.value("backend", std::string())}});
+        write_image(stem + ".png", shaded_image(p.image), attributes, overwrite);
+        write_render_exr(stem + ".exr", p.image, attributes, overwrite);
+        if (p.has_metrics) write_text_atomically(stem + ".metrics.json", metrics_to_json(p.metrics).dump(2) + "\n", overwrite);
+    }
+    if (figure.has_reference) {
+        const nlohmann::json attributes =
+            with(provenance, {{"render_seconds", figure.reference.info.value("seconds", 0.0)},
+                              {"reconstruction", "mesh reference"},
+                              {"camera", camera_to_json(figure.camera)}});
+        write_image(base + "_reference.png", shaded_image(figure.reference), attributes, overwrite);
+        write_render_exr(base + "_reference.exr", figure.reference, attributes, overwrite);
+    }
+    const nlohmann::json grid_attributes = with(provenance, {{"camera", camera_to_json(figure.camera)},
+                                                             {"labels", label_grid_text(figure.rows, figure.style)}});
+    const std::string grid = write_image(base + "_grid.png", figure.grid, grid_attributes, overwrite);
+    write_image(base + "_grid.exr", figure.grid, grid_attributes, overwrite);
+    write_text_atomically(base + "_summary.json", with(figure.summary, {{"provenance", provenance}}).dump(2) + "\n",
+                          overwrite);
+    return grid;
+}
+
+}  // namespace sdf

@@ -1,0 +1,76 @@
+/// @file thesis_figure.h
+/// @brief One figure in the layout of the thesis's Figures 5-2 to 5-11: five reconstructions
+/// of a mesh's distance field rendered from one camera and assembled into a labelled grid,
+/// with optional rows for the mesh reference and for normal-error heat maps, and the image
+/// metrics of every panel against the reference (docs/raycast.md, "Grids").
+///
+///   row 1:  A catmull_rom (CC)   B bcc_cubic, true derivatives   C bcc_cubic, fd
+///   row 2:  D tricubic_lm, true derivatives (CC)   E tricubic_lm, fd (CC)
+///   row 3:  the mesh reference, and the heat maps' colour bar         (reference_row)
+///   rows 4-5: normal error of A..E against the reference, same layout (error_rows)
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cpu_reference/raycast/image_metrics.h"
+#include "cpu_reference/raycast/mesh_reference.h"
+#include "harness/io/atomic_file.h"
+#include "harness/render/image_grid.h"
+#include "harness/render/render_backend.h"
+
+namespace sdf {
+
+/// One panel: which lattice, interpolator and derivative source.
+struct FigurePanelSpec {
+    std::string letter;
+    LatticeType lattice = LatticeType::CC;
+    std::string interpolator, derivatives;
+    std::string caption;  ///< "Catmull-Rom", "BCC cubic, true derivatives", ...
+};
+
+/// The thesis's five panels, in order A..E; row 1 is A-C, row 2 is D-E.
+std::vector<FigurePanelSpec> thesis_figure_panels();
+
+struct FigureOptions {
+    RenderOptions render{};
+    MeshRenderOptions mesh{};
+    bool reference_row = true;   ///< needs a mesh
+    bool error_rows = true;      ///< needs a mesh
+    double heat_max_degrees = 10;
+    std::string title;
+    int downsample = 1;          ///< grid images reduced by this factor (1 = full size)
+};
+
+struct FigurePanel {
+    FigurePanelSpec spec;
+    std::string label;           ///< as drawn under the image
+    RenderedImage image;
+    bool has_metrics = false;
+    ImageMetrics metrics;        ///< against the reference
+};
+
+struct ThesisFigure {
+    CameraSpec camera;
+    std::vector<FigurePanel> panels;
+    bool has_reference = false;
+    RenderedImage reference;
+    GridStyle style;
+    std::vector<GridRow> rows;
+    ImageRgb grid;
+    nlohmann::json summary;      ///< camera, panels (reconstruction, lattice, timings, metrics)
+};
+
+/// Renders the five reconstructions (cc: a CC field with gradients; bcc: a BCC one) and,
+/// when `mesh` is given, the reference and the metrics; assembles the grid.
+ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bcc, const PreparedMesh* mesh,
+                                  const CameraSpec& camera, const FigureOptions& options);
+
+/// Writes into `dir` (which must exist): NAME_grid.png and NAME_grid.exr; per panel
+/// NAME_<letter>_<interpolator>_<derivatives>.png, .exr (all channels) and .metrics.json;
+/// NAME_reference.png/.exr; NAME_summary.json. `provenance` becomes the EXR/PNG attributes
+/// (with render_seconds and reconstruction/camera added per image). Returns the grid path.
+std::string write_thesis_figure(const std::string& dir, const std::string& name, const ThesisFigure& figure,
+                                const nlohmann::json& provenance, Overwrite overwrite = Overwrite::Forbid);
+
+}  // namespace sdf

@@ -1,0 +1,218 @@
+// Grids and image files: the layout's size and centring, labels drawn in their bands (with
+// OpenImageIO), PNG/EXR round trips with the provenance attributes, PPM/PFM, no silent
+// overwrite, and the thesis figure's panels, rows and metrics on a small pawn.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <unistd.h>
+
+#include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "harness/render/heat_map.h"
+#include "harness/render/image_io.h"
+#include "harness/render/label_font.h"
+#include "harness/render/netpbm.h"
+#include "harness/render/thesis_figure.h"
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+public:
+    TempDir() : path_(fs::temp_directory_path() / ("sdf_grid_test." + std::to_string(getpid()))) {
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() { fs::remove_all(path_); }
+    std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+private:
+    fs::path path_;
+};
+
+ImageRgb solid(int w, int h, float r, float g, float b) {
+    ImageRgb im(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) im.set(x, y, r, g, b);
+    return im;
+}
+
+std::vector<GridRow> thesis_shaped_rows() {
+    const ImageRgb img = solid(40, 30, 0.5f, 0.2f, 0.1f);
+    return {{{img, "A"}, {img, "B  label"}, {img, "C"}}, {{img, "D"}, {img, "E"}}};
+}
+
+/// Pixels of `im` in the rectangle that differ from the grey level `bg`.
+int non_background(const ImageRgb& im, int x0, int y0, int w, int h, float bg) {
+    int n = 0;
+    for (int y = y0; y < y0 + h; ++y)
+        for (int x = x0; x < x0 + w; ++x) {
+            const float* p = im.at(x, y);
+            n += (std::abs(p[0] - bg) > 0.05f || std::abs(p[1] - bg) > 0.05f || std::abs(p[2] - bg) > 0.05f);
+        }
+    return n;
+}
+
+TEST(ImageGrid, LayoutSizeAndCentredRows) {
+    GridStyle style;  // padding 12, font 20 -> label band 32, no title
+    const GridLayout g = layout_grid(thesis_shaped_rows(), style);
+    EXPECT_EQ(g.width, 3 * 40 + 4 * 12);
+    EXPECT_EQ(g.height, 12 + 2 * (30 + 32 + 12));
+    ASSERT_EQ(g.cells.size(), 2u);
+    EXPECT_EQ(g.cells[0][0].x, 12);
+    EXPECT_EQ(g.cells[1][0].x, (g.width - (2 * 40 + 3 * 12)) / 2 + 12);  // row 2 centred
+    EXPECT_EQ(g.cells[1][0].y, 12 + 30 + 32 + 12);
+    EXPECT_EQ(g.cells[0][1].label_y, 12 + 30);
+    style.title = "a title";
+    EXPECT_EQ(layout_grid(thesis_shaped_rows(), style).height, g.height + (26 * 8 + 4) / 5);
+}
+
+TEST(ImageGrid, ImagesAndLabelsAreDrawn) {
+    const GridStyle style;
+    const std::vector<GridRow> rows = thesis_shaped_rows();
+    const ImageRgb grid = make_image_grid(rows, style);
+    const GridLayout g = layout_grid(rows, style);
+    ASSERT_EQ(grid.width, g.width);
+    ASSERT_EQ(grid.height, g.height);
+    // Every image is where the layout says
+    for (const auto& row : g.cells)
+        for (const GridCellPlacement& p : row) EXPECT_NEAR(grid.at(p.x + 5, p.y + 5)[1], 0.2f, 1e-6f);
+    if (!have_openimageio()) GTEST_SKIP() << "built without OpenImageIO: labels are not drawn";
+    for (const auto& row : g.cells)
+        for (const GridCellPlacement& p : row)
+            EXPECT_GT(non_background(grid, p.label_x, p.label_y, p.label_width, p.label_height, style.background), 10);
+    // The longer label covers more pixels than a one-letter one
+    const GridCellPlacement& a = g.cells[0][0];
+    const GridCellPlacement& b = g.cells[0][1];
+    EXPECT_GT(non_background(grid, b.label_x, b.label_y, b.label_width, b.label_height, 1.0f),
+              non_background(grid, a.label_x, a.label_y, a.label_width, a.label_height, 1.0f));
+}
+
+TEST(ImageGrid, LabelFontIsFoundOrOverridden) {
+    if (!have_openimageio()) GTEST_SKIP() << "labels need OpenImageIO";
+    const std::string font = find_label_font();
+    EXPECT_TRUE(fs::is_regular_file(font)) << font;
+    setenv("SDF_FONT", font.c_str(), 1);
+    EXPECT_EQ(find_label_font(), font);
+    unsetenv("SDF_FONT");
+}
+
+TEST(ImageFiles, PngAndExrRoundTripWithProvenance) {
+    TempDir dir;
+    const ImageRgb im = solid(7, 5, 0.25f, 0.5f, 1.0f);
+    const nlohmann::json attributes = {{"config_hash", "abc123"}, {"git_commit", "deadbeef"}, {"render_seconds", 0.5}};
+    if (!have_openimageio()) {
+        EXPECT_EQ(write_image(dir.file("a.png"), im, attributes), dir.file("a.ppm"));
+        EXPECT_TRUE(fs::exists(dir.file("a.ppm.json")));
+        GTEST_SKIP() << "built without OpenImageIO: PNG/EXR fall back to PPM/PFM";
+    }
+    EXPECT_EQ(write_image(dir.file("a.png"), im, attributes), dir.file("a.png"));
+    const ImageRgb png = read_image_rgb(dir.file("a.png"));
+    ASSERT_EQ(png.width, 7);
+    ASSERT_EQ(png.height, 5);
+    EXPECT_NEAR(png.at(3, 2)[0], 64.0f / 255.0f, 1e-6f);
+    write_image(dir.file("a.exr"), im, attributes);
+    const ImageRgb exr = read_image_rgb(dir.file("a.exr"));
+    EXPECT_EQ(exr.at(6, 4)[1], 0.5f);  // exact float
+    EXPECT_EQ(read_image_attribute(dir.file("a.exr"), "sdf:config_hash"), "abc123");
+    EXPECT_EQ(read_image_attribute(dir.file("a.exr"), "sdf:git_commit"), "deadbeef");
+    // Never replaced silently
+    EXPECT_THROW(write_image(dir.file("a.png"), im, attributes), std::exception);
+    EXPECT_NO_THROW(write_image(dir.file("a.png"), im, attributes, Overwrite::Allow));
+    // No temporaries left behind
+    int files = 0;
+    for (const auto& e : fs::directory_iterator(dir.file(""))) files += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(files, 2);
+}
+
+TEST(ImageFiles, RenderExrKeepsEveryChannel) {
+    if (!have_openimageio()) GTEST_SKIP() << "built without OpenImageIO";
+    TempDir dir;
+    RenderedImage r(3, 2);
+    r.at(1, 1).hit = HitKind::Surface;
+    r.at(1, 1).depth = 2.5f;
+    r.at(1, 1).normal = Vec3f(0, 0.6f, 0.8f);
+    r.at(1, 1).shade = 0.75f;
+    write_render_exr(dir.file("r.exr"), r, {{"reconstruction", "bcc_cubic/true"}});
+    EXPECT_EQ(read_image_attribute(dir.file("r.exr"), "sdf:reconstruction"), "bcc_cubic/true");
+    EXPECT_EQ(read_image_rgb(dir.file("r.exr")).at(1, 1)[0], 0.75f);
+}
+
+TEST(ImageFiles, PpmAndPfmRoundTrip) {
+    TempDir dir;
+    ImageRgb im(4, 3);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) im.set(x, y, x / 3.0f, y / 2.0f, 0.125f);
+    write_image(dir.file("a.pfm"), im);
+    write_image(dir.file("a.ppm"), im);
+    const ImageRgb pfm = read_netpbm(dir.file("a.pfm"));
+    EXPECT_EQ(pfm.data, im.data);  // rows flipped and back
+    const ImageRgb ppm = read_netpbm(dir.file("a.ppm"));
+    EXPECT_NEAR(ppm.at(3, 2)[0], 1.0f, 1e-6f);
+    EXPECT_NEAR(ppm.at(0, 1)[1], 128.0f / 255.0f, 1e-6f);
+}
+
+TEST(HeatMap, ColoursErrorsAndMismatches) {
+    RenderedImage a(3, 1), b(3, 1);
+    for (RenderedImage* r : {&a, &b})
+        for (PixelRecord& p : r->pixels) {
+            p.hit = HitKind::Surface;
+            p.normal = Vec3f(0, 0, 1);
+        }
+    a.pixels[1].normal = Vec3f(1, 0, 0);   // 90 degrees: clamped to the top of the map
+    b.pixels[2].hit = HitKind::Miss;        // coverage mismatch
+    const ImageRgb h = normal_error_heat_map(a, b, 10);
+    float low[3], high[3];
+    viridis(0, low);
+    viridis(1, high);
+    EXPECT_NEAR(h.at(0, 0)[0], low[0], 1e-6f);
+    EXPECT_NEAR(h.at(1, 0)[1], high[1], 1e-6f);
+    EXPECT_EQ(h.at(2, 0)[0], 1.0f);
+    EXPECT_EQ(h.at(2, 0)[1], 0.0f);
+}
+
+TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
+    const PreparedMesh mesh = prepare_mesh(make_pawn());
+    SamplerOptions so;
+    so.progress = false;
+    auto sampler = make_cpu_brute_force_sampler(so);
+    const SampledField cc = sampler->sample(mesh, fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds, 0.1));
+    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {16, 16, 16}, mesh.bounds, 0.1));
+    FigureOptions options;
+    options.render.progress = false;
+    options.mesh.progress = false;
+    options.title = "pawn";
+    const CameraSpec camera = resolve_view(named_view("front"), mesh.bounds, 48, 64);
+    const ThesisFigure f = render_thesis_figure(cc, bcc, &mesh, camera, options);
+    ASSERT_EQ(f.panels.size(), 5u);
+    const char* letters[] = {"A", "B", "C", "D", "E"};
+    for (size_t i = 0; i < 5; ++i) {
+        EXPECT_EQ(f.panels[i].spec.letter, letters[i]);
+        EXPECT_TRUE(f.panels[i].has_metrics);
+        EXPECT_GT(f.panels[i].metrics.hit_both, 300);
+        EXPECT_LT(f.panels[i].metrics.normal_angle_degrees.mean, 30.0);
+    }
+    EXPECT_EQ(f.panels[1].label, "B  BCC cubic, true derivatives (16x16x32)");
+    // Rows: A-C, D-E, reference + colour bar, heat maps A-C, D-E
+    ASSERT_EQ(f.rows.size(), 5u);
+    EXPECT_EQ(f.rows[0].size(), 3u);
+    EXPECT_EQ(f.rows[1].size(), 2u);
+    EXPECT_EQ(f.rows[2].size(), 2u);
+    const GridLayout g = layout_grid(f.rows, f.style);
+    EXPECT_EQ(f.grid.width, g.width);
+    EXPECT_EQ(f.grid.height, g.height);
+    EXPECT_EQ(g.width, 3 * 48 + 4 * f.style.padding);
+    TempDir dir;
+    const std::string grid = write_thesis_figure(dir.file(""), "pawn", f, {{"config_hash", "x"}});
+    if (const char* keep = std::getenv("SDF_TEST_KEEP_GRID")) fs::copy_file(grid, keep, fs::copy_options::overwrite_existing);
+    EXPECT_TRUE(fs::exists(grid));
+    EXPECT_TRUE(fs::exists(dir.file("pawn_summary.json")));
+    EXPECT_TRUE(fs::exists(dir.file("pawn_B_bcc_cubic_true.metrics.json")));
+}
+
+}  // namespace
+}  // namespace sdf

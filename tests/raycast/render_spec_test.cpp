@@ -1,0 +1,72 @@
+// The "render" config block: defaults, named and explicit views, and errors that name the
+// key, the value and what was expected.
+#include <gtest/gtest.h>
+
+#include "harness/config/render_spec.h"
+
+namespace sdf {
+namespace {
+
+RenderSpec parse(const std::string& text) {
+    static nlohmann::json keep;  // the reader refers to the JSON while parsing
+    keep = nlohmann::json::parse(text);
+    JsonReader r(keep, "test.json", "render");
+    return parse_render_spec(r);
+}
+
+std::string error_of(const std::string& text) {
+    try {
+        parse(text);
+    } catch (const ConfigError& e) {
+        return e.what();
+    }
+    return "(accepted)";
+}
+
+TEST(RenderSpec, Defaults) {
+    const RenderSpec s = parse("{}");
+    EXPECT_EQ(s.width, 512);
+    EXPECT_EQ(s.height, 512);
+    ASSERT_EQ(s.views.size(), 1u);
+    EXPECT_EQ(s.views[0].name, "three_quarter");
+    EXPECT_TRUE(s.reference);
+    EXPECT_EQ(s.backend, "auto");
+}
+
+TEST(RenderSpec, NamedExplicitAndAdjustedViews) {
+    const RenderSpec s = parse(R"({"size": [640, 480], "fov": 25, "views": ["dragon_side", "dragon_front",
+        {"name": "close", "eye": [0, 0.2, 0.4], "target": [0, 0.12, 0], "fov": 20},
+        {"view": "top", "margin": 0.1, "name": "top_wide"}], "backend": "cpu", "grid_downsample": 2})");
+    EXPECT_EQ(s.width, 640);
+    EXPECT_EQ(s.height, 480);
+    ASSERT_EQ(s.views.size(), 4u);
+    EXPECT_EQ(s.views[0].name, "dragon_side");
+    EXPECT_EQ(s.views[0].fov_y_degrees, 25);
+    EXPECT_TRUE(s.views[2].explicit_camera);
+    EXPECT_EQ(s.views[2].eye, Vec3d(0, 0.2, 0.4));
+    EXPECT_EQ(s.views[2].up, Vec3d(0, 1, 0));
+    EXPECT_EQ(s.views[2].fov_y_degrees, 20);
+    EXPECT_FALSE(s.views[3].explicit_camera);
+    EXPECT_EQ(s.views[3].name, "top_wide");
+    EXPECT_EQ(s.views[3].margin, 0.1);
+    EXPECT_EQ(s.grid_downsample, 2);
+    EXPECT_EQ(parse(R"({"size": 256})").height, 256);
+}
+
+TEST(RenderSpec, ErrorsNameKeyValueAndExpectation) {
+    EXPECT_NE(error_of(R"({"views": ["sidee"]})").find("unknown view \"sidee\""), std::string::npos);
+    EXPECT_NE(error_of(R"({"views": ["sidee"]})").find("render.views[0]"), std::string::npos);
+    EXPECT_NE(error_of(R"({"size": [0, 5]})").find("render.size"), std::string::npos);
+    EXPECT_NE(error_of(R"({"fov": 200})").find("(0, 180)"), std::string::npos);
+    EXPECT_NE(error_of(R"({"views": [{"name": "x", "eye": [0, 0, 1]}]})").find("target"), std::string::npos);
+    EXPECT_NE(error_of(R"({"views": [{"name": "x", "eye": [0, 0, 1], "target": [0, 0, 0], "up": [0, 0, 2]}]})")
+                  .find("parallel"), std::string::npos);
+    EXPECT_NE(error_of(R"({"views": [{"name": "x", "eye": [0, 0, 1], "target": [0, 0, 0], "fov": 30, "zoom": 2}]})")
+                  .find("zoom"), std::string::npos);
+    EXPECT_NE(error_of(R"({"backend": "gpu"})").find("backend"), std::string::npos);
+    EXPECT_NE(error_of(R"({"sise": 5})").find("sise"), std::string::npos);
+    EXPECT_NE(error_of(R"({"views": []})").find("non-empty"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sdf
