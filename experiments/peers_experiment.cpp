@@ -15,6 +15,8 @@
 /// are checked against that reference. Rows: time (build, query, total), threads, points/s,
 /// max |distance error|, sign disagreements, notes. GPU rows without a GPU say
 /// "unavailable"; peers whose package is missing say "not built".
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -39,6 +41,13 @@ struct CaseSpec {
     MeshSpec mesh;
     std::vector<int64_t> samples;
 };
+
+/// CPU time of this process, all threads (robust to other load on a shared machine).
+double process_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 double median_of(std::vector<double> s) {
     std::sort(s.begin(), s.end());
@@ -190,15 +199,18 @@ private:
             auto sampler = make_sampler(o);
             std::vector<double> query, total;
             SampledField f;
+            const double cpu0 = process_cpu_seconds();
             for (int r = 0; r < repetitions_; ++r) {
                 f = sampler->sample(mesh, lattice);  // the first call builds the BVH
                 query.push_back(f.timings.kernel);
                 total.push_back(f.timings.total);
             }
+            const double cpu = (process_cpu_seconds() - cpu0) / repetitions_;
             if (reference.empty()) reference = f.distance;
             nlohmann::json row = base_row(label, lattice, mesh, "bvh_cpu", "ours");
             const double build = f.sampler["bvh"]["build_seconds"].get<double>();
             set_times(row, build, median_of(query), lattice.num_points());
+            row["cpu_seconds"] = cpu;
             row["threads"] = resolve_thread_count(t);
             set_errors(row, compare(f.distance, reference, {}, true), true);
             row["notes"] = "reference field (exact: equals brute force, tests/cpu_reference/bvh); kernel " +
@@ -226,6 +238,7 @@ private:
             auto sampler = make_sampler(o);
             std::vector<double> secs;
             std::vector<PointSample> res;
+            const double cpu0 = process_cpu_seconds();
             for (int r = 0; r < repetitions_; ++r) {
                 const auto start = std::chrono::steady_clock::now();
                 res = sampler->query(mesh, pts);
@@ -235,6 +248,7 @@ private:
             for (const auto& s : res) d.push_back(s.distance);
             nlohmann::json row = base_row(label, lattice, mesh, "brute_cpu", "ours");
             set_times(row, 0.0, median_of(secs) * double(n) / double(pts.size()), n);
+            row["cpu_seconds"] = (process_cpu_seconds() - cpu0) / repetitions_ * double(n) / double(pts.size());
             row["threads"] = resolve_thread_count(t);
             set_errors(row, compare(d, reference, index, true), true);
             row["notes"] = "timed on " + std::to_string(pts.size()) + " evenly strided points and scaled to the lattice";
@@ -282,11 +296,14 @@ private:
             return;
         }
         for (int t : threads_) {
+            const double cpu0 = process_cpu_seconds();
             const peers::PeerResult r = peer.adapter->run(mesh, lattice, points, resolve_thread_count(t));
+            const double cpu = r.cpu_seconds >= 0 ? r.cpu_seconds : process_cpu_seconds() - cpu0;
             nlohmann::json row = base_row(label, lattice, mesh, peer.name, "peer");
             row["version"] = peer.adapter->version();
             row["exact"] = peer.adapter->exact();
             set_times(row, r.build_seconds, r.query_seconds, lattice.num_points());
+            row["cpu_seconds"] = cpu;
             row["threads"] = r.threads;
             set_errors(row, compare(r.distance, reference, {}, r.is_signed), r.is_signed);
             if (!r.in_band.empty()) {
@@ -337,15 +354,16 @@ private:
             if (!ours || !best) continue;
             const double q = (*best)["query_seconds"].get<double>() / (*ours)["query_seconds"].get<double>();
             const double tot = (*best)["total_seconds"].get<double>() / (*ours)["total_seconds"].get<double>();
+            const double cpu = (*best)["cpu_seconds"].get<double>() / (*ours)["cpu_seconds"].get<double>();
             const nlohmann::json s = {{"mesh", label}, {"resolution", res}, {"threads", threads},
                                       {"fastest_exact_peer", (*best)["method"]}, {"query_speedup", q},
-                                      {"total_speedup", tot}, {"goal", 1.5}};
+                                      {"total_speedup", tot}, {"cpu_time_ratio", cpu}, {"goal", 1.5}};
             ctx.metrics["summary"].push_back(s);
             ctx.metrics["regression"][label + "/" + res + "/" + std::to_string(threads) + "/bvh_cpu_vs_fastest_peer"] =
                 {{"value", q}, {"kind", "speedup"}};
             char line[256];
-            std::snprintf(line, sizeof line, "    => bvh_cpu vs fastest exact peer (%s), %d threads: %.2fx query, %.2fx build+query\n",
-                          (*best)["method"].get<std::string>().c_str(), threads, q, tot);
+            std::snprintf(line, sizeof line, "    => bvh_cpu vs fastest exact peer (%s), %d threads: %.2fx query, %.2fx build+query, %.2fx CPU time\n",
+                          (*best)["method"].get<std::string>().c_str(), threads, q, tot, cpu);
             *ctx.log << line;
         }
     }
@@ -359,10 +377,10 @@ private:
             const std::string threads = row["threads"].is_string() ? row["threads"].get<std::string>() : std::to_string(row["threads"].get<int>());
             const std::string signs = row["sign_disagreements"].is_string() ? "n/a" : std::to_string(row["sign_disagreements"].get<int64_t>());
             std::snprintf(line, sizeof line,
-                          "    %-10s %4s threads  build %8.4f s  query %9.4f s  %10.4g points/s  max|dd| %.3g (unsigned %.3g)  "
+                          "    %-10s %4s threads  build %8.4f s  query %9.4f s  cpu %9.4f s  %10.4g points/s  max|dd| %.3g (unsigned %.3g)  "
                           "sign disagreements %s\n",
                           row["method"].get<std::string>().c_str(), threads.c_str(), row["build_seconds"].get<double>(),
-                          row["query_seconds"].get<double>(), row["points_per_second"].get<double>(),
+                          row["query_seconds"].get<double>(), row.value("cpu_seconds", -1.0), row["points_per_second"].get<double>(),
                           row["max_abs_error"].get<double>(), row["max_abs_error_unsigned"].get<double>(), signs.c_str());
         }
         *ctx.log << line << std::flush;

@@ -85,7 +85,9 @@ public:
         r.build_seconds = j["build_seconds"].get<double>();
         r.query_seconds = j["signed_seconds"].get<double>();
         r.distance.assign(signed_distance.begin(), signed_distance.end());
+        r.cpu_seconds = j["cpu_seconds"].get<double>();
         r.details = {{"unsigned_query_seconds", j["unsigned_seconds"]},
+                     {"cpu_seconds_note", "includes the unsigned compute_distance call as well"},
                      {"sign", "ray intersection count (compute_signed_distance)"},
                      {"precision", "float"},
                      {"interface", "python3-open3d via experiments/peers/open3d_peer.py"}};

@@ -25,6 +25,7 @@ struct PeerResult {
     double build_seconds = 0;       ///< acceleration structure (BVH, tree, grid set-up)
     double query_seconds = 0;       ///< the distance queries (and signs) themselves
     int threads = 1;                ///< threads the peer actually used
+    double cpu_seconds = -1;        ///< CPU time of build + query over all threads, if the adapter measures it (else the experiment does)
     nlohmann::json details = nlohmann::json::object();  ///< band width, sign method, split times
 };
 
