@@ -9,7 +9,8 @@
 ///   "metrics": {"domain_probes": 100000, "band_probes": 100000, "band": 1.0, "seed": 1, "threads": 0}
 ///     band: half-width of the surface band in units of the coarsest lattice spacing
 ///   "render": {"size": [512, 512], "views": ["side", "front"]}
-///     reserved for the ray caster: validated and shown in the plan as a TODO; nothing is rendered
+///     reserved for the ray caster: validated (views named in cpu_reference/raycast/views.h)
+///     and shown in the plan as a TODO; nothing is rendered yet
 ///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
 /// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <sstream>
 
 #include "cpu_reference/lattice/lattice_fitting.h"
+#include "cpu_reference/raycast/views.h"
 #include "cpu_reference/reconstruction/reconstruction.h"
 #include "experiments/common/field_source.h"
 #include "experiments/common/probes.h"
@@ -71,6 +73,14 @@ public:
             r.fail("size", "expected [width, height] with positive entries, got " + nlohmann::json(render_.size).dump());
         render_.views = r.optional<std::vector<std::string>>("views", render_.views, "an array of view names");
         if (render_.views.empty()) r.fail("views", "expected at least one view name, got []");
+        for (const std::string& v : render_.views)
+            if (!is_named_view(v)) {
+                std::string list;
+                for (const std::string& n : named_view_names()) list += (list.empty() ? "" : ", ") + n;
+                const std::string near = nearest_match(v, named_view_names());
+                r.fail("views", "unknown view \"" + v + "\"; expected one of " + list +
+                                    (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+            }
         r.finish();
         figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
     }
