@@ -23,12 +23,18 @@ nlohmann::json ObtainedField::describe() const {
 }
 
 FieldSource::FieldSource(const RunContext& context, SamplerOptions options)
-    : cache_(context.fields), options_(std::move(options)) {}
+    : cache_(context.fields), options_(std::move(options)), where_(context.config_path + ": key 'sampler'") {}
 
 FieldSource::~FieldSource() = default;
 
 Sampler& FieldSource::sampler() {
-    if (!sampler_) sampler_ = make_sampler(options_);
+    if (!sampler_) {
+        try {
+            sampler_ = make_sampler(options_);
+        } catch (const std::exception& e) {
+            throw std::runtime_error(where_ + ": " + e.what());
+        }
+    }
     return *sampler_;
 }
 

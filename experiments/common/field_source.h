@@ -38,6 +38,7 @@ private:
     const FieldCache* cache_;
     SamplerOptions options_;
     std::unique_ptr<Sampler> sampler_;
+    std::string where_;  ///< "<config>: key 'sampler'", for errors of the sampler's making
 };
 
 }  // namespace sdf

@@ -74,7 +74,14 @@ nlohmann::json describe_mesh(const PreparedMesh& m) {
 }
 
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
-    PreparedMesh mesh = prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
+    PreparedMesh mesh;
+    try {
+        mesh = prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
+    } catch (const ConfigError&) {
+        throw;  // already names the config file and key
+    } catch (const std::exception& e) {
+        throw std::runtime_error(inputs.mesh.config_file + ": key '" + inputs.mesh.key_path + "': " + e.what());
+    }
     const MeshReport& r = mesh.report;
     log << "mesh " << mesh.name << " (" << mesh.source << "): " << mesh.vertices.size() << " vertices, "
         << mesh.triangles.size() << " triangles, " << r.components << " component(s), "

@@ -613,6 +613,7 @@ TEST_F(Cli, FailedRunLeavesNoDirectories) {
     const Result late = experiment("late.json --output-root out/deeper");
     EXPECT_NE(late.code, 0);
     EXPECT_TRUE(Contains(late.err, "nan.obj:3")) << late.err;
+    EXPECT_TRUE(Contains(late.err, "late.json: key 'mesh'")) << late.err;  // run-time errors name the config too
     EXPECT_FALSE(fs::exists(dir_ / "out")) << count_files(dir_ / "out");
     // An output root that existed before is kept.
     fs::create_directories(dir_ / "kept");
