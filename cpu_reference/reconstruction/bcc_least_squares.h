@@ -19,22 +19,10 @@
 
 #include <Eigen/Dense>
 
+#include "cpu_reference/reconstruction/stencil_weighting.h"
 #include "kernels/reconstruction/bcc_stencils.h"
 
 namespace sdf {
-
-enum class SigmaUnits { LatticeUnits, Spacing };
-
-struct StencilWeighting {
-    bool gaussian = false;       ///< false: W = I (plain least squares)
-    double sigma2 = 0.5;         ///< sigma^2 of eq. 4-15, in `units`^2
-    SigmaUnits units = SigmaUnits::LatticeUnits;
-};
-
-const char* sigma_units_name(SigmaUnits u);
-
-/// sigma^2 expressed in lattice units (h/2)^2.
-double sigma2_in_lattice_units(const StencilWeighting& w);
 
 /// Gaussian weights are raised to this floor so that the fit stays well conditioned: it only
 /// acts where exp(-r^2 / sigma^2) < 1e-12, i.e. for sigma^2 < 0.5 (lattice units) or for the

@@ -2,6 +2,7 @@
 
 #include "cpu_reference/parallel/parallel_for.h"
 #include "cpu_reference/reconstruction/bcc_cubic_tables.h"
+#include "cpu_reference/reconstruction/bcc_least_squares.h"
 #include "kernels/reconstruction/bcc_stencils.h"
 #include "kernels/reconstruction/cc_finite_differences.h"
 

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/reconstruction/bcc_least_squares.h"
+#include "cpu_reference/reconstruction/stencil_weighting.h"
 #include "kernels/reconstruction/interpolators.h"
 
 namespace sdf {
