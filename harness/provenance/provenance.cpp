@@ -93,6 +93,13 @@ nlohmann::json machine_kind(const nlohmann::json& provenance) {
     return kind;
 }
 
+nlohmann::json load_average() {
+    std::ifstream in("/proc/loadavg");
+    double a = 0, b = 0, c = 0;
+    if (!(in >> a >> b >> c)) return nullptr;
+    return {a, b, c};
+}
+
 nlohmann::json machine_and_build() {
     char host[256] = "unknown";
     gethostname(host, sizeof host - 1);

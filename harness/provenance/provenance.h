@@ -27,6 +27,9 @@ std::string compact_utc_timestamp();
 /// The machine a result was measured on, from a provenance object (machine_and_build()):
 /// {"cpu": model, "gpu": name or null}. Timings are comparable only between equal kinds.
 nlohmann::json machine_kind(const nlohmann::json& provenance);
+/// The 1-, 5- and 15-minute load averages (/proc/loadavg), or null where unknown: timings
+/// taken on a loaded machine are not comparable.
+nlohmann::json load_average();
 /// Host name, CPU model and hardware threads, GPU; build; git.
 nlohmann::json machine_and_build();
 

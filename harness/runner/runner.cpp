@@ -143,8 +143,8 @@ nlohmann::json combined_metrics(std::vector<PlannedRun>& runs) {
 }
 
 nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<PlannedRun>& runs, const std::string& hash,
-                             const std::string& run_id, const std::string& started, const RunnerOptions& options,
-                             const std::string& cache_root) {
+                             const std::string& run_id, const std::string& started, const nlohmann::json& load_at_start,
+                             const RunnerOptions& options, const std::string& cache_root) {
     const PlannedRun& first = runs[0];
     nlohmann::json manifest = {{"run_id", run_id},
                                {"name", JsonReader(config.merged, config.label()).raw("name")},
@@ -158,6 +158,7 @@ nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<Plann
                                {"finished", utc_timestamp()},
                                {"cache", {{"used", !options.no_cache}, {"root", options.no_cache ? "" : cache_root}}},
                                {"provenance", machine_and_build()}};
+    manifest["provenance"]["load_average"] = {{"start", load_at_start}, {"end", load_average()}};
     if (runs.size() == 1) {
         manifest["config"]["resolved"] = *first.resolved;
         manifest["inputs"] = first.context.inputs;
@@ -192,6 +193,7 @@ int run_experiment(const RunnerOptions& options) {
     }
 
     const std::string started = utc_timestamp();
+    const nlohmann::json load_at_start = load_average();
     const fs::path parent = fs::path(options.output_root) / name;
     CreatedDirectories created;  // declared first: removed (when empty) after the staging directory
     created.create(parent);
@@ -212,7 +214,7 @@ int run_experiment(const RunnerOptions& options) {
     }
 
     const nlohmann::json metrics = combined_metrics(runs);
-    nlohmann::json manifest = make_manifest(config, runs, hash, run_id, started, options, cache_root);
+    nlohmann::json manifest = make_manifest(config, runs, hash, run_id, started, load_at_start, options, cache_root);
     write_text_atomically(out.path() + "/metrics.json", metrics.dump(2) + "\n");
     write_text_atomically(out.path() + "/manifest.json", manifest.dump(2) + "\n");
     // A run of the same config may have taken this id meanwhile: take the next free one.

@@ -116,6 +116,8 @@ TEST_F(E2e, CiSmokeRunPassesItsCommittedBaseline) {
     for (const char* key : {"run_id", "config", "provenance", "started", "finished", "inputs"}) EXPECT_TRUE(manifest.contains(key)) << key;
     EXPECT_TRUE(manifest.at("provenance").at("git").contains("dirty"));
     EXPECT_TRUE(manifest.at("provenance").at("build").contains("cxx_flags"));
+    EXPECT_TRUE(manifest.at("provenance").at("load_average").contains("start"));
+    EXPECT_TRUE(manifest.at("provenance").at("load_average").contains("end"));
     EXPECT_TRUE(manifest.at("config").contains("resolved"));
     EXPECT_EQ(manifest.at("inputs").at("fields").size(), 2u);
 }
