@@ -25,7 +25,7 @@ const NamedView kNamedViews[] = {
     {"bottom", {0, -1, 0}, {0, 0, 1}},
     {"three_quarter", {0.61237243569579, 0.5, 0.61237243569579}, {0, 1, 0}},  // az 45, el 30
     {"dragon_side", {0, 0, 1}, {0, 1, 0}},
-    {"dragon_front", {0.93, 0.26, 0.26}, {0, 1, 0}},
+    {"dragon_front", {-1.0, 0.15, 0.35}, {0, 1, 0}},  // the head is at -x
 };
 
 const NamedView& find_named_view(const std::string& name) {

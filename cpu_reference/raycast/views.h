@@ -11,9 +11,11 @@
 ///   front  +z        back  -z        side / right  +x        left  -x
 ///   top    +y (up -z)               bottom -y (up +z)
 ///   three_quarter  azimuth 45 deg from front towards right, elevation 30 deg
-///   dragon_side    the thesis's Figure 5-3 (side view of the Stanford dragon): +z
-///   dragon_front   the thesis's Figure 5-4 (front view): the head seen from ahead and
-///                  slightly from the right and above, (0.93, 0.26, 0.26)
+///   dragon_side    the thesis's Figure 5-3 (side view of the Stanford dragon, head to the
+///                  left): +z
+///   dragon_front   the thesis's Figure 5-4 (front view): the dragon's head (at -x) and the
+///                  ridges under its belly seen from ahead, a little from above and from
+///                  the +z side: (-1, 0.15, 0.35)
 ///
 /// The field of view is vertical, in degrees (default 30).
 #pragma once

@@ -13,7 +13,7 @@
 ///     "margin": 0.04,                  // default free border of named views (fraction)
 ///     "reference": true,               // render the mesh reference (ground truth) and metrics
 ///     "error_maps": true,              // heat-map rows in the grid
-///     "heat_max_degrees": 10,          // heat-map scale
+///     "heat_max_degrees": 20,          // heat-map scale
 ///     "backend": "auto",               // cpu, cuda or auto
 ///     "precision": "float",            // cpu casts in float (as the GPU) or double
 ///     "grid_downsample": 1             // grid images reduced by this factor
@@ -35,7 +35,7 @@ struct RenderSpec {
     std::vector<ViewRequest> views{named_view("three_quarter")};
     bool reference = true;
     bool error_maps = true;
-    double heat_max_degrees = 10;
+    double heat_max_degrees = 20;
     std::string backend = "auto";
     std::string precision = "float";
     int grid_downsample = 1;

@@ -41,33 +41,32 @@ void draw_text(OIIO::ImageBuf& buf, int cx, int y, const std::string& text, int 
 
 GridLayout layout_grid(const std::vector<GridRow>& rows, const GridStyle& style) {
     GridLayout g;
-    int cell_w = 0;
-    size_t max_cells = 0;
-    for (const GridRow& r : rows) {
-        max_cells = std::max(max_cells, r.size());
-        for (const GridCell& c : r) cell_w = std::max(cell_w, c.image.width);
-    }
-    if (max_cells == 0) throw std::invalid_argument("image grid: no images");
     const int pad = style.padding, band = label_band(style);
+    // Cells are as wide as the widest image of their row; the grid as wide as its widest row
+    std::vector<int> cell_w(rows.size(), 0);
+    for (size_t r = 0; r < rows.size(); ++r) {
+        for (const GridCell& c : rows[r]) cell_w[r] = std::max(cell_w[r], c.image.width);
+        g.width = std::max(g.width, int(rows[r].size()) * cell_w[r] + int(rows[r].size() + 1) * pad);
+    }
+    if (g.width == 0) throw std::invalid_argument("image grid: no images");
     g.title_height = title_band(style);
-    g.width = int(max_cells) * cell_w + int(max_cells + 1) * pad;
     int y = pad + g.title_height;
-    for (const GridRow& r : rows) {
+    for (size_t r = 0; r < rows.size(); ++r) {
         int row_h = 0;
-        for (const GridCell& c : r) row_h = std::max(row_h, c.image.height);
-        const int row_w = int(r.size()) * cell_w + int(r.size() + 1) * pad;
+        for (const GridCell& c : rows[r]) row_h = std::max(row_h, c.image.height);
+        const int row_w = int(rows[r].size()) * cell_w[r] + int(rows[r].size() + 1) * pad;
         const int x0 = (g.width - row_w) / 2;  // centred row
         std::vector<GridCellPlacement> placed;
-        for (size_t i = 0; i < r.size(); ++i) {
+        for (size_t i = 0; i < rows[r].size(); ++i) {
             GridCellPlacement p;
-            const int cx = x0 + pad + int(i) * (cell_w + pad);
-            p.width = r[i].image.width;
-            p.height = r[i].image.height;
-            p.x = cx + (cell_w - p.width) / 2;
+            const int cx = x0 + pad + int(i) * (cell_w[r] + pad);
+            p.width = rows[r][i].image.width;
+            p.height = rows[r][i].image.height;
+            p.x = cx + (cell_w[r] - p.width) / 2;
             p.y = y + (row_h - p.height) / 2;
             p.label_x = cx;
             p.label_y = y + row_h;
-            p.label_width = cell_w;
+            p.label_width = cell_w[r];
             p.label_height = band;
             placed.push_back(p);
         }
@@ -89,15 +88,19 @@ ImageRgb make_image_grid(const std::vector<GridRow>& rows, const GridStyle& styl
     if (!style.title.empty())
         draw_text(buf, g.width / 2, style.padding + (g.title_height + style.title_size) / 2 - style.title_size / 5,
                   style.title, fitting_size(style.title, style.title_size, g.width - 2 * style.padding, font), font);
-    for (size_t r = 0; r < rows.size(); ++r)
+    for (size_t r = 0; r < rows.size(); ++r) {
+        // One size per row: the largest <= font_size at which every label fits its cell
+        int size = style.font_size;
+        for (size_t c = 0; c < rows[r].size(); ++c)
+            if (!rows[r][c].label.empty())
+                size = std::min(size, fitting_size(rows[r][c].label, style.font_size, g.cells[r][c].label_width - 4, font));
         for (size_t c = 0; c < rows[r].size(); ++c) {
             const GridCellPlacement& p = g.cells[r][c];
             if (rows[r][c].label.empty()) continue;
-            // Labels wider than their cell are drawn smaller, never cut
-            const std::string& label = rows[r][c].label;
-            const int size = fitting_size(label, style.font_size, p.label_width - 4, font);
-            draw_text(buf, p.label_x + p.label_width / 2, p.label_y + (p.label_height + size) / 2 - 2, label, size, font);
+            draw_text(buf, p.label_x + p.label_width / 2, p.label_y + (p.label_height + size) / 2 - 2, rows[r][c].label,
+                      size, font);
         }
+    }
 #endif
     return canvas;
 }

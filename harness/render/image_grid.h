@@ -3,10 +3,11 @@
 /// row centred, each image with a text label in a band below it, an optional title band on
 /// top (docs/raycast.md, "Grids").
 ///
-/// Layout: every cell is as wide as the widest image and every row as tall as its tallest
-/// image plus the label band; `padding` pixels separate cells, rows and the border. Labels
-/// are drawn with OpenImageIO's render_text in the font of label_font.h (black on the
-/// background), centred, at font_size or smaller where a label would not fit its cell. Without OpenImageIO the grid keeps its layout but labels and title are not
+/// Layout: the cells of a row are as wide as its widest image and the row as tall as its
+/// tallest image plus the label band; the grid is as wide as its widest row; `padding`
+/// pixels separate cells, rows and the border. Labels are drawn with OpenImageIO's
+/// render_text in the font of label_font.h (black on the background), centred, in one size
+/// per row: font_size, or smaller so that every label of the row fits its cell. Without OpenImageIO the grid keeps its layout but labels and title are not
 /// drawn (label_grid_text() lists them for a sidecar file instead).
 #pragma once
 

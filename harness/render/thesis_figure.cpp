@@ -28,34 +28,30 @@ std::string panel_file_stem(const std::string& name, const FigurePanelSpec& p) {
 
 ImageRgb reduced(const ImageRgb& image, int factor) { return factor > 1 ? downsample(image, factor) : image; }
 
-/// Rows 1-2 from per-panel images (in panel order A..E).
-void add_thesis_rows(std::vector<GridRow>& rows, const std::vector<GridCell>& cells) {
-    rows.push_back({cells[0], cells[1], cells[2]});
-    rows.push_back({cells[3], cells[4]});
-}
+std::string percent(double fraction) { return fixed(100.0 * fraction, 2) + "%"; }
 
 std::vector<GridRow> figure_rows(const ThesisFigure& f, const FigureOptions& o) {
-    std::vector<GridRow> rows;
-    std::vector<GridCell> renders, errors;
+    std::vector<GridCell> renders;
+    GridRow errors;
     for (const FigurePanel& p : f.panels) {
         renders.push_back({reduced(shaded_image(p.image), o.downsample), p.label});
         if (o.error_rows && f.has_reference)
-            errors.push_back({reduced(normal_error_heat_map(p.image, f.reference, o.heat_max_degrees), o.downsample),
-                              p.spec.letter + "  normal error: mean " + fixed(p.metrics.normal_angle_degrees.mean, 2) +
-                                  ", p95 " + fixed(p.metrics.normal_angle_degrees.p95, 2) + " deg; " +
-                                  std::to_string(p.metrics.coverage_mismatch) + " px coverage"});
+            errors.push_back({reduced(normal_error_heat_map(p.image, f.reference, o.heat_max_degrees), 2 * o.downsample),
+                              p.spec.letter + ": " + fixed(p.metrics.normal_angle_degrees.mean, 1) + " / " +
+                                  fixed(p.metrics.normal_angle_degrees.p95, 1) + " deg, " +
+                                  percent(p.metrics.coverage_mismatch_fraction)});
     }
-    add_thesis_rows(rows, renders);
+    std::vector<GridRow> rows{{renders[0], renders[1], renders[2]}, {renders[3], renders[4]}};
     if (o.reference_row && f.has_reference) {
         GridRow r{{reduced(shaded_image(f.reference), o.downsample), "Reference: the mesh, ray-traced"}};
-        if (o.error_rows) {
+        if (!errors.empty()) {
             const int w = r[0].image.width;
             r.push_back({viridis_bar(w, std::max(8, w / 16)),
-                         "normal error 0 - " + fixed(o.heat_max_degrees, 0) + " deg; magenta: coverage differs"});
+                         "heat maps: 0 - " + fixed(o.heat_max_degrees, 0) + " deg; mean / p95, % coverage"});
         }
         rows.push_back(r);
     }
-    if (!errors.empty()) add_thesis_rows(rows, errors);
+    if (!errors.empty()) rows.push_back(errors);
     return rows;
 }
 

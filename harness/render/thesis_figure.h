@@ -7,7 +7,8 @@
 ///   row 1:  A catmull_rom (CC)   B bcc_cubic, true derivatives   C bcc_cubic, fd
 ///   row 2:  D tricubic_lm, true derivatives (CC)   E tricubic_lm, fd (CC)
 ///   row 3:  the mesh reference, and the heat maps' colour bar         (reference_row)
-///   rows 4-5: normal error of A..E against the reference, same layout (error_rows)
+///   row 4:  normal error of A..E against the reference at half size, with mean / p95
+///           angle and the coverage mismatch as a percentage of the pixels (error_rows)
 #pragma once
 
 #include <string>
@@ -37,7 +38,7 @@ struct FigureOptions {
     MeshRenderOptions mesh{};
     bool reference_row = true;   ///< needs a mesh
     bool error_rows = true;      ///< needs a mesh
-    double heat_max_degrees = 10;
+    double heat_max_degrees = 20;
     std::string title;
     int downsample = 1;          ///< grid images reduced by this factor (1 = full size)
 };

@@ -54,7 +54,7 @@ struct Options {
     bool reference = false, grid = false, no_reference = false, no_error_maps = false, no_exr = false;
     bool overwrite = false, quiet = false, no_cache = false;
     int downsample = 1;
-    double heat_max = 10;
+    double heat_max = 20;
     std::string out = "render.png", out_dir = ".", name, title, cache_dir;
     std::string sampler_backend = "auto", sampler_method = "brute_force";
 };

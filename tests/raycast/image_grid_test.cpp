@@ -197,15 +197,17 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
         EXPECT_LT(f.panels[i].metrics.normal_angle_degrees.mean, 30.0);
     }
     EXPECT_EQ(f.panels[1].label, "B  BCC cubic, true derivatives (16x16x32)");
-    // Rows: A-C, D-E, reference + colour bar, heat maps A-C, D-E
-    ASSERT_EQ(f.rows.size(), 5u);
+    // Rows: A-C, D-E, reference + colour bar, the five heat maps at half size
+    ASSERT_EQ(f.rows.size(), 4u);
     EXPECT_EQ(f.rows[0].size(), 3u);
     EXPECT_EQ(f.rows[1].size(), 2u);
     EXPECT_EQ(f.rows[2].size(), 2u);
+    EXPECT_EQ(f.rows[3].size(), 5u);
+    EXPECT_EQ(f.rows[3][0].image.width, 24);
     const GridLayout g = layout_grid(f.rows, f.style);
     EXPECT_EQ(f.grid.width, g.width);
     EXPECT_EQ(f.grid.height, g.height);
-    EXPECT_EQ(g.width, 3 * 48 + 4 * f.style.padding);
+    EXPECT_EQ(g.width, std::max(3 * 48 + 4 * f.style.padding, 5 * 24 + 6 * f.style.padding));
     TempDir dir;
     const std::string grid = write_thesis_figure(dir.file(""), "pawn", f, {{"config_hash", "x"}});
     if (const char* keep = std::getenv("SDF_TEST_KEEP_GRID")) fs::copy_file(grid, keep, fs::copy_options::overwrite_existing);
