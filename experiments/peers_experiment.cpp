@@ -58,8 +58,10 @@ double median_of(std::vector<double> s) {
 struct Errors {
     double max_abs = 0;          ///< max |d - ref| (unsigned peers: max ||d| - |ref||)
     double max_abs_unsigned = 0; ///< max ||d| - |ref||: the distance alone, whatever the sign
+    double sum_abs = 0;          ///< for the mean
     int64_t sign_disagreements = 0;
     int64_t compared = 0;
+    double mean_abs() const { return compared > 0 ? sum_abs / double(compared) : 0.0; }
 };
 
 Errors compare(const std::vector<double>& d, const std::vector<double>& ref, const std::vector<int64_t>& index,
@@ -69,7 +71,9 @@ Errors compare(const std::vector<double>& d, const std::vector<double>& ref, con
         if (mask && !mask->empty() && bool((*mask)[k]) != mask_value) continue;
         const double r = ref[size_t(index.empty() ? int64_t(k) : index[k])];
         const double unsigned_error = std::abs(std::abs(d[k]) - std::abs(r));
-        e.max_abs = std::max(e.max_abs, is_signed ? std::abs(d[k] - r) : unsigned_error);
+        const double error = is_signed ? std::abs(d[k] - r) : unsigned_error;
+        e.max_abs = std::max(e.max_abs, error);
+        e.sum_abs += error;
         e.max_abs_unsigned = std::max(e.max_abs_unsigned, unsigned_error);
         if (is_signed && r != 0 && (d[k] < 0) != (r < 0)) ++e.sign_disagreements;
         ++e.compared;
@@ -184,6 +188,7 @@ private:
     static void set_errors(nlohmann::json& row, const Errors& e, bool is_signed) {
         row["max_abs_error"] = e.max_abs;
         row["max_abs_error_unsigned"] = e.max_abs_unsigned;
+        row["mean_abs_error"] = e.mean_abs();
         row["compared_points"] = e.compared;
         row["sign_disagreements"] = is_signed ? nlohmann::json(e.sign_disagreements) : nlohmann::json("n/a (unsigned)");
     }
@@ -310,6 +315,7 @@ private:
                 const Errors in = compare(r.distance, reference, {}, true, &r.in_band, true);
                 const Errors out = compare(r.distance, reference, {}, true, &r.in_band, false);
                 row["band"] = {{"points_in_band", in.compared}, {"max_abs_error_in_band", in.max_abs},
+                               {"mean_abs_error_in_band", in.mean_abs()},
                                {"sign_disagreements_in_band", in.sign_disagreements},
                                {"max_abs_error_outside_band", out.max_abs},
                                {"sign_disagreements_outside_band", out.sign_disagreements}};
