@@ -1,7 +1,8 @@
 // Google Benchmark of the BVH samplers: exact queries per second on the CC lattices of the
 // bunny and the dragon (262k = 64^3 and 2,097k = 128^3 points).
-//   CPU: 1 thread and all threads, seeded (lattice-coherent) and unseeded; the BVH build.
-//   GPU (when a device is present): manual time from the sampler's CUDA events.
+//   CPU: 1 thread and all threads; kernels brick (16-point packets), seeded, unseeded; the build.
+//   GPU (when a device is present): manual time from the sampler's CUDA events, the three
+//   BVH kernels in float and double, and the tuned brute force beside them (issue 7's 100x).
 //   SDF_DATA_PATH=... bench_bvh --benchmark_counters_tabular=true --benchmark_filter=Cpu
 #include <benchmark/benchmark.h>
 
@@ -88,11 +89,29 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
     SamplerOptions o;
     o.backend = "cuda";
     o.method = "bvh";
-    o.kernel = state.range(1) ? "seeded" : "unseeded";
+    o.kernel = kKernels[state.range(1)];
     o.precision = state.range(2) ? Precision::Double : Precision::Float;
     o.progress = false;
     auto sampler = make_sampler(o);
     SampledField f = sampler->sample(*mesh, lattice);  // warm-up: module load, BVH upload
+    for (auto _ : state) {
+        f = sampler->sample(*mesh, lattice);
+        state.SetIterationTime(f.timings.kernel);
+    }
+    set_counters(state, *mesh, lattice, f);
+}
+
+/// The tuned CUDA brute force on the same lattices (float), for the BVH's speedup.
+void BM_CudaBrute(benchmark::State& state, const std::string& file) {
+    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o;
+    o.backend = "cuda";
+    o.progress = false;
+    auto sampler = make_sampler(o);
+    SampledField f = sampler->sample(*mesh, lattice);  // warm-up
     for (auto _ : state) {
         f = sampler->sample(*mesh, lattice);
         state.SetIterationTime(f.timings.kernel);
@@ -110,9 +129,9 @@ void cpu_args(benchmark::internal::Benchmark* b) {
 
 void cuda_args(benchmark::internal::Benchmark* b) {
     for (int r : {64, 128})
-        for (int seeded : {1, 0})
-            for (int dbl : {0, 1}) b->Args({r, seeded, dbl});
-    b->ArgNames({"res", "seeded", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
+        for (int kernel : {0, 1, 2})
+            for (int dbl : {0, 1}) b->Args({r, kernel, dbl});
+    b->ArgNames({"res", "kernel", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 }
 
 BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark::kMillisecond);
@@ -121,6 +140,10 @@ BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, bunny, std::string("bunny.obj"))->Apply(cuda_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, dragon, std::string("dragon.obj"))->Apply(cuda_args);
+BENCHMARK_CAPTURE(BM_CudaBrute, bunny, std::string("bunny.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()
+    ->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_CudaBrute, dragon, std::string("dragon.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()
+    ->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 }  // namespace sdf
