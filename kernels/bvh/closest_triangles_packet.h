@@ -19,8 +19,9 @@
 
 namespace sdf {
 
-/// K points in structure-of-arrays form with their current best hits. Lanes beyond the
-/// real points must repeat a real point (they then never widen the packet's bounds).
+/// K points in structure-of-arrays form with their current best hits. A packet with fewer
+/// real points fills the other lanes with copies of a real point (duplicate work, same
+/// result), so every loop runs over all K lanes.
 template <typename T, int K>
 struct BvhPacket {
     T x[K], y[K], z[K];
