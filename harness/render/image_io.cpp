@@ -35,9 +35,14 @@ void write_sidecar(const std::string& path, const nlohmann::json& attributes, Ov
 }
 
 #if !SDF_HAVE_OIIO
+/// Says once per process that PNG/EXR became PPM/PFM.
 void note_fallback(const std::string& asked, const std::string& written) {
-    std::fprintf(stderr, "note: built without OpenImageIO: %s written as %s (attributes in %s.json)\n", asked.c_str(),
-                 written.c_str(), written.c_str());
+    static std::atomic<bool> said{false};
+    if (said.exchange(true)) return;
+    std::fprintf(stderr,
+                 "note: built without OpenImageIO: .png files are written as .ppm and .exr as .pfm, attributes in "
+                 ".json sidecars (first: %s written as %s)\n",
+                 asked.c_str(), written.c_str());
 }
 #endif
 

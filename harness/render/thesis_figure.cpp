@@ -71,6 +71,17 @@ std::vector<FigurePanelSpec> thesis_figure_panels() {
             {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives"}};
 }
 
+FigureOptions figure_options(const RenderSpec& spec) {
+    FigureOptions o;
+    o.render.backend = spec.backend;
+    o.render.precision = spec.precision == "double" ? Precision::Double : Precision::Float;
+    o.reference_row = spec.reference;
+    o.error_rows = spec.reference && spec.error_maps;
+    o.heat_max_degrees = spec.heat_max_degrees;
+    o.downsample = spec.grid_downsample;
+    return o;
+}
+
 ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bcc, const PreparedMesh* mesh,
                                   const CameraSpec& camera, const FigureOptions& options) {
     ThesisFigure f;
@@ -139,7 +150,11 @@ std::string write_thesis_figure(const std::string& dir, const std::string& name,
         write_image(base + "_reference.png", shaded_image(figure.reference), attributes, overwrite);
         write_render_exr(base + "_reference.exr", figure.reference, attributes, overwrite);
     }
+    nlohmann::json seconds = nlohmann::json::object();
+    for (const FigurePanel& p : figure.panels) seconds[p.spec.letter] = p.image.info.value("seconds", 0.0);
+    if (figure.has_reference) seconds["reference"] = figure.reference.info.value("seconds", 0.0);
     const nlohmann::json grid_attributes = with(provenance, {{"camera", camera_to_json(figure.camera)},
+                                                             {"render_seconds", seconds},
                                                              {"labels", label_grid_text(figure.rows, figure.style)}});
     const std::string grid = write_image(base + "_grid.png", figure.grid, grid_attributes, overwrite);
     write_image(base + "_grid.exr", figure.grid, grid_attributes, overwrite);

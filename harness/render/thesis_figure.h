@@ -16,6 +16,7 @@
 
 #include "cpu_reference/raycast/image_metrics.h"
 #include "cpu_reference/raycast/mesh_reference.h"
+#include "harness/config/render_spec.h"
 #include "harness/io/atomic_file.h"
 #include "harness/render/image_grid.h"
 #include "harness/render/render_backend.h"
@@ -42,6 +43,10 @@ struct FigureOptions {
     std::string title;
     int downsample = 1;          ///< grid images reduced by this factor (1 = full size)
 };
+
+/// The options a config's "render" block asks for (backend, precision, rows, heat-map scale,
+/// downsampling); threads and progress keep their defaults.
+FigureOptions figure_options(const RenderSpec& spec);
 
 struct FigurePanel {
     FigurePanelSpec spec;

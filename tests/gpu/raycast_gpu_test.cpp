@@ -1,7 +1,7 @@
 // The CUDA ray caster against the CPU one (both cast_pixel, both in float from the same
 // float Hermite data): every interpolator, on the exact sphere and on a sampled pawn, CC and
-// BCC. Stated tolerances (the two differ only by multiply-add contraction, which nvcc does
-// and g++ -std=c++17 does not):
+// BCC. Stated tolerances (the two differ only in rounding: nvcc and g++ -march=native both
+// contract multiply-adds into FMAs, but not in the same places):
 //   - hit/miss differs in at most 0.05% of the pixels (a silhouette ray may graze a root
 //     within the float rounding of the two evaluations);
 //   - over pixels hit by both, 99.9% have |depth difference| <= 2e-3 lattice units (twice

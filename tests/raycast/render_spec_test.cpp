@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "harness/config/render_spec.h"
+#include "harness/render/thesis_figure.h"
 
 namespace sdf {
 namespace {
@@ -51,6 +52,18 @@ TEST(RenderSpec, NamedExplicitAndAdjustedViews) {
     EXPECT_EQ(s.views[3].margin, 0.1);
     EXPECT_EQ(s.grid_downsample, 2);
     EXPECT_EQ(parse(R"({"size": 256})").height, 256);
+}
+
+TEST(RenderSpec, BecomesFigureOptions) {
+    const FigureOptions o = figure_options(parse(
+        R"({"backend": "cpu", "precision": "double", "error_maps": false, "heat_max_degrees": 5, "grid_downsample": 3})"));
+    EXPECT_EQ(o.render.backend, "cpu");
+    EXPECT_EQ(o.render.precision, Precision::Double);
+    EXPECT_TRUE(o.reference_row);
+    EXPECT_FALSE(o.error_rows);
+    EXPECT_EQ(o.heat_max_degrees, 5);
+    EXPECT_EQ(o.downsample, 3);
+    EXPECT_FALSE(figure_options(parse(R"({"reference": false})")).error_rows);  // heat maps need the reference
 }
 
 TEST(RenderSpec, ErrorsNameKeyValueAndExpectation) {
