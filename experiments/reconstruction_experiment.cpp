@@ -8,14 +8,17 @@
 ///
 ///   "metrics": {"domain_probes": 100000, "band_probes": 100000, "band": 1.0, "seed": 1, "threads": 0}
 ///     band: half-width of the surface band in units of the coarsest lattice spacing
-///   "render": {"size": [512, 512], "views": ["side", "front"]}
-///     reserved for the ray caster: validated (views named in cpu_reference/raycast/views.h)
-///     and shown in the plan as a TODO; nothing is rendered yet
+///   "render": {"size": [512, 512], "views": ["side", "front"], ...}   (harness/config/render_spec.h)
+///     optional: for every view, the five reconstructions of the thesis's figures (the first
+///     CC and the first BCC lattice), the mesh reference and the image metrics, as a labelled
+///     grid in the thesis's layout (harness/render/thesis_figure.h) under images/<view>/
 ///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
 /// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -28,14 +31,11 @@
 #include "experiments/common/study_inputs.h"
 #include "experiments/experiment.h"
 #include "harness/io/field_file.h"
+#include "harness/provenance/provenance.h"
+#include "harness/render/thesis_figure.h"
 
 namespace sdf {
 namespace {
-
-struct RenderRequest {
-    std::vector<int> size{512, 512};
-    std::vector<std::string> views{"side", "front"};
-};
 
 /// The box every reconstruction covers (probes outside one of them would be clamped there).
 DomainBox<double> common_domain(const std::vector<std::unique_ptr<Reconstruction>>& recons) {
@@ -67,21 +67,16 @@ public:
         threads_ = m.optional<int>("threads", inputs_.sampler.threads, "a thread count (0 = all cores)");
         if (threads_ < 0) m.fail("threads", "expected 0 (all cores) or a positive count, got " + std::to_string(threads_));
         m.finish();
-        JsonReader r = config.optional_object("render");
-        render_.size = r.optional<std::vector<int>>("size", render_.size, "[width, height] in pixels");
-        if (render_.size.size() != 2 || render_.size[0] < 1 || render_.size[1] < 1)
-            r.fail("size", "expected [width, height] with positive entries, got " + nlohmann::json(render_.size).dump());
-        render_.views = r.optional<std::vector<std::string>>("views", render_.views, "an array of view names");
-        if (render_.views.empty()) r.fail("views", "expected at least one view name, got []");
-        for (const std::string& v : render_.views)
-            if (!is_named_view(v)) {
-                std::string list;
-                for (const std::string& n : named_view_names()) list += (list.empty() ? "" : ", ") + n;
-                const std::string near = nearest_match(v, named_view_names());
-                r.fail("views", "unknown view \"" + v + "\"; expected one of " + list +
-                                    (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
-            }
-        r.finish();
+        if (config.has("render")) {
+            JsonReader r = config.optional_object("render");
+            render_ = parse_render_spec(r);
+            const bool has_cc = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
+                                            [](const LatticeSpec& l) { return l.type == LatticeType::CC; });
+            const bool has_bcc = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
+                                             [](const LatticeSpec& l) { return l.type == LatticeType::BCC; });
+            if (!has_cc || !has_bcc)
+                config.fail("render", "the thesis's figures need a CC and a BCC lattice in \"lattices\"");
+        }
         figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
     }
 
@@ -105,10 +100,14 @@ public:
         for (const ReconstructionEntry& e : recons_)
             lines.push_back("reconstruct " + e.id + (e.thesis_panel.empty() ? "" : " (thesis panel " + e.thesis_panel + ")") +
                             ": errors at the probes");
-        lines.push_back("TODO(ray caster): render views " + join(render_.views) + " at " + std::to_string(render_.size[0]) +
-                        "x" + std::to_string(render_.size[1]) + " for every reconstruction");
-        lines.push_back("TODO(ray caster): image grid (thesis layout: A catmull_rom, B bcc_cubic/true, C bcc_cubic/fd; "
-                        "D tricubic_lm/true, E tricubic_lm/fd) and image metrics");
+        if (render_) {
+            std::string views;
+            for (const ViewRequest& v : render_->views) views += (views.empty() ? "" : ", ") + v.name;
+            lines.push_back("render " + views + " at " + std::to_string(render_->width) + "x" +
+                            std::to_string(render_->height) + " (" + render_->backend +
+                            "): the thesis's five reconstructions" + (render_->reference ? ", the mesh reference and image metrics" : "") +
+                            ", one labelled grid per view");
+        }
         return lines;
     }
 
@@ -160,9 +159,7 @@ public:
         ctx.metrics["regression"]["probes/in_band"] = {{"value", in_band}, {"kind", "exact"}};
         print_header(log, h_ref);
         for (size_t k = 0; k < recons.size(); ++k) measure(ctx, recons_[k], *recons[k], probes, h_ref);
-        ctx.metrics["render"] = {{"status", "TODO: needs the ray caster (not built yet); nothing was rendered"},
-                                 {"size", render_.size},
-                                 {"views", render_.views}};
+        if (render_) render_figures(ctx, mesh, fields);
         ctx.metrics["thesis_figures"] = figures_;
     }
 
@@ -210,11 +207,39 @@ private:
         add("gradient_angle_p95_deg", b["gradient_angle_p95_deg"]);
     }
 
+    /// The thesis's grid for every configured view, from the first CC and BCC fields.
+    void render_figures(RunContext& ctx, const PreparedMesh& mesh, const std::vector<SampledField>& fields) {
+        const SampledField* cc = nullptr;
+        const SampledField* bcc = nullptr;
+        for (const SampledField& f : fields) {
+            if (!cc && f.lattice.type == LatticeType::CC) cc = &f;
+            if (!bcc && f.lattice.type == LatticeType::BCC) bcc = &f;
+        }
+        const FigureOptions options = figure_options(*render_);
+        const nlohmann::json provenance = {{"run", ctx.output_dir}, {"git", machine_and_build()["git"]}};
+        for (const ViewRequest& view : render_->views) {
+            const CameraSpec camera = resolve_view(view, mesh.vertices, render_->width, render_->height);
+            *ctx.log << "  rendering view " << view.name << " (" << render_->width << "x" << render_->height << ")\n";
+            const ThesisFigure figure = render_thesis_figure(*cc, *bcc, render_->reference ? &mesh : nullptr, camera, options);
+            const std::string dir = ctx.output_dir + "/images/" + view.name;
+            std::filesystem::create_directories(dir);
+            const std::string grid = write_thesis_figure(dir, mesh.name + "_" + view.name, figure, provenance);
+            nlohmann::json summary = figure.summary;
+            summary["grid_file"] = std::filesystem::relative(grid, ctx.output_dir).string();
+            ctx.metrics["render"]["views"][view.name] = summary;
+            for (const FigurePanel& p : figure.panels) {
+                if (!p.has_metrics) continue;
+                const std::string id = "render/" + view.name + "/" + p.spec.letter + "_" + p.spec.interpolator + "_" + p.spec.derivatives;
+                ctx.metrics["regression"][id + "/normal_angle_mean_deg"] = {{"value", p.metrics.normal_angle_degrees.mean}, {"kind", "error"}};
+            }
+        }
+    }
+
     StudyInputs inputs_;
     std::vector<ReconstructionEntry> recons_;
     ProbeSpec probes_;
     int threads_ = 0;
-    RenderRequest render_;
+    std::optional<RenderSpec> render_;
     std::vector<std::string> figures_;
 };
 

@@ -224,6 +224,31 @@ TEST_F(E2e, SweepWithParentRunsEveryPointInOneRunDirectory) {
     EXPECT_FALSE(manifest.at("config").at("merged").contains("parent"));
 }
 
+TEST_F(E2e, ReconstructionStudyRendersTheThesisGridWithImageMetrics) {
+    json cfg = tiny_study("render_tiny");
+    cfg["mesh"] = {{"shape", "pawn"}};
+    cfg["lattices"] = {{{"type", "cc"}, {"resolution", {16, 16, 16}}}, {{"type", "bcc"}, {"resolution", {13, 13, 26}}}};
+    cfg["render"] = {{"size", {48, 48}}, {"views", {"front"}}, {"backend", "cpu"}};
+    write("render.json", cfg.dump());
+    const Result dry = run("render.json --output-root out --dry-run");
+    ASSERT_EQ(dry.code, 0) << dry.err;
+    EXPECT_TRUE(Contains(dry.out, "render front at 48x48")) << dry.out;
+    const Result r = run("render.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const fs::path run_dir = only_run("render_tiny");
+    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    const json& view = metrics.at("render").at("views").at("front");
+    ASSERT_EQ(view.at("panels").size(), 5u);  // A..E of the thesis's figures
+    for (const json& panel : view["panels"]) {
+        // Every panel sees the pawn: most reference pixels are hit by the reconstruction too.
+        const json& m = panel.at("metrics");
+        EXPECT_GT(m.at("hit_both").get<int64_t>(), 200) << panel.dump();
+        EXPECT_LT(m.at("coverage_mismatch_fraction").get<double>(), 0.05) << panel.dump();
+    }
+    EXPECT_TRUE(fs::is_regular_file(run_dir / view.at("grid_file").get<std::string>()));
+    EXPECT_TRUE(metrics.at("regression").contains("render/front/B_bcc_cubic_true/normal_angle_mean_deg"));
+}
+
 // ---- the other kinds at tiny sizes -------------------------------------------------------------
 
 TEST_F(E2e, AnalyticKindTinyTable41AndConvergence) {
