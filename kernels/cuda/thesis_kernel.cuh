@@ -91,9 +91,11 @@ __global__ void fill_thesis_minima(int64_t n, ThesisMinima<T> m) {
     m.feature[i] = 0;
 }
 
-/// "Sign computations, gradient computations" of thesis Figure 3-2: the closest point from
-/// the stored (s, t) and feature, then the pseudonormal sign and the gradient (in double, on
-/// the double mesh, at the exact lattice position).
+/// "Sign computations, gradient computations" of thesis Figure 3-2, after the search. The
+/// kernel returned (s, t) in float as the thesis's did; like every sampler here, the final
+/// closest point, feature, sign and gradient are re-evaluated with Eberly's algorithm in
+/// double on the winning triangle at the exact lattice position, so the thesis kernel's
+/// fields equal the CPU reference's except where the float search broke a near-tie.
 template <typename T, typename Piece>
 __global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, ThesisMinima<T> minima, PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -101,12 +103,7 @@ __global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, Thes
     const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
     out.output_index[i] = o;
     if (o < 0) return;
-    const int tri = minima.triangle[i];
-    const Int3 v = mesh.triangles[tri];
-    const TriangleFeature feature = TriangleFeature(minima.feature[i]);
-    const Vec3d closest = point_on_triangle(mesh.vertices[v.x], mesh.vertices[v.y], mesh.vertices[v.z],
-                                            double(minima.s[i]), double(minima.t[i]), feature);
-    const SignedDistanceSample<double> s = signed_sample(mesh, piece.position(i), tri, closest, feature);
+    const SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, piece.position(i), minima.triangle[i]);
     out.distance[i] = s.distance;
     out.gradient[i] = s.gradient;
     out.triangle[i] = s.triangle;
