@@ -46,7 +46,7 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
                         const SampledField gpu = make_sampler(options("cuda", "bvh", precision, kernel, s))->sample(m.mesh, lattice);
                         const std::string what = m.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
                                                  " " + kernel + " " + bcc_strategy_name(s);
-                        test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13);
+                        test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
                         cmp.fields(cpu, gpu, what);
                         if (HasFatalFailure()) return;
                         print(what, cmp.agreement(), gpu);
@@ -78,7 +78,7 @@ TEST(CudaBvh, PointQueriesEqualTheCpu) {
         for (Precision precision : {Precision::Float, Precision::Double}) {
             const auto cpu = make_sampler(options("cpu", "bvh", precision))->query(m.mesh, pts);
             const auto gpu = make_sampler(options("cuda", "bvh", precision))->query(m.mesh, pts);
-            test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13);
+            test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
             cmp.samples(pts, cpu, gpu, m.name + " points " + precision_name(precision));
             if (HasFatalFailure()) return;
         }

@@ -319,7 +319,7 @@ TEST_F(E2e, BaselinesOnlyFromCleanRuns) {
     const fs::path run_dir = only_run("a");
     json manifest = json::parse(read_text(run_dir / "manifest.json"));
     fs::permissions(run_dir / "manifest.json", fs::perms::owner_write, fs::perm_options::add);
-    manifest["provenance"]["git"]["dirty"] = true;
+    manifest["provenance"]["git"] = {{"commit", "0123abcd"}, {"dirty", true}};  // also where git is absent
     std::ofstream(run_dir / "manifest.json") << manifest.dump(2);
     const Result dirty = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
     EXPECT_EQ(dirty.code, 1);
