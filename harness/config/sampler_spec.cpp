@@ -7,6 +7,7 @@
 namespace sdf {
 
 std::vector<std::string> sampler_kernel_names(const std::string& backend, const std::string& method) {
+    if (method == "bvh" && backend == "cuda") return {"brick", "seeded", "unseeded", "warp"};
     if (method == "bvh") return {"brick", "seeded", "unseeded"};
     if (backend == "cpu") return {"vectorized", "eberly"};
     if (backend == "cuda") return {"tuned", "thesis"};
@@ -18,7 +19,7 @@ SamplerOptions parse_sampler_options(JsonReader& r) {
     const std::string backend = r.choice("backend", {"cpu", "cuda", "auto"}, "cpu");
     o.backend = backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : backend;
     o.method = r.choice("method", {"brute_force", "bvh"}, "brute_force");
-    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis; bvh: brick, seeded, unseeded)");
+    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis; bvh: brick, seeded, unseeded; cuda bvh also warp)");
     const std::vector<std::string> kernels = sampler_kernel_names(o.backend, o.method);
     if (backend == "auto" && !o.kernel.empty())
         r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +

@@ -9,7 +9,8 @@
 ///   kernel "brick":    the thread's 4 points share one packet traversal (K = 4);
 ///   kernel "seeded":   the 4 points one after the other, each seeded with the previous
 ///                      point's triangle (an exact upper bound on its distance);
-///   kernel "unseeded": the same without seeds.
+///   kernel "unseeded": the same without seeds;
+///   kernel "warp":     the warp's 128 points share one traversal (bvh_warp_kernel.cuh).
 /// Point lists take one thread per point.
 #pragma once
 
@@ -22,7 +23,7 @@ namespace sdf::cuda {
 constexpr int kRunPoints = 4;       ///< lattice points per thread, consecutive along x
 constexpr int kBvhThreads = 128;    ///< threads per block (4 warps)
 
-enum class BvhGpuKernel : int { Brick = 0, Seeded = 1, Unseeded = 2 };
+enum class BvhGpuKernel : int { Brick = 0, Seeded = 1, Unseeded = 2, Warp = 3 };
 
 /// A slab of z-layers [z0, z0 + nz) of one GridBlock; piece-local ids run x fastest, as in
 /// GridRangePiece (whose begin = z0 * rx * ry), so finalize_samples() takes it as is.

@@ -10,6 +10,7 @@
 
 #include "cpu_reference/bvh/bvh_cache.h"
 #include "kernels/cuda/bvh_kernel.cuh"
+#include "kernels/cuda/bvh_warp_kernel.cuh"
 #include "kernels/cuda/cuda_check.h"
 #include "kernels/cuda/cuda_device.h"
 #include "kernels/cuda/device_buffer.h"
@@ -74,9 +75,11 @@ struct PieceResults {
 class CudaBvhSampler final : public Sampler {
 public:
     explicit CudaBvhSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "brick") kernel_ = BvhGpuKernel::Brick;
+        if (options.kernel.empty() || options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;  // measured fastest
+        else if (options.kernel == "brick") kernel_ = BvhGpuKernel::Brick;
         else if (options.kernel == "seeded") kernel_ = BvhGpuKernel::Seeded;
         else if (options.kernel == "unseeded") kernel_ = BvhGpuKernel::Unseeded;
+        else if (options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;
         else
             throw std::invalid_argument("sampler.kernel: unknown CUDA BVH kernel '" + options.kernel +
                                         "'; expected \"brick\", \"seeded\" or \"unseeded\"");
@@ -94,7 +97,12 @@ public:
 
 private:
     const char* kernel_name() const {
-        return kernel_ == BvhGpuKernel::Brick ? "brick" : (kernel_ == BvhGpuKernel::Seeded ? "seeded" : "unseeded");
+        switch (kernel_) {
+            case BvhGpuKernel::Brick: return "brick";
+            case BvhGpuKernel::Seeded: return "seeded";
+            case BvhGpuKernel::Warp: return "warp";
+            default: return "unseeded";
+        }
     }
 
     /// The device copy of this mesh's BVH, uploaded when the mesh (or precision) changes.
@@ -148,6 +156,9 @@ private:
                 break;
             case BvhGpuKernel::Unseeded:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                break;
+            case BvhGpuKernel::Warp:
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
                 break;
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
@@ -247,7 +258,7 @@ private:
     }
 
     SamplerOptions options_;
-    BvhGpuKernel kernel_ = BvhGpuKernel::Brick;
+    BvhGpuKernel kernel_ = BvhGpuKernel::Warp;
     BvhCache cache_;
     std::shared_ptr<const TriangleBvh> host_bvh_;
     const TriangleBvh* uploaded_for_ = nullptr;

@@ -51,8 +51,8 @@ void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Latti
     }
 }
 
-/// Kernels by argument: 0 brick (packets of 16 lattice points), 1 seeded, 2 unseeded.
-const char* const kKernels[] = {"brick", "seeded", "unseeded"};
+/// Kernels by argument: 0 brick (packets of 16 lattice points), 1 seeded, 2 unseeded, 3 warp (CUDA).
+const char* const kKernels[] = {"brick", "seeded", "unseeded", "warp"};  // warp: CUDA only
 
 /// Args: resolution, threads (0 = all), kernel.
 void BM_CpuBvh(benchmark::State& state, const std::string& file) {
@@ -129,7 +129,7 @@ void cpu_args(benchmark::internal::Benchmark* b) {
 
 void cuda_args(benchmark::internal::Benchmark* b) {
     for (int r : {64, 128})
-        for (int kernel : {0, 1, 2})
+        for (int kernel : {0, 1, 2, 3})
             for (int dbl : {0, 1}) b->Args({r, kernel, dbl});
     b->ArgNames({"res", "kernel", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 }

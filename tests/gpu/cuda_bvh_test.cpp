@@ -40,7 +40,7 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
             const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds, 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
                 const SampledField cpu = make_sampler(options("cpu", "brute_force", precision))->sample(m.mesh, lattice);
-                for (const char* kernel : {"brick", "seeded", "unseeded"})
+                for (const char* kernel : {"brick", "seeded", "unseeded", "warp"})
                     for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                         if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
                         const SampledField gpu = make_sampler(options("cuda", "bvh", precision, kernel, s))->sample(m.mesh, lattice);
