@@ -3,15 +3,11 @@
 // manifest, metrics, readable fields) and its config errors. Executables come from CMake
 // (SDF_QUERY_EXE, RUN_EXPERIMENT_EXE); stdout and stderr are captured into files.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -32,45 +28,23 @@
 #endif
 
 #include "harness/sampling/make_sampler.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
+using test::Contains;
+using test::quote;
+using test::read_json;
+using test::read_text;
+using test::ShellResult;
+using test::sorted_entries;
 
 std::string lower(std::string s) {
     for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
     return s;
-}
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-std::vector<std::string> visible_entries(const fs::path& dir) {
-    std::vector<std::string> names;
-    if (!fs::exists(dir)) return names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
 }
 
 int count_files(const fs::path& dir) {
@@ -165,43 +139,19 @@ std::vector<QueryLine> parse_query_output(const std::string& out) {
 
 // ---- fixture ------------------------------------------------------------------------------
 
-class Cli : public ::testing::Test {
+class Cli : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_cli_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string at(const std::string& rel) const { return (dir_ / rel).string(); }
-    std::string write(const std::string& rel, const std::string& text) const {
-        const fs::path p = dir_ / rel;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
+    Cli() : ScratchDirTest("sdf_cli_test") {}
 
     /// Runs `exe args` in the temporary directory with SDF_DATA_PATH set to `data_path`.
-    Result run(const std::string& exe, const std::string& args, const std::string& data_path = "") const {
-        const std::string out = at(".stdout"), err = at(".stderr");
-        const std::string cmd = "cd " + quote(dir_.string()) + " && SDF_DATA_PATH=" + quote(data_path) +
-                                " SDF_CACHE_DIR=" + quote(at("cache")) + " " + quote(exe) + " " + args + " > " +
-                                quote(out) + " 2> " + quote(err);
-        const int status = std::system(cmd.c_str());
-        Result r;
-        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = read_text(out);
-        r.err = read_text(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
+    ShellResult run(const std::string& exe, const std::string& args, const std::string& data_path = "") const {
+        return test::run_in(dir_, "SDF_DATA_PATH=" + quote(data_path) + " SDF_CACHE_DIR=" + quote(at("cache")) + " " +
+                                      quote(exe) + " " + args);
     }
-    Result query(const std::string& args, const std::string& data_path = "") const {
+    ShellResult query(const std::string& args, const std::string& data_path = "") const {
         return run(SDF_QUERY_EXE, args, data_path);
     }
-    Result experiment(const std::string& args, const std::string& data_path = "") const {
+    ShellResult experiment(const std::string& args, const std::string& data_path = "") const {
         return run(RUN_EXPERIMENT_EXE, args, data_path);
     }
 
@@ -217,8 +167,6 @@ protected:
         }
         return write(rel, c.dump(2));
     }
-
-    fs::path dir_;
 };
 
 /// Points for the box: random in [-2.5, 2.5]^3 (fixed seed), plus hand-picked ones in every
@@ -275,7 +223,7 @@ void check_box_answers(const std::vector<Vec3d>& pts, const std::string& out, do
 TEST_F(Cli, QueryBoxFloatMatchesAnalyticSdfInInputOrder) {
     const std::vector<Vec3d> pts = box_points();
     write("points.txt", points_text(pts));
-    const Result r = query("shape:box points.txt");
+    const ShellResult r = query("shape:box points.txt");
     ASSERT_EQ(r.code, 0) << r.err;
     check_box_answers(pts, r.out, 1e-6, 1e-5);
 }
@@ -283,7 +231,7 @@ TEST_F(Cli, QueryBoxFloatMatchesAnalyticSdfInInputOrder) {
 TEST_F(Cli, QueryBoxDoubleMatchesAnalyticSdf) {
     const std::vector<Vec3d> pts = box_points();
     write("points.txt", points_text(pts));
-    const Result r = query("shape:box points.txt --precision double --threads 2");
+    const ShellResult r = query("shape:box points.txt --precision double --threads 2");
     ASSERT_EQ(r.code, 0) << r.err;
     check_box_answers(pts, r.out, 1e-12, 1e-10);
 }
@@ -291,7 +239,7 @@ TEST_F(Cli, QueryBoxDoubleMatchesAnalyticSdf) {
 TEST_F(Cli, QueryReadsStdin) {
     const std::vector<Vec3d> pts = {{2, 0, 0}, {0, 0, 0.5}, {3, 4, 1}};
     write("p.txt", points_text(pts));
-    const Result r = query("shape:box - < p.txt --precision double");
+    const ShellResult r = query("shape:box - < p.txt --precision double");
     ASSERT_EQ(r.code, 0) << r.err;
     const std::vector<QueryLine> lines = parse_query_output(r.out);
     ASSERT_EQ(lines.size(), 3u);
@@ -302,7 +250,7 @@ TEST_F(Cli, QueryReadsStdin) {
 
 TEST_F(Cli, QueryEmptyPointsFileGivesNoOutput) {
     write("p.txt", "# nothing\n\n");
-    const Result r = query("shape:box p.txt");
+    const ShellResult r = query("shape:box p.txt");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.out, "");
 }
@@ -311,7 +259,7 @@ TEST_F(Cli, QueryMalformedLineNamesFileAndLine) {
     // Line 1 comment, 2 blank, 3 good, 4 bad.
     for (const std::string bad : {"1.0 2.0 x", "1 2", "1 2 3 4", "nan 0 0", "1e999 0 0", "1,2,3"}) {
         write("bad.txt", "# header\n\n0 0 0\n" + bad + "\n1 1 1\n");
-        const Result r = query("shape:box bad.txt");
+        const ShellResult r = query("shape:box bad.txt");
         EXPECT_NE(r.code, 0) << bad;
         EXPECT_TRUE(Contains(r.err, "bad.txt:4")) << bad;
         EXPECT_TRUE(Contains(r.err, "x y z")) << bad;
@@ -320,18 +268,18 @@ TEST_F(Cli, QueryMalformedLineNamesFileAndLine) {
 
 TEST_F(Cli, QueryErrorsAreClear) {
     write("p.txt", "0 0 0\n");
-    const Result missing_points = query("shape:box nope.txt");
+    const ShellResult missing_points = query("shape:box nope.txt");
     EXPECT_NE(missing_points.code, 0);
     EXPECT_TRUE(Contains(missing_points.err, "nope.txt"));
-    const Result shape = query("shape:bxo p.txt");
+    const ShellResult shape = query("shape:bxo p.txt");
     EXPECT_NE(shape.code, 0);
     EXPECT_TRUE(Contains(shape.err, "did you mean 'box'?"));
-    const Result mesh = query("no_such_mesh.obj p.txt", at("env_meshes"));
+    const ShellResult mesh = query("no_such_mesh.obj p.txt", at("env_meshes"));
     EXPECT_NE(mesh.code, 0);
     EXPECT_TRUE(Contains(mesh.err, "no_such_mesh.obj"));
     EXPECT_TRUE(Contains(mesh.err, at("env_meshes")));
     EXPECT_TRUE(Contains(mesh.err, "scripts/fetch-meshes"));
-    const Result precision = query("shape:box p.txt --precision half");
+    const ShellResult precision = query("shape:box p.txt --precision half");
     EXPECT_NE(precision.code, 0);
     EXPECT_TRUE(Contains(precision.err, "half"));
 }
@@ -339,7 +287,7 @@ TEST_F(Cli, QueryErrorsAreClear) {
 TEST_F(Cli, QueryCudaBackendWithoutGpuFailsClearly) {
     if (cuda_backend_available()) GTEST_SKIP() << "a GPU is present: nothing to fail";
     write("p.txt", "0 0 0\n");
-    const Result r = query("shape:box p.txt --backend cuda");
+    const ShellResult r = query("shape:box p.txt --backend cuda");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(lower(r.err), "cuda")) << r.err;
     EXPECT_EQ(r.out, "");
@@ -367,7 +315,7 @@ TEST_F(Cli, QueryObjTriangleIndicesFollowTheFileFaceOrder) {
     const std::vector<Vec3d> pts = {{1.5, 0.1, 0.2}, {0.2, -1.5, 0.1}, {0.1, 0.2, 1.5},
                                     {-1.5, 0.2, 0.1}, {0.1, 1.5, -0.2}, {0.2, 0.1, -1.5}};
     write("p.txt", points_text(pts));
-    const Result r = query(quote(at("box.obj")) + " p.txt --precision double");
+    const ShellResult r = query(quote(at("box.obj")) + " p.txt --precision double");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");  // closed and consistently oriented: no warnings
     const std::vector<QueryLine> lines = parse_query_output(r.out);
@@ -381,7 +329,7 @@ TEST_F(Cli, QueryObjTriangleIndicesFollowTheFileFaceOrder) {
 TEST_F(Cli, QueryOpenMeshWarns) {
     write("open.obj", box_obj(/*skip=*/2));  // no +z face
     write("p.txt", "0 0 3\n");
-    const Result r = query("open.obj p.txt", dir_.string());
+    const ShellResult r = query("open.obj p.txt", dir_.string());
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(Contains(r.err, "open"));
 }
@@ -390,18 +338,18 @@ TEST_F(Cli, QueryOpenMeshWarns) {
 
 TEST_F(Cli, RunTinyConfigEndToEnd) {
     config("c.json");
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(Contains(r.out, "results in"));
     // Exactly one run directory, nothing hidden (no staging leftovers).
-    EXPECT_EQ(visible_entries(dir_ / "out"), (std::vector<std::string>{"tiny"}));
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    EXPECT_EQ(sorted_entries(dir_ / "out"), (std::vector<std::string>{"tiny"}));
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 1u);
     const fs::path run = dir_ / "out/tiny" / runs[0];
     EXPECT_NE(runs[0][0], '.');
-    EXPECT_EQ(visible_entries(run), (std::vector<std::string>{"fields", "manifest.json", "metrics.json"}));
+    EXPECT_EQ(sorted_entries(run), (std::vector<std::string>{"fields", "manifest.json", "metrics.json"}));
 
-    const json manifest = json::parse(read_text(run / "manifest.json"));
+    const json manifest = read_json(run / "manifest.json");
     EXPECT_EQ(manifest.at("run_id"), runs[0]);
     const std::string sha = manifest.at("config").at("sha256");
     EXPECT_TRUE(std::regex_match(sha, std::regex("[0-9a-f]{64}"))) << sha;
@@ -417,7 +365,7 @@ TEST_F(Cli, RunTinyConfigEndToEnd) {
     EXPECT_EQ(manifest.at("kind"), "sampling");
     EXPECT_EQ(manifest.at("inputs").at("mesh").at("name"), "box");
 
-    const json metrics = json::parse(read_text(run / "metrics.json"));
+    const json metrics = read_json(run / "metrics.json");
     ASSERT_EQ(metrics.at("fields").size(), 2u);
     for (const json& f : metrics.at("fields")) {
         EXPECT_TRUE(f.at("pairs_per_second").is_number()) << f.dump();
@@ -425,7 +373,7 @@ TEST_F(Cli, RunTinyConfigEndToEnd) {
     }
 
     // The fields read back, with the right point counts and the box's distances.
-    const std::vector<std::string> files = visible_entries(run / "fields");
+    const std::vector<std::string> files = sorted_entries(run / "fields");
     std::vector<std::string> headers;
     for (const auto& f : files)
         if (fs::path(f).extension() == ".json") headers.push_back(f);
@@ -451,37 +399,37 @@ TEST_F(Cli, RunDataPathRelativeToConfigAndOpenMeshWarning) {
                           {"data_path", {"meshes"}},
                           {"lattices", {{{"type", "cc"}, {"resolution", {4, 4, 4}}}}}});
     // Run from another directory: data_path is relative to the config, not the cwd.
-    const Result r = experiment("cfg/c.json --output-root out");
+    const ShellResult r = experiment("cfg/c.json --output-root out");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(Contains(r.err, "open")) << r.err;
     EXPECT_TRUE(Contains(r.err, "openbox"));
-    EXPECT_EQ(visible_entries(dir_ / "out/open").size(), 1u);
+    EXPECT_EQ(sorted_entries(dir_ / "out/open").size(), 1u);
 }
 
 TEST_F(Cli, DryRunPrintsPlanAndCreatesNothing) {
     config("c.json");
-    const Result r = experiment("c.json --output-root out --dry-run");
+    const ShellResult r = experiment("c.json --output-root out --dry-run");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(Contains(r.out, "plan"));
     EXPECT_TRUE(Contains(r.out, "cc 8x8x8"));
     EXPECT_TRUE(Contains(r.out, "bcc 6x6x12"));
     EXPECT_TRUE(Contains(r.out, "box"));
     EXPECT_FALSE(fs::exists(dir_ / "out"));
-    EXPECT_EQ(visible_entries(dir_), (std::vector<std::string>{"c.json"}));
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"c.json"}));
 }
 
 TEST_F(Cli, SamplesLatticeAndOutputOptions) {
     config("c.json", {{"lattices", {{{"type", "bcc"}, {"samples", 100}}, {{"type", "cc"}, {"resolution", {3, 3, 3}}}}},
                       {"output", {{"dtype", "float64"}, {"nrrd", true}, {"uint8", true}}}});
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     ASSERT_EQ(r.code, 0) << r.err;
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 1u);
     const fs::path fields = dir_ / "out/tiny" / runs[0] / "fields";
     // 100 samples: BCC r = 4 (4^3 + 3^3 = 91; r = 5 gives 189).
     const SampledField b = read_field((fields / "box-bcc-4x4x8.json").string());
     EXPECT_EQ(b.size(), 91);
-    EXPECT_EQ(json::parse(read_text(fields / "box-bcc-4x4x8.json")).at("channels").at("distance").at("dtype"), "float64");
+    EXPECT_EQ(read_json(fields / "box-bcc-4x4x8.json").at("channels").at("distance").at("dtype"), "float64");
     EXPECT_TRUE(fs::exists(fields / "box-cc-3x3x3.nrrd"));
     EXPECT_FALSE(fs::exists(fields / "box-bcc-4x4x8.nrrd"));  // NRRD is CC only
     EXPECT_EQ(fs::file_size(fields / "box-cc-3x3x3.u8.raw"), 27u);
@@ -491,11 +439,11 @@ TEST_F(Cli, SamplesLatticeAndOutputOptions) {
 // ---- run-experiment: config errors ----------------------------------------------------------
 
 TEST_F(Cli, TypoInOptionalKeyNamesItAndSuggests) {
-    json c = json::parse(read_text(config("c.json")));
+    json c = read_json(config("c.json"));
     c["sampeler"] = c["sampler"];
     c.erase("sampler");
     write("c.json", c.dump());
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "c.json"));
     EXPECT_TRUE(Contains(r.err, "'sampeler'"));
@@ -505,7 +453,7 @@ TEST_F(Cli, TypoInOptionalKeyNamesItAndSuggests) {
 
 TEST_F(Cli, TypoInNestedKeyNamesThePath) {
     config("c.json", {{"sampler", {{"threads", 1}, {"precison", "double"}}}});
-    const Result r = experiment("c.json --output-root out --dry-run");
+    const ShellResult r = experiment("c.json --output-root out --dry-run");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "'sampler.precison'"));
     EXPECT_TRUE(Contains(r.err, "did you mean 'precision'?"));
@@ -513,11 +461,11 @@ TEST_F(Cli, TypoInNestedKeyNamesThePath) {
 
 // "latices" for the required "lattices": the message names the typo and suggests the key.
 TEST_F(Cli, TypoInRequiredKeyNamesItAndSuggests) {
-    json c = json::parse(read_text(config("c.json")));
+    json c = read_json(config("c.json"));
     c["latices"] = c["lattices"];
     c.erase("lattices");
     write("c.json", c.dump());
-    const Result r = experiment("c.json --output-root out --dry-run");
+    const ShellResult r = experiment("c.json --output-root out --dry-run");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "c.json"));
     EXPECT_TRUE(Contains(r.err, "'lattices': missing"));
@@ -527,7 +475,7 @@ TEST_F(Cli, TypoInRequiredKeyNamesItAndSuggests) {
 
 TEST_F(Cli, MalformedJsonNamesFileLineColumn) {
     write("bad.json", "{\n  \"name\": \"tiny\",\n  \"mesh\": {\"shape\": \"box\"}\n  \"lattices\": []\n}\n");
-    const Result r = experiment("bad.json --output-root out");
+    const ShellResult r = experiment("bad.json --output-root out");
     EXPECT_NE(r.code, 0);
     // Line 4 `  "lattices": []`: the unexpected string literal ends at column 12.
     EXPECT_TRUE(Contains(r.err, "bad.json:4:12:")) << r.err;
@@ -555,7 +503,7 @@ TEST_F(Cli, WrongTypesAndValuesNameTheKey) {
     };
     for (const Case& c : cases) {
         config("c.json", c.overrides);
-        const Result r = experiment("c.json --output-root out --dry-run");
+        const ShellResult r = experiment("c.json --output-root out --dry-run");
         EXPECT_NE(r.code, 0) << c.overrides.dump();
         EXPECT_TRUE(Contains(r.err, "c.json")) << c.overrides.dump();
         EXPECT_TRUE(Contains(r.err, c.key)) << c.overrides.dump();
@@ -565,7 +513,7 @@ TEST_F(Cli, WrongTypesAndValuesNameTheKey) {
 
 TEST_F(Cli, MissingMeshNamesSearchPathAndFetchScript) {
     config("cfg/c.json", {{"mesh", "no_such_mesh.obj"}, {"data_path", {"meshes"}}});
-    const Result r = experiment("cfg/c.json --output-root out", at("envdir"));
+    const ShellResult r = experiment("cfg/c.json --output-root out", at("envdir"));
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "no_such_mesh.obj"));
     EXPECT_TRUE(Contains(r.err, (fs::path("cfg") / "meshes").string()));  // the config's data_path entry
@@ -579,10 +527,10 @@ TEST_F(Cli, BadMeshFilesNameFileAndLine) {
     write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\n");
     config("nan.json", {{"mesh", "nan.obj"}});
     config("lines.json", {{"mesh", "lines.obj"}});
-    const Result nan = experiment("nan.json --output-root out", dir_.string());
+    const ShellResult nan = experiment("nan.json --output-root out", dir_.string());
     EXPECT_NE(nan.code, 0);
     EXPECT_TRUE(Contains(nan.err, "nan.obj:3")) << nan.err;
-    const Result lines = experiment("lines.json --output-root out", dir_.string());
+    const ShellResult lines = experiment("lines.json --output-root out", dir_.string());
     EXPECT_NE(lines.code, 0);
     EXPECT_TRUE(Contains(lines.err, "lines.obj"));
     EXPECT_TRUE(Contains(lines.err, "no triangles"));
@@ -590,10 +538,10 @@ TEST_F(Cli, BadMeshFilesNameFileAndLine) {
 }
 
 TEST_F(Cli, MissingConfigFileAndCommandLineErrors) {
-    const Result none = experiment("nope.json");
+    const ShellResult none = experiment("nope.json");
     EXPECT_NE(none.code, 0);
     EXPECT_TRUE(Contains(none.err, "nope.json"));
-    const Result no_args = experiment("");
+    const ShellResult no_args = experiment("");
     EXPECT_NE(no_args.code, 0);
     EXPECT_TRUE(Contains(lower(no_args.err), "config"));
 }
@@ -605,7 +553,7 @@ TEST_F(Cli, MissingConfigFileAndCommandLineErrors) {
 TEST_F(Cli, FailedRunLeavesNoDirectories) {
     // Configure-time failure: nothing is created at all.
     config("missing.json", {{"mesh", "no_such_mesh.obj"}});
-    const Result r = experiment("missing.json --output-root out", dir_.string());
+    const ShellResult r = experiment("missing.json --output-root out", dir_.string());
     EXPECT_NE(r.code, 0);
     EXPECT_FALSE(fs::exists(dir_ / "out"));
     // Run-time failure (the file is found when the config is read, its line 3 is bad when it
@@ -613,7 +561,7 @@ TEST_F(Cli, FailedRunLeavesNoDirectories) {
     write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n");
     config("late.json", {{"mesh", "nan.obj"}, {"lattices", {{{"type", "cc"}, {"resolution", {3, 3, 3}}}}}});
     ASSERT_EQ(experiment("late.json --output-root out --dry-run").code, 1);  // the plan loads the mesh too
-    const Result late = experiment("late.json --output-root out/deeper");
+    const ShellResult late = experiment("late.json --output-root out/deeper");
     EXPECT_NE(late.code, 0);
     EXPECT_TRUE(Contains(late.err, "nan.obj:3")) << late.err;
     EXPECT_TRUE(Contains(late.err, "late.json: key 'mesh'")) << late.err;  // run-time errors name the config too
@@ -628,16 +576,16 @@ TEST_F(Cli, FailedRunLeavesNoDirectories) {
 // Two runs of the same config within a second get distinct ids (milliseconds, then a suffix).
 TEST_F(Cli, TwoRunsOfTheSameConfigBothSucceed) {
     config("c.json", {{"lattices", {{{"type", "cc"}, {"resolution", {3, 3, 3}}}}}});
-    const Result first = experiment("c.json --output-root out");
+    const ShellResult first = experiment("c.json --output-root out");
     ASSERT_EQ(first.code, 0) << first.err;
-    const Result second = experiment("c.json --output-root out");
+    const ShellResult second = experiment("c.json --output-root out");
     EXPECT_EQ(second.code, 0) << second.err;
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 2u);
     EXPECT_NE(runs[0], runs[1]);
     for (const std::string& id : runs) {
         EXPECT_TRUE(std::regex_match(id, std::regex(R"(\d{8}T\d{6}\.\d{3}Z-[0-9a-f]{8}(-\d+)?)"))) << id;
-        EXPECT_EQ(json::parse(read_text(dir_ / "out/tiny" / id / "manifest.json")).at("run_id"), id);
+        EXPECT_EQ(read_json(dir_ / "out/tiny" / id / "manifest.json").at("run_id"), id);
     }
 }
 
@@ -645,7 +593,7 @@ TEST_F(Cli, TwoRunsOfTheSameConfigBothSucceed) {
 TEST_F(Cli, RunNameCannotEscapeTheOutputRoot) {
     for (const std::string name : {"..", ".", ".hidden", "-x", "_x"}) {
         config("c.json", {{"name", name}, {"lattices", {{{"type", "cc"}, {"resolution", {3, 3, 3}}}}}});
-        const Result r = experiment("c.json --output-root out/root");
+        const ShellResult r = experiment("c.json --output-root out/root");
         EXPECT_NE(r.code, 0) << name;
         EXPECT_TRUE(Contains(r.err, "'name'")) << name;
         EXPECT_TRUE(Contains(r.err, "starting with a letter or digit")) << name;
@@ -657,22 +605,22 @@ TEST_F(Cli, RunNameCannotEscapeTheOutputRoot) {
 TEST_F(Cli, TwoLatticesWithTheSameResolution) {
     config("c.json", {{"lattices", {{{"type", "cc"}, {"resolution", {4, 4, 4}}},
                                     {{"type", "cc"}, {"resolution", {4, 4, 4}}, {"margin", 0.5}}}}});
-    const Result dry = experiment("c.json --output-root out --dry-run");
+    const ShellResult dry = experiment("c.json --output-root out --dry-run");
     EXPECT_EQ(dry.code, 0) << dry.err;
     EXPECT_TRUE(Contains(dry.out, "fields/box-cc-4x4x4.json"));
     EXPECT_TRUE(Contains(dry.out, "fields/box-cc-4x4x4-1.json"));
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     ASSERT_EQ(r.code, 0) << r.err;
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 1u);
     std::vector<std::string> headers;
-    for (const auto& f : visible_entries(dir_ / "out/tiny" / runs[0] / "fields"))
+    for (const auto& f : sorted_entries(dir_ / "out/tiny" / runs[0] / "fields"))
         if (fs::path(f).extension() == ".json") headers.push_back(f);
     EXPECT_EQ(headers, (std::vector<std::string>{"box-cc-4x4x4-1.json", "box-cc-4x4x4.json"}));
     // Given names that collide are rejected before anything runs.
     config("n.json", {{"lattices", {{{"type", "cc"}, {"resolution", {4, 4, 4}}, {"name", "a"}},
                                     {{"type", "cc"}, {"resolution", {5, 5, 5}}, {"name", "a"}}}}});
-    const Result named = experiment("n.json --output-root out2 --dry-run");
+    const ShellResult named = experiment("n.json --output-root out2 --dry-run");
     EXPECT_NE(named.code, 0);
     EXPECT_TRUE(Contains(named.err, "'lattices[1].name'")) << named.err;
 }
@@ -691,7 +639,7 @@ TEST_F(Cli, DryRunValidatesTheMesh) {
                                            {json{{"shape", "torus"}, {"minor_radius", 2.0}}, "'mesh.minor_radius'"},
                                            {json{{"file", "x.obj"}, {"shape", "box"}}, "not both"}}) {
         config("c.json", {{"mesh", c.mesh}});
-        const Result r = experiment("c.json --output-root out --dry-run", dir_.string());
+        const ShellResult r = experiment("c.json --output-root out --dry-run", dir_.string());
         EXPECT_NE(r.code, 0) << c.mesh.dump();
         EXPECT_TRUE(Contains(r.err, "c.json")) << c.mesh.dump();
         EXPECT_TRUE(Contains(r.err, "'mesh")) << c.mesh.dump();
@@ -713,7 +661,7 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
                                            {{{"threads", 1}, {"method", "bvh"}, {"kernel", "vectorized"}}, "'sampler.kernel'"},
                                            {{{"threads", 1}, {"method", "octree"}}, "'sampler.method'"}}) {
         config("c.json", {{"sampler", c.sampler}});
-        const Result r = experiment("c.json --output-root out --dry-run");
+        const ShellResult r = experiment("c.json --output-root out --dry-run");
         EXPECT_NE(r.code, 0) << c.sampler.dump();
         EXPECT_TRUE(Contains(r.err, "c.json")) << r.err;
         EXPECT_TRUE(Contains(r.err, c.key)) << r.err;
@@ -726,7 +674,7 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
 #if !SDF_HAVE_CUDA
     config("c.json", {{"sampler", {{"backend", "cuda"}}}});
-    const Result cuda = experiment("c.json --output-root out --dry-run");
+    const ShellResult cuda = experiment("c.json --output-root out --dry-run");
     EXPECT_NE(cuda.code, 0);
     EXPECT_TRUE(Contains(cuda.err, "'sampler.backend'")) << cuda.err;
     EXPECT_TRUE(Contains(cuda.err, "not available")) << cuda.err;
@@ -735,10 +683,10 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
 
 TEST_F(Cli, QueryRejectsNegativeThreadCountAndUnknownKernel) {
     write("p.txt", "0 0 0\n");
-    const Result r = query("shape:box p.txt --threads -5");
+    const ShellResult r = query("shape:box p.txt --threads -5");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "threads"));
-    const Result k = query("shape:box p.txt --kernel tuned");
+    const ShellResult k = query("shape:box p.txt --kernel tuned");
     EXPECT_NE(k.code, 0);
     EXPECT_TRUE(Contains(k.err, "tuned"));
     EXPECT_EQ(query("shape:box p.txt --kernel eberly").code, 0);
@@ -751,22 +699,22 @@ TEST_F(Cli, WorkingDirectoryDoesNotShadowTheDataPath) {
     write("shadow.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
     config("cfg/c.json", {{"mesh", "shadow.obj"}, {"data_path", {"meshes"}},
                           {"lattices", {{{"type", "cc"}, {"resolution", {3, 3, 3}}}}}});
-    const Result r = experiment("cfg/c.json --output-root out");
+    const ShellResult r = experiment("cfg/c.json --output-root out");
     ASSERT_EQ(r.code, 0) << r.err;
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 1u);
-    const json manifest = json::parse(read_text(dir_ / "out/tiny" / runs[0] / "manifest.json"));
+    const json manifest = read_json(dir_ / "out/tiny" / runs[0] / "manifest.json");
     EXPECT_EQ(manifest.at("inputs").at("mesh").at("triangles"), 12);
     EXPECT_EQ(fs::path(manifest.at("inputs").at("mesh").at("source").get<std::string>()),
               fs::weakly_canonical(dir_ / "cfg/meshes/shadow.obj"));
     // Beside the config wins over data_path.
     write("cfg/shadow.obj", read_text(dir_ / "shadow.obj"));
     ASSERT_EQ(experiment("cfg/c.json --output-root out2").code, 0);
-    const std::string run2 = visible_entries(dir_ / "out2/tiny").at(0);
-    EXPECT_EQ(json::parse(read_text(dir_ / "out2/tiny" / run2 / "manifest.json")).at("inputs").at("mesh").at("triangles"), 4);
+    const std::string run2 = sorted_entries(dir_ / "out2/tiny").at(0);
+    EXPECT_EQ(read_json(dir_ / "out2/tiny" / run2 / "manifest.json").at("inputs").at("mesh").at("triangles"), 4);
     // sdf-query (no config) looks in the working directory first.
     write("p.txt", "0 0 3\n");
-    const Result q = query("shadow.obj p.txt --precision double", at("cfg/meshes"));
+    const ShellResult q = query("shadow.obj p.txt --precision double", at("cfg/meshes"));
     ASSERT_EQ(q.code, 0) << q.err;
     EXPECT_LT(parse_query_output(q.out).at(0).tri, 4);
 }
@@ -775,11 +723,11 @@ TEST_F(Cli, WorkingDirectoryDoesNotShadowTheDataPath) {
 // hash of the resolved one.
 TEST_F(Cli, ManifestRecordsTheResolvedConfig) {
     config("c.json", {{"sampler", nullptr}, {"lattices", {{{"type", "cc"}, {"resolution", {3, 3, 3}}}}}});
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     ASSERT_EQ(r.code, 0) << r.err;
-    const std::vector<std::string> runs = visible_entries(dir_ / "out/tiny");
+    const std::vector<std::string> runs = sorted_entries(dir_ / "out/tiny");
     ASSERT_EQ(runs.size(), 1u);
-    const json cfg = json::parse(read_text(dir_ / "out/tiny" / runs[0] / "manifest.json")).at("config");
+    const json cfg = read_json(dir_ / "out/tiny" / runs[0] / "manifest.json").at("config");
     const json resolved = cfg.at("resolved");
     EXPECT_EQ(resolved.at("sampler").at("precision"), "float");
     EXPECT_EQ(resolved.at("sampler").at("backend"), "cpu");
@@ -795,7 +743,7 @@ TEST_F(Cli, ManifestRecordsTheResolvedConfig) {
 // Errors in procedural shape parameters name the config file and the key.
 TEST_F(Cli, ShapeParameterErrorNamesTheConfigFile) {
     config("c.json", {{"mesh", {{"shape", "box"}, {"half_extnt", {1, 1, 1}}}}});
-    const Result r = experiment("c.json --output-root out");
+    const ShellResult r = experiment("c.json --output-root out");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "c.json: unknown key 'mesh.half_extnt'"));
     EXPECT_TRUE(Contains(r.err, "did you mean 'half_extent'?"));
@@ -805,7 +753,7 @@ TEST_F(Cli, ShapeParameterErrorNamesTheConfigFile) {
 
 TEST_F(Cli, EmptyLatticeListRejected) {
     config("c.json", {{"lattices", json::array()}});
-    const Result r = experiment("c.json --output-root out --dry-run");
+    const ShellResult r = experiment("c.json --output-root out --dry-run");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "'lattices'"));
     EXPECT_TRUE(Contains(r.err, "at least one"));

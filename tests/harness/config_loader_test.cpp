@@ -1,54 +1,26 @@
 // Config inheritance ("parent") and sweeps: merge rules, relative parent paths, cycles and
 // their messages; cartesian products, labels, key paths into arrays, and bad sweeps.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "harness/config/config_loader.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/sweep.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::Contains;
+using test::error_of;
 
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "nothing was thrown";
-    return {};
-}
-
-class Configs : public ::testing::Test {
+class Configs : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_config_loader_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string write(const std::string& rel, const std::string& text) const {
-        const fs::path p = dir_ / rel;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p) << text;
-        return p.string();
-    }
-    fs::path dir_;
+    Configs() : ScratchDirTest("sdf_config_loader_test") {}
 };
 
 // ---- merge rules ------------------------------------------------------------------------------

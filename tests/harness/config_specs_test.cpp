@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -18,29 +17,15 @@
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
-
-/// Runs `f` and returns what it throws (any std::exception); fails the test when nothing is.
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "nothing was thrown";
-    return {};
-}
+using test::Contains;
+using test::error_of;
 
 /// Parses one lattice object as the runner does (path "lattices[0]", then finish()).
 LatticeSpec lattice(const json& j) {
@@ -476,25 +461,18 @@ TEST(MeshSpec, ShapeParametersCheckedAtParseTimeNamingTheFile) {
 
 // ---- files: search path, locating, loading ------------------------------------------------
 
-class MeshFiles : public ::testing::Test {
+/// A scratch directory, and $SDF_DATA_PATH restored after each test.
+class MeshFiles : public test::ScratchDirTest {
 protected:
+    MeshFiles() : ScratchDirTest("sdf_config_specs_test") {}
     void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_config_specs_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        ScratchDirTest::SetUp();
         if (const char* v = std::getenv("SDF_DATA_PATH")) saved_ = std::string(v);
     }
     void TearDown() override {
         if (saved_) ::setenv("SDF_DATA_PATH", saved_->c_str(), 1);
         else ::unsetenv("SDF_DATA_PATH");
-        fs::remove_all(dir_);
-    }
-    std::string write(const std::string& rel, const std::string& text) const {
-        const fs::path p = dir_ / rel;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p) << text;
-        return p.string();
+        ScratchDirTest::TearDown();
     }
     static std::vector<std::string> defaults() {
         std::vector<std::string> out;
@@ -503,7 +481,6 @@ protected:
             if (!item.empty()) out.push_back(item);
         return out;
     }
-    fs::path dir_;
     std::optional<std::string> saved_;
 };
 

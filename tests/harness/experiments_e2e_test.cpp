@@ -3,19 +3,18 @@
 // with inheritance, the analytic and speedup kinds at tiny sizes, baselines from clean runs
 // only, and scripts/make-report on a fake results tree.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "harness/build_config.h"
+#include "harness_test_util.h"
 
 #ifndef RUN_EXPERIMENT_EXE
 #error "RUN_EXPERIMENT_EXE must be defined by CMake"
@@ -26,59 +25,20 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::Contains;
+using test::quote;
+using test::read_json;
+using test::read_text;
+using test::ShellResult;
 
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-class E2e : public ::testing::Test {
+class E2e : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_e2e_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    E2e() : ScratchDirTest("sdf_e2e_test") {}
 
-    std::string at(const std::string& rel) const { return (dir_ / rel).string(); }
-    std::string write(const std::string& rel, const std::string& text) const {
-        const fs::path p = dir_ / rel;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
+    ShellResult shell(const std::string& command) const {
+        return test::run_in(dir_, "SDF_CACHE_DIR=" + quote(at("cache")) + " " + command);
     }
-    Result shell(const std::string& command) const {
-        const std::string out = at(".stdout"), err = at(".stderr");
-        const std::string cmd = "cd " + quote(dir_.string()) + " && SDF_CACHE_DIR=" + quote(at("cache")) + " " + command +
-                                " > " + quote(out) + " 2> " + quote(err);
-        const int status = std::system(cmd.c_str());
-        Result r;
-        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = read_text(out);
-        r.err = read_text(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
-    }
-    Result run(const std::string& args) const { return shell(quote(RUN_EXPERIMENT_EXE) + " " + args); }
+    ShellResult run(const std::string& args) const { return shell(quote(RUN_EXPERIMENT_EXE) + " " + args); }
     /// The single run directory under out/<name>/.
     fs::path only_run(const std::string& name, const std::string& root = "out") const {
         std::vector<fs::path> runs;
@@ -86,7 +46,6 @@ protected:
         EXPECT_EQ(runs.size(), 1u) << name;
         return runs.empty() ? fs::path() : runs[0];
     }
-    fs::path dir_;
 };
 
 const std::string kSource = SDF_SOURCE_DIR;
@@ -104,15 +63,15 @@ json tiny_study(const std::string& name) {
 // ---- the CI-sized config and its committed baseline ----------------------------------------
 
 TEST_F(E2e, CiSmokeRunPassesItsCommittedBaseline) {
-    const Result r = run(quote(kSource + "/configs/ci_smoke.json") + " --output-root out --check --quiet");
+    const ShellResult r = run(quote(kSource + "/configs/ci_smoke.json") + " --output-root out --check --quiet");
     EXPECT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(Contains(r.out, "check of ci_smoke/"));
     EXPECT_TRUE(Contains(r.out, "PASSED"));
     const fs::path run_dir = only_run("ci_smoke");
-    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    const json metrics = read_json(run_dir / "metrics.json");
     EXPECT_EQ(metrics.at("reconstructions").size(), 7u);
     EXPECT_GE(metrics.at("regression").size(), 40u);
-    const json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    const json manifest = read_json(run_dir / "manifest.json");
     for (const char* key : {"run_id", "config", "provenance", "started", "finished", "inputs"}) EXPECT_TRUE(manifest.contains(key)) << key;
     EXPECT_TRUE(manifest.at("provenance").at("git").contains("dirty"));
     EXPECT_TRUE(manifest.at("provenance").at("build").contains("cxx_flags"));
@@ -128,14 +87,14 @@ TEST_F(E2e, PerturbedResultFailsTheCheckReadably) {
     const std::string baseline = kSource + "/results/baselines/ci_smoke.json";
     EXPECT_EQ(run("--check-run " + quote(run_dir.string()) + " --baseline " + quote(baseline)).code, 0);
     // Make one error 50 % worse.
-    json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    json metrics = read_json(run_dir / "metrics.json");
     const std::string key = "cc-14x14x14/catmull_rom/fd/domain_rms";
     ASSERT_TRUE(metrics.at("regression").contains(key));
     const double before = metrics["regression"][key]["value"];
     metrics["regression"][key]["value"] = before * 1.5;
     fs::permissions(run_dir / "metrics.json", fs::perms::owner_write, fs::perm_options::add);
     std::ofstream(run_dir / "metrics.json") << metrics.dump(2);
-    const Result r = run("--check-run " + quote(run_dir.string()));  // the baseline named by the config
+    const ShellResult r = run("--check-run " + quote(run_dir.string()));  // the baseline named by the config
     EXPECT_EQ(r.code, 3) << r.out << r.err;
     EXPECT_TRUE(Contains(r.out, "FAIL  " + key)) << r.out;
     EXPECT_TRUE(Contains(r.out, "(+50%)")) << r.out;
@@ -155,35 +114,35 @@ TEST_F(E2e, FieldsAreCachedAcrossRunsAndKindsAndNoCacheResamples) {
 
     // The sampling kind fills the BCC entry; the reconstruction kind then finds it.
     ASSERT_EQ(run("s.json --output-root out --quiet").code, 0);
-    const Result dry = run("a.json --output-root out --dry-run");
+    const ShellResult dry = run("a.json --output-root out --dry-run");
     ASSERT_EQ(dry.code, 0) << dry.err;
     EXPECT_TRUE(Contains(dry.out, "field cc-6x6x6: cc 6x6x6, 216 points, cpu/brute_force: to sample")) << dry.out;
     EXPECT_TRUE(Contains(dry.out, "field bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: cached")) << dry.out;
-    const Result first = run("a.json --output-root out --quiet");
+    const ShellResult first = run("a.json --output-root out --quiet");
     ASSERT_EQ(first.code, 0) << first.err;
     EXPECT_TRUE(Contains(first.out, "cc-6x6x6 (6x6x6, 216 points): sampled")) << first.out;
     EXPECT_TRUE(Contains(first.out, "bcc-5x5x10 (5x5x10, 189 points): from the cache")) << first.out;
     EXPECT_TRUE(Contains(first.out, "probes: exact distances computed")) << first.out;
     // A second run samples nothing and gets the same numbers.
-    const Result second = run("a.json --output-root out2 --quiet");
+    const ShellResult second = run("a.json --output-root out2 --quiet");
     ASSERT_EQ(second.code, 0) << second.err;
     EXPECT_FALSE(Contains(second.out, "sampled in")) << second.out;
     EXPECT_TRUE(Contains(second.out, "probes from the cache")) << second.out;
-    const json m1 = json::parse(read_text(only_run("a") / "metrics.json"));
-    const json m2 = json::parse(read_text(only_run("a", "out2") / "metrics.json"));
+    const json m1 = read_json(only_run("a") / "metrics.json");
+    const json m2 = read_json(only_run("a", "out2") / "metrics.json");
     EXPECT_EQ(m1.at("regression"), m2.at("regression"));
     EXPECT_TRUE(m2.at("lattices")[0].at("from_cache").get<bool>());
     // --no-cache samples everything again and leaves the cache alone.
-    const Result dry_nc = run("a.json --output-root out3 --dry-run --no-cache");
+    const ShellResult dry_nc = run("a.json --output-root out3 --dry-run --no-cache");
     EXPECT_TRUE(Contains(dry_nc.out, "to sample (--no-cache)")) << dry_nc.out;
-    const Result nc = run("a.json --output-root out3 --no-cache --quiet");
+    const ShellResult nc = run("a.json --output-root out3 --no-cache --quiet");
     ASSERT_EQ(nc.code, 0) << nc.err;
     EXPECT_TRUE(Contains(nc.out, "cc-6x6x6 (6x6x6, 216 points): sampled")) << nc.out;
     EXPECT_TRUE(Contains(nc.out, "bcc-5x5x10 (5x5x10, 189 points): sampled")) << nc.out;
-    const json m3 = json::parse(read_text(only_run("a", "out3") / "metrics.json"));
+    const json m3 = read_json(only_run("a", "out3") / "metrics.json");
     EXPECT_FALSE(m3.at("lattices")[0].at("from_cache").get<bool>());
     EXPECT_EQ(m1.at("regression"), m3.at("regression"));
-    EXPECT_FALSE(json::parse(read_text(only_run("a", "out3") / "manifest.json")).at("cache").at("used").get<bool>());
+    EXPECT_FALSE(read_json(only_run("a", "out3") / "manifest.json").at("cache").at("used").get<bool>());
     // --cache-dir chooses another cache: nothing there yet.
     EXPECT_TRUE(Contains(run("a.json --dry-run --cache-dir " + quote(at("other"))).out, "bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: to sample"));
 }
@@ -199,23 +158,23 @@ TEST_F(E2e, SweepWithParentRunsEveryPointInOneRunDirectory) {
                                  {"sweep", {{"lattices[0].resolution", {{5, 5, 5}, {7, 7, 7}}}}},
                                  {"reconstructions", {{{"lattice", "cc"}, {"interpolator", "catmull_rom"}}}}}
                                 .dump());
-    const Result dry = run("cfg/sweep.json --output-root out --dry-run");
+    const ShellResult dry = run("cfg/sweep.json --output-root out --dry-run");
     ASSERT_EQ(dry.code, 0) << dry.err;
     EXPECT_TRUE(Contains(dry.out, "2 runs")) << dry.out;
     EXPECT_TRUE(Contains(dry.out, "[1/2] sw-resolution_5x5x5")) << dry.out;
     EXPECT_TRUE(Contains(dry.out, "[2/2] sw-resolution_7x7x7")) << dry.out;
     EXPECT_TRUE(Contains(dry.out, "inheriting from")) << dry.out;
-    const Result r = run("cfg/sweep.json --output-root out --quiet");
+    const ShellResult r = run("cfg/sweep.json --output-root out --quiet");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(Contains(r.out, "[2/2] sw-resolution_7x7x7"));
     const fs::path run_dir = only_run("sw");
-    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    const json metrics = read_json(run_dir / "metrics.json");
     ASSERT_EQ(metrics.at("points").size(), 2u);
     EXPECT_EQ(metrics["points"][0].at("name"), "sw-resolution_5x5x5");
     EXPECT_EQ(metrics["points"][1].at("parameters").at("lattices[0].resolution"), json({7, 7, 7}));
     EXPECT_EQ(metrics["points"][1].at("metrics").at("reconstructions").size(), 1u);
     EXPECT_TRUE(metrics.at("regression").contains("sw-resolution_7x7x7/cc-7x7x7/catmull_rom/fd/domain_rms"));
-    const json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    const json manifest = read_json(run_dir / "manifest.json");
     ASSERT_EQ(manifest.at("points").size(), 2u);
     EXPECT_EQ(manifest["points"][1].at("resolved").at("lattices")[0].at("resolution"), json({7, 7, 7}));
     EXPECT_EQ(manifest["points"][1].at("resolved").at("metrics").at("band"), 1.0);  // a default, filled in
@@ -230,13 +189,13 @@ TEST_F(E2e, ReconstructionStudyRendersTheThesisGridWithImageMetrics) {
     cfg["lattices"] = {{{"type", "cc"}, {"resolution", {16, 16, 16}}}, {{"type", "bcc"}, {"resolution", {13, 13, 26}}}};
     cfg["render"] = {{"size", {48, 48}}, {"views", {"front"}}, {"backend", "cpu"}};
     write("render.json", cfg.dump());
-    const Result dry = run("render.json --output-root out --dry-run");
+    const ShellResult dry = run("render.json --output-root out --dry-run");
     ASSERT_EQ(dry.code, 0) << dry.err;
     EXPECT_TRUE(Contains(dry.out, "render front at 48x48")) << dry.out;
-    const Result r = run("render.json --output-root out --quiet");
+    const ShellResult r = run("render.json --output-root out --quiet");
     ASSERT_EQ(r.code, 0) << r.err;
     const fs::path run_dir = only_run("render_tiny");
-    const json metrics = json::parse(read_text(run_dir / "metrics.json"));
+    const json metrics = read_json(run_dir / "metrics.json");
     const json& view = metrics.at("render").at("views").at("front");
     ASSERT_EQ(view.at("panels").size(), 5u);  // A..E of the thesis's figures
     for (const json& panel : view["panels"]) {
@@ -259,10 +218,10 @@ TEST_F(E2e, AnalyticKindTinyTable41AndConvergence) {
                           {"convergence", {{"samples", {2000, 4000}}, {"interpolators", {"catmull_rom", "bcc_cubic/fd"}},
                                            {"probes_per_axis", 8}}}}
                          .dump());
-    const Result r = run("ml.json --output-root out --quiet");
+    const ShellResult r = run("ml.json --output-root out --quiet");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(Contains(r.out, "thesis 8.725 / 8.939"));
-    const json m = json::parse(read_text(only_run("ml_tiny") / "metrics.json"));
+    const json m = read_json(only_run("ml_tiny") / "metrics.json");
     EXPECT_EQ(m.at("table_4_1").at("lattice"), "10x10x20");
     EXPECT_GT(m.at("table_4_1").at("plain").at("rms").get<double>(), 0.0);
     EXPECT_EQ(m.at("table_4_1").at("thesis").at("plain"), 8.939);
@@ -271,12 +230,12 @@ TEST_F(E2e, AnalyticKindTinyTable41AndConvergence) {
     EXPECT_EQ(m["convergence"]["curves"][1].at("points").size(), 2u);
     EXPECT_TRUE(m.at("regression").contains("convergence/catmull_rom/fd/2000/rms"));
     write("small.json", json{{"name", "s"}, {"kind", "analytic"}, {"convergence", {{"samples", {200}}}}}.dump());
-    const Result small = run("small.json --dry-run");
+    const ShellResult small = run("small.json --dry-run");
     EXPECT_NE(small.code, 0);
     EXPECT_TRUE(Contains(small.err, "'convergence.samples': 200 samples give trilinear/fd a 6^3 lattice")) << small.err;
     // Errors name the key.
     write("bad.json", json{{"name", "b"}, {"kind", "analytic"}, {"convergence", {{"interpolators", {"bcc_cubic/fd_weird"}}}}}.dump());
-    const Result bad = run("bad.json --dry-run");
+    const ShellResult bad = run("bad.json --dry-run");
     EXPECT_NE(bad.code, 0);
     EXPECT_TRUE(Contains(bad.err, "'convergence.interpolators'")) << bad.err;
 }
@@ -291,9 +250,9 @@ TEST_F(E2e, SpeedupKindReportsGpuBackendsAsUnavailableWithoutAGpu) {
                                         {{"name", "gpu_tuned"}, {"backend", "cuda"}, {"kernel", "tuned"}}}},
                           {"repetitions", 1}}
                          .dump());
-    const Result r = run("sp.json --output-root out --quiet");
+    const ShellResult r = run("sp.json --output-root out --quiet");
     ASSERT_EQ(r.code, 0) << r.err;
-    const json m = json::parse(read_text(only_run("sp") / "metrics.json"));
+    const json m = read_json(only_run("sp") / "metrics.json");
     ASSERT_EQ(m.at("rows").size(), 2u);
     EXPECT_EQ(m.at("meshes").at("bunny").at("thesis_table_3_1").at("triangles"), 69666);
     const json& backends = m["rows"][0].at("backends");
@@ -317,28 +276,28 @@ TEST_F(E2e, BaselinesOnlyFromCleanRuns) {
     write("a.json", tiny_study("a").dump());
     ASSERT_EQ(run("a.json --output-root out --quiet").code, 0);
     const fs::path run_dir = only_run("a");
-    json manifest = json::parse(read_text(run_dir / "manifest.json"));
+    json manifest = read_json(run_dir / "manifest.json");
     fs::permissions(run_dir / "manifest.json", fs::perms::owner_write, fs::perm_options::add);
     manifest["provenance"]["git"] = {{"commit", "0123abcd"}, {"dirty", true}};  // also where git is absent
     std::ofstream(run_dir / "manifest.json") << manifest.dump(2);
-    const Result dirty = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
+    const ShellResult dirty = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
     EXPECT_EQ(dirty.code, 1);
     EXPECT_TRUE(Contains(dirty.err, "dirty work tree")) << dirty.err;
     EXPECT_FALSE(fs::exists(dir_ / "b/a.json"));
     manifest["provenance"]["git"] = {{"commit", "0123abcd"}, {"dirty", false}};
     std::ofstream(run_dir / "manifest.json") << manifest.dump(2);
-    const Result clean = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
+    const ShellResult clean = run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json");
     ASSERT_EQ(clean.code, 0) << clean.err;
     EXPECT_TRUE(Contains(clean.out, "baseline b/a.json"));
-    EXPECT_EQ(json::parse(read_text(dir_ / "b/a.json")).at("made_from").at("git_commit"), "0123abcd");
+    EXPECT_EQ(read_json(dir_ / "b/a.json").at("made_from").at("git_commit"), "0123abcd");
     EXPECT_TRUE(Contains(run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json").err, "already exists"));
     EXPECT_EQ(run("--write-baseline " + quote(run_dir.string()) + " --baseline b/a.json --force").code, 0);
     // A new run checks against it.
-    const Result check = run("a.json --output-root out2 --check --baseline b/a.json --quiet");
+    const ShellResult check = run("a.json --output-root out2 --check --baseline b/a.json --quiet");
     EXPECT_EQ(check.code, 0) << check.out << check.err;
     EXPECT_TRUE(Contains(check.out, "PASSED"));
     // Without a baseline file: a clear error.
-    const Result none = run("a.json --output-root out3 --check --baseline b/none.json --quiet");
+    const ShellResult none = run("a.json --output-root out3 --check --baseline b/none.json --quiet");
     EXPECT_EQ(none.code, 1);
     EXPECT_TRUE(Contains(none.err, "no baseline at b/none.json"));
     EXPECT_TRUE(Contains(none.err, "--write-baseline"));
@@ -408,7 +367,7 @@ TEST_F(E2e, ReportFromAFakeResultsTree) {
                                   {{"name", "gpu_tuned"}, {"status", "unavailable (no CUDA device)"}}}}}}}});
     fs::create_directories(dir_ / "res/dragon/.r3.partial.1.0");  // staging leftovers are ignored
     const std::string script = quote(kSource + "/scripts/make-report");
-    const Result r = shell(script + " --results res --out report");
+    const ShellResult r = shell(script + " --results res --out report");
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const std::string md = read_text(dir_ / "report/report.md");
     EXPECT_TRUE(Contains(md, "| dragon | reconstruction | 2026-02-01T00:00:00Z-00000000 |")) << md;
@@ -433,7 +392,7 @@ TEST_F(E2e, ReportFromAFakeResultsTree) {
     EXPECT_TRUE(Contains(page, "data:image/png;base64,"));
 
     // Sections without results say so; given run directories are used as they are.
-    const Result one = shell(script + " --out report2 res/dragon/r1");
+    const ShellResult one = shell(script + " --out report2 res/dragon/r1");
     ASSERT_EQ(one.code, 0) << one.err;
     const std::string md2 = read_text(dir_ / "report2/report.md");
     EXPECT_TRUE(Contains(md2, "No speedup run in the results")) << md2;

@@ -2,17 +2,13 @@
 // made: the backends compute the same field up to float ties. Skipped without a GPU
 // (tests/gpu_test_main.cpp).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "harness/build_config.h"
+#include "harness_test_util.h"
 
 #ifndef RUN_EXPERIMENT_EXE
 #error "RUN_EXPERIMENT_EXE must be defined by CMake"
@@ -21,32 +17,21 @@
 namespace sdf {
 namespace {
 
-namespace fs = std::filesystem;
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 class GpuSmoke : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(GpuSmoke, CiSmokeOnTheGpuPassesTheCpuBaseline) {
-    const fs::path dir = fs::temp_directory_path() / ("sdf_gpu_smoke_" + std::to_string(::getpid()) + "_" + GetParam());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const test::ScratchDir dir("sdf_gpu_smoke");
     const std::string source = SDF_SOURCE_DIR;
     const nlohmann::json config = {{"parent", source + "/configs/ci_smoke.json"},
                                    {"sampler", {{"backend", "cuda"}, {"kernel", GetParam()}, {"threads", nullptr}}},
                                    {"baseline", source + "/results/baselines/ci_smoke.json"}};
-    std::ofstream(dir / "gpu.json") << config.dump();
-    const std::string cmd = "cd '" + dir.string() + "' && '" + RUN_EXPERIMENT_EXE +
-                            "' gpu.json --output-root out --no-cache --check --quiet > out.txt 2>&1";
-    const int status = std::system(cmd.c_str());
-    const std::string out = read_text(dir / "out.txt");
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+    dir.write("gpu.json", config.dump());
+    const test::ShellResult r = test::run_in(
+        dir.path(), test::quote(RUN_EXPERIMENT_EXE) + " gpu.json --output-root out --no-cache --check --quiet");
+    const std::string out = r.out + r.err;
+    EXPECT_EQ(r.code, 0) << out;
     EXPECT_NE(out.find("PASSED"), std::string::npos) << out;
     EXPECT_NE(out.find("sampling with cuda/"), std::string::npos) << out;
-    fs::remove_all(dir);
 }
 
 // The tuned kernel searches with the CPU's own branch-free formula, so it breaks exact ties

@@ -6,24 +6,20 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
 
 #include "harness/cache/content_cache.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/atomic_file.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
+using test::Contains;
 
 Lattice lattice(LatticeType type, Int3 res, double h = 0.1) {
     Lattice l;
@@ -50,15 +46,10 @@ SampledField field(const Lattice& l) {
     return f;
 }
 
-class Cache : public ::testing::Test {
+/// The cache root does not exist beforehand: the cache creates it.
+class Cache : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_field_cache_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    fs::path dir_;
+    Cache() : ScratchDirTest("sdf_field_cache_test", /*create=*/false) {}
 };
 
 TEST(FieldCacheKey, BackendAndThreadsAreNotPartOfTheKey) {

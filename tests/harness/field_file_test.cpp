@@ -5,14 +5,11 @@
 
 #include <atomic>
 #include <thread>
-#include <unistd.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -21,46 +18,23 @@
 #include "harness/config/json_reader.h"
 #include "harness/io/atomic_file.h"
 #include "harness/io/field_file.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "nothing was thrown";
-    return {};
-}
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using test::Contains;
+using test::error_of;
+using test::read_json;
+using test::read_text;
+using test::sorted_entries;
 
 template <typename T>
 void write_raw(const fs::path& p, const std::vector<T>& v) {
     std::ofstream out(p, std::ios::binary);
     out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
-}
-
-/// Every name in `dir` (not recursive), sorted.
-std::vector<std::string> listing(const fs::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
 }
 
 Lattice make_lattice(LatticeType type, Int3 res) {
@@ -91,21 +65,9 @@ SampledField make_field(LatticeType type, Int3 res, bool gradient = true) {
     return f;
 }
 
-class FieldFiles : public ::testing::Test {
+class FieldFiles : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_field_file_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string at(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) const {
-        std::ofstream(dir_ / name, std::ios::binary) << text;
-        return at(name);
-    }
-    fs::path dir_;
+    FieldFiles() : ScratchDirTest("sdf_field_file_test") {}
 };
 
 // ---- round trips ------------------------------------------------------------------------
@@ -158,12 +120,12 @@ TEST_F(FieldFiles, HeaderAndChannelFilesAsDocumented) {
     const SampledField f = make_field(LatticeType::BCC, {3, 4, 5});
     write_field(at("x.json"), f);
     const int64_t n = 60 + 24;
-    EXPECT_EQ(listing(dir_), (std::vector<std::string>{"x.closest_triangle.raw", "x.distance.raw", "x.gradient.raw",
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"x.closest_triangle.raw", "x.distance.raw", "x.gradient.raw",
                                                        "x.json"}));
     EXPECT_EQ(fs::file_size(dir_ / "x.distance.raw"), uintmax_t(n * 4));
     EXPECT_EQ(fs::file_size(dir_ / "x.gradient.raw"), uintmax_t(n * 12));
     EXPECT_EQ(fs::file_size(dir_ / "x.closest_triangle.raw"), uintmax_t(n * 4));
-    const json h = json::parse(read_text(dir_ / "x.json"));
+    const json h = read_json(dir_ / "x.json");
     EXPECT_EQ(h.at("format"), "sdf-lattice-field");
     EXPECT_EQ(h.at("version"), 1);
     EXPECT_EQ(h.at("value_channel"), "distance");
@@ -190,8 +152,8 @@ TEST_F(FieldFiles, WithoutGradientOrClosestTriangle) {
     FieldWriteOptions o;
     o.closest_triangle = false;
     write_field(at("v.json"), f, o);
-    EXPECT_EQ(listing(dir_), (std::vector<std::string>{"v.distance.raw", "v.json"}));
-    const json h = json::parse(read_text(dir_ / "v.json"));
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"v.distance.raw", "v.json"}));
+    const json h = read_json(dir_ / "v.json");
     EXPECT_FALSE(h.contains("gradient_channel"));
     const SampledField g = read_field(at("v.json"));
     EXPECT_EQ(g.size(), 27);
@@ -251,7 +213,7 @@ TEST_F(FieldFiles, RefusedWriteLeavesNoPartialChannels) {
     EXPECT_FALSE(fs::exists(dir_ / "h.distance.raw"));
     write("k.closest_triangle.raw", "mine");
     EXPECT_ANY_THROW(write_field(at("k.json"), make_field(LatticeType::CC, {2, 2, 2})));
-    EXPECT_EQ(listing(dir_), (std::vector<std::string>{"h.gradient.raw", "k.closest_triangle.raw"}));
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"h.gradient.raw", "k.closest_triangle.raw"}));
 }
 
 // ---- fields written by a user -------------------------------------------------------------
@@ -523,7 +485,7 @@ TEST_F(FieldFiles, NrrdRejectsBccAndExistingFiles) {
     const std::string msg = error_of([&] { export_nrrd(at("b.nrrd"), make_field(LatticeType::BCC, {3, 3, 3}), true); });
     EXPECT_TRUE(Contains(msg, "b.nrrd"));
     EXPECT_TRUE(Contains(msg, "CC"));
-    EXPECT_TRUE(listing(dir_).empty());
+    EXPECT_TRUE(sorted_entries(dir_).empty());
     write("e.nrrd", "old");
     EXPECT_TRUE(Contains(error_of([&] { export_nrrd(at("e.nrrd"), make_field(LatticeType::CC, {2, 2, 2}), false); }),
                          "already exists"));
@@ -568,10 +530,10 @@ TEST_F(FieldFiles, AtomicWriteLeavesOnlyTheTarget) {
     const std::string data = std::string("binary\0data", 11);
     write_file_atomically(at("a.bin"), data.data(), data.size());
     EXPECT_EQ(read_text(dir_ / "a.bin"), data);
-    EXPECT_EQ(listing(dir_), (std::vector<std::string>{"a.bin"}));
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"a.bin"}));
     write_text_atomically(at("sub/dir/t.txt"), "text");  // parents are created
     EXPECT_EQ(read_text(dir_ / "sub/dir/t.txt"), "text");
-    EXPECT_EQ(listing(dir_ / "sub/dir"), (std::vector<std::string>{"t.txt"}));
+    EXPECT_EQ(sorted_entries(dir_ / "sub/dir"), (std::vector<std::string>{"t.txt"}));
     write_text_atomically(at("empty"), "");
     EXPECT_EQ(fs::file_size(dir_ / "empty"), 0u);
 }
@@ -584,7 +546,7 @@ TEST_F(FieldFiles, AtomicWriteRefusesExistingUnlessAllowed) {
     EXPECT_EQ(read_text(dir_ / "r.txt"), "first");
     write_text_atomically(at("r.txt"), "second", Overwrite::Allow);
     EXPECT_EQ(read_text(dir_ / "r.txt"), "second");
-    EXPECT_EQ(listing(dir_), (std::vector<std::string>{"r.txt"}));
+    EXPECT_EQ(sorted_entries(dir_), (std::vector<std::string>{"r.txt"}));
 }
 
 // A failed final rename (here: the target is a directory) must not leave the temporary file.
@@ -594,7 +556,7 @@ TEST_F(FieldFiles, FailedAtomicWriteLeavesNoTemporaryFile) {
     EXPECT_ANY_THROW(write_text_atomically(at("target"), "x", Overwrite::Allow));
     EXPECT_ANY_THROW(write_text_atomically(at("target"), "x", Overwrite::Forbid));
     EXPECT_TRUE(fs::is_directory(dir_ / "target/keep"));
-    EXPECT_EQ(listing(dir_), std::vector<std::string>{"target"});
+    EXPECT_EQ(sorted_entries(dir_), std::vector<std::string>{"target"});
 }
 
 // Writers racing for one name: exactly one wins, nobody's file is replaced, and no
@@ -615,7 +577,7 @@ TEST_F(FieldFiles, ConcurrentAtomicWritesNeverReplace) {
     for (auto& th : threads) th.join();
     EXPECT_EQ(won.load(), 1);
     EXPECT_EQ(refused.load(), kThreads - 1);
-    EXPECT_EQ(listing(dir_), std::vector<std::string>{"race.txt"});
+    EXPECT_EQ(sorted_entries(dir_), std::vector<std::string>{"race.txt"});
     EXPECT_TRUE(Contains(read_text(dir_ / "race.txt"), "writer "));
 }
 
@@ -650,7 +612,7 @@ TEST_F(FieldFiles, StagedDirectoryCommitMovesIntoPlace) {
         EXPECT_FALSE(fs::exists(s.path()));
     }
     EXPECT_EQ(read_text(final_path + "/m.json"), "{}");  // the destructor keeps a committed run
-    EXPECT_EQ(listing(dir_ / "runs"), (std::vector<std::string>{"r1"}));
+    EXPECT_EQ(sorted_entries(dir_ / "runs"), (std::vector<std::string>{"r1"}));
 }
 
 TEST_F(FieldFiles, StagedDirectoryWithoutCommitLeavesNothing) {
@@ -665,7 +627,7 @@ TEST_F(FieldFiles, StagedDirectoryWithoutCommitLeavesNothing) {
     }
     EXPECT_FALSE(fs::exists(staged));
     EXPECT_FALSE(fs::exists(final_path));
-    EXPECT_TRUE(listing(dir_ / "runs").empty());
+    EXPECT_TRUE(sorted_entries(dir_ / "runs").empty());
 }
 
 TEST_F(FieldFiles, StagedDirectoryRefusesAnExistingFinalPath) {
@@ -674,7 +636,7 @@ TEST_F(FieldFiles, StagedDirectoryRefusesAnExistingFinalPath) {
     const std::string msg = error_of([&] { StagedDirectory s(at("runs/r3")); });
     EXPECT_TRUE(Contains(msg, at("runs/r3")));
     EXPECT_TRUE(Contains(msg, "already exists"));
-    EXPECT_EQ(listing(dir_ / "runs"), (std::vector<std::string>{"r3"}));
+    EXPECT_EQ(sorted_entries(dir_ / "runs"), (std::vector<std::string>{"r3"}));
     EXPECT_EQ(read_text(dir_ / "runs/r3/old.json"), "old");
 }
 
@@ -688,8 +650,8 @@ TEST_F(FieldFiles, StagedDirectoryCommitRefusesAFinalPathThatAppeared) {
         const std::string msg = error_of([&] { s.commit(); });
         EXPECT_TRUE(Contains(msg, final_path));
     }
-    EXPECT_EQ(listing(final_path), (std::vector<std::string>{"other.json"}));
-    EXPECT_EQ(listing(dir_ / "runs"), (std::vector<std::string>{"r4"}));  // staging removed
+    EXPECT_EQ(sorted_entries(final_path), (std::vector<std::string>{"other.json"}));
+    EXPECT_EQ(sorted_entries(dir_ / "runs"), (std::vector<std::string>{"r4"}));  // staging removed
 }
 
 // A trailing slash (or "." components) is normalised away: staging happens beside the final
@@ -704,7 +666,7 @@ TEST_F(FieldFiles, StagedDirectoryWithTrailingSlash) {
         s.commit();
     }
     EXPECT_TRUE(fs::exists(dir_ / "runs/r5/m.json"));
-    EXPECT_EQ(listing(dir_ / "runs"), (std::vector<std::string>{"r5"}));
+    EXPECT_EQ(sorted_entries(dir_ / "runs"), (std::vector<std::string>{"r5"}));
 }
 
 // commit() never replaces an existing directory, not even an empty one (rename(2) would).
@@ -720,7 +682,7 @@ TEST_F(FieldFiles, StagedDirectoryNeverReplacesAnEmptyDirectory) {
     }
     EXPECT_TRUE(fs::is_empty(final_path));
     EXPECT_EQ(read_text(dir_ / "runs/r6-2/new.json"), "new");
-    EXPECT_EQ(listing(dir_ / "runs"), (std::vector<std::string>{"r6", "r6-2"}));
+    EXPECT_EQ(sorted_entries(dir_ / "runs"), (std::vector<std::string>{"r6", "r6-2"}));
 }
 
 }  // namespace

@@ -3,25 +3,20 @@
 // nearest known key suggested. Truth is written by hand here (line/column counted in the
 // literal texts, edit distances from the textbook examples).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include "harness/config/json_reader.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
+using test::Contains;
 
 /// Runs `f` and returns the ConfigError message; fails the test when nothing is thrown.
 template <typename F>
@@ -38,22 +33,9 @@ std::string config_error(F&& f) {
     return {};
 }
 
-/// A fresh directory under the system's temporary directory, removed after each test.
-class JsonFile : public ::testing::Test {
+class JsonFile : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("sdf_json_reader_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string write(const std::string& name, const std::string& text) const {
-        const fs::path p = dir_ / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
-    fs::path dir_;
+    JsonFile() : ScratchDirTest("sdf_json_reader_test") {}
 };
 
 // ---- read_json_file -------------------------------------------------------------------

@@ -6,16 +6,13 @@
 #include <string>
 
 #include "harness/check/regression_check.h"
+#include "harness_test_util.h"
 
 namespace sdf {
 namespace {
 
 using nlohmann::json;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-    if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "\"" << text << "\"\n  does not contain \"" << part << "\"";
-}
+using test::Contains;
 
 json manifest(bool dirty = false, const std::string& cpu = "CPU A", const json& gpu = nullptr) {
     return {{"run_id", "20261121T000000.000Z-abcdef12"},

@@ -5,7 +5,6 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <unistd.h>
 
 #include "cpu_reference/lattice/lattice_fitting.h"
 #include "cpu_reference/mesh/shapes/procedural_shapes.h"
@@ -15,24 +14,12 @@
 #include "harness/render/label_font.h"
 #include "harness/render/netpbm.h"
 #include "harness/render/thesis_figure.h"
+#include "tests/test_util/scratch_dir.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
-
-class TempDir {
-public:
-    TempDir() : path_(fs::temp_directory_path() / ("sdf_grid_test." + std::to_string(getpid()))) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    std::string file(const std::string& name) const { return (path_ / name).string(); }
-
-private:
-    fs::path path_;
-};
 
 ImageRgb solid(int w, int h, float r, float g, float b) {
     ImageRgb im(w, h);
@@ -102,56 +89,56 @@ TEST(ImageGrid, LabelFontIsFoundOrOverridden) {
 }
 
 TEST(ImageFiles, PngAndExrRoundTripWithProvenance) {
-    TempDir dir;
+    const test::ScratchDir dir("sdf_grid_test");
     const ImageRgb im = solid(7, 5, 0.25f, 0.5f, 1.0f);
     const nlohmann::json attributes = {{"config_hash", "abc123"}, {"git_commit", "deadbeef"}, {"render_seconds", 0.5}};
     if (!have_openimageio()) {
-        EXPECT_EQ(write_image(dir.file("a.png"), im, attributes), dir.file("a.ppm"));
-        EXPECT_TRUE(fs::exists(dir.file("a.ppm.json")));
+        EXPECT_EQ(write_image(dir.at("a.png"), im, attributes), dir.at("a.ppm"));
+        EXPECT_TRUE(fs::exists(dir.at("a.ppm.json")));
         GTEST_SKIP() << "built without OpenImageIO: PNG/EXR fall back to PPM/PFM";
     }
-    EXPECT_EQ(write_image(dir.file("a.png"), im, attributes), dir.file("a.png"));
-    const ImageRgb png = read_image_rgb(dir.file("a.png"));
+    EXPECT_EQ(write_image(dir.at("a.png"), im, attributes), dir.at("a.png"));
+    const ImageRgb png = read_image_rgb(dir.at("a.png"));
     ASSERT_EQ(png.width, 7);
     ASSERT_EQ(png.height, 5);
     EXPECT_NEAR(png.at(3, 2)[0], 64.0f / 255.0f, 1e-6f);
-    write_image(dir.file("a.exr"), im, attributes);
-    const ImageRgb exr = read_image_rgb(dir.file("a.exr"));
+    write_image(dir.at("a.exr"), im, attributes);
+    const ImageRgb exr = read_image_rgb(dir.at("a.exr"));
     EXPECT_EQ(exr.at(6, 4)[1], 0.5f);  // exact float
-    EXPECT_EQ(read_image_attribute(dir.file("a.exr"), "sdf:config_hash"), "abc123");
-    EXPECT_EQ(read_image_attribute(dir.file("a.exr"), "sdf:git_commit"), "deadbeef");
+    EXPECT_EQ(read_image_attribute(dir.at("a.exr"), "sdf:config_hash"), "abc123");
+    EXPECT_EQ(read_image_attribute(dir.at("a.exr"), "sdf:git_commit"), "deadbeef");
     // Never replaced silently
-    EXPECT_THROW(write_image(dir.file("a.png"), im, attributes), std::exception);
-    EXPECT_NO_THROW(write_image(dir.file("a.png"), im, attributes, Overwrite::Allow));
+    EXPECT_THROW(write_image(dir.at("a.png"), im, attributes), std::exception);
+    EXPECT_NO_THROW(write_image(dir.at("a.png"), im, attributes, Overwrite::Allow));
     // No temporaries left behind
     int files = 0;
-    for (const auto& e : fs::directory_iterator(dir.file(""))) files += e.is_regular_file() ? 1 : 0;
+    for (const auto& e : fs::directory_iterator(dir.at(""))) files += e.is_regular_file() ? 1 : 0;
     EXPECT_EQ(files, 2);
 }
 
 TEST(ImageFiles, RenderExrKeepsEveryChannel) {
     if (!have_openimageio()) GTEST_SKIP() << "built without OpenImageIO";
-    TempDir dir;
+    const test::ScratchDir dir("sdf_grid_test");
     RenderedImage r(3, 2);
     r.at(1, 1).hit = HitKind::Surface;
     r.at(1, 1).depth = 2.5f;
     r.at(1, 1).normal = Vec3f(0, 0.6f, 0.8f);
     r.at(1, 1).shade = 0.75f;
-    write_render_exr(dir.file("r.exr"), r, {{"reconstruction", "bcc_cubic/true"}});
-    EXPECT_EQ(read_image_attribute(dir.file("r.exr"), "sdf:reconstruction"), "bcc_cubic/true");
-    EXPECT_EQ(read_image_rgb(dir.file("r.exr")).at(1, 1)[0], 0.75f);
+    write_render_exr(dir.at("r.exr"), r, {{"reconstruction", "bcc_cubic/true"}});
+    EXPECT_EQ(read_image_attribute(dir.at("r.exr"), "sdf:reconstruction"), "bcc_cubic/true");
+    EXPECT_EQ(read_image_rgb(dir.at("r.exr")).at(1, 1)[0], 0.75f);
 }
 
 TEST(ImageFiles, PpmAndPfmRoundTrip) {
-    TempDir dir;
+    const test::ScratchDir dir("sdf_grid_test");
     ImageRgb im(4, 3);
     for (int y = 0; y < 3; ++y)
         for (int x = 0; x < 4; ++x) im.set(x, y, x / 3.0f, y / 2.0f, 0.125f);
-    write_image(dir.file("a.pfm"), im);
-    write_image(dir.file("a.ppm"), im);
-    const ImageRgb pfm = read_netpbm(dir.file("a.pfm"));
+    write_image(dir.at("a.pfm"), im);
+    write_image(dir.at("a.ppm"), im);
+    const ImageRgb pfm = read_netpbm(dir.at("a.pfm"));
     EXPECT_EQ(pfm.data, im.data);  // rows flipped and back
-    const ImageRgb ppm = read_netpbm(dir.file("a.ppm"));
+    const ImageRgb ppm = read_netpbm(dir.at("a.ppm"));
     EXPECT_NEAR(ppm.at(3, 2)[0], 1.0f, 1e-6f);
     EXPECT_NEAR(ppm.at(0, 1)[1], 128.0f / 255.0f, 1e-6f);
 }
@@ -208,12 +195,12 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     EXPECT_EQ(f.grid.width, g.width);
     EXPECT_EQ(f.grid.height, g.height);
     EXPECT_EQ(g.width, std::max(3 * 48 + 4 * f.style.padding, 5 * 24 + 6 * f.style.padding));
-    TempDir dir;
-    const std::string grid = write_thesis_figure(dir.file(""), "pawn", f, {{"config_hash", "x"}});
+    const test::ScratchDir dir("sdf_grid_test");
+    const std::string grid = write_thesis_figure(dir.at(""), "pawn", f, {{"config_hash", "x"}});
     if (const char* keep = std::getenv("SDF_TEST_KEEP_GRID")) fs::copy_file(grid, keep, fs::copy_options::overwrite_existing);
     EXPECT_TRUE(fs::exists(grid));
-    EXPECT_TRUE(fs::exists(dir.file("pawn_summary.json")));
-    EXPECT_TRUE(fs::exists(dir.file("pawn_B_bcc_cubic_true.metrics.json")));
+    EXPECT_TRUE(fs::exists(dir.at("pawn_summary.json")));
+    EXPECT_TRUE(fs::exists(dir.at("pawn_B_bcc_cubic_true.metrics.json")));
 }
 
 }  // namespace

@@ -3,13 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
+#include <sstream>
 
 #include "harness/io/field_file.h"
 #include "reconstruction_test_util.h"
+#include "tests/test_util/shell.h"
 
 namespace sdf {
 namespace {
@@ -91,43 +91,34 @@ std::string write_user_field(const fs::path& dir, const SampledField& f) {
     return json.string();
 }
 
-fs::path scratch_dir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("sdf_recon_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
 TEST(ReconstructionApi, UserWrittenFieldFileReconstructsLikeTheInMemoryField) {
-    const fs::path dir = scratch_dir("user");
+    const test::ScratchDir dir("sdf_recon");
     const SampledField field = values_only(kBcc);
-    const SampledField read = read_field(write_user_field(dir, field));
+    const SampledField read = read_field(write_user_field(dir.path(), field));
     ASSERT_TRUE(read.gradient.empty());
     const Reconstruction a(field, "bcc_cubic", "fd"), b(read, "bcc_cubic", "fd");
     std::mt19937 rng(61);
     for (const Vec3d& p : test::random_points(rng, a.domain(), 100)) EXPECT_EQ(a.evaluate(p).value, b.evaluate(p).value);
-    fs::remove_all(dir);
 }
 
 TEST(ReconstructionApi, SdfEvalPrintsValueAndGradientPerPointInInputOrder) {
-    const fs::path dir = scratch_dir("cli");
+    const test::ScratchDir dir("sdf_recon");
     const SampledField field = values_only(kBcc);
-    const std::string header = write_user_field(dir, field);
+    const std::string header = write_user_field(dir.path(), field);
     const Reconstruction recon(field, "bcc_cubic", "fd");
     std::mt19937 rng(62);
     std::vector<Vec3d> points = test::random_points(rng, recon.domain(), 50);
     points.push_back({100.0, 0.0, 0.0});  // outside: clamped, with a warning
     {
-        std::ofstream pts(dir / "points.txt");
+        std::ofstream pts(dir.path() / "points.txt");
         pts << "# x y z\n";
         pts.precision(17);
         for (const Vec3d& p : points) pts << p.x << " " << p.y << " " << p.z << "\n";
     }
-    const std::string cmd = std::string(SDF_EVAL_PATH) + " " + header + " " + (dir / "points.txt").string() +
-                            " --interpolator bcc_cubic --derivatives fd > " + (dir / "out.txt").string() + " 2> " +
-                            (dir / "err.txt").string();
-    ASSERT_EQ(std::system(cmd.c_str()), 0);
-    std::ifstream out(dir / "out.txt");
+    const std::string eval = test::quote(SDF_EVAL_PATH) + " " + test::quote(header) + " points.txt --interpolator bcc_cubic";
+    const test::ShellResult r = test::run_in(dir.path(), eval + " --derivatives fd");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::istringstream out(r.out);
     for (const Vec3d& p : points) {
         const ReconstructedSample<double> want = recon.evaluate(p);
         double f, gx, gy, gz;
@@ -136,14 +127,9 @@ TEST(ReconstructionApi, SdfEvalPrintsValueAndGradientPerPointInInputOrder) {
         EXPECT_NEAR(gx, want.gradient.x, 1e-8 * (1 + length(want.gradient)));
         EXPECT_NEAR(gz, want.gradient.z, 1e-8 * (1 + length(want.gradient)));
     }
-    std::ifstream err(dir / "err.txt");
-    const std::string warning((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
-    EXPECT_NE(warning.find("1 of 51 points lie outside"), std::string::npos) << warning;
+    EXPECT_NE(r.err.find("1 of 51 points lie outside"), std::string::npos) << r.err;
     // A meaningless combination fails with a message
-    const std::string bad = std::string(SDF_EVAL_PATH) + " " + header + " " + (dir / "points.txt").string() +
-                            " --interpolator bcc_cubic --derivatives true > /dev/null 2> " + (dir / "err2.txt").string();
-    EXPECT_NE(std::system(bad.c_str()), 0);
-    fs::remove_all(dir);
+    EXPECT_NE(test::run_in(dir.path(), eval + " --derivatives true").code, 0);
 }
 
 }  // namespace

@@ -5,40 +5,26 @@
 // without a word, so load_obj() checks the `v` lines itself; both "nan" and an overflowing
 // "1e999" are tested.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "cpu_reference/mesh/load_obj.h"
 #include "cpu_reference/mesh/prepared_mesh.h"
+#include "tests/test_util/scratch_dir.h"
 
 namespace sdf {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh directory under the system's temporary directory, removed after each test.
-class LoadObj : public ::testing::Test {
+/// OBJ files written to a fresh scratch directory per test.
+class LoadObj : public test::ScratchDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("sdf_load_obj_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string write(const std::string& name, const std::string& text) const {
-        const fs::path path = dir_ / name;
-        std::ofstream(path) << text;
-        return path.string();
-    }
+    LoadObj() : ScratchDirTest("sdf_load_obj_test") {}
 
     /// Runs load_obj and returns the message it throws (fails the test if it does not throw).
     static std::string error_of(const std::string& path) {
@@ -50,8 +36,6 @@ protected:
         ADD_FAILURE() << "load_obj(" << path << ") did not throw";
         return {};
     }
-
-    fs::path dir_;
 };
 
 const char* kSquareVertices =
