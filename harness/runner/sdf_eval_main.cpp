@@ -9,42 +9,12 @@
 // docs/reconstruction.md describes the interpolators and derivative sources.
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "cpu_reference/reconstruction/reconstruction.h"
 #include "harness/io/field_file.h"
-
-namespace {
-
-std::vector<sdf::Vec3d> read_points(const std::string& path) {
-    std::ifstream file;
-    if (path != "-") {
-        file.open(path);
-        if (!file) throw std::runtime_error(path + ": cannot open points file");
-    }
-    std::istream& in = path == "-" ? std::cin : file;
-    std::vector<sdf::Vec3d> points;
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-        const size_t first = line.find_first_not_of(" \t\r");
-        if (first == std::string::npos || line[first] == '#') continue;
-        std::istringstream ss(line);
-        sdf::Vec3d p;
-        std::string extra;
-        if (!(ss >> p.x >> p.y >> p.z) || (ss >> extra) || !std::isfinite(p.x) || !std::isfinite(p.y) ||
-            !std::isfinite(p.z))
-            throw std::runtime_error(path + ":" + std::to_string(number) + ": expected three finite numbers \"x y z\", got \"" +
-                                     line + "\"");
-        points.push_back(p);
-    }
-    return points;
-}
-
-}  // namespace
+#include "harness/io/points_file.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Reconstructs a CC or BCC field file at given points: prints \"f gx gy gz\" per point."};
@@ -75,7 +45,7 @@ int main(int argc, char** argv) {
         spec.sigma_units = sigma_units == "lattice" ? sdf::SigmaUnits::LatticeUnits : sdf::SigmaUnits::Spacing;
         spec.threads = threads;
         const sdf::Reconstruction recon(field, spec);
-        const std::vector<sdf::Vec3d> points = read_points(points_path);
+        const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
         const auto samples = recon.evaluate(points, threads);
         int64_t outside = 0;
         for (const auto& s : samples) {

@@ -8,43 +8,14 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "cpu_reference/mesh/prepared_mesh.h"
 #include "cpu_reference/parallel/progress.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/io/points_file.h"
 #include "harness/sampling/make_sampler.h"
-
-namespace {
-
-std::vector<sdf::Vec3d> read_points(const std::string& path) {
-    std::ifstream file;
-    if (path != "-") {
-        file.open(path);
-        if (!file) throw std::runtime_error(path + ": cannot open points file");
-    }
-    std::istream& in = path == "-" ? std::cin : file;
-    std::vector<sdf::Vec3d> points;
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-        const size_t first = line.find_first_not_of(" \t\r");
-        if (first == std::string::npos || line[first] == '#') continue;
-        std::istringstream ss(line);
-        sdf::Vec3d p;
-        std::string extra;
-        if (!(ss >> p.x >> p.y >> p.z) || (ss >> extra) || !std::isfinite(p.x) || !std::isfinite(p.y) ||
-            !std::isfinite(p.z))
-            throw std::runtime_error(path + ":" + std::to_string(number) + ": expected three finite numbers \"x y z\", got \"" +
-                                     line + "\"");
-        points.push_back(p);
-    }
-    return points;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"Exact signed distance, gradient and closest triangle of points to a mesh."};
@@ -70,7 +41,7 @@ int main(int argc, char** argv) {
         const sdf::PreparedMesh mesh = sdf::prepare_mesh(
             sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-query: warning: " << w << "\n";
-        const std::vector<sdf::Vec3d> points = read_points(points_path);
+        const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
         const auto results = sdf::make_sampler(options)->query(mesh, points);
         const char* fmt = options.precision == sdf::Precision::Float ? "%.9g %.9g %.9g %.9g %d\n"
                                                                      : "%.17g %.17g %.17g %.17g %d\n";

@@ -1,0 +1,45 @@
+#include "harness/io/points_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace sdf {
+namespace {
+
+bool is_blank_or_comment(const std::string& line) {
+    const size_t first = line.find_first_not_of(" \t\r");
+    return first == std::string::npos || line[first] == '#';
+}
+
+/// The point on `line` (line `number` of `name`), or a message naming both.
+Vec3d parse_point(const std::string& line, const std::string& name, int number) {
+    std::istringstream ss(line);
+    Vec3d p;
+    std::string extra;
+    if (!(ss >> p.x >> p.y >> p.z) || (ss >> extra) || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw std::runtime_error(name + ":" + std::to_string(number) + ": expected three finite numbers \"x y z\", got \"" +
+                                 line + "\"");
+    return p;
+}
+
+std::vector<Vec3d> read_points(std::istream& in, const std::string& name) {
+    std::vector<Vec3d> points;
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number)
+        if (!is_blank_or_comment(line)) points.push_back(parse_point(line, name, number));
+    return points;
+}
+
+}  // namespace
+
+std::vector<Vec3d> read_points_file(const std::string& path) {
+    if (path == "-") return read_points(std::cin, path);
+    std::ifstream file(path);
+    if (!file) throw std::runtime_error(path + ": cannot open points file");
+    return read_points(file, path);
+}
+
+}  // namespace sdf
