@@ -24,6 +24,7 @@
 
 #include "cpu_reference/lattice/lattice_fitting.h"
 #include "cpu_reference/parallel/parallel_for.h"
+#include "experiments/common/statistics.h"
 #include "experiments/common/study_inputs.h"
 #include "experiments/experiment.h"
 #include "experiments/peers/peer.h"
@@ -47,11 +48,6 @@ double process_cpu_seconds() {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-double median_of(std::vector<double> s) {
-    std::sort(s.begin(), s.end());
-    return s.empty() ? 0 : (s.size() % 2 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2 - 1] + s[s.size() / 2]));
 }
 
 /// Errors of `d` against the reference at the same points (`index[k]` = lattice index of d[k]).

@@ -23,6 +23,7 @@
 #include <ostream>
 
 #include "cpu_reference/lattice/lattice_fitting.h"
+#include "experiments/common/statistics.h"
 #include "experiments/common/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
 #include "experiments/experiment.h"
@@ -44,12 +45,6 @@ struct CaseSpec {
     MeshSpec mesh;
     std::vector<int64_t> samples;
 };
-
-double median_of(std::vector<double> s) {
-    std::sort(s.begin(), s.end());
-    const size_t n = s.size();
-    return n == 0 ? 0 : (n % 2 ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]));
-}
 
 struct Timing {
     std::vector<double> seconds;  ///< computation per repetition (scaled to the lattice if subset)
