@@ -24,6 +24,8 @@
 
 #include "cpu_reference/lattice/lattice_fitting.h"
 #include "cpu_reference/parallel/parallel_for.h"
+#include "experiments/common/lattice_points.h"
+#include "experiments/common/mesh_cases.h"
 #include "experiments/common/statistics.h"
 #include "experiments/common/study_inputs.h"
 #include "experiments/experiment.h"
@@ -36,12 +38,6 @@ namespace {
 
 const std::vector<std::string> kOurs = {"brute_cpu", "bvh_cpu", "brute_gpu", "bvh_gpu"};
 const std::vector<std::string> kPeers = {"cgal", "embree", "open3d", "openvdb"};
-
-struct CaseSpec {
-    std::string label;
-    MeshSpec mesh;
-    std::vector<int64_t> samples;
-};
 
 /// CPU time of this process, all threads (robust to other load on a shared machine).
 double process_cpu_seconds() {
@@ -83,7 +79,7 @@ public:
         search_path_ = read_search_path(config, context);
         base_dir_ = context.config_dir;
         margin_ = read_domain_margin(config);
-        read_cases(config);
+        cases_ = read_mesh_cases(config, search_path_, base_dir_);
         threads_ = config.optional<std::vector<int>>("threads", {1, 0}, "thread counts (0 = all cores)");
         for (int t : threads_)
             if (t < 0) config.fail("threads", "expected thread counts >= 0, got " + std::to_string(t));
@@ -100,7 +96,7 @@ public:
 
     std::vector<std::string> plan(const RunContext&) const override {
         std::vector<std::string> lines;
-        for (const CaseSpec& c : cases_)
+        for (const MeshCase& c : cases_)
             for (int64_t n : c.samples) {
                 const int r = cubic_resolution_for_samples(LatticeType::CC, n);
                 std::string line = c.label + " (" + c.mesh.label() + ") CC " + std::to_string(r) + "^3:";
@@ -117,35 +113,14 @@ public:
             ctx.metrics["peers"][p.name] = p.available ? nlohmann::json{{"version", p.adapter->version()}, {"exact", p.adapter->exact()}}
                                                        : nlohmann::json{{"status", p.reason}};
         ctx.metrics["machine"] = {{"hardware_threads", hardware_threads()}};
-        for (const CaseSpec& c : cases_) {
-            StudyInputs in;
-            in.mesh = c.mesh;
-            in.search_path = search_path_;
-            in.base_dir = base_dir_;
-            const PreparedMesh mesh = load_prepared_mesh(in, *ctx.log);
-            ctx.inputs["meshes"][c.label] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
+        for (const MeshCase& c : cases_) {
+            const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
             ctx.metrics["meshes"][c.label] = describe_mesh(mesh);
             for (int64_t samples : c.samples) run_case(ctx, c, mesh, samples);
         }
     }
 
 private:
-    void read_cases(JsonReader& config) {
-        std::vector<JsonReader> cases = config.objects("cases");
-        if (cases.empty()) config.fail("cases", "expected at least one case, got []");
-        for (JsonReader& c : cases) {
-            CaseSpec spec;
-            spec.label = c.required<std::string>("label", "a mesh label such as \"dragon\"");
-            spec.mesh = parse_mesh_spec(c, "mesh");
-            resolve_mesh_file(spec.mesh, search_path_, base_dir_);
-            spec.samples = c.required<std::vector<int64_t>>("samples", "an array of sample counts");
-            for (int64_t n : spec.samples)
-                if (n < 8) c.fail("samples", "expected sample counts of at least 8, got " + std::to_string(n));
-            c.finish();
-            cases_.push_back(spec);
-        }
-    }
-
     static std::vector<std::string> read_names(JsonReader& config, const std::string& key, const std::vector<std::string>& known) {
         const auto names = config.optional<std::vector<std::string>>(key, known, "names");
         for (const std::string& n : names)
@@ -224,14 +199,8 @@ private:
     void run_brute_cpu(RunContext& ctx, const std::string& label, const PreparedMesh& mesh, const Lattice& lattice,
                        const std::vector<double>& reference) {
         const int64_t n = lattice.num_points();
-        const int64_t m = brute_max_points_ > 0 ? std::min(brute_max_points_, n) : n;
-        const int64_t stride = std::max<int64_t>(1, n / m);
-        std::vector<Vec3d> pts;
-        std::vector<int64_t> index;
-        for (int64_t i = 0; i < n && int64_t(pts.size()) < m; i += stride) {
-            pts.push_back(lattice.position(i));
-            index.push_back(i);
-        }
+        const LatticeSubset subset = strided_lattice_subset(lattice, brute_max_points_);
+        const std::vector<Vec3d>& pts = subset.points;
         for (int t : threads_) {
             SamplerOptions o;
             o.threads = t;
@@ -251,7 +220,7 @@ private:
             set_times(row, 0.0, median_of(secs) * double(n) / double(pts.size()), n);
             row["cpu_seconds"] = (process_cpu_seconds() - cpu0) / repetitions_ * double(n) / double(pts.size());
             row["threads"] = resolve_thread_count(t);
-            set_errors(row, compare(d, reference, index, true), true);
+            set_errors(row, compare(d, reference, subset.index, true), true);
             row["notes"] = "timed on " + std::to_string(pts.size()) + " evenly strided points and scaled to the lattice";
             row["extrapolated"] = int64_t(pts.size()) < n;
             emit(ctx, row);
@@ -321,7 +290,7 @@ private:
         }
     }
 
-    void run_case(RunContext& ctx, const CaseSpec& c, const PreparedMesh& mesh, int64_t samples) {
+    void run_case(RunContext& ctx, const MeshCase& c, const PreparedMesh& mesh, int64_t samples) {
         const int r = cubic_resolution_for_samples(LatticeType::CC, samples);
         const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds, margin_);
         *ctx.log << c.label << " CC " << lattice_notation(lattice) << " (" << with_commas(lattice.num_points()) << " points x "
@@ -331,8 +300,7 @@ private:
         if (std::count(ours_.begin(), ours_.end(), "brute_cpu")) run_brute_cpu(ctx, c.label, mesh, lattice, reference);
         for (const char* gpu : {"brute_gpu", "bvh_gpu"})
             if (std::count(ours_.begin(), ours_.end(), gpu)) run_gpu(ctx, c.label, mesh, lattice, reference, gpu);
-        std::vector<Vec3d> points(size_t(lattice.num_points()));
-        for (int64_t i = 0; i < lattice.num_points(); ++i) points[size_t(i)] = lattice.position(i);
+        const std::vector<Vec3d> points = lattice_points(lattice);
         for (auto& p : peers_)
             if (std::count(peer_names_.begin(), peer_names_.end(), p.name)) run_peer(ctx, c.label, mesh, lattice, points, reference, p);
         summarise(ctx, c.label, lattice);
@@ -392,7 +360,7 @@ private:
     std::vector<std::string> search_path_;
     std::string base_dir_;
     double margin_ = 0.1;
-    std::vector<CaseSpec> cases_;
+    std::vector<MeshCase> cases_;
     std::vector<int> threads_;
     std::vector<std::string> ours_, peer_names_;
     int64_t brute_max_points_ = 4096;

@@ -23,6 +23,8 @@
 #include <ostream>
 
 #include "cpu_reference/lattice/lattice_fitting.h"
+#include "experiments/common/lattice_points.h"
+#include "experiments/common/mesh_cases.h"
 #include "experiments/common/statistics.h"
 #include "experiments/common/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
@@ -40,12 +42,6 @@ struct BackendSpec {
     int64_t max_points = 0;  ///< 0 = the whole lattice
 };
 
-struct CaseSpec {
-    std::string label;
-    MeshSpec mesh;
-    std::vector<int64_t> samples;
-};
-
 struct Timing {
     std::vector<double> seconds;  ///< computation per repetition (scaled to the lattice if subset)
     std::vector<double> total;    ///< end to end per repetition: transfers and host work included
@@ -60,20 +56,7 @@ public:
         search_path_ = read_search_path(config, context);
         base_dir_ = context.config_dir;
         margin_ = read_domain_margin(config);
-        std::vector<JsonReader> cases = config.objects("cases");
-        if (cases.empty()) config.fail("cases", "expected at least one case, got []");
-        for (JsonReader& c : cases) {
-            CaseSpec spec;
-            spec.label = c.required<std::string>("label", "a mesh label such as \"dragon\"");
-            spec.mesh = parse_mesh_spec(c, "mesh");
-            resolve_mesh_file(spec.mesh, search_path_, base_dir_);
-            spec.samples = c.required<std::vector<int64_t>>("samples", "an array of sample counts");
-            if (spec.samples.empty()) c.fail("samples", "expected at least one sample count, got []");
-            for (int64_t n : spec.samples)
-                if (n < 8) c.fail("samples", "expected sample counts of at least 8, got " + std::to_string(n));
-            c.finish();
-            cases_.push_back(spec);
-        }
+        cases_ = read_mesh_cases(config, search_path_, base_dir_);
         const auto types = config.optional<std::vector<std::string>>("lattice_types", {"cc"}, "[\"cc\"], [\"bcc\"] or both");
         if (types.empty()) config.fail("lattice_types", "expected \"cc\", \"bcc\" or both, got []");
         for (const std::string& t : types) {
@@ -103,7 +86,7 @@ public:
 
     std::vector<std::string> plan(const RunContext&) const override {
         std::vector<std::string> lines;
-        for (const CaseSpec& c : cases_)
+        for (const MeshCase& c : cases_)
             for (int64_t n : c.samples)
                 for (LatticeType t : lattice_types_) {
                     const int r = cubic_resolution_for_samples(t, n);
@@ -122,15 +105,9 @@ public:
     }
 
     void run(RunContext& ctx) override {
-        std::ostream& log = *ctx.log;
-        for (const CaseSpec& c : cases_) {
-            StudyInputs in;
-            in.mesh = c.mesh;
-            in.search_path = search_path_;
-            in.base_dir = base_dir_;
-            const PreparedMesh mesh = load_prepared_mesh(in, log);
+        for (const MeshCase& c : cases_) {
+            const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
             nlohmann::json described = describe_mesh(mesh);
-            ctx.inputs["meshes"][c.label] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
             for (const ThesisMeshCounts& t : kThesisTable31)
                 if (c.label == t.mesh) described["thesis_table_3_1"] = {{"triangles", t.triangles}, {"vertices", t.vertices}};
             ctx.metrics["meshes"][c.label] = described;
@@ -141,19 +118,19 @@ public:
 
 private:
     Timing time_backend(const BackendSpec& b, const PreparedMesh& mesh, const Lattice& lattice,
-                        std::vector<double>& subset_distance, const std::vector<Vec3d>& subset) {
+                        std::vector<double>& subset_distance, const LatticeSubset& subset) {
         Timing t;
         auto sampler = make_sampler(b.options);
         const int64_t n = lattice.num_points();
         const bool whole = b.max_points <= 0 || b.max_points >= n;
         if (!whole) {
             // Strided subset: same cost per point as the whole lattice.
-            t.points_timed = int64_t(subset.size());
+            t.points_timed = int64_t(subset.points.size());
             for (int r = 0; r < repetitions_; ++r) {
                 const auto start = std::chrono::steady_clock::now();
-                const auto res = sampler->query(mesh, subset);
+                const auto res = sampler->query(mesh, subset.points);
                 const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-                t.seconds.push_back(s * double(n) / double(subset.size()));
+                t.seconds.push_back(s * double(n) / double(subset.points.size()));
                 t.total.push_back(t.seconds.back());
                 if (r == 0) for (const auto& q : res) subset_distance.push_back(q.distance);
             }
@@ -165,15 +142,13 @@ private:
             const SampledField f = sampler->sample(mesh, lattice);
             t.seconds.push_back(f.timings.kernel);
             t.total.push_back(f.timings.total);
-            if (r == 0) {
-                const int64_t stride = std::max<int64_t>(1, n / int64_t(subset.size()));
-                for (size_t k = 0; k < subset.size(); ++k) subset_distance.push_back(f.distance[size_t(int64_t(k) * stride)]);
-            }
+            if (r == 0)
+                for (int64_t i : subset.index) subset_distance.push_back(f.distance[size_t(i)]);
         }
         return t;
     }
 
-    void run_row(RunContext& ctx, const CaseSpec& c, const PreparedMesh& mesh, int64_t samples, LatticeType type) {
+    void run_row(RunContext& ctx, const MeshCase& c, const PreparedMesh& mesh, int64_t samples, LatticeType type) {
         const int r = cubic_resolution_for_samples(type, samples);
         const Lattice lattice = fit_lattice(type, {r, r, r}, mesh.bounds, margin_);
         const int64_t n = lattice.num_points();
@@ -181,9 +156,7 @@ private:
         int64_t subset_size = n;
         for (const BackendSpec& b : backends_)
             if (b.max_points > 0) subset_size = std::min(subset_size, b.max_points);
-        const int64_t stride = std::max<int64_t>(1, n / subset_size);
-        std::vector<Vec3d> subset;
-        for (int64_t i = 0; i < n && int64_t(subset.size()) < subset_size; i += stride) subset.push_back(lattice.position(i));
+        const LatticeSubset subset = strided_lattice_subset(lattice, subset_size);
 
         nlohmann::json row = {{"mesh", c.label},
                               {"samples_requested", samples},
@@ -268,7 +241,7 @@ private:
     std::vector<std::string> search_path_;
     std::string base_dir_;
     double margin_ = 0.1;
-    std::vector<CaseSpec> cases_;
+    std::vector<MeshCase> cases_;
     std::vector<LatticeType> lattice_types_;
     std::vector<BackendSpec> backends_;
     std::string reference_;

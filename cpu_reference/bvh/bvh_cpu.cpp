@@ -7,6 +7,7 @@
 #include "cpu_reference/bvh/bvh_cache.h"
 #include "cpu_reference/parallel/parallel_for.h"
 #include "cpu_reference/parallel/progress.h"
+#include "cpu_reference/sampling/sampler_results.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/distance/signed_distance.h"
@@ -146,7 +147,7 @@ public:
             evaluate_points<T>(mesh, *bvh, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
                                [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   out[size_t(i)] = {s.distance, s.gradient, mesh.source_triangle[size_t(s.triangle)]};
+                                   out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
                                });
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
@@ -166,10 +167,7 @@ private:
         bool built = false;
         const auto bvh = cache_.get(mesh, built);
         const auto query_start = std::chrono::steady_clock::now();
-        SampledField field;
-        field.lattice = lattice;
-        field.precision = options_.precision;
-        field.resize(lattice.num_points());
+        SampledField field = unfilled_field(lattice, options_.precision);
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;
@@ -179,9 +177,7 @@ private:
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                 const int64_t out = block.output_index(lattice, i);
                 if (out < 0) return;  // strategy A: not a BCC point
-                field.distance[size_t(out)] = s.distance;
-                field.gradient[size_t(out)] = s.gradient;
-                field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
+                store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
             };
             if (kernel_ == BvhKernel::Brick)
                 evaluate_bricks<T>(mesh, *bvh, lattice, block, options_.threads, options_.progress, counters, emit);
@@ -199,14 +195,9 @@ private:
         bvh_info["built_by_this_call"] = built;
         bvh_info["node_visits_per_point"] = computed > 0 ? double(counters.nodes) / double(computed) : 0.0;
         bvh_info["point_triangle_tests_per_point"] = computed > 0 ? double(counters.triangles) / double(computed) : 0.0;
-        field.sampler = {{"backend", "cpu"},
-                         {"method", "bvh"},
-                         {"kernel", kernel_name()},
-                         {"threads", resolve_thread_count(options_.threads)},
-                         {"precision", precision_name(options_.precision)},
-                         {"points_computed", computed},
-                         {"bvh", bvh_info}};
-        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed);
+        field.sampler["threads"] = resolve_thread_count(options_.threads);
+        field.sampler["bvh"] = bvh_info;
         return field;
     }
 

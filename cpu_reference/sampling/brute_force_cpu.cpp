@@ -6,6 +6,7 @@
 #include "cpu_reference/parallel/parallel_for.h"
 #include "cpu_reference/parallel/progress.h"
 #include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "cpu_reference/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf {
@@ -53,9 +54,7 @@ public:
                                         "'; expected \"vectorized\" or \"eberly\"");
     }
 
-    std::string name() const override {
-        return std::string("cpu/brute_force/") + (kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly");
-    }
+    std::string name() const override { return std::string("cpu/brute_force/") + kernel_name(); }
 
     SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
         return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice)
@@ -69,7 +68,7 @@ public:
             evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, int64_t(points.size()),
                                [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   out[size_t(i)] = {s.distance, s.gradient, mesh.source_triangle[size_t(s.triangle)]};
+                                   out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
                                });
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
@@ -77,13 +76,12 @@ public:
     }
 
 private:
+    const char* kernel_name() const { return kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly"; }
+
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
-        SampledField field;
-        field.lattice = lattice;
-        field.precision = options_.precision;
-        field.resize(lattice.num_points());
+        SampledField field = unfilled_field(lattice, options_.precision);
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;
@@ -94,9 +92,7 @@ private:
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    const int64_t out = block.output_index(lattice, i);
                                    if (out < 0) return;  // strategy A: not a BCC point
-                                   field.distance[size_t(out)] = s.distance;
-                                   field.gradient[size_t(out)] = s.gradient;
-                                   field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(s.triangle)];
+                                   store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
                                });
             computed += block.count();
         }
@@ -104,13 +100,8 @@ private:
         field.timings.total = seconds;
         field.timings.kernel = seconds;
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
-        field.sampler = {{"backend", "cpu"},
-                         {"method", "brute_force"},
-                         {"kernel", kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly"},
-                         {"threads", resolve_thread_count(options_.threads)},
-                         {"precision", precision_name(options_.precision)},
-                         {"points_computed", computed}};
-        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed);
+        field.sampler["threads"] = resolve_thread_count(options_.threads);
         return field;
     }
 

@@ -121,43 +121,10 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     return l;
 }
 
-void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
-    const std::string stem = stem_of_header(header_path);
-    const size_t n = size_t(field.size());
-    const bool gradient = !field.gradient.empty() && field.gradient.size() == n;
-    const bool triangles = options.closest_triangle && field.closest_triangle.size() == n;
-    // Every target is checked before anything is written, so a refusal leaves no orphan
-    // channel behind; a file that appears meanwhile is still refused by the atomic write,
-    // and then what this call wrote is removed again.
-    std::vector<std::string> targets = {stem + ".json", stem + ".distance.raw"};
-    if (gradient) targets.push_back(stem + ".gradient.raw");
-    if (triangles) targets.push_back(stem + ".closest_triangle.raw");
-    if (options.overwrite == Overwrite::Forbid)
-        for (const std::string& t : targets)
-            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
-    std::vector<std::string> written;
-    nlohmann::json channels;
-    try {
-        channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
-        written.push_back(stem + ".distance.raw");
-        if (gradient) {
-            channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
-            written.push_back(stem + ".gradient.raw");
-        }
-        if (triangles) {
-            const std::string file = stem + ".closest_triangle.raw";
-            write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
-            written.push_back(file);
-            channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
-        }
-    } catch (...) {
-        if (options.overwrite == Overwrite::Forbid)
-            for (const std::string& w : written) {
-                std::error_code ec;
-                fs::remove(w, ec);
-            }
-        throw;
-    }
+namespace {
+
+/// The header of `field`, whose channel files are described by `channels`.
+nlohmann::json field_header(const SampledField& field, const nlohmann::json& channels) {
     nlohmann::json header = {{"format", "sdf-lattice-field"},
                              {"version", 1},
                              {"lattice", lattice_to_json(field.lattice)},
@@ -173,14 +140,51 @@ void write_field(const std::string& header_path, const SampledField& field, cons
                                                   {"download", field.timings.download}}},
                              {"point_triangle_pairs", field.timings.point_triangle_pairs}};
     if (channels.contains("gradient")) header["gradient_channel"] = "gradient";
+    return header;
+}
+
+/// Removes `files`, ignoring errors: the caller is already failing.
+void remove_quietly(const std::vector<std::string>& files) {
+    for (const std::string& f : files) {
+        std::error_code ec;
+        fs::remove(f, ec);
+    }
+}
+
+}  // namespace
+
+void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
+    const std::string stem = stem_of_header(header_path);
+    const size_t n = size_t(field.size());
+    const bool gradient = !field.gradient.empty() && field.gradient.size() == n;
+    const bool triangles = options.closest_triangle && field.closest_triangle.size() == n;
+    // Every target is checked before anything is written, so a refusal leaves no orphan
+    // channel behind; a file that appears meanwhile is still refused by the atomic write,
+    // and then what this call wrote is removed again.
+    std::vector<std::string> targets = {stem + ".json", stem + ".distance.raw"};
+    if (gradient) targets.push_back(stem + ".gradient.raw");
+    if (triangles) targets.push_back(stem + ".closest_triangle.raw");
+    if (options.overwrite == Overwrite::Forbid)
+        for (const std::string& t : targets)
+            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
+    std::vector<std::string> written;
     try {
-        write_text_atomically(stem + ".json", header.dump(2) + "\n", options.overwrite);
+        nlohmann::json channels;
+        channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
+        written.push_back(stem + ".distance.raw");
+        if (gradient) {
+            channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
+            written.push_back(stem + ".gradient.raw");
+        }
+        if (triangles) {
+            const std::string file = stem + ".closest_triangle.raw";
+            write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
+            written.push_back(file);
+            channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
+        }
+        write_text_atomically(stem + ".json", field_header(field, channels).dump(2) + "\n", options.overwrite);
     } catch (...) {
-        if (options.overwrite == Overwrite::Forbid)
-            for (const std::string& w : written) {
-                std::error_code ec;
-                fs::remove(w, ec);
-            }
+        if (options.overwrite == Overwrite::Forbid) remove_quietly(written);  // all new: leave none behind
         throw;
     }
 }
