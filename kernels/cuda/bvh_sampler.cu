@@ -9,7 +9,6 @@
 #include <string>
 
 #include "cpu_reference/bvh/bvh_cache.h"
-#include "cpu_reference/sampling/sampler_results.h"
 #include "kernels/cuda/bvh_kernel.cuh"
 #include "kernels/cuda/bvh_warp_kernel.cuh"
 #include "kernels/cuda/cuda_check.h"
@@ -188,8 +187,19 @@ private:
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        SampledField field = unfilled_field(lattice, options_.precision);
-        auto sink = [&](const PieceResults::Host& h) { scatter_batch(h, mesh, field); };
+        SampledField field;
+        field.lattice = lattice;
+        field.precision = options_.precision;
+        field.resize(lattice.num_points());
+        auto sink = [&](const PieceResults::Host& h) {
+            for (size_t i = 0; i < h.output_index.size(); ++i) {
+                const int64_t o = h.output_index[i];
+                if (o < 0) continue;
+                field.distance[size_t(o)] = h.distance[i];
+                field.gradient[size_t(o)] = h.gradient[i];
+                field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
+            }
+        };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0, pieces = 0;
@@ -208,10 +218,15 @@ private:
         nlohmann::json bvh_info = host_bvh_->stats.to_json();
         bvh_info["built_by_this_call"] = built;
         bvh_info["uploaded_by_this_call"] = uploaded;
-        field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed);
-        field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
-        field.sampler["bvh"] = bvh_info;
-        field.sampler["device"] = describe_device(options_.device);
+        field.sampler = {{"backend", "cuda"},
+                         {"method", "bvh"},
+                         {"kernel", kernel_name()},
+                         {"precision", precision_name(options_.precision)},
+                         {"points_computed", computed},
+                         {"plan", {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}}},
+                         {"bvh", bvh_info},
+                         {"device", describe_device(options_.device)}};
+        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
         return field;
     }
 
@@ -235,7 +250,9 @@ private:
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh_points");
             finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
-            scatter_batch(r.download(piece.count), mesh, out);
+            const PieceResults::Host h = r.download(piece.count);
+            for (size_t i = 0; i < h.output_index.size(); ++i)
+                out[size_t(h.output_index[i])] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
         }
         return out;
     }

@@ -7,7 +7,6 @@
 #include <functional>
 #include <string>
 
-#include "cpu_reference/sampling/sampler_results.h"
 #include "kernels/cuda/cuda_check.h"
 #include "kernels/cuda/cuda_device.h"
 #include "kernels/cuda/device_buffer.h"
@@ -308,9 +307,20 @@ private:
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(lattice, options_.precision);
+        SampledField field;
+        field.lattice = lattice;
+        field.precision = options_.precision;
+        field.resize(lattice.num_points());
         Engine<T> engine(mesh, options_, kernel_);
-        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
+        auto sink = [&](const HostPiece& h) {
+            for (size_t i = 0; i < h.output_index.size(); ++i) {
+                const int64_t o = h.output_index[i];
+                if (o < 0) continue;
+                field.distance[size_t(o)] = h.distance[i];
+                field.gradient[size_t(o)] = h.gradient[i];
+                field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
+            }
+        };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;
@@ -342,9 +352,14 @@ private:
         field.timings.download = engine.download_seconds();
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed);
-        field.sampler["plan"] = engine.plan();
-        field.sampler["device"] = describe_device(options_.device);
+        field.sampler = {{"backend", "cuda"},
+                         {"method", "brute_force"},
+                         {"kernel", kernel_name()},
+                         {"precision", precision_name(options_.precision)},
+                         {"points_computed", computed},
+                         {"plan", engine.plan()},
+                         {"device", describe_device(options_.device)}};
+        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
         return field;
     }
 
@@ -355,7 +370,13 @@ private:
         Engine<T> engine(mesh, options_, kernel_);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
-        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, out); };
+        auto sink = [&](const HostPiece& h) {
+            for (size_t i = 0; i < h.output_index.size(); ++i) {
+                const int64_t o = h.output_index[i];
+                if (o < 0) continue;
+                out[size_t(o)] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
+            }
+        };
         const int64_t n = int64_t(points.size());
         if (kernel_ == CudaKernel::Tuned) {
             engine.run_tuned(n, [&](int64_t begin, int64_t count) { return PointListPiece{device_points.get(), begin, count}; },
