@@ -16,11 +16,11 @@
 #include <cstdio>
 #include <ostream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/reconstruction/analytic_study.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/reconstruction/analytic_study.h"
 #include "experiments/common/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
-#include "experiments/experiment.h"
+#include "harness/experiment/experiment.h"
 
 namespace sdf {
 namespace {

@@ -22,13 +22,13 @@
 #include <cstdio>
 #include <ostream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/parallel/parallel_for.h"
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
-#include "experiments/common/statistics.h"
+#include "core/statistics.h"
 #include "experiments/common/study_inputs.h"
-#include "experiments/experiment.h"
+#include "harness/experiment/experiment.h"
 #include "experiments/peers/peer.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/sampling/make_sampler.h"

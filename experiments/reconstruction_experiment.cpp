@@ -22,14 +22,14 @@
 #include <ostream>
 #include <sstream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/raycast/views.h"
-#include "cpu_reference/reconstruction/reconstruction.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/raycast/views.h"
+#include "core/reconstruction/reconstruction.h"
 #include "experiments/common/field_source.h"
 #include "experiments/common/probes.h"
 #include "experiments/common/reconstruction_list.h"
 #include "experiments/common/study_inputs.h"
-#include "experiments/experiment.h"
+#include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"
 #include "harness/provenance/provenance.h"
 #include "harness/render/thesis_figure.h"

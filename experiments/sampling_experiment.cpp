@@ -11,10 +11,10 @@
 #include <ostream>
 #include <sstream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "experiments/common/field_source.h"
 #include "experiments/common/study_inputs.h"
-#include "experiments/experiment.h"
+#include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"
 
 namespace sdf {

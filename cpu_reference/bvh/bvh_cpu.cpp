@@ -4,10 +4,10 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "cpu_reference/bvh/bvh_cache.h"
-#include "cpu_reference/parallel/parallel_for.h"
-#include "cpu_reference/parallel/progress.h"
-#include "cpu_reference/sampling/sampler_results.h"
+#include "core/bvh/bvh_cache.h"
+#include "core/parallel/parallel_for.h"
+#include "core/parallel/progress.h"
+#include "core/sampling/sampler_results.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/distance/signed_distance.h"

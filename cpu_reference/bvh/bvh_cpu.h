@@ -12,7 +12,7 @@
 
 #include <memory>
 
-#include "cpu_reference/sampling/sampler.h"
+#include "core/sampling/sampler.h"
 
 namespace sdf {
 

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <limits>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "cpu_reference/raycast/tile_loop.h"
 #include "kernels/bvh/ray_traversal.h"
 #include "kernels/raycast/cast_pixel.h"

@@ -13,9 +13,9 @@
 
 #include <memory>
 
-#include "cpu_reference/bvh/triangle_bvh.h"
-#include "cpu_reference/raycast/rendered_image.h"
-#include "cpu_reference/raycast/views.h"
+#include "core/bvh/triangle_bvh.h"
+#include "core/raycast/rendered_image.h"
+#include "core/raycast/views.h"
 
 namespace sdf {
 

@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "cpu_reference/raycast/tile_loop.h"
 #include "kernels/raycast/cast_pixel.h"
 

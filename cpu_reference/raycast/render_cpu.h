@@ -9,9 +9,9 @@
 /// up to the contraction of multiply-adds; Precision::Double casts from the double data.
 #pragma once
 
-#include "cpu_reference/raycast/rendered_image.h"
-#include "cpu_reference/raycast/views.h"
-#include "cpu_reference/reconstruction/reconstruction.h"
+#include "core/raycast/rendered_image.h"
+#include "core/raycast/views.h"
+#include "core/reconstruction/reconstruction.h"
 #include "kernels/raycast/march.h"
 
 namespace sdf {

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "cpu_reference/parallel/parallel_for.h"
-#include "cpu_reference/parallel/progress.h"
+#include "core/parallel/parallel_for.h"
+#include "core/parallel/progress.h"
 
 namespace sdf {
 

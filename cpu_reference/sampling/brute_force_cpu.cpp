@@ -3,10 +3,10 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "cpu_reference/parallel/parallel_for.h"
-#include "cpu_reference/parallel/progress.h"
+#include "core/parallel/parallel_for.h"
+#include "core/parallel/progress.h"
 #include "cpu_reference/sampling/nearest_triangle_cpu.h"
-#include "cpu_reference/sampling/sampler_results.h"
+#include "core/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf {

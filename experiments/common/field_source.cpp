@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <ostream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "experiments/common/study_inputs.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/field_file.h"

@@ -8,9 +8,9 @@
 #include <memory>
 #include <string>
 
-#include "cpu_reference/mesh/prepared_mesh.h"
-#include "cpu_reference/sampling/sampler.h"
-#include "experiments/experiment.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampler.h"
+#include "harness/experiment/experiment.h"
 
 namespace sdf {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/mesh/prepared_mesh.h"
-#include "experiments/experiment.h"
+#include "core/mesh/prepared_mesh.h"
+#include "harness/experiment/experiment.h"
 #include "harness/config/mesh_spec.h"
 
 namespace sdf {

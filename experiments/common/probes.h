@@ -16,8 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cpu_reference/mesh/prepared_mesh.h"
-#include "cpu_reference/sampling/sampler.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampler.h"
 #include "kernels/reconstruction/interpolator.h"
 
 namespace sdf {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/reconstruction/reconstruction_spec.h"
+#include "core/reconstruction/reconstruction_spec.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 

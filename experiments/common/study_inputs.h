@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/mesh/prepared_mesh.h"
-#include "cpu_reference/sampling/sampler.h"
-#include "experiments/experiment.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampler.h"
+#include "harness/experiment/experiment.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
 

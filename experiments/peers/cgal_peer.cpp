@@ -16,7 +16,7 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/version.h>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "experiments/peers/peer.h"
 
 namespace sdf::peers {

@@ -13,7 +13,7 @@
 
 #include <embree3/rtcore.h>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "experiments/peers/peer.h"
 
 namespace sdf::peers {

@@ -15,7 +15,7 @@
 #include <openvdb/tools/MeshToVolume.h>
 #include <tbb/global_control.h>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "experiments/peers/peer.h"
 
 namespace sdf::peers {

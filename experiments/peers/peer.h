@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cpu_reference/mesh/prepared_mesh.h"
+#include "core/mesh/prepared_mesh.h"
 #include "kernels/lattice/lattice.h"
 
 namespace sdf::peers {

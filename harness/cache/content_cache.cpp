@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "cpu_reference/mesh/sha256.h"
+#include "core/mesh/sha256.h"
 #include "harness/build_config.h"
 #include "harness/config/json_reader.h"
 #include "harness/io/atomic_file.h"

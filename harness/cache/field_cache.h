@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "cpu_reference/sampling/sampler.h"
+#include "core/sampling/sampler.h"
 #include "harness/cache/content_cache.h"
 
 namespace sdf {

@@ -16,7 +16,8 @@ std::string num(double v) {
 }
 
 std::string machine_text(const nlohmann::json& kind) {
-    return "CPU \"" + kind.value("cpu", std::string("unknown")) + "\", GPU " +
+    return "CPU \"" + kind.value("cpu", std::string("unknown")) + "\" (build target \"" +
+           kind.value("cpu_target", std::string("unrecorded")) + "\"), GPU " +
            (kind["gpu"].is_string() ? "\"" + kind["gpu"].get<std::string>() + "\"" : std::string("none"));
 }
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <regex>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 
 namespace sdf {
 

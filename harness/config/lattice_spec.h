@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/mesh/triangle_mesh.h"
+#include "core/mesh/triangle_mesh.h"
 #include "harness/config/json_reader.h"
 #include "kernels/lattice/lattice.h"
 

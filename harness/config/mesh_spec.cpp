@@ -7,8 +7,8 @@
 #include <functional>
 #include <sstream>
 
-#include "cpu_reference/mesh/load_obj.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/mesh/load_obj.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 
 #include "harness/build_config.h"
 

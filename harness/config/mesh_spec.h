@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/mesh/triangle_mesh.h"
+#include "core/mesh/triangle_mesh.h"
 #include "harness/config/json_reader.h"
 
 namespace sdf {

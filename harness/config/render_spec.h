@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/raycast/views.h"
+#include "core/raycast/views.h"
 #include "harness/config/json_reader.h"
 
 namespace sdf {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/sampling/sampler.h"
+#include "core/sampling/sampler.h"
 #include "harness/config/json_reader.h"
 
 namespace sdf {

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "harness/config/json_reader.h"
 
 namespace sdf {

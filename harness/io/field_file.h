@@ -16,7 +16,7 @@
 
 #include <string>
 
-#include "cpu_reference/sampling/sampled_field.h"
+#include "core/sampling/sampled_field.h"
 #include "harness/io/atomic_file.h"
 
 namespace sdf {

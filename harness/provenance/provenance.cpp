@@ -9,11 +9,11 @@
 #include <fstream>
 #include <memory>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "harness/build_config.h"
 #include "harness/sampling/make_sampler.h"
 #if SDF_HAVE_CUDA
-#include "kernels/cuda/cuda_device.h"
+#include "cuda/cuda_device.h"
 #endif
 
 namespace sdf {
@@ -56,6 +56,8 @@ nlohmann::json build_info() {
     return {{"build_type", SDF_BUILD_TYPE},
             {"cxx_compiler", SDF_CXX_COMPILER},
             {"cxx_flags", SDF_CXX_FLAGS},
+            {"cpu_target", {{"option", SDF_CPU_TARGET}, {"march", SDF_CPU_MARCH}, {"isa", SDF_CPU_ISA}}},
+            {"fp_contract", "off"},
             {"cuda_flags", SDF_HAVE_CUDA ? SDF_CUDA_FLAGS : ""},
             {"cuda", SDF_HAVE_CUDA ? true : false},
             {"fast_math", false}};
@@ -86,8 +88,13 @@ std::string compact_utc_timestamp() {
 }
 
 nlohmann::json machine_kind(const nlohmann::json& provenance) {
-    nlohmann::json kind = {{"cpu", "unknown"}, {"gpu", nullptr}};
+    nlohmann::json kind = {{"cpu", "unknown"}, {"gpu", nullptr}, {"cpu_target", "unrecorded"}};
     if (provenance.contains("cpu") && provenance["cpu"].contains("model")) kind["cpu"] = provenance["cpu"]["model"];
+    // The build target is part of the machine: the same CPU runs an x86-64-v2 build and a
+    // native AVX-512 build at different speeds.
+    const nlohmann::json build = provenance.value("build", nlohmann::json());
+    if (build.is_object() && build.contains("cpu_target") && build["cpu_target"].is_object())
+        kind["cpu_target"] = build["cpu_target"].value("march", std::string("unrecorded"));
     const nlohmann::json gpu = provenance.value("gpu", nlohmann::json());
     if (gpu.is_object() && gpu.contains("name")) kind["gpu"] = gpu["name"];
     return kind;

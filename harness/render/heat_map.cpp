@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/raycast/image_metrics.h"
 
 namespace sdf {
 

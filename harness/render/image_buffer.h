@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "cpu_reference/raycast/rendered_image.h"
+#include "core/raycast/rendered_image.h"
 
 namespace sdf {
 

@@ -7,7 +7,7 @@
 #include "harness/sampling/make_sampler.h"
 
 #if SDF_HAVE_CUDA_RAYCAST
-#include "kernels/cuda/raycast.h"
+#include "cuda/raycast.h"
 #endif
 
 namespace sdf {

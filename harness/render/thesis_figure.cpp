@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "harness/render/heat_map.h"
 #include "harness/render/image_io.h"
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/raycast/image_metrics.h"
 #include "cpu_reference/raycast/mesh_reference.h"
 #include "harness/config/render_spec.h"
 #include "harness/io/atomic_file.h"

@@ -4,8 +4,8 @@
 #include <iostream>
 #include <regex>
 
-#include "cpu_reference/mesh/sha256.h"
-#include "experiments/experiment.h"
+#include "core/mesh/sha256.h"
+#include "harness/experiment/experiment.h"
 #include "harness/build_config.h"
 #include "harness/cache/field_cache.h"
 #include "harness/check/regression_check.h"
@@ -76,7 +76,7 @@ std::vector<PlannedRun> configure_runs(const LoadedConfig& config, const RunnerO
         r.resolved = std::make_shared<nlohmann::json>(r.point.config);
         JsonReader root(r.point.config, file, "", r.resolved, nlohmann::json::json_pointer());
         read_run_name(root);
-        r.kind = root.choice("kind", experiment_kinds(), "sampling");
+        r.kind = root.choice("kind", experiment_kind_names(*options.experiments), "sampling");
         root.optional<std::string>("description", "", "a string");
         r.baseline = root.optional<std::string>("baseline", "", "the path of the baseline file (relative to the config)");
         r.context.config_path = options.config_path;
@@ -85,7 +85,7 @@ std::vector<PlannedRun> configure_runs(const LoadedConfig& config, const RunnerO
         r.context.log = &std::cout;
         r.context.fields = fields;
         r.context.cache = cache;
-        r.experiment = make_experiment(r.kind);
+        r.experiment = make_experiment(*options.experiments, r.kind);
         r.experiment->configure(root, r.context);
         root.finish();
         runs.push_back(std::move(r));
@@ -179,6 +179,8 @@ nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<Plann
 }  // namespace
 
 int run_experiment(const RunnerOptions& options) {
+    if (options.experiments == nullptr || options.experiments->empty())
+        throw std::logic_error("run_experiment: no experiment registry given (RunnerOptions::experiments)");
     const LoadedConfig config = load_config(options.config_path);
     const std::string cache_root = options.cache_dir.empty() ? ContentCache::default_root() : options.cache_dir;
     const FieldCache fields(cache_root);

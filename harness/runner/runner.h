@@ -11,9 +11,12 @@
 
 #include <string>
 
+#include "harness/experiment/experiment.h"
+
 namespace sdf {
 
 struct RunnerOptions {
+    const ExperimentRegistry* experiments = nullptr;  ///< the kinds a config may name (required)
     std::string config_path;
     std::string output_root = "results";
     bool dry_run = false;

@@ -6,9 +6,9 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/build_config.h"
 #if SDF_HAVE_CUDA
-#include "kernels/cuda/cuda_device.h"
-#include "kernels/cuda/bvh_sampler.h"
-#include "kernels/cuda/cuda_sampler.h"
+#include "cuda/cuda_device.h"
+#include "cuda/bvh_sampler.h"
+#include "cuda/cuda_sampler.h"
 #endif
 
 namespace sdf {

@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "cpu_reference/sampling/sampler.h"
+#include "core/sampling/sampler.h"
 
 namespace sdf {
 

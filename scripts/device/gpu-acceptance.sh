@@ -37,12 +37,12 @@ $B/tests/benchmarks/bench_bvh --benchmark_filter='Cuda' --benchmark_counters_tab
 grep -E "^BM_Cuda" "$OUT/bench_bvh.txt" | tee -a "$OUT/summary.txt"
 pack
 step "1024^2 BCC cubic render on the GPU"
-$B/harness/runner/sdf-render dragon.obj --lattice bcc --resolution 64,64,128 --interpolator bcc_cubic --derivatives true \
+$B/bin/sdf-render dragon.obj --lattice bcc --resolution 64,64,128 --interpolator bcc_cubic --derivatives true \
     --view dragon_side --size 1024 --backend cuda --repeat 20 --out "$OUT/dragon_bcc_1024.ppm" --overwrite 2>&1 | tee "$OUT/render.txt" | tail -3
 pack
 for cfg in configs/gpu_kernels.json configs/dragon.json configs/speedup.json configs/peers.json; do
     step "run-experiment $cfg"
-    $B/harness/runner/run-experiment "$cfg" --output-root "$OUT/results" --quiet > "$OUT/$(basename "$cfg" .json).log" 2>&1
+    $B/bin/run-experiment "$cfg" --output-root "$OUT/results" --quiet > "$OUT/$(basename "$cfg" .json).log" 2>&1
     echo "$cfg exit $?" | tee -a "$OUT/summary.txt"
     tail -4 "$OUT/$(basename "$cfg" .json).log"
     pack

@@ -52,7 +52,7 @@ run_step() {
                      "$BUILD/tests/benchmarks/bench_cuda_sampler" --benchmark_filter='^tuned/dragon_legacy/64x64x64cc' \
                      --benchmark_min_time=0.01 > "$OUT/ncu.txt" 2>&1; grep -E "Issue|Executed Ipc|Warp Cycles|Stall|Occupancy|Registers|Instructions" "$OUT/ncu.txt" | head -40 ;;
         experiment\ *) local cfg=${1#experiment }; log "run-experiment $cfg";
-                       "$BUILD/harness/runner/run-experiment" "$cfg" --output-root "$OUT" --quiet 2>&1 | tee -a "$OUT/experiments.log" ;;
+                       "$BUILD/bin/run-experiment" "$cfg" --output-root "$OUT" --quiet 2>&1 | tee -a "$OUT/experiments.log" ;;
         *) echo "unknown step: $1"; return 2 ;;
     esac
 }

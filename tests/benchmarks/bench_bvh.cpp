@@ -14,10 +14,10 @@
 #include <sstream>
 
 #include "cpu_reference/bvh/bvh_cpu.h"
-#include "cpu_reference/bvh/triangle_bvh.h"
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/mesh/load_obj.h"
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/bvh/triangle_bvh.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/load_obj.h"
+#include "core/parallel/parallel_for.h"
 #include "harness/build_config.h"
 #include "harness/sampling/make_sampler.h"
 

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "cpu_reference/sampling/nearest_triangle_cpu.h"
 #include "kernels/distance/signed_distance.h"

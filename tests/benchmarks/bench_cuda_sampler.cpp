@@ -5,8 +5,8 @@
 
 #include <cstdio>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/sampling/make_sampler.h"
 

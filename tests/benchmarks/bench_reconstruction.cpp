@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/reconstruction/analytic_study.h"
+#include "core/reconstruction/analytic_study.h"
 
 namespace sdf {
 namespace {

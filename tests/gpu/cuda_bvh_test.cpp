@@ -6,7 +6,7 @@
 
 #include <random>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "harness/sampling/make_sampler.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 

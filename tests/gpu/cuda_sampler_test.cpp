@@ -5,8 +5,8 @@
 
 #include <random>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/sampling/make_sampler.h"

@@ -14,8 +14,8 @@
 #include <cstdio>
 
 #include "../raycast/raycast_test_util.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/raycast/image_metrics.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/render/render_backend.h"
 

@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cpu_reference/mesh/sha256.h"
+#include "core/mesh/sha256.h"
 #include "harness/build_config.h"
 #include "harness/io/field_file.h"
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "harness/build_config.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"

@@ -10,7 +10,7 @@
 #include <tuple>
 #include <vector>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "kernels/lattice/lattice.h"
 #include "kernels/lattice/sampling_grid.h"
 

@@ -36,7 +36,7 @@ TEST(MakeBaseline, FromACleanRunWithDefaultTolerances) {
     EXPECT_EQ(b.at("format"), "sdf-baseline");
     EXPECT_EQ(b.at("name"), "study");
     EXPECT_EQ(b.at("made_from").at("git_commit"), "feedbeef");
-    EXPECT_EQ(b.at("machine"), (json{{"cpu", "CPU A"}, {"gpu", "GPU X"}}));
+    EXPECT_EQ(b.at("machine"), (json{{"cpu", "CPU A"}, {"gpu", "GPU X"}, {"cpu_target", "unrecorded"}}));
     const json& m = b.at("metrics");
     EXPECT_EQ(m.at("cc/catmull_rom/fd/domain_rms").at("relative"), 0.01);
     EXPECT_DOUBLE_EQ(m.at("dragon/262144/cc/gpu_tuned/speedup").at("floor").get<double>(), 80.0);

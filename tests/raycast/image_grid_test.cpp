@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/render/heat_map.h"
 #include "harness/render/image_io.h"

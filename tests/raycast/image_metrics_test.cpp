@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/raycast/image_metrics.h"
 #include "cpu_reference/raycast/mesh_reference.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
+#include "core/mesh/shapes/procedural_shapes.h"
 
 namespace sdf {
 namespace {

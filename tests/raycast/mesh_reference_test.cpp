@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/raycast/image_metrics.h"
 #include "cpu_reference/raycast/mesh_reference.h"
 #include "kernels/raycast/ray_triangle.h"
 #include "kernels/raycast/shading.h"

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/reconstruction/analytic_study.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/reconstruction/analytic_study.h"
 #include "kernels/raycast/camera.h"
 
 namespace sdf::test {

@@ -7,7 +7,7 @@
 
 #include <cstdio>
 
-#include "cpu_reference/raycast/image_metrics.h"
+#include "core/raycast/image_metrics.h"
 #include "cpu_reference/raycast/render_cpu.h"
 #include "raycast_test_util.h"
 

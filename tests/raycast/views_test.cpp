@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "cpu_reference/raycast/views.h"
+#include "core/raycast/views.h"
 
 namespace sdf {
 namespace {

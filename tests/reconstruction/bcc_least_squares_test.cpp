@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "cpu_reference/reconstruction/bcc_least_squares.h"
+#include "core/reconstruction/bcc_least_squares.h"
 #include "reconstruction_test_util.h"
 
 namespace sdf {

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "cpu_reference/reconstruction/lekien_marsden_matrix.h"
+#include "core/reconstruction/lekien_marsden_matrix.h"
 #include "kernels/reconstruction/tricubic_lekien_marsden.h"
 #include "reconstruction_test_util.h"
 

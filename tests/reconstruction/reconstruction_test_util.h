@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include "cpu_reference/reconstruction/analytic_study.h"
-#include "cpu_reference/reconstruction/bcc_cubic_tables.h"
+#include "core/reconstruction/analytic_study.h"
+#include "core/reconstruction/bcc_cubic_tables.h"
 
 namespace sdf::test {
 

@@ -10,7 +10,7 @@
 
 #include <cstdio>
 
-#include "cpu_reference/reconstruction/analytic_study.h"
+#include "core/reconstruction/analytic_study.h"
 
 namespace sdf {
 namespace {

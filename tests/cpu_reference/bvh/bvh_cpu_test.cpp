@@ -8,7 +8,7 @@
 #include <random>
 
 #include "cpu_reference/bvh/bvh_cpu.h"
-#include "cpu_reference/lattice/lattice_fitting.h"
+#include "core/lattice/lattice_fitting.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 

@@ -18,10 +18,10 @@
 #include <tuple>
 #include <vector>
 
-#include "cpu_reference/mesh/load_obj.h"
-#include "cpu_reference/mesh/prepared_mesh.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
-#include "cpu_reference/sampling/sampler.h"
+#include "core/mesh/load_obj.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/sampling/sampler.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 
 namespace sdf::test {

@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "cpu_reference/bvh/triangle_bvh.h"
+#include "core/bvh/triangle_bvh.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 

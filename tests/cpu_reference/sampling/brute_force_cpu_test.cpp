@@ -5,9 +5,9 @@
 
 #include <random>
 
-#include "cpu_reference/lattice/lattice_fitting.h"
-#include "cpu_reference/mesh/shapes/procedural_shapes.h"
-#include "cpu_reference/parallel/progress.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/parallel/progress.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"

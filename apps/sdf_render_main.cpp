@@ -1,0 +1,334 @@
+// sdf-render INPUT [options]: ray-cast images of reconstructed distance fields without the
+// harness (docs/raycast.md, "sdf-render").
+//
+// INPUT is a field file (NAME.json, docs/field-format.md) or a mesh (an OBJ file found on
+// the data search path, or shape:NAME). A mesh is sampled on --lattice/--resolution (fields
+// are kept in the field cache shared with run-experiment); a field file is used as it is.
+//
+//   one image per view:  sdf-render dragon.obj --lattice bcc --resolution 64,64,128
+//                          --interpolator bcc_cubic --derivatives true --view dragon_side
+//                          --size 1024 --backend cuda --repeat 20 --out dragon.png
+//   thesis grid:         sdf-render dragon.obj --grid --view dragon_side --view dragon_front
+//                          --size 512 --out-dir results/figures
+//
+// Single images write OUT (PNG, or PPM without OpenImageIO), OUT's .exr (all channels, or
+// PFMs) and, with --reference, the mesh reference and OUT's .metrics.json. With several
+// views the view name is appended to OUT's stem. Grids write the files of
+// harness/render/thesis_figure.h. Timings are printed (CPU: wall time; CUDA: median
+// kernel time over --repeat launches, CUDA events).
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/sha256.h"
+#include "core/parallel/progress.h"
+#include "harness/cache/field_cache.h"
+#include "harness/config/mesh_spec.h"
+#include "harness/io/field_file.h"
+#include "harness/provenance/provenance.h"
+#include "harness/render/image_io.h"
+#include "harness/render/thesis_figure.h"
+#include "harness/sampling/make_sampler.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace sdf;
+
+struct Options {
+    std::string input, mesh_file;
+    std::string lattice = "bcc";
+    std::vector<int> resolution;
+    std::vector<int> cc_resolution{80, 80, 80}, bcc_resolution{64, 64, 128};
+    double margin = 0.1;
+    std::string interpolator, derivatives;
+    std::vector<std::string> views;
+    std::vector<double> eye, target, up{0, 1, 0};
+    double fov = 30;
+    std::vector<int> size{512};
+    std::string backend = "auto", precision = "float";
+    int threads = 0, repeat = 1, device = 0;
+    bool reference = false, grid = false, no_reference = false, no_error_maps = false, no_exr = false;
+    bool overwrite = false, quiet = false, no_cache = false;
+    int downsample = 1;
+    double heat_max = 20;
+    std::string out = "render.png", out_dir = ".", name, title, cache_dir;
+    std::string sampler_backend = "auto", sampler_method = "brute_force";
+};
+
+bool is_field_file(const std::string& input) { return fs::path(input).extension() == ".json"; }
+
+Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+/// Bounds of a field's solid: the lattice points with f <= 0, grown by one spacing.
+Bounds3 solid_bounds(const SampledField& f) {
+    Bounds3 b;
+    for (int64_t i = 0; i < f.size(); ++i)
+        if (f.distance[size_t(i)] <= 0) b.extend(f.lattice.position(i));
+    if (b.empty()) throw std::runtime_error("the field has no point with a value <= 0: nothing to frame");
+    b.extend(b.min - Vec3d(f.lattice.spacing));
+    b.extend(b.max + Vec3d(f.lattice.spacing));
+    return b;
+}
+
+SamplerOptions sampler_options(const Options& o) {
+    SamplerOptions s;
+    s.backend = o.sampler_backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : o.sampler_backend;
+    s.method = o.sampler_method;
+    s.precision = Precision::Float;
+    s.progress = !o.quiet;
+    return s;
+}
+
+/// The field of `mesh` on `lattice`, from the field cache or sampled (and stored there).
+SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, const Options& o) {
+    const SamplerOptions s = sampler_options(o);
+    const std::optional<FieldCache> cache =
+        o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
+    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, s);
+    if (cache) {
+        if (std::optional<SampledField> f = cache->load(key)) {
+            std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name.c_str(), lattice_notation(lattice).c_str(),
+                         cache->entry_path(key).c_str());
+            return *f;
+        }
+    }
+    std::fprintf(stderr, "field %s %s: sampling %lld points x %zu triangles (%s/%s)\n", mesh.name.c_str(),
+                 lattice_notation(lattice).c_str(), static_cast<long long>(lattice.num_points()), mesh.triangles.size(),
+                 s.backend.c_str(), s.method.c_str());
+    SampledField f = make_sampler(s)->sample(mesh, lattice);
+    std::fprintf(stderr, "  sampled in %.1f s\n", f.timings.total);
+    if (cache) cache->store(key, f);
+    return f;
+}
+
+Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const std::vector<int>& res, double margin) {
+    if (res.size() != 3) throw std::invalid_argument("a resolution needs 3 integers, e.g. 80,80,80");
+    const bool bcc = type == "bcc";
+    const Int3 r{res[0], res[1], res[2]};
+    return fit_lattice(bcc ? LatticeType::BCC : LatticeType::CC, bcc ? bcc_primary_from_notation(r) : r, mesh.bounds,
+                       margin);
+}
+
+std::vector<ViewRequest> view_requests(const Options& o) {
+    std::vector<ViewRequest> views;
+    if (!o.eye.empty() || !o.target.empty()) {
+        if (o.eye.size() != 3 || o.target.size() != 3)
+            throw std::invalid_argument("--eye and --target are both needed for an explicit camera");
+        ViewRequest v;
+        v.name = "camera";
+        v.explicit_camera = true;
+        v.eye = vec3(o.eye);
+        v.target = vec3(o.target);
+        v.up = vec3(o.up);
+        v.fov_y_degrees = o.fov;
+        views.push_back(v);
+    }
+    for (const std::string& name : o.views) {
+        ViewRequest v = named_view(name);
+        v.fov_y_degrees = o.fov;
+        views.push_back(v);
+    }
+    if (views.empty()) views.push_back(named_view("three_quarter"));
+    return views;
+}
+
+RenderOptions render_options(const Options& o) {
+    RenderOptions r;
+    r.backend = o.backend;
+    r.threads = o.threads;
+    r.progress = !o.quiet;
+    r.precision = o.precision == "double" ? Precision::Double : Precision::Float;
+    r.repetitions = o.repeat;
+    r.device = o.device;
+    return r;
+}
+
+std::string with_suffix(const std::string& path, const std::string& suffix, const std::string& ext = "") {
+    const fs::path p(path);
+    return (p.parent_path() / (p.stem().string() + suffix + (ext.empty() ? p.extension().string() : ext))).string();
+}
+
+void print_timing(const std::string& what, const RenderedImage& image) {
+    const nlohmann::json& i = image.info;
+    std::printf("%s: %dx%d, backend %s, %.4f s", what.c_str(), image.width, image.height,
+                i.value("backend", std::string("?")).c_str(), i.value("seconds", 0.0));
+    if (i.contains("kernel_seconds"))
+        std::printf(", kernel %.3f ms median of %d (min %.3f ms)", 1e3 * i["kernel_seconds"].get<double>(),
+                    i.value("repetitions", 1), 1e3 * i.value("kernel_seconds_min", 0.0));
+    if (i.contains("march"))
+        std::printf(", %.1f steps/pixel, %lld hits", i["march"].value("mean_steps", 0.0),
+                    static_cast<long long>(i["march"].value("hits", 0)));
+    std::printf("\n");
+}
+
+nlohmann::json provenance(const Options& o, const nlohmann::json& resolved, const std::string& mesh_sha) {
+    const GitState git = git_state();
+    const std::string text = resolved.dump();
+    return {{"tool", "sdf-render"},
+            {"config_hash", sha256_hex(text.data(), text.size())},
+            {"config", resolved},
+            {"git_commit", git.commit},
+            {"git_dirty", git.dirty},
+            {"created", utc_timestamp()},
+            {"mesh_sha256", mesh_sha},
+            {"machine", machine_and_build()},
+            {"input", o.input}};
+}
+
+int run_single(const Options& o, const nlohmann::json& resolved) {
+    std::optional<PreparedMesh> mesh;
+    SampledField field;
+    if (is_field_file(o.input)) {
+        field = read_field(o.input);
+        if (!o.mesh_file.empty())
+            mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), "."));
+    } else {
+        mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
+        const std::vector<int> res = !o.resolution.empty() ? o.resolution : (o.lattice == "cc" ? o.cc_resolution : o.bcc_resolution);
+        field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
+    }
+    if (o.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
+    const Bounds3 bounds = mesh ? mesh->bounds : solid_bounds(field);
+    const Reconstruction recon(field, o.interpolator.empty() ? (field.lattice.type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm")
+                                                             : o.interpolator,
+                               o.derivatives);
+    const std::vector<ViewRequest> views = view_requests(o);
+    const nlohmann::json prov = provenance(o, resolved, mesh ? mesh->content_sha256 : std::string());
+    const Overwrite overwrite = o.overwrite ? Overwrite::Allow : Overwrite::Forbid;
+    std::optional<MeshReferenceRenderer> reference_renderer;
+    if (o.reference) reference_renderer.emplace(*mesh);
+    for (const ViewRequest& v : views) {
+        const int w = o.size[0], h = o.size.size() > 1 ? o.size[1] : o.size[0];
+        const CameraSpec camera = mesh ? resolve_view(v, mesh->vertices, w, h) : resolve_view(v, bounds, w, h);
+        const RenderedImage image = render_reconstruction(recon, camera, render_options(o));
+        print_timing(recon.description() + " " + lattice_notation(field.lattice) + ", view " + v.name, image);
+        const std::string out = views.size() > 1 ? with_suffix(o.out, "_" + v.name) : o.out;
+        nlohmann::json attributes = prov;
+        attributes["render_seconds"] = image.info.value("seconds", 0.0);
+        attributes["reconstruction"] = recon.description();
+        attributes["lattice"] = lattice_notation(field.lattice);
+        attributes["camera"] = camera_to_json(camera);
+        attributes["render"] = image.info;
+        const std::string written = write_image(out, shaded_image(image), attributes, overwrite);
+        if (!o.no_exr) write_render_exr(with_suffix(out, "", ".exr"), image, attributes, overwrite);
+        std::printf("  wrote %s\n", written.c_str());
+        if (reference_renderer) {
+            MeshRenderOptions mo;
+            mo.threads = o.threads;
+            mo.progress = !o.quiet;
+            const RenderedImage ref = reference_renderer->render(camera, mo);
+            print_timing("mesh reference, view " + v.name, ref);
+            const ImageMetrics m = compare_images(image, ref, field.lattice.spacing);
+            write_image(with_suffix(out, "_reference"), shaded_image(ref), prov, overwrite);
+            if (!o.no_exr) write_render_exr(with_suffix(out, "_reference", ".exr"), ref, prov, overwrite);
+            write_text_atomically(with_suffix(out, "", ".metrics.json"), metrics_to_json(m).dump(2) + "\n", overwrite);
+            std::printf("  normal error mean %.3f p95 %.3f deg, coverage mismatch %lld px, shade RMSE %.4f\n",
+                        m.normal_angle_degrees.mean, m.normal_angle_degrees.p95,
+                        static_cast<long long>(m.coverage_mismatch), m.shade_rmse);
+        }
+    }
+    return 0;
+}
+
+int run_grid(const Options& o, const nlohmann::json& resolved) {
+    if (is_field_file(o.input)) throw std::invalid_argument("--grid needs a mesh INPUT (it samples CC and BCC fields)");
+    const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
+    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, "cc", o.cc_resolution, o.margin), o);
+    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, "bcc", o.bcc_resolution, o.margin), o);
+    FigureOptions fo;
+    fo.render = render_options(o);
+    fo.mesh.threads = o.threads;
+    fo.mesh.progress = !o.quiet;
+    fo.reference_row = !o.no_reference;
+    fo.error_rows = !o.no_error_maps && !o.no_reference;
+    fo.heat_max_degrees = o.heat_max;
+    fo.downsample = o.downsample;
+    const nlohmann::json prov = provenance(o, resolved, mesh.content_sha256);
+    const std::string name = o.name.empty() ? mesh.name : o.name;
+    fs::create_directories(o.out_dir);
+    for (const ViewRequest& v : view_requests(o)) {
+        const CameraSpec camera = resolve_view(v, mesh.vertices, o.size[0], o.size.size() > 1 ? o.size[1] : o.size[0]);
+        fo.title = o.title.empty() ? name + ", view " + v.name + ": CC " + lattice_notation(cc.lattice) + " / BCC " +
+                                         lattice_notation(bcc.lattice)
+                                   : o.title;
+        std::fprintf(stderr, "figure %s, view %s\n", name.c_str(), v.name.c_str());
+        const ThesisFigure figure = render_thesis_figure(cc, bcc, fo.reference_row || fo.error_rows ? &mesh : nullptr,
+                                                         camera, fo);
+        for (const FigurePanel& p : figure.panels) print_timing(p.label, p.image);
+        const std::string grid = write_thesis_figure(o.out_dir, name + "_" + v.name, figure, prov,
+                                                     o.overwrite ? Overwrite::Allow : Overwrite::Forbid);
+        std::printf("  wrote %s (%dx%d)\n", grid.c_str(), figure.grid.width, figure.grid.height);
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Ray-casts reconstructed distance fields (docs/raycast.md): one image per view, or the thesis grid."};
+    Options o;
+    app.add_option("input", o.input, "field file (NAME.json) or mesh (OBJ on the data path, or shape:NAME)")->required();
+    app.add_option("--mesh", o.mesh_file, "field input: the mesh, for --reference and framing");
+    app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("--resolution", o.resolution, "mesh input: resolution, BCC in thesis notation (64,64,128); default "
+                                                 "--cc-resolution or --bcc-resolution")->delimiter(',')->expected(3);
+    app.add_option("--cc-resolution", o.cc_resolution, "CC resolution (grid, and the default for --lattice cc)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    app.add_option("--bcc-resolution", o.bcc_resolution, "BCC resolution Rx,Ry,2Rz (grid, and the default for --lattice bcc)")
+        ->delimiter(',')->expected(3)->capture_default_str();
+    app.add_option("--margin", o.margin, "mesh input: lattice margin, fraction of the largest extent")->capture_default_str();
+    app.add_option("--interpolator", o.interpolator, "default: bcc_cubic (BCC) or tricubic_lm (CC)")
+        ->check(CLI::IsMember(interpolator_names()));
+    app.add_option("--derivatives", o.derivatives, "true, fd or fd_weighted (default: true when available)")
+        ->check(CLI::IsMember({"true", "fd", "fd_weighted"}));
+    app.add_option("--view", o.views, "named view (repeatable): " + [] {
+        std::string s;
+        for (const std::string& n : named_view_names()) s += (s.empty() ? "" : ", ") + n;
+        return s;
+    }())->check(CLI::IsMember(named_view_names()));
+    app.add_option("--eye", o.eye, "explicit camera: eye x,y,z")->delimiter(',')->expected(3);
+    app.add_option("--target", o.target, "explicit camera: target x,y,z")->delimiter(',')->expected(3);
+    app.add_option("--up", o.up, "explicit camera: up x,y,z")->delimiter(',')->expected(3)->capture_default_str();
+    app.add_option("--fov", o.fov, "vertical field of view, degrees")->capture_default_str();
+    app.add_option("--size", o.size, "image size W[,H]")->delimiter(',')->expected(1, 2)->capture_default_str();
+    app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
+    app.add_option("--precision", o.precision, "cpu casting precision")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
+    app.add_option("--threads", o.threads, "CPU threads (0 = all)")->capture_default_str();
+    app.add_option("--repeat", o.repeat, "timed renders (cuda: kernel launches after a warm-up); the median is printed")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--device", o.device, "CUDA device")->capture_default_str();
+    app.add_flag("--reference", o.reference, "single images: also ray-trace the mesh and write metrics");
+    app.add_option("--out", o.out, "single images: output image (.png, .exr, .ppm, .pfm)")->capture_default_str();
+    app.add_flag("--no-exr", o.no_exr, "single images: skip the EXR with all channels");
+    app.add_flag("--grid", o.grid, "the thesis figure (CC and BCC fields of a mesh, five reconstructions)");
+    app.add_option("--out-dir", o.out_dir, "grid: output directory")->capture_default_str();
+    app.add_option("--name", o.name, "grid: file name prefix (default: the mesh's name)");
+    app.add_option("--title", o.title, "grid: title line (default: mesh, view and lattices)");
+    app.add_flag("--no-reference", o.no_reference, "grid: no reference row (and no heat maps)");
+    app.add_flag("--no-error-maps", o.no_error_maps, "grid: no heat-map rows");
+    app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->capture_default_str();
+    app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--sampler-backend", o.sampler_backend, "mesh input: sampler backend")
+        ->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
+    app.add_option("--sampler-method", o.sampler_method, "mesh input: sampler method")
+        ->check(CLI::IsMember({"brute_force", "bvh"}))->capture_default_str();
+    app.add_option("--cache-dir", o.cache_dir, "field cache (default $SDF_CACHE_DIR or <repo>/cache)");
+    app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");
+    app.add_flag("--overwrite", o.overwrite, "replace existing output files");
+    app.add_flag("--quiet", o.quiet, "no progress lines");
+    CLI11_PARSE(app, argc, argv);
+    try {
+        if (o.quiet) ProgressReporter::set_globally_enabled(false);
+        // Every option's value (defaults included) as CLI11 writes a config file: the
+        // "config" whose SHA-256 is the images' config_hash
+        const nlohmann::json resolved = app.config_to_str(true, false);
+        return o.grid ? run_grid(o, resolved) : run_single(o, resolved);
+    } catch (const std::exception& e) {
+        std::cerr << "sdf-render: error: " << e.what() << "\n";
+        return 1;
+    }
+}

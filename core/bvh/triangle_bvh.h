@@ -1,0 +1,51 @@
+/// @file triangle_bvh.h
+/// @brief A BVH over a prepared mesh's triangles, built on the CPU with binned SAH (Wald,
+/// "On fast Construction of SAH-based Bounding Volume Hierarchies", IEEE RT 2007) into the
+/// flat layout of kernels/bvh/bvh_node.h, with the search constants of every triangle
+/// stored in BVH order for the float and the double query.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/mesh/prepared_mesh.h"
+#include "kernels/bvh/bvh_view.h"
+
+namespace sdf {
+
+struct BvhBuildOptions {
+    int max_leaf_size = 4;        ///< leaves hold at most this many triangles (except unsplittable ranges)
+    int bins = 32;                ///< SAH bins per axis
+    double node_cost = 1.0;       ///< SAH cost of visiting a node, relative to one triangle test
+    int median_split_depth = 32;  ///< below this depth, split at the object median (bounds the depth)
+};
+
+struct BvhBuildStats {
+    int nodes = 0, leaves = 0, depth = 0, largest_leaf = 0;
+    double sah_cost = 0;  ///< expected cost of a query through the root, in triangle tests
+    double seconds = 0;
+    nlohmann::json to_json() const;
+};
+
+class TriangleBvh {
+public:
+    std::vector<BvhNode> nodes;
+    std::vector<int32_t> triangle_index;  ///< BVH slot -> prepared-mesh triangle
+    std::vector<PackedTriangle<float>> packed_float;    ///< search constants in BVH order
+    std::vector<PackedTriangle<double>> packed_double;
+    BvhBuildStats stats;
+
+    template <typename T>
+    BvhView<T> view() const;
+};
+
+/// Builds the BVH of `mesh` (throws std::invalid_argument for an empty mesh).
+TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& options = {});
+
+/// The same box, rounded outward from double to float so that it still contains the input.
+float round_down_to_float(double x);
+float round_up_to_float(double x);
+
+}  // namespace sdf

@@ -1,0 +1,17 @@
+/// @file load_obj.h
+/// @brief Wavefront OBJ loading through tinyobjloader (double precision, polygons triangulated).
+#pragma once
+
+#include <string>
+
+#include "core/mesh/triangle_mesh.h"
+
+namespace sdf {
+
+/// Loads every face of every shape in file order; polygons are triangulated by tinyobjloader
+/// (quads along their shorter diagonal, larger polygons as fans).
+/// Throws std::runtime_error naming the file (and the line where known) when the file is
+/// missing, unparsable, holds no triangles, or has non-finite coordinates.
+TriangleMesh load_obj(const std::string& path);
+
+}  // namespace sdf

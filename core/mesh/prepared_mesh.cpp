@@ -1,0 +1,258 @@
+#include "core/mesh/prepared_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+namespace sdf {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct PositionKey {
+    double x, y, z;
+    bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct PositionHash {
+    size_t operator()(const PositionKey& k) const {
+        std::hash<double> h;
+        return h(k.x) ^ (h(k.y) * 0x9e3779b97f4a7c15ull) ^ (h(k.z) * 0xc2b2ae3d27d4eb4full);
+    }
+};
+
+/// Maps every input vertex to a welded vertex id. With tolerance 0 only bit-identical
+/// positions merge; otherwise a vertex merges into the first kept vertex within `tolerance`
+/// (searched in the 27 grid cells of size `tolerance` around it), so closeness and not
+/// grid alignment decides.
+std::vector<int> weld_vertices(const std::vector<Vec3d>& in, double tolerance, std::vector<Vec3d>& out) {
+    std::vector<int> remap(in.size());
+    std::unordered_map<PositionKey, std::vector<int>, PositionHash> cells;
+    auto cell_of = [&](const Vec3d& p) {
+        return tolerance > 0 ? PositionKey{std::floor(p.x / tolerance), std::floor(p.y / tolerance), std::floor(p.z / tolerance)}
+                             : PositionKey{p.x, p.y, p.z};
+    };
+    for (size_t i = 0; i < in.size(); ++i) {
+        const PositionKey c = cell_of(in[i]);
+        int found = -1;
+        const int reach = tolerance > 0 ? 1 : 0;
+        for (int dz = -reach; dz <= reach && found < 0; ++dz)
+            for (int dy = -reach; dy <= reach && found < 0; ++dy)
+                for (int dx = -reach; dx <= reach && found < 0; ++dx) {
+                    auto it = cells.find({c.x + dx, c.y + dy, c.z + dz});
+                    if (it == cells.end()) continue;
+                    for (int id : it->second)
+                        if (tolerance > 0 ? length(out[size_t(id)] - in[i]) <= tolerance : true) { found = id; break; }
+                }
+        if (found < 0) {
+            found = int(out.size());
+            out.push_back(in[i]);
+            cells[c].push_back(found);
+        }
+        remap[i] = found;
+    }
+    return remap;
+}
+
+double corner_angle(const Vec3d& at, const Vec3d& a, const Vec3d& b) {
+    const Vec3d u = normalize_or_zero(a - at), v = normalize_or_zero(b - at);
+    return std::atan2(length(cross(u, v)), dot(u, v));
+}
+
+struct EdgeUse {
+    int triangle;
+    int local_edge;
+    bool forward;  ///< traversed from the lower vertex id to the higher one
+};
+
+int find_root(std::vector<int>& parent, int i) {
+    while (parent[size_t(i)] != i) i = parent[size_t(i)] = parent[size_t(parent[size_t(i)])];
+    return i;
+}
+
+}  // namespace
+
+PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options) {
+    PreparedMesh out;
+    out.name = mesh.name;
+    out.source = mesh.source;
+    out.content_sha256 = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;
+    MeshReport& rep = out.report;
+    rep.input_vertices = int(mesh.vertices.size());
+    rep.input_triangles = int(mesh.triangles.size());
+
+    // Weld, then drop triangles with a repeated vertex or exactly zero area.
+    std::vector<Vec3d> welded;
+    const std::vector<int> remap = weld_vertices(mesh.vertices, options.weld_tolerance, welded);
+    rep.welded_vertices = int(mesh.vertices.size() - welded.size());
+    std::vector<Int3> tris;
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+        const Int3 t = mesh.triangles[i];
+        const Int3 w{remap[size_t(t.x)], remap[size_t(t.y)], remap[size_t(t.z)]};
+        const bool repeated = w.x == w.y || w.y == w.z || w.z == w.x;
+        if (repeated || length_squared(cross(welded[size_t(w.y)] - welded[size_t(w.x)],
+                                              welded[size_t(w.z)] - welded[size_t(w.x)])) == 0.0) {
+            ++rep.degenerate_triangles;
+            continue;
+        }
+        tris.push_back(w);
+        out.source_triangle.push_back(int(i));
+    }
+
+    // Compact away unreferenced vertices.
+    std::vector<int> used(welded.size(), -1);
+    for (Int3& t : tris)
+        for (int k = 0; k < 3; ++k) {
+            int& id = used[size_t(t[k])];
+            if (id < 0) { id = int(out.vertices.size()); out.vertices.push_back(welded[size_t(t[k])]); }
+            t[k] = id;
+        }
+    rep.unreferenced_vertices = int(welded.size() - out.vertices.size());
+    out.triangles = std::move(tris);
+
+    // Edge adjacency: boundary, non-manifold and orientation checks; components.
+    std::map<std::pair<int, int>, std::vector<EdgeUse>> edges;
+    for (size_t i = 0; i < out.triangles.size(); ++i)
+        for (int e = 0; e < 3; ++e) {
+            const int a = out.triangles[i][e], b = out.triangles[i][(e + 1) % 3];
+            edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
+        }
+    std::vector<int> parent(out.triangles.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const auto& [key, uses] : edges) {
+        if (uses.size() == 1) ++rep.boundary_edges;
+        if (uses.size() > 2) ++rep.nonmanifold_edges;
+        if (uses.size() == 2 && uses[0].forward == uses[1].forward) ++rep.inconsistent_edges;
+        for (size_t u = 1; u < uses.size(); ++u)
+            parent[size_t(find_root(parent, uses[u].triangle))] = find_root(parent, uses[0].triangle);
+    }
+    for (size_t i = 0; i < parent.size(); ++i)
+        if (find_root(parent, int(i)) == int(i)) ++rep.components;
+
+    // Orientation: make a closed, consistent mesh point outward.
+    for (const Int3& t : out.triangles)
+        rep.signed_volume += dot(out.vertices[size_t(t.x)],
+                                 cross(out.vertices[size_t(t.y)], out.vertices[size_t(t.z)])) / 6.0;
+    if (options.orient_outward && rep.closed() && rep.consistently_oriented() && rep.signed_volume < 0) {
+        for (Int3& t : out.triangles) std::swap(t.y, t.z);
+        rep.signed_volume = -rep.signed_volume;
+        rep.flipped = true;
+        // Edge e of a flipped triangle is a different edge; rebuild the adjacency lookups below.
+        edges.clear();
+        for (size_t i = 0; i < out.triangles.size(); ++i)
+            for (int e = 0; e < 3; ++e) {
+                const int a = out.triangles[i][e], b = out.triangles[i][(e + 1) % 3];
+                edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
+            }
+    }
+
+    // Angle-weighted pseudonormals.
+    const size_t nt = out.triangles.size();
+    out.face_normals.resize(nt);
+    out.edge_normals.assign(3 * nt, Vec3d(0.0));
+    out.vertex_normals.assign(out.vertices.size(), Vec3d(0.0));
+    for (size_t i = 0; i < nt; ++i) {
+        const Int3 t = out.triangles[i];
+        const Vec3d& a = out.vertices[size_t(t.x)];
+        const Vec3d& b = out.vertices[size_t(t.y)];
+        const Vec3d& c = out.vertices[size_t(t.z)];
+        const Vec3d n = normalize_or_zero(cross(b - a, c - a));
+        out.face_normals[i] = n;
+        out.vertex_normals[size_t(t.x)] += n * corner_angle(a, b, c);
+        out.vertex_normals[size_t(t.y)] += n * corner_angle(b, c, a);
+        out.vertex_normals[size_t(t.z)] += n * corner_angle(c, a, b);
+    }
+    for (Vec3d& n : out.vertex_normals) n = normalize_or_zero(n);
+    for (const auto& [key, uses] : edges) {
+        // Each incident face contributes its normal with weight pi (the angle of a face
+        // around an edge); for a manifold edge this is the normalised sum of both normals.
+        Vec3d sum(0.0);
+        for (const EdgeUse& u : uses) sum += out.face_normals[size_t(u.triangle)] * kPi;
+        const Vec3d n = normalize_or_zero(sum);
+        for (const EdgeUse& u : uses)
+            out.edge_normals[3 * size_t(u.triangle) + size_t(u.local_edge)] =
+                length_squared(n) > 0 ? n : out.face_normals[size_t(u.triangle)];
+    }
+    out.bounds = triangle_bounds(out.vertices, out.triangles);
+    return out;
+}
+
+std::vector<std::string> PreparedMesh::warnings() const {
+    std::vector<std::string> w;
+    const std::string who = "mesh '" + name + "' (" + source + ")";
+    if (report.boundary_edges > 0)
+        w.push_back(who + " is open: " + std::to_string(report.boundary_edges) +
+                    " boundary edges. Distances are exact, but the sign is only the side of the "
+                    "nearest surface feature (negative = behind its pseudonormal); near and "
+                    "through the holes 'inside' and 'outside' are not defined.");
+    if (report.nonmanifold_edges > 0)
+        w.push_back(who + " has " + std::to_string(report.nonmanifold_edges) +
+                    " non-manifold edges (used by more than two triangles); signs next to them "
+                    "may be wrong.");
+    if (report.inconsistent_edges > 0)
+        w.push_back(who + " is not consistently oriented (" + std::to_string(report.inconsistent_edges) +
+                    " edges traversed twice in the same direction); pseudonormal signs are "
+                    "unreliable near those edges.");
+    if (report.flipped)
+        w.push_back(who + " was oriented inward (negative signed volume); all triangles were flipped.");
+    if (report.degenerate_triangles > 0)
+        w.push_back(who + ": dropped " + std::to_string(report.degenerate_triangles) +
+                    " degenerate triangles (repeated vertex or zero area).");
+    return w;
+}
+
+template <typename T>
+MeshView<T> MeshBuffers<T>::view() const {
+    MeshView<T> v;
+    v.vertices = vertices.data();
+    v.triangles = triangles.data();
+    v.face_normals = face_normals.data();
+    v.edge_normals = edge_normals.data();
+    v.vertex_normals = vertex_normals.data();
+    v.packed = packed.data();
+    v.num_triangles = int(triangles.size());
+    v.num_vertices = int(vertices.size());
+    return v;
+}
+
+namespace {
+template <typename T>
+std::vector<Vec3<T>> convert(const std::vector<Vec3d>& in) {
+    std::vector<Vec3<T>> out(in.size());
+    for (size_t i = 0; i < in.size(); ++i) out[i] = Vec3<T>(in[i]);
+    return out;
+}
+
+template <typename T>
+std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m) {
+    auto b = std::make_shared<MeshBuffers<T>>();
+    b->vertices = convert<T>(m.vertices);
+    b->face_normals = convert<T>(m.face_normals);
+    b->edge_normals = convert<T>(m.edge_normals);
+    b->vertex_normals = convert<T>(m.vertex_normals);
+    b->triangles = m.triangles;
+    b->packed.reserve(m.triangles.size());
+    for (const Int3& t : m.triangles)
+        b->packed.push_back(pack_triangle<T>(m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
+                                             m.vertices[size_t(t.z)]));
+    return b;
+}
+}  // namespace
+
+template <>
+const MeshBuffers<float>& PreparedMesh::buffers<float>() const {
+    if (!float_buffers_) float_buffers_ = make_buffers<float>(*this);
+    return *float_buffers_;
+}
+template <>
+const MeshBuffers<double>& PreparedMesh::buffers<double>() const {
+    if (!double_buffers_) double_buffers_ = make_buffers<double>(*this);
+    return *double_buffers_;
+}
+
+template struct MeshBuffers<float>;
+template struct MeshBuffers<double>;
+
+}  // namespace sdf

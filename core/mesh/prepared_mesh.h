@@ -1,0 +1,78 @@
+/// @file prepared_mesh.h
+/// @brief A mesh made ready for exact signed distance: welded, cleaned, checked, with the
+/// angle-weighted pseudonormals of faces, edges and vertices (Baerentzen & Aanaes 2005).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/mesh/triangle_mesh.h"
+#include "kernels/distance/mesh_view.h"
+
+namespace sdf {
+
+struct MeshPreparationOptions {
+    /// Vertices closer than this (absolute, mesh units) are merged; 0 merges only
+    /// bit-identical positions.
+    double weld_tolerance = 0.0;
+    /// Flip every triangle of a closed, consistently oriented mesh whose signed volume is
+    /// negative, so that normals point outward.
+    bool orient_outward = true;
+};
+
+/// What preparation found; printed in summaries and stored in field headers.
+struct MeshReport {
+    int input_vertices = 0;
+    int input_triangles = 0;
+    int welded_vertices = 0;        ///< vertices merged into others
+    int unreferenced_vertices = 0;  ///< dropped because no triangle uses them
+    int degenerate_triangles = 0;   ///< dropped: repeated vertex or exactly zero area
+    int boundary_edges = 0;         ///< used by one triangle
+    int nonmanifold_edges = 0;      ///< used by more than two triangles
+    int inconsistent_edges = 0;     ///< interior edges traversed in the same direction twice
+    int components = 0;             ///< edge-connected pieces
+    double signed_volume = 0.0;
+    bool flipped = false;           ///< orientation was reversed to point outward
+    bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
+    bool consistently_oriented() const { return inconsistent_edges == 0; }
+    /// True when signs from pseudonormals are trustworthy everywhere.
+    bool sign_reliable() const { return closed() && consistently_oriented(); }
+};
+
+/// Float or double copies of a PreparedMesh's arrays, owning what a MeshView points to.
+template <typename T>
+struct MeshBuffers {
+    std::vector<Vec3<T>> vertices, face_normals, edge_normals, vertex_normals;
+    std::vector<Int3> triangles;
+    std::vector<PackedTriangle<T>> packed;
+    MeshView<T> view() const;
+};
+
+class PreparedMesh {
+public:
+    std::string name, source, content_sha256;
+    std::vector<Vec3d> vertices;
+    std::vector<Int3> triangles;
+    std::vector<int> source_triangle;  ///< index of each triangle in the input's face order
+    std::vector<Vec3d> face_normals;   ///< unit
+    std::vector<Vec3d> edge_normals;   ///< 3 per triangle, unit; edge e = (v_e, v_(e+1)%3)
+    std::vector<Vec3d> vertex_normals; ///< unit, angle-weighted
+    MeshReport report;
+    Bounds3 bounds;
+
+    /// Human-readable warnings (open, non-manifold, inconsistent orientation, flipped).
+    std::vector<std::string> warnings() const;
+
+    /// Arrays in precision T, built on first use and cached.
+    template <typename T>
+    const MeshBuffers<T>& buffers() const;
+
+private:
+    mutable std::shared_ptr<MeshBuffers<float>> float_buffers_;
+    mutable std::shared_ptr<MeshBuffers<double>> double_buffers_;
+};
+
+PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options = {});
+
+}  // namespace sdf

@@ -1,0 +1,114 @@
+#include "core/reconstruction/analytic_study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/parallel/parallel_for.h"
+
+namespace sdf {
+namespace {
+
+/// Per-chunk sums, merged in chunk order so results do not depend on the thread count.
+struct ErrorSums {
+    double squares = 0, abs = 0, max_abs = 0, gradient_squares = 0;
+};
+
+Vec3d probe_position(const DomainBox<double>& box, int n, int64_t index) {
+    const int64_t i = index % n, j = (index / n) % n, k = index / (int64_t(n) * n);
+    const Vec3d t((double(i) + 0.5) / n, (double(j) + 0.5) / n, (double(k) + 0.5) / n);
+    return box.lo + component_mul(box.hi - box.lo, t);
+}
+
+}  // namespace
+
+AnalyticSample<double> evaluate_analytic(const std::string& function, const Vec3d& p) {
+    if (function == "marschner_lobb") return MarschnerLobb<double>{}(p);
+    if (function == "trig") return TrigFunction<double>{}(p);
+    throw std::invalid_argument("unknown analytic function '" + function + "'; expected marschner_lobb or trig");
+}
+
+Lattice lattice_spanning(LatticeType type, Int3 resolution, const Vec3d& lo, const Vec3d& hi) {
+    const double h = (hi.x - lo.x) / (resolution.x - 1);
+    for (int a = 0; a < 3; ++a)
+        if (resolution[a] < 2 || std::abs((hi[a] - lo[a]) - h * (resolution[a] - 1)) > 1e-9 * std::abs(hi[a] - lo[a]))
+            throw std::invalid_argument("lattice_spanning: the box and resolution need one isotropic spacing");
+    Lattice l;
+    l.type = type;
+    l.origin = lo;
+    l.spacing = h;
+    l.resolution = resolution;
+    return l;
+}
+
+AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
+    const auto f = [&](const Vec3d& p) { return evaluate_analytic(spec.function, p); };
+    const Lattice lattice = lattice_spanning(spec.lattice, spec.resolution, spec.domain_min, spec.domain_max);
+    ReconstructionSpec rspec = spec.reconstruction;
+    rspec.threads = spec.threads;
+    const Reconstruction recon(sample_analytic_field(lattice, f), rspec);
+
+    AnalyticStudyResult r;
+    r.description = spec.function + " / " + recon.description();
+    r.lattice = lattice_notation(lattice);
+    r.lattice_points = lattice.num_points();
+    r.probe_box = recon.domain();
+    const Vec3d inset(spec.margin * lattice.spacing);
+    r.probe_box = {r.probe_box.lo + inset, r.probe_box.hi - inset};
+    for (int a = 0; a < 3; ++a)
+        if (!(r.probe_box.lo[a] < r.probe_box.hi[a]))
+            throw std::invalid_argument("analytic study: margin " + std::to_string(spec.margin) +
+                                        " h leaves no probe box on this lattice");
+    const int n = spec.probes_per_axis;
+    r.probes = int64_t(n) * n * n;
+    const int64_t chunk = int64_t(n) * n;  // one z slice
+    std::vector<ErrorSums> slices(static_cast<size_t>(n));
+    parallel_for(r.probes, chunk, spec.threads, [&](int64_t begin, int64_t end) {
+        ErrorSums& s = slices[size_t(begin / chunk)];
+        for (int64_t i = begin; i < end; ++i) {
+            const Vec3d p = probe_position(r.probe_box, n, i);
+            const ReconstructedSample<double> got = recon.evaluate(p);
+            const AnalyticSample<double> want = f(p);
+            const double e = got.value - want.value;
+            s.squares += e * e;
+            s.abs += std::abs(e);
+            s.max_abs = std::max(s.max_abs, std::abs(e));
+            s.gradient_squares += length_squared(got.gradient - want.gradient);
+        }
+    });
+    ErrorSums total;
+    for (const ErrorSums& s : slices) {
+        total.squares += s.squares;
+        total.abs += s.abs;
+        total.max_abs = std::max(total.max_abs, s.max_abs);
+        total.gradient_squares += s.gradient_squares;
+    }
+    const double count = double(r.probes);
+    r.rms = std::sqrt(total.squares / count);
+    r.max_abs = total.max_abs;
+    r.mean_abs = total.abs / count;
+    r.l2_norm = std::sqrt(total.squares);
+    r.rms_255 = 255.0 * r.rms;
+    r.l2_norm_255 = 255.0 * r.l2_norm;
+    r.gradient_rms = std::sqrt(total.gradient_squares / count);
+    return r;
+}
+
+nlohmann::json to_json(const AnalyticStudyResult& r) {
+    return {{"description", r.description},
+            {"lattice", r.lattice},
+            {"lattice_points", r.lattice_points},
+            {"probes", r.probes},
+            {"probe_box", {{r.probe_box.lo.x, r.probe_box.lo.y, r.probe_box.lo.z},
+                           {r.probe_box.hi.x, r.probe_box.hi.y, r.probe_box.hi.z}}},
+            {"rms", r.rms},
+            {"max_abs", r.max_abs},
+            {"mean_abs", r.mean_abs},
+            {"l2_norm", r.l2_norm},
+            {"rms_255", r.rms_255},
+            {"l2_norm_255", r.l2_norm_255},
+            {"gradient_rms", r.gradient_rms}};
+}
+
+}  // namespace sdf

@@ -1,0 +1,52 @@
+/// @file sampler.h
+/// @brief The interface every sampling backend implements (CPU threads, CUDA), and the
+/// options that select one. A sampler knows a PreparedMesh and a Lattice, never a config.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampled_field.h"
+#include "kernels/lattice/sampling_grid.h"
+
+namespace sdf {
+
+struct SamplerOptions {
+    std::string backend = "cpu";        ///< "cpu" or "cuda"
+    std::string method = "brute_force"; ///< "brute_force" (later "bvh")
+    std::string kernel;                 ///< backend-specific variant; empty = backend default
+    Precision precision = Precision::Float;
+    int threads = 0;                    ///< CPU threads; 0 = all
+    BccStrategy bcc_strategy = BccStrategy::TwoGrids;
+    bool progress = true;
+    int device = 0;                     ///< CUDA device ordinal
+    // GPU work sizes; 0 = chosen from the device's memory and multiprocessor count.
+    int64_t max_points_per_piece = 0;   ///< lattice points per GPU piece (memory split)
+    int max_triangles_per_chunk = 0;    ///< triangles resident on the GPU at a time
+    int points_per_thread = 0;          ///< tuned kernel: points per thread (1, 2, 4, 8)
+};
+
+/// Result for one arbitrary query point.
+struct PointSample {
+    double distance = 0;
+    Vec3d gradient{};
+    int32_t triangle = -1;  ///< 0-based, in the mesh file's face order
+};
+
+class Sampler {
+public:
+    virtual ~Sampler() = default;
+    /// e.g. "cpu/brute_force/vectorized"
+    virtual std::string name() const = 0;
+    /// Samples every point of the lattice.
+    virtual SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) = 0;
+    /// Samples arbitrary points, returned in input order.
+    virtual std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) = 0;
+};
+
+/// Names a BCC strategy as in configs ("two_grids" / "double_resolution").
+const char* bcc_strategy_name(BccStrategy s);
+
+}  // namespace sdf

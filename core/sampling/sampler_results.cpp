@@ -1,0 +1,16 @@
+#include "core/sampling/sampler_results.h"
+
+namespace sdf {
+
+nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
+                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed) {
+    nlohmann::json p = {{"backend", backend},
+                        {"method", method},
+                        {"kernel", kernel},
+                        {"precision", precision_name(options.precision)},
+                        {"points_computed", points_computed}};
+    if (lattice.type == LatticeType::BCC) p["bcc_strategy"] = bcc_strategy_name(options.bcc_strategy);
+    return p;
+}
+
+}  // namespace sdf

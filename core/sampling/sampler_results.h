@@ -1,0 +1,66 @@
+/// @file sampler_results.h
+/// @brief What every sampler (CPU and CUDA, brute force and BVH) does with its results:
+/// each is stored at its lattice index or query position, its triangle renumbered from the
+/// prepared mesh to the mesh file's face order, and the provenance keys they all share are
+/// recorded the same way.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampled_field.h"
+#include "core/sampling/sampler.h"
+
+namespace sdf {
+
+/// A field on `lattice` with every point unset (distance 0, triangle -1), to be filled.
+inline SampledField unfilled_field(const Lattice& lattice, Precision precision) {
+    SampledField field;
+    field.lattice = lattice;
+    field.precision = precision;
+    field.resize(lattice.num_points());
+    return field;
+}
+
+/// Stores one result at lattice index `out`; `triangle` indexes `mesh`'s prepared triangles.
+inline void store_sample(SampledField& field, int64_t out, const PreparedMesh& mesh, double distance,
+                         const Vec3d& gradient, int32_t triangle) {
+    field.distance[size_t(out)] = distance;
+    field.gradient[size_t(out)] = gradient;
+    field.closest_triangle[size_t(out)] = mesh.source_triangle[size_t(triangle)];
+}
+
+/// The result of one query point; `triangle` indexes `mesh`'s prepared triangles.
+inline PointSample point_sample(const PreparedMesh& mesh, double distance, const Vec3d& gradient, int32_t triangle) {
+    return {distance, gradient, mesh.source_triangle[size_t(triangle)]};
+}
+
+/// Scatters a batch of results (per point: distance, gradient, triangle, output_index) into
+/// a field. A negative output_index has no destination: a padding thread, or a point of
+/// BCC strategy A's double-resolution grid that is not a BCC point.
+template <typename Batch>
+void scatter_batch(const Batch& batch, const PreparedMesh& mesh, SampledField& field) {
+    for (size_t i = 0; i < batch.output_index.size(); ++i)
+        if (batch.output_index[i] >= 0)
+            store_sample(field, batch.output_index[i], mesh, batch.distance[i], batch.gradient[i], batch.triangle[i]);
+}
+
+/// The same into the results of a point list (output_index = position in the list).
+template <typename Batch>
+void scatter_batch(const Batch& batch, const PreparedMesh& mesh, std::vector<PointSample>& points) {
+    for (size_t i = 0; i < batch.output_index.size(); ++i)
+        if (batch.output_index[i] >= 0)
+            points[size_t(batch.output_index[i])] = point_sample(mesh, batch.distance[i], batch.gradient[i], batch.triangle[i]);
+}
+
+/// The provenance every sampler records in SampledField::sampler: "backend", "method",
+/// "kernel", "precision", "points_computed", and "bcc_strategy" on a BCC lattice. Each
+/// sampler adds its own keys (threads, plan, bvh, device).
+nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
+                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed);
+
+}  // namespace sdf

@@ -1,0 +1,275 @@
+// The CUDA BVH sampler: uploads the BVH (nodes, packed triangles in BVH order) and the
+// double mesh, cuts the lattice into slabs of z-layers that fit GPU memory, runs the BVH
+// search and the double-precision finalize on each, and scatters the results.
+#include "cuda/bvh_sampler.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "core/bvh/bvh_cache.h"
+#include "cuda/bvh_kernel.cuh"
+#include "cuda/bvh_warp_kernel.cuh"
+#include "cuda/cuda_check.h"
+#include "cuda/cuda_device.h"
+#include "cuda/device_buffer.h"
+#include "cuda/device_mesh.h"
+#include "cuda/finalize_kernel.cuh"
+
+namespace sdf::cuda {
+namespace {
+
+int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
+
+/// A BVH and the double mesh on the device, for one precision of the search.
+template <typename T>
+struct DeviceBvh {
+    DeviceBuffer<BvhNode> nodes;
+    DeviceBuffer<PackedTriangle<T>> packed;
+    DeviceBuffer<int32_t> triangle_index;
+    std::unique_ptr<DeviceMesh<double>> mesh;
+    BvhView<T> view{};
+
+    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared) {
+        nodes.upload(bvh.nodes);
+        if constexpr (std::is_same_v<T, float>) packed.upload(bvh.packed_float);
+        else packed.upload(bvh.packed_double);
+        triangle_index.upload(bvh.triangle_index);
+        mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
+        view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+    }
+};
+
+/// Per-piece results on the device, and their download.
+struct PieceResults {
+    DeviceBuffer<int> nearest;
+    DeviceBuffer<double> distance;
+    DeviceBuffer<Vec3d> gradient;
+    DeviceBuffer<int> triangle;
+    DeviceBuffer<int64_t> output_index;
+    static size_t bytes_per_point() { return 2 * sizeof(int) + 4 * sizeof(double) + sizeof(int64_t); }
+
+    explicit PieceResults(int64_t n)
+        : nearest{size_t(n)}, distance{size_t(n)}, gradient{size_t(n)}, triangle{size_t(n)}, output_index{size_t(n)} {}
+    PieceOutputs outputs() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
+
+    struct Host {
+        std::vector<double> distance;
+        std::vector<Vec3d> gradient;
+        std::vector<int> triangle;
+        std::vector<int64_t> output_index;
+    };
+    Host download(int64_t n) const {
+        Host h{std::vector<double>(size_t(n)), std::vector<Vec3d>(size_t(n)), std::vector<int>(size_t(n)),
+               std::vector<int64_t>(size_t(n))};
+        distance.download(h.distance.data(), size_t(n));
+        gradient.download(h.gradient.data(), size_t(n));
+        triangle.download(h.triangle.data(), size_t(n));
+        output_index.download(h.output_index.data(), size_t(n));
+        CUDA_CHECK(cudaStreamSynchronize(0));
+        return h;
+    }
+};
+
+class CudaBvhSampler final : public Sampler {
+public:
+    explicit CudaBvhSampler(const SamplerOptions& options) : options_(options) {
+        if (options.kernel.empty() || options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;  // measured fastest
+        else if (options.kernel == "brick") kernel_ = BvhGpuKernel::Brick;
+        else if (options.kernel == "seeded") kernel_ = BvhGpuKernel::Seeded;
+        else if (options.kernel == "unseeded") kernel_ = BvhGpuKernel::Unseeded;
+        else if (options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;
+        else
+            throw std::invalid_argument("sampler.kernel: unknown CUDA BVH kernel '" + options.kernel +
+                                        "'; expected \"brick\", \"seeded\" or \"unseeded\"");
+    }
+
+    std::string name() const override { return std::string("cuda/bvh/") + kernel_name(); }
+
+    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
+        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice) : sample_as<double>(mesh, lattice);
+    }
+
+    std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        return options_.precision == Precision::Float ? query_as<float>(mesh, points) : query_as<double>(mesh, points);
+    }
+
+private:
+    const char* kernel_name() const {
+        switch (kernel_) {
+            case BvhGpuKernel::Brick: return "brick";
+            case BvhGpuKernel::Seeded: return "seeded";
+            case BvhGpuKernel::Warp: return "warp";
+            default: return "unseeded";
+        }
+    }
+
+    /// The device copy of this mesh's BVH, uploaded when the mesh (or precision) changes.
+    template <typename T>
+    const DeviceBvh<T>& device_bvh(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
+        CUDA_CHECK(cudaSetDevice(options_.device));
+        const auto bvh = cache_.get(mesh, built);
+        std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
+        uploaded = !slot || uploaded_for_ != bvh.get();
+        if (uploaded) {
+            device_float_.reset();
+            device_double_.reset();
+            upload.begin();
+            slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh);
+            upload.end();
+            uploaded_for_ = bvh.get();
+            host_bvh_ = bvh;
+        }
+        return *slot;
+    }
+
+    template <typename T>
+    std::unique_ptr<DeviceBvh<T>>& slot_of() {
+        if constexpr (std::is_same_v<T, float>) return device_float_;
+        else return device_double_;
+    }
+
+    /// z-layers per slab: as many as 80% of free GPU memory holds (and max_points_per_piece).
+    int layers_per_slab(const GridBlock& block) const {
+        size_t free_bytes = 0, total = 0;
+        CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
+        const int64_t layer = int64_t(block.resolution.x) * block.resolution.y;
+        int64_t points = int64_t(0.8 * double(free_bytes)) / int64_t(PieceResults::bytes_per_point());
+        if (options_.max_points_per_piece > 0) points = std::min(points, options_.max_points_per_piece);
+        const int64_t layers = points / std::max<int64_t>(1, layer);
+        if (layers < 1 && options_.max_points_per_piece <= 0)
+            throw std::runtime_error("CUDA BVH sampler: " + std::to_string(free_bytes >> 20) +
+                                     " MiB of free GPU memory cannot hold one z-layer of " + std::to_string(layer) + " points");
+        return int(std::clamp<int64_t>(layers, 1, block.resolution.z));
+    }
+
+    template <typename T>
+    void launch_slab(const BvhView<T>& view, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) const {
+        const int blocks = blocks_for(slab.threads(), kBvhThreads);
+        switch (kernel_) {
+            case BvhGpuKernel::Brick:
+                nearest_triangle_bvh_slab<T, BvhGpuKernel::Brick><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                break;
+            case BvhGpuKernel::Seeded:
+                nearest_triangle_bvh_slab<T, BvhGpuKernel::Seeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                break;
+            case BvhGpuKernel::Unseeded:
+                nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                break;
+            case BvhGpuKernel::Warp:
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                break;
+        }
+        CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
+    }
+
+    template <typename T, typename Sink>
+    void run_slab(const DeviceBvh<T>& dev, const Lattice& lattice, const GridBlock& block, int z0, int nz, EventTimer& compute,
+                  EventTimer& download, Sink sink) {
+        const int64_t layer = int64_t(block.resolution.x) * block.resolution.y;
+        const GridRangePiece piece{lattice, block, z0 * layer, nz * layer};
+        const SlabGeometry slab{block.resolution, z0, nz};
+        PieceResults r(piece.count);
+        compute.begin();
+        launch_slab<T>(dev.view, piece, slab, r.nearest.get());
+        finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
+        CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
+        compute.end();
+        download.begin();
+        sink(r.download(piece.count));
+        download.end();
+    }
+
+    template <typename T>
+    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
+        const auto start = std::chrono::steady_clock::now();
+        EventTimer upload, compute, download;
+        bool built = false, uploaded = false;
+        const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
+        SampledField field;
+        field.lattice = lattice;
+        field.precision = options_.precision;
+        field.resize(lattice.num_points());
+        auto sink = [&](const PieceResults::Host& h) {
+            for (size_t i = 0; i < h.output_index.size(); ++i) {
+                const int64_t o = h.output_index[i];
+                if (o < 0) continue;
+                field.distance[size_t(o)] = h.distance[i];
+                field.gradient[size_t(o)] = h.gradient[i];
+                field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
+            }
+        };
+        GridBlock blocks[2];
+        const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
+        int64_t computed = 0, pieces = 0;
+        for (int b = 0; b < nblocks; ++b) {
+            const GridBlock block = blocks[b];
+            const int layers = layers_per_slab(block);
+            for (int z0 = 0; z0 < block.resolution.z; z0 += layers, ++pieces)
+                run_slab<T>(dev, lattice, block, z0, std::min(layers, block.resolution.z - z0), compute, download, sink);
+            computed += block.count();
+        }
+        field.timings.upload = upload.seconds();
+        field.timings.kernel = compute.seconds();
+        field.timings.download = download.seconds();
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());  // brute-force equivalent
+        field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        nlohmann::json bvh_info = host_bvh_->stats.to_json();
+        bvh_info["built_by_this_call"] = built;
+        bvh_info["uploaded_by_this_call"] = uploaded;
+        field.sampler = {{"backend", "cuda"},
+                         {"method", "bvh"},
+                         {"kernel", kernel_name()},
+                         {"precision", precision_name(options_.precision)},
+                         {"points_computed", computed},
+                         {"plan", {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}}},
+                         {"bvh", bvh_info},
+                         {"device", describe_device(options_.device)}};
+        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        return field;
+    }
+
+    template <typename T>
+    std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
+        std::vector<PointSample> out(points.size());
+        if (points.empty()) return out;
+        EventTimer upload, compute, download;
+        bool built = false, uploaded = false;
+        const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
+        DeviceBuffer<Vec3d> device_points;
+        device_points.upload(points);
+        const int64_t n = int64_t(points.size());
+        int64_t step = n;
+        if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
+        for (int64_t begin = 0; begin < n; begin += step) {
+            const PointListPiece piece{device_points.get(), begin, std::min(step, n - begin)};
+            PieceResults r(piece.count);
+            nearest_triangle_bvh_points<T><<<blocks_for(piece.count, kBvhThreads), kBvhThreads>>>(dev.view, piece,
+                                                                                                  r.nearest.get());
+            CUDA_CHECK_LAUNCH("nearest_triangle_bvh_points");
+            finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
+            CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
+            const PieceResults::Host h = r.download(piece.count);
+            for (size_t i = 0; i < h.output_index.size(); ++i)
+                out[size_t(h.output_index[i])] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
+        }
+        return out;
+    }
+
+    SamplerOptions options_;
+    BvhGpuKernel kernel_ = BvhGpuKernel::Warp;
+    BvhCache cache_;
+    std::shared_ptr<const TriangleBvh> host_bvh_;
+    const TriangleBvh* uploaded_for_ = nullptr;
+    std::unique_ptr<DeviceBvh<float>> device_float_;
+    std::unique_ptr<DeviceBvh<double>> device_double_;
+};
+
+}  // namespace
+
+std::unique_ptr<Sampler> make_cuda_bvh_sampler(const SamplerOptions& options) {
+    return std::make_unique<CudaBvhSampler>(options);
+}
+
+}  // namespace sdf::cuda

@@ -1,0 +1,79 @@
+/// @file device_buffer.h
+/// @brief RAII device memory and CUDA-event timing for the launchers.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <vector>
+
+#include "cuda/cuda_check.h"
+
+namespace sdf::cuda {
+
+template <typename T>
+class DeviceBuffer {
+public:
+    DeviceBuffer() = default;
+    explicit DeviceBuffer(size_t count) { allocate(count); }
+    ~DeviceBuffer() { release(); }
+    DeviceBuffer(const DeviceBuffer&) = delete;
+    DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+    DeviceBuffer(DeviceBuffer&& o) noexcept : ptr_(o.ptr_), count_(o.count_) { o.ptr_ = nullptr; o.count_ = 0; }
+
+    void allocate(size_t count) {
+        release();
+        if (count > 0) CUDA_CHECK(cudaMalloc(&ptr_, count * sizeof(T)));
+        count_ = count;
+    }
+    void release() {
+        if (ptr_) cudaFree(ptr_);
+        ptr_ = nullptr;
+        count_ = 0;
+    }
+    void upload(const T* host, size_t count, cudaStream_t stream = 0) {
+        if (count > count_) allocate(count);
+        if (count > 0) CUDA_CHECK(cudaMemcpyAsync(ptr_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream));
+    }
+    void upload(const std::vector<T>& host, cudaStream_t stream = 0) { upload(host.data(), host.size(), stream); }
+    void download(T* host, size_t count, cudaStream_t stream = 0) const {
+        if (count > 0) CUDA_CHECK(cudaMemcpyAsync(host, ptr_, count * sizeof(T), cudaMemcpyDeviceToHost, stream));
+    }
+    T* get() const { return ptr_; }
+    size_t size() const { return count_; }
+
+private:
+    T* ptr_ = nullptr;
+    size_t count_ = 0;
+};
+
+/// Accumulates the time between begin() and end() pairs on one stream, in seconds.
+class EventTimer {
+public:
+    EventTimer() {
+        CUDA_CHECK(cudaEventCreate(&start_));
+        CUDA_CHECK(cudaEventCreate(&stop_));
+    }
+    ~EventTimer() {
+        cudaEventDestroy(start_);
+        cudaEventDestroy(stop_);
+    }
+    EventTimer(const EventTimer&) = delete;
+    EventTimer& operator=(const EventTimer&) = delete;
+
+    void begin(cudaStream_t stream = 0) { CUDA_CHECK(cudaEventRecord(start_, stream)); }
+    void end(cudaStream_t stream = 0) {
+        CUDA_CHECK(cudaEventRecord(stop_, stream));
+        CUDA_CHECK(cudaEventSynchronize(stop_));
+        float ms = 0;
+        CUDA_CHECK(cudaEventElapsedTime(&ms, start_, stop_));
+        seconds_ += 1e-3 * ms;
+    }
+    double seconds() const { return seconds_; }
+
+private:
+    cudaEvent_t start_{}, stop_{};
+    double seconds_ = 0;
+};
+
+}  // namespace sdf::cuda

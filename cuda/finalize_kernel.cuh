@@ -1,0 +1,35 @@
+/// @file finalize_kernel.cuh
+/// @brief After the nearest-triangle search: Eberly's closest point on the winning triangle,
+/// the pseudonormal sign and the exact gradient (thesis sections 3.3-3.4), on the GPU, with
+/// the same signed_distance_to_triangle() the CPU reference calls. As on the CPU, this step
+/// runs in double at the exact lattice position whatever the search precision: it costs one
+/// triangle per point and makes float fields exact to double rounding.
+#pragma once
+
+#include "cuda/point_pieces.h"
+#include "kernels/distance/signed_distance.h"
+
+namespace sdf::cuda {
+
+/// Per-piece results, downloaded and scattered into the field by the host.
+struct PieceOutputs {
+    double* distance;
+    Vec3d* gradient;
+    int* triangle;
+    int64_t* output_index;  ///< -1: padding or discarded
+};
+
+template <typename Piece>
+__global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, PieceOutputs out) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= piece.size()) return;
+    const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
+    out.output_index[i] = o;
+    if (o < 0) return;
+    const SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, piece.position(i), nearest[i]);
+    out.distance[i] = s.distance;
+    out.gradient[i] = s.gradient;
+    out.triangle[i] = s.triangle;
+}
+
+}  // namespace sdf::cuda
