@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     int threads = 0;
     app.add_option("field", field_path, "field header (NAME.json, docs/field-format.md)")->required();
     app.add_option("points", points_path, "file with \"x y z\" per line (world units), or - for stdin")->required();
-    app.add_option("--interpolator", interpolator, "trilinear, catmull_rom, tricubic_lm (CC); bcc_linear, bcc_cubic, bcc_cubic_c0 (BCC)")
+    app.add_option("--interpolator", interpolator, sdf::interpolator_help())
         ->required()
         ->check(CLI::IsMember(sdf::interpolator_names()));
     app.add_option("--derivatives", derivatives,

@@ -15,7 +15,7 @@
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/io/points_file.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Exact signed distance, gradient and closest triangle of points to a mesh."};
@@ -23,8 +23,10 @@ int main(int argc, char** argv) {
     sdf::SamplerOptions options;
     app.add_option("mesh", mesh_arg, "OBJ file or shape:NAME (sphere, box, torus, pawn, soccer_ball)")->required();
     app.add_option("points", points_path, "file with \"x y z\" per line, or - for stdin")->required();
-    app.add_option("--backend", options.backend, "cpu or cuda")->check(CLI::IsMember({"cpu", "cuda"}))->capture_default_str();
-    app.add_option("--kernel", options.kernel, "backend kernel (cpu: vectorized, eberly; cuda: thesis, tuned)");
+    app.add_option("--backend", options.backend, "sampler backend")
+        ->check(CLI::IsMember(sdf::sampler_backends()))
+        ->capture_default_str();
+    app.add_option("--kernel", options.kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
     app.add_option("--threads", options.threads, "CPU threads (0 = all)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
@@ -34,10 +36,7 @@ int main(int argc, char** argv) {
     options.progress = false;
     sdf::ProgressReporter::set_globally_enabled(false);
     try {
-        const std::vector<std::string> kernels = sdf::sampler_kernel_names(options.backend);
-        if (!options.kernel.empty() && std::find(kernels.begin(), kernels.end(), options.kernel) == kernels.end())
-            throw std::invalid_argument("--kernel: unknown " + options.backend + " kernel '" + options.kernel +
-                                        "'; expected " + kernels[0] + " or " + kernels[1]);
+        sdf::check_sampler_kernel(options);
         const sdf::PreparedMesh mesh = sdf::prepare_mesh(
             sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-query: warning: " << w << "\n";

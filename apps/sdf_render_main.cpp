@@ -31,7 +31,7 @@
 #include "harness/provenance/provenance.h"
 #include "harness/render/image_io.h"
 #include "harness/render/thesis_figure.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace {
 
@@ -88,16 +88,16 @@ SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, cons
     const SamplerOptions s = sampler_options(o);
     const std::optional<FieldCache> cache =
         o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
-    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, s);
+    const nlohmann::json key = field_cache_key(mesh.content_sha256(), lattice, s);
     if (cache) {
         if (std::optional<SampledField> f = cache->load(key)) {
-            std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name.c_str(), lattice_notation(lattice).c_str(),
+            std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name().c_str(), lattice_notation(lattice).c_str(),
                          cache->entry_path(key).c_str());
             return *f;
         }
     }
-    std::fprintf(stderr, "field %s %s: sampling %lld points x %zu triangles (%s/%s)\n", mesh.name.c_str(),
-                 lattice_notation(lattice).c_str(), static_cast<long long>(lattice.num_points()), mesh.triangles.size(),
+    std::fprintf(stderr, "field %s %s: sampling %lld points x %zu triangles (%s/%s)\n", mesh.name().c_str(),
+                 lattice_notation(lattice).c_str(), static_cast<long long>(lattice.num_points()), mesh.triangles().size(),
                  s.backend.c_str(), s.method.c_str());
     SampledField f = make_sampler(s)->sample(mesh, lattice);
     std::fprintf(stderr, "  sampled in %.1f s\n", f.timings.total);
@@ -109,7 +109,7 @@ Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const st
     if (res.size() != 3) throw std::invalid_argument("a resolution needs 3 integers, e.g. 80,80,80");
     const bool bcc = type == "bcc";
     const Int3 r{res[0], res[1], res[2]};
-    return fit_lattice(bcc ? LatticeType::BCC : LatticeType::CC, bcc ? bcc_primary_from_notation(r) : r, mesh.bounds,
+    return fit_lattice(bcc ? LatticeType::BCC : LatticeType::CC, bcc ? bcc_primary_from_notation(r) : r, mesh.bounds(),
                        margin);
 }
 
@@ -192,18 +192,18 @@ int run_single(const Options& o, const nlohmann::json& resolved) {
         field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
     }
     if (o.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
-    const Bounds3 bounds = mesh ? mesh->bounds : solid_bounds(field);
+    const Bounds3 bounds = mesh ? mesh->bounds() : solid_bounds(field);
     const Reconstruction recon(field, o.interpolator.empty() ? (field.lattice.type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm")
                                                              : o.interpolator,
                                o.derivatives);
     const std::vector<ViewRequest> views = view_requests(o);
-    const nlohmann::json prov = provenance(o, resolved, mesh ? mesh->content_sha256 : std::string());
+    const nlohmann::json prov = provenance(o, resolved, mesh ? mesh->content_sha256() : std::string());
     const Overwrite overwrite = o.overwrite ? Overwrite::Allow : Overwrite::Forbid;
     std::optional<MeshReferenceRenderer> reference_renderer;
     if (o.reference) reference_renderer.emplace(*mesh);
     for (const ViewRequest& v : views) {
         const int w = o.size[0], h = o.size.size() > 1 ? o.size[1] : o.size[0];
-        const CameraSpec camera = mesh ? resolve_view(v, mesh->vertices, w, h) : resolve_view(v, bounds, w, h);
+        const CameraSpec camera = mesh ? resolve_view(v, mesh->vertices(), w, h) : resolve_view(v, bounds, w, h);
         const RenderedImage image = render_reconstruction(recon, camera, render_options(o));
         print_timing(recon.description() + " " + lattice_notation(field.lattice) + ", view " + v.name, image);
         const std::string out = views.size() > 1 ? with_suffix(o.out, "_" + v.name) : o.out;
@@ -247,11 +247,11 @@ int run_grid(const Options& o, const nlohmann::json& resolved) {
     fo.error_rows = !o.no_error_maps && !o.no_reference;
     fo.heat_max_degrees = o.heat_max;
     fo.downsample = o.downsample;
-    const nlohmann::json prov = provenance(o, resolved, mesh.content_sha256);
-    const std::string name = o.name.empty() ? mesh.name : o.name;
+    const nlohmann::json prov = provenance(o, resolved, mesh.content_sha256());
+    const std::string name = o.name.empty() ? mesh.name() : o.name;
     fs::create_directories(o.out_dir);
     for (const ViewRequest& v : view_requests(o)) {
-        const CameraSpec camera = resolve_view(v, mesh.vertices, o.size[0], o.size.size() > 1 ? o.size[1] : o.size[0]);
+        const CameraSpec camera = resolve_view(v, mesh.vertices(), o.size[0], o.size.size() > 1 ? o.size[1] : o.size[0]);
         fo.title = o.title.empty() ? name + ", view " + v.name + ": CC " + lattice_notation(cc.lattice) + " / BCC " +
                                          lattice_notation(bcc.lattice)
                                    : o.title;
@@ -281,7 +281,7 @@ int main(int argc, char** argv) {
     app.add_option("--bcc-resolution", o.bcc_resolution, "BCC resolution Rx,Ry,2Rz (grid, and the default for --lattice bcc)")
         ->delimiter(',')->expected(3)->capture_default_str();
     app.add_option("--margin", o.margin, "mesh input: lattice margin, fraction of the largest extent")->capture_default_str();
-    app.add_option("--interpolator", o.interpolator, "default: bcc_cubic (BCC) or tricubic_lm (CC)")
+    app.add_option("--interpolator", o.interpolator, interpolator_help() + "; default: bcc_cubic (BCC) or tricubic_lm (CC)")
         ->check(CLI::IsMember(interpolator_names()));
     app.add_option("--derivatives", o.derivatives, "true, fd or fd_weighted (default: true when available)")
         ->check(CLI::IsMember({"true", "fd", "fd_weighted"}));
@@ -313,9 +313,11 @@ int main(int argc, char** argv) {
     app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->capture_default_str();
     app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--sampler-backend", o.sampler_backend, "mesh input: sampler backend")
-        ->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
+        ->check(CLI::IsMember([] { auto b = sampler_backends(); b.emplace_back("auto"); return b; }()))
+        ->capture_default_str();
     app.add_option("--sampler-method", o.sampler_method, "mesh input: sampler method")
-        ->check(CLI::IsMember({"brute_force", "bvh"}))->capture_default_str();
+        ->check(CLI::IsMember(sampler_methods()))
+        ->capture_default_str();
     app.add_option("--cache-dir", o.cache_dir, "field cache (default $SDF_CACHE_DIR or <repo>/cache)");
     app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");
     app.add_flag("--overwrite", o.overwrite, "replace existing output files");

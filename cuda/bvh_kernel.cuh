@@ -16,14 +16,13 @@
 
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
+#include "cuda/bvh_sampler.h"
 #include "cuda/point_pieces.h"
 
 namespace sdf::cuda {
 
 constexpr int kRunPoints = 4;       ///< lattice points per thread, consecutive along x
 constexpr int kBvhThreads = 128;    ///< threads per block (4 warps)
-
-enum class BvhGpuKernel : int { Brick = 0, Seeded = 1, Unseeded = 2, Warp = 3 };
 
 /// A slab of z-layers [z0, z0 + nz) of one GridBlock; piece-local ids run x fastest, as in
 /// GridRangePiece (whose begin = z0 * rx * ry), so finalize_samples() takes it as is.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/bvh/bvh_cache.h"
+#include "core/sampling/sampler_results.h"
 #include "cuda/bvh_kernel.cuh"
 #include "cuda/bvh_warp_kernel.cuh"
 #include "cuda/cuda_check.h"
@@ -75,14 +76,7 @@ struct PieceResults {
 class CudaBvhSampler final : public Sampler {
 public:
     explicit CudaBvhSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;  // measured fastest
-        else if (options.kernel == "brick") kernel_ = BvhGpuKernel::Brick;
-        else if (options.kernel == "seeded") kernel_ = BvhGpuKernel::Seeded;
-        else if (options.kernel == "unseeded") kernel_ = BvhGpuKernel::Unseeded;
-        else if (options.kernel == "warp") kernel_ = BvhGpuKernel::Warp;
-        else
-            throw std::invalid_argument("sampler.kernel: unknown CUDA BVH kernel '" + options.kernel +
-                                        "'; expected \"brick\", \"seeded\" or \"unseeded\"");
+        kernel_ = kernel_from_name(kCudaBvhKernels, options.kernel, "CUDA BVH");
     }
 
     std::string name() const override { return std::string("cuda/bvh/") + kernel_name(); }
@@ -96,14 +90,7 @@ public:
     }
 
 private:
-    const char* kernel_name() const {
-        switch (kernel_) {
-            case BvhGpuKernel::Brick: return "brick";
-            case BvhGpuKernel::Seeded: return "seeded";
-            case BvhGpuKernel::Warp: return "warp";
-            default: return "unseeded";
-        }
-    }
+    const char* kernel_name() const { return sdf::kernel_name(kCudaBvhKernels, kernel_); }
 
     /// The device copy of this mesh's BVH, uploaded when the mesh (or precision) changes.
     template <typename T>
@@ -187,19 +174,8 @@ private:
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        SampledField field;
-        field.lattice = lattice;
-        field.precision = options_.precision;
-        field.resize(lattice.num_points());
-        auto sink = [&](const PieceResults::Host& h) {
-            for (size_t i = 0; i < h.output_index.size(); ++i) {
-                const int64_t o = h.output_index[i];
-                if (o < 0) continue;
-                field.distance[size_t(o)] = h.distance[i];
-                field.gradient[size_t(o)] = h.gradient[i];
-                field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
-            }
-        };
+        SampledField field = unfilled_field(lattice, options_.precision);
+        auto sink = [&](const PieceResults::Host& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0, pieces = 0;
@@ -213,20 +189,15 @@ private:
         field.timings.upload = upload.seconds();
         field.timings.kernel = compute.seconds();
         field.timings.download = download.seconds();
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());  // brute-force equivalent
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());  // brute-force equivalent
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         nlohmann::json bvh_info = host_bvh_->stats.to_json();
         bvh_info["built_by_this_call"] = built;
         bvh_info["uploaded_by_this_call"] = uploaded;
-        field.sampler = {{"backend", "cuda"},
-                         {"method", "bvh"},
-                         {"kernel", kernel_name()},
-                         {"precision", precision_name(options_.precision)},
-                         {"points_computed", computed},
-                         {"plan", {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}}},
-                         {"bvh", bvh_info},
-                         {"device", describe_device(options_.device)}};
-        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed);
+        field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
+        field.sampler["bvh"] = bvh_info;
+        field.sampler["device"] = describe_device(options_.device);
         return field;
     }
 
@@ -251,8 +222,7 @@ private:
             finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
             const PieceResults::Host h = r.download(piece.count);
-            for (size_t i = 0; i < h.output_index.size(); ++i)
-                out[size_t(h.output_index[i])] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
+            scatter_batch(h, mesh, out);
         }
         return out;
     }

@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "core/sampling/sampler_results.h"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
@@ -19,7 +20,7 @@
 namespace sdf::cuda {
 namespace {
 
-enum class CudaKernel { Thesis, Tuned };
+using CudaKernel = CudaBruteForceKernel;
 
 constexpr int kFinalizeThreads = 256;
 
@@ -284,11 +285,7 @@ private:
 class CudaBruteForceSampler final : public Sampler {
 public:
     explicit CudaBruteForceSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "tuned") kernel_ = CudaKernel::Tuned;
-        else if (options.kernel == "thesis") kernel_ = CudaKernel::Thesis;
-        else
-            throw std::invalid_argument("sampler.kernel: unknown CUDA kernel '" + options.kernel +
-                                        "'; expected \"tuned\" or \"thesis\"");
+        kernel_ = kernel_from_name(kCudaBruteForceKernels, options.kernel, "CUDA brute-force");
     }
 
     std::string name() const override { return std::string("cuda/brute_force/") + kernel_name(); }
@@ -302,25 +299,14 @@ public:
     }
 
 private:
-    const char* kernel_name() const { return kernel_ == CudaKernel::Tuned ? "tuned" : "thesis"; }
+    const char* kernel_name() const { return sdf::kernel_name(kCudaBruteForceKernels, kernel_); }
 
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
-        SampledField field;
-        field.lattice = lattice;
-        field.precision = options_.precision;
-        field.resize(lattice.num_points());
+        SampledField field = unfilled_field(lattice, options_.precision);
         Engine<T> engine(mesh, options_, kernel_);
-        auto sink = [&](const HostPiece& h) {
-            for (size_t i = 0; i < h.output_index.size(); ++i) {
-                const int64_t o = h.output_index[i];
-                if (o < 0) continue;
-                field.distance[size_t(o)] = h.distance[i];
-                field.gradient[size_t(o)] = h.gradient[i];
-                field.closest_triangle[size_t(o)] = mesh.source_triangle[size_t(h.triangle[i])];
-            }
-        };
+        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;
@@ -350,16 +336,11 @@ private:
         field.timings.upload = engine.upload_seconds();
         field.timings.kernel = engine.kernel_seconds();
         field.timings.download = engine.download_seconds();
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        field.sampler = {{"backend", "cuda"},
-                         {"method", "brute_force"},
-                         {"kernel", kernel_name()},
-                         {"precision", precision_name(options_.precision)},
-                         {"points_computed", computed},
-                         {"plan", engine.plan()},
-                         {"device", describe_device(options_.device)}};
-        if (lattice.type == LatticeType::BCC) field.sampler["bcc_strategy"] = bcc_strategy_name(options_.bcc_strategy);
+        field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed);
+        field.sampler["plan"] = engine.plan();
+        field.sampler["device"] = describe_device(options_.device);
         return field;
     }
 
@@ -370,13 +351,7 @@ private:
         Engine<T> engine(mesh, options_, kernel_);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
-        auto sink = [&](const HostPiece& h) {
-            for (size_t i = 0; i < h.output_index.size(); ++i) {
-                const int64_t o = h.output_index[i];
-                if (o < 0) continue;
-                out[size_t(o)] = {h.distance[i], h.gradient[i], mesh.source_triangle[size_t(h.triangle[i])]};
-            }
-        };
+        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, out); };
         const int64_t n = int64_t(points.size());
         if (kernel_ == CudaKernel::Tuned) {
             engine.run_tuned(n, [&](int64_t begin, int64_t count) { return PointListPiece{device_points.get(), begin, count}; },

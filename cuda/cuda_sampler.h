@@ -5,9 +5,18 @@
 
 #include <memory>
 
+#include "core/sampling/kernel_table.h"
 #include "core/sampling/sampler.h"
 
 namespace sdf::cuda {
+
+enum class CudaBruteForceKernel { Tuned, Thesis };
+
+/// The kernels of method "brute_force" on the GPU; the first is the default.
+inline constexpr NamedKernel<CudaBruteForceKernel> kCudaBruteForceKernels[] = {
+    {"tuned", CudaBruteForceKernel::Tuned},
+    {"thesis", CudaBruteForceKernel::Thesis},
+};
 
 std::unique_ptr<Sampler> make_cuda_brute_force_sampler(const SamplerOptions& options);
 

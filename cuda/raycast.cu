@@ -90,23 +90,14 @@ RenderedImage render_field_view_cuda(const LatticeFieldView<float>& view, Interp
 
     std::vector<double> kernel;
     const char* name = "";
-    // One case per interpolator (visit_interpolator is host/device; a host lambda in it
-    // would make nvcc warn), each instantiating the kernel for that type
-    auto run = [&](auto interp) {
+    // One kernel instantiation per filter of the interpolator table
+    visit_interpolator(kind, [&](auto interp) {
         using Interp = decltype(interp);
         name = Interp::name();
         const RaycastScene<float> scene =
             make_raycast_scene<Interp>(device_view.view(), camera.as<float>(), options.march.as<float>());
         kernel = launch_timed<Interp>(scene, out.get(), options.repetitions);
-    };
-    switch (kind) {
-        case InterpolatorKind::Trilinear: run(Trilinear{}); break;
-        case InterpolatorKind::CatmullRom: run(CatmullRom{}); break;
-        case InterpolatorKind::TricubicLM: run(TricubicLekienMarsden{}); break;
-        case InterpolatorKind::BccLinear: run(BccLinear{}); break;
-        case InterpolatorKind::BccCubic: run(BccCubic{}); break;
-        case InterpolatorKind::BccCubicC0: run(BccCubicC0{}); break;
-    }
+    });
 
     download.begin();
     out.download(image.pixels.data(), image.pixels.size());

@@ -1,6 +1,6 @@
 /// @file analytic_experiment.cpp
 /// @brief Kind "analytic": reconstruction of analytic functions (no mesh, no sampler), via
-/// run_analytic_study() of cpu_reference/reconstruction/analytic_study.h.
+/// run_analytic_study() of core/reconstruction/analytic_study.h.
 ///
 ///   "table_4_1": {"function": "marschner_lobb", "resolution": [111, 111, 222],
 ///                 "probes_per_axis": 256, "margin": 2.0, "sigma2": 0.5, "sigma_units": "lattice"}
@@ -185,7 +185,7 @@ private:
 
     void run_table(RunContext& ctx) {
         std::ostream& log = *ctx.log;
-        ReconstructionSpec rs{InterpolatorKind::BccCubic, DerivativeSource::FiniteDifferences};
+        ReconstructionSpec rs{kind_of<BccCubic>(), DerivativeSource::FiniteDifferences};
         rs.sigma2 = table_.sigma2;
         rs.sigma_units = table_.units;
         log << "Table 4-1 (" << table_.function << "), plain least squares ..." << std::endl;

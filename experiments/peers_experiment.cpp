@@ -31,7 +31,7 @@
 #include "harness/experiment/experiment.h"
 #include "experiments/peers/peer.h"
 #include "harness/config/lattice_spec.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 namespace {
@@ -146,7 +146,7 @@ private:
     nlohmann::json base_row(const std::string& label, const Lattice& lattice, const PreparedMesh& mesh,
                             const std::string& method, const std::string& who) const {
         return {{"mesh", label}, {"resolution", lattice_notation(lattice)}, {"points", lattice.num_points()},
-                {"triangles", mesh.triangles.size()}, {"method", method}, {"by", who}};
+                {"triangles", mesh.triangles().size()}, {"method", method}, {"by", who}};
     }
 
     static void set_times(nlohmann::json& row, double build, double query, int64_t points) {
@@ -292,9 +292,9 @@ private:
 
     void run_case(RunContext& ctx, const MeshCase& c, const PreparedMesh& mesh, int64_t samples) {
         const int r = cubic_resolution_for_samples(LatticeType::CC, samples);
-        const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds, margin_);
+        const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds(), margin_);
         *ctx.log << c.label << " CC " << lattice_notation(lattice) << " (" << with_commas(lattice.num_points()) << " points x "
-                 << with_commas(int64_t(mesh.triangles.size())) << " triangles)\n";
+                 << with_commas(int64_t(mesh.triangles().size())) << " triangles)\n";
         std::vector<double> reference;
         run_bvh_cpu(ctx, c.label, mesh, lattice, reference);  // always: it is the reference
         if (std::count(ours_.begin(), ours_.end(), "brute_cpu")) run_brute_cpu(ctx, c.label, mesh, lattice, reference);

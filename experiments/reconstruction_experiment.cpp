@@ -1,7 +1,7 @@
 /// @file reconstruction_experiment.cpp
 /// @brief Kind "reconstruction": thesis Figures 5-2..5-11 as numbers. One mesh is sampled on
 /// CC and BCC lattices of matched point counts (through the field cache), the configured
-/// reconstructions are built (cpu_reference/reconstruction), and their errors against the
+/// reconstructions are built (core/reconstruction), and their errors against the
 /// exact signed distance are measured at probe points (experiments/common/probes.h): RMS,
 /// max and mean |error| over the domain and in a band around the surface, and the angle
 /// between reconstructed and exact gradients in the band.
@@ -84,11 +84,11 @@ public:
         std::ostringstream quiet;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, quiet);
         FieldSource source(ctx, inputs_.sampler);
-        std::vector<std::string> lines = {"mesh " + mesh.name + " (" + mesh.source + ", " +
-                                          with_commas(int64_t(mesh.triangles.size())) + " triangles, sha256 " +
-                                          mesh.content_sha256.substr(0, 12) + ")"};
+        std::vector<std::string> lines = {"mesh " + mesh.name() + " (" + mesh.source() + ", " +
+                                          with_commas(int64_t(mesh.triangles().size())) + " triangles, sha256 " +
+                                          mesh.content_sha256().substr(0, 12) + ")"};
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
-            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
+            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
             lines.push_back("field " + inputs_.lattice_labels[i] + ": " + lattice_spec_notation(inputs_.lattices[i]) + ", " +
                             with_commas(l.num_points()) + " points, " + inputs_.sampler.backend + "/" +
                             inputs_.sampler.method + ": " + source.status(mesh, l));
@@ -115,14 +115,14 @@ public:
         std::ostream& log = *ctx.log;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
         ctx.metrics["mesh"] = describe_mesh(mesh);
-        ctx.inputs["mesh"] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
+        ctx.inputs["mesh"] = {{"source", mesh.source()}, {"sha256", mesh.content_sha256()}};
         FieldSource source(ctx, inputs_.sampler);
 
         // Fields, then every reconstruction built from them.
         std::vector<SampledField> fields;
         double h_ref = 0;
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
-            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
+            const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
             ObtainedField got = source.get(mesh, l, inputs_.lattice_labels[i], log);
             nlohmann::json d = got.describe();
             d["label"] = inputs_.lattice_labels[i];
@@ -218,12 +218,12 @@ private:
         const FigureOptions options = figure_options(*render_);
         const nlohmann::json provenance = {{"run", ctx.output_dir}, {"git", machine_and_build()["git"]}};
         for (const ViewRequest& view : render_->views) {
-            const CameraSpec camera = resolve_view(view, mesh.vertices, render_->width, render_->height);
+            const CameraSpec camera = resolve_view(view, mesh.vertices(), render_->width, render_->height);
             *ctx.log << "  rendering view " << view.name << " (" << render_->width << "x" << render_->height << ")\n";
             const ThesisFigure figure = render_thesis_figure(*cc, *bcc, render_->reference ? &mesh : nullptr, camera, options);
             const std::string dir = ctx.output_dir + "/images/" + view.name;
             std::filesystem::create_directories(dir);
-            const std::string grid = write_thesis_figure(dir, mesh.name + "_" + view.name, figure, provenance);
+            const std::string grid = write_thesis_figure(dir, mesh.name() + "_" + view.name, figure, provenance);
             nlohmann::json summary = figure.summary;
             summary["grid_file"] = std::filesystem::relative(grid, ctx.output_dir).string();
             ctx.metrics["render"]["views"][view.name] = summary;

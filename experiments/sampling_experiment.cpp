@@ -35,14 +35,14 @@ public:
         std::ostringstream quiet;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, quiet);
         FieldSource source(ctx, inputs_.sampler);
-        std::vector<std::string> lines = {"mesh " + mesh.name + " (" + mesh.source + ", " +
-                                          with_commas(int64_t(mesh.triangles.size())) + " triangles)"};
+        std::vector<std::string> lines = {"mesh " + mesh.name() + " (" + mesh.source() + ", " +
+                                          with_commas(int64_t(mesh.triangles().size())) + " triangles)"};
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
-            const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
-            lines.push_back("sample " + mesh.name + " on " + lattice_spec_notation(inputs_.lattices[i]) + " (" +
+            const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
+            lines.push_back("sample " + mesh.name() + " on " + lattice_spec_notation(inputs_.lattices[i]) + " (" +
                             with_commas(lattice.num_points()) + " points) with " + inputs_.sampler.backend + "/" +
                             inputs_.sampler.method + ": " + source.status(mesh, lattice) + "; write fields/" +
-                            mesh.name + "-" + inputs_.lattice_labels[i] + ".json");
+                            mesh.name() + "-" + inputs_.lattice_labels[i] + ".json");
         }
         return lines;
     }
@@ -56,11 +56,11 @@ public:
         FieldSource source(ctx, inputs_.sampler);
         const std::string fields_dir = (std::filesystem::path(ctx.output_dir) / "fields").string();
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
-            const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds, inputs_.margin);
+            const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
             ObtainedField got = source.get(mesh, lattice, inputs_.lattice_labels[i], log);
             SampledField& field = got.field;
             field.mesh = mesh_json;
-            const std::string stem = mesh.name + "-" + inputs_.lattice_labels[i];
+            const std::string stem = mesh.name() + "-" + inputs_.lattice_labels[i];
             FieldWriteOptions wo;
             wo.dtype = dtype_;
             write_field(fields_dir + "/" + stem + ".json", field, wo);
@@ -83,7 +83,7 @@ private:
                       "%s %s: %s points x %s triangles = %.3g pairs in %.3f s (%s, %s threads, %s%s): %.3g pairs/s\n"
                       "    distance in [%.6g, %.6g], %s points inside\n",
                       lattice_type_name(f.lattice.type), lattice_notation(f.lattice).c_str(),
-                      with_commas(f.size()).c_str(), with_commas(int64_t(mesh.triangles.size())).c_str(),
+                      with_commas(f.size()).c_str(), with_commas(int64_t(mesh.triangles().size())).c_str(),
                       t.point_triangle_pairs, t.kernel,
                       (f.sampler.value("backend", std::string("?")) + "/" + f.sampler.value("kernel", std::string("?"))).c_str(),
                       f.sampler.value("threads", nlohmann::json(0)).dump().c_str(), precision_name(f.precision),

@@ -31,7 +31,7 @@
 #include "harness/experiment/experiment.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 namespace {
@@ -150,7 +150,7 @@ private:
 
     void run_row(RunContext& ctx, const MeshCase& c, const PreparedMesh& mesh, int64_t samples, LatticeType type) {
         const int r = cubic_resolution_for_samples(type, samples);
-        const Lattice lattice = fit_lattice(type, {r, r, r}, mesh.bounds, margin_);
+        const Lattice lattice = fit_lattice(type, {r, r, r}, mesh.bounds(), margin_);
         const int64_t n = lattice.num_points();
         // The subset every backend reports distances on, for a cross-check of the results.
         int64_t subset_size = n;
@@ -163,7 +163,7 @@ private:
                               {"lattice", lattice_type_name(type)},
                               {"resolution", lattice_notation(lattice)},
                               {"points", n},
-                              {"triangles", mesh.triangles.size()}};
+                              {"triangles", mesh.triangles().size()}};
         std::map<std::string, double> medians;
         std::vector<double> reference_distance;
         for (const BackendSpec& b : backends_) {
@@ -185,7 +185,7 @@ private:
             entry["seconds_all"] = t.seconds;
             entry["points_timed"] = t.points_timed;
             entry["extrapolated"] = t.points_timed < n;
-            entry["pairs_per_second"] = double(n) * double(mesh.triangles.size()) / med;
+            entry["pairs_per_second"] = double(n) * double(mesh.triangles().size()) / med;
             if (b.name == reference_) reference_distance = dist;
             if (!reference_distance.empty() && dist.size() == reference_distance.size()) {
                 double worst = 0;

@@ -17,13 +17,13 @@ public:
     std::shared_ptr<const TriangleBvh> get(const PreparedMesh& mesh, bool& built, const BvhBuildOptions& options = {}) {
         std::lock_guard<std::mutex> lock(mutex_);
         built = false;
-        if (!bvh_ || mesh_ != &mesh || sha_ != mesh.content_sha256 || triangles_ != mesh.triangles.size() ||
-            !same_bounds(mesh.bounds)) {
+        if (!bvh_ || mesh_ != &mesh || sha_ != mesh.content_sha256() || triangles_ != mesh.triangles().size() ||
+            !same_bounds(mesh.bounds())) {
             bvh_ = std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh, options));
             mesh_ = &mesh;
-            sha_ = mesh.content_sha256;
-            triangles_ = mesh.triangles.size();
-            bounds_ = mesh.bounds;
+            sha_ = mesh.content_sha256();
+            triangles_ = mesh.triangles().size();
+            bounds_ = mesh.bounds();
             built = true;
         }
         return bvh_;

@@ -164,11 +164,11 @@ private:
 };
 
 std::vector<BuildRef> build_refs(const PreparedMesh& mesh) {
-    std::vector<BuildRef> refs(mesh.triangles.size());
+    std::vector<BuildRef> refs(mesh.triangles().size());
     for (size_t i = 0; i < refs.size(); ++i) {
-        const Int3 t = mesh.triangles[i];
+        const Int3 t = mesh.triangles()[i];
         Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(mesh.vertices[size_t(t[k])]);
+        for (int k = 0; k < 3; ++k) b.extend(mesh.vertices()[size_t(t[k])]);
         refs[i] = {b, b.center(), int32_t(i)};
     }
     return refs;
@@ -227,7 +227,7 @@ BvhView<double> TriangleBvh::view<double>() const {
 }
 
 TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& options) {
-    if (mesh.triangles.empty()) throw std::invalid_argument("BVH build: mesh '" + mesh.name + "' has no triangles");
+    if (mesh.triangles().empty()) throw std::invalid_argument("BVH build: mesh '" + mesh.name() + "' has no triangles");
     if (options.max_leaf_size < 1 || options.bins < 2 || options.bins > kMaxBins)
         throw std::invalid_argument("BVH build: max_leaf_size must be >= 1 and bins in [2, 64], got " +
                                     std::to_string(options.max_leaf_size) + " and " + std::to_string(options.bins));

@@ -74,12 +74,36 @@ int find_root(std::vector<int>& parent, int i) {
 
 }  // namespace
 
+namespace {
+template <typename T>
+std::vector<Vec3<T>> convert(const std::vector<Vec3d>& in) {
+    std::vector<Vec3<T>> out(in.size());
+    for (size_t i = 0; i < in.size(); ++i) out[i] = Vec3<T>(in[i]);
+    return out;
+}
+
+template <typename T>
+std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m) {
+    auto b = std::make_shared<MeshBuffers<T>>();
+    b->vertices = convert<T>(m.vertices());
+    b->face_normals = convert<T>(m.face_normals());
+    b->edge_normals = convert<T>(m.edge_normals());
+    b->vertex_normals = convert<T>(m.vertex_normals());
+    b->triangles = m.triangles();
+    b->packed.reserve(m.triangles().size());
+    for (const Int3& t : m.triangles())
+        b->packed.push_back(pack_triangle<T>(m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
+                                             m.vertices()[size_t(t.z)]));
+    return b;
+}
+}  // namespace
+
 PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options) {
     PreparedMesh out;
-    out.name = mesh.name;
-    out.source = mesh.source;
-    out.content_sha256 = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;
-    MeshReport& rep = out.report;
+    out.name_ = mesh.name;
+    out.source_ = mesh.source;
+    out.content_sha256_ = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;
+    MeshReport& rep = out.report_;
     rep.input_vertices = int(mesh.vertices.size());
     rep.input_triangles = int(mesh.triangles.size());
 
@@ -98,7 +122,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
             continue;
         }
         tris.push_back(w);
-        out.source_triangle.push_back(int(i));
+        out.source_triangle_.push_back(int(i));
     }
 
     // Compact away unreferenced vertices.
@@ -106,20 +130,20 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     for (Int3& t : tris)
         for (int k = 0; k < 3; ++k) {
             int& id = used[size_t(t[k])];
-            if (id < 0) { id = int(out.vertices.size()); out.vertices.push_back(welded[size_t(t[k])]); }
+            if (id < 0) { id = int(out.vertices_.size()); out.vertices_.push_back(welded[size_t(t[k])]); }
             t[k] = id;
         }
-    rep.unreferenced_vertices = int(welded.size() - out.vertices.size());
-    out.triangles = std::move(tris);
+    rep.unreferenced_vertices = int(welded.size() - out.vertices_.size());
+    out.triangles_ = std::move(tris);
 
     // Edge adjacency: boundary, non-manifold and orientation checks; components.
     std::map<std::pair<int, int>, std::vector<EdgeUse>> edges;
-    for (size_t i = 0; i < out.triangles.size(); ++i)
+    for (size_t i = 0; i < out.triangles_.size(); ++i)
         for (int e = 0; e < 3; ++e) {
-            const int a = out.triangles[i][e], b = out.triangles[i][(e + 1) % 3];
+            const int a = out.triangles_[i][e], b = out.triangles_[i][(e + 1) % 3];
             edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
         }
-    std::vector<int> parent(out.triangles.size());
+    std::vector<int> parent(out.triangles_.size());
     std::iota(parent.begin(), parent.end(), 0);
     for (const auto& [key, uses] : edges) {
         if (uses.size() == 1) ++rep.boundary_edges;
@@ -132,73 +156,75 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         if (find_root(parent, int(i)) == int(i)) ++rep.components;
 
     // Orientation: make a closed, consistent mesh point outward.
-    for (const Int3& t : out.triangles)
-        rep.signed_volume += dot(out.vertices[size_t(t.x)],
-                                 cross(out.vertices[size_t(t.y)], out.vertices[size_t(t.z)])) / 6.0;
+    for (const Int3& t : out.triangles_)
+        rep.signed_volume += dot(out.vertices_[size_t(t.x)],
+                                 cross(out.vertices_[size_t(t.y)], out.vertices_[size_t(t.z)])) / 6.0;
     if (options.orient_outward && rep.closed() && rep.consistently_oriented() && rep.signed_volume < 0) {
-        for (Int3& t : out.triangles) std::swap(t.y, t.z);
+        for (Int3& t : out.triangles_) std::swap(t.y, t.z);
         rep.signed_volume = -rep.signed_volume;
         rep.flipped = true;
         // Edge e of a flipped triangle is a different edge; rebuild the adjacency lookups below.
         edges.clear();
-        for (size_t i = 0; i < out.triangles.size(); ++i)
+        for (size_t i = 0; i < out.triangles_.size(); ++i)
             for (int e = 0; e < 3; ++e) {
-                const int a = out.triangles[i][e], b = out.triangles[i][(e + 1) % 3];
+                const int a = out.triangles_[i][e], b = out.triangles_[i][(e + 1) % 3];
                 edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
             }
     }
 
     // Angle-weighted pseudonormals.
-    const size_t nt = out.triangles.size();
-    out.face_normals.resize(nt);
-    out.edge_normals.assign(3 * nt, Vec3d(0.0));
-    out.vertex_normals.assign(out.vertices.size(), Vec3d(0.0));
+    const size_t nt = out.triangles_.size();
+    out.face_normals_.resize(nt);
+    out.edge_normals_.assign(3 * nt, Vec3d(0.0));
+    out.vertex_normals_.assign(out.vertices_.size(), Vec3d(0.0));
     for (size_t i = 0; i < nt; ++i) {
-        const Int3 t = out.triangles[i];
-        const Vec3d& a = out.vertices[size_t(t.x)];
-        const Vec3d& b = out.vertices[size_t(t.y)];
-        const Vec3d& c = out.vertices[size_t(t.z)];
+        const Int3 t = out.triangles_[i];
+        const Vec3d& a = out.vertices_[size_t(t.x)];
+        const Vec3d& b = out.vertices_[size_t(t.y)];
+        const Vec3d& c = out.vertices_[size_t(t.z)];
         const Vec3d n = normalize_or_zero(cross(b - a, c - a));
-        out.face_normals[i] = n;
-        out.vertex_normals[size_t(t.x)] += n * corner_angle(a, b, c);
-        out.vertex_normals[size_t(t.y)] += n * corner_angle(b, c, a);
-        out.vertex_normals[size_t(t.z)] += n * corner_angle(c, a, b);
+        out.face_normals_[i] = n;
+        out.vertex_normals_[size_t(t.x)] += n * corner_angle(a, b, c);
+        out.vertex_normals_[size_t(t.y)] += n * corner_angle(b, c, a);
+        out.vertex_normals_[size_t(t.z)] += n * corner_angle(c, a, b);
     }
-    for (Vec3d& n : out.vertex_normals) n = normalize_or_zero(n);
+    for (Vec3d& n : out.vertex_normals_) n = normalize_or_zero(n);
     for (const auto& [key, uses] : edges) {
         // Each incident face contributes its normal with weight pi (the angle of a face
         // around an edge); for a manifold edge this is the normalised sum of both normals.
         Vec3d sum(0.0);
-        for (const EdgeUse& u : uses) sum += out.face_normals[size_t(u.triangle)] * kPi;
+        for (const EdgeUse& u : uses) sum += out.face_normals_[size_t(u.triangle)] * kPi;
         const Vec3d n = normalize_or_zero(sum);
         for (const EdgeUse& u : uses)
-            out.edge_normals[3 * size_t(u.triangle) + size_t(u.local_edge)] =
-                length_squared(n) > 0 ? n : out.face_normals[size_t(u.triangle)];
+            out.edge_normals_[3 * size_t(u.triangle) + size_t(u.local_edge)] =
+                length_squared(n) > 0 ? n : out.face_normals_[size_t(u.triangle)];
     }
-    out.bounds = triangle_bounds(out.vertices, out.triangles);
+    out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
+    out.float_buffers_ = make_buffers<float>(out);
+    out.double_buffers_ = make_buffers<double>(out);
     return out;
 }
 
 std::vector<std::string> PreparedMesh::warnings() const {
     std::vector<std::string> w;
-    const std::string who = "mesh '" + name + "' (" + source + ")";
-    if (report.boundary_edges > 0)
-        w.push_back(who + " is open: " + std::to_string(report.boundary_edges) +
+    const std::string who = "mesh '" + name_ + "' (" + source_ + ")";
+    if (report_.boundary_edges > 0)
+        w.push_back(who + " is open: " + std::to_string(report_.boundary_edges) +
                     " boundary edges. Distances are exact, but the sign is only the side of the "
                     "nearest surface feature (negative = behind its pseudonormal); near and "
                     "through the holes 'inside' and 'outside' are not defined.");
-    if (report.nonmanifold_edges > 0)
-        w.push_back(who + " has " + std::to_string(report.nonmanifold_edges) +
+    if (report_.nonmanifold_edges > 0)
+        w.push_back(who + " has " + std::to_string(report_.nonmanifold_edges) +
                     " non-manifold edges (used by more than two triangles); signs next to them "
                     "may be wrong.");
-    if (report.inconsistent_edges > 0)
-        w.push_back(who + " is not consistently oriented (" + std::to_string(report.inconsistent_edges) +
+    if (report_.inconsistent_edges > 0)
+        w.push_back(who + " is not consistently oriented (" + std::to_string(report_.inconsistent_edges) +
                     " edges traversed twice in the same direction); pseudonormal signs are "
                     "unreliable near those edges.");
-    if (report.flipped)
+    if (report_.flipped)
         w.push_back(who + " was oriented inward (negative signed volume); all triangles were flipped.");
-    if (report.degenerate_triangles > 0)
-        w.push_back(who + ": dropped " + std::to_string(report.degenerate_triangles) +
+    if (report_.degenerate_triangles > 0)
+        w.push_back(who + ": dropped " + std::to_string(report_.degenerate_triangles) +
                     " degenerate triangles (repeated vertex or zero area).");
     return w;
 }
@@ -217,38 +243,13 @@ MeshView<T> MeshBuffers<T>::view() const {
     return v;
 }
 
-namespace {
-template <typename T>
-std::vector<Vec3<T>> convert(const std::vector<Vec3d>& in) {
-    std::vector<Vec3<T>> out(in.size());
-    for (size_t i = 0; i < in.size(); ++i) out[i] = Vec3<T>(in[i]);
-    return out;
-}
-
-template <typename T>
-std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m) {
-    auto b = std::make_shared<MeshBuffers<T>>();
-    b->vertices = convert<T>(m.vertices);
-    b->face_normals = convert<T>(m.face_normals);
-    b->edge_normals = convert<T>(m.edge_normals);
-    b->vertex_normals = convert<T>(m.vertex_normals);
-    b->triangles = m.triangles;
-    b->packed.reserve(m.triangles.size());
-    for (const Int3& t : m.triangles)
-        b->packed.push_back(pack_triangle<T>(m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
-                                             m.vertices[size_t(t.z)]));
-    return b;
-}
-}  // namespace
 
 template <>
 const MeshBuffers<float>& PreparedMesh::buffers<float>() const {
-    if (!float_buffers_) float_buffers_ = make_buffers<float>(*this);
     return *float_buffers_;
 }
 template <>
 const MeshBuffers<double>& PreparedMesh::buffers<double>() const {
-    if (!double_buffers_) double_buffers_ = make_buffers<double>(*this);
     return *double_buffers_;
 }
 

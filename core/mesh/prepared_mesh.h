@@ -49,30 +49,48 @@ struct MeshBuffers {
     MeshView<T> view() const;
 };
 
+/// A prepared mesh is immutable: only prepare_mesh() builds one, with its float and double
+/// buffers made at once, so that any number of threads and samplers can share it.
 class PreparedMesh {
 public:
-    std::string name, source, content_sha256;
-    std::vector<Vec3d> vertices;
-    std::vector<Int3> triangles;
-    std::vector<int> source_triangle;  ///< index of each triangle in the input's face order
-    std::vector<Vec3d> face_normals;   ///< unit
-    std::vector<Vec3d> edge_normals;   ///< 3 per triangle, unit; edge e = (v_e, v_(e+1)%3)
-    std::vector<Vec3d> vertex_normals; ///< unit, angle-weighted
-    MeshReport report;
-    Bounds3 bounds;
+    const std::string& name() const { return name_; }
+    const std::string& source() const { return source_; }                  ///< file path or "shape:NAME"
+    const std::string& content_sha256() const { return content_sha256_; }  ///< of the input file or geometry
+    const std::vector<Vec3d>& vertices() const { return vertices_; }
+    const std::vector<Int3>& triangles() const { return triangles_; }
+    /// Index of each triangle in the input's face order.
+    const std::vector<int>& source_triangle() const { return source_triangle_; }
+    const std::vector<Vec3d>& face_normals() const { return face_normals_; }      ///< unit
+    /// 3 per triangle, unit; edge e = (v_e, v_(e+1)%3).
+    const std::vector<Vec3d>& edge_normals() const { return edge_normals_; }
+    const std::vector<Vec3d>& vertex_normals() const { return vertex_normals_; }  ///< unit, angle-weighted
+    const MeshReport& report() const { return report_; }
+    const Bounds3& bounds() const { return bounds_; }
 
     /// Human-readable warnings (open, non-manifold, inconsistent orientation, flipped).
     std::vector<std::string> warnings() const;
 
-    /// Arrays in precision T, built on first use and cached.
+    /// The arrays in precision T (float or double), built with the mesh.
     template <typename T>
     const MeshBuffers<T>& buffers() const;
 
 private:
-    mutable std::shared_ptr<MeshBuffers<float>> float_buffers_;
-    mutable std::shared_ptr<MeshBuffers<double>> double_buffers_;
+    friend PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options);
+    PreparedMesh() = default;
+
+    std::string name_, source_, content_sha256_;
+    std::vector<Vec3d> vertices_;
+    std::vector<Int3> triangles_;
+    std::vector<int> source_triangle_;
+    std::vector<Vec3d> face_normals_, edge_normals_, vertex_normals_;
+    MeshReport report_;
+    Bounds3 bounds_;
+    // Shared, so that copies of a prepared mesh share one set of buffers.
+    std::shared_ptr<const MeshBuffers<float>> float_buffers_;
+    std::shared_ptr<const MeshBuffers<double>> double_buffers_;
 };
 
 PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options = {});
+
 
 }  // namespace sdf

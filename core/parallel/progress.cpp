@@ -12,7 +12,7 @@ bool ProgressReporter::globally_enabled() { return g_enabled; }
 
 ProgressReporter::ProgressReporter(std::string label, int64_t total, bool enabled, double interval_seconds)
     : label_(std::move(label)), total_(total), enabled_(enabled && g_enabled), interval_(interval_seconds),
-      start_(Clock::now()), last_(start_) {}
+      start_(Clock::now()) {}
 
 ProgressReporter::~ProgressReporter() { finish(); }
 
@@ -20,10 +20,13 @@ void ProgressReporter::advance(int64_t items) {
     const int64_t done = done_.fetch_add(items) + items;
     if (!enabled_) return;
     const auto now = Clock::now();
-    if (std::chrono::duration<double>(now - last_).count() < interval_) return;
+    const auto since_last = [&] {
+        return std::chrono::duration<double>(now - (start_ + Clock::duration(last_.load()))).count();
+    };
+    if (since_last() < interval_) return;
     std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || std::chrono::duration<double>(now - last_).count() < interval_) return;
-    last_ = now;
+    if (!lock.owns_lock() || since_last() < interval_) return;
+    last_.store((now - start_).count());
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double fraction = total_ > 0 ? double(done) / double(total_) : 1.0;
     const double left = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;

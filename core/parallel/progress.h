@@ -30,7 +30,10 @@ private:
     bool enabled_;
     double interval_;
     std::atomic<int64_t> done_{0};
-    Clock::time_point start_, last_;
+    Clock::time_point start_;
+    /// Time of the last line, in Clock ticks since start_: atomic, because every thread reads
+    /// it before deciding whether to take the mutex.
+    std::atomic<Clock::rep> last_{0};
     std::mutex mutex_;
     bool printed_ = false;
     bool finished_ = false;

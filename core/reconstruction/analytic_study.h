@@ -51,7 +51,7 @@ struct AnalyticStudySpec {
     LatticeType lattice = LatticeType::BCC;
     Int3 resolution{111, 111, 111};
     Vec3d domain_min{-1, -1, -1}, domain_max{1, 1, 1};
-    ReconstructionSpec reconstruction{InterpolatorKind::BccCubic, DerivativeSource::FiniteDifferences};
+    ReconstructionSpec reconstruction{kind_of<BccCubic>(), DerivativeSource::FiniteDifferences};
     int probes_per_axis = 256;  ///< probes at the cell centres of a regular grid over the box:
     double margin = 0;          ///< the interpolator's domain() shrunk by margin * h per side
     int threads = 0;

@@ -67,8 +67,9 @@ void build_bcc_cubic(HermiteData<double>& d, const SampledField& field, const Re
             h[kBccDzz] = jet.hessian.zz;
         }
     });
-    d.faces = to_face_table<double>(spec.interpolator == InterpolatorKind::BccCubicC0 ? bcc_cubic_c0_face_weights()
-                                                                                      : bcc_cubic_face_weights());
+    d.faces = to_face_table<double>(interpolator_point_data(spec.interpolator) == PointData::BccCubicC0Jet
+                                        ? bcc_cubic_c0_face_weights()
+                                        : bcc_cubic_face_weights());
 }
 
 }  // namespace
@@ -103,9 +104,12 @@ HermiteData<double> build_hermite_data(const SampledField& field, const Reconstr
     d.values = field.distance;
     d.higher_stride = interpolator_higher_stride(spec.interpolator);
     const double unit = field.lattice.type == LatticeType::CC ? field.lattice.spacing : field.lattice.half_spacing();
-    if (spec.interpolator == InterpolatorKind::TricubicLM) build_cc_tricubic(d, field, spec, unit);
-    if (spec.interpolator == InterpolatorKind::BccCubic || spec.interpolator == InterpolatorKind::BccCubicC0)
-        build_bcc_cubic(d, field, spec, unit);
+    switch (interpolator_point_data(spec.interpolator)) {
+        case PointData::Values: break;
+        case PointData::CcTricubicJet: build_cc_tricubic(d, field, spec, unit); break;
+        case PointData::BccCubicJet:
+        case PointData::BccCubicC0Jet: build_bcc_cubic(d, field, spec, unit); break;
+    }
     return d;
 }
 

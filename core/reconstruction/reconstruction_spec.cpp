@@ -9,10 +9,6 @@
 namespace sdf {
 namespace {
 
-constexpr InterpolatorKind kAllKinds[kInterpolatorKinds] = {
-    InterpolatorKind::Trilinear, InterpolatorKind::CatmullRom, InterpolatorKind::TricubicLM,
-    InterpolatorKind::BccLinear, InterpolatorKind::BccCubic,   InterpolatorKind::BccCubicC0};
-
 std::string joined(const std::vector<std::string>& names) {
     std::string s;
     for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
@@ -25,11 +21,10 @@ std::string source_names(const std::vector<DerivativeSource>& sources) {
     return joined(names);
 }
 
-/// Smallest resolution per axis each interpolator and source needs.
+/// Smallest resolution per axis the interpolator needs (its support, and for the BCC cubics
+/// the 27-point fit of their derivative data).
 int minimum_resolution(const ReconstructionSpec& spec) {
-    const bool bcc = interpolator_lattice(spec.interpolator) == LatticeType::BCC;
-    if (!bcc) return spec.interpolator == InterpolatorKind::Trilinear ? 2 : 3;
-    return spec.interpolator == InterpolatorKind::BccLinear ? 3 : 4;  // the 27-point fit needs 4
+    return visit_interpolator(spec.interpolator, [](auto interp) { return decltype(interp)::min_resolution(); });
 }
 
 }  // namespace
@@ -48,13 +43,23 @@ const char* derivative_source_name(DerivativeSource source) {
 
 std::vector<std::string> interpolator_names() {
     std::vector<std::string> names;
-    for (InterpolatorKind k : kAllKinds) names.emplace_back(interpolator_name(k));
+    for_each_interpolator([&](auto interp) { names.emplace_back(decltype(interp)::name()); });
     return names;
 }
 
+std::string interpolator_help() {
+    std::string cc, bcc;
+    for_each_interpolator([&](auto interp) {
+        using I = decltype(interp);
+        std::string& list = I::lattice_type() == LatticeType::CC ? cc : bcc;
+        list += (list.empty() ? "" : ", ") + std::string(I::name());
+    });
+    return cc + " (CC); " + bcc + " (BCC)";
+}
+
 InterpolatorKind parse_interpolator(const std::string& name) {
-    for (InterpolatorKind k : kAllKinds)
-        if (name == interpolator_name(k)) return k;
+    for (int k = 0; k < kInterpolatorKinds; ++k)
+        if (name == interpolator_name(InterpolatorKind(k))) return InterpolatorKind(k);
     throw std::invalid_argument("unknown interpolator '" + name + "'; expected one of: " + joined(interpolator_names()));
 }
 
@@ -71,6 +76,10 @@ LatticeType interpolator_lattice(InterpolatorKind kind) {
 
 bool interpolator_uses_first(InterpolatorKind kind) {
     return visit_interpolator(kind, [](auto interp) { return decltype(interp)::uses_first(); });
+}
+
+PointData interpolator_point_data(InterpolatorKind kind) {
+    return visit_interpolator(kind, [](auto interp) { return decltype(interp)::point_data(); });
 }
 
 int interpolator_higher_stride(InterpolatorKind kind) {

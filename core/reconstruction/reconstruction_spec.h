@@ -28,7 +28,7 @@ namespace sdf {
 enum class DerivativeSource { True, FiniteDifferences, FiniteDifferencesWeighted };
 
 struct ReconstructionSpec {
-    InterpolatorKind interpolator = InterpolatorKind::Trilinear;
+    InterpolatorKind interpolator = kind_of<Trilinear>();
     DerivativeSource derivatives = DerivativeSource::FiniteDifferences;
     /// fd_weighted only: sigma^2 of eq. 4-15 and its unit (bcc_least_squares.h).
     double sigma2 = 0.5;
@@ -40,6 +40,9 @@ const char* interpolator_name(InterpolatorKind kind);
 const char* derivative_source_name(DerivativeSource source);
 std::vector<std::string> interpolator_names();
 
+/// The names by lattice, for the tools' help: "trilinear, ... (CC); bcc_linear, ... (BCC)".
+std::string interpolator_help();
+
 /// Parse config names; unknown names throw std::invalid_argument listing the valid ones.
 InterpolatorKind parse_interpolator(const std::string& name);
 DerivativeSource parse_derivative_source(const std::string& name);
@@ -47,6 +50,7 @@ DerivativeSource parse_derivative_source(const std::string& name);
 LatticeType interpolator_lattice(InterpolatorKind kind);
 bool interpolator_uses_first(InterpolatorKind kind);
 int interpolator_higher_stride(InterpolatorKind kind);
+PointData interpolator_point_data(InterpolatorKind kind);
 
 /// The derivative sources that `kind` accepts.
 std::vector<DerivativeSource> valid_derivative_sources(InterpolatorKind kind);

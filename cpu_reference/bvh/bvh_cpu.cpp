@@ -24,7 +24,7 @@ constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY 
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
 
-enum class BvhKernel { Brick, Seeded, Unseeded };
+using BvhKernel = CpuBvhKernel;
 
 struct QueryCounters {
     std::atomic<int64_t> nodes{0}, triangles{0};
@@ -38,7 +38,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, bool seed
                      int64_t n, QueryCounters& counters, PositionFn pos, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
-    ProgressReporter reporter("sampling " + mesh.name + " (bvh)", n, progress);
+    ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         int32_t previous = -1;
@@ -92,7 +92,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lat
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
-    ProgressReporter reporter("sampling " + mesh.name + " (bvh)", block.count(), progress);
+    ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", block.count(), progress);
     parallel_for(n, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         int32_t seed[kBrick];
@@ -122,12 +122,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lat
 class CpuBvhSampler final : public Sampler {
 public:
     explicit CpuBvhSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "brick") kernel_ = BvhKernel::Brick;
-        else if (options.kernel == "seeded") kernel_ = BvhKernel::Seeded;
-        else if (options.kernel == "unseeded") kernel_ = BvhKernel::Unseeded;
-        else
-            throw std::invalid_argument("sampler.kernel: unknown CPU BVH kernel '" + options.kernel +
-                                        "'; expected \"brick\", \"seeded\" or \"unseeded\"");
+        kernel_ = kernel_from_name(kCpuBvhKernels, options.kernel, "CPU BVH");
     }
 
     std::string name() const override { return std::string("cpu/bvh/") + kernel_name(); }
@@ -155,9 +150,7 @@ public:
     }
 
 private:
-    const char* kernel_name() const {
-        return kernel_ == BvhKernel::Brick ? "brick" : (kernel_ == BvhKernel::Seeded ? "seeded" : "unseeded");
-    }
+    const char* kernel_name() const { return sdf::kernel_name(kCpuBvhKernels, kernel_); }
     /// Point lists have no bricks: "brick" queries them one by one, seeded.
     bool seeded() const { return kernel_ != BvhKernel::Unseeded; }
 
@@ -190,7 +183,7 @@ private:
         field.timings.total = std::chrono::duration<double>(now - start).count();
         field.timings.kernel = std::chrono::duration<double>(now - query_start).count();
         // Brute-force-equivalent pairs, so pairs/s compares with the brute-force samplers.
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         nlohmann::json bvh_info = bvh->stats.to_json();
         bvh_info["built_by_this_call"] = built;
         bvh_info["node_visits_per_point"] = computed > 0 ? double(counters.nodes) / double(computed) : 0.0;

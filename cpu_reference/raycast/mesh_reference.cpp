@@ -14,8 +14,8 @@ namespace sdf {
 MeshReferenceRenderer::MeshReferenceRenderer(const PreparedMesh& mesh) : mesh_(mesh), bvh_(build_triangle_bvh(mesh)) {
     corners_.reserve(bvh_.triangle_index.size() * 3);
     for (int32_t t : bvh_.triangle_index) {
-        const Int3 tri = mesh.triangles[size_t(t)];
-        for (int k = 0; k < 3; ++k) corners_.push_back(mesh.vertices[size_t(tri[k])]);
+        const Int3 tri = mesh.triangles()[size_t(t)];
+        for (int k = 0; k < 3; ++k) corners_.push_back(mesh.vertices()[size_t(tri[k])]);
     }
 }
 
@@ -39,11 +39,11 @@ PixelRecord MeshReferenceRenderer::cast(const Ray<double>& ray, const Vec3d& key
     if (triangle) *triangle = best_slot < 0 ? -1 : bvh_.triangle_index[size_t(best_slot)];
     if (best_slot < 0) return background_pixel();
     const int32_t t = bvh_.triangle_index[size_t(best_slot)];
-    Vec3d n = mesh_.face_normals[size_t(t)];
+    Vec3d n = mesh_.face_normals()[size_t(t)];
     if (interpolate_normals) {
-        const Int3 tri = mesh_.triangles[size_t(t)];
-        n = mesh_.vertex_normals[size_t(tri.x)] * best.b0 + mesh_.vertex_normals[size_t(tri.y)] * best.b1 +
-            mesh_.vertex_normals[size_t(tri.z)] * best.b2;
+        const Int3 tri = mesh_.triangles()[size_t(t)];
+        n = mesh_.vertex_normals()[size_t(tri.x)] * best.b0 + mesh_.vertex_normals()[size_t(tri.y)] * best.b1 +
+            mesh_.vertex_normals()[size_t(tri.z)] * best.b2;
     }
     return shade_hit(ray, HitKind::Surface, best.t, n, key_light);
 }
@@ -53,7 +53,7 @@ RenderedImage MeshReferenceRenderer::render(const CameraSpec& camera, const Mesh
     const Vec3d key = key_light_direction(pinhole);
     RenderedImage image(camera.width, camera.height);
     const auto start = std::chrono::steady_clock::now();
-    for_each_tile(image.width, image.height, options.tile, options.threads, "render mesh " + mesh_.name,
+    for_each_tile(image.width, image.height, options.tile, options.threads, "render mesh " + mesh_.name(),
                   options.progress, [&](int x0, int y0, int x1, int y1) {
                       for (int y = y0; y < y1; ++y)
                           for (int x = x0; x < x1; ++x)
@@ -63,8 +63,8 @@ RenderedImage MeshReferenceRenderer::render(const CameraSpec& camera, const Mesh
                   {"backend", "cpu"},
                   {"precision", "double"},
                   {"threads", resolve_thread_count(options.threads)},
-                  {"mesh", {{"name", mesh_.name}, {"sha256", mesh_.content_sha256},
-                            {"triangles", mesh_.triangles.size()}}},
+                  {"mesh", {{"name", mesh_.name()}, {"sha256", mesh_.content_sha256()},
+                            {"triangles", mesh_.triangles().size()}}},
                   {"normals", options.interpolate_normals ? "interpolated_vertex" : "face"},
                   {"intersection", "watertight (Woop et al. 2013), double, BVH"},
                   {"camera", camera_to_json(camera)},

@@ -4,7 +4,7 @@
 ///
 /// Exact closest hits in double: the watertight ray-triangle test
 /// (kernels/raycast/ray_triangle.h; no tolerance, no cracks along shared edges) over the
-/// project's binned-SAH BVH (cpu_reference/bvh/triangle_bvh.h) with the closest-hit
+/// project's binned-SAH BVH (core/bvh/triangle_bvh.h) with the closest-hit
 /// traversal of kernels/bvh/ray_traversal.h. The normal is the triangle's face normal; with
 /// `interpolate_normals` (off by default) the barycentric blend of the angle-weighted vertex
 /// normals. The depth is the hit distance along the unit ray direction, as for the ray

@@ -12,7 +12,7 @@
 namespace sdf {
 namespace {
 
-enum class CpuKernel { Vectorized, Eberly };
+using CpuKernel = CpuBruteForceKernel;
 
 /// Evaluates n points: pos(i) gives the position, emit(i, sample) receives the result.
 /// The nearest triangle is searched in precision T; the winner is then evaluated in double
@@ -25,7 +25,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bo
     const MeshView<T> view = buffers.view();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const TriangleSoA<T> soa(buffers.packed);
-    ProgressReporter reporter("sampling " + mesh.name, n, progress);
+    ProgressReporter reporter("sampling " + mesh.name(), n, progress);
     parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
         const int count = int(end - begin);
         T px[kPointTile], py[kPointTile], pz[kPointTile], best_q[kPointTile];
@@ -47,11 +47,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bo
 class CpuBruteForceSampler final : public Sampler {
 public:
     explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options) {
-        if (options.kernel.empty() || options.kernel == "vectorized") kernel_ = CpuKernel::Vectorized;
-        else if (options.kernel == "eberly") kernel_ = CpuKernel::Eberly;
-        else
-            throw std::invalid_argument("sampler.kernel: unknown CPU kernel '" + options.kernel +
-                                        "'; expected \"vectorized\" or \"eberly\"");
+        kernel_ = kernel_from_name(kCpuBruteForceKernels, options.kernel, "CPU brute-force");
     }
 
     std::string name() const override { return std::string("cpu/brute_force/") + kernel_name(); }
@@ -76,7 +72,7 @@ public:
     }
 
 private:
-    const char* kernel_name() const { return kernel_ == CpuKernel::Vectorized ? "vectorized" : "eberly"; }
+    const char* kernel_name() const { return sdf::kernel_name(kCpuBruteForceKernels, kernel_); }
 
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
@@ -99,7 +95,7 @@ private:
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         field.timings.total = seconds;
         field.timings.kernel = seconds;
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles.size());
+        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         return field;

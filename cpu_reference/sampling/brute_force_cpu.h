@@ -9,9 +9,18 @@
 
 #include <memory>
 
+#include "core/sampling/kernel_table.h"
 #include "core/sampling/sampler.h"
 
 namespace sdf {
+
+enum class CpuBruteForceKernel { Vectorized, Eberly };
+
+/// The kernels of method "brute_force" on the CPU; the first is the default.
+inline constexpr NamedKernel<CpuBruteForceKernel> kCpuBruteForceKernels[] = {
+    {"vectorized", CpuBruteForceKernel::Vectorized},
+    {"eberly", CpuBruteForceKernel::Eberly},
+};
 
 std::unique_ptr<Sampler> make_cpu_brute_force_sampler(const SamplerOptions& options);
 

@@ -7,7 +7,7 @@
 #include "experiments/common/study_inputs.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/field_file.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 
@@ -40,14 +40,14 @@ Sampler& FieldSource::sampler() {
 
 std::string FieldSource::status(const PreparedMesh& mesh, const Lattice& lattice) const {
     if (!cache_) return "to sample (--no-cache)";
-    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, options_);
+    const nlohmann::json key = field_cache_key(mesh.content_sha256(), lattice, options_);
     return cache_->contains(key) ? "cached " + ContentCache::key_hash(key).substr(0, 12) : "to sample";
 }
 
 ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice, const std::string& label,
                                std::ostream& log) {
     ObtainedField out;
-    const nlohmann::json key = field_cache_key(mesh.content_sha256, lattice, options_);
+    const nlohmann::json key = field_cache_key(mesh.content_sha256(), lattice, options_);
     out.cache_key = ContentCache::key_hash(key);
     const std::string what = label + " (" + lattice_notation(lattice) + ", " + with_commas(lattice.num_points()) + " points)";
     if (cache_) {

@@ -36,7 +36,7 @@ PreparedMesh load_case_mesh(const MeshCase& c, const std::vector<std::string>& s
     in.search_path = search_path;
     in.base_dir = base_dir;
     PreparedMesh mesh = load_prepared_mesh(in, *ctx.log);
-    ctx.inputs["meshes"][c.label] = {{"source", mesh.source}, {"sha256", mesh.content_sha256}};
+    ctx.inputs["meshes"][c.label] = {{"source", mesh.source()}, {"sha256", mesh.content_sha256()}};
     return mesh;
 }
 

@@ -26,7 +26,7 @@ nlohmann::json cache_key(const PreparedMesh& mesh, const DomainBox<double>& box,
                          const SamplerOptions& o) {
     return {{"what", "probes"},
             {"code_version", kProbeCodeVersion},
-            {"mesh_sha256", mesh.content_sha256},
+            {"mesh_sha256", mesh.content_sha256()},
             {"box", {exact(box.lo.x), exact(box.lo.y), exact(box.lo.z), exact(box.hi.x), exact(box.hi.y), exact(box.hi.z)}},
             {"band_width", exact(band_width)},
             {"domain_probes", spec.domain_probes},
@@ -43,12 +43,12 @@ std::vector<Vec3d> place_probes(const PreparedMesh& mesh, const DomainBox<double
     for (int64_t i = 0; i < spec.domain_probes; ++i)
         pts.push_back(box.lo + Vec3d(unit(rng) * size.x, unit(rng) * size.y, unit(rng) * size.z));
     // Area-weighted triangle choice.
-    std::vector<double> cdf(mesh.triangles.size());
+    std::vector<double> cdf(mesh.triangles().size());
     double total = 0;
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-        const Int3 v = mesh.triangles[t];
-        total += 0.5 * length(cross(mesh.vertices[size_t(v.y)] - mesh.vertices[size_t(v.x)],
-                                    mesh.vertices[size_t(v.z)] - mesh.vertices[size_t(v.x)]));
+    for (size_t t = 0; t < mesh.triangles().size(); ++t) {
+        const Int3 v = mesh.triangles()[t];
+        total += 0.5 * length(cross(mesh.vertices()[size_t(v.y)] - mesh.vertices()[size_t(v.x)],
+                                    mesh.vertices()[size_t(v.z)] - mesh.vertices()[size_t(v.x)]));
         cdf[t] = total;
     }
     auto inside = [&](const Vec3d& p) {
@@ -56,11 +56,11 @@ std::vector<Vec3d> place_probes(const PreparedMesh& mesh, const DomainBox<double
     };
     for (int64_t i = 0, attempts = 0; i < spec.band_probes && attempts < 100 * spec.band_probes + 1000; ++attempts) {
         const size_t t = size_t(std::lower_bound(cdf.begin(), cdf.end(), unit(rng) * total) - cdf.begin());
-        const Int3 v = mesh.triangles[std::min(t, cdf.size() - 1)];
+        const Int3 v = mesh.triangles()[std::min(t, cdf.size() - 1)];
         const double r1 = std::sqrt(unit(rng)), r2 = unit(rng);
-        const Vec3d on = mesh.vertices[size_t(v.x)] * (1 - r1) + mesh.vertices[size_t(v.y)] * (r1 * (1 - r2)) +
-                         mesh.vertices[size_t(v.z)] * (r1 * r2);
-        const Vec3d p = on + mesh.face_normals[std::min(t, cdf.size() - 1)] * ((2 * unit(rng) - 1) * w);
+        const Vec3d on = mesh.vertices()[size_t(v.x)] * (1 - r1) + mesh.vertices()[size_t(v.y)] * (r1 * (1 - r2)) +
+                         mesh.vertices()[size_t(v.z)] * (r1 * r2);
+        const Vec3d p = on + mesh.face_normals()[std::min(t, cdf.size() - 1)] * ((2 * unit(rng) - 1) * w);
         if (!inside(p)) continue;
         pts.push_back(p);
         ++i;

@@ -50,9 +50,9 @@ void check_entry(JsonReader& r, const ReconstructionEntry& e, const LatticeSpec&
 std::string thesis_panel(const ReconstructionSpec& s) {
     const bool truth = s.derivatives == DerivativeSource::True, fd = s.derivatives == DerivativeSource::FiniteDifferences;
     switch (s.interpolator) {
-        case InterpolatorKind::CatmullRom: return "A";
-        case InterpolatorKind::BccCubic: return truth ? "B" : fd ? "C" : "";
-        case InterpolatorKind::TricubicLM: return truth ? "D" : fd ? "E" : "";
+        case kind_of<CatmullRom>(): return "A";
+        case kind_of<BccCubic>(): return truth ? "B" : fd ? "C" : "";
+        case kind_of<TricubicLekienMarsden>(): return truth ? "D" : fd ? "E" : "";
         default: return "";
     }
 }
@@ -63,14 +63,14 @@ std::vector<ReconstructionEntry> read_reconstructions(JsonReader& config, const 
     if (!config.has("reconstructions")) {
         for (size_t i = 0; i < lattices.size(); ++i) {
             if (lattices[i].type == LatticeType::CC) {
-                out.push_back(entry(i, labels[i], InterpolatorKind::Trilinear, DerivativeSource::FiniteDifferences));
-                out.push_back(entry(i, labels[i], InterpolatorKind::CatmullRom, DerivativeSource::FiniteDifferences));
-                out.push_back(entry(i, labels[i], InterpolatorKind::TricubicLM, DerivativeSource::True));
-                out.push_back(entry(i, labels[i], InterpolatorKind::TricubicLM, DerivativeSource::FiniteDifferences));
+                out.push_back(entry(i, labels[i], kind_of<Trilinear>(), DerivativeSource::FiniteDifferences));
+                out.push_back(entry(i, labels[i], kind_of<CatmullRom>(), DerivativeSource::FiniteDifferences));
+                out.push_back(entry(i, labels[i], kind_of<TricubicLekienMarsden>(), DerivativeSource::True));
+                out.push_back(entry(i, labels[i], kind_of<TricubicLekienMarsden>(), DerivativeSource::FiniteDifferences));
             } else {
-                out.push_back(entry(i, labels[i], InterpolatorKind::BccLinear, DerivativeSource::FiniteDifferences));
-                out.push_back(entry(i, labels[i], InterpolatorKind::BccCubic, DerivativeSource::True));
-                out.push_back(entry(i, labels[i], InterpolatorKind::BccCubic, DerivativeSource::FiniteDifferences));
+                out.push_back(entry(i, labels[i], kind_of<BccLinear>(), DerivativeSource::FiniteDifferences));
+                out.push_back(entry(i, labels[i], kind_of<BccCubic>(), DerivativeSource::True));
+                out.push_back(entry(i, labels[i], kind_of<BccCubic>(), DerivativeSource::FiniteDifferences));
             }
         }
         nlohmann::json all = nlohmann::json::array();

@@ -4,7 +4,7 @@
 
 #include "harness/build_config.h"
 #include "harness/config/sampler_spec.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 
@@ -52,14 +52,14 @@ StudyInputs read_study_inputs(JsonReader& config, const RunContext& context, boo
 }
 
 nlohmann::json describe_mesh(const PreparedMesh& m) {
-    const MeshReport& r = m.report;
-    return {{"name", m.name},
-            {"source", m.source},
-            {"sha256", m.content_sha256},
-            {"vertices", m.vertices.size()},
-            {"triangles", m.triangles.size()},
-            {"bounds", {{"min", {m.bounds.min.x, m.bounds.min.y, m.bounds.min.z}},
-                        {"max", {m.bounds.max.x, m.bounds.max.y, m.bounds.max.z}}}},
+    const MeshReport& r = m.report();
+    return {{"name", m.name()},
+            {"source", m.source()},
+            {"sha256", m.content_sha256()},
+            {"vertices", m.vertices().size()},
+            {"triangles", m.triangles().size()},
+            {"bounds", {{"min", {m.bounds().min.x, m.bounds().min.y, m.bounds().min.z}},
+                        {"max", {m.bounds().max.x, m.bounds().max.y, m.bounds().max.z}}}},
             {"report", {{"input_vertices", r.input_vertices},
                         {"input_triangles", r.input_triangles},
                         {"welded_vertices", r.welded_vertices},
@@ -74,17 +74,18 @@ nlohmann::json describe_mesh(const PreparedMesh& m) {
 }
 
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
-    PreparedMesh mesh;
-    try {
-        mesh = prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
-    } catch (const ConfigError&) {
-        throw;  // already names the config file and key
-    } catch (const std::exception& e) {
-        throw std::runtime_error(inputs.mesh.config_file + ": key '" + inputs.mesh.key_path + "': " + e.what());
-    }
-    const MeshReport& r = mesh.report;
-    log << "mesh " << mesh.name << " (" << mesh.source << "): " << mesh.vertices.size() << " vertices, "
-        << mesh.triangles.size() << " triangles, " << r.components << " component(s), "
+    const PreparedMesh mesh = [&] {
+        try {
+            return prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
+        } catch (const ConfigError&) {
+            throw;  // already names the config file and key
+        } catch (const std::exception& e) {
+            throw std::runtime_error(inputs.mesh.config_file + ": key '" + inputs.mesh.key_path + "': " + e.what());
+        }
+    }();
+    const MeshReport& r = mesh.report();
+    log << "mesh " << mesh.name() << " (" << mesh.source() << "): " << mesh.vertices().size() << " vertices, "
+        << mesh.triangles().size() << " triangles, " << r.components << " component(s), "
         << (r.closed() ? "closed" : "open") << (r.consistently_oriented() ? ", consistently oriented" : ", INCONSISTENT orientation")
         << "\n";
     for (const std::string& w : mesh.warnings()) std::cerr << "warning: " << w << "\n";

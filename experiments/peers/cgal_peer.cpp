@@ -37,8 +37,8 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 Mesh surface_mesh(const PreparedMesh& m) {
     Mesh sm;
     std::vector<Mesh::Vertex_index> v;
-    for (const Vec3d& p : m.vertices) v.push_back(sm.add_vertex(Point(p.x, p.y, p.z)));
-    for (const Int3& t : m.triangles) sm.add_face(v[size_t(t.x)], v[size_t(t.y)], v[size_t(t.z)]);
+    for (const Vec3d& p : m.vertices()) v.push_back(sm.add_vertex(Point(p.x, p.y, p.z)));
+    for (const Int3& t : m.triangles()) sm.add_face(v[size_t(t.x)], v[size_t(t.y)], v[size_t(t.z)]);
     return sm;
 }
 
@@ -54,9 +54,9 @@ public:
         r.threads = threads;
         auto start = std::chrono::steady_clock::now();
         std::vector<Triangle> triangles;
-        triangles.reserve(mesh.triangles.size());
-        for (const Int3& t : mesh.triangles) {
-            const Vec3d a = mesh.vertices[size_t(t.x)], b = mesh.vertices[size_t(t.y)], c = mesh.vertices[size_t(t.z)];
+        triangles.reserve(mesh.triangles().size());
+        for (const Int3& t : mesh.triangles()) {
+            const Vec3d a = mesh.vertices()[size_t(t.x)], b = mesh.vertices()[size_t(t.y)], c = mesh.vertices()[size_t(t.z)];
             triangles.emplace_back(Point(a.x, a.y, a.z), Point(b.x, b.y, b.z), Point(c.x, c.y, c.z));
         }
         Tree tree(triangles.begin(), triangles.end());

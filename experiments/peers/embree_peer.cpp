@@ -93,16 +93,16 @@ public:
         RTCScene scene = rtcNewScene(device);
         RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         float* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                3 * sizeof(float), mesh.vertices.size()));
+                                                                3 * sizeof(float), mesh.vertices().size()));
         unsigned* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                      3 * sizeof(unsigned), mesh.triangles.size()));
-        for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-            vb[3 * i] = float(mesh.vertices[i].x);
-            vb[3 * i + 1] = float(mesh.vertices[i].y);
-            vb[3 * i + 2] = float(mesh.vertices[i].z);
+                                                                      3 * sizeof(unsigned), mesh.triangles().size()));
+        for (size_t i = 0; i < mesh.vertices().size(); ++i) {
+            vb[3 * i] = float(mesh.vertices()[i].x);
+            vb[3 * i + 1] = float(mesh.vertices()[i].y);
+            vb[3 * i + 2] = float(mesh.vertices()[i].z);
         }
-        for (size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (int k = 0; k < 3; ++k) ib[3 * i + size_t(k)] = unsigned(mesh.triangles[i][k]);
+        for (size_t i = 0; i < mesh.triangles().size(); ++i)
+            for (int k = 0; k < 3; ++k) ib[3 * i + size_t(k)] = unsigned(mesh.triangles()[i][k]);
         rtcCommitGeometry(geom);
         rtcAttachGeometry(scene, geom);
         rtcReleaseGeometry(geom);

@@ -64,8 +64,8 @@ public:
         const std::string dir = dir_template;
         std::vector<float> v, p;
         std::vector<uint32_t> t;
-        for (const Vec3d& x : mesh.vertices) v.insert(v.end(), {float(x.x), float(x.y), float(x.z)});
-        for (const Int3& x : mesh.triangles) t.insert(t.end(), {uint32_t(x.x), uint32_t(x.y), uint32_t(x.z)});
+        for (const Vec3d& x : mesh.vertices()) v.insert(v.end(), {float(x.x), float(x.y), float(x.z)});
+        for (const Int3& x : mesh.triangles()) t.insert(t.end(), {uint32_t(x.x), uint32_t(x.y), uint32_t(x.z)});
         for (const Vec3d& x : points) p.insert(p.end(), {float(x.x), float(x.y), float(x.z)});
         write_raw(dir + "/vertices.f32", v);
         write_raw(dir + "/triangles.u32", t);

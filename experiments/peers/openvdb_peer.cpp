@@ -47,8 +47,8 @@ public:
         std::vector<openvdb::Vec3s> vertices;
         std::vector<openvdb::Vec3I> triangles;
         std::vector<openvdb::Vec4I> quads;
-        for (const Vec3d& v : mesh.vertices) vertices.emplace_back(float(v.x), float(v.y), float(v.z));
-        for (const Int3& t : mesh.triangles) triangles.emplace_back(unsigned(t.x), unsigned(t.y), unsigned(t.z));
+        for (const Vec3d& v : mesh.vertices()) vertices.emplace_back(float(v.x), float(v.y), float(v.z));
+        for (const Int3& t : mesh.triangles()) triangles.emplace_back(unsigned(t.x), unsigned(t.y), unsigned(t.z));
         const float band = float(band_);
         openvdb::FloatGrid::Ptr grid =
             openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*xform, vertices, triangles, quads, band, band);

@@ -35,7 +35,10 @@ nlohmann::json read_json_file(const std::string& path);
 
 class JsonReader {
 public:
+    /// The reader keeps a reference to `value`: it must outlive the reader (a temporary
+    /// cannot be passed).
     JsonReader(const nlohmann::json& value, std::string file, std::string path = "");
+    JsonReader(nlohmann::json&& value, std::string file, std::string path = "") = delete;
     /// A reader that also writes every value it reads (defaults included) into `*resolved`
     /// at `where` (a JSON pointer into that tree).
     JsonReader(const nlohmann::json& value, std::string file, std::string path,

@@ -2,25 +2,28 @@
 
 #include <algorithm>
 
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 
-std::vector<std::string> sampler_kernel_names(const std::string& backend, const std::string& method) {
-    if (method == "bvh" && backend == "cuda") return {"brick", "seeded", "unseeded", "warp"};
-    if (method == "bvh") return {"brick", "seeded", "unseeded"};
-    if (backend == "cpu") return {"vectorized", "eberly"};
-    if (backend == "cuda") return {"tuned", "thesis"};
-    return {};
+std::string sampler_kernels_help() {
+    std::string help;
+    for (const SamplerKind& k : sampler_table()) {
+        help += (help.empty() ? "" : "; ") + std::string(k.backend) + " " + k.method + ": ";
+        for (size_t i = 0; i < k.kernels.size(); ++i) help += (i ? ", " : "") + k.kernels[i];
+    }
+    return help;
 }
 
 SamplerOptions parse_sampler_options(JsonReader& r) {
     SamplerOptions o;
-    const std::string backend = r.choice("backend", {"cpu", "cuda", "auto"}, "cpu");
+    std::vector<std::string> backends = sampler_backends();
+    backends.emplace_back("auto");
+    const std::string backend = r.choice("backend", backends, "cpu");
     o.backend = backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : backend;
-    o.method = r.choice("method", {"brute_force", "bvh"}, "brute_force");
-    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (cpu: vectorized, eberly; cuda: tuned, thesis; bvh: brick, seeded, unseeded; cuda bvh also warp)");
-    const std::vector<std::string> kernels = sampler_kernel_names(o.backend, o.method);
+    o.method = r.choice("method", sampler_methods(), "brute_force");
+    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (" + sampler_kernels_help() + ")");
+    const std::vector<std::string> kernels = sampler_kind(o.backend, o.method).kernels;
     if (backend == "auto" && !o.kernel.empty())
         r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +
                              "\": name the backend to choose a kernel");

@@ -1,11 +1,11 @@
 /// @file sampler_spec.h
 /// @brief The "sampler" object of a config:
-///   {"backend": "cpu" | "cuda" | "auto", "method": "brute_force", "kernel": "...",
+///   {"backend": "cpu" | "cuda" | "auto", "method": "brute_force" | "bvh", "kernel": "...",
 ///    "threads": 0, "precision": "float" | "double", "bcc_strategy": "two_grids" | "double_resolution",
 ///    "progress": true, "device": 0, "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
 ///    "points_per_thread": 0}
-/// Kernels per backend: cpu "vectorized" (default) | "eberly"; cuda "tuned" (default) |
-/// "thesis". "auto" is cuda when this build has the CUDA backend and a GPU is present, else
+/// Backends, methods and kernels (the first is the default) come from the sampler table,
+/// harness/sampling/sampler_table.h. "auto" is cuda when this build has the CUDA backend and a GPU is present, else
 /// cpu (it takes no "kernel"); the choice is made when the config is read.
 #pragma once
 
@@ -22,7 +22,8 @@ namespace sdf {
 SamplerOptions parse_sampler_options(JsonReader& r);
 nlohmann::json sampler_options_to_json(const SamplerOptions& o);
 
-/// The kernels a backend's method accepts ("" = its default is always accepted too).
-std::vector<std::string> sampler_kernel_names(const std::string& backend, const std::string& method = "brute_force");
+/// "cpu brute_force: vectorized, eberly; cpu bvh: brick, ..." from the sampler table, for
+/// help texts and messages.
+std::string sampler_kernels_help();
 
 }  // namespace sdf

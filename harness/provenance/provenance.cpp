@@ -11,7 +11,7 @@
 
 #include "core/parallel/parallel_for.h"
 #include "harness/build_config.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
 #endif

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 #if SDF_HAVE_CUDA_RAYCAST
 #include "cuda/raycast.h"

@@ -1,7 +1,7 @@
 /// @file render_backend.h
 /// @brief The one place that maps a render backend name to an implementation (as
-/// make_sampler.h does for samplers): "cpu" (cpu_reference/raycast/render_cpu.h, all
-/// cores), "cuda" (kernels/cuda/raycast.h; this build must have the CUDA backend and the
+/// harness/sampling/sampler_table.h does for samplers): "cpu" (cpu_reference/raycast/render_cpu.h, all
+/// cores), "cuda" (cuda/raycast.h; this build must have the CUDA backend and the
 /// machine a GPU), or "auto" (cuda when available, else cpu). Both run cast_pixel.
 #pragma once
 

@@ -11,8 +11,9 @@
 /// brute-force samplers.
 ///
 /// Exactness. A subtree is skipped only when its box, which contains every one of its
-/// triangles, is at least as far as the best triangle so far, so no triangle that could be
-/// strictly nearer is skipped: the result is the brute-force minimum of squared_distance()
+/// triangles, is farther than the best triangle so far (by more than the rounding of the two
+/// distances: may_hold_nearer), so no triangle that could be strictly nearer is skipped:
+/// the result is the brute-force minimum of squared_distance()
 /// (up to ties, and in float up to the rounding of the box and triangle distances, which
 /// brute force shares). A query may be seeded with any triangle (e.g. the winner of a
 /// neighbouring lattice point): its distance is a true upper bound, so the seed only
@@ -56,6 +57,16 @@ SDF_CPU_GPU SDF_INLINE BvhHit<T> seed_hit(const BvhView<T>& bvh, int32_t slot, c
     return h;
 }
 
+/// Whether a subtree whose box is `box_d2` away may hold a triangle nearer than `radius`.
+/// Both distances are rounded: where the true distances tie (a vertex shared by several
+/// triangles is also a corner of their boxes) the box can come out a few ulps beyond a
+/// triangle distance that is itself a few ulps below the tie. Entering boxes within 8 ulps
+/// of the radius keeps the result the brute-force minimum of the computed distances.
+template <typename T>
+SDF_CPU_GPU SDF_INLINE bool may_hold_nearer(T box_d2, T radius) {
+    return box_d2 <= radius * (T(1) + T(8) * std::numeric_limits<T>::epsilon());
+}
+
 /// Scans leaf triangles [first, first + count) and keeps the nearest in `best`.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int32_t count, const Vec3<T>& p,
@@ -84,7 +95,7 @@ SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>&
         const T d_near = near ? d1 : d0, d_far = near ? d0 : d1;
         int32_t next = -1;
         // Nearer child first: scanning a leaf shrinks the radius before the farther test.
-        if (d_near < best.distance_squared) {
+        if (may_hold_nearer(d_near, best.distance_squared)) {
             if (bvh_child_is_leaf(n, near)) {
                 stats.test_triangles(n.count[near]);
                 scan_leaf(bvh, n.ref[near], n.count[near], p, best);
@@ -92,7 +103,7 @@ SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>&
                 next = n.ref[near];
             }
         }
-        if (d_far < best.distance_squared) {
+        if (may_hold_nearer(d_far, best.distance_squared)) {
             const int far = 1 - near;
             if (bvh_child_is_leaf(n, far)) {
                 stats.test_triangles(n.count[far]);
@@ -109,7 +120,7 @@ SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>&
         // Pop the next subtree still inside the (shrunken) radius.
         while (next < 0 && top > 0) {
             --top;
-            if (stack_d2[top] < best.distance_squared) next = stack_node[top];
+            if (may_hold_nearer(stack_d2[top], best.distance_squared)) next = stack_node[top];
         }
         node = next;
     }

@@ -9,7 +9,7 @@
 /// edge coefficients, c_2i+j = f_i + grad f_i . (v_j - v_i) / 3; the 4 face-centre
 /// coefficients c_i+j+k are exactly the null space of the constraint matrix M of eq. 4-5,
 /// and are linear in the vertex data. Their weights were solved once with Eigen for the
-/// reference tetrahedron (eq. 4-9, cpu_reference/reconstruction/bcc_cubic_tables.h) and
+/// reference tetrahedron (eq. 4-9, core/reconstruction/bcc_cubic_tables.h) and
 /// come in LatticeFieldView::bcc_faces; every tetrahedron reuses them through the symmetry
 /// of bcc_tetrahedron.h, since eq. 4-3 is invariant under signed axis permutations.
 ///
@@ -136,6 +136,8 @@ struct BccCubic {
     SDF_CPU_GPU static constexpr LatticeType lattice_type() { return LatticeType::BCC; }
     SDF_CPU_GPU static constexpr bool uses_first() { return true; }
     SDF_CPU_GPU static constexpr int higher_stride() { return kBccMixedStride; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return PointData::BccCubicJet; }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 4; }
 
     template <typename T>
     SDF_CPU_GPU static DomainBox<T> domain(const LatticeFieldView<T>& v) { return bcc_domain(v); }

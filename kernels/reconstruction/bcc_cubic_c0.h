@@ -31,6 +31,8 @@ struct BccCubicC0 {
     SDF_CPU_GPU static constexpr LatticeType lattice_type() { return LatticeType::BCC; }
     SDF_CPU_GPU static constexpr bool uses_first() { return true; }
     SDF_CPU_GPU static constexpr int higher_stride() { return kBccFullStride; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return PointData::BccCubicC0Jet; }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 4; }
 
     template <typename T>
     SDF_CPU_GPU static DomainBox<T> domain(const LatticeFieldView<T>& v) { return bcc_domain(v); }

@@ -16,6 +16,8 @@ struct BccLinear {
     SDF_CPU_GPU static constexpr LatticeType lattice_type() { return LatticeType::BCC; }
     SDF_CPU_GPU static constexpr bool uses_first() { return false; }
     SDF_CPU_GPU static constexpr int higher_stride() { return 0; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return PointData::Values; }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 3; }
 
     template <typename T>
     SDF_CPU_GPU static DomainBox<T> domain(const LatticeFieldView<T>& v) { return bcc_domain(v); }

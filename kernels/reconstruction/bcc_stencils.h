@@ -5,7 +5,7 @@
 ///
 /// The fit is a = K y, with y the 27 values (in bcc_neighbour_offset order, lattice.h) and
 /// K = (Phi^T W Phi)^-1 Phi^T W (eq. 4-13), a 20 x 27 matrix computed once on the host with
-/// Eigen (cpu_reference/reconstruction/bcc_least_squares.h). A derivative at the centre is
+/// Eigen (core/reconstruction/bcc_least_squares.h). A derivative at the centre is
 /// one row of K (eq. 4-14): fx = K[x], fyz = K[yz], fxx = 2 K[x^2], ...: the stencils.
 /// Coordinates are the integer lattice units of Figure 4-2 (h/2), so derivatives come out
 /// per h/2, the unit LatticeFieldView stores.

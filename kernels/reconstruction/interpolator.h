@@ -17,6 +17,8 @@
 ///   static LatticeType lattice_type();  // CC or BCC
 ///   static bool uses_first();           // reads LatticeFieldView::first
 ///   static int higher_stride();         // LatticeFieldView::higher entries it reads per point
+///   static PointData point_data();      // which per-point arrays core/reconstruction builds
+///   static int min_resolution();        // primary lattice points per axis it needs
 ///   template <typename T> static DomainBox<T> domain(const LatticeFieldView<T>&);
 ///   template <typename T> static ReconstructedSample<T> evaluate(const LatticeFieldView<T>&,
 ///                                                                const Vec3<T>& p);
@@ -30,6 +32,16 @@
 #include "kernels/core/vec3.h"
 
 namespace sdf {
+
+/// The per-point arrays of a LatticeFieldView that an interpolator reads beyond the values;
+/// core/reconstruction/hermite_data builds them with one case per enumerator (a new layout
+/// without its case is a -Wswitch warning, an error in developers' builds).
+enum class PointData {
+    Values,         ///< the lattice values alone
+    CcTricubicJet,  ///< CC: gradient and the cross derivatives fxy, fxz, fyz, fxyz (Lekien-Marsden)
+    BccCubicJet,    ///< BCC: gradient and the mixed second derivatives (thesis eq. 4-3..4-9)
+    BccCubicC0Jet,  ///< BCC: gradient and all second derivatives, face-local centre data
+};
 
 template <typename T>
 struct ReconstructedSample {

@@ -2,7 +2,7 @@
 /// @brief The POD that every interpolator reads: lattice geometry, the sampled values and the
 /// per-point derivative arrays ("Hermite data") that the chosen derivative source produced.
 ///
-/// The view owns nothing; the host (cpu_reference/reconstruction/hermite_data.h) or a CUDA
+/// The view owns nothing; the host (core/reconstruction/hermite_data.h) or a CUDA
 /// uploader fills the arrays and points the view at them. All derivatives are stored per
 /// *lattice unit* u, where world = origin + unit * u: unit = h on CC (a cell is [0,1]^3) and
 /// unit = h/2 on BCC (integer coordinates of lattice.h, neighbours at (+-1,+-1,+-1) and

@@ -113,6 +113,8 @@ struct TricubicLekienMarsden {
     SDF_CPU_GPU static constexpr LatticeType lattice_type() { return LatticeType::CC; }
     SDF_CPU_GPU static constexpr bool uses_first() { return true; }
     SDF_CPU_GPU static constexpr int higher_stride() { return kCcHigherStride; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return PointData::CcTricubicJet; }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 3; }
 
     template <typename T>
     SDF_CPU_GPU static DomainBox<T> domain(const LatticeFieldView<T>& v) { return cc_domain(v); }

@@ -19,7 +19,7 @@
 #include "core/mesh/load_obj.h"
 #include "core/parallel/parallel_for.h"
 #include "harness/build_config.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 namespace {
@@ -38,13 +38,13 @@ std::shared_ptr<PreparedMesh> load(const std::string& file) {
     return cache[file] = nullptr;
 }
 
-Lattice cubic_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds, 0.1); }
+Lattice cubic_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds(), 0.1); }
 
 void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Lattice& lattice, const SampledField& f) {
     const double points = double(lattice.num_points());
     state.counters["queries/s"] = benchmark::Counter(points * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["points"] = points;
-    state.counters["triangles"] = double(mesh.triangles.size());
+    state.counters["triangles"] = double(mesh.triangles().size());
     if (f.sampler.contains("bvh") && f.sampler["bvh"].contains("node_visits_per_point")) {
         state.counters["nodes/pt"] = f.sampler["bvh"]["node_visits_per_point"].get<double>();
         state.counters["tris/pt"] = f.sampler["bvh"]["point_triangle_tests_per_point"].get<double>();
@@ -78,7 +78,7 @@ void BM_BvhBuild(benchmark::State& state, const std::string& file) {
     const auto mesh = load(file);
     if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
     for (auto _ : state) benchmark::DoNotOptimize(build_triangle_bvh(*mesh).nodes.data());
-    state.counters["triangles"] = double(mesh->triangles.size());
+    state.counters["triangles"] = double(mesh->triangles().size());
 }
 
 void BM_CudaBvh(benchmark::State& state, const std::string& file) {

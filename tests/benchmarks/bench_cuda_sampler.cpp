@@ -8,7 +8,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "harness/config/mesh_spec.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 
 namespace sdf {
 namespace {
@@ -35,7 +35,7 @@ void run(benchmark::State& state, const Case& c, const std::string& kernel, int 
     }
     state.counters["pairs/s"] = benchmark::Counter(pairs * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["points"] = double(c.lattice.num_points());
-    state.counters["triangles"] = double(c.mesh->triangles.size());
+    state.counters["triangles"] = double(c.mesh->triangles().size());
 }
 
 std::vector<Case> cases() {

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "core/lattice/lattice_fitting.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
@@ -33,11 +33,11 @@ void print(const std::string& what, const test::Agreement& a, const SampledField
 
 TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
-        const bool big = m.mesh.triangles.size() > 20000;
+        const bool big = m.mesh.triangles().size() > 20000;
         for (Precision precision : {Precision::Float, Precision::Double}) {
             const int r = big ? (precision == Precision::Double ? 12 : 20) : 28;
-            const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds, 0.1);
-            const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds, 0.1);
+            const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds(), 0.1);
+            const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds(), 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
                 const SampledField cpu = make_sampler(options("cpu", "brute_force", precision))->sample(m.mesh, lattice);
                 for (const char* kernel : {"brick", "seeded", "unseeded", "warp"})
@@ -59,7 +59,7 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
 
 TEST(CudaBvh, SlabsDoNotChangeTheResult) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
-    const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 25, 26}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 25, 26}, mesh.bounds(), 0.1);
     SamplerOptions o = options("cuda", "bvh", Precision::Float);
     const SampledField whole = make_sampler(o)->sample(mesh, lattice);
     o.max_points_per_piece = 1000;  // a few z-layers per slab
@@ -74,7 +74,7 @@ TEST(CudaBvh, PointQueriesEqualTheCpu) {
         std::mt19937_64 rng(3);
         std::uniform_real_distribution<double> u(-0.75, 0.75);
         std::vector<Vec3d> pts(4001);
-        for (auto& p : pts) p = m.mesh.bounds.center() + component_mul(m.mesh.bounds.extent(), Vec3d{u(rng), u(rng), u(rng)});
+        for (auto& p : pts) p = m.mesh.bounds().center() + component_mul(m.mesh.bounds().extent(), Vec3d{u(rng), u(rng), u(rng)});
         for (Precision precision : {Precision::Float, Precision::Double}) {
             const auto cpu = make_sampler(options("cpu", "bvh", precision))->query(m.mesh, pts);
             const auto gpu = make_sampler(options("cuda", "bvh", precision))->query(m.mesh, pts);
@@ -87,7 +87,7 @@ TEST(CudaBvh, PointQueriesEqualTheCpu) {
 
 TEST(CudaBvh, RepeatedCallsReuseTheUploadedBvh) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
-    const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, mesh.bounds(), 0.1);
     auto sampler = make_sampler(options("cuda", "bvh", Precision::Float));
     const SampledField first = sampler->sample(mesh, lattice);
     const SampledField second = sampler->sample(mesh, lattice);

@@ -9,7 +9,7 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/config/mesh_spec.h"
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 
 namespace sdf {
@@ -43,15 +43,15 @@ const std::vector<NamedMesh>& test_meshes() {
 
 /// Prepared-mesh index of each file-order triangle index.
 std::vector<int> prepared_index(const PreparedMesh& m) {
-    std::vector<int> inverse(size_t(m.report.input_triangles), -1);
-    for (size_t i = 0; i < m.source_triangle.size(); ++i) inverse[size_t(m.source_triangle[i])] = int(i);
+    std::vector<int> inverse(size_t(m.report().input_triangles), -1);
+    for (size_t i = 0; i < m.source_triangle().size(); ++i) inverse[size_t(m.source_triangle()[i])] = int(i);
     return inverse;
 }
 
 double distance_to(const PreparedMesh& m, const Vec3d& p, int prepared) {
-    const Int3 t = m.triangles[size_t(prepared)];
-    return std::sqrt(closest_point_on_triangle(p, m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
-                                               m.vertices[size_t(t.z)]).distance_squared);
+    const Int3 t = m.triangles()[size_t(prepared)];
+    return std::sqrt(closest_point_on_triangle(p, m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
+                                               m.vertices()[size_t(t.z)]).distance_squared);
 }
 
 struct Agreement {
@@ -61,7 +61,7 @@ struct Agreement {
 
 /// Compares a GPU field with the CPU reference point by point.
 Agreement compare(const PreparedMesh& mesh, const SampledField& cpu, const SampledField& gpu, const std::string& what) {
-    const double diag = mesh.bounds.diagonal(), tol = 1e-5 * diag;
+    const double diag = mesh.bounds().diagonal(), tol = 1e-5 * diag;
     const std::vector<int> index = prepared_index(mesh);
     Agreement a;
     EXPECT_EQ(cpu.size(), gpu.size()) << what;
@@ -106,19 +106,19 @@ SampledField sample(const PreparedMesh& mesh, const Lattice& lattice, const std:
 
 TEST(CudaSampler, BothKernelsAgreeWithTheCpuReferenceOnEveryMesh) {
     for (const NamedMesh& m : test_meshes()) {
-        const bool big = m.mesh.triangles.size() > 50000;
-        const Lattice cc = fit_lattice(LatticeType::CC, big ? Int3{32, 32, 32} : Int3{40, 36, 33}, m.mesh.bounds, 0.1);
-        const Lattice bcc = fit_lattice(LatticeType::BCC, big ? Int3{26, 26, 26} : Int3{31, 29, 27}, m.mesh.bounds, 0.1);
+        const bool big = m.mesh.triangles().size() > 50000;
+        const Lattice cc = fit_lattice(LatticeType::CC, big ? Int3{32, 32, 32} : Int3{40, 36, 33}, m.mesh.bounds(), 0.1);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, big ? Int3{26, 26, 26} : Int3{31, 29, 27}, m.mesh.bounds(), 0.1);
         for (const Lattice& lattice : {cc, bcc}) {
             const SampledField cpu = sample(m.mesh, lattice, "cpu", "vectorized");
             for (const char* kernel : {"thesis", "tuned"})
                 for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                     if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
-                    const std::string what = m.name + " " + lattice_notation(lattice) + " " + kernel + " " + bcc_strategy_name(s);
+                    const std::string what = m.name() + " " + lattice_notation(lattice) + " " + kernel + " " + bcc_strategy_name(s);
                     const SampledField gpu = sample(m.mesh, lattice, "cuda", kernel, s);
                     const Agreement a = compare(m.mesh, cpu, gpu, what);
                     std::printf("%-44s max|dd| = %.3g (%.2g of diag), triangle ties %d, sign ties %d, %.3g pairs/s\n",
-                                what.c_str(), a.max_abs_distance, a.max_abs_distance / m.mesh.bounds.diagonal(),
+                                what.c_str(), a.max_abs_distance, a.max_abs_distance / m.mesh.bounds().diagonal(),
                                 a.triangle_ties, a.sign_ties, gpu.timings.pairs_per_second());
                 }
         }
@@ -127,18 +127,18 @@ TEST(CudaSampler, BothKernelsAgreeWithTheCpuReferenceOnEveryMesh) {
 
 TEST(CudaSampler, DoublePrecisionMatchesTheCpuInDouble) {
     const PreparedMesh& mesh = test_meshes()[4].mesh;  // soccer ball
-    const Lattice lattice = fit_lattice(LatticeType::BCC, {20, 21, 22}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {20, 21, 22}, mesh.bounds(), 0.1);
     const SampledField cpu = sample(mesh, lattice, "cpu", "", BccStrategy::TwoGrids, Precision::Double);
     for (const char* kernel : {"thesis", "tuned"}) {
         const SampledField gpu = sample(mesh, lattice, "cuda", kernel, BccStrategy::TwoGrids, Precision::Double);
         for (int64_t i = 0; i < cpu.size(); ++i)
-            ASSERT_NEAR(gpu.distance[size_t(i)], cpu.distance[size_t(i)], 1e-12 * mesh.bounds.diagonal()) << kernel << " " << i;
+            ASSERT_NEAR(gpu.distance[size_t(i)], cpu.distance[size_t(i)], 1e-12 * mesh.bounds().diagonal()) << kernel << " " << i;
     }
 }
 
 TEST(CudaSampler, SplittingLatticesAndMeshesDoesNotChangeTheResult) {
     const PreparedMesh& mesh = test_meshes()[4].mesh;
-    const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 24, 24}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 24, 24}, mesh.bounds(), 0.1);
     for (const char* kernel : {"thesis", "tuned"}) {
         const SampledField whole = sample(mesh, lattice, "cuda", kernel);
         SamplerOptions o;
@@ -160,7 +160,7 @@ TEST(CudaSampler, PointQueriesMatchTheCpu) {
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> u(-0.8, 0.8);
     std::vector<Vec3d> pts(5001);
-    for (auto& p : pts) p = mesh.bounds.center() + Vec3d{u(rng), u(rng), u(rng)};
+    for (auto& p : pts) p = mesh.bounds().center() + Vec3d{u(rng), u(rng), u(rng)};
     SamplerOptions o;
     o.progress = false;
     const auto cpu = make_sampler(o)->query(mesh, pts);
@@ -170,7 +170,7 @@ TEST(CudaSampler, PointQueriesMatchTheCpu) {
         const auto gpu = make_sampler(o)->query(mesh, pts);
         ASSERT_EQ(gpu.size(), pts.size());
         for (size_t i = 0; i < pts.size(); ++i)
-            ASSERT_NEAR(gpu[i].distance, cpu[i].distance, 1e-5 * mesh.bounds.diagonal()) << kernel << " " << i;
+            ASSERT_NEAR(gpu[i].distance, cpu[i].distance, 1e-5 * mesh.bounds().diagonal()) << kernel << " " << i;
     }
 }
 

@@ -38,8 +38,8 @@ const std::vector<FieldCase>& fields() {
         SamplerOptions so;
         so.progress = false;
         auto sampler = make_cpu_brute_force_sampler(so);
-        c.push_back({"pawn", sampler->sample(pawn, fit_lattice(LatticeType::CC, {40, 40, 40}, pawn.bounds, 0.1)),
-                     sampler->sample(pawn, fit_lattice(LatticeType::BCC, {32, 32, 32}, pawn.bounds, 0.1)), pawn.bounds});
+        c.push_back({"pawn", sampler->sample(pawn, fit_lattice(LatticeType::CC, {40, 40, 40}, pawn.bounds(), 0.1)),
+                     sampler->sample(pawn, fit_lattice(LatticeType::BCC, {32, 32, 32}, pawn.bounds(), 0.1)), pawn.bounds()});
         return c;
     }();
     return cases;
@@ -110,7 +110,7 @@ TEST(CudaRaycast, ReportsKernelTimesOfA1024SquaredBccCubicRender) {
     RenderOptions gpu;
     gpu.backend = "cuda";
     gpu.repetitions = 20;
-    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds, 1024, 1024);
+    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds(), 1024, 1024);
     const RenderedImage image = render_reconstruction(recon, camera, gpu);
     ASSERT_EQ(image.info["kernel_seconds_all"].size(), 20u);
     EXPECT_GT(image.info["kernel_seconds"].get<double>(), 0.0);

@@ -27,7 +27,7 @@
 #error "RUN_EXPERIMENT_EXE must be defined by CMake"
 #endif
 
-#include "harness/sampling/make_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #include "harness_test_util.h"
 
 namespace sdf {

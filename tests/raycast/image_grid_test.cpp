@@ -167,13 +167,13 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     SamplerOptions so;
     so.progress = false;
     auto sampler = make_cpu_brute_force_sampler(so);
-    const SampledField cc = sampler->sample(mesh, fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds, 0.1));
-    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {16, 16, 16}, mesh.bounds, 0.1));
+    const SampledField cc = sampler->sample(mesh, fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds(), 0.1));
+    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {16, 16, 16}, mesh.bounds(), 0.1));
     FigureOptions options;
     options.render.progress = false;
     options.mesh.progress = false;
     options.title = "pawn";
-    const CameraSpec camera = resolve_view(named_view("front"), mesh.bounds, 48, 64);
+    const CameraSpec camera = resolve_view(named_view("front"), mesh.bounds(), 48, 64);
     const ThesisFigure f = render_thesis_figure(cc, bcc, &mesh, camera, options);
     ASSERT_EQ(f.panels.size(), 5u);
     const char* letters[] = {"A", "B", "C", "D", "E"};

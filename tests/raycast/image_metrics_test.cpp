@@ -31,7 +31,7 @@ TEST(ImageMetrics, ARenderComparedWithItselfIsZero) {
     MeshRenderOptions options;
     options.progress = false;
     const RenderedImage image =
-        render_mesh_reference(mesh, resolve_view(named_view("three_quarter"), mesh.bounds, 64, 48), options);
+        render_mesh_reference(mesh, resolve_view(named_view("three_quarter"), mesh.bounds(), 64, 48), options);
     const ImageMetrics m = compare_images(image, image, 0.01);
     EXPECT_GT(m.hit_both, 200);
     EXPECT_EQ(m.hit_both, m.hit_test);

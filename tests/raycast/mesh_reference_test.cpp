@@ -27,9 +27,9 @@ TEST(MeshReference, IcosphereMatchesTheAnalyticSphereSilhouette) {
     const test::Sphere sphere;
     const PreparedMesh mesh = prepare_mesh(make_icosphere(5, sphere.radius, sphere.centre));
     double sagitta = 0;
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-        const Vec3d a = mesh.vertices[size_t(mesh.triangles[t].x)];
-        sagitta = std::max(sagitta, sphere.radius - std::abs(dot(a - sphere.centre, mesh.face_normals[t])));
+    for (size_t t = 0; t < mesh.triangles().size(); ++t) {
+        const Vec3d a = mesh.vertices()[size_t(mesh.triangles()[t].x)];
+        sagitta = std::max(sagitta, sphere.radius - std::abs(dot(a - sphere.centre, mesh.face_normals()[t])));
     }
     const CameraSpec camera = resolve_view(named_view("three_quarter"), sphere.bounds(), kSize, kSize);
     MeshRenderOptions options;
@@ -92,7 +92,7 @@ TEST(MeshReference, InterpolatedNormalsAreSmootherThanFaceNormals) {
 TEST(MeshReference, BvhTraversalFindsTheBruteForceClosestHit) {
     // Every pixel's triangle and depth equal the closest watertight hit over all triangles
     const PreparedMesh mesh = prepare_mesh(make_pawn());
-    const CameraSpec camera = resolve_view(named_view("three_quarter"), mesh.bounds, 48, 48);
+    const CameraSpec camera = resolve_view(named_view("three_quarter"), mesh.bounds(), 48, 48);
     const MeshReferenceRenderer renderer(mesh);
     const PinholeCamera<double> pinhole = make_camera(camera);
     const Vec3d key = key_light_direction(pinhole);
@@ -104,10 +104,10 @@ TEST(MeshReference, BvhTraversalFindsTheBruteForceClosestHit) {
             const PixelRecord p = renderer.cast(ray, key, false, &triangle);
             const WatertightRay<double> w = make_watertight_ray(ray);
             double best = std::numeric_limits<double>::infinity();
-            for (const Int3& t : mesh.triangles) {
+            for (const Int3& t : mesh.triangles()) {
                 TriangleHit<double> h;
-                if (intersect_watertight(w, mesh.vertices[size_t(t.x)], mesh.vertices[size_t(t.y)],
-                                         mesh.vertices[size_t(t.z)], best, &h))
+                if (intersect_watertight(w, mesh.vertices()[size_t(t.x)], mesh.vertices()[size_t(t.y)],
+                                         mesh.vertices()[size_t(t.z)], best, &h))
                     best = h.t;
             }
             ASSERT_EQ(p.is_hit(), best < std::numeric_limits<double>::infinity()) << x << "," << y;
@@ -125,9 +125,9 @@ TEST(MeshReference, WatertightTestHasNoCracksAlongSharedEdges) {
     const MeshReferenceRenderer renderer(mesh);
     const Vec3d eye{0.31, 2.7, 3.3};
     int misses = 0, rays = 0;
-    for (const Int3& t : mesh.triangles)
+    for (const Int3& t : mesh.triangles())
         for (int k = 0; k < 3; ++k) {
-            const Vec3d a = mesh.vertices[size_t(t[k])], b = mesh.vertices[size_t(t[(k + 1) % 3])];
+            const Vec3d a = mesh.vertices()[size_t(t[k])], b = mesh.vertices()[size_t(t[(k + 1) % 3])];
             for (const Vec3d target : {a, (a + b) * 0.5, a * 0.25 + b * 0.75}) {
                 const Ray<double> ray{eye, normalize_or_zero(target - eye)};
                 if (dot(ray.direction, normalize_or_zero(target)) > -0.5) continue;  // no grazing rays

@@ -76,7 +76,7 @@ HermiteData<double> random_bcc_data(InterpolatorKind kind) {
         d.first.emplace_back(u(rng), u(rng), u(rng));
         for (int k = 0; k < kBccFullStride; ++k) d.higher.push_back(u(rng));
     }
-    d.faces = to_face_table<double>(kind == InterpolatorKind::BccCubicC0 ? bcc_cubic_c0_face_weights()
+    d.faces = to_face_table<double>(kind == kind_of<BccCubicC0>() ? bcc_cubic_c0_face_weights()
                                                                          : bcc_cubic_face_weights());
     return d;
 }
@@ -87,8 +87,8 @@ void print(const char* what, const Jumps& j) {
 }
 
 TEST(Continuity, RandomData) {
-    const HermiteData<double> faithful = random_bcc_data(InterpolatorKind::BccCubic);
-    const HermiteData<double> c0 = random_bcc_data(InterpolatorKind::BccCubicC0);
+    const HermiteData<double> faithful = random_bcc_data(kind_of<BccCubic>());
+    const HermiteData<double> c0 = random_bcc_data(kind_of<BccCubicC0>());
     const Jumps jl = measure_jumps<BccLinear>(faithful.view(), 4000, 1);
     const Jumps jf = measure_jumps<BccCubic>(faithful.view(), 4000, 1);
     const Jumps jc = measure_jumps<BccCubicC0>(c0.view(), 4000, 1);
@@ -109,8 +109,8 @@ TEST(Continuity, SmoothData) {
             const Lattice l = lattice_spanning(LatticeType::BCC, {intervals + 1, intervals + 1, intervals + 1},
                                                Vec3d(0.0), Vec3d(1.0));
             const SampledField field = sample_analytic_field(l, TrigFunction<double>{2.0});
-            const Reconstruction faithful(field, {InterpolatorKind::BccCubic, src});
-            const Reconstruction c0(field, {InterpolatorKind::BccCubicC0, src});
+            const Reconstruction faithful(field, {kind_of<BccCubic>(), src});
+            const Reconstruction c0(field, {kind_of<BccCubicC0>(), src});
             const Jumps jf = measure_jumps<BccCubic>(faithful.view(), 3000, 2);
             const Jumps jc = measure_jumps<BccCubicC0>(c0.view(), 3000, 2);
             const std::string tag = "h = 1/" + std::to_string(intervals) + ", " + derivative_source_name(src) + ", ";

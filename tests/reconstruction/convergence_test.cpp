@@ -39,10 +39,10 @@ Errors measure(const ReconstructionSpec& spec, int intervals) {
 
 double expected_order(const ReconstructionSpec& s) {
     switch (s.interpolator) {
-        case InterpolatorKind::Trilinear:
-        case InterpolatorKind::BccLinear: return 2;
-        case InterpolatorKind::CatmullRom: return 3;
-        case InterpolatorKind::TricubicLM: return s.derivatives == DerivativeSource::True ? 4 : 3;
+        case kind_of<Trilinear>():
+        case kind_of<BccLinear>(): return 2;
+        case kind_of<CatmullRom>(): return 3;
+        case kind_of<TricubicLekienMarsden>(): return s.derivatives == DerivativeSource::True ? 4 : 3;
         default: return 4;
     }
 }

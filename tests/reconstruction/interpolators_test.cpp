@@ -60,7 +60,7 @@ TEST(Interpolators, ReproduceTheLatticeValues) {
 
 TEST(Interpolators, CubicSchemesReproduceEveryCubicGivenExactDerivatives) {
     std::mt19937 rng(31);
-    for (InterpolatorKind k : {InterpolatorKind::TricubicLM, InterpolatorKind::BccCubic, InterpolatorKind::BccCubicC0}) {
+    for (InterpolatorKind k : {kind_of<TricubicLekienMarsden>(), kind_of<BccCubic>(), kind_of<BccCubicC0>()}) {
         for (int trial = 0; trial < 3; ++trial) {
             const CubicPolynomial<double> p = test::random_cubic(rng);
             const HermiteData<double> d = test::exact_hermite_data(lattice_for(k), k, p);
@@ -80,9 +80,9 @@ TEST(Interpolators, EveryDerivativeSourceOfTheCubicSchemesReproducesCubics) {
     std::mt19937 rng(32);
     const CubicPolynomial<double> p = test::random_cubic(rng);
     for (const ReconstructionSpec& spec : test::all_valid_specs()) {
-        const bool cubic = spec.interpolator == InterpolatorKind::BccCubic ||
-                           spec.interpolator == InterpolatorKind::BccCubicC0 ||
-                           (spec.interpolator == InterpolatorKind::TricubicLM && spec.derivatives == DerivativeSource::True);
+        const bool cubic = spec.interpolator == kind_of<BccCubic>() ||
+                           spec.interpolator == kind_of<BccCubicC0>() ||
+                           (spec.interpolator == kind_of<TricubicLekienMarsden>() && spec.derivatives == DerivativeSource::True);
         if (!cubic) continue;
         const Reconstruction r(sample_analytic_field(lattice_for(spec.interpolator), p), spec);
         const Worst w = probe(r, p, 1000, 33);
@@ -109,8 +109,8 @@ TEST(Interpolators, LowerOrderSchemesReproduceTheirPolynomials) {
     };
     // trilinear: the trilinear span; bcc_linear: linear; Catmull-Rom and tricubic_lm with
     // central differences: every polynomial of degree 2 per axis... (quadratic precision)
-    for (const Case& c : {Case{InterpolatorKind::Trilinear, 1, 3}, Case{InterpolatorKind::BccLinear, 1, 1},
-                          Case{InterpolatorKind::CatmullRom, 2, 6}, Case{InterpolatorKind::TricubicLM, 2, 6}}) {
+    for (const Case& c : {Case{kind_of<Trilinear>(), 1, 3}, Case{kind_of<BccLinear>(), 1, 1},
+                          Case{kind_of<CatmullRom>(), 2, 6}, Case{kind_of<TricubicLekienMarsden>(), 2, 6}}) {
         const TricubicPolynomial<double> p = restricted_polynomial(rng, c.per_axis, c.total);
         ReconstructionSpec spec{c.kind, DerivativeSource::FiniteDifferences};
         const Reconstruction r(sample_analytic_field(lattice_for(c.kind), p), spec);
@@ -122,8 +122,8 @@ TEST(Interpolators, LowerOrderSchemesReproduceTheirPolynomials) {
 
 TEST(Interpolators, CatmullRomEqualsTricubicWithCentralDifferences) {
     const SampledField field = sample_analytic_field(kCc, TrigFunction<double>{4.0});
-    const Reconstruction cr(field, {InterpolatorKind::CatmullRom, DerivativeSource::FiniteDifferences});
-    const Reconstruction lm(field, {InterpolatorKind::TricubicLM, DerivativeSource::FiniteDifferences});
+    const Reconstruction cr(field, {kind_of<CatmullRom>(), DerivativeSource::FiniteDifferences});
+    const Reconstruction lm(field, {kind_of<TricubicLekienMarsden>(), DerivativeSource::FiniteDifferences});
     std::mt19937 rng(36);
     for (const Vec3d& p : test::random_points(rng, cr.domain(), 2000)) {
         const auto a = cr.evaluate(p), b = lm.evaluate(p);

@@ -31,7 +31,7 @@ TEST(LekienMarsden, ReproducesEveryTricubicFromExactHermiteData) {
     const Lattice l = test::make_lattice(LatticeType::CC, {5, 4, 6}, 0.3);
     for (int trial = 0; trial < 5; ++trial) {
         const TricubicPolynomial<double> p = test::random_tricubic(rng);
-        const HermiteData<double> d = test::exact_hermite_data(l, InterpolatorKind::TricubicLM, p);
+        const HermiteData<double> d = test::exact_hermite_data(l, kind_of<TricubicLekienMarsden>(), p);
         const LatticeFieldView<double> v = d.view();
         for (const Vec3d& x : test::random_points(rng, TricubicLekienMarsden::domain(v), 200)) {
             const ReconstructedSample<double> got = TricubicLekienMarsden::evaluate(v, x);
@@ -46,7 +46,7 @@ TEST(LekienMarsden, ReproducesEveryTricubicFromExactHermiteData) {
 TEST(LekienMarsden, MatrixPathEqualsFactoredEvaluation) {
     std::mt19937 rng(22);
     const Lattice l = test::make_lattice(LatticeType::CC, {4, 4, 4}, 0.5);
-    HermiteData<double> d = test::exact_hermite_data(l, InterpolatorKind::TricubicLM, TrigFunction<double>{2.0});
+    HermiteData<double> d = test::exact_hermite_data(l, kind_of<TricubicLekienMarsden>(), TrigFunction<double>{2.0});
     const LatticeFieldView<double> v = d.view();
     for (const Vec3d& x : test::random_points(rng, TricubicLekienMarsden::domain(v), 100)) {
         const CcCell<double> cell = cc_cell_at(v, x);

@@ -49,18 +49,18 @@ TEST(ReconstructionApi, RejectsMeaninglessCombinationsWithClearMessages) {
     const SampledField bcc = sample_analytic_field(kBcc, TrigFunction<double>{});
     using K = InterpolatorKind;
     using S = DerivativeSource;
-    const std::string wrong_lattice = rejection(bcc, {K::CatmullRom, S::FiniteDifferences});
+    const std::string wrong_lattice = rejection(bcc, {kind_of<CatmullRom>(), S::FiniteDifferences});
     EXPECT_NE(wrong_lattice.find("needs a CC field; this field is BCC"), std::string::npos) << wrong_lattice;
-    EXPECT_NE(rejection(cc, {K::BccCubic, S::True}).find("needs a BCC field"), std::string::npos);
-    const std::string no_gradient = rejection(values_only(kBcc), {K::BccCubic, S::True});
+    EXPECT_NE(rejection(cc, {kind_of<BccCubic>(), S::True}).find("needs a BCC field"), std::string::npos);
+    const std::string no_gradient = rejection(values_only(kBcc), {kind_of<BccCubic>(), S::True});
     EXPECT_NE(no_gradient.find("need the field's gradient channel"), std::string::npos) << no_gradient;
-    const std::string weighted_cc = rejection(cc, {K::TricubicLM, S::FiniteDifferencesWeighted});
+    const std::string weighted_cc = rejection(cc, {kind_of<TricubicLekienMarsden>(), S::FiniteDifferencesWeighted});
     EXPECT_NE(weighted_cc.find("does not accept derivatives 'fd_weighted'"), std::string::npos) << weighted_cc;
-    EXPECT_NE(rejection(cc, {K::Trilinear, S::True}).find("reads no derivative data"), std::string::npos);
-    EXPECT_NE(rejection(bcc, {K::BccLinear, S::FiniteDifferencesWeighted}).find("expected fd"), std::string::npos);
+    EXPECT_NE(rejection(cc, {kind_of<Trilinear>(), S::True}).find("reads no derivative data"), std::string::npos);
+    EXPECT_NE(rejection(bcc, {kind_of<BccLinear>(), S::FiniteDifferencesWeighted}).find("expected fd"), std::string::npos);
     const SampledField tiny = sample_analytic_field(test::make_lattice(LatticeType::BCC, {3, 5, 5}, 0.2), TrigFunction<double>{});
-    EXPECT_NE(rejection(tiny, {K::BccCubic, S::FiniteDifferences}).find("at least 4"), std::string::npos);
-    EXPECT_EQ(rejection(tiny, {K::BccLinear, S::FiniteDifferences}), "(accepted)");
+    EXPECT_NE(rejection(tiny, {kind_of<BccCubic>(), S::FiniteDifferences}).find("at least 4"), std::string::npos);
+    EXPECT_EQ(rejection(tiny, {kind_of<BccLinear>(), S::FiniteDifferences}), "(accepted)");
 }
 
 TEST(ReconstructionApi, DefaultDerivativeSource) {

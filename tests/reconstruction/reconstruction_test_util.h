@@ -65,8 +65,8 @@ HermiteData<double> exact_hermite_data(const Lattice& l, InterpolatorKind kind, 
                 for (double x : {h.xx, h.yy, h.zz}) d.higher.push_back(x * u * u);
         }
     }
-    if (kind == InterpolatorKind::BccCubic) d.faces = to_face_table<double>(bcc_cubic_face_weights());
-    if (kind == InterpolatorKind::BccCubicC0) d.faces = to_face_table<double>(bcc_cubic_c0_face_weights());
+    if (kind == kind_of<BccCubic>()) d.faces = to_face_table<double>(bcc_cubic_face_weights());
+    if (kind == kind_of<BccCubicC0>()) d.faces = to_face_table<double>(bcc_cubic_c0_face_weights());
     return d;
 }
 

@@ -16,7 +16,7 @@ namespace sdf {
 namespace {
 
 AnalyticStudyResult run(DerivativeSource source, SigmaUnits units, double margin,
-                        InterpolatorKind kind = InterpolatorKind::BccCubic) {
+                        InterpolatorKind kind = kind_of<BccCubic>()) {
     AnalyticStudySpec spec;  // marschner_lobb, BCC {111, 111, 111} over [-1,1]^3, 256^3 probes
     spec.reconstruction.interpolator = kind;
     spec.reconstruction.derivatives = source;
@@ -39,7 +39,7 @@ TEST(Table41, MarschnerLobbPlainVersusWeightedLeastSquares) {
         if (margin == 0)
             for (DerivativeSource s : {DerivativeSource::True, DerivativeSource::FiniteDifferences,
                                        DerivativeSource::FiniteDifferencesWeighted})
-                run(s, SigmaUnits::LatticeUnits, margin, InterpolatorKind::BccCubicC0);
+                run(s, SigmaUnits::LatticeUnits, margin, kind_of<BccCubicC0>());
         std::printf("  ratio weighted / plain (RMS): sigma^2 = 0.5 (h/2)^2: %.4f, sigma^2 = 0.5 h^2: %.4f (thesis 0.976)\n",
                     lattice.rms / plain.rms, spacing.rms / plain.rms);
         EXPECT_EQ(plain.lattice, "111x111x222");

@@ -148,16 +148,16 @@ TEST(LoadObjData, BunnyIsClosedAndTheOpenBunnyHas223BoundaryEdges) {
     EXPECT_EQ(closed_mesh.vertices.size(), 34834u);
     EXPECT_EQ(closed_mesh.triangles.size(), 69664u);
     const PreparedMesh closed = prepare_mesh(closed_mesh);
-    EXPECT_TRUE(closed.report.sign_reliable());
-    EXPECT_EQ(closed.report.components, 1);
-    EXPECT_FALSE(closed.report.flipped);
-    EXPECT_NEAR(closed.report.signed_volume, 0.000754759, 1e-9);  // meshes/README.md
+    EXPECT_TRUE(closed.report().sign_reliable());
+    EXPECT_EQ(closed.report().components, 1);
+    EXPECT_FALSE(closed.report().flipped);
+    EXPECT_NEAR(closed.report().signed_volume, 0.000754759, 1e-9);  // meshes/README.md
 
     const PreparedMesh open_mesh = prepare_mesh(load_obj(open));
-    EXPECT_EQ(open_mesh.report.input_triangles, 69451);
-    EXPECT_EQ(open_mesh.report.boundary_edges, 223);
-    EXPECT_EQ(open_mesh.report.nonmanifold_edges, 0);
-    EXPECT_TRUE(open_mesh.report.consistently_oriented());
+    EXPECT_EQ(open_mesh.report().input_triangles, 69451);
+    EXPECT_EQ(open_mesh.report().boundary_edges, 223);
+    EXPECT_EQ(open_mesh.report().nonmanifold_edges, 0);
+    EXPECT_TRUE(open_mesh.report().consistently_oriented());
     bool warned = false;
     for (const std::string& w : open_mesh.warnings()) warned |= w.find("open") != std::string::npos;
     EXPECT_TRUE(warned);

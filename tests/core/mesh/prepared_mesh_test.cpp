@@ -52,10 +52,10 @@ TEST(PreparedMesh, PseudonormalsAreUnitLength) {
     for (const TriangleMesh& mesh : {make_box({1.0, 2.0, 0.5}), make_icosphere(2), make_torus(1.0, 0.35, 16, 8),
                                      make_pawn(), make_soccer_ball(1)}) {
         const PreparedMesh m = prepare_mesh(mesh);
-        ASSERT_EQ(m.face_normals.size(), m.triangles.size());
-        ASSERT_EQ(m.edge_normals.size(), 3 * m.triangles.size());
-        ASSERT_EQ(m.vertex_normals.size(), m.vertices.size());
-        for (const auto* normals : {&m.face_normals, &m.edge_normals, &m.vertex_normals})
+        ASSERT_EQ(m.face_normals().size(), m.triangles().size());
+        ASSERT_EQ(m.edge_normals().size(), 3 * m.triangles().size());
+        ASSERT_EQ(m.vertex_normals().size(), m.vertices().size());
+        for (const auto* normals : {&m.face_normals(), &m.edge_normals(), &m.vertex_normals()})
             for (const Vec3d& n : *normals) ASSERT_NEAR(length(n), 1.0, 1e-12) << mesh.name;
     }
 }
@@ -66,11 +66,11 @@ TEST(PreparedMesh, PseudonormalsAreUnitLength) {
 TEST(PreparedMesh, BoxCornerPseudonormalsPointAlongTheDiagonals) {
     const Vec3d center{0.5, -0.25, 2.0};
     const PreparedMesh m = prepare_mesh(make_box({1.0, 2.0, 0.5}, center));
-    ASSERT_EQ(m.vertices.size(), 8u);
+    ASSERT_EQ(m.vertices().size(), 8u);
     const double s = 1.0 / std::sqrt(3.0);
-    for (size_t i = 0; i < m.vertices.size(); ++i) {
-        const Vec3d d = m.vertices[i] - center;
-        expect_near(m.vertex_normals[i], Vec3d{d.x > 0 ? s : -s, d.y > 0 ? s : -s, d.z > 0 ? s : -s}, kExact);
+    for (size_t i = 0; i < m.vertices().size(); ++i) {
+        const Vec3d d = m.vertices()[i] - center;
+        expect_near(m.vertex_normals()[i], Vec3d{d.x > 0 ? s : -s, d.y > 0 ? s : -s, d.z > 0 ? s : -s}, kExact);
     }
 }
 
@@ -78,30 +78,30 @@ TEST(PreparedMesh, BoxCornerPseudonormalsPointAlongTheDiagonals) {
 // face's diagonal both triangles share the face normal.
 TEST(PreparedMesh, BoxEdgePseudonormalsAreNormalisedSumsOfFaceNormals) {
     const PreparedMesh m = prepare_mesh(make_box({1.0, 2.0, 0.5}));
-    ASSERT_EQ(m.triangles.size(), 12u);
+    ASSERT_EQ(m.triangles().size(), 12u);
     // Face normals of the box, from which coordinate its three corners share.
     std::vector<Vec3d> axis_normal;
-    for (const Int3& t : m.triangles) {
-        const Vec3d a = m.vertices[size_t(t.x)], b = m.vertices[size_t(t.y)], c = m.vertices[size_t(t.z)];
+    for (const Int3& t : m.triangles()) {
+        const Vec3d a = m.vertices()[size_t(t.x)], b = m.vertices()[size_t(t.y)], c = m.vertices()[size_t(t.z)];
         Vec3d n(0.0);
         for (int k = 0; k < 3; ++k)
             if (a[k] == b[k] && b[k] == c[k]) n[k] = a[k] > 0 ? 1.0 : -1.0;
         axis_normal.push_back(n);
     }
     std::map<std::pair<int, int>, std::vector<int>> faces_of_edge;
-    for (size_t i = 0; i < m.triangles.size(); ++i)
+    for (size_t i = 0; i < m.triangles().size(); ++i)
         for (int e = 0; e < 3; ++e)
-            faces_of_edge[std::minmax(m.triangles[i][e], m.triangles[i][(e + 1) % 3])].push_back(int(i));
+            faces_of_edge[std::minmax(m.triangles()[i][e], m.triangles()[i][(e + 1) % 3])].push_back(int(i));
     ASSERT_EQ(faces_of_edge.size(), 18u);  // 12 box edges, 6 face diagonals
     int box_edges = 0;
-    for (size_t i = 0; i < m.triangles.size(); ++i) {
-        expect_near(m.face_normals[i], axis_normal[i], kExact);
+    for (size_t i = 0; i < m.triangles().size(); ++i) {
+        expect_near(m.face_normals()[i], axis_normal[i], kExact);
         for (int e = 0; e < 3; ++e) {
-            const std::vector<int>& f = faces_of_edge.at(std::minmax(m.triangles[i][e], m.triangles[i][(e + 1) % 3]));
+            const std::vector<int>& f = faces_of_edge.at(std::minmax(m.triangles()[i][e], m.triangles()[i][(e + 1) % 3]));
             ASSERT_EQ(f.size(), 2u);
             const Vec3d sum = axis_normal[size_t(f[0])] + axis_normal[size_t(f[1])];
             box_edges += sum != axis_normal[i] * 2.0;
-            expect_near(m.edge_normals[3 * i + size_t(e)], sum / length(sum), kExact);
+            expect_near(m.edge_normals()[3 * i + size_t(e)], sum / length(sum), kExact);
         }
     }
     EXPECT_EQ(box_edges, 2 * 12);  // each box edge seen from both of its triangles
@@ -110,14 +110,14 @@ TEST(PreparedMesh, BoxEdgePseudonormalsAreNormalisedSumsOfFaceNormals) {
 TEST(PreparedMesh, WeldsBitIdenticalVerticesIntoAClosedMesh) {
     const TriangleMesh box = make_box({1.0, 2.0, 0.5});
     const PreparedMesh m = prepare_mesh(as_separate_triangles(box));
-    EXPECT_EQ(m.report.input_vertices, 36);
-    EXPECT_EQ(m.report.welded_vertices, 28);
-    EXPECT_EQ(m.vertices.size(), 8u);
-    EXPECT_EQ(m.triangles.size(), 12u);
-    EXPECT_TRUE(m.report.closed());
-    EXPECT_TRUE(m.report.consistently_oriented());
-    EXPECT_EQ(m.report.components, 1);
-    EXPECT_NEAR(m.report.signed_volume, 8.0, kExact);
+    EXPECT_EQ(m.report().input_vertices, 36);
+    EXPECT_EQ(m.report().welded_vertices, 28);
+    EXPECT_EQ(m.vertices().size(), 8u);
+    EXPECT_EQ(m.triangles().size(), 12u);
+    EXPECT_TRUE(m.report().closed());
+    EXPECT_TRUE(m.report().consistently_oriented());
+    EXPECT_EQ(m.report().components, 1);
+    EXPECT_NEAR(m.report().signed_volume, 8.0, kExact);
     EXPECT_TRUE(m.warnings().empty());
 }
 
@@ -125,15 +125,15 @@ TEST(PreparedMesh, WeldsSeparatedSpheresAndKeepsTheirPseudonormals) {
     const TriangleMesh sphere = make_icosphere(2);
     const PreparedMesh welded = prepare_mesh(as_separate_triangles(sphere));
     const PreparedMesh direct = prepare_mesh(sphere);
-    ASSERT_EQ(welded.vertices.size(), direct.vertices.size());
-    EXPECT_TRUE(welded.report.sign_reliable());
+    ASSERT_EQ(welded.vertices().size(), direct.vertices().size());
+    EXPECT_TRUE(welded.report().sign_reliable());
     // Welding keeps first-use order, so compare by position.
     std::map<std::tuple<double, double, double>, Vec3d> normal_at;
-    for (size_t i = 0; i < direct.vertices.size(); ++i)
-        normal_at[{direct.vertices[i].x, direct.vertices[i].y, direct.vertices[i].z}] = direct.vertex_normals[i];
-    for (size_t i = 0; i < welded.vertices.size(); ++i)
-        expect_near(welded.vertex_normals[i],
-                    normal_at.at({welded.vertices[i].x, welded.vertices[i].y, welded.vertices[i].z}), kExact);
+    for (size_t i = 0; i < direct.vertices().size(); ++i)
+        normal_at[{direct.vertices()[i].x, direct.vertices()[i].y, direct.vertices()[i].z}] = direct.vertex_normals()[i];
+    for (size_t i = 0; i < welded.vertices().size(); ++i)
+        expect_near(welded.vertex_normals()[i],
+                    normal_at.at({welded.vertices()[i].x, welded.vertices()[i].y, welded.vertices()[i].z}), kExact);
 }
 
 TEST(PreparedMesh, DropsDegenerateTrianglesAndMapsTheRestToTheirSource) {
@@ -151,16 +151,16 @@ TEST(PreparedMesh, DropsDegenerateTrianglesAndMapsTheRestToTheirSource) {
     mesh.content_sha256.clear();
 
     const PreparedMesh m = prepare_mesh(mesh);
-    EXPECT_EQ(m.report.input_triangles, 14);
-    EXPECT_EQ(m.report.degenerate_triangles, 2);
-    EXPECT_EQ(m.report.unreferenced_vertices, 1);  // the midpoint, used only by a dropped triangle
-    ASSERT_EQ(m.triangles.size(), 12u);
-    EXPECT_EQ(m.source_triangle, (std::vector<int>{0, 1, 2, 3, 5, 6, 7, 8, 9, 11, 12, 13}));
-    for (size_t i = 0; i < m.triangles.size(); ++i)
+    EXPECT_EQ(m.report().input_triangles, 14);
+    EXPECT_EQ(m.report().degenerate_triangles, 2);
+    EXPECT_EQ(m.report().unreferenced_vertices, 1);  // the midpoint, used only by a dropped triangle
+    ASSERT_EQ(m.triangles().size(), 12u);
+    EXPECT_EQ(m.source_triangle(), (std::vector<int>{0, 1, 2, 3, 5, 6, 7, 8, 9, 11, 12, 13}));
+    for (size_t i = 0; i < m.triangles().size(); ++i)
         for (int k = 0; k < 3; ++k)
-            EXPECT_EQ(m.vertices[size_t(m.triangles[i][k])],
-                      mesh.vertices[size_t(mesh.triangles[size_t(m.source_triangle[i])][k])]);
-    EXPECT_TRUE(m.report.sign_reliable());
+            EXPECT_EQ(m.vertices()[size_t(m.triangles()[i][k])],
+                      mesh.vertices[size_t(mesh.triangles[size_t(m.source_triangle()[i])][k])]);
+    EXPECT_TRUE(m.report().sign_reliable());
     EXPECT_TRUE(any_warning_contains(m, "degenerate"));
 }
 
@@ -169,45 +169,45 @@ TEST(PreparedMesh, OpenBoxReportsItsBoundaryAndWarns) {
     mesh.triangles.pop_back();
     mesh.content_sha256.clear();
     const PreparedMesh m = prepare_mesh(mesh);
-    EXPECT_EQ(m.report.boundary_edges, 3);
-    EXPECT_EQ(m.report.nonmanifold_edges, 0);
-    EXPECT_FALSE(m.report.closed());
-    EXPECT_FALSE(m.report.sign_reliable());
-    EXPECT_FALSE(m.report.flipped);
+    EXPECT_EQ(m.report().boundary_edges, 3);
+    EXPECT_EQ(m.report().nonmanifold_edges, 0);
+    EXPECT_FALSE(m.report().closed());
+    EXPECT_FALSE(m.report().sign_reliable());
+    EXPECT_FALSE(m.report().flipped);
     EXPECT_TRUE(any_warning_contains(m, "open"));
 }
 
 TEST(PreparedMesh, InwardMeshIsFlippedOutwardWithAWarning) {
     const TriangleMesh outward = make_icosphere(1);
     const PreparedMesh m = prepare_mesh(reversed(outward, 0, outward.triangles.size()));
-    EXPECT_TRUE(m.report.flipped);
-    EXPECT_TRUE(m.report.sign_reliable());
-    EXPECT_GT(m.report.signed_volume, 0.0);
-    EXPECT_NEAR(m.report.signed_volume, prepare_mesh(outward).report.signed_volume, 1e-12);
+    EXPECT_TRUE(m.report().flipped);
+    EXPECT_TRUE(m.report().sign_reliable());
+    EXPECT_GT(m.report().signed_volume, 0.0);
+    EXPECT_NEAR(m.report().signed_volume, prepare_mesh(outward).report().signed_volume, 1e-12);
     // The flipped triangles are the original ones, and their normals point outward.
-    for (size_t i = 0; i < m.triangles.size(); ++i) {
-        const Int3 t = m.triangles[i];
-        const Vec3d& a = m.vertices[size_t(t.x)];
-        EXPECT_GT(dot(m.face_normals[i], a), 0.0);
-        EXPECT_GT(dot(m.vertex_normals[size_t(t.x)], a), 0.0);
-        for (int e = 0; e < 3; ++e) EXPECT_GT(dot(m.edge_normals[3 * i + size_t(e)], a), 0.0);
+    for (size_t i = 0; i < m.triangles().size(); ++i) {
+        const Int3 t = m.triangles()[i];
+        const Vec3d& a = m.vertices()[size_t(t.x)];
+        EXPECT_GT(dot(m.face_normals()[i], a), 0.0);
+        EXPECT_GT(dot(m.vertex_normals()[size_t(t.x)], a), 0.0);
+        for (int e = 0; e < 3; ++e) EXPECT_GT(dot(m.edge_normals()[3 * i + size_t(e)], a), 0.0);
     }
     EXPECT_TRUE(any_warning_contains(m, "flipped"));
 
     MeshPreparationOptions keep;
     keep.orient_outward = false;
     const PreparedMesh kept = prepare_mesh(reversed(outward, 0, outward.triangles.size()), keep);
-    EXPECT_FALSE(kept.report.flipped);
-    EXPECT_LT(kept.report.signed_volume, 0.0);
+    EXPECT_FALSE(kept.report().flipped);
+    EXPECT_LT(kept.report().signed_volume, 0.0);
 }
 
 TEST(PreparedMesh, OneReversedTriangleIsReportedAsInconsistent) {
     const PreparedMesh m = prepare_mesh(reversed(make_icosphere(1), 7, 1));
-    EXPECT_EQ(m.report.inconsistent_edges, 3);
-    EXPECT_TRUE(m.report.closed());
-    EXPECT_FALSE(m.report.consistently_oriented());
-    EXPECT_FALSE(m.report.sign_reliable());
-    EXPECT_FALSE(m.report.flipped);
+    EXPECT_EQ(m.report().inconsistent_edges, 3);
+    EXPECT_TRUE(m.report().closed());
+    EXPECT_FALSE(m.report().consistently_oriented());
+    EXPECT_FALSE(m.report().sign_reliable());
+    EXPECT_FALSE(m.report().flipped);
     EXPECT_TRUE(any_warning_contains(m, "not consistently oriented"));
 }
 
@@ -218,8 +218,8 @@ TEST(PreparedMesh, CountsComponents) {
     two.vertices.insert(two.vertices.end(), other.vertices.begin(), other.vertices.end());
     two.content_sha256.clear();
     const PreparedMesh m = prepare_mesh(two);
-    EXPECT_EQ(m.report.components, 2);
-    EXPECT_NEAR(m.report.signed_volume, 8.0 + 1.0, kExact);
+    EXPECT_EQ(m.report().components, 2);
+    EXPECT_NEAR(m.report().signed_volume, 8.0 + 1.0, kExact);
 }
 
 TEST(PreparedMesh, WeldsWithinATolerance) {
@@ -228,9 +228,9 @@ TEST(PreparedMesh, WeldsWithinATolerance) {
     MeshPreparationOptions options;
     options.weld_tolerance = 1e-6;
     const PreparedMesh m = prepare_mesh(soup, options);
-    EXPECT_EQ(m.vertices.size(), 8u);
-    EXPECT_TRUE(m.report.sign_reliable());
-    EXPECT_NEAR(m.report.signed_volume, 8.0, 1e-6);
+    EXPECT_EQ(m.vertices().size(), 8u);
+    EXPECT_TRUE(m.report().sign_reliable());
+    EXPECT_NEAR(m.report().signed_volume, 8.0, 1e-6);
 }
 
 // Two copies of a vertex 1e-7 apart but on either side of a grid-cell boundary (x = 0.75 =
@@ -245,8 +245,8 @@ TEST(PreparedMesh, WeldsVerticesCloserThanTheToleranceAcrossGridCells) {
     MeshPreparationOptions options;
     options.weld_tolerance = 0.5;
     const PreparedMesh m = prepare_mesh(soup, options);
-    EXPECT_EQ(m.vertices.size(), 8u);
-    EXPECT_TRUE(m.report.closed());
+    EXPECT_EQ(m.vertices().size(), 8u);
+    EXPECT_TRUE(m.report().closed());
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ int count_edges(const std::vector<Int3>& triangles) {
 void expect_clean_closed_surface(const TriangleMesh& mesh, int euler_characteristic) {
     SCOPED_TRACE(mesh.source);
     const PreparedMesh m = prepare_mesh(mesh);
-    const MeshReport& r = m.report;
+    const MeshReport& r = m.report();
     EXPECT_TRUE(r.closed()) << r.boundary_edges << " boundary, " << r.nonmanifold_edges << " non-manifold";
     EXPECT_TRUE(r.consistently_oriented()) << r.inconsistent_edges << " inconsistent edges";
     EXPECT_FALSE(r.flipped);
@@ -110,7 +110,7 @@ TEST(Icosphere, VolumeApproachesTheBallWithinTheChordError) {
                         c = mesh.vertices[size_t(t.z)] - center;
             inradius = std::min(inradius, dot(normalize_or_zero(cross(b - a, c - a)), a));
         }
-        const double volume = prepare_mesh(mesh).report.signed_volume;
+        const double volume = prepare_mesh(mesh).report().signed_volume;
         EXPECT_LE(volume, ball * (1 + 1e-12)) << "k=" << k;
         EXPECT_GE(volume, ball * std::pow(inradius / radius, 3) * (1 - 1e-12)) << "k=" << k;
         EXPECT_LT(ball - volume, previous_error) << "k=" << k;
@@ -126,7 +126,7 @@ TEST(Box, TwelveTrianglesAndExactVolume) {
     EXPECT_EQ(mesh.triangles.size(), 12u);
     EXPECT_EQ(mesh.vertices.size(), 8u);
     expect_clean_closed_surface(mesh, 2);
-    EXPECT_NEAR(prepare_mesh(mesh).report.signed_volume, 8.0 * 1.0 * 2.0 * 0.5, 1e-14);
+    EXPECT_NEAR(prepare_mesh(mesh).report().signed_volume, 8.0 * 1.0 * 2.0 * 0.5, 1e-14);
     const Bounds3 b = triangle_bounds(mesh.vertices, mesh.triangles);
     EXPECT_EQ(b.min, (Vec3d{-0.75, -3.0, 2.5}));
     EXPECT_EQ(b.max, (Vec3d{1.25, 1.0, 3.5}));
@@ -188,7 +188,7 @@ TEST(Pawn, OneUnitTallStandingOnTheXZPlaneAroundTheYAxis) {
     EXPECT_GT(b.extent().x, 0.4);           // a base wide enough to stand on
     EXPECT_LT(b.extent().x, 0.8);
     // Volume: between a thin rod and the cylinder around it.
-    const double volume = prepare_mesh(mesh).report.signed_volume;
+    const double volume = prepare_mesh(mesh).report().signed_volume;
     EXPECT_GT(volume, 0.02);
     EXPECT_LT(volume, kPi * 0.25 * b.extent().x * b.extent().x);
 }
@@ -234,7 +234,7 @@ TEST(SoccerBall, UnitRadiusWithSeamsEngravedToTheirDepth) {
         EXPECT_EQ(deep, 60 + 2 * 90 + 3 * 180);
     }
     // Without depth it is a tessellated sphere, inside the unit ball.
-    const double volume = prepare_mesh(make_soccer_ball(2, 0.0, 0.03)).report.signed_volume;
+    const double volume = prepare_mesh(make_soccer_ball(2, 0.0, 0.03)).report().signed_volume;
     EXPECT_LT(volume, 4.0 / 3.0 * kPi);
     EXPECT_GT(volume, 4.0 / 3.0 * kPi * 0.97);
 }

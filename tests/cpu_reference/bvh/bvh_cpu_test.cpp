@@ -29,7 +29,7 @@ SamplerOptions options(Precision precision, const std::string& kernel = "", int 
 std::vector<Vec3d> random_points_around(const PreparedMesh& mesh, int n, unsigned seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-0.75, 0.75);
-    const Vec3d c = mesh.bounds.center(), e = mesh.bounds.extent();
+    const Vec3d c = mesh.bounds().center(), e = mesh.bounds().extent();
     std::vector<Vec3d> pts(static_cast<size_t>(n));
     for (auto& p : pts) p = c + component_mul(e, Vec3d{u(rng), u(rng), u(rng)});
     return pts;
@@ -37,18 +37,18 @@ std::vector<Vec3d> random_points_around(const PreparedMesh& mesh, int n, unsigne
 
 void print(const std::string& what, const test::Agreement& a, const PreparedMesh& mesh) {
     std::printf("%-40s %7lld points: max|dd| = %.3g (%.2g of diag), triangle ties %lld, sign ties %lld\n", what.c_str(),
-                (long long)a.points, a.max_abs_distance, a.max_abs_distance / mesh.bounds.diagonal(),
+                (long long)a.points, a.max_abs_distance, a.max_abs_distance / mesh.bounds().diagonal(),
                 (long long)a.triangle_ties, (long long)a.sign_ties);
 }
 
 TEST(CpuBvh, EqualsBruteForceOnLatticesOfEveryMesh) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
-        const bool big = m.mesh.triangles.size() > 20000;
+        const bool big = m.mesh.triangles().size() > 20000;
         for (Precision precision : {Precision::Float, Precision::Double}) {
             // Brute force in double on 100k triangles is the slow part: smaller lattices there.
             const int r = big ? (precision == Precision::Double ? 10 : 14) : 24;
-            const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds, 0.1);
-            const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds, 0.1);
+            const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds(), 0.1);
+            const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds(), 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
                 const SampledField brute = make_cpu_brute_force_sampler(options(precision))->sample(m.mesh, lattice);
                 const SampledField bvh = make_cpu_bvh_sampler(options(precision))->sample(m.mesh, lattice);
@@ -65,7 +65,7 @@ TEST(CpuBvh, EqualsBruteForceOnLatticesOfEveryMesh) {
 
 TEST(CpuBvh, EqualsBruteForceOnRandomPoints) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
-        const bool big = m.mesh.triangles.size() > 20000;
+        const bool big = m.mesh.triangles().size() > 20000;
         const auto pts = random_points_around(m.mesh, big ? 1500 : 5000, 17);
         for (Precision precision : {Precision::Float, Precision::Double}) {
             if (big && precision == Precision::Double) continue;  // covered on lattices above
@@ -84,7 +84,7 @@ TEST(CpuBvh, EqualsBruteForceOnRandomPoints) {
 
 TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
-    const Lattice lattice = fit_lattice(LatticeType::BCC, {17, 18, 19}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {17, 18, 19}, mesh.bounds(), 0.1);
     const SampledField two = make_cpu_bvh_sampler(options(Precision::Float, "", 1))->sample(mesh, lattice);
     const SampledField two_threads = make_cpu_bvh_sampler(options(Precision::Float, "", 2))->sample(mesh, lattice);
     const SampledField doubled =
@@ -100,7 +100,7 @@ double work_seeded_or_zero(const SampledField& f) { return f.sampler["bvh"]["nod
 
 TEST(CpuBvh, BrickSeededAndUnseededKernelsAgreeAndCoherenceSavesWork) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
-    const Lattice lattice = fit_lattice(LatticeType::CC, {32, 32, 32}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::CC, {32, 32, 32}, mesh.bounds(), 0.1);
     const SampledField seeded = make_cpu_bvh_sampler(options(Precision::Float, "seeded"))->sample(mesh, lattice);
     const SampledField unseeded = make_cpu_bvh_sampler(options(Precision::Float, "unseeded"))->sample(mesh, lattice);
     test::FieldComparer cmp(mesh, test::epsilon_of(Precision::Float));

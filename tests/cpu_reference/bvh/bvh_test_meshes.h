@@ -130,22 +130,22 @@ inline const std::vector<NamedMesh>& bvh_test_meshes() {
 
 /// Prepared-mesh index of each file-order triangle index.
 inline std::vector<int> prepared_index(const PreparedMesh& m) {
-    std::vector<int> inverse(size_t(m.report.input_triangles), -1);
-    for (size_t i = 0; i < m.source_triangle.size(); ++i) inverse[size_t(m.source_triangle[i])] = int(i);
+    std::vector<int> inverse(size_t(m.report().input_triangles), -1);
+    for (size_t i = 0; i < m.source_triangle().size(); ++i) inverse[size_t(m.source_triangle()[i])] = int(i);
     return inverse;
 }
 
 inline double exact_distance_to(const PreparedMesh& m, const Vec3d& p, int prepared) {
-    const Int3 t = m.triangles[size_t(prepared)];
-    return std::sqrt(closest_point_on_triangle(p, m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
-                                               m.vertices[size_t(t.z)]).distance_squared);
+    const Int3 t = m.triangles()[size_t(prepared)];
+    return std::sqrt(closest_point_on_triangle(p, m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
+                                               m.vertices()[size_t(t.z)]).distance_squared);
 }
 
 inline double longest_edge(const PreparedMesh& m) {
     double e = 0;
-    for (const Int3& t : m.triangles)
+    for (const Int3& t : m.triangles())
         for (int k = 0; k < 3; ++k)
-            e = std::max(e, length(m.vertices[size_t(t[k])] - m.vertices[size_t(t[(k + 1) % 3])]));
+            e = std::max(e, length(m.vertices()[size_t(t[k])] - m.vertices()[size_t(t[(k + 1) % 3])]));
     return e;
 }
 

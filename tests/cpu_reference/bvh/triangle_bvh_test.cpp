@@ -24,7 +24,7 @@ bool contains(const BvhNode& n, int c, const Vec3d& v) {
 
 /// Walks the tree from the root and checks every invariant; returns the leaf count.
 void check_invariants(const PreparedMesh& mesh, const TriangleBvh& bvh, const BvhBuildOptions& o, const std::string& what) {
-    const int n = int(mesh.triangles.size());
+    const int n = int(mesh.triangles().size());
     ASSERT_EQ(int(bvh.triangle_index.size()), n) << what;
     std::vector<int> seen_slot(size_t(n), 0), seen_triangle(size_t(n), 0);
     for (int32_t t : bvh.triangle_index) ++seen_triangle[size_t(t)];
@@ -44,9 +44,9 @@ void check_invariants(const PreparedMesh& mesh, const TriangleBvh& bvh, const Bv
                 ASSERT_LE(node.count[c], o.max_leaf_size) << what;
                 for (int s = node.ref[c]; s < node.ref[c] + node.count[c]; ++s) {
                     ++seen_slot[size_t(s)];
-                    const Int3 t = mesh.triangles[size_t(bvh.triangle_index[size_t(s)])];
+                    const Int3 t = mesh.triangles()[size_t(bvh.triangle_index[size_t(s)])];
                     for (int k = 0; k < 3; ++k) {
-                        ASSERT_TRUE(contains(node, c, mesh.vertices[size_t(t[k])])) << what;
+                        ASSERT_TRUE(contains(node, c, mesh.vertices()[size_t(t[k])])) << what;
                     }
                 }
                 continue;
@@ -101,7 +101,7 @@ TEST(TriangleBvh, InvariantsOnEveryTestMesh) {
             const TriangleBvh bvh = build_triangle_bvh(m.mesh, o);
             check_invariants(m.mesh, bvh, o, m.name + " leaf " + std::to_string(leaf));
             if (leaf == 4)
-                std::printf("%-14s %7zu triangles: %s\n", m.name.c_str(), m.mesh.triangles.size(), bvh.stats.to_json().dump().c_str());
+                std::printf("%-14s %7zu triangles: %s\n", m.name.c_str(), m.mesh.triangles().size(), bvh.stats.to_json().dump().c_str());
         }
     }
 }
@@ -113,11 +113,11 @@ void expect_query_matches_loop(const PreparedMesh& mesh, const TriangleBvh& bvh,
         double best = std::numeric_limits<double>::infinity();
         for (int s = 0; s < view.num_triangles; ++s) best = std::min(best, squared_distance(view.packed[s], p));
         const BvhHit<double> hit = closest_triangle_bvh(view, p);
-        ASSERT_GE(hit.slot, 0) << mesh.name;
-        ASSERT_EQ(hit.distance_squared, best) << mesh.name;  // same arithmetic: the very same minimum
+        ASSERT_GE(hit.slot, 0) << mesh.name();
+        ASSERT_EQ(hit.distance_squared, best) << mesh.name();  // same arithmetic: the very same minimum
         // Seeding with any triangle changes nothing but the work.
         const BvhHit<double> seeded = closest_triangle_bvh(view, p, seed_hit(view, int32_t(view.num_triangles / 2), p));
-        ASSERT_EQ(seeded.distance_squared, best) << mesh.name;
+        ASSERT_EQ(seeded.distance_squared, best) << mesh.name();
     }
 }
 
@@ -134,7 +134,7 @@ TEST(TriangleBvh, QueryFindsTheLoopMinimumOnStressMeshes) {
             BvhBuildOptions o;
             o.max_leaf_size = leaf;
             const TriangleBvh bvh = build_triangle_bvh(mesh, o);
-            check_invariants(mesh, bvh, o, mesh.name);
+            check_invariants(mesh, bvh, o, mesh.name());
             expect_query_matches_loop(mesh, bvh, pts);
         }
     }

@@ -105,9 +105,9 @@ void expect_signs(const PreparedMesh& mesh, double extent, double ambiguous, Tru
     for (size_t i = 0; i < pts.size(); ++i) {
         if (std::abs(d[i].distance) <= ambiguous) continue;
         ++checked;
-        ASSERT_EQ(d[i].distance < 0, inside(pts[i])) << mesh.name << " point " << i << " d=" << d[i].distance;
+        ASSERT_EQ(d[i].distance < 0, inside(pts[i])) << mesh.name() << " point " << i << " d=" << d[i].distance;
     }
-    EXPECT_GT(checked, 98000) << mesh.name;  // at most 2% of the points lie in the ambiguous shell
+    EXPECT_GT(checked, 98000) << mesh.name();  // at most 2% of the points lie in the ambiguous shell
 }
 
 TEST(CpuBruteForce, SignsOfAnalyticShapes) {
@@ -124,8 +124,8 @@ TEST(CpuBruteForce, SignsOfAnalyticShapes) {
 TEST(CpuBruteForce, SignsOfPawnAndSoccerBallAgreeWithRayParity) {
     for (const TriangleMesh& raw : {make_pawn(), make_soccer_ball()}) {
         const PreparedMesh mesh = prepare_mesh(raw);
-        const Vec3d c = mesh.bounds.center();
-        const double extent = 0.7 * length(mesh.bounds.extent());
+        const Vec3d c = mesh.bounds().center();
+        const double extent = 0.7 * length(mesh.bounds().extent());
         // Ray parity is exact away from the surface (O(points x triangles): a few seconds).
         std::mt19937_64 rng(11);
         std::uniform_real_distribution<double> u(-extent, extent);
@@ -136,8 +136,8 @@ TEST(CpuBruteForce, SignsOfPawnAndSoccerBallAgreeWithRayParity) {
         for (size_t i = 0; i < pts.size(); ++i) {
             if (std::abs(d[i].distance) < 1e-4) continue;
             ++checked;
-            ASSERT_EQ(d[i].distance < 0, test::inside_by_ray_parity(pts[i], mesh.vertices, mesh.triangles))
-                << mesh.name << " point " << i;
+            ASSERT_EQ(d[i].distance < 0, test::inside_by_ray_parity(pts[i], mesh.vertices(), mesh.triangles()))
+                << mesh.name() << " point " << i;
         }
         EXPECT_GT(checked, 99500);
     }
@@ -145,7 +145,7 @@ TEST(CpuBruteForce, SignsOfPawnAndSoccerBallAgreeWithRayParity) {
 
 TEST(CpuBruteForce, GradientsAreUnitAndMatchCentralDifferences) {
     const PreparedMesh mesh = prepare_mesh(make_pawn());
-    const Vec3d c = mesh.bounds.center();
+    const Vec3d c = mesh.bounds().center();
     auto pts = random_points(2000, 0.6, 9);
     for (auto& p : pts) p += c;
     const double h = 1e-6;
@@ -174,7 +174,7 @@ TEST(CpuBruteForce, GradientsAreUnitAndMatchCentralDifferences) {
 
 TEST(CpuBruteForce, BccStrategiesGiveIdenticalFields) {
     const PreparedMesh mesh = prepare_mesh(make_soccer_ball(0));
-    const Lattice lattice = fit_lattice(LatticeType::BCC, {11, 12, 10}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {11, 12, 10}, mesh.bounds(), 0.1);
     SamplerOptions o;
     o.progress = false;
     o.bcc_strategy = BccStrategy::TwoGrids;
@@ -192,7 +192,7 @@ TEST(CpuBruteForce, BccStrategiesGiveIdenticalFields) {
 
 TEST(CpuBruteForce, OneThreadAndManyThreadsAreBitIdentical) {
     const PreparedMesh mesh = prepare_mesh(make_pawn());
-    const Lattice lattice = fit_lattice(LatticeType::CC, {14, 15, 16}, mesh.bounds, 0.1);
+    const Lattice lattice = fit_lattice(LatticeType::CC, {14, 15, 16}, mesh.bounds(), 0.1);
     SamplerOptions o;
     o.progress = false;
     o.threads = 1;
@@ -206,15 +206,15 @@ TEST(CpuBruteForce, OneThreadAndManyThreadsAreBitIdentical) {
 
 /// Distance from p to one triangle of the prepared mesh, in double (for tie checks).
 double distance_to_triangle(const PreparedMesh& m, const Vec3d& p, int tri) {
-    const Int3 t = m.triangles[size_t(tri)];
-    return std::sqrt(closest_point_on_triangle(p, m.vertices[size_t(t.x)], m.vertices[size_t(t.y)],
-                                               m.vertices[size_t(t.z)]).distance_squared);
+    const Int3 t = m.triangles()[size_t(tri)];
+    return std::sqrt(closest_point_on_triangle(p, m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
+                                               m.vertices()[size_t(t.z)]).distance_squared);
 }
 
 TEST(CpuBruteForce, FloatMatchesDoubleAndEberlyMatchesVectorized) {
     const PreparedMesh mesh = prepare_mesh(make_soccer_ball());
-    ASSERT_EQ(mesh.source_triangle.back(), int(mesh.triangles.size()) - 1);  // file order = prepared order
-    const double diag = mesh.bounds.diagonal();
+    ASSERT_EQ(mesh.source_triangle().back(), int(mesh.triangles().size()) - 1);  // file order = prepared order
+    const double diag = mesh.bounds().diagonal();
     auto pts = random_points(3000, 0.8, 13);
     const auto d64 = query(mesh, pts, Precision::Double);
     const auto d32 = query(mesh, pts, Precision::Float);

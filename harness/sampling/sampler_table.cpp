@@ -1,0 +1,94 @@
+#include "harness/sampling/sampler_table.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "core/sampling/kernel_table.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "cuda/bvh_sampler.h"
+#include "cuda/cuda_sampler.h"
+#include "harness/build_config.h"
+#if SDF_HAVE_CUDA
+#include "cuda/cuda_device.h"
+#endif
+
+namespace sdf {
+
+namespace {
+#if SDF_HAVE_CUDA
+constexpr auto kCudaBruteForce = cuda::make_cuda_brute_force_sampler;
+constexpr auto kCudaBvh = cuda::make_cuda_bvh_sampler;
+#else
+constexpr std::unique_ptr<Sampler> (*kCudaBruteForce)(const SamplerOptions&) = nullptr;
+constexpr std::unique_ptr<Sampler> (*kCudaBvh)(const SamplerOptions&) = nullptr;
+#endif
+
+void add_unique(std::vector<std::string>& list, const char* name) {
+    if (std::find(list.begin(), list.end(), name) == list.end()) list.emplace_back(name);
+}
+}  // namespace
+
+const std::vector<SamplerKind>& sampler_table() {
+    static const std::vector<SamplerKind> table = {
+        {"cpu", "brute_force", kernel_names(kCpuBruteForceKernels), make_cpu_brute_force_sampler},
+        {"cpu", "bvh", kernel_names(kCpuBvhKernels), make_cpu_bvh_sampler},
+        {"cuda", "brute_force", kernel_names(cuda::kCudaBruteForceKernels), kCudaBruteForce},
+        {"cuda", "bvh", kernel_names(cuda::kCudaBvhKernels), kCudaBvh},
+    };
+    return table;
+}
+
+std::vector<std::string> sampler_backends() {
+    std::vector<std::string> names;
+    for (const SamplerKind& k : sampler_table()) add_unique(names, k.backend);
+    return names;
+}
+
+std::vector<std::string> sampler_methods() {
+    std::vector<std::string> names;
+    for (const SamplerKind& k : sampler_table()) add_unique(names, k.method);
+    return names;
+}
+
+const SamplerKind& sampler_kind(const std::string& backend, const std::string& method) {
+    const std::vector<std::string> backends = sampler_backends();
+    if (std::find(backends.begin(), backends.end(), backend) == backends.end())
+        throw std::invalid_argument("sampler.backend: unknown backend '" + backend + "'; expected " +
+                                    quoted_alternatives(backends));
+    for (const SamplerKind& k : sampler_table())
+        if (backend == k.backend && method == k.method) return k;
+    throw std::invalid_argument("sampler.method: backend '" + backend + "' has no method '" + method + "'; expected " +
+                                quoted_alternatives(sampler_methods()));
+}
+
+void check_sampler_kernel(const SamplerOptions& options) {
+    const SamplerKind& kind = sampler_kind(options.backend, options.method);
+    if (options.kernel.empty() ||
+        std::find(kind.kernels.begin(), kind.kernels.end(), options.kernel) != kind.kernels.end())
+        return;
+    throw std::invalid_argument("sampler.kernel: unknown " + options.backend + " " + options.method + " kernel '" +
+                                options.kernel + "'; expected " + quoted_alternatives(kind.kernels));
+}
+
+bool cuda_backend_available() {
+#if SDF_HAVE_CUDA
+    return cuda::device_count() > 0;
+#else
+    return false;
+#endif
+}
+
+std::unique_ptr<Sampler> make_sampler(const SamplerOptions& options) {
+    const SamplerKind& kind = sampler_kind(options.backend, options.method);
+    check_sampler_kernel(options);
+    if (kind.make == nullptr)
+        throw std::runtime_error("sampler.backend \"" + options.backend +
+                                 "\": this build has no CUDA backend (configure with nvcc available and "
+                                 "SDF_ENABLE_CUDA=AUTO or ON)");
+    if (options.backend == "cuda" && !cuda_backend_available())
+        throw std::runtime_error("sampler.backend \"cuda\": no CUDA device is present on this machine");
+    return kind.make(options);
+}
+
+}  // namespace sdf
