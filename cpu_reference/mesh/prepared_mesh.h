@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cpu_reference/mesh/triangle_mesh.h"
@@ -19,6 +20,9 @@ struct MeshPreparationOptions {
     /// Flip every triangle of a closed, consistently oriented mesh whose signed volume is
     /// negative, so that normals point outward.
     bool orient_outward = true;
+    /// Look for intersecting triangle pairs (self-intersections, overlapping shells) with a
+    /// BVH; costs about a BVH build (self_intersections.h).
+    bool detect_intersections = true;
 };
 
 /// What preparation found; printed in summaries and stored in field headers.
@@ -34,6 +38,10 @@ struct MeshReport {
     int components = 0;             ///< edge-connected pieces
     double signed_volume = 0.0;
     bool flipped = false;           ///< orientation was reversed to point outward
+    bool intersections_checked = false;  ///< the two counts below were computed
+    int self_intersecting_pairs = 0;     ///< intersecting triangle pairs within one shell
+    int shell_intersecting_pairs = 0;    ///< intersecting triangle pairs from two shells
+    int overlapping_shells = 0;          ///< pairs of shells that intersect
     bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
     bool consistently_oriented() const { return inconsistent_edges == 0; }
     /// True when signs from pseudonormals are trustworthy everywhere.
@@ -58,6 +66,9 @@ public:
     std::vector<Vec3d> face_normals;   ///< unit
     std::vector<Vec3d> edge_normals;   ///< 3 per triangle, unit; edge e = (v_e, v_(e+1)%3)
     std::vector<Vec3d> vertex_normals; ///< unit, angle-weighted
+    std::vector<int> shell_of;         ///< edge-connected component of each triangle (0-based)
+    /// Intersecting triangle pairs (prepared-mesh ids, first < second) when checked.
+    std::vector<std::pair<int, int>> intersecting_triangles;
     MeshReport report;
     Bounds3 bounds;
 
