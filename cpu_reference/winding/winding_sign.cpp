@@ -48,7 +48,7 @@ WindingSign::WindingSign(const PreparedMesh& mesh, std::shared_ptr<const Triangl
                                     std::to_string(options.accuracy.beta));
     if (options.accuracy.order != 1 && options.accuracy.order != 2)
         throw std::invalid_argument("winding sign: order must be 1 or 2, got " + std::to_string(options.accuracy.order));
-    if (!(options.refine_factor > 1.0))
+    if (options.certify && !(options.refine_factor > 1.0))
         throw std::invalid_argument("winding sign: refine_factor must be > 1, got " + std::to_string(options.refine_factor));
     view_ = winding_.view<double>(mesh);
 }
@@ -58,14 +58,17 @@ WindingEstimate<double> WindingSign::estimate(const Vec3d& p, const WindingAccur
 }
 
 bool WindingSign::inside(const Vec3d& p) const {
-    const auto certain = [](const WindingEstimate<double>& e) { return std::abs(e.value - 0.5) > e.error_bound; };
     WindingEstimate<double> e = estimate(p);
+    if (!options_.certify) return e.value > 0.5;
+    const auto certain = [](const WindingEstimate<double>& x) { return std::abs(x.value - 0.5) > x.error_bound; };
     if (certain(e)) return e.value > 0.5;
     ++refined_;
     WindingAccuracy<double> finer = options_.accuracy;
-    finer.beta *= options_.refine_factor;
-    e = estimate(p, finer);
-    if (certain(e)) return e.value > 0.5;
+    for (int k = 0; k < options_.max_refinements; ++k) {
+        finer.beta *= options_.refine_factor;
+        e = estimate(p, finer);
+        if (certain(e)) return e.value > 0.5;
+    }
     ++exact_;
     finer.beta = std::numeric_limits<double>::infinity();
     return estimate(p, finer).value > 0.5;
