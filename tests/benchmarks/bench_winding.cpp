@@ -1,5 +1,5 @@
 // Google Benchmark of the winding-number sign on the CC lattice of a mesh (default the
-// dragon; 64^3 = 262k points), side by side with the unsigned work it adds to:
+// dragon; 64^3 = 262k and 128^3 = 2,097k points), side by side with the unsigned work it adds to:
 //   UnsignedBvh   the CPU BVH sampler (seeded kernel: nearest triangle + pseudonormal sign)
 //   WindingFast   Barill et al.'s fast winding number at beta (x10 in the name) and order
 //   WindingCertified  the same, with every sign certified against the rigorous bound
@@ -123,9 +123,9 @@ void BM_WindingExact(benchmark::State& state) {
     run_winding(state, options(std::numeric_limits<double>::infinity(), 2, false), 512);
 }
 
-BENCHMARK(BM_UnsignedBvh)->Args({64, 1})->Args({64, 2})->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_UnsignedBvh)->Args({64, 1})->Args({64, 2})->Args({128, 2})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WindingFast)
-    ->Args({64, 1, 20, 2})->Args({64, 2, 20, 2})->Args({64, 1, 20, 1})->Args({64, 1, 30, 2})
+    ->Args({64, 1, 20, 2})->Args({64, 2, 20, 2})->Args({64, 1, 20, 1})->Args({64, 1, 30, 2})->Args({128, 2, 20, 2})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_WindingCertified)->Args({64, 1, 40, 2})->Args({64, 2, 40, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_WindingExact)->Args({64, 1})->Args({64, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
