@@ -5,6 +5,7 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(tinyobjloader REQUIRED)
 find_package(OpenSSL REQUIRED)            # SHA-256 of inputs for provenance
+find_package(ZLIB REQUIRED)               # gzip-compressed mesh files
 find_package(Threads REQUIRED)
 
 # OpenImageIO writes PNG/EXR images; it is optional so that GPU machines without it can

@@ -14,4 +14,8 @@ namespace sdf {
 /// missing, unparsable, holds no triangles, or has non-finite coordinates.
 TriangleMesh load_obj(const std::string& path);
 
+/// The same from OBJ text already in memory (e.g. a gunzipped .obj.gz); `path` names it in
+/// errors and in the mesh's name and source. content_sha256 is left to the caller.
+TriangleMesh load_obj_text(const std::string& text, const std::string& path);
+
 }  // namespace sdf

@@ -7,6 +7,9 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "core/bvh/triangle_bvh.h"
+#include "core/mesh/self_intersections.h"
+
 namespace sdf {
 namespace {
 
@@ -152,8 +155,13 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         for (size_t u = 1; u < uses.size(); ++u)
             parent[size_t(find_root(parent, uses[u].triangle))] = find_root(parent, uses[0].triangle);
     }
-    for (size_t i = 0; i < parent.size(); ++i)
-        if (find_root(parent, int(i)) == int(i)) ++rep.components;
+    out.shell_of_.assign(parent.size(), -1);
+    std::vector<int> shell_of_root(parent.size(), -1);
+    for (size_t i = 0; i < parent.size(); ++i) {
+        int& shell = shell_of_root[size_t(find_root(parent, int(i)))];
+        if (shell < 0) shell = rep.components++;
+        out.shell_of_[i] = shell;
+    }
 
     // Orientation: make a closed, consistent mesh point outward.
     for (const Int3& t : out.triangles_)
@@ -202,6 +210,15 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
     out.float_buffers_ = make_buffers<float>(out);
     out.double_buffers_ = make_buffers<double>(out);
+
+    if (options.detect_intersections && !out.triangles_.empty()) {
+        const SelfIntersections found = find_self_intersections(out, build_triangle_bvh(out), out.shell_of_);
+        out.intersecting_triangles_ = found.pairs;
+        rep.intersections_checked = true;
+        rep.self_intersecting_pairs = found.within_shell;
+        rep.shell_intersecting_pairs = found.between_shells;
+        rep.overlapping_shells = found.overlapping_shell_pairs;
+    }
     return out;
 }
 
@@ -221,6 +238,15 @@ std::vector<std::string> PreparedMesh::warnings() const {
         w.push_back(who + " is not consistently oriented (" + std::to_string(report_.inconsistent_edges) +
                     " edges traversed twice in the same direction); pseudonormal signs are "
                     "unreliable near those edges.");
+    if (report_.self_intersecting_pairs > 0)
+        w.push_back(who + " intersects itself: " + std::to_string(report_.self_intersecting_pairs) +
+                    " triangle pairs cross within a shell; pseudonormal signs are wrong in the regions they enclose "
+                    "twice (use the winding-number sign).");
+    if (report_.overlapping_shells > 0)
+        w.push_back(who + " has " + std::to_string(report_.overlapping_shells) + " pairs of overlapping shells (" +
+                    std::to_string(report_.shell_intersecting_pairs) +
+                    " intersecting triangle pairs); pseudonormal signs are wrong where one shell is inside another "
+                    "(use the winding-number sign).");
     if (report_.flipped)
         w.push_back(who + " was oriented inward (negative signed volume); all triangles were flipped.");
     if (report_.degenerate_triangles > 0)

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/mesh/triangle_mesh.h"
@@ -19,6 +20,9 @@ struct MeshPreparationOptions {
     /// Flip every triangle of a closed, consistently oriented mesh whose signed volume is
     /// negative, so that normals point outward.
     bool orient_outward = true;
+    /// Look for intersecting triangle pairs (self-intersections, overlapping shells) with a
+    /// BVH; costs about a BVH build (self_intersections.h).
+    bool detect_intersections = true;
 };
 
 /// What preparation found; printed in summaries and stored in field headers.
@@ -34,6 +38,10 @@ struct MeshReport {
     int components = 0;             ///< edge-connected pieces
     double signed_volume = 0.0;
     bool flipped = false;           ///< orientation was reversed to point outward
+    bool intersections_checked = false;  ///< the two counts below were computed
+    int self_intersecting_pairs = 0;     ///< intersecting triangle pairs within one shell
+    int shell_intersecting_pairs = 0;    ///< intersecting triangle pairs from two shells
+    int overlapping_shells = 0;          ///< pairs of shells that intersect
     bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
     bool consistently_oriented() const { return inconsistent_edges == 0; }
     /// True when signs from pseudonormals are trustworthy everywhere.
@@ -66,6 +74,10 @@ public:
     const std::vector<Vec3d>& vertex_normals() const { return vertex_normals_; }  ///< unit, angle-weighted
     const MeshReport& report() const { return report_; }
     const Bounds3& bounds() const { return bounds_; }
+    /// Edge-connected component (shell) of each triangle, 0-based.
+    const std::vector<int>& shell_of() const { return shell_of_; }
+    /// Intersecting triangle pairs (prepared-mesh ids, first < second) when checked.
+    const std::vector<std::pair<int, int>>& intersecting_triangles() const { return intersecting_triangles_; }
 
     /// Human-readable warnings (open, non-manifold, inconsistent orientation, flipped).
     std::vector<std::string> warnings() const;
@@ -83,6 +95,8 @@ private:
     std::vector<Int3> triangles_;
     std::vector<int> source_triangle_;
     std::vector<Vec3d> face_normals_, edge_normals_, vertex_normals_;
+    std::vector<int> shell_of_;
+    std::vector<std::pair<int, int>> intersecting_triangles_;
     MeshReport report_;
     Bounds3 bounds_;
     // Shared, so that copies of a prepared mesh share one set of buffers.

@@ -2,6 +2,10 @@
 
 namespace sdf {
 
+const char* bcc_strategy_name(BccStrategy s) {
+    return s == BccStrategy::TwoGrids ? "two_grids" : "double_resolution";
+}
+
 nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
                                   const SamplerOptions& options, const Lattice& lattice, int64_t points_computed) {
     nlohmann::json p = {{"backend", backend},

@@ -107,10 +107,6 @@ private:
 
 }  // namespace
 
-const char* bcc_strategy_name(BccStrategy s) {
-    return s == BccStrategy::TwoGrids ? "two_grids" : "double_resolution";
-}
-
 std::unique_ptr<Sampler> make_cpu_brute_force_sampler(const SamplerOptions& options) {
     return std::make_unique<CpuBruteForceSampler>(options);
 }

@@ -7,7 +7,7 @@
 #include <functional>
 #include <sstream>
 
-#include "core/mesh/load_obj.h"
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 
 #include "harness/build_config.h"
@@ -207,7 +207,7 @@ TriangleMesh load_mesh(const MeshSpec& spec, const std::vector<std::string>& sea
         return shape_builder(spec)();
     }
     const std::string path = spec.resolved_file.empty() ? locate_mesh_file(spec.file, search_path, base_dir) : spec.resolved_file;
-    return load_obj(path);
+    return load_mesh_file(path);
 }
 
 }  // namespace sdf

@@ -1,0 +1,28 @@
+/// @file mesh_readers.h
+/// @brief The readers behind load_mesh_file(), one per format, each from the file's bytes
+/// (already gunzipped). Every one returns the file's own vertices (exactly, in double) and
+/// its faces triangulated as fans in file order, and throws std::runtime_error naming the
+/// file and the header line, element or byte offset of what it could not read.
+#pragma once
+
+#include <string>
+
+#include "core/mesh/triangle_mesh.h"
+
+namespace sdf {
+
+/// PLY (Turk 1994): ascii, binary_little_endian and binary_big_endian; element "vertex"
+/// with scalar properties x, y, z of any type; element "face" with a list property
+/// "vertex_indices" (or "vertex_index"); other elements and properties are skipped.
+TriangleMesh read_ply(const std::string& bytes, const std::string& path);
+
+/// STL, binary (80-byte header, uint32 count, 50 bytes per triangle; recognised by its exact
+/// size even when the header starts with "solid") or ASCII. STL repeats each corner per
+/// triangle: vertices with equal coordinates are welded exactly, in order of first use.
+TriangleMesh read_stl(const std::string& bytes, const std::string& path);
+
+/// OFF (Geomview): header OFF, COFF, NOFF, CNOFF, STOFF, ... (extra per-vertex columns
+/// skipped), counts, vertex lines, face lines "n i_0 ... i_(n-1) [colour]"; `#` comments.
+TriangleMesh read_off(const std::string& bytes, const std::string& path);
+
+}  // namespace sdf

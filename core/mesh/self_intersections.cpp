@@ -1,0 +1,109 @@
+#include "core/mesh/self_intersections.h"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "core/mesh/triangle_intersection.h"
+
+namespace sdf {
+namespace {
+
+/// A child of a BVH node as the pair descent sees it: its box and what it refers to.
+struct Child {
+    float lo[3], hi[3];
+    int32_t ref, count;
+    bool leaf;
+};
+
+Child child_of(const BvhNode& n, int c) {
+    return {{n.min_x[c], n.min_y[c], n.min_z[c]}, {n.max_x[c], n.max_y[c], n.max_z[c]}, n.ref[c], n.count[c],
+            bvh_child_is_leaf(n, c)};
+}
+
+bool boxes_overlap(const Child& a, const Child& b) {
+    for (int k = 0; k < 3; ++k)
+        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+    return true;
+}
+
+class PairDescent {
+public:
+    PairDescent(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<std::pair<int, int>>& pairs)
+        : mesh_(mesh), bvh_(bvh), pairs_(pairs) {}
+
+    /// Pairs within the subtree of `c`.
+    void within(const Child& c) {
+        if (c.leaf) {
+            for (int32_t i = c.ref; i < c.ref + c.count; ++i)
+                for (int32_t j = i + 1; j < c.ref + c.count; ++j) test(i, j);
+            return;
+        }
+        const BvhNode& n = bvh_.nodes[size_t(c.ref)];
+        const Child l = child_of(n, 0), r = child_of(n, 1);
+        within(l);
+        within(r);
+        between(l, r);
+    }
+
+    /// Pairs with one triangle under `a` and one under `b` (disjoint subtrees).
+    void between(const Child& a, const Child& b) {
+        if (!boxes_overlap(a, b)) return;
+        if (a.leaf && b.leaf) {
+            for (int32_t i = a.ref; i < a.ref + a.count; ++i)
+                for (int32_t j = b.ref; j < b.ref + b.count; ++j) test(i, j);
+            return;
+        }
+        // Open the inner child (the larger one when both are inner).
+        const bool open_a = !a.leaf && (b.leaf || volume(a) >= volume(b));
+        const Child& open = open_a ? a : b;
+        const Child& keep = open_a ? b : a;
+        const BvhNode& n = bvh_.nodes[size_t(open.ref)];
+        between(child_of(n, 0), keep);
+        between(child_of(n, 1), keep);
+    }
+
+private:
+    static double volume(const Child& c) {
+        return double(c.hi[0] - c.lo[0]) * double(c.hi[1] - c.lo[1]) * double(c.hi[2] - c.lo[2]);
+    }
+
+    void test(int32_t slot_a, int32_t slot_b) {
+        const int ta = bvh_.triangle_index[size_t(slot_a)], tb = bvh_.triangle_index[size_t(slot_b)];
+        const Int3 ia = mesh_.triangles()[size_t(ta)], ib = mesh_.triangles()[size_t(tb)];
+        const Vec3d a[3] = {mesh_.vertices()[size_t(ia.x)], mesh_.vertices()[size_t(ia.y)], mesh_.vertices()[size_t(ia.z)]};
+        const Vec3d b[3] = {mesh_.vertices()[size_t(ib.x)], mesh_.vertices()[size_t(ib.y)], mesh_.vertices()[size_t(ib.z)]};
+        if (triangles_intersect(a, ia, b, ib)) pairs_.push_back({std::min(ta, tb), std::max(ta, tb)});
+    }
+
+    const PreparedMesh& mesh_;
+    const TriangleBvh& bvh_;
+    std::vector<std::pair<int, int>>& pairs_;
+};
+
+}  // namespace
+
+SelfIntersections find_self_intersections(const PreparedMesh& mesh, const TriangleBvh& bvh, const std::vector<int>& shell_of) {
+    const auto start = std::chrono::steady_clock::now();
+    SelfIntersections out;
+    if (!bvh.nodes.empty()) {
+        PairDescent descent(mesh, bvh, out.pairs);
+        const BvhNode& root = bvh.nodes[0];
+        const Child l = child_of(root, 0), r = child_of(root, 1);
+        descent.within(l);
+        descent.within(r);
+        descent.between(l, r);
+    }
+    std::sort(out.pairs.begin(), out.pairs.end());
+    std::set<std::pair<int, int>> shell_pairs;
+    for (const auto& [a, b] : out.pairs) {
+        const int sa = shell_of.empty() ? 0 : shell_of[size_t(a)], sb = shell_of.empty() ? 0 : shell_of[size_t(b)];
+        if (sa == sb) ++out.within_shell;
+        else { ++out.between_shells; shell_pairs.insert({std::min(sa, sb), std::max(sa, sb)}); }
+    }
+    out.overlapping_shell_pairs = int(shell_pairs.size());
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+}  // namespace sdf

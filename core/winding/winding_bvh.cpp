@@ -1,0 +1,115 @@
+#include "core/winding/winding_bvh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sdf {
+namespace {
+
+/// The triangle slots under a child: a leaf's range, or the union of an inner node's
+/// children's ranges (the builder partitions in place, so a subtree's slots are contiguous).
+struct SlotRange {
+    int32_t begin = 0, end = 0;
+};
+
+class MomentBuilder {
+public:
+    MomentBuilder(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<WindingNode<double>>& out)
+        : mesh_(mesh), bvh_(bvh), out_(out) {}
+
+    /// Fills the moments of both children of `node`; returns the slots under it.
+    SlotRange visit(int32_t node) {
+        const BvhNode& n = bvh_.nodes[size_t(node)];
+        SlotRange under{INT32_MAX, INT32_MIN};
+        for (int c = 0; c < 2; ++c) {
+            SlotRange r{0, 0};
+            if (bvh_child_is_leaf(n, c)) r = {std::max(n.ref[c], 0), std::max(n.ref[c], 0) + n.count[c]};
+            else r = visit(n.ref[c]);
+            out_[size_t(node)].child[c] = moments_of(r);
+            if (r.end > r.begin) { under.begin = std::min(under.begin, r.begin); under.end = std::max(under.end, r.end); }
+        }
+        return under.end > under.begin ? under : SlotRange{0, 0};
+    }
+
+private:
+    Vec3d corner(int32_t slot, int k) const {
+        return mesh_.vertices()[size_t(mesh_.triangles()[size_t(bvh_.triangle_index[size_t(slot)])][k])];
+    }
+
+    WindingMoments<double> moments_of(SlotRange r) const {
+        WindingMoments<double> m;
+        Vec3d weighted_centroids(0.0);
+        for (int32_t s = r.begin; s < r.end; ++s) {
+            const Vec3d a = corner(s, 0), b = corner(s, 1), c = corner(s, 2);
+            const Vec3d area_normal = cross(b - a, c - a) * 0.5;  // a_i n_i
+            const double area = length(area_normal);
+            m.area += area;
+            m.normal_sum += area_normal;
+            weighted_centroids += (a + b + c) * (area / 3.0);
+        }
+        if (r.end <= r.begin) return m;
+        m.center = m.area > 0 ? weighted_centroids / m.area : corner(r.begin, 0);
+        for (int32_t s = r.begin; s < r.end; ++s) {
+            const Vec3d a = corner(s, 0), b = corner(s, 1), c = corner(s, 2);
+            for (const Vec3d& v : {a, b, c}) m.radius = std::max(m.radius, length(v - m.center));
+            const Vec3d area_normal = cross(b - a, c - a) * 0.5;
+            const Vec3d h = (a + b + c) / 3.0 - m.center;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) m.second[3 * i + j] += h[i] * area_normal[j];
+        }
+        // Rounding of |v - p~| must not shrink the ball: widen it by a relative 1e-12.
+        m.radius *= 1.0 + 1e-12;
+        return m;
+    }
+
+    const PreparedMesh& mesh_;
+    const TriangleBvh& bvh_;
+    std::vector<WindingNode<double>>& out_;
+};
+
+WindingMoments<float> to_float(const WindingMoments<double>& m) {
+    WindingMoments<float> f;
+    f.center = Vec3<float>(m.center);
+    // The float center is off by up to half an ulp per axis; widen the ball to cover it.
+    f.radius = round_up_to_float(m.radius * (1.0 + 1e-6) + length(m.center - Vec3d(f.center)));
+    f.area = round_up_to_float(m.area);
+    f.normal_sum = Vec3<float>(m.normal_sum);
+    for (int i = 0; i < 9; ++i) f.second[i] = float(m.second[i]);
+    return f;
+}
+
+}  // namespace
+
+WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
+    const auto start = std::chrono::steady_clock::now();
+    WindingBvh w;
+    w.bvh = std::move(bvh);
+    w.moments.resize(w.bvh->nodes.size());
+    MomentBuilder(mesh, *w.bvh, w.moments).visit(0);
+    w.moments_float.resize(w.moments.size());
+    for (size_t i = 0; i < w.moments.size(); ++i)
+        for (int c = 0; c < 2; ++c) w.moments_float[i].child[c] = to_float(w.moments[i].child[c]);
+    w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return w;
+}
+
+WindingBvh build_winding_bvh(const PreparedMesh& mesh) {
+    return build_winding_bvh(mesh, std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh)));
+}
+
+template <>
+WindingView<double> WindingBvh::view<double>(const PreparedMesh& mesh) const {
+    const MeshBuffers<double>& b = mesh.buffers<double>();
+    return {bvh->nodes.data(), moments.data(), bvh->triangle_index.data(), b.vertices.data(), b.triangles.data(),
+            int(bvh->nodes.size())};
+}
+
+template <>
+WindingView<float> WindingBvh::view<float>(const PreparedMesh& mesh) const {
+    const MeshBuffers<float>& b = mesh.buffers<float>();
+    return {bvh->nodes.data(), moments_float.data(), bvh->triangle_index.data(), b.vertices.data(), b.triangles.data(),
+            int(bvh->nodes.size())};
+}
+
+}  // namespace sdf

@@ -1,0 +1,35 @@
+/// @file winding_bvh.h
+/// @brief The moments of the fast winding number (kernels/winding/fast_winding_number.h),
+/// computed once per mesh over the nodes of its TriangleBvh, and the views that the host
+/// and a device upload give to the kernel.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/bvh/triangle_bvh.h"
+#include "core/mesh/prepared_mesh.h"
+#include "kernels/winding/fast_winding_number.h"
+
+namespace sdf {
+
+class WindingBvh {
+public:
+    std::shared_ptr<const TriangleBvh> bvh;
+    std::vector<WindingNode<double>> moments;  ///< one per bvh->nodes entry
+    std::vector<WindingNode<float>> moments_float;
+    double seconds = 0;                        ///< time to compute the moments
+
+    /// The view over `mesh` (the mesh the BVH was built from), in precision T.
+    template <typename T>
+    WindingView<T> view(const PreparedMesh& mesh) const;
+};
+
+/// Moments of every node child of `bvh` (built from `mesh`): center, radius, area, the
+/// area-weighted normal sum and the second-order matrix. O(triangles x depth).
+WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh);
+
+/// Builds the BVH too.
+WindingBvh build_winding_bvh(const PreparedMesh& mesh);
+
+}  // namespace sdf

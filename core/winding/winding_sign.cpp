@@ -1,0 +1,77 @@
+#include "core/winding/winding_sign.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace sdf {
+
+const char* sign_mode_name(SignMode mode) {
+    switch (mode) {
+        case SignMode::Auto: return "auto";
+        case SignMode::Pseudonormal: return "pseudonormal";
+        case SignMode::Winding: return "winding";
+    }
+    return "?";
+}
+
+SignMode sign_mode_from_name(const std::string& name, const std::string& where) {
+    for (SignMode m : {SignMode::Auto, SignMode::Pseudonormal, SignMode::Winding})
+        if (name == sign_mode_name(m)) return m;
+    throw std::invalid_argument(where + ": unknown sign mode '" + name + "'; expected auto, pseudonormal or winding");
+}
+
+SignModeChoice choose_sign_mode(const MeshReport& r, SignMode requested) {
+    if (requested != SignMode::Auto) return {requested, std::string(sign_mode_name(requested)) + " requested"};
+    const auto winding = [](const std::string& why) {
+        return SignModeChoice{SignMode::Winding, why + ": pseudonormal signs are not reliable there; using the winding number"};
+    };
+    if (r.boundary_edges > 0) return winding("the mesh is open (" + std::to_string(r.boundary_edges) + " boundary edges)");
+    if (r.nonmanifold_edges > 0) return winding("the mesh has " + std::to_string(r.nonmanifold_edges) + " non-manifold edges");
+    if (r.inconsistent_edges > 0)
+        return winding("the mesh is not consistently oriented (" + std::to_string(r.inconsistent_edges) + " edges)");
+    if (r.components > 1) return winding("the mesh has " + std::to_string(r.components) + " shells");
+    if (!r.intersections_checked) return winding("self-intersections were not checked");
+    if (r.self_intersecting_pairs > 0)
+        return winding("the mesh intersects itself (" + std::to_string(r.self_intersecting_pairs) + " triangle pairs)");
+    return {SignMode::Pseudonormal,
+            "closed, manifold, consistently oriented, one shell, no self-intersections: pseudonormal signs are exact"};
+}
+
+WindingSign::WindingSign(const PreparedMesh& mesh, const WindingSignOptions& options)
+    : WindingSign(mesh, std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh)), options) {}
+
+WindingSign::WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options)
+    : options_(options), winding_(build_winding_bvh(mesh, std::move(bvh))) {
+    if (!(options.accuracy.beta > 1.0))
+        throw std::invalid_argument("winding sign: beta must be > 1 (the far field needs d > r), got " +
+                                    std::to_string(options.accuracy.beta));
+    if (options.accuracy.order != 1 && options.accuracy.order != 2)
+        throw std::invalid_argument("winding sign: order must be 1 or 2, got " + std::to_string(options.accuracy.order));
+    if (options.certify && !(options.refine_factor > 1.0))
+        throw std::invalid_argument("winding sign: refine_factor must be > 1, got " + std::to_string(options.refine_factor));
+    view_ = winding_.view<double>(mesh);
+}
+
+WindingEstimate<double> WindingSign::estimate(const Vec3d& p, const WindingAccuracy<double>& accuracy) const {
+    return fast_winding_number(view_, p, accuracy);
+}
+
+bool WindingSign::inside(const Vec3d& p) const {
+    WindingEstimate<double> e = estimate(p);
+    if (!options_.certify) return e.value > 0.5;
+    const auto certain = [](const WindingEstimate<double>& x) { return std::abs(x.value - 0.5) > x.error_bound; };
+    if (certain(e)) return e.value > 0.5;
+    ++refined_;
+    WindingAccuracy<double> finer = options_.accuracy;
+    for (int k = 0; k < options_.max_refinements; ++k) {
+        finer.beta *= options_.refine_factor;
+        e = estimate(p, finer);
+        if (certain(e)) return e.value > 0.5;
+    }
+    ++exact_;
+    finer.beta = std::numeric_limits<double>::infinity();
+    return estimate(p, finer).value > 0.5;
+}
+
+}  // namespace sdf

@@ -1,0 +1,212 @@
+// load_mesh_file(): every format and encoding written by independent writers
+// (mesh_file_writers.h), plain and gzip-compressed, reads back as the same mesh as its OBJ
+// through load_obj() (vertices and triangles identical; STL compared triangle by triangle
+// after its exact welding) and gives bit-identical distances through the CPU brute force.
+// Malformed files of each format get errors that name the file and the place.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/mesh/load_mesh.h"
+#include "core/mesh/load_obj.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/core/mesh/mesh_file_writers.h"
+#include "tests/test_util/scratch_dir.h"
+
+namespace sdf {
+namespace {
+
+using test::PlyEncoding;
+
+/// A torus under an affine map with non-dyadic factors, so coordinates use all 53 bits.
+TriangleMesh test_shape(bool float_coordinates) {
+    TriangleMesh m = make_torus(1.0, 0.35, 24, 12);
+    for (Vec3d& p : m.vertices) {
+        p = {p.x * 0.731 + 0.1, p.y * 1.13 - 0.2, p.z * 0.917 + 1.0 / 3.0};
+        if (float_coordinates) p = Vec3d(Vec3<float>(p));
+    }
+    return m;
+}
+
+struct FormatCase {
+    const char* name;
+    const char* extension;
+    bool float_coordinates;  ///< the format stores float (binary STL, float PLY)
+    bool welds;              ///< the format repeats corners (STL)
+    std::string (*write)(const TriangleMesh&);
+};
+
+const FormatCase kFormats[] = {
+    {"ply_ascii", "ply", false, false, [](const TriangleMesh& m) { return test::ply_text(m, PlyEncoding::Ascii); }},
+    {"ply_binary_le", "ply", false, false, [](const TriangleMesh& m) { return test::ply_text(m, PlyEncoding::BinaryLittleEndian); }},
+    {"ply_binary_be", "ply", false, false, [](const TriangleMesh& m) { return test::ply_text(m, PlyEncoding::BinaryBigEndian); }},
+    {"ply_binary_be_float", "ply", true, false, [](const TriangleMesh& m) { return test::ply_text(m, PlyEncoding::BinaryBigEndian, true); }},
+    {"stl_ascii", "stl", false, true, test::stl_ascii_text},
+    {"stl_binary", "stl", true, true, test::stl_binary_text},
+    {"off", "off", false, false, test::off_text},
+    {"obj", "obj", false, false, test::obj_text},
+};
+
+class MeshFormats : public ::testing::TestWithParam<std::tuple<FormatCase, bool>> {};
+
+std::vector<PointSample> distances(const TriangleMesh& mesh) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-2.0, 2.0);
+    std::vector<Vec3d> points(300);
+    for (Vec3d& p : points) p = {u(rng), u(rng), u(rng)};
+    SamplerOptions o;
+    o.precision = Precision::Double;
+    o.progress = false;
+    o.threads = 1;
+    return make_cpu_brute_force_sampler(o)->query(prepare_mesh(mesh), points);
+}
+
+TEST_P(MeshFormats, ReadBackEqualsTheObjAndGivesIdenticalDistances) {
+    const auto& [format, gzip] = GetParam();
+    test::ScratchDir dir("sdf_load_mesh_test");
+    const TriangleMesh shape = test_shape(format.float_coordinates);
+    const TriangleMesh reference = load_obj(dir.write("reference.obj", test::obj_text(shape)));
+
+    const std::string file = dir.at(std::string("shape.") + format.extension + (gzip ? ".gz" : ""));
+    if (gzip) test::write_gzip(file, format.write(shape));
+    else dir.write(std::string("shape.") + format.extension, format.write(shape));
+    const TriangleMesh read = load_mesh_file(file);
+
+    EXPECT_EQ(read.name, "shape");
+    EXPECT_EQ(read.source, file);
+    EXPECT_EQ(read.content_sha256.size(), 64u);
+    ASSERT_EQ(read.vertices.size(), reference.vertices.size());
+    ASSERT_EQ(read.triangles.size(), reference.triangles.size());
+    if (format.welds) {
+        for (size_t i = 0; i < read.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k)
+                ASSERT_EQ(read.vertices[size_t(read.triangles[i][k])], reference.vertices[size_t(reference.triangles[i][k])])
+                    << "triangle " << i << " corner " << k;
+    } else {
+        EXPECT_EQ(read.vertices, reference.vertices);
+        EXPECT_EQ(read.triangles, reference.triangles);
+    }
+
+    const std::vector<PointSample> want = distances(reference), got = distances(read);
+    for (size_t i = 0; i < want.size(); ++i) {
+        ASSERT_EQ(got[i].distance, want[i].distance) << "point " << i;
+        ASSERT_EQ(got[i].triangle, want[i].triangle) << "point " << i;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFormats, MeshFormats, ::testing::Combine(::testing::ValuesIn(kFormats), ::testing::Bool()),
+                         [](const auto& info) {
+                             return std::string(std::get<0>(info.param).name) + (std::get<1>(info.param) ? "_gz" : "");
+                         });
+
+// ---- Content decides over the extension; unknown formats are named ---------------------
+
+class LoadMeshErrors : public test::ScratchDirTest {
+protected:
+    LoadMeshErrors() : ScratchDirTest("sdf_load_mesh_errors") {}
+
+    /// The message load_mesh_file throws for `text` written as `name`; checks it names the file and `expected`.
+    void expect_error(const std::string& name, const std::string& text, const std::string& expected) {
+        const std::string path = write(name, text);
+        try {
+            load_mesh_file(path);
+            ADD_FAILURE() << name << ": no error; expected one containing \"" << expected << "\"";
+        } catch (const std::runtime_error& e) {
+            const std::string message = e.what();
+            EXPECT_NE(message.find(path), std::string::npos) << message;
+            EXPECT_NE(message.find(expected), std::string::npos) << "expected \"" << expected << "\" in: " << message;
+        }
+    }
+};
+
+const char* kTrianglePly =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+
+TEST_F(LoadMeshErrors, PlyNamedObjIsReadAsPly) {
+    const TriangleMesh m = load_mesh_file(write("actually-ply.obj", kTrianglePly));
+    ASSERT_EQ(m.triangles.size(), 1u);
+    EXPECT_EQ(m.vertices[1], (Vec3d{1, 0, 0}));
+}
+
+TEST_F(LoadMeshErrors, UnknownFormatsAreNamed) {
+    expect_error("scene.fbx", "Kaydara FBX Binary  \0\x1a", "unsupported mesh format 'fbx'");
+    expect_error("noext", "hello\n", "unsupported mesh format (no extension");
+}
+
+TEST_F(LoadMeshErrors, Ply) {
+    expect_error("magic.ply", "plx\n", "first line");
+    expect_error("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", "PLY header line 2: unknown format 'binary_middle_endian'");
+    expect_error("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty flot x\nend_header\n", "line 4: unknown property type 'flot'");
+    expect_error("noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n", "without 'end_header'");
+    expect_error("nox.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nelement face 0\n"
+                            "property list uchar int vertex_indices\nend_header\n1 2\n", "lacks property x");
+    expect_error("noface.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                               "end_header\n1 2 3\n", "no element 'face'");
+    std::string bad_index = kTrianglePly;
+    bad_index.replace(bad_index.size() - 2, 1, "3");
+    expect_error("index.ply", bad_index, "element 'face' 0 (line 13): vertex index 3 out of range");
+    std::string bad_number = kTrianglePly;
+    bad_number.replace(bad_number.find("1 0 0"), 1, "x");
+    expect_error("number.ply", bad_number, "element 'vertex' 1 (line 11): expected a number, found 'x'");
+    std::string two_corners = kTrianglePly;
+    two_corners.replace(two_corners.size() - 8, 8, "2 0 1\n");
+    expect_error("two.ply", two_corners, "face has 2 vertices");
+    // Binary with fewer bytes than the header declares: refused before allocation.
+    std::string truncated = test::ply_text(test_shape(false), PlyEncoding::BinaryLittleEndian);
+    truncated.resize(truncated.size() / 2);
+    expect_error("truncated.ply", truncated, "file ends early (truncated?)");
+    std::string huge = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty double x\n"
+                       "property double y\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n";
+    expect_error("huge.ply", huge, "need at least 96000000000 bytes");
+}
+
+TEST_F(LoadMeshErrors, Stl) {
+    expect_error("short.stl", "abc", "too short for binary STL");
+    std::string binary = test::stl_binary_text(test_shape(true));
+    binary.resize(binary.size() - 10);
+    binary.replace(0, 5, "xxxxx");  // no "solid": cannot be ASCII either
+    expect_error("truncated.stl", binary, "binary STL header: declares 576 triangles");
+    expect_error("keyword.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertx 1 0 0\n", "ASCII STL line 5: expected 'vertex' or 'endloop', found 'vertx'");
+    expect_error("nan.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n", "line 5: non-finite coordinate 'nan'");
+    expect_error("open.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "file ends early");
+    expect_error("empty.stl", "solid s\nendsolid s\n", "no triangles");
+}
+
+TEST_F(LoadMeshErrors, Off) {
+    expect_error("header.off", "OF\n", "expected 'OFF'");
+    expect_error("dim.off", "4OFF\n1 1 0\n", "4-D and n-D OFF");
+    expect_error("binary.off", "OFF BINARY\n", "binary OFF is not supported");
+    expect_error("counts.off", "OFF\n1000 1000 0\n0 0 0\n", "more than the file's remaining");
+    expect_error("coords.off", "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "OFF line 4: vertex line has fewer than 3 coordinates");
+    expect_error("index.off", "OFF\n# comment\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n", "OFF line 7: face 0 refers to vertex 5");
+    expect_error("short.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "file ends after 1 of 2 faces");
+}
+
+TEST_F(LoadMeshErrors, OffAcceptsColoursCommentsAndCountsOnTheKeywordLine) {
+    const TriangleMesh m = load_mesh_file(write("c.off", "COFF 4 2 0 # counts here\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n"
+                                                        "1 1 0 0 0 255 255\n0 1 0 1 1 1 255\n4 0 1 2 3 0.5 0.5 0.5\n3 0 2 3\n"));
+    ASSERT_EQ(m.triangles.size(), 3u);  // the quad as a fan, then the triangle
+    EXPECT_EQ(m.triangles[1], (Int3{0, 2, 3}));
+    EXPECT_EQ(m.vertices[2], (Vec3d{1, 1, 0}));
+}
+
+TEST_F(LoadMeshErrors, Gzip) {
+    std::string gz;
+    {
+        const std::string path = at("whole.ply.gz");
+        test::write_gzip(path, kTrianglePly);
+        gz = test::read_text(path);
+    }
+    expect_error("cut.ply.gz", gz.substr(0, gz.size() - 12), "gzip stream");
+    std::string corrupt = gz;
+    for (size_t i = 12; i < corrupt.size() - 8; ++i) corrupt[i] = char(corrupt[i] ^ 0x5a);
+    expect_error("corrupt.ply.gz", corrupt, "gzip stream");
+}
+
+}  // namespace
+}  // namespace sdf

@@ -1,0 +1,129 @@
+// Self-intersection and overlapping-shell detection: the triangle-pair predicate on
+// constructed pairs (crossing, touching, sharing an edge or a corner, folded), the BVH
+// search on closed shapes (none), overlapping and nested shells, and dragon-legacy.obj
+// (25 intersecting pairs, as counted for the issue).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "core/mesh/load_mesh.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/mesh/triangle_intersection.h"
+
+namespace sdf {
+namespace {
+
+bool intersect(const Vec3d (&a)[3], Int3 ia, const Vec3d (&b)[3], Int3 ib) {
+    const bool ab = triangles_intersect(a, ia, b, ib), ba = triangles_intersect(b, ib, a, ia);
+    EXPECT_EQ(ab, ba) << "the predicate must be symmetric";
+    return ab;
+}
+
+const Vec3d kFlat[3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};  // in z = 0
+const Int3 kFlatIds{0, 1, 2};
+
+TEST(TrianglesIntersect, SeparateTrianglesCrossingOrNot) {
+    const Vec3d piercing[3] = {{0.5, 0.5, -1}, {0.5, 0.5, 1}, {0.6, 0.4, 1}};
+    const Vec3d above[3] = {{0.5, 0.5, 0.1}, {0.5, 0.6, 1}, {0.6, 0.4, 1}};
+    const Vec3d touching_corner[3] = {{0.5, 0.5, 0}, {0.5, 0.6, 1}, {0.6, 0.4, 1}};  // a corner on the face
+    const Vec3d coplanar_overlap[3] = {{1, 1, 0}, {3, 1, 0}, {1, 3, 0}};
+    const Vec3d coplanar_apart[3] = {{3, 3, 0}, {4, 3, 0}, {3, 4, 0}};
+    const Int3 other{3, 4, 5};
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, piercing, other));
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, above, other));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, touching_corner, other));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, coplanar_overlap, other));
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, coplanar_apart, other));
+}
+
+TEST(TrianglesIntersect, SharedEdgeOnlyWhenFoldedOntoEachOther) {
+    const Vec3d hinge[3] = {{2, 0, 0}, {0, 0, 0}, {1, -1, 0.5}};  // shares edge 0-1, bends away
+    const Vec3d flat_neighbour[3] = {{2, 0, 0}, {0, 0, 0}, {1, -1, 0}};
+    const Vec3d folded[3] = {{2, 0, 0}, {0, 0, 0}, {0.5, 0.5, 0}};  // third corner on the same side
+    const Int3 ids{1, 0, 7};
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, hinge, ids));
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, flat_neighbour, ids));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, folded, ids));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, kFlat, kFlatIds));  // the same triangle twice
+}
+
+TEST(TrianglesIntersect, SharedCornerOnlyWhenTheOppositeEdgePierces) {
+    const Vec3d fan[3] = {{0, 0, 0}, {-1, 0, 1}, {-1, -1, 1}};            // shares corner 0, elsewhere
+    const Vec3d through[3] = {{0, 0, 0}, {1, 1, -1}, {1, 0.5, 1}};         // its far edge crosses the face
+    const Vec3d coplanar_inside[3] = {{0, 0, 0}, {0.5, 0.2, 0}, {0.2, 0.5, 0}};
+    const Int3 ids{0, 8, 9};
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, fan, ids));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, through, ids));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, coplanar_inside, ids));
+}
+
+TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b) {
+    TriangleMesh all = a;
+    const int first = int(a.vertices.size());
+    all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
+    for (const Int3& t : b.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
+    all.content_sha256.clear();
+    return all;
+}
+
+TEST(SelfIntersections, ClosedShapesHaveNone) {
+    for (const TriangleMesh& shape : {make_box({1, 2, 0.5}), make_icosphere(3), make_torus(1.0, 0.35, 32, 16), make_pawn(),
+                                      make_soccer_ball(2)}) {
+        const PreparedMesh m = prepare_mesh(shape);
+        EXPECT_TRUE(m.report().intersections_checked);
+        EXPECT_EQ(m.report().self_intersecting_pairs, 0) << shape.name;
+        EXPECT_EQ(m.report().overlapping_shells, 0) << shape.name;
+    }
+}
+
+TEST(SelfIntersections, OverlappingShellsAreCountedApartFromSelfIntersections) {
+    const PreparedMesh overlapping = prepare_mesh(concatenated(make_box({1, 1, 1}), make_box({1, 1, 1}, {1, 0.5, 0.25})));
+    EXPECT_EQ(overlapping.report().components, 2);
+    EXPECT_EQ(overlapping.report().overlapping_shells, 1);
+    EXPECT_GT(overlapping.report().shell_intersecting_pairs, 0);
+    EXPECT_EQ(overlapping.report().self_intersecting_pairs, 0);
+    EXPECT_EQ(overlapping.intersecting_triangles().size(), size_t(overlapping.report().shell_intersecting_pairs));
+
+    const PreparedMesh nested = prepare_mesh(concatenated(make_box({1, 1, 1}), make_icosphere(2, 0.5)));
+    EXPECT_EQ(nested.report().components, 2);
+    EXPECT_EQ(nested.report().overlapping_shells, 0);
+    EXPECT_EQ(nested.report().shell_intersecting_pairs, 0);
+}
+
+TEST(SelfIntersections, OneShellFoldedThroughItself) {
+    // A torus whose tube is thicker than its hole: the inner side crosses itself.
+    const PreparedMesh m = prepare_mesh(make_torus(0.3, 0.5, 32, 16));
+    EXPECT_EQ(m.report().components, 1);
+    EXPECT_GT(m.report().self_intersecting_pairs, 0);
+    bool warned = false;
+    for (const std::string& w : m.warnings()) warned = warned || w.find("intersects itself") != std::string::npos;
+    EXPECT_TRUE(warned);
+}
+
+std::string find_data_file(const std::string& file) {
+    const char* env = std::getenv("SDF_DATA_PATH");
+    std::stringstream dirs(env ? env : "");
+    for (std::string dir; std::getline(dirs, dir, ':');)
+        if (!dir.empty() && std::filesystem::is_regular_file(std::filesystem::path(dir) / file))
+            return (std::filesystem::path(dir) / file).string();
+    return {};
+}
+
+TEST(SelfIntersectionsData, DragonLegacyHas25IntersectingPairs) {
+    const std::string path = find_data_file("dragon-legacy.obj");
+    if (path.empty()) GTEST_SKIP() << "dragon-legacy.obj not on SDF_DATA_PATH";
+    const PreparedMesh m = prepare_mesh(load_mesh_file(path));
+    EXPECT_EQ(m.report().components, 1);
+    EXPECT_EQ(m.report().self_intersecting_pairs, 25);
+    EXPECT_EQ(m.report().shell_intersecting_pairs, 0);
+    // Two of them by file face index (1-based OBJ faces 5324/25178 and 48018/99756).
+    EXPECT_EQ(m.source_triangle()[size_t(m.intersecting_triangles().front().first)], 5323);
+    const PreparedMesh dragon = prepare_mesh(load_mesh_file(find_data_file("dragon.obj")));
+    EXPECT_EQ(dragon.report().self_intersecting_pairs, 0);
+}
+
+}  // namespace
+}  // namespace sdf
