@@ -42,6 +42,7 @@ SDF_CPU_GPU inline int mirror_coordinate(int k, int top) {
 /// c at storage index i: the lattice value without a prefilter, else the stored coefficient.
 template <SplinePrefilter P, typename T>
 SDF_CPU_GPU T spline_coefficient(const LatticeFieldView<T>& v, int64_t i) {
+    SDF_DCHECK(P == SplinePrefilter::None || (v.higher != nullptr && v.higher_stride == 1));
     return P == SplinePrefilter::None ? v.values[i] : v.higher[i];
 }
 
