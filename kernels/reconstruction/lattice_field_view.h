@@ -48,8 +48,9 @@ struct LatticeFieldView {
     T inv_unit{1};
     const T* values = nullptr;      ///< f at every point, storage order
     const Vec3<T>* first = nullptr; ///< df/du at every point (true or estimated), or null
-    const T* higher = nullptr;      ///< higher derivatives, `higher_stride` per point, or null
-    int higher_stride = 0;          ///< 0, kCcHigherStride, kBccMixedStride or kBccFullStride
+    const T* higher = nullptr;      ///< higher derivatives, `higher_stride` per point, or null;
+                                    ///< for the prefiltered splines their coefficients (stride 1)
+    int higher_stride = 0;          ///< 0, 1, kCcHigherStride, kBccMixedStride or kBccFullStride
     BccFaceTable<T> bcc_faces{};    ///< for bcc_cubic / bcc_cubic_c0
 
     /// Lattice coordinates of a world point.
