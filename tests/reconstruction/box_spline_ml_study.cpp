@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_reference/parallel/parallel_for.h"
+#include "core/parallel/parallel_for.h"
 #include "core/reconstruction/analytic_study.h"
 #include "core/reconstruction/spline_prefilters.h"
 #include "kernels/reconstruction/bcc_box_quintic.h"
