@@ -51,6 +51,7 @@ def heat_map_colour_bar(path, max_degrees):
     fig.subplots_adjust(left=0.04, right=0.70, bottom=0.5, top=0.92)
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=Normalize(0.0, max_degrees), cmap="viridis"),
                        cax=ax, orientation="horizontal", extend="max")
+    bar.set_ticks([max_degrees * i / 4 for i in range(5)])
     bar.set_label("angle between reconstructed and true normal (degrees; above %g shown as %g)"
                   % (max_degrees, max_degrees), fontsize=8)
     bar.ax.tick_params(labelsize=8)
