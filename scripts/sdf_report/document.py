@@ -84,7 +84,8 @@ class Document:
 
 _STYLE = ("body{font-family:sans-serif;max-width:80em;margin:2em auto;padding:0 1em;color:#222;line-height:1.4}"
           "table{border-collapse:collapse;margin:1em 0;font-size:85%}"
-          "td,th{border:1px solid #bbb;padding:.2em .5em;text-align:right;vertical-align:top}"
+          "div.table{overflow-x:auto}"
+          "td,th{border:1px solid #bbb;padding:.2em .5em;text-align:right;vertical-align:top}td{white-space:nowrap}"
           "th{background:#eee}td.text,th.text{text-align:left}"
           "tr:nth-child(even) td{background:#f7f7f7}"
           "blockquote{color:#555;border-left:3px solid #ccc;margin:1em 0;padding-left:1em}"
@@ -108,8 +109,9 @@ def _html_table(table):
     def cell(tag, i, value):
         cls = " class=\"text\"" if i in text_columns else ""
         return "<%s%s>%s</%s>" % (tag, cls, html.escape(str(value)), tag)
-    parts = ["<table><thead><tr>" + "".join(cell("th", i, h) for i, h in enumerate(table.header)) + "</tr></thead><tbody>"]
+    parts = ["<div class=\"table\"><table><thead><tr>" + "".join(cell("th", i, h) for i, h in enumerate(table.header)) +
+             "</tr></thead><tbody>"]
     for row in table.rows:
         parts.append("<tr>" + "".join(cell("td", i, c) for i, c in enumerate(row)) + "</tr>")
-    parts.append("</tbody></table>")
+    parts.append("</tbody></table></div>")
     return "\n".join(parts)

@@ -29,6 +29,15 @@ def test_identical_interpolants_are_labelled():
     assert tables.split_curve_id("bcc_cubic/fd_weighted") == ("bcc_cubic", "fd_weighted")
 
 
+def test_identical_interpolants_are_one_curve_in_plots():
+    keys = [("catmull_rom", "fd"), ("tricubic_lm", "true"), ("tricubic_lm", "fd"), ("bcc_cubic", "fd")]
+    assert tables.distinct_functions(keys) == [
+        (("catmull_rom", "fd"), "catmull_rom/fd = tricubic_lm/fd (same function)"),
+        (("tricubic_lm", "true"), "tricubic_lm/true"), (("bcc_cubic", "fd"), "bcc_cubic/fd")]
+    # Alone, tricubic_lm/fd is plotted under its own name.
+    assert tables.distinct_functions([("tricubic_lm", "fd")]) == [(("tricubic_lm", "fd"), "tricubic_lm/fd")]
+
+
 def test_table_rows_must_match_the_header():
     t = Table(["a", "b"])
     with pytest.raises(ValueError):
@@ -60,6 +69,7 @@ def test_markdown_and_self_contained_html(tmp_path):
     assert "![A plot](plot.png)" in md
     page = doc.html("title")
     assert "<h2>Section &lt;1&gt;</h2>" in page
+    assert "<div class=\"table\"><table>" in page  # wide tables scroll, cells do not wrap
     assert "Text with | a pipe &amp; an ampersand." in page
     # Self-contained: every image is a data URI of the PNG's bytes, nothing is fetched.
     sources = re.findall(r"src=\"([^\"]*)\"", page)
