@@ -5,7 +5,7 @@ figures come from the metrics (experiments/common/thesis_tables.h writes them)."
 import os
 
 from . import plots
-from .tables import Table, count, number, reconstruction_label, split_curve_id
+from .tables import Table, count, distinct_functions, number, reconstruction_label, split_curve_id
 
 
 def table_4_1(t):
@@ -31,9 +31,10 @@ def convergence_table(c):
 
 
 def convergence_plot(doc, point, c):
-    curves = [plots.Curve(reconstruction_label(*split_curve_id(curve["id"])),
-                          [p["lattice_points"] for p in curve["points"]], [p["rms"] for p in curve["points"]],
-                          dashed=curve["lattice_type"] == "bcc") for curve in c["curves"]]
+    by_key = {split_curve_id(curve["id"]): curve for curve in c["curves"]}
+    curves = [plots.Curve(label, [p["lattice_points"] for p in by_key[key]["points"]],
+                          [p["rms"] for p in by_key[key]["points"]], dashed=by_key[key]["lattice_type"] == "bcc")
+              for key, label in distinct_functions(by_key)]
     filename = "%s_error_vs_samples.png" % point.name
     plots.log_log(os.path.join(doc.out_dir, filename), "%s: error vs samples (solid CC, dashed BCC)" % c["function"],
                   "lattice points", "RMS error", curves)

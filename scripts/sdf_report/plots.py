@@ -8,9 +8,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
 from matplotlib.colors import Normalize  # noqa: E402
+from matplotlib.ticker import LogFormatterSciNotation  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 DPI = 110
+MARKERS = "osD^vP*Xph<>"  # a marker per curve: curves that nearly coincide stay distinguishable
 
 
 class Curve:
@@ -28,13 +30,18 @@ def log_log(path, title, xlabel, ylabel, curves, markers=None):
     """Writes a log-log plot of `curves`; `markers`: optional (label, xs, ys) drawn as crosses
     (e.g. the thesis's figures)."""
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
-    for c in curves:
-        ax.plot(c.xs, c.ys, marker="o", markersize=4, linestyle="--" if c.dashed else "-", label=c.label)
+    for i, c in enumerate(curves):
+        ax.plot(c.xs, c.ys, marker=MARKERS[i % len(MARKERS)], markersize=5, fillstyle="none",
+                linestyle="--" if c.dashed else "-", label=c.label)
     if markers:
         label, xs, ys = markers
         ax.scatter(xs, ys, marker="x", color="k", zorder=5, label=label)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    for axis in (ax.xaxis, ax.yaxis):
+        # Axes spanning less than two decades get values at some minor ticks too, not one label.
+        axis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+    ax.tick_params(which="minor", labelsize=7)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)

@@ -5,7 +5,7 @@ for sweeps, and the thesis's image grids with their image metrics."""
 import os
 
 from . import images, plots
-from .tables import Table, count, number, percent, reconstruction_label, same_function_as
+from .tables import Table, count, distinct_functions, number, percent, reconstruction_label, same_function_as
 
 ERROR_HEADER = ["reconstruction", "thesis panel", "RMS / h", "max / h", "band mean / h", "band RMS / h",
                 "angle mean (deg)", "angle p95 (deg)"]
@@ -26,9 +26,10 @@ def error_table(metrics):
 def study_summary(metrics):
     mesh = metrics["mesh"]
     probes = metrics["probes"]
-    lattices = ", ".join("%s %s (%s points%s)" % (l["label"], l["lattice"]["notation"], count(l["lattice"]["points"]),
-                                                  ", from the cache" if l["from_cache"] else "")
-                         for l in metrics["lattices"])
+    def lattice_text(l):
+        name = l["label"] if l["lattice"]["notation"] in l["label"] else "%s %s" % (l["label"], l["lattice"]["notation"])
+        return "%s (%s points%s)" % (name, count(l["lattice"]["points"]), ", from the cache" if l["from_cache"] else "")
+    lattices = ", ".join(lattice_text(l) for l in metrics["lattices"])
     return ("Mesh %s (%s, %s triangles); %s; h = %s; %s domain probes, %s in the band w = %s h."
             % (mesh["name"], os.path.basename(mesh["source"]), count(mesh["triangles"]), lattices,
                number(probes["h_ref"]), count(probes["domain"]), count(probes["in_band"]), number(probes["band_spacings"])))
@@ -42,8 +43,8 @@ def sweep_plot(doc, run):
         for rec in point.metrics["reconstructions"]:
             key = (rec["interpolator"], rec["derivatives"])
             curves.setdefault(key, []).append((mean_points, rec["errors"]["band"]["rms"]))
-    lines = [plots.Curve(reconstruction_label(*key), [v[0] for v in values], [v[1] for v in values],
-                         dashed=key[0].startswith("bcc")) for key, values in sorted(curves.items())]
+    lines = [plots.Curve(label, [v[0] for v in curves[key]], [v[1] for v in curves[key]], dashed=key[0].startswith("bcc"))
+             for key, label in distinct_functions(sorted(curves))]
     filename = "%s_error_vs_samples.png" % run.name
     plots.log_log(os.path.join(doc.out_dir, filename), "%s: error vs samples (solid CC, dashed BCC)" % run.name,
                   "lattice points (mean of CC and BCC)", "band RMS error (mesh units)", lines)
@@ -130,18 +131,19 @@ def grids_section(doc, runs):
     if not found:
         doc.note("No rendered grids in these results (the studies' \"render\" block renders them).")
         return
-    scales = sorted({view["grid"]["heat_max_degrees"] for _, _, view, _ in found
-                     if any("metrics" in p for p in view["panels"])})
-    for scale in scales:
-        filename = "heat_map_scale_%g.png" % scale
-        plots.heat_map_colour_bar(os.path.join(doc.out_dir, filename), scale)
-        doc.image(filename, "Colour scale of the heat maps (0 to %g degrees)" % scale)
+    scales = {}
     for point, name, view, path in found:
         doc.heading(3, "%s, view %s" % (point.name, name))
         if os.path.isfile(path):
             target = "grid_%s_%s.png" % (point.name, name)
             images.write_reduced_grid(path, os.path.join(doc.out_dir, target))
             doc.image(target, "%s, view %s" % (point.name, name))
+            if any("metrics" in p for p in view["panels"]):  # the grid has heat maps: their scale
+                scale = view["grid"]["heat_max_degrees"]
+                if scale not in scales:
+                    scales[scale] = "heat_map_scale_%g.png" % scale
+                    plots.heat_map_colour_bar(os.path.join(doc.out_dir, scales[scale]), scale)
+                doc.image(scales[scale], "Colour scale of the heat maps above (0 to %g degrees)" % scale)
         else:
             doc.note("The grid image %s is missing (the run's images were not kept)." % path)
         table = image_metrics_table(view)

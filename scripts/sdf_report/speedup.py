@@ -67,6 +67,12 @@ def throughput_table(metrics):
     return table
 
 
+def reference_is_one_cpu_thread(metrics):
+    """The thesis's speedups are against one CPU core: comparable only when ours are too."""
+    return any(b["name"] == metrics["reference"] and b["sampler"]["backend"] == "cpu" and b["sampler"]["threads"] == 1
+               for row in metrics["rows"] for b in row["backends"])
+
+
 def speedup_plot(doc, run):
     metrics = run.metrics
     reference = metrics["reference"]
@@ -83,7 +89,9 @@ def speedup_plot(doc, run):
     if not curves:
         return
     thesis = sorted({(row["samples_requested"], row["thesis"]["speedup"]) for row in metrics["rows"] if "thesis" in row})
-    markers = ("thesis (GTX 465 vs 1 core)", [t[0] for t in thesis], [t[1] for t in thesis]) if thesis else None
+    markers = None
+    if thesis and reference_is_one_cpu_thread(metrics):
+        markers = ("thesis (GTX 465 vs 1 core)", [t[0] for t in thesis], [t[1] for t in thesis])
     filename = "speedup_vs_size_%s.png" % run.name
     plots.log_log(os.path.join(doc.out_dir, filename), "%s: speedup vs lattice size (CC rows)" % run.name,
                   "lattice points (CC)", "speedup vs %s" % reference, curves, markers)
@@ -116,8 +124,7 @@ def section(doc, runs):
                 "the lattice and scaled to all points. Speedups are ratios of medians measured in the same run, relative "
                 "to %s. n/a = backend unavailable on the machine of the run. Thesis: GeForce GTX 465 against one CPU "
                 "core." % reference)
-        if not any(b["name"] == reference and b["sampler"]["threads"] == 1 and b["sampler"]["backend"] == "cpu"
-                   for row in metrics["rows"] for b in row["backends"]):
+        if not reference_is_one_cpu_thread(metrics):
             text += (" This run's reference is not one CPU thread, so its speedups are not comparable with the "
                      "thesis's.")
         doc.paragraph(text)

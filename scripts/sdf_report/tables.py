@@ -80,6 +80,23 @@ def reconstruction_label(interpolator, derivatives, prefix=""):
     return label
 
 
+def distinct_functions(keys):
+    """[(key, label)] for the (interpolator, derivatives) keys to plot: a key identical to
+    another present key is left out and that one labelled with both names (one line, not
+    two lines drawn on top of each other)."""
+    keys = list(keys)
+    twins = {same_function_as(*k): k for k in keys if same_function_as(*k) in keys}
+    out = []
+    for key in keys:
+        if key in twins.values():
+            continue
+        label = "%s/%s" % key
+        if key in twins:
+            label += " = %s/%s (same function)" % twins[key]
+        out.append((key, label))
+    return out
+
+
 def split_curve_id(curve_id):
     """'tricubic_lm/fd' -> ('tricubic_lm', 'fd')."""
     interpolator, _, derivatives = curve_id.partition("/")

@@ -67,6 +67,8 @@ def test_speedup_against_another_reference_is_flagged(tmp_path, schema):
     metrics["reference"] = "cpu_all"
     run = load(tmp_path, schema, "gpu_kernels", "speedup", metrics)
     assert "not comparable with the thesis's" in render(speedup.section, tmp_path, [run])
+    assert not speedup.reference_is_one_cpu_thread(metrics)  # and the plot leaves the thesis's speedups out
+    assert speedup.reference_is_one_cpu_thread(fake_runs.speedup_metrics())
 
 
 def test_analytic_table_4_1_and_identical_curves(tmp_path, schema):
@@ -92,11 +94,11 @@ def test_reconstruction_error_tables_sweeps_and_grids(tmp_path, schema):
     assert "| cc-8x8x8/tricubic_lm/fd (= catmull_rom: same function) | E | 0.02 | 0.2 | 0.02 | 0.04 | 3.5 | 9.25 |" in md
     assert "#### pawn_sweep-200k" in md
     assert "| cc-12x12x12/catmull_rom/fd | A | 0.02 |" in md
-    assert "(512 points), bcc-6x6x12 6x6x12 (341 points, from the cache)" in md
+    assert "cc-8x8x8 (512 points), bcc-6x6x12 (341 points, from the cache)" in md
     assert "![pawn_sweep: band RMS error versus samples](pawn_sweep_error_vs_samples.png)" in md
     # The grid, its colour scale and its image metrics, E marked as the same function as A.
-    assert "![Colour scale of the heat maps (0 to 20 degrees)](heat_map_scale_20.png)" in md
-    assert "![dragon, view front](grid_dragon_front.png)" in md
+    assert "![dragon, view front](grid_dragon_front.png)\n\n" \
+           "![Colour scale of the heat maps above (0 to 20 degrees)](heat_map_scale_20.png)" in md
     assert "| A | Catmull-Rom (8x8x8) | 4 | 8 | 4 | 2.00% | 0.05 | 0.125 |" in md
     assert "| E | CC tricubic, estimated derivatives (8x8x8) (= A: same function) | 8 | 16 | 8 | 2.00% | 0.05 | 0.125 |" in md
     for png in ("heat_map_scale_20.png", "grid_dragon_front.png", "pawn_sweep_error_vs_samples.png"):
@@ -107,6 +109,7 @@ def test_missing_grid_image_is_a_note(tmp_path, schema):
     run = load(tmp_path, schema, "dragon", "reconstruction", fake_runs.reconstruction_metrics(render=True))
     md = render(reconstruction.section, tmp_path, [run])
     assert "dragon_front_grid.png is missing" in md
+    assert "heat_map_scale" not in md
     assert "| B | BCC cubic, true derivatives (6x6x12) | 5 |" in md
 
 
