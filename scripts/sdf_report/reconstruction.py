@@ -151,7 +151,16 @@ def grids_section(doc, runs):
             doc.table(table)
 
 
+def thesis_order(run):
+    """Sort key: the run's first thesis figure ("5-2" < "5-3" < ... < "5-11"), then its name;
+    studies standing for no figure come last."""
+    figures = run.points[0].metrics["thesis_figures"]
+    if figures and all(part.isdigit() for part in figures[0].split("-")):
+        return (0, tuple(int(part) for part in figures[0].split("-")), run.name)
+    return (1, (), run.name)
+
+
 def section(doc, runs):
-    reconstruction_runs = [r for r in runs if r.kind == "reconstruction"]
+    reconstruction_runs = sorted((r for r in runs if r.kind == "reconstruction"), key=thesis_order)
     studies_section(doc, reconstruction_runs)
     grids_section(doc, reconstruction_runs)

@@ -105,6 +105,14 @@ def test_reconstruction_error_tables_sweeps_and_grids(tmp_path, schema):
         assert os.path.isfile(tmp_path / "out" / png), png
 
 
+def test_studies_in_the_order_of_the_thesis_figures(tmp_path, schema):
+    def study(name, figures):
+        return load(tmp_path, schema, name, "reconstruction", fake_runs.reconstruction_metrics(figures=figures))
+    ordered = sorted([study("a_none", ()), study("pawn", ("5-7", "5-11")), study("soccer", ("5-2",)),
+                      study("dragon", ("5-3", "5-4"))], key=reconstruction.thesis_order)
+    assert [r.name for r in ordered] == ["soccer", "dragon", "pawn", "a_none"]
+
+
 def test_missing_grid_image_is_a_note(tmp_path, schema):
     run = load(tmp_path, schema, "dragon", "reconstruction", fake_runs.reconstruction_metrics(render=True))
     md = render(reconstruction.section, tmp_path, [run])
