@@ -29,7 +29,7 @@ class Curve:
 def log_log(path, title, xlabel, ylabel, curves, markers=None):
     """Writes a log-log plot of `curves`; `markers`: optional (label, xs, ys) drawn as crosses
     (e.g. the thesis's figures)."""
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    fig, ax = plt.subplots(figsize=(9.5, 4.8))
     for i, c in enumerate(curves):
         ax.plot(c.xs, c.ys, marker=MARKERS[i % len(MARKERS)], markersize=5, fillstyle="none",
                 linestyle="--" if c.dashed else "-", label=c.label)
@@ -39,14 +39,14 @@ def log_log(path, title, xlabel, ylabel, curves, markers=None):
     ax.set_xscale("log")
     ax.set_yscale("log")
     for axis in (ax.xaxis, ax.yaxis):
-        # Axes spanning less than two decades get values at some minor ticks too, not one label.
-        axis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+        # An axis spanning less than 1.5 decades gets values at some minor ticks too, not one label.
+        axis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(1.5, 0.4)))
     ax.tick_params(which="minor", labelsize=7)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # beside: no curve hidden
     _save(fig, path)
 
 
