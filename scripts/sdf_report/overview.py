@@ -30,6 +30,13 @@ def load_text(run):
     return "/".join(number(load[k][0], 2) if load[k] else "unknown" for k in ("start", "end"))
 
 
+def overloaded(run):
+    """True when the 1-minute load at the start or end exceeded the machine's hardware threads."""
+    load = run.provenance.get("load_average")
+    threads = run.provenance["cpu"]["hardware_threads"]
+    return bool(load) and any(load[k] and load[k][0] > threads for k in ("start", "end"))
+
+
 def check_text(run):
     check = run.manifest.get("check")
     if check is None:
@@ -62,6 +69,10 @@ def section(doc, runs, repo):
     for r in published:
         doc.paragraph("%s is a published run (%s, scripts/publish-gpu-results)%s" % (
             r.name, source_text(r, repo), ": " + r.published["note"] if "note" in r.published else "."))
+    loaded = [r.name for r in runs if overloaded(r)]
+    if loaded:
+        doc.note("Made on a loaded machine (load above its hardware threads): %s. Their times and speedups are "
+                 "inflated or compressed by other work; errors and counts are unaffected." % ", ".join(loaded))
     if any(r.provenance["git"]["dirty"] for r in runs):
         doc.note("Runs marked dirty were made from a work tree with uncommitted changes (or without git: commit "
                  "\"unknown\").")

@@ -33,6 +33,12 @@ def test_overview_shows_machine_load_and_check(tmp_path, schema):
            "0.5/0.75 | FAILED (2 failed, 1 missing) |" in md
     assert "| ml | analytic | 2026-02-01T000000Z-00000000 | 0123456789 | Test CPU x2 | NVIDIA H200 | Release | " \
            "0.5/0.75 | not checked |" in md
+    assert "loaded machine" not in md
+    busy = fake_runs.manifest("busy", "analytic")
+    busy["provenance"]["load_average"]["end"] = [6.5, 5.0, 4.0]
+    assert overview.overloaded(runs.Run("x", busy, {}))
+    del busy["provenance"]["load_average"]
+    assert not overview.overloaded(runs.Run("x", busy, {}))
 
 
 def test_sampling_times_of_sampling_and_reconstruction_runs(tmp_path, schema):
