@@ -118,13 +118,24 @@ std::string baseline_path_for(const std::string& explicit_path, const std::strin
     return (fs::path(SDF_SOURCE_DIR) / "results" / "baselines" / (name + ".json")).string();
 }
 
-int report_check(const nlohmann::json& manifest, const nlohmann::json& metrics, const std::string& baseline_path) {
+CheckResult check_against(const nlohmann::json& manifest, const nlohmann::json& metrics, const std::string& baseline_path) {
     if (!fs::is_regular_file(baseline_path))
         throw std::runtime_error("no baseline at " + baseline_path +
                                  "; make one from a clean run with: run-experiment --write-baseline RUN_DIR");
     const CheckResult r = check_run(manifest, metrics, read_json_file(baseline_path), baseline_path);
     std::cout << r.text();
-    return r.passed() ? 0 : kCheckFailedExitCode;
+    return r;
+}
+
+int report_check(const nlohmann::json& manifest, const nlohmann::json& metrics, const std::string& baseline_path) {
+    return check_against(manifest, metrics, baseline_path).passed() ? 0 : kCheckFailedExitCode;
+}
+
+/// What a stored run records of its --check (harness/schema/run_schema.json: "check").
+nlohmann::json check_record(const CheckResult& r, const std::string& baseline_path) {
+    return {{"baseline", baseline_path}, {"passed", r.passed()},    {"ok", r.ok},
+            {"failed", r.failed},        {"not_comparable", r.not_comparable}, {"missing", r.missing},
+            {"added", r.added}};
 }
 
 nlohmann::json combined_metrics(std::vector<PlannedRun>& runs) {
@@ -227,8 +238,12 @@ int run_experiment(const RunnerOptions& options) {
     }
     std::cout << "results in " << out.final_path() << std::endl;
     if (!options.check) return 0;
-    return report_check(manifest, metrics,
-                        baseline_path_for(options.baseline, runs[0].baseline, runs[0].context.config_dir, name));
+    const std::string baseline = baseline_path_for(options.baseline, runs[0].baseline, runs[0].context.config_dir, name);
+    const CheckResult r = check_against(manifest, metrics, baseline);
+    // The stored run says whether it passed its check (the report shows it).
+    manifest["check"] = check_record(r, baseline);
+    write_text_atomically(out.final_path() + "/manifest.json", manifest.dump(2) + "\n", Overwrite::Allow);
+    return r.passed() ? 0 : kCheckFailedExitCode;
 }
 
 int check_stored_run(const std::string& run_dir, const std::string& baseline_path) {

@@ -1,11 +1,10 @@
 // run-experiment end to end: configs/ci_smoke.json and its committed baseline, a perturbed
 // result failing the check, the field cache across runs and kinds (and --no-cache), sweeps
-// with inheritance, the analytic and speedup kinds at tiny sizes, baselines from clean runs
-// only, and scripts/make-report on a fake results tree.
+// with inheritance, the analytic and speedup kinds at tiny sizes, and baselines from clean runs
+// only. The report (scripts/make-report) is tested with pytest: tests/python.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -28,7 +27,6 @@ using nlohmann::json;
 using test::Contains;
 using test::quote;
 using test::read_json;
-using test::read_text;
 using test::ShellResult;
 
 class E2e : public test::ScratchDirTest {
@@ -303,101 +301,6 @@ TEST_F(E2e, BaselinesOnlyFromCleanRuns) {
     EXPECT_TRUE(Contains(none.err, "--write-baseline"));
     // Modes are exclusive.
     EXPECT_EQ(run("a.json --check-run " + quote(run_dir.string())).code, 1);
-}
-
-// ---- the report script ------------------------------------------------------------------------------
-
-json fake_manifest(const std::string& name, const std::string& kind, const std::string& finished) {
-    return {{"name", name},
-            {"kind", kind},
-            {"run_id", finished + "-00000000"},
-            {"finished", finished},
-            {"config", {{"resolved", {{"thesis_figures", {"5-3"}}}}}},
-            {"provenance", {{"git", {{"commit", "0123456789ab"}, {"dirty", false}}},
-                            {"cpu", {{"model", "Test CPU"}}},
-                            {"gpu", nullptr},
-                            {"build", {{"build_type", "Release"}}}}}};
-}
-
-json fake_reconstruction_metrics(double scale) {
-    json recs = json::array();
-    for (const auto& [id, panel] : std::vector<std::pair<std::string, std::string>>{{"cc-8x8x8/catmull_rom/fd", "A"},
-                                                                                     {"bcc-6x6x12/bcc_cubic/true", "B"}}) {
-        const std::string interp = id.find("catmull") != std::string::npos ? "catmull_rom" : "bcc_cubic";
-        recs.push_back({{"id", id}, {"interpolator", interp}, {"derivatives", panel == "A" ? "fd" : "true"},
-                        {"lattice", id.substr(0, id.find('/'))}, {"thesis_panel", panel},
-                        {"errors", {{"domain", {{"rms", 0.01 * scale}, {"max_abs", 0.1 * scale}, {"mean_abs", 0.005 * scale}}},
-                                    {"band", {{"rms", 0.02 * scale}, {"max_abs", 0.1 * scale}, {"mean_abs", 0.01 * scale},
-                                              {"gradient_angle_mean_deg", 3.5}, {"gradient_angle_p95_deg", 9.25}}},
-                                    {"max_abs", 0.1 * scale}}}});
-    }
-    return {{"mesh", {{"name", "dragon"}, {"source", "/x/dragon.obj"}, {"triangles", 99902}}},
-            {"lattices", {{{"label", "cc-8x8x8"}, {"lattice", {{"notation", "8x8x8"}, {"points", 512}}}}}},
-            {"probes", {{"h_ref", 0.5}, {"domain", 100}, {"in_band", 80}, {"band_spacings", 1.0}}},
-            {"reconstructions", recs}};
-}
-
-TEST_F(E2e, ReportFromAFakeResultsTree) {
-    if (std::system("python3 --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "python3 is not available";
-    auto put = [&](const std::string& rel, const json& manifest, const json& metrics) {
-        write("res/" + rel + "/manifest.json", manifest.dump());
-        write("res/" + rel + "/metrics.json", metrics.dump());
-    };
-    // Two dragon runs: only the later one is reported.
-    put("dragon/r1", fake_manifest("dragon", "reconstruction", "2026-01-01T00:00:00Z"), fake_reconstruction_metrics(100));
-    put("dragon/r2", fake_manifest("dragon", "reconstruction", "2026-02-01T00:00:00Z"), fake_reconstruction_metrics(1));
-    put("pawn_sweep/r1", fake_manifest("pawn_sweep", "reconstruction", "2026-02-01T00:00:00Z"),
-        {{"points", {{{"name", "pawn_sweep-33k"}, {"parameters", json::object()}, {"metrics", fake_reconstruction_metrics(2)}},
-                     {{"name", "pawn_sweep-200k"}, {"parameters", json::object()}, {"metrics", fake_reconstruction_metrics(1)}}}}});
-    put("ml/r1", fake_manifest("ml", "analytic", "2026-02-01T00:00:00Z"),
-        {{"table_4_1", {{"function", "marschner_lobb"}, {"lattice", "111x111x222"}, {"sigma2", 0.5}, {"sigma_units", "lattice_units"},
-                        {"margin_spacings", 2.0}, {"ratio_rms", 0.98},
-                        {"plain", {{"rms", 0.035}, {"max_abs", 0.2}, {"rms_255", 8.9}, {"l2_norm_255", 9000.0}}},
-                        {"weighted", {{"rms", 0.0343}, {"max_abs", 0.2}, {"rms_255", 8.7}, {"l2_norm_255", 8800.0}}}}},
-         {"convergence", {{"function", "trig"},
-                          {"curves", {{{"id", "bcc_cubic/true"}, {"lattice_type", "bcc"},
-                                       {"points", {{{"lattice", "13x13x26"}, {"lattice_points", 3925}, {"rms", 1e-5}, {"max_abs", 5e-5}, {"gradient_rms", 1e-3}},
-                                                   {{"lattice", "26x26x52"}, {"lattice_points", 33201}, {"rms", 1e-6}, {"max_abs", 5e-6}, {"gradient_rms", 1e-4}}}}}}}}}});
-    put("speedup/r1", fake_manifest("speedup", "speedup", "2026-02-01T00:00:00Z"),
-        {{"reference", "cpu_1"},
-         {"meshes", {{"dragon", {{"source", "/x/dragon-legacy.obj"}, {"triangles", 100000}, {"vertices", 50000}}}}},
-         {"rows", {{{"mesh", "dragon"}, {"samples_requested", 32768}, {"lattice", "cc"}, {"resolution", "32x32x32"}, {"points", 32768},
-                    {"backends", {{{"name", "cpu_1"}, {"status", "ok"}, {"total_seconds_median", 40.0}, {"extrapolated", true},
-                                   {"speedup_vs_reference", 1.0}},
-                                  {{"name", "gpu_tuned"}, {"status", "unavailable (no CUDA device)"}}}}}}}});
-    fs::create_directories(dir_ / "res/dragon/.r3.partial.1.0");  // staging leftovers are ignored
-    const std::string script = quote(kSource + "/scripts/make-report");
-    const ShellResult r = shell(script + " --results res --out report");
-    ASSERT_EQ(r.code, 0) << r.out << r.err;
-    const std::string md = read_text(dir_ / "report/report.md");
-    EXPECT_TRUE(Contains(md, "| dragon | reconstruction | 2026-02-01T00:00:00Z-00000000 |")) << md;
-    EXPECT_FALSE(Contains(md, "2026-01-01T00:00:00Z-00000000"));
-    EXPECT_TRUE(Contains(md, "## Table 3-1: meshes"));
-    EXPECT_TRUE(Contains(md, "| dragon | dragon-legacy.obj | 100,000 | 50,000 | 100,000 | 50,000 |")) << md;
-    EXPECT_TRUE(Contains(md, "| dragon | 32,768 | cc 32x32x32 | 32,768 | 40* | n/a | n/a | 1.232 | 383.6 | 311 |")) << md;
-    EXPECT_TRUE(Contains(md, "## Table 4-1")) << md;
-    EXPECT_TRUE(Contains(md, "| plain | 0.035 | 0.2 | 8.9 | 9000 | 8.939 |")) << md;
-    EXPECT_TRUE(Contains(md, "### dragon (thesis Figures 5-3)")) << md;
-    EXPECT_TRUE(Contains(md, "| cc-8x8x8/catmull_rom/fd | A | 0.02 | 0.2 | 0.02 | 0.04 | 3.5 | 9.25 |")) << md;
-    EXPECT_TRUE(Contains(md, "#### pawn_sweep-200k")) << md;
-    EXPECT_TRUE(Contains(md, "Image grids")) << md;
-    const std::string page = read_text(dir_ / "report/index.html");
-    EXPECT_TRUE(Contains(page, "<table>"));
-    EXPECT_FALSE(Contains(page, "src=\"http"));
-    if (Contains(md, "matplotlib is not available")) GTEST_SKIP() << "matplotlib is not available: plots not checked";
-    for (const char* png : {"speedup_vs_size.png", "analytic_error_vs_samples.png", "pawn_sweep_error_vs_samples.png"}) {
-        EXPECT_TRUE(fs::exists(dir_ / "report" / png)) << png;
-        EXPECT_TRUE(Contains(md, std::string("](") + png + ")")) << png;
-    }
-    EXPECT_TRUE(Contains(page, "data:image/png;base64,"));
-
-    // Sections without results say so; given run directories are used as they are.
-    const ShellResult one = shell(script + " --out report2 res/dragon/r1");
-    ASSERT_EQ(one.code, 0) << one.err;
-    const std::string md2 = read_text(dir_ / "report2/report.md");
-    EXPECT_TRUE(Contains(md2, "No speedup run in the results")) << md2;
-    EXPECT_TRUE(Contains(md2, "No analytic run")) << md2;
-    EXPECT_TRUE(Contains(md2, "| cc-8x8x8/catmull_rom/fd | A | 2 |")) << md2;
 }
 
 }  // namespace

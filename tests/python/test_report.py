@@ -1,0 +1,108 @@
+"""scripts/make-report end to end: a full report from a fake results tree, where it is
+written, and its errors."""
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+import fake_runs
+from conftest import REPO
+from sdf_report import cli
+
+SCRIPT = os.path.join(REPO, "scripts", "make-report")
+
+
+def make_report(*args):
+    """Runs scripts/make-report with this interpreter (the one that has numpy and matplotlib)."""
+    return subprocess.run([sys.executable, SCRIPT] + [str(a) for a in args], capture_output=True, text=True)
+
+
+def test_full_report_from_a_fake_results_tree(tmp_path):
+    fake_runs.full_tree(tmp_path / "results")
+    out = tmp_path / "report"
+    r = make_report("--results", tmp_path / "results", "--output", out)
+    assert r.returncode == 0, r.stderr
+    assert "(6 runs)" in r.stdout
+    md = (out / "report.md").read_text()
+    # Every section, the later dragon run only, a note that this is not the published report.
+    for heading in ("## Runs", "## Sampling times and throughput", "## Table 3-1: meshes",
+                    "## Table 3-2: sampling times and speedups", "## Table 4-1", "## Error versus sample count",
+                    "## Reconstruction errors per mesh and interpolator", "## Image grids",
+                    "## Exact sampling against the peer libraries"):
+        assert heading in md, heading
+    assert "A local report of the runs on this machine" in md
+    assert md.count("| dragon | reconstruction |") == 1
+    assert "passed (41 ok, 0 not comparable)" in md
+    assert "| cc-8x8x8/catmull_rom/fd | A | 0.02 | 0.2 |" in md  # r2 (scale 1), not r1 (scale 100)
+    assert "| dragon_32k | box-cc-8 | cc 8x8x8 |" in md
+    # Every image the Markdown names exists, and the HTML embeds them all: nothing is fetched.
+    names = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md)
+    assert sorted(set(names)) == ["grid_dragon_front.png", "grid_pawn_sweep-200k_front.png",
+                                  "grid_pawn_sweep-33k_front.png", "heat_map_scale_20.png", "ml_error_vs_samples.png",
+                                  "pawn_sweep_error_vs_samples.png", "speedup_vs_size_speedup.png"]
+    assert names.count("heat_map_scale_20.png") == 3  # under each grid
+    for name in names:
+        assert (out / name).is_file(), name
+    page = (out / "index.html").read_text()
+    sources = re.findall(r"<img src=\"([^\"]*)\"", page)
+    assert len(sources) == len(names) and all(s.startswith("data:image/png;base64,") for s in sources)
+    assert not re.search(r"(src|href)=\"(?!data:)", page)
+    assert not re.search(r"<link|<script|@import|url\(", page)
+
+
+def test_default_output_is_the_local_report_and_publish_the_committed_one():
+    assert cli.parse_args([]).output == os.path.join(REPO, "results", "report-local")
+    assert cli.parse_args(["--publish"]).output == os.path.join(REPO, "results", "report")
+    assert cli.parse_args(["--output", os.path.join(REPO, "results", "report")]).output == cli.PUBLISHED
+    with pytest.raises(SystemExit):
+        cli.parse_args(["--publish", "--output", "/tmp/elsewhere"])
+
+
+def test_the_local_report_is_ignored_by_git():
+    r = subprocess.run(["git", "-C", REPO, "check-ignore", "-q", "results/report-local/index.html"])
+    if r.returncode == 128:
+        pytest.skip("not a git work tree")
+    assert r.returncode == 0
+
+
+def test_an_invalid_run_fails_naming_file_and_key(tmp_path):
+    metrics = fake_runs.reconstruction_metrics()
+    del metrics["probes"]["h_ref"]
+    path = fake_runs.write_run(tmp_path / "results", "dragon", "reconstruction", metrics)
+    r = make_report("--results", tmp_path / "results", "--output", tmp_path / "report")
+    assert r.returncode == 1
+    assert "%s: does not match the run schema" % os.path.join(path, "metrics.json") in r.stderr
+    assert "key 'probes.h_ref': missing (expected number: the coarsest lattice spacing" in r.stderr
+    assert not (tmp_path / "report").exists()
+    r = make_report("--results", tmp_path / "results", "--output", tmp_path / "report", "--skip-invalid")
+    assert r.returncode == 0, r.stderr
+    assert "warning: skipping an invalid run" in r.stderr
+    assert "Left out (--skip-invalid)" in (tmp_path / "report" / "report.md").read_text()
+
+
+def test_refuses_to_write_into_a_directory_that_holds_no_report(tmp_path):
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "photos" / "holiday.png").write_bytes(b"not ours")
+    r = make_report("--results", tmp_path / "none", "--output", tmp_path / "photos")
+    assert r.returncode != 0
+    assert "holds no report" in r.stderr
+    assert (tmp_path / "photos" / "holiday.png").read_bytes() == b"not ours"
+
+
+def test_a_new_report_replaces_the_old_plots(tmp_path):
+    fake_runs.full_tree(tmp_path / "results")
+    out = tmp_path / "report"
+    assert make_report("--results", tmp_path / "results", "--output", out).returncode == 0
+    (out / "old_plot.png").write_bytes(b"stale")
+    r = make_report("--results", tmp_path / "results", "--output", out, tmp_path / "results" / "ml" / "r1")
+    assert r.returncode == 0, r.stderr
+    assert sorted(os.listdir(out)) == ["index.html", "ml_error_vs_samples.png", "report.md"]
+    assert "No speedup run in the results" in (out / "report.md").read_text()
+
+
+def test_no_runs_at_all(tmp_path):
+    r = make_report("--results", tmp_path / "nothing", "--output", tmp_path / "report")
+    assert r.returncode == 0, r.stderr
+    assert "No runs found" in (tmp_path / "report" / "report.md").read_text()
