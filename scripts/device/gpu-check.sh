@@ -26,7 +26,7 @@ build)
     cmake -S . -B $B "${cmake_common[@]}" -DSDF_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DSDF_WARNINGS_AS_ERRORS=ON \
         > "$OUT/configure.log" 2>&1 || { tail -30 "$OUT/configure.log"; exit 1; }
     grep "sdf:" "$OUT/configure.log" | tee -a "$OUT/summary.txt"
-    cmake --build $B -j "$(nproc)" > "$OUT/build.log" 2>&1 || { grep -E "error|warning|FAILED" "$OUT/build.log" | head -40; exit 1; }
+    cmake --build $B -j "$(nproc)" -- -k 0 > "$OUT/build.log" 2>&1 || { grep -E "error|warning|FAILED" "$OUT/build.log" | head -40; exit 1; }
     log "built" ;;
 gputest)
     log "GPU tests"

@@ -113,7 +113,7 @@ TEST(CudaRaycast, ReportsKernelTimesOfA1024SquaredBccCubicRender) {
     RenderOptions gpu;
     gpu.backend = "cuda";
     gpu.repetitions = 20;
-    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds(), 1024, 1024);
+    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds, 1024, 1024);
     const RenderedImage image = render_reconstruction(recon, camera, gpu);
     ASSERT_EQ(image.info["kernel_seconds_all"].size(), 20u);
     EXPECT_GT(image.info["kernel_seconds"].get<double>(), 0.0);
