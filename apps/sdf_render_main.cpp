@@ -56,7 +56,7 @@ struct Options {
     int downsample = 1;
     double heat_max = 20;
     std::string out = "render.png", out_dir = ".", name, title, cache_dir;
-    std::string sampler_backend = "auto", sampler_method = "brute_force";
+    std::string sampler_backend = "auto", sampler_method = "brute_force", sign = kSignModes[0].name;
 };
 
 bool is_field_file(const std::string& input) { return fs::path(input).extension() == ".json"; }
@@ -79,6 +79,7 @@ SamplerOptions sampler_options(const Options& o) {
     s.backend = o.sampler_backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : o.sampler_backend;
     s.method = o.sampler_method;
     s.precision = Precision::Float;
+    s.sign = sign_mode_from_name(o.sign, "--sign");
     s.progress = !o.quiet;
     return s;
 }
@@ -317,6 +318,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--sampler-method", o.sampler_method, "mesh input: sampler method")
         ->check(CLI::IsMember(sampler_methods()))
+        ->capture_default_str();
+    app.add_option("--sign", o.sign,
+                   "mesh input: sign mode: pseudonormal, winding (generalized winding number), or auto (winding "
+                   "where the mesh report says pseudonormal signs are not exact)")
+        ->check(CLI::IsMember(sign_mode_names()))
         ->capture_default_str();
     app.add_option("--cache-dir", o.cache_dir, "field cache (default $SDF_CACHE_DIR or <repo>/cache)");
     app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");
