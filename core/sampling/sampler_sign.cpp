@@ -5,12 +5,6 @@
 namespace sdf {
 
 const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
-    bool built = false;
-    return prepare(mesh, std::move(bvh), built);
-}
-
-const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, bool& built) {
-    built = false;
     const bool same_mesh =
         mesh_ == &mesh && mesh_sha_ == mesh.content_sha256() && mesh_triangles_ == mesh.triangles().size();
     if (same_mesh) return choice_;
@@ -22,7 +16,6 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared
     if (choice_.mode == SignMode::Winding) {
         winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
                        : std::make_shared<const WindingSign>(mesh, winding_options());
-        built = true;
     }
     mesh_ = &mesh;
     mesh_sha_ = mesh.content_sha256();

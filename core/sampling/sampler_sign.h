@@ -22,10 +22,9 @@ public:
     explicit SamplerSign(SignMode requested = SignMode::Auto) : requested_(requested) {}
 
     /// Resolves the mode for `mesh` and, for winding, builds its WindingSign over `bvh`
-    /// (built here when null). Both are kept while the mesh stays the same; `built` tells
-    /// whether this call built the winding sign.
+    /// (built here when null). Both are kept while the mesh stays the same (the warning is
+    /// written once per mesh). Not thread-safe: call it before the parallel loop.
     const SignModeChoice& prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh = nullptr);
-    const SignModeChoice& prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, bool& built);
 
     SignMode requested() const { return requested_; }
     const SignModeChoice& choice() const { return choice_; }
