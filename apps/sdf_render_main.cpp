@@ -25,6 +25,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
+#include "core/sampling/sampler_sign.h"
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"
@@ -94,6 +95,8 @@ SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, cons
         if (std::optional<SampledField> f = cache->load(key)) {
             std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name().c_str(), lattice_notation(lattice).c_str(),
                          cache->entry_path(key).c_str());
+            const std::string sign_warning = auto_sign_warning(f->sampler, mesh);
+            if (!sign_warning.empty()) std::fprintf(stderr, "warning: %s\n", sign_warning.c_str());
             return *f;
         }
     }

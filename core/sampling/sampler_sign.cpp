@@ -3,6 +3,13 @@
 #include <iostream>
 
 namespace sdf {
+namespace {
+
+std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) {
+    return "sign auto for mesh '" + mesh.name() + "' (" + mesh.source() + "): " + reason;
+}
+
+}  // namespace
 
 const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
     const bool same_mesh =
@@ -11,8 +18,7 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
     if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
-        std::cerr << "warning: sign auto for mesh '" << mesh.name() << "' (" << mesh.source() << "): " << choice_.reason
-                  << "\n";
+        std::cerr << "warning: " << auto_sign_text(mesh, choice_.reason) << "\n";
     if (choice_.mode == SignMode::Winding) {
         winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
                        : std::make_shared<const WindingSign>(mesh, winding_options());
@@ -35,6 +41,13 @@ nlohmann::json SamplerSign::provenance() const {
                         {"moments_seconds", winding_->winding_bvh().seconds}};
     }
     return p;
+}
+
+std::string auto_sign_warning(const nlohmann::json& sampler, const PreparedMesh& mesh) {
+    if (!sampler.is_object() || !sampler.contains("sign")) return "";
+    const nlohmann::json& sign = sampler.at("sign");
+    if (sign.value("requested", "") != "auto" || sign.value("mode", "") != "winding") return "";
+    return auto_sign_text(mesh, sign.value("reason", ""));
 }
 
 }  // namespace sdf

@@ -54,4 +54,9 @@ private:
     size_t mesh_triangles_ = 0;
 };
 
+/// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler
+/// provenance) records that auto chose the winding sign, else "": the warning prepare()
+/// writes, for fields read back from the cache.
+std::string auto_sign_warning(const nlohmann::json& sampler, const PreparedMesh& mesh);
+
 }  // namespace sdf

@@ -107,11 +107,15 @@ TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
         EXPECT_EQ(sign.at("mode"), "winding") << b.name;
         EXPECT_NE(sign.at("reason").get<std::string>().find("3 shells"), std::string::npos) << b.name;
         EXPECT_EQ(sign.at("winding").at("beta"), 2.0) << b.name;
+        // The same warning for the field when it comes back from the cache.
+        EXPECT_EQ("warning: " + auto_sign_warning(winding.sampler, mesh) + "\n", warning) << b.name;
 
         const std::string quiet =
             captured_cerr([&] { pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice); });
         EXPECT_EQ(quiet.find("warning"), std::string::npos) << b.name << ": " << quiet;
         EXPECT_EQ(pseudonormal.sampler.at("sign").at("mode"), "pseudonormal");
+        EXPECT_EQ(auto_sign_warning(pseudonormal.sampler, mesh), "");
+        EXPECT_EQ(auto_sign_warning(nlohmann::json::object(), mesh), "");  // a field sampled before sign modes
 
         int judged = 0, winding_wrong = 0, pseudonormal_wrong = 0, flipped = 0;
         for (int64_t i = 0; i < lattice.num_points(); ++i) {
