@@ -165,8 +165,8 @@ private:
         PieceResults r(piece.count);
         compute.begin();
         launch_slab<T>(dev.view, piece, slab, r.nearest.get());
-        finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
-                                                                r.outputs());
+        launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
+                                r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
         compute.end();
         download.begin();
@@ -225,8 +225,8 @@ private:
             nearest_triangle_bvh_points<T><<<blocks_for(piece.count, kBvhThreads), kBvhThreads>>>(dev.view, piece,
                                                                                                   r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh_points");
-            finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(),
-                                                                    dev.winding.view(), r.outputs());
+            launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
+                                    dev.winding.view(), r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
             const PieceResults::Host h = r.download(piece.count);
             scatter_batch(h, mesh, out);

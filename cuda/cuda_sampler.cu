@@ -219,8 +219,8 @@ private:
             compute_.end();
         }
         compute_.begin();
-        finalize_samples<<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, best_i.get(),
-                                                                                winding_.view(), out.view());
+        launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
+                                winding_.view(), out.view());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
         download_.begin();
@@ -262,8 +262,12 @@ private:
             nearest_triangle_thesis<T><<<blocks_for(n, kThesisThreads), kThesisThreads>>>(piece, first, count, minima);
             CUDA_CHECK_LAUNCH("nearest_triangle_thesis");
         }
-        finalize_thesis_samples<T><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
-                                                                                        winding_.view(), out.view());
+        if (winding_.view().enabled())
+            finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+                                                                                                  winding_.view(), out.view());
+        else
+            finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+                                                                                                   winding_.view(), out.view());
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
         download_.begin();

@@ -21,7 +21,9 @@ struct PieceOutputs {
     int64_t* output_index;  ///< -1: padding or discarded
 };
 
-template <typename Piece>
+/// With `Winding` the sample then takes the winding number's side; without it the kernel has
+/// no winding code at all (pseudonormal mode: the kernel as it was before sign modes).
+template <typename Piece, bool Winding>
 __global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
@@ -29,10 +31,19 @@ __global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* 
     out.output_index[i] = o;
     if (o < 0) return;
     const Vec3d p = piece.position(i);
-    const SignedDistanceSample<double> s = apply_winding_sign(sign, signed_distance_to_triangle(mesh, p, nearest[i]), p);
+    SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, nearest[i]);
+    if constexpr (Winding) s = apply_winding_sign(sign, s, p);
     out.distance[i] = s.distance;
     out.gradient[i] = s.gradient;
     out.triangle[i] = s.triangle;
+}
+
+/// Launches finalize_samples with or without the winding sign, as `sign` says.
+template <typename Piece>
+void launch_finalize_samples(int blocks, int threads, MeshView<double> mesh, const Piece& piece, const int* nearest,
+                             const WindingSignView& sign, PieceOutputs out) {
+    if (sign.enabled()) finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, out);
+    else finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, out);
 }
 
 }  // namespace sdf::cuda
