@@ -6,6 +6,8 @@
 // harness/config/mesh_spec.h) or shape:NAME; POINTS has "x y z" per line ('-' = stdin).
 #include <CLI/CLI.hpp>
 
+#include "apps/cli_exit.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -31,7 +33,7 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    SDF_CLI_PARSE(app, argc, argv);
     options.precision = precision == "float" ? sdf::Precision::Float : sdf::Precision::Double;
     options.progress = false;
     sdf::ProgressReporter::set_globally_enabled(false);
