@@ -395,5 +395,29 @@ TEST_F(Trust, RenderRefusesACameraWithoutADefinedRoll) {
     EXPECT_FALSE(fs::exists(at("x.png")));
 }
 
+// ---- 6. results that claim success with nothing measured ---------------------------------------
+
+TEST_F(Trust, ReconstructionStudyThatPlacesNoProbeFails) {
+    // A band far wider than the common domain: every band probe lands outside it. Before:
+    // all errors 0, exit 0.
+    const std::string study = R"({"name": "noprobes", "kind": "reconstruction", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [6, 6, 6]}],
+        "sampler": {"threads": 1, "progress": false},
+        "reconstructions": [{"lattice": "cc", "interpolator": "trilinear"}],
+        "metrics": {"domain_probes": 0, "band_probes": 50, "band": 1e6}})";
+    write("noprobes.json", study);
+    const ShellResult r = experiment("noprobes.json --no-cache --output-root out");
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_TRUE(Contains(r.err, "noprobes.json: key 'metrics': no probe was placed"));
+    EXPECT_FALSE(fs::exists(at("out/noprobes")) && !fs::is_empty(at("out/noprobes")));
+    // The same study with probes in the domain runs.
+    std::string fine = study;
+    fine.replace(fine.find("\"domain_probes\": 0"), 18, "\"domain_probes\": 9");
+    fine.replace(fine.find("\"band\": 1e6"), 11, "\"band\": 1");
+    write("probes.json", fine);
+    const ShellResult ok = experiment("probes.json --no-cache --output-root out");
+    EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+}
+
 }  // namespace
 }  // namespace sdf
