@@ -1,4 +1,5 @@
 // sdf-query MESH POINTS [--backend cpu|cuda] [--threads N] [--precision float|double]
+//           [--sign auto|pseudonormal|winding]
 //
 // Prints one line per input point, in input order: "d gx gy gz tri" (signed distance,
 // exact gradient, 0-based closest triangle in the file's face order). MESH is an OBJ file
@@ -21,7 +22,7 @@
 
 int main(int argc, char** argv) {
     CLI::App app{"Exact signed distance, gradient and closest triangle of points to a mesh."};
-    std::string mesh_arg, points_path, precision = "float";
+    std::string mesh_arg, points_path, precision = "float", sign = sdf::kSignModes[0].name;
     sdf::SamplerOptions options;
     app.add_option("mesh", mesh_arg, "OBJ file or shape:NAME (sphere, box, torus, pawn, soccer_ball)")->required();
     app.add_option("points", points_path, "file with \"x y z\" per line, or - for stdin")->required();
@@ -33,8 +34,14 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
+    app.add_option("--sign", sign,
+                   "sign mode: pseudonormal, winding (generalized winding number > 1/2), or auto (pseudonormal where "
+                   "the mesh is closed, manifold, oriented, one shell, without self-intersections; winding otherwise)")
+        ->check(CLI::IsMember(sdf::sign_mode_names()))
+        ->capture_default_str();
     SDF_CLI_PARSE(app, argc, argv);
     options.precision = precision == "float" ? sdf::Precision::Float : sdf::Precision::Double;
+    options.sign = sdf::sign_mode_from_name(sign, "--sign");
     options.progress = false;
     sdf::ProgressReporter::set_globally_enabled(false);
     try {

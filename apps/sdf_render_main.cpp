@@ -27,6 +27,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
+#include "core/sampling/sampler_sign.h"
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"
@@ -59,7 +60,7 @@ struct Options {
     int downsample = 1;
     double heat_max = 20;
     std::string out = "render.png", out_dir = ".", name, title, cache_dir;
-    std::string sampler_backend = "auto", sampler_method = "brute_force";
+    std::string sampler_backend = "auto", sampler_method = "brute_force", sign = kSignModes[0].name;
 };
 
 bool is_field_file(const std::string& input) { return fs::path(input).extension() == ".json"; }
@@ -82,6 +83,7 @@ SamplerOptions sampler_options(const Options& o) {
     s.backend = o.sampler_backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : o.sampler_backend;
     s.method = o.sampler_method;
     s.precision = Precision::Float;
+    s.sign = sign_mode_from_name(o.sign, "--sign");
     s.progress = !o.quiet;
     return s;
 }
@@ -96,6 +98,8 @@ SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, cons
         if (std::optional<SampledField> f = cache->load(key)) {
             std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name().c_str(), lattice_notation(lattice).c_str(),
                          cache->entry_path(key).c_str());
+            const std::string sign_warning = auto_sign_warning(f->sampler, mesh);
+            if (!sign_warning.empty()) std::fprintf(stderr, "warning: %s\n", sign_warning.c_str());
             return *f;
         }
     }
@@ -341,6 +345,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--sampler-method", o.sampler_method, "mesh input: sampler method")
         ->check(CLI::IsMember(sampler_methods()))
+        ->capture_default_str();
+    app.add_option("--sign", o.sign,
+                   "mesh input: sign mode: pseudonormal, winding (generalized winding number), or auto (winding "
+                   "where the mesh report says pseudonormal signs are not exact)")
+        ->check(CLI::IsMember(sign_mode_names()))
         ->capture_default_str();
     app.add_option("--cache-dir", o.cache_dir, "field cache (default $SDF_CACHE_DIR or <repo>/cache)");
     app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");

@@ -16,6 +16,7 @@
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
 #include "cuda/device_mesh.h"
+#include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
 
 namespace sdf::cuda {
@@ -23,21 +24,24 @@ namespace {
 
 int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
 
-/// A BVH and the double mesh on the device, for one precision of the search.
+/// A BVH and the double mesh on the device, for one precision of the search, with the
+/// winding moments when the sign (prepared for this mesh) is the winding number's.
 template <typename T>
 struct DeviceBvh {
     DeviceBuffer<BvhNode> nodes;
     DeviceBuffer<PackedTriangle<T>> packed;
     DeviceBuffer<int32_t> triangle_index;
     std::unique_ptr<DeviceMesh<double>> mesh;
+    DeviceWinding winding;
     BvhView<T> view{};
 
-    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared) {
+    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared, const SamplerSign& sign) {
         nodes.upload(bvh.nodes);
         if constexpr (std::is_same_v<T, float>) packed.upload(bvh.packed_float);
         else packed.upload(bvh.packed_double);
         triangle_index.upload(bvh.triangle_index);
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
+        winding.upload(sign, mesh->view());
         view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
     }
 };
@@ -75,7 +79,7 @@ struct PieceResults {
 
 class CudaBvhSampler final : public Sampler {
 public:
-    explicit CudaBvhSampler(const SamplerOptions& options) : options_(options) {
+    explicit CudaBvhSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCudaBvhKernels, options.kernel, "CUDA BVH");
     }
 
@@ -97,13 +101,14 @@ private:
     const DeviceBvh<T>& device_bvh(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
         CUDA_CHECK(cudaSetDevice(options_.device));
         const auto bvh = cache_.get(mesh, built);
+        sign_.prepare(mesh, bvh);  // the winding sign shares the BVH
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
         uploaded = !slot || uploaded_for_ != bvh.get();
         if (uploaded) {
             device_float_.reset();
             device_double_.reset();
             upload.begin();
-            slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh);
+            slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh, sign_);
             upload.end();
             uploaded_for_ = bvh.get();
             host_bvh_ = bvh;
@@ -160,7 +165,8 @@ private:
         PieceResults r(piece.count);
         compute.begin();
         launch_slab<T>(dev.view, piece, slab, r.nearest.get());
-        finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
+        launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
+                                r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
         compute.end();
         download.begin();
@@ -194,7 +200,7 @@ private:
         nlohmann::json bvh_info = host_bvh_->stats.to_json();
         bvh_info["built_by_this_call"] = built;
         bvh_info["uploaded_by_this_call"] = uploaded;
-        field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed);
+        field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
         field.sampler["bvh"] = bvh_info;
         field.sampler["device"] = describe_device(options_.device);
@@ -219,7 +225,8 @@ private:
             nearest_triangle_bvh_points<T><<<blocks_for(piece.count, kBvhThreads), kBvhThreads>>>(dev.view, piece,
                                                                                                   r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh_points");
-            finalize_samples<<<blocks_for(piece.count, 256), 256>>>(dev.mesh->view(), piece, r.nearest.get(), r.outputs());
+            launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
+                                    dev.winding.view(), r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
             const PieceResults::Host h = r.download(piece.count);
             scatter_batch(h, mesh, out);
@@ -230,6 +237,7 @@ private:
     SamplerOptions options_;
     BvhGpuKernel kernel_ = BvhGpuKernel::Warp;
     BvhCache cache_;
+    SamplerSign sign_;
     std::shared_ptr<const TriangleBvh> host_bvh_;
     const TriangleBvh* uploaded_for_ = nullptr;
     std::unique_ptr<DeviceBvh<float>> device_float_;

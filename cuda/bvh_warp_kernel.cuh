@@ -38,7 +38,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
     const int w = threadIdx.x / 32;
 
     // Every thread stays to the end: the votes and shuffles need the whole warp. Threads
-    // past the slab get best = 0, so they never want a box and never hold the warp back.
+    // past the slab get best = -1, so they never want a box and never hold the warp back.
     const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     Int3 s{0, 0, 0};
     bool valid = t < slab.threads();
@@ -50,11 +50,12 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
     for (int k = 0; k < kRunPoints; ++k) {
         const Vec3<T> p(valid ? piece.position(first + (k < count ? k : 0)) : piece.position(0));
         pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
-        pk.best_q[k] = valid ? T(INFINITY) : T(0);
+        pk.best_q[k] = valid ? T(INFINITY) : T(-1);  // -1: never nearer than a box or a triangle
         pk.best_slot[k] = -1;
+        pk.best_triangle[k] = -1;
     }
 
-    T worst = warp_max(valid ? T(INFINITY) : T(0));
+    T worst = warp_max(valid ? T(INFINITY) : T(-1));
     int top = 0;  // warp-uniform
     int32_t node = 0;
     while (node >= 0) {
@@ -98,7 +99,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
         __syncwarp();
         while (next < 0 && top > 0) {
             --top;
-            if (stack_d2[w][top] < worst) next = stack_node[w][top];
+            if (may_hold_nearer(stack_d2[w][top], worst)) next = stack_node[w][top];
         }
         __syncwarp();
         node = next;

@@ -12,6 +12,7 @@
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
 #include "cuda/device_mesh.h"
+#include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
 #include "cuda/point_pieces.h"
 #include "cuda/thesis_kernel.cuh"
@@ -64,7 +65,8 @@ class Engine {
 public:
     using Sink = std::function<void(const HostPiece&)>;
 
-    Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel)
+    /// `sign` is prepared for `mesh`: in winding mode its moments are uploaded too.
+    Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel, const SamplerSign& sign)
         : host_(mesh.buffers<T>()), exact_host_(mesh.buffers<double>()), options_(options), kernel_(kernel) {
         CUDA_CHECK(cudaSetDevice(options.device));
         cudaDeviceProp prop{};
@@ -73,6 +75,7 @@ public:
         max_threads_per_sm_ = prop.maxThreadsPerMultiProcessor;
         upload_.begin();
         mesh_ = std::make_unique<DeviceMesh<double>>(exact_host_);
+        winding_.upload(sign, mesh_->view());
         upload_.end();
         size_t free_bytes = 0, total = 0;
         CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
@@ -216,7 +219,8 @@ private:
             compute_.end();
         }
         compute_.begin();
-        finalize_samples<<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, best_i.get(), out.view());
+        launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
+                                winding_.view(), out.view());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
         download_.begin();
@@ -258,7 +262,12 @@ private:
             nearest_triangle_thesis<T><<<blocks_for(n, kThesisThreads), kThesisThreads>>>(piece, first, count, minima);
             CUDA_CHECK_LAUNCH("nearest_triangle_thesis");
         }
-        finalize_thesis_samples<T><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima, out.view());
+        if (winding_.view().enabled())
+            finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+                                                                                                  winding_.view(), out.view());
+        else
+            finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+                                                                                                   winding_.view(), out.view());
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
         download_.begin();
@@ -272,6 +281,7 @@ private:
     SamplerOptions options_;
     CudaKernel kernel_;
     std::unique_ptr<DeviceMesh<double>> mesh_;
+    DeviceWinding winding_;
     DeviceBuffer<PackedTriangle<T>> packed_;
     std::vector<T> thesis_triangles_;
     EventTimer upload_, compute_, download_;
@@ -284,7 +294,7 @@ private:
 
 class CudaBruteForceSampler final : public Sampler {
 public:
-    explicit CudaBruteForceSampler(const SamplerOptions& options) : options_(options) {
+    explicit CudaBruteForceSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCudaBruteForceKernels, options.kernel, "CUDA brute-force");
     }
 
@@ -305,7 +315,8 @@ private:
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
         SampledField field = unfilled_field(lattice, options_.precision);
-        Engine<T> engine(mesh, options_, kernel_);
+        sign_.prepare(mesh);
+        Engine<T> engine(mesh, options_, kernel_, sign_);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
@@ -338,7 +349,7 @@ private:
         field.timings.download = engine.download_seconds();
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed);
+        field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["plan"] = engine.plan();
         field.sampler["device"] = describe_device(options_.device);
         return field;
@@ -348,7 +359,8 @@ private:
     std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
         std::vector<PointSample> out(points.size());
         if (points.empty()) return out;
-        Engine<T> engine(mesh, options_, kernel_);
+        sign_.prepare(mesh);
+        Engine<T> engine(mesh, options_, kernel_, sign_);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, out); };
@@ -366,6 +378,7 @@ private:
 
     SamplerOptions options_;
     CudaKernel kernel_ = CudaKernel::Tuned;
+    SamplerSign sign_;
 };
 
 }  // namespace

@@ -96,14 +96,18 @@ __global__ void fill_thesis_minima(int64_t n, ThesisMinima<T> m) {
 /// closest point, feature, sign and gradient are re-evaluated with Eberly's algorithm in
 /// double on the winning triangle at the exact lattice position, so the thesis kernel's
 /// fields equal the CPU reference's except where the float search broke a near-tie.
-template <typename T, typename Piece>
-__global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, ThesisMinima<T> minima, PieceOutputs out) {
+/// `Winding`: as finalize_samples (finalize_kernel.cuh).
+template <typename T, bool Winding, typename Piece>
+__global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, ThesisMinima<T> minima, WindingSignView sign,
+                                        PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
     const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
     out.output_index[i] = o;
     if (o < 0) return;
-    const SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, piece.position(i), minima.triangle[i]);
+    const Vec3d p = piece.position(i);
+    SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, minima.triangle[i]);
+    if constexpr (Winding) s = apply_winding_sign(sign, s, p);
     out.distance[i] = s.distance;
     out.gradient[i] = s.gradient;
     out.triangle[i] = s.triangle;

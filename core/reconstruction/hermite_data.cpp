@@ -1,4 +1,5 @@
 #include "core/reconstruction/hermite_data.h"
+#include "core/reconstruction/spline_prefilters.h"
 
 #include "core/parallel/parallel_for.h"
 #include "core/reconstruction/bcc_cubic_tables.h"
@@ -109,6 +110,12 @@ HermiteData<double> build_hermite_data(const SampledField& field, const Reconstr
         case PointData::CcTricubicJet: build_cc_tricubic(d, field, spec, unit); break;
         case PointData::BccCubicJet:
         case PointData::BccCubicC0Jet: build_bcc_cubic(d, field, spec, unit); break;
+        case PointData::SplineInterpolation:
+            build_spline_coefficients(d, SplinePrefilter::Interpolation, spec.threads);
+            break;
+        case PointData::SplineQuasiInterpolation:
+            build_spline_coefficients(d, SplinePrefilter::QuasiInterpolation, spec.threads);
+            break;
     }
     return d;
 }

@@ -9,6 +9,7 @@
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampled_field.h"
+#include "core/winding/sign_mode.h"
 #include "kernels/lattice/sampling_grid.h"
 
 namespace sdf {
@@ -18,6 +19,9 @@ struct SamplerOptions {
     std::string method = "brute_force"; ///< "brute_force" (later "bvh")
     std::string kernel;                 ///< backend-specific variant; empty = backend default
     Precision precision = Precision::Float;
+    /// How the sign is decided (core/winding/sign_mode.h); auto is resolved per mesh by the
+    /// sampler from the mesh's report (core/sampling/sampler_sign.h).
+    SignMode sign = SignMode::Auto;
     int threads = 0;                    ///< CPU threads; 0 = all
     BccStrategy bcc_strategy = BccStrategy::TwoGrids;
     bool progress = true;

@@ -7,12 +7,14 @@ const char* bcc_strategy_name(BccStrategy s) {
 }
 
 nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
-                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed) {
+                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed,
+                                  const SamplerSign& sign) {
     nlohmann::json p = {{"backend", backend},
                         {"method", method},
                         {"kernel", kernel},
                         {"precision", precision_name(options.precision)},
-                        {"points_computed", points_computed}};
+                        {"points_computed", points_computed},
+                        {"sign", sign.provenance()}};
     if (lattice.type == LatticeType::BCC) p["bcc_strategy"] = bcc_strategy_name(options.bcc_strategy);
     return p;
 }

@@ -14,6 +14,7 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler.h"
+#include "core/sampling/sampler_sign.h"
 
 namespace sdf {
 
@@ -58,9 +59,11 @@ void scatter_batch(const Batch& batch, const PreparedMesh& mesh, std::vector<Poi
 }
 
 /// The provenance every sampler records in SampledField::sampler: "backend", "method",
-/// "kernel", "precision", "points_computed", and "bcc_strategy" on a BCC lattice. Each
-/// sampler adds its own keys (threads, plan, bvh, device).
+/// "kernel", "precision", "points_computed", "sign" (the requested and resolved sign mode
+/// and why: SamplerSign::provenance()), and "bcc_strategy" on a BCC lattice. Each sampler
+/// adds its own keys (threads, plan, bvh, device).
 nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
-                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed);
+                                  const SamplerOptions& options, const Lattice& lattice, int64_t points_computed,
+                                  const SamplerSign& sign);
 
 }  // namespace sdf

@@ -7,18 +7,25 @@
 namespace sdf {
 
 const char* sign_mode_name(SignMode mode) {
-    switch (mode) {
-        case SignMode::Auto: return "auto";
-        case SignMode::Pseudonormal: return "pseudonormal";
-        case SignMode::Winding: return "winding";
-    }
-    return "?";
+    for (const NamedSignMode& m : kSignModes)
+        if (m.mode == mode) return m.name;
+    throw std::logic_error("sign mode without a name in kSignModes");
+}
+
+std::vector<std::string> sign_mode_names() {
+    std::vector<std::string> names;
+    for (const NamedSignMode& m : kSignModes) names.emplace_back(m.name);
+    return names;
 }
 
 SignMode sign_mode_from_name(const std::string& name, const std::string& where) {
-    for (SignMode m : {SignMode::Auto, SignMode::Pseudonormal, SignMode::Winding})
-        if (name == sign_mode_name(m)) return m;
-    throw std::invalid_argument(where + ": unknown sign mode '" + name + "'; expected auto, pseudonormal or winding");
+    for (const NamedSignMode& m : kSignModes)
+        if (name == m.name) return m.mode;
+    std::string expected;
+    const std::vector<std::string> names = sign_mode_names();
+    for (size_t i = 0; i < names.size(); ++i)
+        expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + ("\"" + names[i] + "\"");
+    throw std::invalid_argument(where + ": unknown sign mode '" + name + "'; expected " + expected);
 }
 
 SignModeChoice choose_sign_mode(const MeshReport& r, SignMode requested) {

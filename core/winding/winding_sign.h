@@ -1,27 +1,16 @@
 /// @file winding_sign.h
-/// @brief Sign modes and the CPU per-point sign from the generalized winding number.
-///
-/// Modes (config key "sign", tool option --sign): "pseudonormal", the thesis's
-/// angle-weighted pseudonormal of the closest feature (Baerentzen & Aanaes 2005), exact
-/// for closed, manifold, consistently oriented meshes without self-intersections;
-/// "winding", inside where the generalized winding number exceeds 1/2 (Jacobson et al.
-/// 2013), right also for overlapping closed parts, small holes and self-intersections;
-/// "auto", pseudonormal where the mesh report shows it is exact, winding otherwise.
+/// @brief Resolving a sign mode (sign_mode.h) for a mesh, and the CPU per-point sign from
+/// the generalized winding number.
 #pragma once
 
 #include <atomic>
 #include <memory>
 #include <string>
 
+#include "core/winding/sign_mode.h"
 #include "core/winding/winding_bvh.h"
 
 namespace sdf {
-
-enum class SignMode { Auto, Pseudonormal, Winding };
-
-const char* sign_mode_name(SignMode mode);
-/// "auto", "pseudonormal" or "winding"; throws std::invalid_argument naming the value and `where`.
-SignMode sign_mode_from_name(const std::string& name, const std::string& where);
 
 struct SignModeChoice {
     SignMode mode = SignMode::Pseudonormal;

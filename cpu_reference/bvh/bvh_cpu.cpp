@@ -34,7 +34,7 @@ struct QueryCounters {
 /// In a chunk, point i is seeded with point i-1's triangle when `seeded` (any triangle is
 /// a valid seed: its distance only bounds the search radius).
 template <typename T, typename PositionFn, typename EmitFn>
-void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, bool seeded, int threads, bool progress,
+void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, bool seeded, int threads, bool progress,
                      int64_t n, QueryCounters& counters, PositionFn pos, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
@@ -48,7 +48,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, bool seed
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
             const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed, stats);
             previous = hit.slot;
-            emit(i, signed_distance_to_triangle(exact, p, view.triangle_index[hit.slot]));
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[hit.slot]), p));
         }
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
@@ -85,7 +85,7 @@ Brick brick_points(const Lattice& lattice, const GridBlock& block, const Int3& b
 /// Evaluates every point of `block` brick by brick (closest_triangles_packet.h); each lane
 /// is seeded with the triangle of the same lane of the previous brick along x.
 template <typename T, typename EmitFn>
-void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lattice& lattice, const GridBlock& block,
+void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const Lattice& lattice, const GridBlock& block,
                      int threads, bool progress, QueryCounters& counters, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
@@ -109,7 +109,8 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lat
             seed_packet(view, seed, pk);
             closest_triangles_packet(view, pk, stats);
             for (int k = 0; k < br.count; ++k)
-                emit(br.local[k], signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]));
+                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]),
+                                             br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
             done += br.count;
         }
@@ -121,7 +122,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Lat
 
 class CpuBvhSampler final : public Sampler {
 public:
-    explicit CpuBvhSampler(const SamplerOptions& options) : options_(options) {
+    explicit CpuBvhSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCpuBvhKernels, options.kernel, "CPU BVH");
     }
 
@@ -136,10 +137,11 @@ public:
         std::vector<PointSample> out(points.size());
         bool built = false;
         const auto bvh = cache_.get(mesh, built);
+        sign_.prepare(mesh, bvh);
         QueryCounters counters;
         auto run = [&](auto zero) {
             using T = decltype(zero);
-            evaluate_points<T>(mesh, *bvh, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
+            evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
                                [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
@@ -159,6 +161,7 @@ private:
         const auto start = std::chrono::steady_clock::now();
         bool built = false;
         const auto bvh = cache_.get(mesh, built);
+        sign_.prepare(mesh, bvh);  // shares the BVH: only the winding moments are added
         const auto query_start = std::chrono::steady_clock::now();
         SampledField field = unfilled_field(lattice, options_.precision);
         GridBlock blocks[2];
@@ -173,9 +176,9 @@ private:
                 store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
             };
             if (kernel_ == BvhKernel::Brick)
-                evaluate_bricks<T>(mesh, *bvh, lattice, block, options_.threads, options_.progress, counters, emit);
+                evaluate_bricks<T>(mesh, *bvh, sign_, lattice, block, options_.threads, options_.progress, counters, emit);
             else
-                evaluate_points<T>(mesh, *bvh, seeded(), options_.threads, options_.progress, block.count(), counters,
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(), counters,
                                    [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); }, emit);
             computed += block.count();
         }
@@ -188,7 +191,7 @@ private:
         bvh_info["built_by_this_call"] = built;
         bvh_info["node_visits_per_point"] = computed > 0 ? double(counters.nodes) / double(computed) : 0.0;
         bvh_info["point_triangle_tests_per_point"] = computed > 0 ? double(counters.triangles) / double(computed) : 0.0;
-        field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed);
+        field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         field.sampler["bvh"] = bvh_info;
         return field;
@@ -197,6 +200,7 @@ private:
     SamplerOptions options_;
     BvhKernel kernel_ = BvhKernel::Brick;
     BvhCache cache_;
+    SamplerSign sign_;
 };
 
 }  // namespace

@@ -17,10 +17,11 @@ using CpuKernel = CpuBruteForceKernel;
 /// Evaluates n points: pos(i) gives the position, emit(i, sample) receives the result.
 /// The nearest triangle is searched in precision T; the winner is then evaluated in double
 /// (closest point, sign, gradient) at the exact double position, so a float run differs
-/// from a double run only where the float search resolved a near-tie differently.
+/// from a double run only where the float search resolved a near-tie differently. In
+/// winding mode `sign` then gives each sample the winding number's side.
 template <typename T, typename PositionFn, typename EmitFn>
-void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bool progress, int64_t n,
-                     PositionFn pos, EmitFn emit) {
+void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSign& sign, int threads, bool progress,
+                     int64_t n, PositionFn pos, EmitFn emit) {
     const MeshBuffers<T>& buffers = mesh.buffers<T>();
     const MeshView<T> view = buffers.view();
     const MeshView<double> exact = mesh.buffers<double>().view();
@@ -39,14 +40,17 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, int threads, bo
         } else {
             for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
-        for (int k = 0; k < count; ++k) emit(begin + k, signed_distance_to_triangle(exact, pos(begin + k), best[k]));
+        for (int k = 0; k < count; ++k) {
+            const Vec3d p = pos(begin + k);
+            emit(begin + k, sign.apply(signed_distance_to_triangle(exact, p, best[k]), p));
+        }
         reporter.advance(count);
     });
 }
 
 class CpuBruteForceSampler final : public Sampler {
 public:
-    explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options) {
+    explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCpuBruteForceKernels, options.kernel, "CPU brute-force");
     }
 
@@ -59,9 +63,10 @@ public:
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
         std::vector<PointSample> out(points.size());
+        sign_.prepare(mesh);
         auto run = [&](auto zero) {
             using T = decltype(zero);
-            evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, int64_t(points.size()),
+            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()),
                                [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
@@ -77,13 +82,14 @@ private:
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
+        sign_.prepare(mesh);
         SampledField field = unfilled_field(lattice, options_.precision);
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];
-            evaluate_points<T>(mesh, kernel_, options_.threads, options_.progress, block.count(),
+            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, block.count(),
                                [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    const int64_t out = block.output_index(lattice, i);
@@ -96,13 +102,14 @@ private:
         field.timings.total = seconds;
         field.timings.kernel = seconds;
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
-        field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed);
+        field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         return field;
     }
 
     SamplerOptions options_;
     CpuKernel kernel_ = CpuKernel::Vectorized;
+    SamplerSign sign_;
 };
 
 }  // namespace

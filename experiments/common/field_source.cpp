@@ -1,9 +1,11 @@
 #include "experiments/common/field_source.h"
 
 #include <cstdio>
+#include <iostream>
 #include <ostream>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/sampling/sampler_sign.h"
 #include "experiments/common/study_inputs.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/field_file.h"
@@ -53,6 +55,8 @@ ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice,
     if (cache_) {
         if (std::optional<SampledField> f = cache_->load(key)) {
             log << "  " << what << ": from the cache (" << out.cache_key.substr(0, 12) << ")\n";
+            const std::string sign_warning = auto_sign_warning(f->sampler, mesh);
+            if (!sign_warning.empty()) std::cerr << "warning: " << sign_warning << "\n";
             out.field = std::move(*f);
             out.from_cache = true;
             return out;

@@ -33,6 +33,8 @@ nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l,
             {"sampler", {{"method", o.method},
                          {"kernel", o.kernel},
                          {"precision", precision_name(o.precision)},
+                         // The requested mode: auto resolves from the mesh, which mesh_sha256 fixes.
+                         {"sign", sign_mode_name(o.sign)},
                          {"bcc_strategy", bcc ? bcc_strategy_name(o.bcc_strategy) : "-"}}}};
 }
 

@@ -37,6 +37,7 @@ SamplerOptions parse_sampler_options(JsonReader& r) {
     o.threads = r.optional<int>("threads", 0, "a thread count (0 = all cores)");
     if (o.threads < 0) r.fail("threads", "expected 0 (all cores) or a positive count, got " + std::to_string(o.threads));
     o.precision = r.choice("precision", {"float", "double"}, "float") == "float" ? Precision::Float : Precision::Double;
+    o.sign = sign_mode_from_name(r.choice("sign", sign_mode_names(), sign_mode_name(kSignModes[0].mode)), "sampler.sign");
     o.bcc_strategy = r.choice("bcc_strategy", {"two_grids", "double_resolution"}, "two_grids") == "two_grids"
                          ? BccStrategy::TwoGrids
                          : BccStrategy::DoubleResolution;
@@ -64,6 +65,7 @@ nlohmann::json sampler_options_to_json(const SamplerOptions& o) {
             {"kernel", o.kernel},
             {"threads", o.threads},
             {"precision", precision_name(o.precision)},
+            {"sign", sign_mode_name(o.sign)},
             {"bcc_strategy", bcc_strategy_name(o.bcc_strategy)},
             {"device", o.device},
             {"max_points_per_piece", o.max_points_per_piece},

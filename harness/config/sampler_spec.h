@@ -1,7 +1,8 @@
 /// @file sampler_spec.h
 /// @brief The "sampler" object of a config:
 ///   {"backend": "cpu" | "cuda" | "auto", "method": "brute_force" | "bvh", "kernel": "...",
-///    "threads": 0, "precision": "float" | "double", "bcc_strategy": "two_grids" | "double_resolution",
+///    "threads": 0, "precision": "float" | "double", "sign": "auto" | "pseudonormal" | "winding",
+///    "bcc_strategy": "two_grids" | "double_resolution",
 ///    "progress": true, "device": 0, "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
 ///    "points_per_thread": 0}
 /// Backends, methods and kernels (the first is the default) come from the sampler table,

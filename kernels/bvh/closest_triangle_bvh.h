@@ -67,13 +67,23 @@ SDF_CPU_GPU SDF_INLINE bool may_hold_nearer(T box_d2, T radius) {
     return box_d2 <= radius * (T(1) + T(8) * std::numeric_limits<T>::epsilon());
 }
 
+/// The one tie rule of every search, CPU and GPU, brute force and BVH: the smaller squared
+/// distance wins, and of equal ones the smaller triangle index (prepared-mesh order, which is
+/// also the brute-force loop order), so the winner does not depend on the order in which
+/// triangles are met: work split, traversal, thread count or GPU model.
+SDF_CPU_GPU SDF_INLINE bool wins_tie(int32_t triangle, int32_t best_triangle) {
+    return best_triangle < 0 || triangle < best_triangle;
+}
+
 /// Scans leaf triangles [first, first + count) and keeps the nearest in `best`.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int32_t count, const Vec3<T>& p,
                                       BvhHit<T>& best) {
     for (int32_t j = first; j < first + count; ++j) {
         const T q = squared_distance(bvh.packed[j], p);
-        if (q < best.distance_squared) {
+        if (q < best.distance_squared ||
+            (q == best.distance_squared &&
+             wins_tie(bvh.triangle_index[j], best.slot < 0 ? -1 : bvh.triangle_index[best.slot]))) {
             best.distance_squared = q;
             best.slot = j;
         }

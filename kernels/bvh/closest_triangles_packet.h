@@ -27,6 +27,7 @@ struct BvhPacket {
     T x[K], y[K], z[K];
     T best_q[K];
     int32_t best_slot[K];
+    int32_t best_triangle[K];  ///< triangle index of best_slot (-1: none), for the tie rule
 };
 
 namespace detail {
@@ -45,7 +46,7 @@ SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacke
     for (int k = 0; k < K; ++k) {
         const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
         const T d = gx * gx + gy * gy + gz * gz;
-        wanted |= int(d < pk.best_q[k]);
+        wanted |= int(may_hold_nearer(d, pk.best_q[k]));
         m = d < m ? d : m;
     }
     min_d2 = m;
@@ -58,14 +59,18 @@ template <typename T, int K>
 SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk) {
     for (int32_t j = first; j < first + count; ++j) {
         const PackedTriangle<T> tri = bvh.packed[j];
+        const int32_t triangle = bvh.triangle_index[j];
 #if !SDF_IS_GPU_CODE
 #pragma omp simd
 #endif
         for (int k = 0; k < K; ++k) {
             const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
-            const bool better = q < pk.best_q[k];
+            // The tie rule of closest_triangle_bvh.h (wins_tie), lane by lane.
+            const bool better = q < pk.best_q[k] ||
+                                (q == pk.best_q[k] && (pk.best_triangle[k] < 0 || triangle < pk.best_triangle[k]));
             pk.best_q[k] = better ? q : pk.best_q[k];
             pk.best_slot[k] = better ? j : pk.best_slot[k];
+            pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
         }
     }
     T worst = pk.best_q[0];
@@ -80,6 +85,7 @@ template <typename T, int K>
 SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* seed, BvhPacket<T, K>& pk) {
     for (int k = 0; k < K; ++k) {
         pk.best_slot[k] = seed[k];
+        pk.best_triangle[k] = seed[k] >= 0 ? bvh.triangle_index[seed[k]] : -1;
         pk.best_q[k] = seed[k] >= 0 ? squared_distance(bvh.packed[seed[k]], pk.x[k], pk.y[k], pk.z[k])
                                     : std::numeric_limits<T>::infinity();
     }
@@ -128,7 +134,7 @@ SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>
         // A popped subtree is dropped once its nearest lane is beyond every lane's radius.
         while (next < 0 && top > 0) {
             --top;
-            if (stack_d2[top] < worst) next = stack_node[top];
+            if (may_hold_nearer(stack_d2[top], worst)) next = stack_node[top];
         }
         node = next;
     }

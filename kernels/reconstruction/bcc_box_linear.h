@@ -56,6 +56,8 @@ struct BccBoxLinear {
     SDF_CPU_GPU static constexpr bool uses_first() { return false; }
     SDF_CPU_GPU static constexpr int higher_stride() { return 0; }
     SDF_CPU_GPU static constexpr SplinePrefilter prefilter() { return SplinePrefilter::None; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return spline_point_data(prefilter()); }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 3; }
 
     /// The secondary points' box, as bcc_linear: every lattice point whose phi4 reaches a
     /// point of it exists.

@@ -219,6 +219,9 @@ struct BccBoxQuinticFilter {
     SDF_CPU_GPU static constexpr bool uses_first() { return false; }
     SDF_CPU_GPU static constexpr int higher_stride() { return P == SplinePrefilter::None ? 0 : 1; }
     SDF_CPU_GPU static constexpr SplinePrefilter prefilter() { return P; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return spline_point_data(P); }
+    /// Its mirror boundary reflects once: 4 primary points per axis keep every read inside.
+    SDF_CPU_GPU static constexpr int min_resolution() { return 4; }
 
     /// The primary box (mirror boundary). Needs R >= 4 per axis.
     template <typename T>

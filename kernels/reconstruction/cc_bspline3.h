@@ -57,6 +57,8 @@ struct CcBspline3 {
     SDF_CPU_GPU static constexpr bool uses_first() { return false; }
     SDF_CPU_GPU static constexpr int higher_stride() { return 1; }
     SDF_CPU_GPU static constexpr SplinePrefilter prefilter() { return SplinePrefilter::Interpolation; }
+    SDF_CPU_GPU static constexpr PointData point_data() { return spline_point_data(prefilter()); }
+    SDF_CPU_GPU static constexpr int min_resolution() { return 2; }
 
     template <typename T>
     SDF_CPU_GPU static DomainBox<T> domain(const LatticeFieldView<T>& v) { return cc_domain(v); }

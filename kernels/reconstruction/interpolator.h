@@ -41,6 +41,8 @@ enum class PointData {
     CcTricubicJet,  ///< CC: gradient and the cross derivatives fxy, fxz, fyz, fxyz (Lekien-Marsden)
     BccCubicJet,    ///< BCC: gradient and the mixed second derivatives (thesis eq. 4-3..4-9)
     BccCubicC0Jet,  ///< BCC: gradient and all second derivatives, face-local centre data
+    SplineInterpolation,       ///< spline coefficients of the interpolation prefilter (stride 1)
+    SplineQuasiInterpolation,  ///< spline coefficients of the quasi-interpolation prefilter (stride 1)
 };
 
 template <typename T>

@@ -14,10 +14,13 @@
 #include <type_traits>
 #include <utility>
 
+#include "kernels/reconstruction/bcc_box_linear.h"
+#include "kernels/reconstruction/bcc_box_quintic.h"
 #include "kernels/reconstruction/bcc_cubic.h"
 #include "kernels/reconstruction/bcc_cubic_c0.h"
 #include "kernels/reconstruction/bcc_linear.h"
 #include "kernels/reconstruction/catmull_rom.h"
+#include "kernels/reconstruction/cc_bspline3.h"
 #include "kernels/reconstruction/tricubic_lekien_marsden.h"
 #include "kernels/reconstruction/trilinear.h"
 
@@ -29,8 +32,9 @@ struct InterpolatorList {
 };
 
 /// Every filter, in the order the tools list them. An InterpolatorKind is an index here.
-using AllInterpolators =
-    InterpolatorList<Trilinear, CatmullRom, TricubicLekienMarsden, BccLinear, BccCubic, BccCubicC0>;
+using AllInterpolators = InterpolatorList<Trilinear, CatmullRom, TricubicLekienMarsden, CcBspline3,  // CC
+                                         BccLinear, BccCubic, BccCubicC0, BccBoxLinear, BccBoxQuintic,
+                                         BccBoxQuinticQi, BccBoxQuinticApprox>;  // BCC
 
 /// A run-time choice of filter: the index of its type in AllInterpolators. Values come from
 /// kind_of<I>() and parse_interpolator() only.

@@ -25,6 +25,13 @@ namespace sdf {
 
 enum class SplinePrefilter : int { None, QuasiInterpolation, Interpolation };
 
+/// The per-point data (interpolator.h) of a spline filter with prefilter p.
+SDF_CPU_GPU constexpr PointData spline_point_data(SplinePrefilter p) {
+    return p == SplinePrefilter::Interpolation        ? PointData::SplineInterpolation
+           : p == SplinePrefilter::QuasiInterpolation ? PointData::SplineQuasiInterpolation
+                                                      : PointData::Values;
+}
+
 /// Value, gradient and Hessian (world units) of a spline at a point.
 template <typename T>
 struct SplineJet {

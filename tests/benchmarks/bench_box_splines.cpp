@@ -107,11 +107,11 @@ void register_all() {
     register_spline<BccBoxQuinticQi>();
     register_spline<BccBoxQuintic>();
     register_spline<CcBspline3>();
-    register_reference<Trilinear>(InterpolatorKind::Trilinear, DerivativeSource::FiniteDifferences);
-    register_reference<CatmullRom>(InterpolatorKind::CatmullRom, DerivativeSource::FiniteDifferences);
-    register_reference<TricubicLekienMarsden>(InterpolatorKind::TricubicLM, DerivativeSource::True);
-    register_reference<BccLinear>(InterpolatorKind::BccLinear, DerivativeSource::FiniteDifferences);
-    register_reference<BccCubic>(InterpolatorKind::BccCubic, DerivativeSource::FiniteDifferences);
+    register_reference<Trilinear>(kind_of<Trilinear>(), DerivativeSource::FiniteDifferences);
+    register_reference<CatmullRom>(kind_of<CatmullRom>(), DerivativeSource::FiniteDifferences);
+    register_reference<TricubicLekienMarsden>(kind_of<TricubicLekienMarsden>(), DerivativeSource::True);
+    register_reference<BccLinear>(kind_of<BccLinear>(), DerivativeSource::FiniteDifferences);
+    register_reference<BccCubic>(kind_of<BccCubic>(), DerivativeSource::FiniteDifferences);
 }
 
 }  // namespace

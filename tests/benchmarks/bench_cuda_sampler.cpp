@@ -42,7 +42,7 @@ std::vector<Case> cases() {
     std::vector<Case> out;
     auto add = [&](const std::string& label, std::shared_ptr<PreparedMesh> m, LatticeType t, int64_t samples) {
         const int r = cubic_resolution_for_samples(t, samples);
-        const Lattice l = fit_lattice(t, {r, r, r}, m->bounds, 0.1);
+        const Lattice l = fit_lattice(t, {r, r, r}, m->bounds(), 0.1);
         out.push_back({label + "/" + lattice_notation(l) + (t == LatticeType::CC ? "cc" : "bcc"), m, l});
     };
     auto load = [](const std::string& file) -> std::shared_ptr<PreparedMesh> {

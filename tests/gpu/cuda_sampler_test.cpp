@@ -114,7 +114,7 @@ TEST(CudaSampler, BothKernelsAgreeWithTheCpuReferenceOnEveryMesh) {
             for (const char* kernel : {"thesis", "tuned"})
                 for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                     if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
-                    const std::string what = m.name() + " " + lattice_notation(lattice) + " " + kernel + " " + bcc_strategy_name(s);
+                    const std::string what = m.name + " " + lattice_notation(lattice) + " " + kernel + " " + bcc_strategy_name(s);
                     const SampledField gpu = sample(m.mesh, lattice, "cuda", kernel, s);
                     const Agreement a = compare(m.mesh, cpu, gpu, what);
                     std::printf("%-44s max|dd| = %.3g (%.2g of diag), triangle ties %d, sign ties %d, %.3g pairs/s\n",

@@ -50,8 +50,11 @@ struct Spec {
     const char* derivatives;
 };
 
-const Spec kSpecs[] = {{"trilinear", "fd"},   {"catmull_rom", "fd"}, {"tricubic_lm", "true"}, {"tricubic_lm", "fd"},
-                       {"bcc_linear", "fd"},  {"bcc_cubic", "true"}, {"bcc_cubic", "fd"},      {"bcc_cubic_c0", "true"}};
+const Spec kSpecs[] = {{"trilinear", "fd"},        {"catmull_rom", "fd"},        {"tricubic_lm", "true"},
+                       {"tricubic_lm", "fd"},       {"cc_bspline3", "fd"},        {"bcc_linear", "fd"},
+                       {"bcc_cubic", "true"},       {"bcc_cubic", "fd"},          {"bcc_cubic_c0", "true"},
+                       {"bcc_box_linear", "fd"},    {"bcc_box_quintic", "fd"},    {"bcc_box_quintic_qi", "fd"},
+                       {"bcc_box_quintic_approx", "fd"}};
 
 double quantile(std::vector<double> v, double q) {
     if (v.empty()) return 0;
@@ -110,7 +113,7 @@ TEST(CudaRaycast, ReportsKernelTimesOfA1024SquaredBccCubicRender) {
     RenderOptions gpu;
     gpu.backend = "cuda";
     gpu.repetitions = 20;
-    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds(), 1024, 1024);
+    const CameraSpec camera = resolve_view(named_view("three_quarter"), pawn.bounds, 1024, 1024);
     const RenderedImage image = render_reconstruction(recon, camera, gpu);
     ASSERT_EQ(image.info["kernel_seconds_all"].size(), 20u);
     EXPECT_GT(image.info["kernel_seconds"].get<double>(), 0.0);

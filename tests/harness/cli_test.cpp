@@ -334,6 +334,50 @@ TEST_F(Cli, QueryOpenMeshWarns) {
     EXPECT_TRUE(Contains(r.err, "open"));
 }
 
+TEST_F(Cli, QuerySignModes) {
+    // Two overlapping closed boxes, [-1,1]^3 and [0,2]x[-1,1]^2 (two shells). (-0.1, 0, 0) is
+    // inside the first, 0.1 from the second's -x face seen from outside it: the pseudonormal
+    // sign says outside, the winding number (1) inside.
+    std::string two_boxes = box_obj();
+    std::istringstream first(box_obj());
+    std::string line;
+    std::ostringstream second;
+    for (int c = 0; c < 8; ++c)
+        second << "v " << ((c & 1) ? 2 : 0) << " " << ((c & 2) ? 1 : -1) << " " << ((c & 4) ? 1 : -1) << "\n";
+    while (std::getline(first, line)) {
+        if (line.rfind("f ", 0) != 0) continue;
+        std::istringstream f(line.substr(2));
+        second << "f";
+        for (int v; f >> v;) second << " " << v + 8;
+        second << "\n";
+    }
+    write("two_boxes.obj", two_boxes + second.str());
+    write("p.txt", "-0.1 0 0\n");
+    const std::string mesh = quote(at("two_boxes.obj")) + " p.txt --precision double";
+
+    const ShellResult pseudonormal = query(mesh + " --sign pseudonormal");
+    ASSERT_EQ(pseudonormal.code, 0) << pseudonormal.err;
+    ASSERT_EQ(parse_query_output(pseudonormal.out).size(), 1u);
+    EXPECT_NEAR(parse_query_output(pseudonormal.out)[0].d, 0.1, 1e-15);
+    EXPECT_FALSE(Contains(pseudonormal.err, "sign auto")) << pseudonormal.err;
+
+    const ShellResult automatic = query(mesh);  // auto is the default
+    ASSERT_EQ(automatic.code, 0) << automatic.err;
+    EXPECT_NEAR(parse_query_output(automatic.out)[0].d, -0.1, 1e-15);
+    EXPECT_TRUE(Contains(automatic.err, "warning: sign auto")) << automatic.err;
+    EXPECT_TRUE(Contains(automatic.err, "2 shells")) << automatic.err;
+
+    const ShellResult winding = query(mesh + " --sign winding");
+    ASSERT_EQ(winding.code, 0) << winding.err;
+    EXPECT_NEAR(parse_query_output(winding.out)[0].d, -0.1, 1e-15);
+    EXPECT_FALSE(Contains(winding.err, "sign auto")) << winding.err;
+
+    const ShellResult bad = query(mesh + " --sign parity");
+    EXPECT_NE(bad.code, 0);
+    EXPECT_TRUE(Contains(bad.err, "--sign")) << bad.err;
+    EXPECT_TRUE(Contains(bad.err, "parity")) << bad.err;
+}
+
 // ---- run-experiment: a successful run ---------------------------------------------------
 
 TEST_F(Cli, RunTinyConfigEndToEnd) {

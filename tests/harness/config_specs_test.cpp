@@ -285,6 +285,15 @@ TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
     EXPECT_EQ(back.at("threads"), 3);
     EXPECT_EQ(back.at("max_points_per_piece"), 5000000000LL);
     EXPECT_EQ(back.at("points_per_thread"), 4);
+    EXPECT_EQ(back.at("sign"), "auto");  // the default
+}
+
+TEST(SamplerSpec, SignModeIsReadAndWritten) {
+    EXPECT_EQ(sampler(json::object()).sign, SignMode::Auto);
+    EXPECT_EQ(sampler({{"sign", "pseudonormal"}}).sign, SignMode::Pseudonormal);
+    const SamplerOptions w = sampler({{"sign", "winding"}});
+    EXPECT_EQ(w.sign, SignMode::Winding);
+    EXPECT_EQ(sampler_options_to_json(w).at("sign"), "winding");
 }
 
 TEST(SamplerSpec, BadValuesNameTheKey) {
@@ -298,6 +307,9 @@ TEST(SamplerSpec, BadValuesNameTheKey) {
         {{{"threads", 1.5}}, "'sampler.threads'", "a thread count"},
         {{{"precision", "doubel"}}, "'sampler.precision'", "did you mean \"double\""},
         {{{"bcc_strategy", "two_grid"}}, "'sampler.bcc_strategy'", "did you mean \"two_grids\""},
+        {{{"sign", "windng"}}, "'sampler.sign'", "did you mean \"winding\""},
+        {{{"sign", "parity"}}, "'sampler.sign'", "\"auto\", \"pseudonormal\", \"winding\""},
+        {{{"sign", true}}, "'sampler.sign'", "one of \"auto\""},
         {{{"backend", "opencl"}}, "'sampler.backend'", "\"cpu\", \"cuda\""},
         {{{"points_per_thread", 3}}, "'sampler.points_per_thread'", "0, 1, 2, 4 or 8, got 3"},
         {{{"progress", 1}}, "'sampler.progress'", "true or false"},

@@ -88,6 +88,11 @@ TEST(FieldCacheKey, EverythingThatChangesTheFieldIsPartOfTheKey) {
     SamplerOptions s = o;
     s.bcc_strategy = BccStrategy::DoubleResolution;
     EXPECT_TRUE(differs(field_cache_key("abc", l, s)));
+    for (const SignMode mode : {SignMode::Pseudonormal, SignMode::Winding}) {
+        SamplerOptions signed_by = o;  // o asks for auto
+        signed_by.sign = mode;
+        EXPECT_TRUE(differs(field_cache_key("abc", l, signed_by))) << sign_mode_name(mode);
+    }
     EXPECT_EQ(base.at("code_version"), kFieldCodeVersion);
     // The BCC strategy does not matter for a CC lattice.
     const Lattice cc = lattice(LatticeType::CC, {4, 4, 4});

@@ -43,7 +43,7 @@ TEST(Interpolators, ReproduceTheLatticeValues) {
         const Lattice& l = lattice_for(spec.interpolator);
         const Reconstruction r(sample_analytic_field(l, f), spec);
         const bool interpolating = visit_interpolator(spec.interpolator, [](auto i) { return decltype(i)::interpolating(); });
-        ASSERT_TRUE(interpolating);
+        if (!interpolating) continue;  // the quasi-interpolating and approximating splines (box_spline_filters_test)
         const DomainBox<double> box = r.domain();
         int checked = 0;
         for (int64_t i = 0; i < l.num_points(); ++i) {

@@ -36,8 +36,10 @@ std::string rejection(const SampledField& field, const ReconstructionSpec& spec)
 }
 
 TEST(ReconstructionApi, NamesRoundTrip) {
-    EXPECT_EQ(interpolator_names(), (std::vector<std::string>{"trilinear", "catmull_rom", "tricubic_lm", "bcc_linear",
-                                                                "bcc_cubic", "bcc_cubic_c0"}));
+    EXPECT_EQ(interpolator_names(),
+              (std::vector<std::string>{"trilinear", "catmull_rom", "tricubic_lm", "cc_bspline3", "bcc_linear", "bcc_cubic",
+                                        "bcc_cubic_c0", "bcc_box_linear", "bcc_box_quintic", "bcc_box_quintic_qi",
+                                        "bcc_box_quintic_approx"}));
     for (const std::string& n : interpolator_names()) EXPECT_EQ(interpolator_name(parse_interpolator(n)), n);
     for (const char* s : {"true", "fd", "fd_weighted"}) EXPECT_STREQ(derivative_source_name(parse_derivative_source(s)), s);
     EXPECT_THROW(parse_interpolator("tricubic"), std::invalid_argument);
@@ -47,7 +49,6 @@ TEST(ReconstructionApi, NamesRoundTrip) {
 TEST(ReconstructionApi, RejectsMeaninglessCombinationsWithClearMessages) {
     const SampledField cc = sample_analytic_field(kCc, TrigFunction<double>{});
     const SampledField bcc = sample_analytic_field(kBcc, TrigFunction<double>{});
-    using K = InterpolatorKind;
     using S = DerivativeSource;
     const std::string wrong_lattice = rejection(bcc, {kind_of<CatmullRom>(), S::FiniteDifferences});
     EXPECT_NE(wrong_lattice.find("needs a CC field; this field is BCC"), std::string::npos) << wrong_lattice;

@@ -117,6 +117,7 @@ TEST(WindingNumber, OverlappingPartsCountTheirDepthAndSignTheUnion) {
     SamplerOptions o;
     o.precision = Precision::Double;
     o.progress = false;
+    o.sign = SignMode::Pseudonormal;  // auto would pick the winding sign here
     const std::vector<Vec3d> points = random_points(3000, {-1.5, -0.8, -0.8}, {1.5, 0.8, 0.8}, 5);
     const std::vector<PointSample> pseudonormal = make_cpu_brute_force_sampler(o)->query(mesh, points);
     int tested = 0, pseudonormal_wrong = 0;
@@ -199,6 +200,7 @@ TEST(WindingSign, ClosedMeshesAgreeWithThePseudonormalSignOffExactTies) {
         SamplerOptions o;
         o.precision = Precision::Double;
         o.progress = false;
+        o.sign = SignMode::Pseudonormal;
         const std::vector<PointSample> s = make_cpu_brute_force_sampler(o)->query(mesh, points);
         for (size_t i = 0; i < points.size(); ++i) {
             if (std::abs(s[i].distance) < 1e-12) continue;

@@ -53,7 +53,9 @@ void check_invariants(const PreparedMesh& mesh, const TriangleBvh& bvh, const Bv
             }
             const BvhNode& child = bvh.nodes[size_t(node.ref[c])];
             for (int cc = 0; cc < 2; ++cc) {
-                if (child.count[cc] > 0 || child.ref[cc] > 0) ASSERT_TRUE(box_inside(child, cc, node, c)) << what;
+                if (child.count[cc] > 0 || child.ref[cc] > 0) {
+                    ASSERT_TRUE(box_inside(child, cc, node, c)) << what;
+                }
             }
             stack.push_back({node.ref[c], it.depth + 1});
         }

@@ -1,0 +1,53 @@
+#include "core/sampling/sampler_sign.h"
+
+#include <iostream>
+
+namespace sdf {
+namespace {
+
+std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) {
+    return "sign auto for mesh '" + mesh.name() + "' (" + mesh.source() + "): " + reason;
+}
+
+}  // namespace
+
+const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
+    const bool same_mesh =
+        mesh_ == &mesh && mesh_sha_ == mesh.content_sha256() && mesh_triangles_ == mesh.triangles().size();
+    if (same_mesh) return choice_;
+    choice_ = choose_sign_mode(mesh.report(), requested_);
+    winding_.reset();
+    if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
+        std::cerr << "warning: " << auto_sign_text(mesh, choice_.reason) << "\n";
+    if (choice_.mode == SignMode::Winding) {
+        winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
+                       : std::make_shared<const WindingSign>(mesh, winding_options());
+    }
+    mesh_ = &mesh;
+    mesh_sha_ = mesh.content_sha256();
+    mesh_triangles_ = mesh.triangles().size();
+    return choice_;
+}
+
+nlohmann::json SamplerSign::provenance() const {
+    nlohmann::json p = {{"requested", sign_mode_name(requested_)},
+                        {"mode", sign_mode_name(choice_.mode)},
+                        {"reason", choice_.reason}};
+    if (winding_) {
+        const WindingSignOptions o = winding_options();
+        p["winding"] = {{"beta", o.accuracy.beta},
+                        {"order", o.accuracy.order},
+                        {"certified", o.certify},
+                        {"moments_seconds", winding_->winding_bvh().seconds}};
+    }
+    return p;
+}
+
+std::string auto_sign_warning(const nlohmann::json& sampler, const PreparedMesh& mesh) {
+    if (!sampler.is_object() || !sampler.contains("sign")) return "";
+    const nlohmann::json& sign = sampler.at("sign");
+    if (sign.value("requested", "") != "auto" || sign.value("mode", "") != "winding") return "";
+    return auto_sign_text(mesh, sign.value("reason", ""));
+}
+
+}  // namespace sdf

@@ -1,0 +1,62 @@
+/// @file sampler_sign.h
+/// @brief The sign step every sampler shares (CPU and CUDA): resolve the requested sign mode
+/// for the mesh (auto: choose_sign_mode on its preparation report, with a warning on stderr
+/// that says why when it picks winding), build the winding sign once per mesh, and record
+/// the choice in the field's provenance. Distances and gradients stay exact; in winding mode
+/// only their side changes (with_sign), in pseudonormal mode nothing does.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/mesh/prepared_mesh.h"
+#include "core/winding/winding_sign.h"
+#include "kernels/winding/with_sign.h"
+
+namespace sdf {
+
+class SamplerSign {
+public:
+    explicit SamplerSign(SignMode requested = SignMode::Auto) : requested_(requested) {}
+
+    /// Resolves the mode for `mesh` and, for winding, builds its WindingSign over `bvh`
+    /// (built here when null). Both are kept while the mesh stays the same (the warning is
+    /// written once per mesh). Not thread-safe: call it before the parallel loop.
+    const SignModeChoice& prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh = nullptr);
+
+    SignMode requested() const { return requested_; }
+    const SignModeChoice& choice() const { return choice_; }
+    bool winding() const { return choice_.mode == SignMode::Winding; }
+    /// The winding sign of the prepared mesh; null unless the mode resolved to winding.
+    const WindingSign* winding_sign() const { return winding_.get(); }
+
+    /// `s` (evaluated at p) with the winding number's side in winding mode; unchanged otherwise.
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p) const {
+        return winding() ? with_sign(s, winding_->inside(p)) : s;
+    }
+
+    /// {"requested", "mode", "reason"} and, in winding mode, "winding": {"beta", "order",
+    /// "moments_seconds"}: for the field's sampler provenance.
+    nlohmann::json provenance() const;
+
+    /// The accuracy every backend's fast winding sign uses (WindingSignOptions' default:
+    /// beta 2, order 2, uncertified), so that CPU and CUDA decide the same side.
+    static WindingSignOptions winding_options() { return {}; }
+
+private:
+    SignMode requested_;
+    SignModeChoice choice_;
+    std::shared_ptr<const WindingSign> winding_;
+    const PreparedMesh* mesh_ = nullptr;
+    std::string mesh_sha_;
+    size_t mesh_triangles_ = 0;
+};
+
+/// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler
+/// provenance) records that auto chose the winding sign, else "": the warning prepare()
+/// writes, for fields read back from the cache.
+std::string auto_sign_warning(const nlohmann::json& sampler, const PreparedMesh& mesh);
+
+}  // namespace sdf

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# One GPU check of the whole tree on a lent machine (device tool), for a change that moved or
+# touched kernels: builds with CUDA and warnings as errors, runs every GPU test, every CPU test
+# there too, compute-sanitizer on the GPU tests' split/point-query cases, and the CI smoke study
+# from a portable CPU build (whose field checksums must equal those of any other CPU target).
+#   carry: .gpu-prefix data        steps: build gputest test sanitize portable
+# Output under $OUT: summary.txt and the logs.
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+OUT=${OUT:-$PWD/gpu-out}
+mkdir -p "$OUT"
+PREFIX=$PWD/.gpu-prefix/root/usr
+export LD_LIBRARY_PATH=$PREFIX/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+export SDF_DATA_PATH=$PWD/data/meshes
+B=build-gpu
+log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
+cmake_common=(-G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PREFIX")
+[ -f /usr/include/openssl/evp.h ] || cmake_common+=(-DOPENSSL_ROOT_DIR="$PREFIX" -DOPENSSL_INCLUDE_DIR="$PREFIX/include"
+    -DOPENSSL_CRYPTO_LIBRARY="$PREFIX/lib/x86_64-linux-gnu/libcrypto.so.3"
+    -DCMAKE_CXX_FLAGS="-isystem $PREFIX/include/x86_64-linux-gnu" -DCMAKE_CUDA_FLAGS="-isystem $PREFIX/include/x86_64-linux-gnu")
+
+for step in "$@"; do case "$step" in
+build)
+    log "configure + build (CUDA, warnings as errors)"
+    nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee -a "$OUT/summary.txt"
+    cmake -S . -B $B "${cmake_common[@]}" -DSDF_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 -DSDF_WARNINGS_AS_ERRORS=ON \
+        > "$OUT/configure.log" 2>&1 || { tail -30 "$OUT/configure.log"; exit 1; }
+    grep "sdf:" "$OUT/configure.log" | tee -a "$OUT/summary.txt"
+    cmake --build $B -j "$(nproc)" -- -k 0 > "$OUT/build.log" 2>&1 || { grep -E "error|warning|FAILED" "$OUT/build.log" | head -40; exit 1; }
+    log "built" ;;
+gputest)
+    log "GPU tests"
+    (cd $B && ctest -L gpu --output-on-failure > "$OUT/ctest-gpu.log" 2>&1; echo "ctest -L gpu exit $?") | tee -a "$OUT/summary.txt"
+    grep -E "Test +#|tests passed" "$OUT/ctest-gpu.log" | tee -a "$OUT/summary.txt" ;;
+test)
+    log "all tests"
+    (cd $B && ctest -j 8 --output-on-failure > "$OUT/ctest-all.log" 2>&1; echo "ctest exit $?") | tee -a "$OUT/summary.txt"
+    grep -E "tests passed|\(Failed\)|\(Skipped\)|Not Run" "$OUT/ctest-all.log" | tee -a "$OUT/summary.txt" ;;
+sanitize)
+    log "compute-sanitizer"
+    for t in "cuda_sampler_test --gtest_filter=*Splitting*:*PointQueries*" "cuda_bvh_test --gtest_filter=*Slabs*:*PointQueries*" \
+             "raycast_gpu_test"; do
+        compute-sanitizer --tool memcheck --error-exitcode 3 $B/tests/gpu/$t > "$OUT/sanitizer-${t%% *}.txt" 2>&1
+        echo "compute-sanitizer ${t%% *}: exit $? $(grep 'ERROR SUMMARY' "$OUT/sanitizer-${t%% *}.txt")" | tee -a "$OUT/summary.txt"
+    done ;;
+portable)
+    log "portable CPU build: CI smoke field checksums"
+    cmake -S . -B build-portable "${cmake_common[@]}" -DSDF_ENABLE_CUDA=OFF -DSDF_BUILD_TESTS=OFF -DSDF_BUILD_BENCHMARKS=OFF \
+        > "$OUT/configure-portable.log" 2>&1 && cmake --build build-portable -j "$(nproc)" --target run-experiment \
+        > "$OUT/build-portable.log" 2>&1 || { tail -20 "$OUT/build-portable.log"; exit 1; }
+    grep "sdf: CPU target" "$OUT/configure-portable.log" | tee -a "$OUT/summary.txt"
+    rm -rf /tmp/smoke && build-portable/bin/run-experiment configs/ci_smoke.json --output-root /tmp/smoke/results \
+        --cache-dir /tmp/smoke/cache --quiet > "$OUT/smoke.log" 2>&1
+    (cd /tmp/smoke && find cache -name '*.raw' | sort | xargs sha256sum | sed 's#cache/fields/../##') | tee "$OUT/smoke-portable.sha256" ;;
+*) echo "unknown step $step"; exit 2 ;;
+esac; done
+log done

@@ -1,0 +1,194 @@
+// The sign modes in the CPU samplers (core/sampling/sampler_sign.h) against independent
+// truth: on a mesh of overlapping closed parts (two spheres and a box through them, whose
+// union is known analytically) sign "auto" picks the winding number with a warning that
+// says why, records it in the field's provenance, and gets every point clearly inside or
+// outside the union right, with distances and gradients unchanged in magnitude and
+// direction; on a closed single-shell mesh "auto" is the pseudonormal sign, bit for bit,
+// and a requested winding sign agrees with it away from the surface.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/sampling/sampler_sign.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/cpu_reference/sampling/analytic_shapes.h"
+
+namespace sdf {
+namespace {
+
+TriangleMesh concatenated(const std::vector<TriangleMesh>& parts) {
+    TriangleMesh all;
+    all.name = "parts";
+    for (const TriangleMesh& m : parts) {
+        const int first = int(all.vertices.size());
+        all.vertices.insert(all.vertices.end(), m.vertices.begin(), m.vertices.end());
+        for (const Int3& t : m.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
+    }
+    return all;
+}
+
+/// Two spheres and a box through both (as in winding_number_test.cpp), with the analytic union.
+struct Parts {
+    TriangleMesh mesh = concatenated({make_icosphere(3, 0.6, {-0.5, 0, 0}), make_icosphere(3, 0.6, {0.5, 0, 0}),
+                                      make_box({1.3, 0.2, 0.2}, {0, 0, 0})});
+    static bool inside_union(const Vec3d& p) {
+        return test::sphere_sdf(p - Vec3d{-0.5, 0, 0}, 0.6) < 0 || test::sphere_sdf(p - Vec3d{0.5, 0, 0}, 0.6) < 0 ||
+               test::box_sdf(p, {1.3, 0.2, 0.2}) < 0;
+    }
+    /// Distance to the nearest analytic part surface; the mesh spheres lie within 0.01 of theirs.
+    static double surface_distance(const Vec3d& p) {
+        return std::min({std::abs(test::sphere_sdf(p - Vec3d{-0.5, 0, 0}, 0.6)),
+                         std::abs(test::sphere_sdf(p - Vec3d{0.5, 0, 0}, 0.6)), std::abs(test::box_sdf(p, {1.3, 0.2, 0.2}))});
+    }
+};
+
+constexpr double kClear = 0.02;  ///< points nearer a part's surface than this are not judged
+
+using MakeSampler = std::unique_ptr<Sampler> (*)(const SamplerOptions&);
+
+struct Backend {
+    const char* name;
+    MakeSampler make;
+};
+const Backend kCpuSamplers[] = {{"cpu/brute_force", make_cpu_brute_force_sampler}, {"cpu/bvh", make_cpu_bvh_sampler}};
+
+SamplerOptions options(SignMode sign) {
+    SamplerOptions o;
+    o.precision = Precision::Double;
+    o.progress = false;
+    o.sign = sign;
+    return o;
+}
+
+/// Runs f with std::cerr captured; returns what was written.
+template <typename F>
+std::string captured_cerr(F f) {
+    std::ostringstream text;
+    std::streambuf* old = std::cerr.rdbuf(text.rdbuf());
+    try {
+        f();
+    } catch (...) {
+        std::cerr.rdbuf(old);
+        throw;
+    }
+    std::cerr.rdbuf(old);
+    return text.str();
+}
+
+/// `a` and `b` are the same sample up to the side: equal |distance|, triangle, and gradient
+/// times the sign flip.
+void expect_same_up_to_sign(double da, const Vec3d& ga, int ta, double db, const Vec3d& gb, int tb) {
+    ASSERT_EQ(std::abs(da), std::abs(db));
+    ASSERT_EQ(ta, tb);
+    const double flip = (da < 0) == (db < 0) ? 1.0 : -1.0;
+    ASSERT_EQ(ga.x, flip * gb.x);
+    ASSERT_EQ(ga.y, flip * gb.y);
+    ASSERT_EQ(ga.z, flip * gb.z);
+}
+
+TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
+    const PreparedMesh mesh = prepare_mesh(Parts().mesh);
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {20, 12, 24}, mesh.bounds(), 0.15);
+    for (const Backend& b : kCpuSamplers) {
+        SampledField winding, pseudonormal;
+        const std::string warning = captured_cerr([&] { winding = b.make(options(SignMode::Auto))->sample(mesh, lattice); });
+        EXPECT_NE(warning.find("warning: sign auto"), std::string::npos) << b.name << ": " << warning;
+        EXPECT_NE(warning.find("3 shells"), std::string::npos) << b.name << ": " << warning;
+        EXPECT_NE(warning.find("winding number"), std::string::npos) << b.name << ": " << warning;
+        const nlohmann::json& sign = winding.sampler.at("sign");
+        EXPECT_EQ(sign.at("requested"), "auto") << b.name;
+        EXPECT_EQ(sign.at("mode"), "winding") << b.name;
+        EXPECT_NE(sign.at("reason").get<std::string>().find("3 shells"), std::string::npos) << b.name;
+        EXPECT_EQ(sign.at("winding").at("beta"), 2.0) << b.name;
+        // The same warning for the field when it comes back from the cache.
+        EXPECT_EQ("warning: " + auto_sign_warning(winding.sampler, mesh) + "\n", warning) << b.name;
+
+        const std::string quiet =
+            captured_cerr([&] { pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice); });
+        EXPECT_EQ(quiet.find("warning"), std::string::npos) << b.name << ": " << quiet;
+        EXPECT_EQ(pseudonormal.sampler.at("sign").at("mode"), "pseudonormal");
+        EXPECT_EQ(auto_sign_warning(pseudonormal.sampler, mesh), "");
+        EXPECT_EQ(auto_sign_warning(nlohmann::json::object(), mesh), "");  // a field sampled before sign modes
+
+        int judged = 0, winding_wrong = 0, pseudonormal_wrong = 0, flipped = 0;
+        for (int64_t i = 0; i < lattice.num_points(); ++i) {
+            const size_t k = size_t(i);
+            expect_same_up_to_sign(winding.distance[k], winding.gradient[k], winding.closest_triangle[k],
+                                   pseudonormal.distance[k], pseudonormal.gradient[k], pseudonormal.closest_triangle[k]);
+            flipped += int((winding.distance[k] < 0) != (pseudonormal.distance[k] < 0));
+            const Vec3d p = lattice.position(i);
+            if (Parts::surface_distance(p) < kClear) continue;
+            ++judged;
+            winding_wrong += int((winding.distance[k] < 0) != Parts::inside_union(p));
+            pseudonormal_wrong += int((pseudonormal.distance[k] < 0) != Parts::inside_union(p));
+        }
+        EXPECT_GT(judged, lattice.num_points() / 2) << b.name;
+        EXPECT_EQ(winding_wrong, 0) << b.name;
+        // What the winding sign is for: inside one part near another's surface the
+        // pseudonormal says "outside".
+        EXPECT_GT(pseudonormal_wrong, 0) << b.name;
+        EXPECT_GT(flipped, 0) << b.name;
+    }
+}
+
+TEST(SamplerSign, QueriedPointsTakeTheWindingSignToo) {
+    const PreparedMesh mesh = prepare_mesh(Parts().mesh);
+    std::vector<Vec3d> points;
+    for (int i = 0; i <= 60; ++i)
+        for (int j = 0; j <= 6; ++j) points.push_back({-1.3 + 2.6 * i / 60.0, -0.35 + 0.7 * j / 6.0, 0.05});
+    for (const Backend& b : kCpuSamplers) {
+        std::vector<PointSample> winding, pseudonormal;
+        captured_cerr([&] { winding = b.make(options(SignMode::Auto))->query(mesh, points); });
+        pseudonormal = b.make(options(SignMode::Pseudonormal))->query(mesh, points);
+        int judged = 0;
+        for (size_t i = 0; i < points.size(); ++i) {
+            expect_same_up_to_sign(winding[i].distance, winding[i].gradient, winding[i].triangle, pseudonormal[i].distance,
+                                   pseudonormal[i].gradient, pseudonormal[i].triangle);
+            if (Parts::surface_distance(points[i]) < kClear) continue;
+            ++judged;
+            ASSERT_EQ(winding[i].distance < 0, Parts::inside_union(points[i]))
+                << b.name << " at " << points[i].x << " " << points[i].y << " " << points[i].z;
+        }
+        EXPECT_GT(judged, 300) << b.name;
+    }
+}
+
+TEST(SamplerSign, ClosedSingleShellMeshKeepsThePseudonormalSign) {
+    const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.35, 48, 24));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {24, 24, 12}, mesh.bounds(), 0.1);
+    for (const Backend& b : kCpuSamplers) {
+        SampledField automatic, pseudonormal, winding;
+        const std::string log = captured_cerr([&] { automatic = b.make(options(SignMode::Auto))->sample(mesh, lattice); });
+        EXPECT_EQ(log.find("warning"), std::string::npos) << b.name << ": " << log;
+        EXPECT_EQ(automatic.sampler.at("sign").at("mode"), "pseudonormal") << b.name;
+        EXPECT_FALSE(automatic.sampler.at("sign").contains("winding")) << b.name;
+        pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice);
+        winding = b.make(options(SignMode::Winding))->sample(mesh, lattice);
+        EXPECT_EQ(winding.sampler.at("sign").at("reason"), "winding requested") << b.name;
+        int judged = 0;
+        for (int64_t i = 0; i < lattice.num_points(); ++i) {
+            const size_t k = size_t(i);
+            // auto = pseudonormal here, bit for bit
+            ASSERT_EQ(automatic.distance[k], pseudonormal.distance[k]) << b.name;
+            ASSERT_EQ(automatic.gradient[k].x, pseudonormal.gradient[k].x) << b.name;
+            ASSERT_EQ(automatic.gradient[k].y, pseudonormal.gradient[k].y) << b.name;
+            ASSERT_EQ(automatic.gradient[k].z, pseudonormal.gradient[k].z) << b.name;
+            expect_same_up_to_sign(winding.distance[k], winding.gradient[k], winding.closest_triangle[k],
+                                   pseudonormal.distance[k], pseudonormal.gradient[k], pseudonormal.closest_triangle[k]);
+            if (std::abs(pseudonormal.distance[k]) < 1e-3) continue;
+            ++judged;
+            ASSERT_EQ(winding.distance[k] < 0, pseudonormal.distance[k] < 0) << b.name << " point " << i;
+        }
+        EXPECT_GT(judged, lattice.num_points() * 9 / 10) << b.name;
+    }
+}
+
+}  // namespace
+}  // namespace sdf
