@@ -6,6 +6,8 @@
 // docs/harness.md describes configs, caching, results, checks and reports.
 #include <CLI/CLI.hpp>
 
+#include "apps/cli_exit.h"
+
 #include <iostream>
 
 #include "core/parallel/progress.h"
@@ -31,14 +33,14 @@ int main(int argc, char** argv) {
     app.add_option("--write-baseline", make_baseline, "make a baseline from a stored run directory (clean runs only)");
     app.add_flag("--force", force, "with --write-baseline: replace an existing baseline file");
     app.add_flag("--quiet", quiet, "no progress lines");
-    CLI11_PARSE(app, argc, argv);
+    SDF_CLI_PARSE(app, argc, argv);
     sdf::ProgressReporter::set_globally_enabled(!quiet);
     const int modes = int(!options.config_path.empty()) + int(!check_run.empty()) + int(!make_baseline.empty());
     if (modes != 1) {
         std::cerr << "run-experiment: error: give a config to run, or --check-run RUN_DIR, or --write-baseline RUN_DIR "
                      "(exactly one)\n"
                   << app.help();
-        return 1;
+        return sdf::kExitCommandLineError;
     }
     try {
         if (!check_run.empty()) return sdf::check_stored_run(check_run, options.baseline);

@@ -7,6 +7,8 @@
 // harness/config/mesh_spec.h) or shape:NAME; POINTS has "x y z" per line ('-' = stdin).
 #include <CLI/CLI.hpp>
 
+#include "apps/cli_exit.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -37,7 +39,7 @@ int main(int argc, char** argv) {
                    "the mesh is closed, manifold, oriented, one shell, without self-intersections; winding otherwise)")
         ->check(CLI::IsMember(sdf::sign_mode_names()))
         ->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    SDF_CLI_PARSE(app, argc, argv);
     options.precision = precision == "float" ? sdf::Precision::Float : sdf::Precision::Double;
     options.sign = sdf::sign_mode_from_name(sign, "--sign");
     options.progress = false;

@@ -18,6 +18,8 @@
 // kernel time over --repeat launches, CUDA events).
 #include <CLI/CLI.hpp>
 
+#include "apps/cli_exit.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -54,6 +56,7 @@ struct Options {
     int threads = 0, repeat = 1, device = 0;
     bool reference = false, grid = false, no_reference = false, no_error_maps = false, no_exr = false;
     bool overwrite = false, quiet = false, no_cache = false;
+    bool up_given = false;  ///< --up was on the command line (it applies to --eye/--target only)
     int downsample = 1;
     double heat_max = 20;
     std::string out = "render.png", out_dir = ".", name, title, cache_dir;
@@ -119,9 +122,19 @@ Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const st
 
 std::vector<ViewRequest> view_requests(const Options& o) {
     std::vector<ViewRequest> views;
+    if (o.up_given && o.eye.empty())
+        throw std::invalid_argument("--up applies to an explicit camera only; give --eye and --target too");
     if (!o.eye.empty() || !o.target.empty()) {
         if (o.eye.size() != 3 || o.target.size() != 3)
             throw std::invalid_argument("--eye and --target are both needed for an explicit camera");
+        // A zero up vector, or one along the line of sight, leaves the camera's roll undefined.
+        const Vec3d forward = vec3(o.target) - vec3(o.eye);
+        if (length_squared(forward) == 0.0) throw std::invalid_argument("--eye and --target are the same point");
+        if (length_squared(cross(forward, vec3(o.up))) == 0.0)
+            throw std::invalid_argument("--up " + std::to_string(o.up[0]) + "," + std::to_string(o.up[1]) + "," +
+                                        std::to_string(o.up[2]) +
+                                        " is zero or parallel to the line of sight; expected a direction that fixes "
+                                        "the camera's roll");
         ViewRequest v;
         v.name = "camera";
         v.explicit_camera = true;
@@ -284,7 +297,9 @@ int main(int argc, char** argv) {
         ->delimiter(',')->expected(3)->capture_default_str();
     app.add_option("--bcc-resolution", o.bcc_resolution, "BCC resolution Rx,Ry,2Rz (grid, and the default for --lattice bcc)")
         ->delimiter(',')->expected(3)->capture_default_str();
-    app.add_option("--margin", o.margin, "mesh input: lattice margin, fraction of the largest extent")->capture_default_str();
+    app.add_option("--margin", o.margin, "mesh input: lattice margin, fraction of the largest extent")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_option("--interpolator", o.interpolator, interpolator_help() + "; default: bcc_cubic (BCC) or tricubic_lm (CC)")
         ->check(CLI::IsMember(interpolator_names()));
     app.add_option("--derivatives", o.derivatives, "true, fd or fd_weighted (default: true when available)")
@@ -297,11 +312,20 @@ int main(int argc, char** argv) {
     app.add_option("--eye", o.eye, "explicit camera: eye x,y,z")->delimiter(',')->expected(3);
     app.add_option("--target", o.target, "explicit camera: target x,y,z")->delimiter(',')->expected(3);
     app.add_option("--up", o.up, "explicit camera: up x,y,z")->delimiter(',')->expected(3)->capture_default_str();
-    app.add_option("--fov", o.fov, "vertical field of view, degrees")->capture_default_str();
-    app.add_option("--size", o.size, "image size W[,H]")->delimiter(',')->expected(1, 2)->capture_default_str();
+    app.add_option("--fov", o.fov, "vertical field of view, degrees (between 0 and 180, exclusive)")
+        ->check(CLI::Validator(
+            [](const std::string& text) {
+                double fov = 0;
+                return CLI::detail::lexical_cast(text, fov) && fov > 0 && fov < 180
+                           ? std::string()
+                           : "expected a field of view between 0 and 180 degrees (exclusive), got " + text;
+            },
+            "(0, 180)"))
+        ->capture_default_str();
+    app.add_option("--size", o.size, "image size W[,H]")->delimiter(',')->expected(1, 2)->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
     app.add_option("--precision", o.precision, "cpu casting precision")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
-    app.add_option("--threads", o.threads, "CPU threads (0 = all)")->capture_default_str();
+    app.add_option("--threads", o.threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--repeat", o.repeat, "timed renders (cuda: kernel launches after a warm-up); the median is printed")
         ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--device", o.device, "CUDA device")->capture_default_str();
@@ -314,7 +338,7 @@ int main(int argc, char** argv) {
     app.add_option("--title", o.title, "grid: title line (default: mesh, view and lattices)");
     app.add_flag("--no-reference", o.no_reference, "grid: no reference row (and no heat maps)");
     app.add_flag("--no-error-maps", o.no_error_maps, "grid: no heat-map rows");
-    app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->capture_default_str();
+    app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--sampler-backend", o.sampler_backend, "mesh input: sampler backend")
         ->check(CLI::IsMember([] { auto b = sampler_backends(); b.emplace_back("auto"); return b; }()))
@@ -331,7 +355,8 @@ int main(int argc, char** argv) {
     app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");
     app.add_flag("--overwrite", o.overwrite, "replace existing output files");
     app.add_flag("--quiet", o.quiet, "no progress lines");
-    CLI11_PARSE(app, argc, argv);
+    SDF_CLI_PARSE(app, argc, argv);
+    o.up_given = app.count("--up") > 0;
     try {
         if (o.quiet) ProgressReporter::set_globally_enabled(false);
         // Every option's value (defaults included) as CLI11 writes a config file: the

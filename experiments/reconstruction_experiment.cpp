@@ -15,6 +15,7 @@
 ///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
 /// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
 #include <algorithm>
+#include <stdexcept>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -61,6 +62,13 @@ public:
         if (probes_.domain_probes < 0 || probes_.band_probes < 0 || probes_.domain_probes + probes_.band_probes < 1)
             m.fail("domain_probes", "expected non-negative probe counts, at least one probe in all, got " +
                                         std::to_string(probes_.domain_probes) + " and " + std::to_string(probes_.band_probes));
+        // Each probe costs an exact query and 48 bytes; counts beyond this are typos, and
+        // their sum must not overflow the reservation of place_probes.
+        constexpr int64_t kMaxProbes = int64_t(1) << 30;
+        if (probes_.domain_probes > kMaxProbes || probes_.band_probes > kMaxProbes)
+            m.fail(probes_.domain_probes > kMaxProbes ? "domain_probes" : "band_probes",
+                   "expected at most 2^30 probes, got " +
+                       std::to_string(std::max(probes_.domain_probes, probes_.band_probes)));
         probes_.band = m.optional<double>("band", 1.0, "the band half-width in lattice spacings (> 0)");
         if (!(probes_.band > 0)) m.fail("band", "expected a positive number of lattice spacings, got " + std::to_string(probes_.band));
         probes_.seed = m.optional<uint64_t>("seed", 1, "a random seed (a non-negative integer)");
@@ -156,6 +164,17 @@ public:
                                  {"h_ref", h_ref},
                                  {"seed", probes_.seed},
                                  {"box", {{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}}}};
+        // Errors over no probes would read as 0: a perfect score for nothing measured.
+        const int64_t band_placed = int64_t(probes.points.size()) - probes.domain_count;
+        if (probes.points.empty() || (probes_.band_probes > 0 && in_band == 0))
+            throw std::runtime_error(
+                ctx.config_path + ": key 'metrics': no probe " +
+                (probes.points.empty() ? std::string("was placed") : "lies within the band") + ": " +
+                std::to_string(probes.domain_count) + " domain probes, " + std::to_string(band_placed) + " of " +
+                std::to_string(probes_.band_probes) + " band probes placed inside the common domain, " +
+                std::to_string(in_band) + " within " + nlohmann::json(probes_.band).dump() +
+                " spacing(s) of the surface; nothing would be measured. Expected probes in the domain "
+                "(\"domain_probes\" > 0) or a band that fits inside it (a smaller \"band\")");
         ctx.metrics["regression"]["probes/in_band"] = {{"value", in_band}, {"kind", "exact"}};
         print_header(log, h_ref);
         for (size_t k = 0; k < recons.size(); ++k) measure(ctx, recons_[k], *recons[k], probes, h_ref);

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "core/checked_math.h"
+
 namespace sdf {
 
 Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin) {
@@ -12,6 +14,7 @@ Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, do
         if (resolution[a] < 2)
             throw std::invalid_argument("lattice resolution must be at least 2 along every axis, got " +
                                         std::to_string(resolution[a]));
+    checked_lattice_points(type, resolution);
     if (bounds.empty()) throw std::invalid_argument("cannot fit a lattice to an empty mesh");
     const Vec3d extent = bounds.extent();
     const double largest = std::max({extent.x, extent.y, extent.z});
@@ -26,6 +29,24 @@ Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, do
     const Vec3d center = bounds.center();
     for (int a = 0; a < 3; ++a) lattice.origin[a] = center[a] - 0.5 * spacing * (resolution[a] - 1);
     return lattice;
+}
+
+int64_t checked_lattice_points(LatticeType type, Int3 r) {
+    const bool bcc = type == LatticeType::BCC;
+    const std::string notation = std::to_string(r.x) + "x" + std::to_string(r.y) + "x" +
+                                 std::to_string(bcc ? 2 * int64_t(r.z) : int64_t(r.z));
+    if (r.x < 1 || r.y < 1 || r.z < 1)
+        throw std::invalid_argument("lattice resolution " + notation + ": every entry must be positive");
+    // BCC: the primary grid plus the secondary grid (one fewer point per axis).
+    const std::optional<int64_t> primary = checked_mul(r.x, r.y, r.z);
+    const std::optional<int64_t> secondary = bcc ? checked_mul(r.x - 1, r.y - 1, r.z - 1) : int64_t(0);
+    const std::optional<int64_t> total = primary && secondary ? checked_add(*primary, *secondary) : std::nullopt;
+    if (!total || *total > kMaxLatticePoints)
+        throw std::invalid_argument("lattice resolution " + notation + " has " +
+                                    (total ? std::to_string(*total) : std::string("more than 2^63")) +
+                                    " points, more than the largest lattice sampled (2^36 = " +
+                                    std::to_string(kMaxLatticePoints) + ")");
+    return *total;
 }
 
 std::string lattice_notation(const Lattice& l) {

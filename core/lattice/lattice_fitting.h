@@ -17,6 +17,15 @@ namespace sdf {
 /// `resolution` is the CC resolution, or for BCC the primary grid (Rx, Ry, Rz).
 Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin);
 
+/// The largest lattice any tool samples or reads: 2^36 points (16 bytes each with a gradient
+/// channel: 1 TiB), far beyond any machine's memory but far from int64 overflow.
+constexpr int64_t kMaxLatticePoints = int64_t(1) << 36;
+
+/// The number of points of a lattice of `type` with primary resolution `resolution`, in
+/// checked arithmetic; throws std::invalid_argument when a resolution entry is below 1 or the
+/// count exceeds kMaxLatticePoints (an overflowing count included).
+int64_t checked_lattice_points(LatticeType type, Int3 resolution);
+
 /// Thesis notation: "80x80x80" for CC, "Rx x Ry x 2Rz" = "64x64x128" for BCC.
 std::string lattice_notation(const Lattice& lattice);
 

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/io/text_file.h"
 #include "core/mesh/load_obj.h"
 #include "core/mesh/mesh_file_bytes.h"
 #include "core/mesh/mesh_readers.h"
@@ -91,10 +92,17 @@ MeshFormat detect_mesh_format(const std::string& path, const std::string& bytes)
 
 TriangleMesh load_mesh_file(const std::string& path) {
     MeshFileBytes file = read_mesh_file_bytes(path);
+    // Editors put a byte-order mark before text (OBJ, ASCII PLY/STL, OFF); a binary STL's
+    // 80-byte header may begin with anything, so it keeps its bytes.
+    if (!is_binary_stl(file.bytes)) {
+        reject_wide_encodings(file.bytes, path, "mesh file");
+        const size_t bom = file.bytes.size() - without_utf8_bom(file.bytes).size();
+        file.bytes.erase(0, bom);
+    }
     const MeshFormat format = detect_mesh_format(path, file.bytes);
     TriangleMesh mesh;
     switch (format) {
-        case MeshFormat::Obj: mesh = file.gzip ? load_obj_text(file.bytes, path) : load_obj(path); break;
+        case MeshFormat::Obj: mesh = load_obj_text(file.bytes, path); break;
         case MeshFormat::Ply: mesh = read_ply(file.bytes, path); break;
         case MeshFormat::Stl: mesh = read_stl(file.bytes, path); break;
         case MeshFormat::Off: mesh = read_off(file.bytes, path); break;

@@ -6,11 +6,15 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
 
+#include "core/io/text_file.h"
+#include "core/mesh/mesh_file_bytes.h"
 #include "core/mesh/sha256.h"
+#include "core/mesh/text_cursor.h"
 
 namespace sdf {
 namespace {
@@ -20,13 +24,45 @@ namespace {
 /// mantissa-times-power parser; measured on the project's meshes). So every `v` line is
 /// read here with strtod (correctly rounded): three finite numbers, or an error naming the
 /// line; these positions replace tinyobjloader's.
+///
+/// Its face indices are read with a 32-bit atoi: "1.5" reads as 1, 4294967297 wraps to 1,
+/// both valid vertices. So every `f` line's vertex indices are checked here too: whole
+/// decimal integers, not 0, negative ones (relative: -1 is the last vertex so far) within
+/// the vertices before the line, positive ones within the file's vertices; an error quotes
+/// the index as written and names the line.
 std::vector<Vec3d> read_vertex_lines(std::istream& in, const std::string& path) {
     std::vector<Vec3d> vertices;
     std::string line;
+    struct FaceReference {
+        int line;
+        int64_t index;
+        std::string token;
+    };
+    std::vector<FaceReference> largest_positive;  // one entry: the largest positive index seen
     for (int number = 1; std::getline(in, line); ++number) {
         std::istringstream ss(line);
         std::string tag;
-        if (!(ss >> tag) || tag != "v") continue;
+        if (!(ss >> tag)) continue;
+        if (tag == "f") {
+            std::string token;
+            while (ss >> token) {
+                const std::string_view index_part = std::string_view(token).substr(0, token.find('/'));
+                int64_t index = 0;
+                const auto fail = [&](const std::string& why) {
+                    throw std::runtime_error(path + ":" + std::to_string(number) + ": face vertex " + sdf::quoted(token) +
+                                             " " + why);
+                };
+                if (!parse_int(index_part, index)) fail("is not a whole number; expected a vertex index");
+                if (index == 0) fail("is 0; OBJ indices start at 1 (or count back from -1)");
+                if (index < 0 && -index > int64_t(vertices.size()))
+                    fail("counts back further than the " + std::to_string(vertices.size()) +
+                         " vertices before this line");
+                if (index > 0 && (largest_positive.empty() || index > largest_positive[0].index))
+                    largest_positive.assign(1, FaceReference{number, index, token});
+            }
+            continue;
+        }
+        if (tag != "v") continue;
         Vec3d p;
         for (int k = 0; k < 3; ++k) {
             std::string token;
@@ -41,7 +77,15 @@ std::vector<Vec3d> read_vertex_lines(std::istream& in, const std::string& path) 
             p[k] = value;
         }
         vertices.push_back(p);
+        if (vertices.size() > size_t(std::numeric_limits<int>::max()))
+            throw std::runtime_error(path + ":" + std::to_string(number) + ": more than " +
+                                     std::to_string(std::numeric_limits<int>::max()) + " vertices");
     }
+    if (!largest_positive.empty() && largest_positive[0].index > int64_t(vertices.size()))
+        throw std::runtime_error(path + ":" + std::to_string(largest_positive[0].line) + ": face vertex " +
+                                 sdf::quoted(largest_positive[0].token) + " refers to vertex " +
+                                 std::to_string(largest_positive[0].index) + ", but the file has " +
+                                 std::to_string(vertices.size()) + " vertices");
     return vertices;
 }
 
@@ -102,20 +146,15 @@ tinyobj::ObjReaderConfig triangulating_config() {
 }  // namespace
 
 TriangleMesh load_obj(const std::string& path) {
-    if (!std::filesystem::is_regular_file(path))
-        throw std::runtime_error(path + ": mesh file not found");
-
-    std::ifstream in(path);
-    std::vector<Vec3d> vertices = read_vertex_lines(in, path);
-    tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(path, triangulating_config()))
-        throw std::runtime_error(path + ": cannot parse OBJ: " + reader.Error());
-    TriangleMesh mesh = mesh_from_reader(reader, std::move(vertices), path);
+    TriangleMesh mesh = load_obj_text(read_text_file(path, "mesh file", kMaxMeshFileBytes), path);
     mesh.content_sha256 = sha256_of_file(path);
     return mesh;
 }
 
-TriangleMesh load_obj_text(const std::string& text, const std::string& path) {
+TriangleMesh load_obj_text(const std::string& bytes, const std::string& path) {
+    // A byte-order mark would glue itself to the first `v` and shift every index by one.
+    reject_wide_encodings(bytes, path, "OBJ file");
+    const std::string text(without_utf8_bom(bytes));
     std::istringstream in(text);
     std::vector<Vec3d> vertices = read_vertex_lines(in, path);
     tinyobj::ObjReader reader;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 
+#include "core/io/text_file.h"
 #include "core/mesh/sha256.h"
 
 namespace sdf {
@@ -54,9 +55,7 @@ std::string read_gzip(const std::string& path) {
 
 MeshFileBytes read_mesh_file_bytes(const std::string& path) {
     namespace fs = std::filesystem;
-    if (!fs::is_regular_file(path))
-        throw std::runtime_error(path + ": mesh file not found" +
-                                 (fs::exists(path) ? std::string(" (it exists but is not a regular file)") : ""));
+    require_regular_file(path, "mesh file");
     const uint64_t size = fs::file_size(path);
     if (size > kMaxMeshFileBytes)
         throw_mesh_error(path, "", "file has " + std::to_string(size) + " bytes, more than the largest mesh file read (" +

@@ -5,6 +5,7 @@
 #include <map>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "core/bvh/triangle_bvh.h"
@@ -127,6 +128,14 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         tris.push_back(w);
         out.source_triangle_.push_back(int(i));
     }
+
+    // Nothing left to measure distance to: every sampler, BVH and lattice fit downstream
+    // assumes at least one triangle, so refuse here, where the file can still be named.
+    if (tris.empty())
+        throw std::runtime_error((mesh.source.empty() ? mesh.name : mesh.source) + ": no triangle left: all " +
+                                 std::to_string(mesh.triangles.size()) +
+                                 " triangles are degenerate (repeated vertex or zero area); expected at least one "
+                                 "triangle with three distinct, non-collinear vertices");
 
     // Compact away unreferenced vertices.
     std::vector<int> used(welded.size(), -1);

@@ -119,6 +119,23 @@ CheckResult check_run(const nlohmann::json& manifest, const nlohmann::json& metr
         r.lines.push_back("  note: this run's resolved config differs from the baseline's (sha256 " +
                           manifest["config"].value("sha256", std::string()).substr(0, 12) + " vs " +
                           made["config_sha256"].get<std::string>().substr(0, 12) + ")");
+    // A baseline that checks nothing would pass every run: refuse it, and every entry the
+    // checks below could not read as written (an unknown kind would fall back to "error").
+    if (!baseline.contains("metrics") || !baseline["metrics"].is_object() || baseline["metrics"].empty())
+        throw std::runtime_error(label + ": key 'metrics': expected an object with at least one metric to check, got " +
+                                 (baseline.contains("metrics") ? baseline["metrics"].dump().substr(0, 100) : "nothing") +
+                                 "; make a baseline from a clean run with: run-experiment --write-baseline RUN_DIR");
+    for (const auto& [key, base] : baseline["metrics"].items()) {
+        const std::string where = label + ": key 'metrics." + key + "'";
+        if (!base.is_object() || !base.contains("value") || !base["value"].is_number())
+            throw std::runtime_error(where + ": expected an object with a numeric \"value\", got " + base.dump().substr(0, 100));
+        const nlohmann::json kind = base.value("kind", nlohmann::json("error"));
+        if (kind != "error" && kind != "exact" && kind != "speedup")
+            throw std::runtime_error(where + ": unknown kind " + kind.dump() + "; expected \"error\", \"exact\" or \"speedup\"");
+        for (const char* number : {"relative", "absolute", "floor"})
+            if (base.contains(number) && !base[number].is_number())
+                throw std::runtime_error(where + ": key '" + number + "': expected a number, got " + base[number].dump());
+    }
     const nlohmann::json& reg = regression_of(metrics);
     for (const auto& [key, base] : baseline.at("metrics").items()) {
         if (!reg.contains(key)) {

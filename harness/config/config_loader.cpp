@@ -22,7 +22,7 @@ nlohmann::json load_chain(const std::string& path, std::vector<std::string>& fil
     if (int(files.size()) >= kMaxDepth)
         throw ConfigError(files.back() + ": key 'parent': more than " + std::to_string(kMaxDepth) + " levels of parents");
     const std::string shown = files.empty() ? path : absolute;
-    nlohmann::json config = read_json_file(shown);
+    nlohmann::json config = read_json_file(shown, "config file");
     files.push_back(absolute);
     if (!config.is_object()) throw ConfigError(shown + ": the config: expected a JSON object, got " + config.dump());
     if (!config.contains("parent")) return config;
@@ -62,7 +62,7 @@ nlohmann::json merge_config(const nlohmann::json& parent, const nlohmann::json& 
 LoadedConfig load_config(const std::string& path) {
     LoadedConfig c;
     c.path = path;
-    c.as_written = read_json_file(path);
+    c.as_written = read_json_file(path, "config file");
     c.merged = load_chain(path, c.files);
     return c;
 }

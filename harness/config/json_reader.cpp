@@ -4,18 +4,49 @@
 #include <fstream>
 #include <sstream>
 
-namespace sdf {
+#include "core/io/text_file.h"
 
-nlohmann::json read_json_file(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw ConfigError(path + ": cannot open config file");
-    std::stringstream text;
-    text << in.rdbuf();
+namespace sdf {
+namespace {
+/// Configs and field headers are small; a larger "JSON" file is a wrong path.
+constexpr uint64_t kMaxJsonFileBytes = uint64_t(64) << 20;
+}  // namespace
+
+nlohmann::json read_json_file(const std::string& path, const std::string& what) {
+    std::string s;
     try {
-        return nlohmann::json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
+        s = read_text_file(path, what, kMaxJsonFileBytes);
+    } catch (const std::runtime_error& e) {
+        throw ConfigError(e.what());
+    }
+    // JSON says names within an object SHOULD be unique and leaves duplicates to the reader;
+    // nlohmann keeps the last silently. A repeated key is almost always an edit gone wrong,
+    // so it is an error. One set of keys per object being parsed (the callback sees the
+    // objects nested, in order).
+    std::vector<std::vector<std::string>> keys_of_open_objects;
+    const auto refuse_duplicates = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+        using Event = nlohmann::json::parse_event_t;
+        if (event == Event::object_start) keys_of_open_objects.emplace_back();
+        else if (event == Event::object_end) keys_of_open_objects.pop_back();
+        else if (event == Event::key && !keys_of_open_objects.empty()) {
+            std::vector<std::string>& keys = keys_of_open_objects.back();
+            const std::string& key = parsed.get_ref<const std::string&>();
+            if (std::find(keys.begin(), keys.end(), key) != keys.end())
+                throw ConfigError(path + ": key '" + key + "' appears twice in one object; expected each key once");
+            keys.push_back(key);
+        }
+        return true;
+    };
+    try {
+        return nlohmann::json::parse(s, refuse_duplicates, true, /*ignore_comments=*/true);
+    } catch (const nlohmann::json::out_of_range& e) {
+        // Numbers beyond double's range (1e400) are the one out_of_range the parser raises.
+        std::string what = e.what();
+        const size_t bracket = what.find("] ");
+        throw ConfigError(path + ": " + (bracket == std::string::npos ? what : what.substr(bracket + 2)) +
+                          "; expected numbers within double precision's range (about 1.8e308)");
     } catch (const nlohmann::json::parse_error& e) {
         // Translate the byte offset into line:column.
-        const std::string s = text.str();
         const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, s.size());
         const size_t line = size_t(std::count(s.begin(), s.begin() + long(at), '\n')) + 1;
         const size_t last_nl = s.rfind('\n', at == 0 ? 0 : at - 1);
@@ -34,8 +65,9 @@ JsonReader::JsonReader(const nlohmann::json& value, std::string file, std::strin
                        std::shared_ptr<nlohmann::json> resolved, nlohmann::json::json_pointer where)
     : value_(value), file_(std::move(file)), path_(std::move(path)), resolved_(std::move(resolved)), where_(std::move(where)) {
     if (!value_.is_object())
-        throw ConfigError(file_ + ": " + (path_.empty() ? std::string("the config") : "key '" + path_ + "'") +
-                          ": expected a JSON object, got " + value_.dump());
+        throw ConfigError(file_ + ": " + (path_.empty() ? std::string("the top level") : "key '" + path_ + "'") +
+                          ": expected a JSON object, got " + (value_.is_array() ? "an array " : "") +
+                          value_.dump().substr(0, 200));
 }
 
 bool JsonReader::has(const std::string& key) const {

@@ -31,7 +31,7 @@ public:
 };
 
 /// Parses a JSON file; syntax errors name the file, line and column.
-nlohmann::json read_json_file(const std::string& path);
+nlohmann::json read_json_file(const std::string& path, const std::string& what = "JSON file");
 
 class JsonReader {
 public:

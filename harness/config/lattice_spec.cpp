@@ -25,6 +25,11 @@ LatticeSpec parse_lattice_spec(JsonReader& r) {
                                          std::to_string(res[2]));
             spec.resolution = bcc_primary_from_notation(spec.resolution);
         }
+        try {
+            checked_lattice_points(spec.type, spec.resolution);
+        } catch (const std::invalid_argument& e) {
+            r.fail("resolution", e.what());
+        }
     } else {
         spec.samples = r.required<int64_t>("samples", "a target number of lattice points");
         if (spec.samples < 8) r.fail("samples", "expected at least 8 points, got " + std::to_string(spec.samples));

@@ -7,6 +7,7 @@
 #include <functional>
 #include <sstream>
 
+#include "core/io/text_file.h"
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 
@@ -177,9 +178,8 @@ std::vector<std::string> data_search_path(const std::vector<std::string>& config
 std::string locate_mesh_file(const std::string& name, const std::vector<std::string>& search_path,
                              const std::string& base_dir) {
     if (fs::path(name).is_absolute()) {
-        if (fs::is_regular_file(name)) return name;
-        throw std::runtime_error(name + ": mesh file not found" +
-                                 (fs::exists(name) ? std::string(" (it exists but is not a regular file)") : ""));
+        require_regular_file(name, "mesh file");
+        return name;
     }
     std::vector<fs::path> tried;
     if (!base_dir.empty()) tried.push_back(fs::path(base_dir) / name);
@@ -187,7 +187,10 @@ std::string locate_mesh_file(const std::string& name, const std::vector<std::str
     for (const fs::path& candidate : tried)
         if (fs::is_regular_file(candidate)) return fs::weakly_canonical(fs::absolute(candidate)).string();
     std::string places;
-    for (const fs::path& c : tried) places += "\n  " + c.string();
+    for (const fs::path& c : tried) {
+        const std::string kind = file_kind(c.string());
+        places += "\n  " + c.string() + (kind == "missing" ? "" : " (" + kind + ", not a regular file)");
+    }
     throw std::runtime_error("mesh '" + name + "' not found; tried, in order:" + places +
                              "\nSet SDF_DATA_PATH or the config key \"data_path\", or run scripts/fetch-meshes.");
 }

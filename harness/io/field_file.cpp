@@ -117,6 +117,12 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
                                      r.raw("resolution").dump());
         l.resolution.z = res[2] / 2;
     }
+    // Checked before any channel size is computed from it (points x components x bytes).
+    try {
+        checked_lattice_points(l.type, l.resolution);
+    } catch (const std::invalid_argument& e) {
+        r.fail("resolution", e.what());
+    }
     r.finish({"notation", "points"});
     return l;
 }
@@ -190,7 +196,7 @@ void write_field(const std::string& header_path, const SampledField& field, cons
 }
 
 SampledField read_field(const std::string& header_path) {
-    const nlohmann::json j = read_json_file(header_path);
+    const nlohmann::json j = read_json_file(header_path, "field header");
     JsonReader r(j, header_path);
     const std::string format = r.required<std::string>("format", "\"sdf-lattice-field\"");
     if (format != "sdf-lattice-field") r.fail("format", "expected \"sdf-lattice-field\", got \"" + format + "\"");

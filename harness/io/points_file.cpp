@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/io/text_file.h"
+
 namespace sdf {
 namespace {
 
@@ -25,7 +27,8 @@ Vec3d parse_point(const std::string& line, const std::string& name, int number) 
     return p;
 }
 
-std::vector<Vec3d> read_points(std::istream& in, const std::string& name) {
+std::vector<Vec3d> read_points(const std::string& text, const std::string& name) {
+    std::istringstream in(text);
     std::vector<Vec3d> points;
     std::string line;
     for (int number = 1; std::getline(in, line); ++number)
@@ -36,10 +39,12 @@ std::vector<Vec3d> read_points(std::istream& in, const std::string& name) {
 }  // namespace
 
 std::vector<Vec3d> read_points_file(const std::string& path) {
-    if (path == "-") return read_points(std::cin, path);
-    std::ifstream file(path);
-    if (!file) throw std::runtime_error(path + ": cannot open points file");
-    return read_points(file, path);
+    if (path != "-") return read_points(read_text_file(path, "points file"), path);
+    std::stringstream all;
+    all << std::cin.rdbuf();
+    const std::string bytes = all.str();
+    reject_wide_encodings(bytes, path, "points file");
+    return read_points(std::string(without_utf8_bom(bytes)), path);
 }
 
 }  // namespace sdf

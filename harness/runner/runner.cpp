@@ -122,7 +122,7 @@ CheckResult check_against(const nlohmann::json& manifest, const nlohmann::json& 
     if (!fs::is_regular_file(baseline_path))
         throw std::runtime_error("no baseline at " + baseline_path +
                                  "; make one from a clean run with: run-experiment --write-baseline RUN_DIR");
-    const CheckResult r = check_run(manifest, metrics, read_json_file(baseline_path), baseline_path);
+    const CheckResult r = check_run(manifest, metrics, read_json_file(baseline_path, "baseline"), baseline_path);
     std::cout << r.text();
     return r;
 }

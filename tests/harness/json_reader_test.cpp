@@ -94,7 +94,7 @@ TEST_F(JsonFile, MissingFileNamesThePath) {
     const std::string path = (dir_ / "nope.json").string();
     const std::string msg = config_error([&] { read_json_file(path); });
     EXPECT_TRUE(Contains(msg, path));
-    EXPECT_TRUE(Contains(msg, "cannot open"));
+    EXPECT_TRUE(Contains(msg, "JSON file not found"));
 }
 
 // ---- JsonReader: typed access -----------------------------------------------------------

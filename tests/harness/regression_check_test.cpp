@@ -121,3 +121,35 @@ TEST(CheckRun, ExactMissingAndNewMetrics) {
 
 }  // namespace
 }  // namespace sdf
+
+namespace sdf {
+namespace {
+
+// Issue 11: a baseline that checks nothing, or that the check cannot read as written, is an
+// error, never a pass.
+TEST(CheckRun, EmptyOrUnreadableBaselinesAreErrors) {
+    json base = make_baseline(manifest(), metrics());
+    json empty = base;
+    empty["metrics"] = json::object();
+    EXPECT_TRUE(Contains(test::error_of([&] { check_run(manifest(), metrics(), empty, "b.json"); }),
+                         "b.json: key 'metrics': expected an object with at least one metric"));
+    json missing = base;
+    missing.erase("metrics");
+    EXPECT_TRUE(Contains(test::error_of([&] { check_run(manifest(), metrics(), missing, "b.json"); }), "key 'metrics'"));
+    json unknown = base;
+    unknown["metrics"]["lattices/cc/points"]["kind"] = "exakt";
+    EXPECT_TRUE(Contains(test::error_of([&] { check_run(manifest(), metrics(), unknown, "b.json"); }),
+                         "b.json: key 'metrics.lattices/cc/points': unknown kind \"exakt\""));
+    json no_value = base;
+    no_value["metrics"]["lattices/cc/points"].erase("value");
+    EXPECT_TRUE(Contains(test::error_of([&] { check_run(manifest(), metrics(), no_value, "b.json"); }),
+                         "expected an object with a numeric \"value\""));
+    json text_tolerance = base;
+    text_tolerance["metrics"]["cc/catmull_rom/fd/domain_rms"]["relative"] = "1%";
+    EXPECT_TRUE(Contains(test::error_of([&] { check_run(manifest(), metrics(), text_tolerance, "b.json"); }),
+                         "key 'relative': expected a number"));
+    EXPECT_TRUE(check_run(manifest(), metrics(), base, "b.json").passed());
+}
+
+}  // namespace
+}  // namespace sdf

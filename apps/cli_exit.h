@@ -1,0 +1,26 @@
+// One exit-code table for every tool (README, "Exit codes"): 0 success (and --help),
+// 1 an error in the inputs or the run, 2 a command-line error. CLI11's own codes (105 for
+// a failed validator, 106 for a missing required option, ...) differ per kind of mistake
+// and were undocumented; scripts only need to know "the command line was wrong".
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace sdf {
+
+constexpr int kExitCommandLineError = 2;
+
+/// Prints CLI11's message (or the help) as CLI11 does; returns the tool's exit code.
+inline int command_line_exit(const CLI::App& app, const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kExitCommandLineError;
+}
+
+}  // namespace sdf
+
+/// CLI11_PARSE with the exit codes of the table above.
+#define SDF_CLI_PARSE(app, argc, argv)                           \
+    try {                                                        \
+        (app).parse((argc), (argv));                             \
+    } catch (const CLI::ParseError& e) {                         \
+        return sdf::command_line_exit((app), e);                 \
+    }

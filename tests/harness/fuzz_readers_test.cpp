@@ -1,0 +1,275 @@
+// A deterministic fuzz battery for every reader of outside input (issue 11): mesh files of
+// every format (OBJ, ASCII and binary PLY and STL, OFF, gzip), points files, field headers
+// and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
+// are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
+// huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
+// Every input must either parse or throw one of the project's error types (std::runtime_error
+// or std::invalid_argument, ConfigError included) with a message naming the file: never a
+// crash (the test would die), never another exception type (a library's own, bad_alloc,
+// length_error), never a nameless message. Meshes that load are prepared too.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <cstdint>
+#include <iostream>
+#include <typeinfo>
+#include <filesystem>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/mesh/load_mesh.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/parallel/progress.h"
+#include "experiments/experiment_registry.h"
+#include "harness/io/field_file.h"
+#include "harness/io/points_file.h"
+#include "harness/runner/runner.h"
+#include "harness_test_util.h"
+#include "tests/core/mesh/mesh_file_writers.h"
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Deterministic mutations of one valid input.
+class Mutator {
+public:
+    explicit Mutator(uint64_t seed) : rng_(seed) {}
+
+    std::string mutate(const std::string& seed_bytes) {
+        std::string s = seed_bytes;
+        const int rounds = 1 + int(pick(3));
+        for (int r = 0; r < rounds; ++r) s = mutate_once(s);
+        return s;
+    }
+
+private:
+    size_t pick(size_t n) { return n == 0 ? 0 : size_t(rng_() % n); }
+
+    /// [start, end) of whitespace-separated tokens.
+    static std::vector<std::pair<size_t, size_t>> tokens(const std::string& s) {
+        std::vector<std::pair<size_t, size_t>> t;
+        for (size_t i = 0; i < s.size();) {
+            while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+            const size_t start = i;
+            while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+            if (i > start) t.emplace_back(start, i);
+        }
+        return t;
+    }
+
+    std::string mutate_once(std::string s) {
+        static const char* const kNumbers[] = {"4294967297", "-4294967297", "2147483648",  "-2147483649",
+                                               "99999999999999999999999", "1e400", "-1e400", "nan", "inf", "-inf",
+                                               "-0", "0", "-1", "1.5", "1e-320", "9223372036854775807",
+                                               "18446744073709551616", "0x10", "+", "-", "", "\"\"", "[]", "{}", "null"};
+        const auto toks = tokens(s);
+        switch (pick(11)) {
+            case 0:  // bit flips
+                for (int k = 0, n = 1 + int(pick(4)); k < n && !s.empty(); ++k) s[pick(s.size())] ^= char(1 << pick(8));
+                return s;
+            case 1:  // truncation
+                return s.substr(0, pick(s.size() + 1));
+            case 2:  // two tokens swapped
+                if (toks.size() >= 2) {
+                    auto a = toks[pick(toks.size())], b = toks[pick(toks.size())];
+                    if (a.first > b.first) std::swap(a, b);
+                    if (a.second <= b.first) {
+                        const std::string ta = s.substr(a.first, a.second - a.first);
+                        const std::string tb = s.substr(b.first, b.second - b.first);
+                        s.replace(b.first, tb.size(), ta);
+                        s.replace(a.first, ta.size(), tb);
+                    }
+                }
+                return s;
+            case 3:
+            case 4:  // a token replaced by an extreme number or an empty value
+                if (!toks.empty()) {
+                    const auto t = toks[pick(toks.size())];
+                    std::string replacement = kNumbers[pick(sizeof kNumbers / sizeof *kNumbers)];
+                    // Keep JSON punctuation around numbers so that the value, not the syntax, is tested.
+                    const std::string old = s.substr(t.first, t.second - t.first);
+                    const size_t digit = old.find_first_of("0123456789");
+                    if (digit != std::string::npos) {
+                        const size_t end = old.find_last_of("0123456789.e") + 1;
+                        replacement = old.substr(0, digit) + replacement + old.substr(end);
+                    }
+                    s.replace(t.first, t.second - t.first, replacement);
+                }
+                return s;
+            case 5:  // a token deleted
+                if (!toks.empty()) {
+                    const auto t = toks[pick(toks.size())];
+                    s.erase(t.first, t.second - t.first);
+                }
+                return s;
+            case 6: {  // a line deleted or duplicated
+                const size_t at = s.find('\n', pick(s.size() + 1));
+                if (at == std::string::npos) return s;
+                const size_t end = s.find('\n', at + 1);
+                const std::string line = s.substr(at, (end == std::string::npos ? s.size() : end) - at);
+                if (pick(2)) s.erase(at, line.size());
+                else s.insert(at, line);
+                return s;
+            }
+            case 7:  // UTF-8 byte-order mark
+                return "\xEF\xBB\xBF" + s;
+            case 8: {  // CRLF line ends
+                std::string out;
+                for (char c : s) out += c == '\n' ? std::string("\r\n") : std::string(1, c);
+                return out;
+            }
+            case 9:  // UTF-16 byte-order mark, or a NUL byte
+                if (pick(2)) return std::string("\xFF\xFE", 2) + s;
+                s.insert(pick(s.size() + 1), 1, '\0');
+                return s;
+            default:  // a random byte inserted
+                s.insert(pick(s.size() + 1), 1, char(pick(256)));
+                return s;
+        }
+    }
+
+    std::mt19937_64 rng_;
+};
+
+/// Runs `read` on every mutation of `seed_bytes` written to `path`; fails on any throw
+/// that is not a project error naming the file. Returns {parsed, refused}.
+template <typename Read>
+std::pair<int, int> fuzz(const std::string& path, const std::string& seed_bytes, int count, uint64_t seed, Read read) {
+    Mutator m(seed);
+    int parsed = 0, refused = 0;
+    const std::string name = fs::path(path).filename().string();
+    EXPECT_NO_THROW(read(path, seed_bytes)) << "the seed itself must parse: " << path;
+    for (int i = 0; i < count; ++i) {
+        const std::string bytes = m.mutate(seed_bytes);
+        try {
+            read(path, bytes);
+            ++parsed;
+        } catch (const std::runtime_error& e) {
+            ++refused;
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos)
+                << "mutation " << i << " of " << name << ": the message does not name the file: " << e.what();
+        } catch (const std::invalid_argument& e) {
+            ++refused;
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos)
+                << "mutation " << i << " of " << name << ": the message does not name the file: " << e.what();
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "mutation " << i << " of " << name << " threw a foreign exception ("
+                          << typeid(e).name() << "): " << e.what();
+        }
+    }
+    std::cout << name << ": " << count << " mutations, " << parsed << " parsed, " << refused << " refused\n";
+    return {parsed, refused};
+}
+
+class FuzzReaders : public test::ScratchDirTest {
+protected:
+    FuzzReaders() : ScratchDirTest("sdf_fuzz_readers_test") {}
+    static constexpr int kPerSeed = 300;
+
+    /// Loads and prepares the mesh file `path` holding `bytes`.
+    static void load_and_prepare(const std::string& path, const std::string& bytes) {
+        test::write_file(path, bytes);
+        MeshPreparationOptions o;
+        o.detect_intersections = false;
+        prepare_mesh(load_mesh_file(path), o);
+    }
+};
+
+TEST_F(FuzzReaders, MeshFilesOfEveryFormat) {
+    const TriangleMesh box = make_box({1.0, 0.5, 0.25});
+    const std::vector<std::pair<std::string, std::string>> seeds = {
+        {"m.obj", test::obj_text(box)},
+        {"m.off", test::off_text(box)},
+        {"a.ply", test::ply_text(box, test::PlyEncoding::Ascii)},
+        {"le.ply", test::ply_text(box, test::PlyEncoding::BinaryLittleEndian)},
+        {"be.ply", test::ply_text(box, test::PlyEncoding::BinaryBigEndian, true)},
+        {"a.stl", test::stl_ascii_text(box)},
+        {"b.stl", test::stl_binary_text(box)},
+    };
+    int total = 0;
+    for (size_t k = 0; k < seeds.size(); ++k) {
+        const auto [parsed, refused] = fuzz(at(seeds[k].first), seeds[k].second, kPerSeed, 1000 + k, load_and_prepare);
+        EXPECT_GT(refused, 0) << seeds[k].first;
+        total += parsed + refused;
+    }
+    // gzip: mutations of the compressed stream (corrupt and truncated streams).
+    test::write_gzip(at("z.obj.gz"), test::obj_text(box));
+    const std::string gz = test::read_text(at("z.obj.gz"));
+    total += fuzz(at("z.obj.gz"), gz, kPerSeed / 3, 2000, load_and_prepare).second > 0;
+    EXPECT_GE(total, int(seeds.size()) * kPerSeed);
+}
+
+TEST_F(FuzzReaders, PointsFiles) {
+    const std::string seed = "# points\n0 0 0\n\n0.5 -1 2.25\n1e-3 4 5\n";
+    const auto [parsed, refused] = fuzz(at("p.txt"), seed, kPerSeed, 3000, [](const std::string& path, const std::string& bytes) {
+        test::write_file(path, bytes);
+        read_points_file(path);
+    });
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+}
+
+TEST_F(FuzzReaders, FieldHeaders) {
+    // CC 3x3x3, one float32 value channel and a float32 gradient channel.
+    SampledField f;
+    f.lattice.type = LatticeType::CC;
+    f.lattice.spacing = 0.5;
+    f.lattice.resolution = {3, 3, 3};
+    for (int64_t i = 0; i < f.lattice.num_points(); ++i) {
+        f.distance.push_back(double(i) * 0.25 - 3);
+        f.gradient.push_back({1, 0, 0});
+    }
+    FieldWriteOptions o;
+    write_field(at("f.json"), f, o);
+    const std::string seed = test::read_text(at("f.json"));
+    const auto [parsed, refused] = fuzz(at("f.json"), seed, kPerSeed, 4000, [](const std::string& path, const std::string& bytes) {
+        test::write_file(path, bytes);
+        read_field(path);
+    });
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+}
+
+TEST_F(FuzzReaders, ConfigsReadValidatedAndPlanned) {
+    ProgressReporter::set_globally_enabled(false);
+    const std::string seed = R"({
+  "name": "fuzz",
+  "kind": "reconstruction",
+  "mesh": {"shape": "torus", "major_radius": 1.0, "minor_radius": 0.35, "major_segments": 12, "minor_segments": 6},
+  "domain": {"margin": 0.1},
+  "lattices": [{"type": "cc", "resolution": [6, 6, 6]}, {"type": "bcc", "resolution": [5, 5, 10], "margin": 0.2}],
+  "sampler": {"backend": "cpu", "threads": 1, "precision": "float", "progress": false},
+  "reconstructions": [{"lattice": "cc", "interpolator": "trilinear"}],
+  "metrics": {"domain_probes": 20, "band_probes": 20, "band": 1.0, "seed": 1}
+}
+)";
+    const std::string cache = at("cache"), out = at("out");
+    std::streambuf* const cout = std::cout.rdbuf();
+    std::ostringstream sink;
+    std::cout.rdbuf(sink.rdbuf());  // the plans
+    const auto [parsed, refused] =
+        fuzz(at("c.json"), seed, kPerSeed, 5000, [&](const std::string& path, const std::string& bytes) {
+            test::write_file(path, bytes);
+            RunnerOptions o;
+            o.experiments = &experiment_registry();
+            o.config_path = path;
+            o.dry_run = true;
+            o.no_cache = true;
+            o.cache_dir = cache;
+            o.output_root = out;
+            run_experiment(o);
+        });
+    std::cout.rdbuf(cout);
+    std::cout << "c.json: " << kPerSeed << " mutations, " << parsed << " parsed, " << refused << " refused\n";
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+    EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace sdf

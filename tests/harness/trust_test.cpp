@@ -1,0 +1,423 @@
+// Issue 11, "trustworthy on every input": each class of bad input the tools once crashed on
+// or answered wrongly with exit code 0, run through every tool it reaches, with the clear
+// error (naming the file, line or key) or the correct answer asserted. Correct answers are
+// against closed-form truth: the unit-corner tetrahedron's distances and a linear field that
+// trilinear reconstruction reproduces exactly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/checked_math.h"
+#include "core/io/text_file.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/load_mesh.h"
+#include "core/mesh/prepared_mesh.h"
+#include "harness/config/json_reader.h"
+#include "harness/io/points_file.h"
+#include "harness_test_util.h"
+
+#if !defined(SDF_QUERY_EXE) || !defined(SDF_EVAL_EXE) || !defined(SDF_RENDER_EXE) || !defined(RUN_EXPERIMENT_EXE)
+#error "the tools' paths must be defined by CMake"
+#endif
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+using test::Contains;
+using test::error_of;
+using test::quote;
+using test::ShellResult;
+
+const std::string kBom = "\xEF\xBB\xBF";
+
+/// The tetrahedron with corners 0, e_x, e_y, e_z, outward, in OBJ; `eol` ends each line.
+std::string tetra_obj(const std::string& eol = "\n") {
+    return "v 0 0 0" + eol + "v 1 0 0" + eol + "v 0 1 0" + eol + "v 0 0 1" + eol + "f 1 3 2" + eol + "f 1 2 4" + eol +
+           "f 1 4 3" + eol + "f 2 3 4" + eol;
+}
+std::string tetra_ply(const std::string& eol) {
+    return "ply" + eol + "format ascii 1.0" + eol + "element vertex 4" + eol + "property float x" + eol +
+           "property float y" + eol + "property float z" + eol + "element face 4" + eol +
+           "property list uchar int vertex_indices" + eol + "end_header" + eol + "0 0 0" + eol + "1 0 0" + eol +
+           "0 1 0" + eol + "0 0 1" + eol + "3 0 2 1" + eol + "3 0 1 3" + eol + "3 0 3 2" + eol + "3 1 2 3" + eol;
+}
+std::string tetra_off(const std::string& eol) {
+    return "OFF" + eol + "4 4 0" + eol + "0 0 0" + eol + "1 0 0" + eol + "0 1 0" + eol + "0 0 1" + eol + "3 0 2 1" +
+           eol + "3 0 1 3" + eol + "3 0 3 2" + eol + "3 1 2 3" + eol;
+}
+std::string tetra_stl(const std::string& eol) {
+    const char* faces[4][3] = {{"0 0 0", "0 1 0", "1 0 0"},
+                               {"0 0 0", "1 0 0", "0 0 1"},
+                               {"0 0 0", "0 0 1", "0 1 0"},
+                               {"1 0 0", "0 1 0", "0 0 1"}};
+    std::string s = "solid tetra" + eol;
+    for (const auto& f : faces) {
+        s += "facet normal 0 0 0" + eol + " outer loop" + eol;
+        for (const char* v : f) s += "  vertex " + std::string(v) + eol;
+        s += " endloop" + eol + "endfacet" + eol;
+    }
+    return s + "endsolid tetra" + eol;
+}
+
+/// Points with known distances to the tetrahedron: inside (nearest: the three axis faces at
+/// 0.2; the slanted face is (1 - 0.6)/sqrt(3) away), and outside (nearest: the corner e_x).
+const std::string kPointsText = "0.2 0.2 0.2\n3 0 0\n";
+const double kTruth[2] = {-0.2, 2.0};
+
+/// Distances of sdf-query's output lines.
+std::vector<double> distances(const std::string& out) {
+    std::vector<double> d;
+    std::istringstream in(out);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream ls(line);
+        double v = NAN;
+        ls >> v;
+        d.push_back(v);
+    }
+    return d;
+}
+
+class Trust : public test::ScratchDirTest {
+protected:
+    Trust() : ScratchDirTest("sdf_trust_test") {}
+
+    ShellResult run(const std::string& exe, const std::string& args) const {
+        return test::run_in(dir_, "SDF_DATA_PATH=" + quote(at("nowhere")) + " SDF_CACHE_DIR=" + quote(at("cache")) +
+                                      " " + quote(exe) + " " + args);
+    }
+    ShellResult query(const std::string& args) const { return run(SDF_QUERY_EXE, args); }
+    ShellResult eval(const std::string& args) const { return run(SDF_EVAL_EXE, args); }
+    ShellResult render(const std::string& args) const { return run(SDF_RENDER_EXE, args); }
+    ShellResult experiment(const std::string& args) const { return run(RUN_EXPERIMENT_EXE, args); }
+
+    /// A tiny config sampling `mesh` (a file name or "shape:box").
+    std::string config(const std::string& rel, const std::string& mesh, const std::string& resolution = "[4, 4, 4]",
+                       const std::string& prefix = "", const std::string& eol = "\n") const {
+        const std::string mesh_json = mesh.rfind("shape:", 0) == 0 ? "{\"shape\": \"" + mesh.substr(6) + "\"}"
+                                                                     : "{\"file\": \"" + mesh + "\"}";
+        return write(rel, prefix + "{" + eol + "  \"name\": \"trust\"," + eol + "  \"mesh\": " + mesh_json + "," + eol +
+                              "  \"lattices\": [{\"type\": \"cc\", \"resolution\": " + resolution + "}]," + eol +
+                              "  \"sampler\": {\"threads\": 1, \"progress\": false}" + eol + "}" + eol);
+    }
+
+    /// A CC 2x2x2 field of f = x + y + z (spacing 1, origin 0), whose header starts with
+    /// `prefix` and ends lines with `eol`; f is symmetric in the axes, so the point order of
+    /// the channel does not matter.
+    std::string linear_field(const std::string& rel, const std::string& prefix = "", const std::string& eol = "\n",
+                             const std::string& resolution = "[2, 2, 2]", const std::string& extra = "") const {
+        std::string raw;
+        for (int i = 0; i < 8; ++i) {
+            const float f = float((i & 1) + ((i >> 1) & 1) + ((i >> 2) & 1));
+            raw.append(reinterpret_cast<const char*>(&f), sizeof f);
+        }
+        write("f.value.raw", raw);
+        return write(rel, prefix + "{" + eol + "\"format\": \"sdf-lattice-field\", \"version\": 1," + eol + extra +
+                              "\"lattice\": {\"type\": \"cc\", \"origin\": [0, 0, 0], \"spacing\": 1, \"resolution\": " +
+                              resolution + "}," + eol +
+                              "\"channels\": {\"value\": {\"file\": \"f.value.raw\", \"dtype\": \"float32\"}}" + eol +
+                              "}" + eol);
+    }
+};
+
+// ---- 1. degenerate meshes -------------------------------------------------------------------
+
+const std::string kDegenerateObj = "v 0 0 0\nv 1 1 1\nv 2 2 2\nv 0 1 0\nf 1 2 3\nf 1 1 4\nf 4 4 4\n";
+
+TEST(TrustDegenerate, PrepareMeshRefusesAMeshWithNoTriangleLeft) {
+    TriangleMesh m;
+    m.name = "flat";
+    m.source = "flat.obj";
+    m.vertices = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {0, 1, 0}};
+    m.triangles = {{0, 1, 2}, {0, 0, 3}};  // collinear, repeated index
+    const std::string e = error_of([&] { prepare_mesh(m); });
+    EXPECT_TRUE(Contains(e, "flat.obj: no triangle left"));
+    EXPECT_TRUE(Contains(e, "all 2 triangles are degenerate"));
+    // One good triangle left: prepared, with the other two counted as dropped.
+    m.triangles.push_back({0, 3, 1});
+    EXPECT_EQ(prepare_mesh(m).triangles().size(), 1u);
+    EXPECT_EQ(prepare_mesh(m).report().degenerate_triangles, 2);
+}
+
+TEST_F(Trust, EveryToolRefusesAnAllDegenerateMeshNamingIt) {
+    write("flat.obj", kDegenerateObj);
+    write("p.txt", kPointsText);
+    const ShellResult q = query("flat.obj p.txt");  // was SIGSEGV
+    EXPECT_EQ(q.code, 1) << q.err;
+    EXPECT_TRUE(Contains(q.err, "flat.obj: no triangle left"));
+    const ShellResult r = render("flat.obj --no-cache --quiet --size 8 --backend cpu --sampler-backend cpu");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_TRUE(Contains(r.err, "flat.obj: no triangle left"));
+    const ShellResult e = experiment(config("c.json", "flat.obj") + " --dry-run --no-cache");
+    EXPECT_EQ(e.code, 1) << e.err;
+    EXPECT_TRUE(Contains(e.err, "flat.obj: no triangle left"));
+}
+
+// ---- 2. text encodings: byte-order marks and CRLF ------------------------------------------
+
+TEST_F(Trust, EveryTextMeshFormatReadsBomAndCrlfToTheSameDistances) {
+    write("p.txt", kPointsText);
+    const std::vector<std::pair<std::string, std::string>> meshes = {
+        {"t.obj", tetra_obj("\r\n")}, {"t.ply", tetra_ply("\r\n")}, {"t.off", tetra_off("\r\n")},
+        {"t.stl", tetra_stl("\r\n")}};
+    for (const auto& [name, text] : meshes) {
+        for (const std::string& prefix : {std::string(), kBom}) {
+            write(name, prefix + text);
+            const ShellResult r = query(name + " p.txt --precision double");
+            ASSERT_EQ(r.code, 0) << name << (prefix.empty() ? "" : " with BOM") << ": " << r.err;
+            const std::vector<double> d = distances(r.out);
+            ASSERT_EQ(d.size(), 2u) << name;
+            EXPECT_NEAR(d[0], kTruth[0], 1e-15) << name << (prefix.empty() ? "" : " with BOM");
+            EXPECT_NEAR(d[1], kTruth[1], 1e-15) << name << (prefix.empty() ? "" : " with BOM");
+        }
+    }
+}
+
+TEST_F(Trust, BomBeforeTheFirstObjVertexKeepsEveryIndex) {
+    // Before: the BOM glued to "v" hid vertex 1; every face index shifted by one.
+    write("t.obj", kBom + tetra_obj());
+    const TriangleMesh m = load_mesh_file(at("t.obj"));
+    ASSERT_EQ(m.vertices.size(), 4u);
+    EXPECT_EQ(m.vertices[1].x, 1.0);
+    ASSERT_EQ(m.triangles.size(), 4u);
+    EXPECT_EQ(m.triangles[0][0], 0);
+    EXPECT_EQ(m.triangles[0][1], 2);
+}
+
+TEST_F(Trust, PointsConfigsAndFieldHeadersReadBomAndCrlf) {
+    write("t.obj", tetra_obj());
+    write("p.txt", kBom + "# points\r\n0.2 0.2 0.2\r\n\r\n3 0 0\r\n");
+    const ShellResult q = query("t.obj p.txt --precision double");
+    ASSERT_EQ(q.code, 0) << q.err;
+    const std::vector<double> d = distances(q.out);
+    ASSERT_EQ(d.size(), 2u);
+    EXPECT_NEAR(d[0], kTruth[0], 1e-15);
+    EXPECT_NEAR(d[1], kTruth[1], 1e-15);
+
+    const ShellResult e = experiment(config("c.json", "shape:box", "[4, 4, 4]", kBom, "\r\n") + " --dry-run");
+    EXPECT_EQ(e.code, 0) << e.err;
+
+    write("q.txt", kBom + "0.5 0.5 0.25\r\n");
+    const ShellResult f = eval(linear_field("field.json", kBom, "\r\n") + " q.txt --interpolator trilinear");
+    ASSERT_EQ(f.code, 0) << f.err;
+    EXPECT_NEAR(distances(f.out).at(0), 1.25, 1e-6);  // trilinear is exact for x + y + z
+}
+
+TEST_F(Trust, WideEncodingsAreRefusedByName) {
+    const std::string utf16 = std::string("\xFF\xFE", 2) + std::string("v\0 \0", 4);
+    write("w.obj", utf16);
+    write("w.txt", utf16);
+    write("w.json", utf16);
+    write("p.txt", kPointsText);
+    const ShellResult m = query("w.obj p.txt");
+    EXPECT_EQ(m.code, 1);
+    EXPECT_TRUE(Contains(m.err, "w.obj: mesh file is encoded as UTF-16LE"));
+    const ShellResult p = query("shape:box w.txt");
+    EXPECT_EQ(p.code, 1);
+    EXPECT_TRUE(Contains(p.err, "w.txt: points file is encoded as UTF-16LE"));
+    const ShellResult c = experiment("w.json --dry-run");
+    EXPECT_EQ(c.code, 1);
+    EXPECT_TRUE(Contains(c.err, "w.json: config file is encoded as UTF-16LE"));
+}
+
+// ---- 3. integer overflow ----------------------------------------------------------------------
+
+TEST(TrustOverflow, CheckedArithmetic) {
+    EXPECT_EQ(checked_mul(int64_t(1) << 31, int64_t(1) << 31).value(), int64_t(1) << 62);
+    EXPECT_FALSE(checked_mul(int64_t(1) << 32, int64_t(1) << 31).has_value());
+    EXPECT_FALSE(checked_add(INT64_MAX, 1).has_value());
+    EXPECT_EQ(checked_mul(2000, 3000, 4000).value(), int64_t(24000000000));
+    EXPECT_FALSE(checked_mul(2000000000, 2000000000, 2000000000).has_value());
+    // BCC: primary + secondary grid; the largest lattice is accepted, one point more is not.
+    EXPECT_EQ(checked_lattice_points(LatticeType::BCC, {3, 4, 5}), 60 + 2 * 3 * 4);
+    EXPECT_EQ(checked_lattice_points(LatticeType::CC, {4096, 4096, 4096}), kMaxLatticePoints);
+    EXPECT_TRUE(Contains(error_of([] { checked_lattice_points(LatticeType::CC, {4096, 4096, 4097}); }),
+                         "has 68736253952 points, more than the largest lattice sampled"));
+    EXPECT_TRUE(Contains(
+        error_of([] { checked_lattice_points(LatticeType::BCC, {2000000000, 2000000000, 1000000000}); }),
+        "2000000000x2000000000x2000000000 has more than 2^63 points"));
+}
+
+TEST_F(Trust, FaceIndicesBeyond32BitsAreRefusedNotWrapped) {
+    // 4294967297 = 2^32 + 1 wrapped to vertex 1 before.
+    write("big.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 4294967297 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    write("p.txt", kPointsText);
+    const ShellResult r = query("big.obj p.txt");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "big.obj:5: face vertex '4294967297' refers to vertex 4294967297, but the file has 4"));
+    write("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999999\n");
+    const ShellResult h = query("huge.obj p.txt");
+    EXPECT_EQ(h.code, 1);
+    EXPECT_TRUE(Contains(h.err, "huge.obj:4: face vertex '99999999999999999999999' is not a whole number"));
+}
+
+TEST_F(Trust, OverflowingLatticeIsRefusedBeforeAnythingIsPlannedOrCached) {
+    // Before: --dry-run printed "0 points" and the run crashed, leaving a cache entry.
+    const std::string c = config("c.json", "shape:box", "[2000000000, 2000000000, 2000000000]");
+    for (const std::string flags : {" --dry-run", ""}) {
+        const ShellResult r = experiment(c + flags);
+        EXPECT_EQ(r.code, 1) << flags;
+        EXPECT_TRUE(Contains(r.err, "c.json: key 'lattices[0].resolution'")) << flags;
+        EXPECT_TRUE(Contains(r.err, "more than 2^63 points")) << flags;
+    }
+    EXPECT_FALSE(fs::exists(at("cache")) && !fs::is_empty(at("cache")));
+    EXPECT_FALSE(fs::exists(at("results")));
+    const ShellResult big = experiment(config("d.json", "shape:box", "[5000, 5000, 5000]") + " --dry-run");
+    EXPECT_EQ(big.code, 1);
+    EXPECT_TRUE(Contains(big.err, "has 125000000000 points, more than the largest lattice sampled"));
+}
+
+TEST_F(Trust, FieldHeaderWithAnOverflowingResolutionIsRefused) {
+    write("p.txt", "0 0 0\n");
+    const ShellResult r =
+        eval(linear_field("h.json", "", "\n", "[2000000000, 2000000000, 2000000000]") + " p.txt --interpolator trilinear");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "h.json: key 'lattice.resolution'"));
+    EXPECT_TRUE(Contains(r.err, "more than 2^63 points"));
+}
+
+// ---- 4. files that are not regular files -----------------------------------------------------
+
+TEST_F(Trust, DirectoriesAndArraysAreNamedForWhatTheyAre) {
+    fs::create_directories(at("adir.json"));
+    fs::create_directories(at("pdir"));
+    write("p.txt", kPointsText);
+    write("t.obj", tetra_obj());
+    const ShellResult q = query("t.obj pdir");  // was: no output, exit 0
+    EXPECT_EQ(q.code, 1);
+    EXPECT_TRUE(Contains(q.err, "pdir: cannot read points file: it is a directory, not a regular file"));
+    const ShellResult e = eval(linear_field("f.json") + " pdir --interpolator trilinear");
+    EXPECT_EQ(e.code, 1);
+    EXPECT_TRUE(Contains(e.err, "pdir: cannot read points file: it is a directory"));
+    const ShellResult h = eval("adir.json p.txt --interpolator trilinear");
+    EXPECT_EQ(h.code, 1);
+    EXPECT_TRUE(Contains(h.err, "adir.json: cannot read field header: it is a directory, not a regular file"));
+    const ShellResult c = experiment("adir.json --dry-run");
+    EXPECT_EQ(c.code, 1);
+    EXPECT_TRUE(Contains(c.err, "adir.json: cannot read config file: it is a directory, not a regular file"));
+    write("array.json", "[1, 2, 3]\n");
+    const ShellResult a = eval("array.json p.txt --interpolator trilinear");
+    EXPECT_EQ(a.code, 1);
+    EXPECT_TRUE(Contains(a.err, "array.json: the top level: expected a JSON object, got an array [1,2,3]"));
+    const ShellResult m = query(at("pdir") + " p.txt");
+    EXPECT_EQ(m.code, 1);
+    EXPECT_TRUE(Contains(m.err, "pdir: cannot read mesh file: it is a directory, not a regular file"));
+    const ShellResult rel = query("pdir p.txt");
+    EXPECT_EQ(rel.code, 1);
+    EXPECT_TRUE(Contains(rel.err, "pdir (a directory, not a regular file)"));
+}
+
+// ---- 5. smaller ones ---------------------------------------------------------------------------
+
+TEST_F(Trust, ObjIndexErrorsQuoteTheIndexAsWritten) {
+    write("p.txt", kPointsText);
+    write("neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -7 -2 -1\n");  // was quoted as "vertex -3"
+    const ShellResult n = query("neg.obj p.txt");
+    EXPECT_EQ(n.code, 1);
+    EXPECT_TRUE(Contains(n.err, "neg.obj:4: face vertex '-7' counts back further than the 3 vertices before this line"));
+    write("frac.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1.5 2 3\n");  // was read as f 1 2 3
+    const ShellResult f = query("frac.obj p.txt");
+    EXPECT_EQ(f.code, 1);
+    EXPECT_TRUE(Contains(f.err, "frac.obj:4: face vertex '1.5' is not a whole number"));
+    write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+    const ShellResult z = query("zero.obj p.txt");
+    EXPECT_EQ(z.code, 1);
+    EXPECT_TRUE(Contains(z.err, "zero.obj:4: face vertex '0' is 0"));
+    // Relative indices, texture and normal references are still read.
+    write("rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvn 0 0 1\nf -4/1/1 -2/1/1 -3/1/1\nf 1//1 2//1 4//1\n"
+                     "f 1 4 3\nf 2 3 4\n");
+    const ShellResult ok = query("rel.obj p.txt --precision double");
+    ASSERT_EQ(ok.code, 0) << ok.err;
+    EXPECT_NEAR(distances(ok.out).at(0), kTruth[0], 1e-15);
+    EXPECT_NEAR(distances(ok.out).at(1), kTruth[1], 1e-15);
+}
+
+TEST_F(Trust, DuplicateKeysAndHugeNumbersInJsonAreErrors) {
+    write("dup.json", "{\"name\": \"a\", \"mesh\": {\"shape\": \"box\", \"shape\": \"sphere\"}, \"lattices\": []}");
+    const ShellResult d = experiment("dup.json --dry-run");
+    EXPECT_EQ(d.code, 1);
+    EXPECT_TRUE(Contains(d.err, "dup.json: key 'shape' appears twice in one object"));
+    // The same key in two different objects is fine.
+    EXPECT_NO_THROW(read_json_file(write("two.json", "{\"a\": {\"x\": 1}, \"b\": {\"x\": 2}, \"x\": [{\"x\": 3}]}")));
+    write("p.txt", "0 0 0\n");
+    const ShellResult h = eval(linear_field("h.json", "", "\n", "[2, 2, 2]", "\"version\": 1,") + " p.txt --interpolator trilinear");
+    EXPECT_EQ(h.code, 1);
+    EXPECT_TRUE(Contains(h.err, "h.json: key 'version' appears twice"));
+    write("big.json", "{\"name\": \"a\", \"x\": 1e400}");
+    const ShellResult b = experiment("big.json --dry-run");  // was a raw nlohmann exception
+    EXPECT_EQ(b.code, 1);
+    EXPECT_TRUE(Contains(b.err, "big.json: number overflow parsing '1e400'"));
+}
+
+TEST_F(Trust, CommandLineErrorsExitWithCode2InEveryTool) {
+    write("p.txt", "0 0 0\n");
+    const std::string field = linear_field("f.json");
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {SDF_QUERY_EXE, "shape:box p.txt --threads -1"},
+        {SDF_QUERY_EXE, "shape:box"},
+        {SDF_QUERY_EXE, "shape:box p.txt --no-such-option"},
+        {SDF_EVAL_EXE, field + " p.txt --interpolator trilinear --threads -1"},
+        {SDF_EVAL_EXE, field + " p.txt"},
+        {SDF_RENDER_EXE, "shape:box --fov 0"},
+        {SDF_RENDER_EXE, "shape:box --fov 180"},
+        {SDF_RENDER_EXE, "shape:box --margin -1"},
+        {SDF_RENDER_EXE, "shape:box --threads -2"},
+        {SDF_RENDER_EXE, "shape:box --size 0"},
+        {RUN_EXPERIMENT_EXE, "--no-such-option"},
+        {RUN_EXPERIMENT_EXE, ""},
+    };
+    for (const auto& [exe, args] : bad) {
+        const ShellResult r = run(exe, args);
+        EXPECT_EQ(r.code, 2) << exe << " " << args << ": " << r.err;
+        EXPECT_FALSE(r.err.empty()) << exe << " " << args;
+    }
+    for (const std::string exe : {SDF_QUERY_EXE, SDF_EVAL_EXE, SDF_RENDER_EXE, RUN_EXPERIMENT_EXE})
+        EXPECT_EQ(run(exe, "--help").code, 0) << exe;
+}
+
+TEST_F(Trust, RenderRefusesACameraWithoutADefinedRoll) {
+    const std::string common = " --no-cache --quiet --size 8 --backend cpu --sampler-backend cpu --out x.png";
+    const ShellResult zero = render("shape:box --eye 3,3,3 --target 0,0,0 --up 0,0,0" + common);
+    EXPECT_EQ(zero.code, 1);
+    EXPECT_TRUE(Contains(zero.err, "is zero or parallel to the line of sight"));
+    const ShellResult parallel = render("shape:box --eye 3,3,3 --target 0,0,0 --up 1,1,1" + common);
+    EXPECT_EQ(parallel.code, 1);
+    EXPECT_TRUE(Contains(parallel.err, "is zero or parallel to the line of sight"));
+    const ShellResult ignored = render("shape:box --view three_quarter --up 0,0,1" + common);
+    EXPECT_EQ(ignored.code, 1);
+    EXPECT_TRUE(Contains(ignored.err, "--up applies to an explicit camera only"));
+    EXPECT_FALSE(fs::exists(at("x.png")));
+}
+
+// ---- 6. results that claim success with nothing measured ---------------------------------------
+
+TEST_F(Trust, ReconstructionStudyThatPlacesNoProbeFails) {
+    // A band far wider than the common domain: every band probe lands outside it. Before:
+    // all errors 0, exit 0.
+    const std::string study = R"({"name": "noprobes", "kind": "reconstruction", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [6, 6, 6]}],
+        "sampler": {"threads": 1, "progress": false},
+        "reconstructions": [{"lattice": "cc", "interpolator": "trilinear"}],
+        "metrics": {"domain_probes": 0, "band_probes": 50, "band": 1e6}})";
+    write("noprobes.json", study);
+    const ShellResult r = experiment("noprobes.json --no-cache --output-root out");
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_TRUE(Contains(r.err, "noprobes.json: key 'metrics': no probe was placed"));
+    EXPECT_FALSE(fs::exists(at("out/noprobes")) && !fs::is_empty(at("out/noprobes")));
+    // The same study with probes in the domain runs.
+    std::string fine = study;
+    fine.replace(fine.find("\"domain_probes\": 0"), 18, "\"domain_probes\": 9");
+    fine.replace(fine.find("\"band\": 1e6"), 11, "\"band\": 1");
+    write("probes.json", fine);
+    const ShellResult ok = experiment("probes.json --no-cache --output-root out");
+    EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
+}
+
+}  // namespace
+}  // namespace sdf
