@@ -59,8 +59,11 @@ public:
         r.in_band.resize(points.size());
         start = std::chrono::steady_clock::now();
         parallel_for(int64_t(points.size()), 4096, threads, [&](int64_t b, int64_t e) {
+            // GridSampler keeps a pointer to the accessor: it must outlive the sampler (a
+            // temporary here was a stack-use-after-scope under AddressSanitizer).
+            const openvdb::FloatGrid::ConstAccessor accessor = grid->getConstAccessor();
             openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
-                grid->getConstAccessor(), grid->transform());
+                accessor, grid->transform());
             for (int64_t i = b; i < e; ++i) {
                 const Vec3d& p = points[size_t(i)];
                 const float v = sampler.wsSample(openvdb::Vec3d(p.x, p.y, p.z));
