@@ -128,7 +128,7 @@ double angle_degrees(const Vec3d& exact_gradient, const Vec3d& got) {
 
 bool probes_cached(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
                    const SamplerOptions& o, const ContentCache* cache) {
-    return cache && cache->find("probes", cache_key(mesh, box, band_width, spec, o)).has_value();
+    return cache && cache->has_entry("probes", cache_key(mesh, box, band_width, spec, o));
 }
 
 ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,

@@ -39,8 +39,9 @@ nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l,
 }
 
 std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {
-    if (!contains(key)) return std::nullopt;
-    const std::string dir = entry_path(key);
+    const std::optional<std::string> found = store_.find("fields", key);
+    if (!found) return std::nullopt;
+    const std::string dir = *found;
     try {
         SampledField field = read_field(dir + "/field.json");
         const nlohmann::json info = read_json_file(dir + "/entry.json").at("info");

@@ -29,10 +29,12 @@ public:
     explicit FieldCache(std::string root) : store_(std::move(root)) {}
     const std::string& root() const { return store_.root(); }
 
-    bool contains(const nlohmann::json& key) const { return store_.find("fields", key).has_value(); }
+    /// Whether an entry exists (not verified: for plans; load() verifies).
+    bool contains(const nlohmann::json& key) const { return store_.has_entry("fields", key); }
     std::string entry_path(const nlohmann::json& key) const { return store_.entry_path("fields", key); }
-    /// The cached field (timings as measured when it was filled), or nullopt. A damaged
-    /// entry throws, naming its directory.
+    /// The cached field (timings as measured when it was filled), or nullopt: also when the
+    /// entry fails verification (ContentCache::find moves it aside with a warning), so the
+    /// caller samples it again.
     std::optional<SampledField> load(const nlohmann::json& key) const;
     /// Stores `field` unless the key is present; returns whether it was stored.
     bool store(const nlohmann::json& key, const SampledField& field) const;

@@ -1,15 +1,20 @@
 // The content-addressed cache: what the field key holds (and leaves out), exact round trips,
-// entries never replaced, damaged entries reported, stale staging removed, and the default
+// entries never replaced, damaged entries (checksums) moved aside and repaired, stale staging removed, and the default
 // root ($SDF_CACHE_DIR).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <optional>
 #include <string>
 
+#include "core/mesh/sha256.h"
 #include "harness/cache/content_cache.h"
+#include "harness/config/json_reader.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/atomic_file.h"
 #include "harness_test_util.h"
@@ -133,20 +138,87 @@ TEST_F(Cache, StoreThenLoadIsExactAndNeverReplaces) {
     EXPECT_EQ(entries, 0);
 }
 
-TEST_F(Cache, DamagedEntryIsReportedWithItsDirectory) {
+/// Damages the stored entry of `key` with `damage`, then checks that load() refuses it with
+/// a warning naming the entry and `why`, moves it aside, and that the next store/load repairs it.
+void expect_repaired(const FieldCache& cache, const json& key, const SampledField& f,
+                     const std::function<void(const fs::path&)>& damage, const std::string& why) {
+    if (!cache.contains(key)) {
+        ASSERT_TRUE(cache.store(key, f));
+    }  // else the previous case repaired it
+    ASSERT_TRUE(cache.load(key).has_value());
+    const fs::path dir = cache.entry_path(key);
+    damage(dir);
+    testing::internal::CaptureStderr();
+    EXPECT_FALSE(cache.load(key).has_value()) << why;
+    const std::string warning = testing::internal::GetCapturedStderr();
+    EXPECT_TRUE(Contains(warning, dir.string())) << warning;
+    EXPECT_TRUE(Contains(warning, why)) << warning;
+    EXPECT_TRUE(Contains(warning, "moved to")) << warning;
+    EXPECT_FALSE(fs::exists(dir));  // moved aside, so the entry can be filled again
+    int aside = 0;
+    for (const auto& e : fs::directory_iterator(dir.parent_path()))
+        aside += e.path().filename().string().rfind(dir.filename().string() + ".damaged-", 0) == 0;
+    EXPECT_GE(aside, 1);
+    ASSERT_TRUE(cache.store(key, f));
+    const std::optional<SampledField> back = cache.load(key);
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back->distance, f.distance);
+}
+
+TEST_F(Cache, DamagedEntriesAreMovedAsideNamedAndRepaired) {
     const FieldCache cache(dir_.string());
-    const Lattice l = lattice(LatticeType::CC, {2, 2, 2});
+    const Lattice l = lattice(LatticeType::CC, {2, 2, 3});
+    const SampledField f = field(l);
+    const json key = field_cache_key("m", l, SamplerOptions{});
+    auto flip_a_byte = [](const fs::path& file) {  // same size, one bit different
+        std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+        io.seekg(5);
+        const char c = char(io.get());
+        io.seekp(5);
+        io.put(char(c ^ 0x10));
+    };
+    expect_repaired(cache, key, f, [&](const fs::path& d) { flip_a_byte(d / "field.distance.raw"); },
+                    "field.distance.raw has SHA-256");
+    // NaN written over a gradient value: the bytes change, the size does not.
+    expect_repaired(cache, key, f, [&](const fs::path& d) {
+        std::fstream io(d / "field.gradient.raw", std::ios::in | std::ios::out | std::ios::binary);
+        const double nan = std::nan("");
+        io.write(reinterpret_cast<const char*>(&nan), sizeof nan);
+    }, "field.gradient.raw has SHA-256");
+    expect_repaired(cache, key, f, [](const fs::path& d) { fs::resize_file(d / "field.distance.raw", 3); },
+                    "field.distance.raw has 3 bytes");
+    expect_repaired(cache, key, f, [](const fs::path& d) { fs::remove(d / "field.json"); }, "field.json is missing");
+    // A missing entry.json: before, the directory blocked every store and the field was
+    // sampled again on every run; now it is repaired once.
+    expect_repaired(cache, key, f, [](const fs::path& d) { fs::remove(d / "entry.json"); }, "entry.json is missing");
+    expect_repaired(cache, key, f, [](const fs::path& d) { write_text_atomically((d / "entry.json").string(), "{", Overwrite::Allow); },
+                    "entry.json is unreadable");
+    // An entry of an older version, without checksums, cannot be verified.
+    expect_repaired(cache, key, f, [](const fs::path& d) {
+        json record = read_json_file((d / "entry.json").string());
+        record.erase("files");
+        write_text_atomically((d / "entry.json").string(), record.dump(), Overwrite::Allow);
+    }, "no file checksums");
+    expect_repaired(cache, key, f, [](const fs::path& d) { write_text_atomically((d / "extra.raw").string(), "x"); },
+                    "extra.raw is not part of the entry");
+}
+
+TEST_F(Cache, EntryRecordListsEveryFileWithItsChecksum) {
+    const FieldCache cache(dir_.string());
+    const Lattice l = lattice(LatticeType::BCC, {2, 2, 4});
     const json key = field_cache_key("m", l, SamplerOptions{});
     ASSERT_TRUE(cache.store(key, field(l)));
-    fs::resize_file(fs::path(cache.entry_path(key)) / "field.distance.raw", 3);
-    try {
-        cache.load(key);
-        FAIL() << "a damaged entry loaded";
-    } catch (const std::exception& e) {
-        EXPECT_TRUE(Contains(e.what(), cache.entry_path(key)));
-        EXPECT_TRUE(Contains(e.what(), "damaged"));
-        EXPECT_TRUE(Contains(e.what(), "--no-cache"));
+    const json files = ContentCache(dir_.string()).entry_record("fields", key).at("files");
+    for (const auto& e : fs::directory_iterator(cache.entry_path(key))) {
+        const std::string name = e.path().filename().string();
+        if (name == "entry.json") continue;
+        ASSERT_TRUE(files.contains(name)) << name;
+        EXPECT_EQ(files[name].at("bytes"), e.file_size());
+        EXPECT_EQ(files[name].at("sha256"), sha256_of_file(e.path().string()));
     }
+    EXPECT_EQ(ContentCache::verification_failure(cache.entry_path(key), key), "");
+    EXPECT_EQ(ContentCache::verification_failure(cache.entry_path(key), json{{"other", 1}}),
+              "entry.json does not hold the key of this entry");
 }
 
 TEST_F(Cache, ContentCacheStoreRemovesStaleStagingAndWritesEntryRecord) {
