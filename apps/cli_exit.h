@@ -9,6 +9,8 @@
 namespace sdf {
 
 constexpr int kExitCommandLineError = 2;
+/// run-experiment: a mesh the config names is on no directory of the data search path.
+constexpr int kExitMeshNotFound = 4;
 
 /// Prints CLI11's message (or the help) as CLI11 does; returns the tool's exit code.
 inline int command_line_exit(const CLI::App& app, const CLI::ParseError& e) {

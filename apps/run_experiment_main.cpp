@@ -12,6 +12,7 @@
 
 #include "core/parallel/progress.h"
 #include "experiments/experiment_registry.h"
+#include "harness/config/mesh_spec.h"
 #include "harness/runner/runner.h"
 
 int main(int argc, char** argv) {
@@ -46,6 +47,9 @@ int main(int argc, char** argv) {
         if (!check_run.empty()) return sdf::check_stored_run(check_run, options.baseline);
         if (!make_baseline.empty()) return sdf::write_baseline(make_baseline, options.baseline, force);
         return sdf::run_experiment(options);
+    } catch (const sdf::MeshFileNotFound& e) {
+        std::cerr << "run-experiment: error: " << e.what() << "\n";
+        return sdf::kExitMeshNotFound;
     } catch (const std::exception& e) {
         std::cerr << "run-experiment: error: " << e.what() << "\n";
         return 1;

@@ -191,7 +191,7 @@ std::string locate_mesh_file(const std::string& name, const std::vector<std::str
         const std::string kind = file_kind(c.string());
         places += "\n  " + c.string() + (kind == "missing" ? "" : " (" + kind + ", not a regular file)");
     }
-    throw std::runtime_error("mesh '" + name + "' not found; tried, in order:" + places +
+    throw MeshFileNotFound("mesh '" + name + "' not found; tried, in order:" + places +
                              "\nSet SDF_DATA_PATH or the config key \"data_path\", or run scripts/fetch-meshes.");
 }
 
@@ -199,6 +199,8 @@ void resolve_mesh_file(MeshSpec& spec, const std::vector<std::string>& search_pa
     if (spec.file.empty() || !spec.resolved_file.empty()) return;
     try {
         spec.resolved_file = locate_mesh_file(spec.file, search_path, base_dir);
+    } catch (const MeshFileNotFound& e) {
+        throw MeshFileNotFound(spec.config_file + ": key '" + spec.key_path + "': " + e.what());
     } catch (const std::exception& e) {
         throw ConfigError(spec.config_file + ": key '" + spec.key_path + "': " + e.what());
     }

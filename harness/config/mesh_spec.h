@@ -36,6 +36,14 @@ struct MeshSpec {
     std::string label() const { return shape.empty() ? file : shape; }
 };
 
+/// A mesh file that is on no directory of the search path. Its own type so that
+/// run-experiment can exit with its own code (README, "Exit codes") and scripts/run-main can
+/// fall back to the procedural study when the real meshes were never fetched.
+class MeshFileNotFound : public ConfigError {
+public:
+    using ConfigError::ConfigError;
+};
+
 /// Parses r[key] (a string or an object); checks shape names and parameters.
 MeshSpec parse_mesh_spec(JsonReader& r, const std::string& key);
 /// Parses "shape:NAME" or a file name, as given on a command line; checks shape names.

@@ -578,6 +578,26 @@ TEST_F(MeshFiles, NotFoundListsDirectoriesAndFetchScript) {
     EXPECT_TRUE(Contains(error_of([&] { load_mesh(mesh_spec("dragon_missing.obj"), path); }), "scripts/fetch-meshes"));
 }
 
+// scripts/run-main falls back to the procedural study on exactly this error (run-experiment
+// exits 4 for it), so it must keep its own type through resolve_mesh_file, with the key named.
+TEST_F(MeshFiles, NotFoundHasItsOwnTypeNamingTheKey) {
+    const std::vector<std::string> path = {(dir_ / "one").string()};
+    EXPECT_THROW(locate_mesh_file("dragon_missing.obj", path), MeshFileNotFound);
+    MeshSpec spec = mesh_spec("dragon_missing.obj");
+    spec.config_file = "study.json";
+    try {
+        resolve_mesh_file(spec, path, "");
+        ADD_FAILURE() << "no exception";
+    } catch (const MeshFileNotFound& e) {
+        EXPECT_TRUE(Contains(e.what(), "study.json: key 'mesh'"));
+        EXPECT_TRUE(Contains(e.what(), "dragon_missing.obj"));
+    }
+    // A file that exists but is not a mesh is a different error (exit 1, not the fallback).
+    write("one/bad.obj", "v 0 0 0\n");
+    MeshSpec found = mesh_spec("bad.obj");
+    EXPECT_NO_THROW(resolve_mesh_file(found, path, ""));
+}
+
 TEST_F(MeshFiles, AbsoluteMissingOrDirectoryNamesTheFile) {
     const std::string missing = (dir_ / "nope.obj").string();
     EXPECT_TRUE(Contains(error_of([&] { locate_mesh_file(missing, {}); }), missing));
