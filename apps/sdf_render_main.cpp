@@ -33,6 +33,7 @@
 #include "harness/io/field_file.h"
 #include "harness/provenance/provenance.h"
 #include "harness/render/image_io.h"
+#include "harness/resources/memory_budget.h"
 #include "harness/render/thesis_figure.h"
 #include "harness/sampling/sampler_table.h"
 
@@ -285,6 +286,20 @@ int run_grid(const Options& o, const nlohmann::json& resolved) {
 
 }  // namespace
 
+/// Host memory of the images (memory_budget.h): measured 67 bytes per pixel of one image
+/// (peak RSS at 1024^2 and 3072^2), rounded up to 96; a grid holds every panel until the
+/// figure is composed (at most 16 panels: two lattices' reconstructions, the reference row
+/// and the heat maps) plus the figure itself.
+MemoryNeed render_memory_need(const Options& o) {
+    const uint64_t w = uint64_t(o.size[0]), h = uint64_t(o.size.size() > 1 ? o.size[1] : o.size[0]);
+    const uint64_t images = o.grid ? 17 : 1;
+    MemoryNeed need;
+    need.host_bytes = kBaseBytes + w * h * 96 * images;  // <= 16384^2 * 96 * 17: no overflow
+    need.what = std::string(o.grid ? "a grid of " : "an image of ") + std::to_string(w) + "x" + std::to_string(h) +
+                (o.grid ? " pixel panels" : " pixels");
+    return need;
+}
+
 int main(int argc, char** argv) {
     CLI::App app{"Ray-casts reconstructed distance fields (docs/raycast.md): one image per view, or the thesis grid."};
     Options o;
@@ -322,7 +337,11 @@ int main(int argc, char** argv) {
             },
             "(0, 180)"))
         ->capture_default_str();
-    app.add_option("--size", o.size, "image size W[,H]")->delimiter(',')->expected(1, 2)->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--size", o.size, "image size W[,H], each in 1..16384 (as in configs)")
+        ->delimiter(',')
+        ->expected(1, 2)
+        ->check(CLI::Range(1, 16384))
+        ->capture_default_str();
     app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
     app.add_option("--precision", o.precision, "cpu casting precision")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
     app.add_option("--threads", o.threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -359,6 +378,7 @@ int main(int argc, char** argv) {
     o.up_given = app.count("--up") > 0;
     try {
         if (o.quiet) ProgressReporter::set_globally_enabled(false);
+        require_host_memory(render_memory_need(o), "");
         // Every option's value (defaults included) as CLI11 writes a config file: the
         // "config" whose SHA-256 is the images' config_hash
         const nlohmann::json resolved = app.config_to_str(true, false);

@@ -88,6 +88,11 @@ public:
         figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
     }
 
+    MemoryNeed memory_need(const RunContext&) const override {
+        // Every lattice's field and reconstructions are alive until the figures are drawn.
+        return lattice_memory_need(inputs_, kReconstructionBytesPerPoint, /*all_at_once=*/true, "reconstructing");
+    }
+
     std::vector<std::string> plan(const RunContext& ctx) const override {
         std::ostringstream quiet;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, quiet);

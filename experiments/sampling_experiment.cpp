@@ -31,6 +31,11 @@ public:
         out.finish();
     }
 
+    MemoryNeed memory_need(const RunContext&) const override {
+        // One lattice at a time: each field is written and released before the next.
+        return lattice_memory_need(inputs_, kSamplingBytesPerPoint, /*all_at_once=*/false, "sampling");
+    }
+
     std::vector<std::string> plan(const RunContext& ctx) const override {
         std::ostringstream quiet;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, quiet);

@@ -99,3 +99,31 @@ std::string with_commas(int64_t v) {
 }
 
 }  // namespace sdf
+
+namespace sdf {
+
+MemoryNeed lattice_memory_need(const StudyInputs& in, uint64_t bytes_per_point, bool all_at_once, const std::string& step) {
+    MemoryNeed need;
+    uint64_t points = 0;  // per-spec counts fit in int64 (parse_lattice_spec checks them)
+    std::string which;
+    for (size_t i = 0; i < in.lattices.size(); ++i) {
+        Lattice l;
+        l.type = in.lattices[i].type;
+        l.resolution = lattice_spec_resolution(in.lattices[i]);
+        const uint64_t n = uint64_t(l.num_points());
+        if (all_at_once) {
+            points += n;
+        } else if (n > points) {
+            points = n;
+            which = " " + lattice_spec_notation(in.lattices[i]);
+        }
+    }
+    // Saturate instead of wrapping: a lattice of 2^60 points "needs" more than any machine has.
+    const uint64_t per_point = points > (UINT64_MAX - kBaseBytes) / bytes_per_point ? UINT64_MAX - kBaseBytes
+                                                                                     : points * bytes_per_point;
+    need.host_bytes = kBaseBytes + per_point;
+    need.what = step + which + " (" + with_commas(int64_t(points)) + " points" + (all_at_once ? " in all" : "") + ")";
+    return need;
+}
+
+}  // namespace sdf

@@ -33,6 +33,11 @@ struct StudyInputs {
 /// lattice given and their names unique, and the sampler's backend present on this machine.
 StudyInputs read_study_inputs(JsonReader& config, const RunContext& context, bool lattices_required = true);
 
+/// The host memory of a study over `in.lattices` (memory_budget.h): kBaseBytes plus
+/// `bytes_per_point` times the largest lattice's points, or their sum when the study holds
+/// every lattice's field at once (`all_at_once`).
+MemoryNeed lattice_memory_need(const StudyInputs& in, uint64_t bytes_per_point, bool all_at_once, const std::string& step);
+
 /// Reads "data_path" and returns the search path it makes (mesh_spec.h).
 std::vector<std::string> read_search_path(JsonReader& config, const RunContext& context);
 /// Reads the optional "domain" object; returns its margin.

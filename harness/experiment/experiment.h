@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/config/json_reader.h"
+#include "harness/resources/memory_budget.h"
 
 namespace sdf {
 
@@ -49,6 +50,10 @@ public:
     /// The plan for --dry-run: one line per step, with the cache's hits and misses (this may
     /// load the mesh to place the lattices), and TODO lines for what is not built yet.
     virtual std::vector<std::string> plan(const RunContext& context) const = 0;
+    /// The host memory its largest step needs (memory_budget.h): the runner refuses a run
+    /// that does not fit before anything is computed, and --dry-run shows it. Known from the
+    /// configuration alone (no mesh loaded). Default: not estimated.
+    virtual MemoryNeed memory_need(const RunContext&) const { return {}; }
     /// Does the work; writes files under context.output_dir, results into context.metrics.
     virtual void run(RunContext& context) = 0;
 };

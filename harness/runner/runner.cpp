@@ -93,11 +93,23 @@ std::vector<PlannedRun> configure_runs(const LoadedConfig& config, const RunnerO
     return runs;
 }
 
+/// The run's peak host memory: runs (sweep points) execute one after the other.
+MemoryNeed largest_memory_need(const std::vector<PlannedRun>& runs) {
+    MemoryNeed largest;
+    for (const PlannedRun& r : runs) {
+        MemoryNeed n = r.experiment->memory_need(r.context);
+        if (runs.size() > 1 && n.host_bytes) n.what += " in " + r.point.name;
+        if (n.host_bytes > largest.host_bytes) largest = std::move(n);
+    }
+    return largest;
+}
+
 void print_plan(const LoadedConfig& config, const std::vector<PlannedRun>& runs, const std::string& hash,
                 const RunnerOptions& options, const std::string& cache_root) {
     std::cout << "plan for " << config.label() << " (kind " << runs[0].kind << ", " << runs.size()
               << (runs.size() == 1 ? " run" : " runs") << ", config " << hash.substr(0, 12) << "):\n";
     std::cout << "  cache: " << (options.no_cache ? "off (--no-cache: everything is sampled again)" : cache_root) << "\n";
+    std::cout << "  memory: " << describe_memory_need(largest_memory_need(runs)) << "\n";
     for (size_t i = 0; i < runs.size(); ++i) {
         const PlannedRun& r = runs[i];
         if (runs.size() > 1)
@@ -204,6 +216,8 @@ int run_experiment(const RunnerOptions& options) {
         print_plan(config, runs, hash, options, cache_root);
         return 0;
     }
+    // Before the run directory exists or anything is sampled (issue 11, class 5).
+    require_host_memory(largest_memory_need(runs), config.label());
 
     const std::string started = utc_timestamp();
     const nlohmann::json load_at_start = load_average();

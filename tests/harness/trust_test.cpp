@@ -273,6 +273,50 @@ TEST_F(Trust, OverflowingLatticeIsRefusedBeforeAnythingIsPlannedOrCached) {
     EXPECT_TRUE(Contains(big.err, "has 125000000000 points, more than the largest lattice sampled"));
 }
 
+// ---- 5. memory: estimated in the plan, refused up front -----------------------------------
+
+TEST_F(Trust, RunThatDoesNotFitInMemoryIsRefusedBeforeSampling) {
+    // Before: std::bad_alloc (or the OOM killer) after sampling had started; --dry-run said
+    // nothing. 1000^3 points need about 60 GiB; the machine is told it has 1 GiB.
+    const std::string c = config("m.json", "shape:box", "[1000, 1000, 1000]");
+    const std::string one_gib = "SDF_MEMORY_AVAILABLE=1073741824 ";
+    const ShellResult plan = run(RUN_EXPERIMENT_EXE, c + " --dry-run");  // the real figure: a plan line
+    EXPECT_EQ(plan.code, 0) << plan.err;
+    EXPECT_TRUE(Contains(plan.out, "memory: about 60.1 GiB of host memory for sampling cc 1000x1000x1000 "
+                                   "(1,000,000,000 points)"))
+        << plan.out;
+    const ShellResult dry = test::run_in(dir_, one_gib + "SDF_CACHE_DIR=" + quote(at("cache")) + " " +
+                                                   quote(RUN_EXPERIMENT_EXE) + " " + c + " --dry-run");
+    EXPECT_EQ(dry.code, 0);
+    EXPECT_TRUE(Contains(dry.out, "1 GiB available (the run would be refused)")) << dry.out;
+    const ShellResult r = test::run_in(dir_, one_gib + "SDF_CACHE_DIR=" + quote(at("cache")) + " " +
+                                                 quote(RUN_EXPERIMENT_EXE) + " " + c);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "m.json: sampling cc 1000x1000x1000 (1,000,000,000 points) needs about 60.1 GiB of "
+                                "host memory, and 1 GiB is available; nothing was computed"))
+        << r.err;
+    EXPECT_FALSE(fs::exists(at("results")));
+    EXPECT_FALSE(fs::exists(at("cache")) && !fs::is_empty(at("cache")));
+    // A small run passes the same check.
+    const ShellResult small = test::run_in(dir_, one_gib + "SDF_CACHE_DIR=" + quote(at("cache")) + " " +
+                                                     quote(RUN_EXPERIMENT_EXE) + " " + config("s.json", "shape:box") +
+                                                     " --quiet");
+    EXPECT_EQ(small.code, 0) << small.err;
+}
+
+TEST_F(Trust, RenderLargerThanMemoryIsRefusedWithTheFigure) {
+    const ShellResult huge = render("shape:sphere --size 100000 --out x.pfm");
+    EXPECT_EQ(huge.code, 2);  // beyond 16384, the configs' limit too
+    EXPECT_TRUE(Contains(huge.err, "--size: Value 100000 not in range 1 to 16384"));
+    const ShellResult grid = test::run_in(dir_, "SDF_MEMORY_AVAILABLE=1073741824 " + quote(SDF_RENDER_EXE) +
+                                                    " shape:sphere --grid --size 8192 --out-dir g");
+    EXPECT_EQ(grid.code, 1);
+    EXPECT_TRUE(Contains(grid.err, "a grid of 8192x8192 pixel panels needs about 102 GiB of host memory, and 1 GiB is "
+                                   "available; nothing was computed"))
+        << grid.err;
+    EXPECT_FALSE(fs::exists(at("g")));
+}
+
 TEST_F(Trust, FieldHeaderWithAnOverflowingResolutionIsRefused) {
     write("p.txt", "0 0 0\n");
     const ShellResult r =

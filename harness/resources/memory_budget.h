@@ -1,0 +1,47 @@
+/// @file memory_budget.h
+/// @brief What a run will need in host memory, estimated before anything is allocated, and a
+/// refusal with the figures when the machine does not have it (instead of std::bad_alloc, or
+/// the kernel's OOM killer, after minutes of sampling).
+///
+/// Estimates are affine in the points a step holds at once: a fixed part (libraries, the
+/// mesh, threads) plus bytes per lattice point, with constants measured as peak resident
+/// memory of the tools at two sizes (docs/harness.md, "Memory"). They are meant to be
+/// generous, not exact: a run that fits by a small margin is let through, a run several
+/// times too large is refused up front with what it needs and what is available. GPU memory
+/// is not estimated: the CUDA samplers cut lattices into pieces sized to free device memory.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace sdf {
+
+struct MemoryNeed {
+    uint64_t host_bytes = 0;  ///< 0: not estimated
+    std::string what;         ///< the step that needs it, e.g. "sampling cc 80x80x80 (512,000 points)"
+};
+
+/// Measured peak resident bytes per lattice point (sphere mesh, CPU BVH, CC 48^3 and 96^3),
+/// rounded up with headroom: a sampling step holds the field (distance, gradient, closest
+/// triangle in double/int32) and the sampler's float results; a reconstruction step also
+/// holds the reconstructions' coefficient arrays and derivative fields.
+constexpr uint64_t kSamplingBytesPerPoint = 64;
+constexpr uint64_t kReconstructionBytesPerPoint = 256;
+/// The fixed part: libraries, thread stacks, a mesh of up to a few 100k triangles and its BVH.
+constexpr uint64_t kBaseBytes = 512ull << 20;
+
+/// "1.5 GiB", "512 MiB", "12 KiB", "300 B".
+std::string format_bytes(uint64_t bytes);
+
+/// Host memory a new allocation can get: $SDF_MEMORY_AVAILABLE (bytes; for tests and to
+/// leave room for other work), else MemAvailable of /proc/meminfo; 0 when unknown.
+uint64_t host_memory_available();
+
+/// "about 1.2 GiB of host memory for sampling cc ...; 20 GiB available" (or "unknown").
+std::string describe_memory_need(const MemoryNeed& need);
+
+/// Throws std::runtime_error naming `where` (when not empty), the step, what it needs and what is available,
+/// when the need is known and exceeds what is available.
+void require_host_memory(const MemoryNeed& need, const std::string& where);
+
+}  // namespace sdf
