@@ -240,7 +240,7 @@ private:
             if (!bcc && f.lattice.type == LatticeType::BCC) bcc = &f;
         }
         const FigureOptions options = figure_options(*render_);
-        const nlohmann::json provenance = {{"run", ctx.output_dir}, {"git", machine_and_build()["git"]}};
+        const nlohmann::json provenance = {{"run", ctx.run_id}, {"git", machine_and_build()["git"]}};
         for (const ViewRequest& view : render_->views) {
             const CameraSpec camera = resolve_view(view, mesh.vertices(), render_->width, render_->height);
             *ctx.log << "  rendering view " << view.name << " (" << render_->width << "x" << render_->height << ")\n";

@@ -33,6 +33,8 @@ struct RunContext {
     std::string config_dir;   ///< absolute: the base of relative paths in the config
     std::string run_name;     ///< the config's name, or the sweep point's
     std::string output_dir;   ///< the (staged) directory to write into
+    std::string run_id;       ///< "<name>/<run-id>": the run's final name, for files' metadata
+                              ///< (output_dir is a staging directory until the run is complete)
     nlohmann::json metrics = nlohmann::json::object();  ///< results; written to metrics.json
     nlohmann::json inputs = nlohmann::json::object();   ///< input hashes for the manifest
     std::ostream* log = nullptr;        ///< human-readable progress and summary (stdout)

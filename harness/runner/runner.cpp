@@ -227,14 +227,29 @@ int run_experiment(const RunnerOptions& options) {
     remove_stale_staging(parent.string());
     // Run ids: UTC time to the millisecond and the config hash; a suffix when still taken.
     const std::string id_base = compact_utc_timestamp() + "-" + hash.substr(0, 8);
+    // The id is reserved (an atomic mkdir) before the run starts, so that what the run writes
+    // into its files (images' metadata) names the directory it will have: a concurrent run of
+    // the same config in the same millisecond takes the next suffix instead of racing for the
+    // final rename.
     std::string run_id = id_base;
     int suffix = 1;
-    while (fs::exists(parent / run_id)) run_id = id_base + "-" + std::to_string(++suffix);
+    auto reservation = [&](const std::string& id) { return parent / ("." + id + ".reserved"); };
+    while (fs::exists(parent / run_id) || !fs::create_directory(reservation(run_id)))
+        run_id = id_base + "-" + std::to_string(++suffix);
+    const std::string reserved_id = run_id;
+    struct Unreserve {
+        fs::path path;
+        ~Unreserve() {
+            std::error_code ec;
+            fs::remove(path, ec);
+        }
+    } unreserve{reservation(reserved_id)};
     StagedDirectory out((parent / run_id).string());
     std::cout << "run " << name << "/" << run_id << " (kind " << runs[0].kind << (runs.size() > 1 ? ", " + std::to_string(runs.size()) + " sweep points" : std::string()) << ")" << std::endl;
     for (size_t i = 0; i < runs.size(); ++i) {
         RunContext& ctx = runs[i].context;
         ctx.output_dir = runs.size() == 1 ? out.path() : (fs::path(out.path()) / runs[i].point.name).string();
+        ctx.run_id = name + "/" + run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
         if (runs.size() > 1)
             std::cout << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
         runs[i].experiment->run(ctx);

@@ -463,5 +463,28 @@ TEST_F(Trust, ReconstructionStudyThatPlacesNoProbeFails) {
     EXPECT_EQ(ok.code, 0) << ok.out << ok.err;
 }
 
+TEST_F(Trust, ImageMetadataNamesTheFinalRunNotItsStagingDirectory) {
+    // Before: the images' provenance "run" was the hidden staging directory's path.
+    write("pics.json", R"({"name": "pics", "kind": "reconstruction", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [6, 6, 6]}, {"type": "bcc", "resolution": [5, 5, 10]}],
+        "sampler": {"threads": 1, "progress": false},
+        "metrics": {"domain_probes": 20, "band_probes": 20, "band": 1},
+        "render": {"size": [24, 24], "views": ["front"]}})");
+    const ShellResult r = experiment("pics.json --no-cache --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    std::vector<fs::path> runs;
+    for (const auto& e : fs::directory_iterator(at("out/pics"))) runs.push_back(e.path());
+    ASSERT_EQ(runs.size(), 1u);  // the run, and no reservation or staging left behind
+    const std::string id = runs[0].filename().string();
+    int summaries = 0;
+    for (const auto& e : fs::recursive_directory_iterator(runs[0])) {
+        if (e.path().string().find("_summary.json") == std::string::npos) continue;
+        ++summaries;
+        const nlohmann::json summary = read_json_file(e.path().string());
+        EXPECT_EQ(summary.at("provenance").at("run"), "pics/" + id) << e.path();
+    }
+    EXPECT_GE(summaries, 1);
+}
+
 }  // namespace
 }  // namespace sdf
