@@ -90,6 +90,7 @@ public:
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        require_search_range(mesh, points, options_.precision);
         return options_.precision == Precision::Float ? query_as<float>(mesh, points) : query_as<double>(mesh, points);
     }
 
@@ -180,7 +181,7 @@ private:
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        SampledField field = unfilled_field(lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, options_.precision);
         auto sink = [&](const PieceResults::Host& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);

@@ -305,6 +305,7 @@ public:
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        require_search_range(mesh, points, options_.precision);
         return options_.precision == Precision::Float ? query_as<float>(mesh, points) : query_as<double>(mesh, points);
     }
 
@@ -314,7 +315,7 @@ private:
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, options_.precision);
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };

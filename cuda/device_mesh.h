@@ -18,6 +18,8 @@ public:
         edge_normals_.upload(host.edge_normals, stream);
         vertex_normals_.upload(host.vertex_normals, stream);
         num_vertices_ = int(host.vertices.size());
+        box_lo_ = host.box_lo;
+        box_hi_ = host.box_hi;
     }
 
     /// Device bytes needed for `triangles` triangles and `vertices` vertices (without packed data).
@@ -35,6 +37,8 @@ public:
         v.packed = packed;
         v.num_triangles = num_triangles_;
         v.num_vertices = num_vertices_;
+        v.box_lo = box_lo_;
+        v.box_hi = box_hi_;
         return v;
     }
 
@@ -42,6 +46,7 @@ private:
     DeviceBuffer<Vec3<T>> vertices_, face_normals_, edge_normals_, vertex_normals_;
     DeviceBuffer<Int3> triangles_;
     int num_triangles_ = 0, num_vertices_ = 0;
+    Vec3<T> box_lo_{}, box_hi_{};
 };
 
 }  // namespace sdf::cuda

@@ -94,6 +94,11 @@ std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m) {
     b->edge_normals = convert<T>(m.edge_normals());
     b->vertex_normals = convert<T>(m.vertex_normals());
     b->triangles = m.triangles();
+    if (!b->vertices.empty()) b->box_lo = b->box_hi = b->vertices.front();
+    for (const Vec3<T>& v : b->vertices) {
+        b->box_lo = {std::min(b->box_lo.x, v.x), std::min(b->box_lo.y, v.y), std::min(b->box_lo.z, v.z)};
+        b->box_hi = {std::max(b->box_hi.x, v.x), std::max(b->box_hi.y, v.y), std::max(b->box_hi.z, v.z)};
+    }
     b->packed.reserve(m.triangles().size());
     for (const Int3& t : m.triangles())
         b->packed.push_back(pack_triangle<T>(m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
@@ -275,6 +280,8 @@ MeshView<T> MeshBuffers<T>::view() const {
     v.packed = packed.data();
     v.num_triangles = int(triangles.size());
     v.num_vertices = int(vertices.size());
+    v.box_lo = box_lo;
+    v.box_hi = box_hi;
     return v;
 }
 

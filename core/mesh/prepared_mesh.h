@@ -54,6 +54,7 @@ struct MeshBuffers {
     std::vector<Vec3<T>> vertices, face_normals, edge_normals, vertex_normals;
     std::vector<Int3> triangles;
     std::vector<PackedTriangle<T>> packed;
+    Vec3<T> box_lo{}, box_hi{};  ///< of `vertices` (as converted to T)
     MeshView<T> view() const;
 };
 

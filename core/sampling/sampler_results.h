@@ -15,11 +15,15 @@
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler.h"
 #include "core/sampling/sampler_sign.h"
+#include "core/sampling/search_range.h"
 
 namespace sdf {
 
-/// A field on `lattice` with every point unset (distance 0, triangle -1), to be filled.
-inline SampledField unfilled_field(const Lattice& lattice, Precision precision) {
+/// A field on `lattice` with every point unset (distance 0, triangle -1), to be filled;
+/// throws first when the mesh or the lattice is beyond what the search answers
+/// (search_range.h).
+inline SampledField unfilled_field(const PreparedMesh& mesh, const Lattice& lattice, Precision precision) {
+    require_search_range(mesh, lattice, precision);
     SampledField field;
     field.lattice = lattice;
     field.precision = precision;

@@ -134,6 +134,7 @@ public:
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        require_search_range(mesh, points, options_.precision);
         std::vector<PointSample> out(points.size());
         bool built = false;
         const auto bvh = cache_.get(mesh, built);
@@ -163,7 +164,7 @@ private:
         const auto bvh = cache_.get(mesh, built);
         sign_.prepare(mesh, bvh);  // shares the BVH: only the winding moments are added
         const auto query_start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, options_.precision);
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;

@@ -62,6 +62,7 @@ public:
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
+        require_search_range(mesh, points, options_.precision);
         std::vector<PointSample> out(points.size());
         sign_.prepare(mesh);
         auto run = [&](auto zero) {
@@ -83,7 +84,7 @@ private:
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
         const auto start = std::chrono::steady_clock::now();
         sign_.prepare(mesh);
-        SampledField field = unfilled_field(lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, options_.precision);
         GridBlock blocks[2];
         const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
         int64_t computed = 0;

@@ -4,7 +4,8 @@
 ///
 /// Sign: Baerentzen & Aanaes, "Signed distance computation using the angle weighted
 /// pseudonormal" (2005): with C the closest point and N the angle-weighted pseudonormal of
-/// the feature (face, edge or vertex) that holds C, P is outside iff (P - C) . N >= 0.
+/// the feature (face, edge or vertex) that holds C, P is outside iff (P - C) . N >= 0; a point
+/// outside the mesh's bounding box is outside whatever N says (MeshView::box_lo).
 /// Negative inside (DESIGN.md). Gradient (thesis section 3.4): the unit vector from C to P
 /// times the sign; at distance 0 it is the feature's pseudonormal.
 #pragma once
@@ -38,7 +39,7 @@ SDF_CPU_GPU SignedDistanceSample<T> signed_sample(const MeshView<T>& mesh, const
     const Vec3<T> n = feature_pseudonormal(mesh, triangle, feature);
     const Vec3<T> away = p - closest;
     const T dist = std::sqrt(length_squared(away));
-    const bool inside = dot(away, n) < T(0);
+    const bool inside = !mesh.outside_box(p) && dot(away, n) < T(0);
 
     SignedDistanceSample<T> r;
     r.distance = inside ? -dist : dist;

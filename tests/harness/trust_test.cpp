@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -271,6 +272,86 @@ TEST_F(Trust, OverflowingLatticeIsRefusedBeforeAnythingIsPlannedOrCached) {
     const ShellResult big = experiment(config("d.json", "shape:box", "[5000, 5000, 5000]") + " --dry-run");
     EXPECT_EQ(big.code, 1);
     EXPECT_TRUE(Contains(big.err, "has 125000000000 points, more than the largest lattice sampled"));
+}
+
+// ---- 2. far points and extreme scales ------------------------------------------------------
+
+/// The tetrahedron scaled by 2^k, written with 17 digits so that its coordinates round-trip.
+std::string scaled_tetra_obj(int k) {
+    char v[64];
+    std::snprintf(v, sizeof v, "%.17g", std::ldexp(1.0, k));
+    const std::string s = v;
+    return "v 0 0 0\nv " + s + " 0 0\nv 0 " + s + " 0\nv 0 0 " + s + "\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+}
+
+TEST_F(Trust, FarPointsGetTheOutsideSignAndDistancesToTheirPrecision) {
+    // Before: 3e7 unit-sphere sizes away the float search picked a triangle on the far side
+    // and printed a negative distance; at 1e20 the vectorised float kernel crashed.
+    write("far.txt", "3e7 0 0\n0 -3e8 1\n2e9 2e9 -2e9\n1e15 0 0\n");
+    const ShellResult f = query("shape:sphere far.txt");
+    const ShellResult d = query("shape:sphere far.txt --precision double");
+    ASSERT_EQ(f.code, 0) << f.err;
+    ASSERT_EQ(d.code, 0) << d.err;
+    const std::vector<double> df = distances(f.out), dd = distances(d.out);
+    ASSERT_EQ(df.size(), 4u);
+    ASSERT_EQ(dd.size(), 4u);
+    for (size_t i = 0; i < 4; ++i) {
+        EXPECT_GT(df[i], 0) << i;
+        EXPECT_GT(dd[i], 0) << i;
+        // The float search may tie triangles whose squared distances round alike: the error
+        // stays within two units of float's relative rounding.
+        EXPECT_LE(std::abs(df[i] - dd[i]), dd[i] * std::ldexp(1.0, -23)) << i;
+    }
+    EXPECT_NEAR(dd[0], 3e7 - 1, 1e-6 * 3e7);
+    // Beyond the float search's range: refused, naming the point; double answers.
+    write("farther.txt", "0 0 0\n1e20 0 0\n");
+    const ShellResult refused = query("shape:sphere farther.txt");
+    EXPECT_EQ(refused.code, 1);
+    EXPECT_TRUE(Contains(refused.err, "query point 2 has a coordinate of magnitude 1e+20, beyond the float search's "
+                                      "range of 1.15e+18"))
+        << refused.err;
+    EXPECT_TRUE(Contains(refused.err, "use precision double"));
+    const ShellResult far_double = query("shape:sphere farther.txt --precision double");
+    ASSERT_EQ(far_double.code, 0) << far_double.err;
+    EXPECT_EQ(distances(far_double.out).at(1), 1e20);
+    EXPECT_EQ(query("shape:sphere far.txt").out, f.out);  // identical runs, identical bits
+}
+
+TEST_F(Trust, TinyAndHugeMeshesAreExactInDoubleAndRefusedInFloat) {
+    // Power-of-two scales are exact in binary floating point, so the double distances of the
+    // scaled tetrahedron are the unit one's times 2^k, bit for bit.
+    write("unit.obj", scaled_tetra_obj(0));
+    write("p.txt", kPointsText);
+    const std::vector<double> unit = distances(query("unit.obj p.txt --precision double").out);
+    ASSERT_EQ(unit.size(), 2u);
+    for (int k : {-70, -66, 66, 120}) {
+        const std::string name = "t" + std::to_string(k) + ".obj";
+        write(name, scaled_tetra_obj(k));
+        char points[128];
+        std::snprintf(points, sizeof points, "%.17g %.17g %.17g\n%.17g 0 0\n", std::ldexp(0.2, k), std::ldexp(0.2, k),
+                      std::ldexp(0.2, k), std::ldexp(3.0, k));
+        write("p" + std::to_string(k) + ".txt", points);
+        const ShellResult d = query(name + " p" + std::to_string(k) + ".txt --precision double");
+        ASSERT_EQ(d.code, 0) << k << d.err;
+        const std::vector<double> got = distances(d.out);
+        ASSERT_EQ(got.size(), 2u);
+        EXPECT_EQ(got[0], std::ldexp(unit[0], k)) << k;
+        EXPECT_EQ(got[1], std::ldexp(unit[1], k)) << k;
+        // Float: 2^-70 and 2^-66 across are below 2^-40 (squared distances would underflow),
+        // 2^66 and 2^120 beyond 2^60 (they would overflow). Before: distances off by 1-2x.
+        const ShellResult f = query(name + " p" + std::to_string(k) + ".txt");
+        EXPECT_EQ(f.code, 1) << k << f.out;
+        EXPECT_TRUE(Contains(f.err, "mesh '")) << f.err;
+        EXPECT_TRUE(Contains(f.err, name)) << f.err;
+        EXPECT_TRUE(Contains(f.err, k < 0 ? "below the float search's smallest extent" : "beyond the float search's range"))
+            << f.err;
+    }
+    // A lattice study of a mesh out of float range is refused before anything is sampled.
+    const ShellResult r = experiment(config("c.json", "t-70.obj") + " --output-root out --quiet");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "below the float search's smallest extent")) << r.err;
+    EXPECT_FALSE(fs::exists(at("out/trust")) && !fs::is_empty(at("out/trust")));
+    EXPECT_FALSE(fs::exists(at("cache/fields")) && !fs::is_empty(at("cache/fields")));
 }
 
 // ---- 5. memory: estimated in the plan, refused up front -----------------------------------

@@ -1,0 +1,38 @@
+/// @file search_range.h
+/// @brief The coordinates a nearest-triangle search can answer to its precision, and a
+/// refusal, naming the mesh or the query, for everything beyond (issue 11, class 2).
+///
+/// Every search compares squared distances. In float they overflow beyond 2^64 and lose
+/// their relative precision to underflow below 2^-126 (about 1e-38): a point 1e20 from the
+/// origin, or a mesh of coordinates 1e20..1e38, gave infinities that no triangle could beat
+/// (a crash), and a mesh 1e-20 across gave squared distances in the denormals, where the
+/// nearest triangle is lost (distances off by factors of 1-2). The float search is therefore
+/// limited to coordinates of magnitude at most 2^60 (squared distances at most 2^124) and to
+/// meshes at least 2^-40 across (squared distances of a millionth of the mesh still 2^-120
+/// and normal); double to 2^500 and 2^-450. Within these ranges the search picks the nearest
+/// triangle up to the precision's rounding of the coordinates, and the winner is evaluated in
+/// double, so the distance is exact for it; the sign of a point outside the mesh's bounding
+/// box is "outside" (MeshView::box_lo), which far from the mesh is where the search cannot
+/// tell the nearest triangle from one on the far side.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/mesh/prepared_mesh.h"
+#include "core/sampling/sampled_field.h"
+
+namespace sdf {
+
+/// The largest coordinate magnitude and the smallest mesh extent a search in `precision`
+/// answers.
+double largest_search_coordinate(Precision precision);
+double smallest_search_extent(Precision precision);
+
+/// Throws std::invalid_argument unless the mesh and the lattice's points are in range.
+void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Precision precision);
+/// Throws std::invalid_argument unless the mesh and every point are in range (and finite),
+/// naming the first point that is not.
+void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision);
+
+}  // namespace sdf
