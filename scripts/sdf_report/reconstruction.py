@@ -88,7 +88,7 @@ def panel_label(panel, panels):
         label = label[len(panel["letter"]):].strip()
     interpolator, _, derivatives = panel["render"]["reconstruction"].partition("/")
     twin = same_function_as(interpolator, derivatives)
-    if twin:
+    if twin and "same function" not in label:  # grids made since issue 13 say so themselves
         for other in panels:
             if other["render"]["reconstruction"] == "%s/%s" % twin:
                 return "%s (= %s: same function)" % (label, other["letter"])
