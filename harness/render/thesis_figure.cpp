@@ -36,7 +36,7 @@ GridCell heat_map_legend(int width, double max_degrees) {
     constexpr int kTicks = 4;
     const int text_band = std::max(12, width / 12);
     GridCell c{colour_bar_with_ticks(width, std::max(8, width / 16), kTicks, text_band),
-               "normal error (deg; magenta: hit in one image only); heat maps: mean / p95 deg, % coverage"};
+               "normal error (deg); below: mean / p95, % coverage"};
     const double step = max_degrees / kTicks;
     const int digits = step == std::floor(step) ? 0 : 1;
     for (int t = 0; t <= kTicks; ++t) c.ticks.push_back({double(t) / kTicks, fixed(t * step, digits)});
@@ -80,8 +80,9 @@ std::vector<FigurePanelSpec> thesis_figure_panels() {
             {"B", LatticeType::BCC, "bcc_cubic", "true", "BCC cubic, true derivatives"},
             {"C", LatticeType::BCC, "bcc_cubic", "fd", "BCC cubic, estimated derivatives"},
             {"D", LatticeType::CC, "tricubic_lm", "true", "CC tricubic, true derivatives"},
-            // tricubic_lm with central differences is Catmull-Rom (docs/reconstruction.md)
-            {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives (= A: same function)"}};
+            // tricubic_lm with central differences is Catmull-Rom (docs/reconstruction.md); a short
+            // mark, since a row's labels share the size at which the longest fits
+            {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives (= A)"}};
 }
 
 FigureOptions figure_options(const RenderSpec& spec) {

@@ -88,9 +88,11 @@ def panel_label(panel, panels):
         label = label[len(panel["letter"]):].strip()
     interpolator, _, derivatives = panel["render"]["reconstruction"].partition("/")
     twin = same_function_as(interpolator, derivatives)
-    if twin and "same function" not in label:  # grids made since issue 13 say so themselves
+    if twin:
         for other in panels:
             if other["render"]["reconstruction"] == "%s/%s" % twin:
+                # Grids made since issue 13 mark it briefly themselves, "(= A)": said once, in full.
+                label = label.replace(" (= %s)" % other["letter"], "")
                 return "%s (= %s: same function)" % (label, other["letter"])
     return label
 

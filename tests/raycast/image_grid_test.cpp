@@ -191,7 +191,7 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     EXPECT_EQ(f.rows[2].size(), 2u);
     EXPECT_EQ(f.rows[3].size(), 5u);
     EXPECT_EQ(f.rows[3][0].image.width, 24);
-    EXPECT_EQ(f.panels[4].label, "E  CC tricubic, estimated derivatives (= A: same function) (20x20x20)");
+    EXPECT_EQ(f.panels[4].label, "E  CC tricubic, estimated derivatives (= A) (20x20x20)");
     // The colour bar's values: 0 .. heat_max_degrees (20) in quarters, under black marks
     const GridCell& bar = f.rows[2][1];
     ASSERT_EQ(bar.ticks.size(), 5u);
