@@ -29,6 +29,25 @@ if(SDF_HAVE_OIIO)
   endforeach()
 endif()
 
+# OpenVDB is optional: with it, fields can be exported as .vdb (harness/io/vdb_file.cpp) and
+# the peers experiment compares with its mesh-to-volume. Debian's FindOpenVDB.cmake fails hard
+# (not QUIET) without libboost-iostreams-dev, which the headers used here do not need: find
+# the header and the library directly. OpenVDB's headers use Imath's half: Imath is linked
+# after the objects that use it (with --as-needed an earlier Imath, pulled in by
+# OpenImageIO, is dropped: "DSO missing").
+set(SDF_HAVE_OPENVDB 0)
+find_path(SDF_OPENVDB_INCLUDE openvdb/openvdb.h)
+find_library(SDF_OPENVDB_LIBRARY openvdb)
+find_package(TBB QUIET)
+find_package(Imath CONFIG QUIET)
+if(SDF_OPENVDB_INCLUDE AND SDF_OPENVDB_LIBRARY AND TBB_FOUND AND Imath_FOUND)
+  set(SDF_HAVE_OPENVDB 1)
+  add_library(sdf_openvdb INTERFACE)
+  target_include_directories(sdf_openvdb SYSTEM INTERFACE ${SDF_OPENVDB_INCLUDE})
+  target_link_libraries(sdf_openvdb INTERFACE ${SDF_OPENVDB_LIBRARY} TBB::tbb Imath::Imath)
+endif()
+message(STATUS "sdf: OpenVDB ${SDF_HAVE_OPENVDB} (.vdb export and the OpenVDB peer)")
+
 if(SDF_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

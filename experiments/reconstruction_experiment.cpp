@@ -13,6 +13,8 @@
 ///     CC and the first BCC lattice), the mesh reference and the image metrics, as a labelled
 ///     grid in the thesis's layout (harness/render/thesis_figure.h) under images/<view>/
 ///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
+///   "output": {"fields": true}   the sampled fields into the run directory, fields/<mesh>-<label>.json
+///     (docs/field-format.md), so a run holds what it measured, not only the cache's hashes
 /// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
 #include <algorithm>
 #include <stdexcept>
@@ -86,6 +88,9 @@ public:
                 config.fail("render", "the thesis's figures need a CC and a BCC lattice in \"lattices\"");
         }
         figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
+        JsonReader out = config.optional_object("output");
+        write_fields_ = out.optional<bool>("fields", true, "true or false");
+        out.finish();
     }
 
     MemoryNeed memory_need(const RunContext&) const override {
@@ -104,7 +109,8 @@ public:
             const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
             lines.push_back("field " + inputs_.lattice_labels[i] + ": " + lattice_spec_notation(inputs_.lattices[i]) + ", " +
                             with_commas(l.num_points()) + " points, " + inputs_.sampler.backend + "/" +
-                            inputs_.sampler.method + ": " + source.status(mesh, l));
+                            inputs_.sampler.method + ": " + source.status(mesh, l) +
+                            (write_fields_ ? "; write fields/" + mesh.name() + "-" + inputs_.lattice_labels[i] + ".json" : ""));
         }
         lines.push_back("probes: " + with_commas(probes_.domain_probes) + " in the common domain + " +
                         with_commas(probes_.band_probes) + " within " + nlohmann::json(probes_.band).dump() +
@@ -140,7 +146,14 @@ public:
             nlohmann::json d = got.describe();
             d["label"] = inputs_.lattice_labels[i];
             ctx.metrics["lattices"].push_back(d);
-            ctx.inputs["fields"].push_back({{"label", inputs_.lattice_labels[i]}, {"cache_key", got.cache_key}});
+            nlohmann::json input = {{"label", inputs_.lattice_labels[i]}, {"cache_key", got.cache_key}};
+            if (write_fields_) {
+                const std::string file = "fields/" + mesh.name() + "-" + inputs_.lattice_labels[i] + ".json";
+                got.field.mesh = ctx.metrics["mesh"];
+                write_field((std::filesystem::path(ctx.output_dir) / file).string(), got.field);
+                input["file"] = file;
+            }
+            ctx.inputs["fields"].push_back(input);
             ctx.metrics["regression"]["lattices/" + inputs_.lattice_labels[i] + "/points"] = {{"value", l.num_points()},
                                                                                               {"kind", "exact"}};
             h_ref = std::max(h_ref, l.spacing);
@@ -265,6 +278,7 @@ private:
     int threads_ = 0;
     std::optional<RenderSpec> render_;
     std::vector<std::string> figures_;
+    bool write_fields_ = true;
 };
 
 }  // namespace

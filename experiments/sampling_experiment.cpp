@@ -3,8 +3,10 @@
 /// (through the field cache), write the fields into the run directory, and summarise
 /// counts, timing and pairs per second.
 ///
-///   "output": {"dtype": "float32" | "float64", "nrrd": false, "uint8": false}
-/// Field files are named <mesh>-<lattice label> (lattice_spec.h: "box-cc-8x8x8").
+///   "output": {"dtype": "float32" | "float64", "nrrd": false, "uint8": false,
+///              "formats": ["vdb", "vti", "npy", "npz"], "vdb_band": 3}
+/// Field files are named <mesh>-<lattice label> (lattice_spec.h: "box-cc-8x8x8"); "formats"
+/// adds the volume formats of harness/io/volume_formats.h beside them.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +18,7 @@
 #include "experiments/common/study_inputs.h"
 #include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"
+#include "harness/io/volume_formats.h"
 
 namespace sdf {
 namespace {
@@ -28,6 +31,7 @@ public:
         dtype_ = out.choice("dtype", {"float32", "float64"}, "float32") == "float32" ? FieldDtype::Float32 : FieldDtype::Float64;
         nrrd_ = out.optional<bool>("nrrd", false, "true or false");
         uint8_ = out.optional<bool>("uint8", false, "true or false");
+        read_volume_formats(out);
         out.finish();
     }
 
@@ -47,7 +51,7 @@ public:
             lines.push_back("sample " + mesh.name() + " on " + lattice_spec_notation(inputs_.lattices[i]) + " (" +
                             with_commas(lattice.num_points()) + " points) with " + inputs_.sampler.backend + "/" +
                             inputs_.sampler.method + ": " + source.status(mesh, lattice) + "; write fields/" +
-                            mesh.name() + "-" + inputs_.lattice_labels[i] + ".json");
+                            mesh.name() + "-" + inputs_.lattice_labels[i] + ".json" + planned_formats());
         }
         return lines;
     }
@@ -71,12 +75,46 @@ public:
             write_field(fields_dir + "/" + stem + ".json", field, wo);
             if (nrrd_ && lattice.type == LatticeType::CC) export_nrrd(fields_dir + "/" + stem + ".nrrd", field, true);
             if (uint8_) export_uint8(fields_dir + "/" + stem + ".u8.raw", field);
+            for (VolumeFormat format : formats_)
+                write_field_as(field, fields_dir + "/" + stem + "." + volume_format_name(format), format, volume_options_);
             ctx.inputs["fields"].push_back({{"name", stem}, {"cache_key", got.cache_key}});
             summarise(log, ctx, mesh, got, stem);
         }
     }
 
 private:
+    /// "formats": names from the one table (volume_formats.h), each at most once; "vdb"
+    /// only where the build has OpenVDB, refused here rather than after sampling.
+    void read_volume_formats(JsonReader& out) {
+        const std::string expected = "an array of volume format names (" + volume_format_names() + ")";
+        const auto names = out.optional<std::vector<std::string>>("formats", {}, expected);
+        for (const std::string& name : names) {
+            VolumeFormat format{};
+            try {
+                format = volume_format_from_name(name);
+            } catch (const std::invalid_argument& e) {
+                out.fail("formats", e.what());
+            }
+            if (std::find(formats_.begin(), formats_.end(), format) != formats_.end())
+                out.fail("formats", "\"" + name + "\" is listed twice");
+            if (!volume_format_available(format))
+                out.fail("formats", "\"" + name + "\" needs OpenVDB, which this build lacks (install libopenvdb-dev, "
+                                    "scripts/install-deps, and configure again)");
+            formats_.push_back(format);
+        }
+        volume_options_.dtype = dtype_;
+        volume_options_.vdb_band = out.optional<double>("vdb_band", 3.0, "the OpenVDB narrow band's half-width in spacings (> 0)");
+        if (!(volume_options_.vdb_band > 0))
+            out.fail("vdb_band", "expected the OpenVDB narrow band's half-width in spacings (> 0), got " +
+                                     out.raw("vdb_band").dump());
+    }
+
+    std::string planned_formats() const {
+        std::string text;
+        for (VolumeFormat format : formats_) text += std::string(text.empty() ? " and " : ", ") + volume_format_name(format);
+        return text;
+    }
+
     void summarise(std::ostream& log, RunContext& ctx, const PreparedMesh& mesh, const ObtainedField& got,
                    const std::string& stem) {
         const SampledField& f = got.field;
@@ -109,6 +147,8 @@ private:
     StudyInputs inputs_;
     FieldDtype dtype_ = FieldDtype::Float32;
     bool nrrd_ = false, uint8_ = false;
+    std::vector<VolumeFormat> formats_;
+    VolumeWriteOptions volume_options_;
 };
 
 }  // namespace

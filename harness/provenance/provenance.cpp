@@ -4,6 +4,7 @@
 
 #include <array>
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -31,15 +32,35 @@ std::string run_command(const std::string& cmd, bool* ok) {
     return out;
 }
 
+/// The commit passed in for a tree without .git: SDF_SOURCE_COMMIT from the environment, else
+/// from the build (cmake -DSDF_SOURCE_COMMIT=...). "<commit>-dirty" marks uncommitted changes,
+/// as `git describe --dirty` does; a commit without it is taken as clean.
+GitState passed_in_commit() {
+    GitState g;
+    const char* env = std::getenv("SDF_SOURCE_COMMIT");
+    std::string commit = env && *env ? env : SDF_SOURCE_COMMIT_AT_BUILD;
+    if (commit.empty()) return g;
+    const std::string dirty_suffix = "-dirty";
+    g.dirty = commit.size() > dirty_suffix.size() &&
+              commit.compare(commit.size() - dirty_suffix.size(), dirty_suffix.size(), dirty_suffix) == 0;
+    if (g.dirty) commit.resize(commit.size() - dirty_suffix.size());
+    g.commit = commit;
+    g.source = "SDF_SOURCE_COMMIT";
+    return g;
+}
+
 }  // namespace
 
-GitState git_state() {
+GitState git_state() { return git_state_of(SDF_SOURCE_DIR); }
+
+GitState git_state_of(const std::string& source_dir) {
     GitState g;
     bool ok = false;
-    const std::string dir = std::string("git -C '") + SDF_SOURCE_DIR + "' ";
+    const std::string dir = "git -C '" + source_dir + "' ";
     const std::string commit = run_command(dir + "rev-parse HEAD 2>/dev/null", &ok);
-    if (!ok || commit.empty()) return g;
+    if (!ok || commit.empty()) return passed_in_commit();
     g.commit = commit;
+    g.source = "git";
     const std::string status = run_command(dir + "status --porcelain --untracked-files=no 2>/dev/null", &ok);
     g.dirty = !ok || !status.empty();
     return g;
@@ -115,7 +136,7 @@ nlohmann::json machine_and_build() {
             {"cpu", {{"model", cpu_model()}, {"hardware_threads", hardware_threads()}}},
             {"gpu", gpu_info()},
             {"build", build_info()},
-            {"git", {{"commit", g.commit}, {"dirty", g.dirty}}}};
+            {"git", {{"commit", g.commit}, {"dirty", g.dirty}, {"source", g.source}}}};
 }
 
 }  // namespace sdf

@@ -12,9 +12,17 @@ namespace sdf {
 struct GitState {
     std::string commit = "unknown";
     bool dirty = true;  ///< unknown counts as dirty: such a run never becomes a baseline
+    /// "git", or where the tree has no .git (a copy sent to a GPU machine) the commit passed
+    /// in: "SDF_SOURCE_COMMIT" (environment at run time, then the CMake variable at configure
+    /// time); "none" when neither is known.
+    std::string source = "none";
 };
 
+/// The commit of this build's source tree (git_state_of(SDF_SOURCE_DIR)).
 GitState git_state();
+/// The commit of the tree at `source_dir`: git's, or where it has no .git the commit passed
+/// in (SDF_SOURCE_COMMIT, see GitState::source).
+GitState git_state_of(const std::string& source_dir);
 std::string cpu_model();
 /// Build type, compiler and flags baked in at configure time.
 nlohmann::json build_info();

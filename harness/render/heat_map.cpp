@@ -50,4 +50,18 @@ ImageRgb viridis_bar(int width, int height) {
     return out;
 }
 
+ImageRgb colour_bar_with_ticks(int width, int bar_height, int ticks, int text_band) {
+    const int mark = std::max(3, bar_height / 3);
+    ImageRgb out(width, bar_height + mark + text_band, 1.0f);
+    blit(out, viridis_bar(width, bar_height), 0, 0);
+    for (int t = 0; t <= ticks; ++t) {
+        const int x = ticks > 0 ? int(double(t) * (width - 1) / ticks + 0.5) : 0;
+        for (int y = 0; y < bar_height + mark; ++y) {
+            if (y < bar_height && t > 0 && t < ticks) continue;  // inner marks below the bar only
+            out.set(x, y, 0.0f, 0.0f, 0.0f);
+        }
+    }
+    return out;
+}
+
 }  // namespace sdf

@@ -21,4 +21,8 @@ ImageRgb normal_error_heat_map(const RenderedImage& test, const RenderedImage& r
 /// A horizontal colour bar 0 .. max (width x height) for a grid legend.
 ImageRgb viridis_bar(int width, int height);
 
+/// The bar with black tick marks at `ticks` + 1 evenly spaced values (0 .. max) and a white
+/// band of `text_band` pixels below for their values (GridCell::ticks draws them).
+ImageRgb colour_bar_with_ticks(int width, int bar_height, int ticks, int text_band);
+
 }  // namespace sdf

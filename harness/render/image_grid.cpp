@@ -96,6 +96,11 @@ ImageRgb make_image_grid(const std::vector<GridRow>& rows, const GridStyle& styl
                 size = std::min(size, fitting_size(rows[r][c].label, style.font_size, g.cells[r][c].label_width - 4, font));
         for (size_t c = 0; c < rows[r].size(); ++c) {
             const GridCellPlacement& p = g.cells[r][c];
+            const GridCell& cell = rows[r][c];
+            const int tick_size = std::min(style.font_size, cell.tick_band * 4 / 5);
+            for (const GridTick& t : cell.ticks)
+                draw_text(buf, p.x + int(t.at * (p.width - 1) + 0.5), p.y + p.height - cell.tick_band / 5, t.text,
+                          tick_size, font);
             if (rows[r][c].label.empty()) continue;
             draw_text(buf, p.label_x + p.label_width / 2, p.label_y + (p.label_height + size) / 2 - 2, rows[r][c].label,
                       size, font);

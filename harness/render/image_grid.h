@@ -18,9 +18,19 @@
 
 namespace sdf {
 
+/// A value written under a colour bar: `at` in [0, 1] along the image's width.
+struct GridTick {
+    double at = 0;
+    std::string text;
+};
+
 struct GridCell {
     ImageRgb image;
     std::string label;
+    /// Tick values drawn centred under their marks in the bottom `tick_band` pixels of the
+    /// image (a colour bar's, heat_map.h: colour_bar_with_ticks leaves that band white).
+    std::vector<GridTick> ticks = {};
+    int tick_band = 0;
 };
 
 using GridRow = std::vector<GridCell>;

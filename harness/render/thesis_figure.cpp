@@ -1,5 +1,6 @@
 #include "harness/render/thesis_figure.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -30,6 +31,19 @@ ImageRgb reduced(const ImageRgb& image, int factor) { return factor > 1 ? downsa
 
 std::string percent(double fraction) { return fixed(100.0 * fraction, 2) + "%"; }
 
+/// The heat maps' colour bar with its values at 0, 1/4, .. 1 of the scale.
+GridCell heat_map_legend(int width, double max_degrees) {
+    constexpr int kTicks = 4;
+    const int text_band = std::max(12, width / 12);
+    GridCell c{colour_bar_with_ticks(width, std::max(8, width / 16), kTicks, text_band),
+               "normal error (deg); below: mean / p95, % coverage"};
+    const double step = max_degrees / kTicks;
+    const int digits = step == std::floor(step) ? 0 : 1;
+    for (int t = 0; t <= kTicks; ++t) c.ticks.push_back({double(t) / kTicks, fixed(t * step, digits)});
+    c.tick_band = text_band;
+    return c;
+}
+
 std::vector<GridRow> figure_rows(const ThesisFigure& f, const FigureOptions& o) {
     std::vector<GridCell> renders;
     GridRow errors;
@@ -45,9 +59,7 @@ std::vector<GridRow> figure_rows(const ThesisFigure& f, const FigureOptions& o) 
     if (o.reference_row && f.has_reference) {
         GridRow r{{reduced(shaded_image(f.reference), o.downsample), "Reference: the mesh, ray-traced"}};
         if (!errors.empty()) {
-            const int w = r[0].image.width;
-            r.push_back({viridis_bar(w, std::max(8, w / 16)),
-                         "heat maps: 0 - " + fixed(o.heat_max_degrees, 0) + " deg; mean / p95, % coverage"});
+            r.push_back(heat_map_legend(r[0].image.width, o.heat_max_degrees));
         }
         rows.push_back(r);
     }
@@ -68,7 +80,9 @@ std::vector<FigurePanelSpec> thesis_figure_panels() {
             {"B", LatticeType::BCC, "bcc_cubic", "true", "BCC cubic, true derivatives"},
             {"C", LatticeType::BCC, "bcc_cubic", "fd", "BCC cubic, estimated derivatives"},
             {"D", LatticeType::CC, "tricubic_lm", "true", "CC tricubic, true derivatives"},
-            {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives"}};
+            // tricubic_lm with central differences is Catmull-Rom (docs/reconstruction.md); a short
+            // mark, since a row's labels share the size at which the longest fits
+            {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives (= A)"}};
 }
 
 FigureOptions figure_options(const RenderSpec& spec) {

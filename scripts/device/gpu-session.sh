@@ -4,6 +4,8 @@
 #   carry: .gpu-prefix (Debian tinyobjloader, CLI11, OpenSSL unpacked) and data (meshes)
 #   scripts/device/gpu-session.sh build test bench "experiment configs/x.json" ...
 # Everything worth keeping is written under $OUT (default: ./gpu-out).
+# The copy has no .git: pass the commit in, SDF_SOURCE_COMMIT=<sha>[-dirty] scripts/device/...,
+# and every run's provenance records it (docs/gpu-notes.md).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 OUT=${OUT:-$PWD/gpu-out}
@@ -25,7 +27,7 @@ build() {
     fi
     log "configure"
     cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSDF_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 \
-        -DCMAKE_PREFIX_PATH="$PREFIX" "${extra[@]}" > "$OUT/configure.log" 2>&1 || { tail -40 "$OUT/configure.log"; return 1; }
+        -DCMAKE_PREFIX_PATH="$PREFIX" -DSDF_SOURCE_COMMIT="${SDF_SOURCE_COMMIT:-}" "${extra[@]}" > "$OUT/configure.log" 2>&1 || { tail -40 "$OUT/configure.log"; return 1; }
     grep -E "sdf:" "$OUT/configure.log"
     log "build"
     # BUILD_TARGETS (space-separated) limits the build, e.g. to the GPU tests and tools.

@@ -87,6 +87,9 @@ _STYLE = ("body{font-family:sans-serif;max-width:80em;margin:2em auto;padding:0 
           "div.table{overflow-x:auto}"
           "td,th{border:1px solid #bbb;padding:.2em .5em;text-align:right;vertical-align:top}td{white-space:nowrap}"
           "th{background:#eee}td.text,th.text{text-align:left}"
+          # Text cells wrap (numbers do not), so wide tables such as the runs' fit the page and
+          # their last column (the check) is seen without scrolling.
+          "td.text{white-space:normal;min-width:4em}"
           "tr:nth-child(even) td{background:#f7f7f7}"
           "blockquote{color:#555;border-left:3px solid #ccc;margin:1em 0;padding-left:1em}"
           "figure{margin:1em 0}figcaption{color:#555;font-size:90%}img{max-width:100%}")

@@ -16,6 +16,8 @@ def machine(run):
 def commit(run):
     git = run.provenance["git"]
     text = git["commit"][:10]
+    if git.get("source") == "SDF_SOURCE_COMMIT":  # a tree without .git, the commit passed in
+        text += " (passed in)"
     if git["dirty"]:
         text += " (dirty)"
     source = (run.published or {}).get("source_commit")
@@ -75,4 +77,4 @@ def section(doc, runs, repo):
                  "inflated or compressed by other work; errors and counts are unaffected." % ", ".join(loaded))
     if any(r.provenance["git"]["dirty"] for r in runs):
         doc.note("Runs marked dirty were made from a work tree with uncommitted changes (or without git: commit "
-                 "\"unknown\").")
+                 "\"unknown\"; a tree without .git records the commit passed in as SDF_SOURCE_COMMIT, \"(passed in)\").")

@@ -91,6 +91,8 @@ def panel_label(panel, panels):
     if twin:
         for other in panels:
             if other["render"]["reconstruction"] == "%s/%s" % twin:
+                # Grids made since issue 13 mark it briefly themselves, "(= A)": said once, in full.
+                label = label.replace(" (= %s)" % other["letter"], "")
                 return "%s (= %s: same function)" % (label, other["letter"])
     return label
 

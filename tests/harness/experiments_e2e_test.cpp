@@ -77,6 +77,13 @@ TEST_F(E2e, CiSmokeRunPassesItsCommittedBaseline) {
     EXPECT_TRUE(manifest.at("provenance").at("load_average").contains("end"));
     EXPECT_TRUE(manifest.at("config").contains("resolved"));
     EXPECT_EQ(manifest.at("inputs").at("fields").size(), 2u);
+    // The run holds the fields it measured (issue 13), named beside their cache keys.
+    for (const json& f : manifest.at("inputs").at("fields")) {
+        const fs::path header = run_dir / f.at("file").get<std::string>();
+        ASSERT_TRUE(fs::exists(header)) << f.dump();
+        EXPECT_EQ(read_json(header).at("lattice").at("points"), metrics.at("regression")
+                      .at("lattices/" + f.at("label").get<std::string>() + "/points").at("value")) << f.dump();
+    }
 }
 
 TEST_F(E2e, PerturbedResultFailsTheCheckReadably) {

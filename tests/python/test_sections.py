@@ -136,3 +136,21 @@ def test_peers_rows_status_rows_and_summary(tmp_path, schema):
     assert "narrow band: max \\|d error\\| 0.001 inside (1,000 points), 0.25 outside" in md
     assert "| bunny 64x64x64 | 2 | embree | 5 | 4.75 | 5 |" in md
     assert "No peers run" in render(peers.section, tmp_path, [])
+
+
+def test_a_grid_that_marks_its_twin_briefly_is_labelled_once_in_full():
+    def panel(letter, label, reconstruction):
+        return {"letter": letter, "label": letter + "  " + label, "render": {"reconstruction": reconstruction}}
+    panels = [panel("A", "Catmull-Rom (8x8x8)", "catmull_rom/fd"),
+              panel("E", "CC tricubic, estimated derivatives (= A) (8x8x8)", "tricubic_lm/fd")]
+    assert reconstruction.panel_label(panels[1], panels) == "CC tricubic, estimated derivatives (8x8x8) (= A: same function)"
+    assert reconstruction.panel_label(panels[0], panels) == "Catmull-Rom (8x8x8)"
+
+
+def test_a_commit_passed_in_for_a_tree_without_git_is_marked():
+    class Stub:
+        published = None
+        provenance = {"git": {"commit": "0123456789abcdef", "dirty": False, "source": "SDF_SOURCE_COMMIT"}}
+    assert overview.commit(Stub()) == "0123456789 (passed in)"
+    Stub.provenance = {"git": {"commit": "0123456789abcdef", "dirty": True, "source": "git"}}
+    assert overview.commit(Stub()) == "0123456789 (dirty)"

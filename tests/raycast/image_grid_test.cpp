@@ -191,6 +191,17 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     EXPECT_EQ(f.rows[2].size(), 2u);
     EXPECT_EQ(f.rows[3].size(), 5u);
     EXPECT_EQ(f.rows[3][0].image.width, 24);
+    EXPECT_EQ(f.panels[4].label, "E  CC tricubic, estimated derivatives (= A) (20x20x20)");
+    // The colour bar's values: 0 .. heat_max_degrees (20) in quarters, under black marks
+    const GridCell& bar = f.rows[2][1];
+    ASSERT_EQ(bar.ticks.size(), 5u);
+    EXPECT_EQ(bar.ticks[0].text, "0");
+    EXPECT_EQ(bar.ticks[2].text, "10");
+    EXPECT_EQ(bar.ticks[4].text, "20");
+    EXPECT_EQ(bar.ticks[4].at, 1.0);
+    EXPECT_GT(bar.tick_band, 0);
+    const int mark_y = bar.image.height - bar.tick_band - 1;
+    for (int x : {0, int(0.5 * (bar.image.width - 1) + 0.5), bar.image.width - 1}) EXPECT_EQ(bar.image.at(x, mark_y)[0], 0.0f) << x;
     const GridLayout g = layout_grid(f.rows, f.style);
     EXPECT_EQ(f.grid.width, g.width);
     EXPECT_EQ(f.grid.height, g.height);

@@ -1,0 +1,30 @@
+/// @file volume_grids.h
+/// @brief The CC grids a field is exported as (one for CC, the primary and the secondary
+/// grid for BCC), shared by the volume format writers (volume_formats.cpp, vdb_file.cpp).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/sampling/sampled_field.h"
+
+namespace sdf {
+
+struct VolumeGrid {
+    std::string part;    ///< "" for a CC field, "primary" or "secondary" for BCC
+    Vec3d origin{};      ///< world position of the grid's point (0,0,0)
+    double spacing = 1;  ///< h
+    Int3 resolution{};   ///< points per axis
+    int64_t first = 0;   ///< storage index of the grid's first point in the field
+    int64_t count() const { return int64_t(resolution.x) * resolution.y * resolution.z; }
+};
+
+/// A CC field's one grid, or a BCC field's primary grid (at the origin) and secondary grid
+/// (at origin + h/2, one point fewer per axis), in storage order.
+std::vector<VolumeGrid> volume_grids(const Lattice& lattice);
+
+/// OpenVDB writer (vdb_file.cpp, built when OpenVDB is found): grids "distance" and
+/// "gradient" (CC) or "distance_primary", ..., "gradient_secondary" (BCC) into `path`.
+void write_vdb_file(const SampledField& field, const std::string& path, double band_in_spacings);
+
+}  // namespace sdf
