@@ -1,6 +1,7 @@
 #include "core/reconstruction/analytic_study.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -45,9 +46,19 @@ Lattice lattice_spanning(LatticeType type, Int3 resolution, const Vec3d& lo, con
 AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     const auto f = [&](const Vec3d& p) { return evaluate_analytic(spec.function, p); };
     const Lattice lattice = lattice_spanning(spec.lattice, spec.resolution, spec.domain_min, spec.domain_max);
+    if (spec.padding < 0) throw std::invalid_argument("analytic study: padding must be >= 0 spacings");
+    const Vec3d pad(spec.padding * lattice.spacing);
+    const int grow = 2 * spec.padding;
+    const Lattice sampled =
+        spec.padding == 0 ? lattice
+                          : lattice_spanning(spec.lattice, {spec.resolution.x + grow, spec.resolution.y + grow, spec.resolution.z + grow},
+                                             spec.domain_min - pad, spec.domain_max + pad);
     ReconstructionSpec rspec = spec.reconstruction;
     rspec.threads = spec.threads;
-    const Reconstruction recon(sample_analytic_field(lattice, f), rspec);
+    const SampledField field = sample_analytic_field(sampled, f);
+    const auto build_start = std::chrono::steady_clock::now();
+    const Reconstruction recon(field, rspec);
+    const double prepare_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 
     AnalyticStudyResult r;
     r.description = spec.function + " / " + recon.description();
@@ -56,6 +67,11 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     r.probe_box = recon.domain();
     const Vec3d inset(spec.margin * lattice.spacing);
     r.probe_box = {r.probe_box.lo + inset, r.probe_box.hi - inset};
+    r.padding = spec.padding;
+    for (int a = 0; a < 3; ++a) {  // probes stay inside the box the samples are counted over
+        r.probe_box.lo[a] = std::max(r.probe_box.lo[a], spec.domain_min[a]);
+        r.probe_box.hi[a] = std::min(r.probe_box.hi[a], spec.domain_max[a]);
+    }
     for (int a = 0; a < 3; ++a)
         if (!(r.probe_box.lo[a] < r.probe_box.hi[a]))
             throw std::invalid_argument("analytic study: margin " + std::to_string(spec.margin) +
@@ -92,6 +108,15 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     r.rms_255 = 255.0 * r.rms;
     r.l2_norm_255 = 255.0 * r.l2_norm;
     r.gradient_rms = std::sqrt(total.gradient_squares / count);
+
+    // Speed at probes spread over the whole grid (every stride-th), not one corner of it.
+    const int64_t timed = std::min<int64_t>(r.probes, int64_t(1) << 16);
+    std::vector<Vec3d> timing_points(static_cast<size_t>(timed));
+    for (int64_t i = 0; i < timed; ++i) timing_points[size_t(i)] = probe_position(r.probe_box, n, i * (r.probes / timed));
+    const EvaluationTiming timing = time_evaluation(recon, timing_points);
+    r.prepare_seconds = prepare_seconds;
+    r.eval_ns_per_point = timing.ns_per_point;
+    r.timed_points = timing.points;
     return r;
 }
 
@@ -99,6 +124,7 @@ nlohmann::json to_json(const AnalyticStudyResult& r) {
     return {{"description", r.description},
             {"lattice", r.lattice},
             {"lattice_points", r.lattice_points},
+            {"padding_spacings", r.padding},
             {"probes", r.probes},
             {"probe_box", {{r.probe_box.lo.x, r.probe_box.lo.y, r.probe_box.lo.z},
                            {r.probe_box.hi.x, r.probe_box.hi.y, r.probe_box.hi.z}}},
@@ -108,7 +134,10 @@ nlohmann::json to_json(const AnalyticStudyResult& r) {
             {"l2_norm", r.l2_norm},
             {"rms_255", r.rms_255},
             {"l2_norm_255", r.l2_norm_255},
-            {"gradient_rms", r.gradient_rms}};
+            {"gradient_rms", r.gradient_rms},
+            {"prepare_seconds", r.prepare_seconds},
+            {"eval_ns_per_point", r.eval_ns_per_point},
+            {"timed_points", r.timed_points}};
 }
 
 }  // namespace sdf

@@ -1,5 +1,8 @@
 #include "core/reconstruction/reconstruction.h"
 
+#include <algorithm>
+#include <chrono>
+
 #include "core/parallel/parallel_for.h"
 
 namespace sdf {
@@ -44,6 +47,24 @@ std::vector<ReconstructedSample<double>> Reconstruction::evaluate(const std::vec
     std::vector<ReconstructedSample<double>> out(points.size());
     evaluate(points.data(), out.data(), int64_t(points.size()), threads);
     return out;
+}
+
+EvaluationTiming time_evaluation(const Reconstruction& recon, const std::vector<Vec3d>& points, int64_t max_points,
+                                 int repetitions) {
+    EvaluationTiming t;
+    t.points = std::min(int64_t(points.size()), max_points);
+    t.repetitions = std::max(1, repetitions);
+    if (t.points == 0) return t;
+    std::vector<ReconstructedSample<double>> out(static_cast<size_t>(t.points));
+    double best = 0;
+    for (int r = 0; r < t.repetitions; ++r) {
+        const auto start = std::chrono::steady_clock::now();
+        recon.evaluate(points.data(), out.data(), t.points, 1);
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        best = r == 0 ? s : std::min(best, s);
+    }
+    t.ns_per_point = 1e9 * best / double(t.points);
+    return t;
 }
 
 }  // namespace sdf
