@@ -16,9 +16,25 @@ struct ErrorSums {
     double squares = 0, abs = 0, max_abs = 0, gradient_squares = 0;
 };
 
-Vec3d probe_position(const DomainBox<double>& box, int n, int64_t index) {
-    const int64_t i = index % n, j = (index / n) % n, k = index / (int64_t(n) * n);
-    const Vec3d t((double(i) + 0.5) / n, (double(j) + 0.5) / n, (double(k) + 0.5) / n);
+/// SplitMix64 (Steele, Lea, Flood 2014) of a counter: a uniform double in [0, 1) per
+/// (index, axis), independent of the order and the threads that ask.
+double counter_uniform(uint64_t counter) {
+    uint64_t z = counter + 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return double(z >> 11) * 0x1.0p-53;
+}
+
+Vec3d probe_position(const DomainBox<double>& box, int n, int64_t index, bool random) {
+    Vec3d t;
+    if (random) {
+        const uint64_t c = 3 * uint64_t(index);
+        t = Vec3d(counter_uniform(c), counter_uniform(c + 1), counter_uniform(c + 2));
+    } else {
+        const int64_t i = index % n, j = (index / n) % n, k = index / (int64_t(n) * n);
+        t = Vec3d((double(i) + 0.5) / n, (double(j) + 0.5) / n, (double(k) + 0.5) / n);
+    }
     return box.lo + component_mul(box.hi - box.lo, t);
 }
 
@@ -68,6 +84,7 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     const Vec3d inset(spec.margin * lattice.spacing);
     r.probe_box = {r.probe_box.lo + inset, r.probe_box.hi - inset};
     r.padding = spec.padding;
+    r.random_probes = spec.random_probes;
     for (int a = 0; a < 3; ++a) {  // probes stay inside the box the samples are counted over
         r.probe_box.lo[a] = std::max(r.probe_box.lo[a], spec.domain_min[a]);
         r.probe_box.hi[a] = std::min(r.probe_box.hi[a], spec.domain_max[a]);
@@ -83,7 +100,7 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     parallel_for(r.probes, chunk, spec.threads, [&](int64_t begin, int64_t end) {
         ErrorSums& s = slices[size_t(begin / chunk)];
         for (int64_t i = begin; i < end; ++i) {
-            const Vec3d p = probe_position(r.probe_box, n, i);
+            const Vec3d p = probe_position(r.probe_box, n, i, spec.random_probes);
             const ReconstructedSample<double> got = recon.evaluate(p);
             const AnalyticSample<double> want = f(p);
             const double e = got.value - want.value;
@@ -112,7 +129,7 @@ AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec) {
     // Speed at probes spread over the whole grid (every stride-th), not one corner of it.
     const int64_t timed = std::min<int64_t>(r.probes, int64_t(1) << 16);
     std::vector<Vec3d> timing_points(static_cast<size_t>(timed));
-    for (int64_t i = 0; i < timed; ++i) timing_points[size_t(i)] = probe_position(r.probe_box, n, i * (r.probes / timed));
+    for (int64_t i = 0; i < timed; ++i) timing_points[size_t(i)] = probe_position(r.probe_box, n, i * (r.probes / timed), spec.random_probes);
     const EvaluationTiming timing = time_evaluation(recon, timing_points);
     r.prepare_seconds = prepare_seconds;
     r.eval_ns_per_point = timing.ns_per_point;
@@ -125,6 +142,7 @@ nlohmann::json to_json(const AnalyticStudyResult& r) {
             {"lattice", r.lattice},
             {"lattice_points", r.lattice_points},
             {"padding_spacings", r.padding},
+            {"random_probes", r.random_probes},
             {"probes", r.probes},
             {"probe_box", {{r.probe_box.lo.x, r.probe_box.lo.y, r.probe_box.lo.z},
                            {r.probe_box.hi.x, r.probe_box.hi.y, r.probe_box.hi.z}}},

@@ -59,6 +59,12 @@ struct AnalyticStudySpec {
     /// inside the box. Padding keeps a filter's boundary treatment (the prefilters' mirror
     /// extension) away from the probes, so that filters are compared on their interior error.
     int padding = 0;
+    /// probes_per_axis^3 uniformly random probes in the probe box (a fixed counter-based
+    /// sequence: the same points for every filter and thread count) instead of the cell
+    /// centres. A regular probe grid whose spacing is commensurate with the lattice's sits at
+    /// the same few offsets in every cell, and an interpolating filter's error there is not
+    /// its mean: orders measured along a series of lattices then alternate.
+    bool random_probes = false;
     int threads = 0;
 };
 
@@ -67,6 +73,7 @@ struct AnalyticStudyResult {
     std::string lattice;       ///< thesis notation, of the lattice over the box (without padding)
     int64_t lattice_points = 0;
     int padding = 0;           ///< spacings the sampled lattice extends beyond the box
+    bool random_probes = false;
     int64_t probes = 0;
     double rms = 0, max_abs = 0, mean_abs = 0, l2_norm = 0;
     double rms_255 = 0, l2_norm_255 = 0;

@@ -253,7 +253,7 @@ TEST_F(E2e, AnalyticConvergencePaddedLatticesAndCosts) {
                            {"threads", 1},
                            {"convergence", {{"function", "marschner_lobb"}, {"samples", {4000}},
                                             {"interpolators", {"cc_bspline3", "bcc_box_quintic", "bcc_linear"}},
-                                            {"probes_per_axis", 8}, {"margin", 0}, {"padding", 4}}}}
+                                            {"probes_per_axis", 8}, {"margin", 0}, {"padding", 4}, {"probes", "random"}}}}
                           .dump());
     const ShellResult r = run("pad.json --output-root out --quiet");
     ASSERT_EQ(r.code, 0) << r.err;
@@ -261,6 +261,7 @@ TEST_F(E2e, AnalyticConvergencePaddedLatticesAndCosts) {
     for (const json& curve : m.at("convergence").at("curves")) {
         const json& p = curve.at("points").at(0);
         EXPECT_EQ(p.at("padding_spacings"), 4);
+        EXPECT_EQ(p.at("random_probes"), true);
         // The samples counted are those over [-1,1]^3 (16^3 CC, 13^3 + 12^3 BCC), not the padding's.
         EXPECT_EQ(p.at("lattice_points"), curve.at("lattice_type") == "cc" ? 4096 : 3925) << curve.at("id");
         // Padding beyond the margin: every filter is probed over all of [-1,1]^3.
