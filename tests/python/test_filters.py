@@ -117,3 +117,15 @@ def test_no_runs_with_the_pair(tmp_path, schema):
     md = render(tmp_path, [run])
     assert "No study has both cc_bspline3 and bcc_box_quintic" in md
     assert "| catmull_rom/fd | cc | 1.000e-05 | 1.000e-06 | 3.32 | n/a | n/a |" in md  # no costs recorded: n/a
+
+
+def test_analogous_pairs_show_the_lattice_and_the_filter(tmp_path, schema):
+    metrics = analytic_metrics(1.15)
+    metrics["convergence"]["curves"] += [analytic_curve("trilinear/fd", "cc", 1e3, order=2.0),
+                                         analytic_curve("bcc_linear/fd", "bcc", 1e3 * 1.3 ** (-2.0 / 3.0), order=2.0)]
+    run = runs.load_run_dir(fake_runs.write_run(tmp_path / "results", "ml_efficiency", "analytic", metrics), schema)
+    md = render(tmp_path, [run])
+    assert "| CC filter | BCC filter | ml_efficiency (marschner_lobb RMS) |" in md
+    assert "| trilinear/fd | bcc_linear/fd | 1.3 (1.3-1.3) |" in md
+    assert "| cc_bspline3/fd | bcc_box_quintic/fd | 1.15 (1.15-1.15) |" in md
+    assert "| catmull_rom/fd | bcc_cubic/fd | - |" in md  # no such curves in this run
