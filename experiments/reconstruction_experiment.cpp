@@ -83,8 +83,8 @@ public:
         if (config.has("render")) {
             JsonReader r = config.optional_object("render");
             render_ = parse_render_spec(r);
-            for (const FigurePanelSpec& p : figure_options(*render_).panels.empty() ? thesis_figure_panels()
-                                                                                     : figure_options(*render_).panels) {
+            const FigureOptions figure = figure_options(*render_);
+            for (const FigurePanelSpec& p : figure.panels.empty() ? thesis_figure_panels() : figure.panels) {
                 const bool present = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
                                                  [&](const LatticeSpec& l) { return l.type == p.lattice; });
                 if (!present)
