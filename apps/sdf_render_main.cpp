@@ -49,7 +49,7 @@ struct Options {
     std::vector<int> cc_resolution{80, 80, 80}, bcc_resolution{64, 64, 128};
     double margin = 0.1;
     std::string interpolator, derivatives;
-    std::vector<std::string> views;
+    std::vector<std::string> views, panels;
     std::vector<double> eye, target, up{0, 1, 0};
     double fov = 30;
     std::vector<int> size{512};
@@ -265,6 +265,9 @@ int run_grid(const Options& o, const nlohmann::json& resolved) {
     fo.error_rows = !o.no_error_maps && !o.no_reference;
     fo.heat_max_degrees = o.heat_max;
     fo.downsample = o.downsample;
+    std::vector<RenderPanelRequest> panels;
+    for (const std::string& p : o.panels) panels.push_back(parse_panel_request(p));
+    fo.panels = figure_panels(panels);
     const nlohmann::json prov = provenance(o, resolved, mesh.content_sha256());
     const std::string name = o.name.empty() ? mesh.name() : o.name;
     fs::create_directories(o.out_dir);
@@ -351,7 +354,7 @@ int main(int argc, char** argv) {
     app.add_flag("--reference", o.reference, "single images: also ray-trace the mesh and write metrics");
     app.add_option("--out", o.out, "single images: output image (.png, .exr, .ppm, .pfm)")->capture_default_str();
     app.add_flag("--no-exr", o.no_exr, "single images: skip the EXR with all channels");
-    app.add_flag("--grid", o.grid, "the thesis figure (CC and BCC fields of a mesh, five reconstructions)");
+    app.add_flag("--grid", o.grid, "the thesis figure (CC and BCC fields of a mesh; the five reconstructions or --panels)");
     app.add_option("--out-dir", o.out_dir, "grid: output directory")->capture_default_str();
     app.add_option("--name", o.name, "grid: file name prefix (default: the mesh's name)");
     app.add_option("--title", o.title, "grid: title line (default: mesh, view and lattices)");
@@ -359,6 +362,19 @@ int main(int argc, char** argv) {
     app.add_flag("--no-error-maps", o.no_error_maps, "grid: no heat-map rows");
     app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--panels", o.panels,
+                   "grid: the reconstructions shown, in order (default: the thesis's five), e.g. "
+                   "bcc_cubic/true,bcc_box_quintic,cc_bspline3; each INTERPOLATOR or INTERPOLATOR/DERIVATIVES of: " +
+                       interpolator_help())
+        ->delimiter(',')
+        ->check([](const std::string& text) {
+            try {
+                parse_panel_request(text);
+                return std::string();
+            } catch (const std::invalid_argument& e) {
+                return std::string(e.what());
+            }
+        });
     app.add_option("--sampler-backend", o.sampler_backend, "mesh input: sampler backend")
         ->check(CLI::IsMember([] { auto b = sampler_backends(); b.emplace_back("auto"); return b; }()))
         ->capture_default_str();

@@ -8,8 +8,15 @@
 ///     ("fd_weighted") least-squares derivatives; the thesis's numbers beside ours.
 ///   "convergence": {"function": "trig", "samples": [4096, 32768, 262144],
 ///                   "interpolators": ["catmull_rom", "bcc_cubic/true", ...],
-///                   "probes_per_axis": 64, "margin": 2.0}
+///                   "probes_per_axis": 64, "margin": 2.0, "padding": 0, "probes": "grid"}
 ///     error versus sample count, CC and BCC lattices of matched counts over [-1,1]^3.
+///     padding: lattice spacings the sampled lattices extend beyond [-1,1]^3 (the samples
+///     counted are still those over [-1,1]^3, and the probes stay in it): with padding above
+///     the margin every filter is measured at the same probes, away from its boundary
+///     treatment. probes: "grid" (cell centres) or "random" (as many uniformly random
+///     points, the same for every filter; analytic_study.h says why). Every point also
+///     records the filter's cost: prepare_seconds (derivative arrays or prefilter) and
+///     eval_ns_per_point (one thread, analytic_study.h).
 ///   "threads": 0
 /// margin: probes stay this many spacings inside the interpolator's domain (2 keeps every
 /// BCC derivative fit centred: analytic_study.h). At least one of the two studies is needed.
@@ -46,6 +53,8 @@ struct ConvergenceSpec {
     std::vector<CurveSpec> curves;
     int probes_per_axis = 64;
     double margin = 2.0;
+    int padding = 0;
+    bool random_probes = false;
 };
 
 std::string function_choice(JsonReader& r, const std::string& fallback) {
@@ -113,7 +122,9 @@ public:
                     counts += (counts.empty() ? "" : ", ") + std::to_string(cubic_resolution_for_samples(interpolator_lattice(c.spec.interpolator), n)) + "^3";
                 lines.push_back("convergence: " + conv_.function + " with " + c.id + " on " +
                                 lattice_type_name(interpolator_lattice(c.spec.interpolator)) + " lattices " + counts +
-                                " (" + std::to_string(conv_.probes_per_axis) + "^3 probes each)");
+                                " (" + std::to_string(conv_.probes_per_axis) + "^3 probes each" +
+                                (conv_.random_probes ? " at random" : "") +
+                                (conv_.padding ? ", lattices padded by " + std::to_string(conv_.padding) + " spacings" : "") + ")");
             }
         return lines;
     }
@@ -159,6 +170,10 @@ private:
         for (const std::string& n : names) conv_.curves.push_back(parse_curve(r, n));
         conv_.probes_per_axis = probes_per_axis(r, 64);
         conv_.margin = margin_of(r);
+        conv_.padding = r.optional<int>("padding", 0, "lattice spacings beyond [-1,1]^3 (0 to 32)");
+        if (conv_.padding < 0 || conv_.padding > 32)
+            r.fail("padding", "expected 0 to 32 lattice spacings, got " + std::to_string(conv_.padding));
+        conv_.random_probes = r.choice("probes", {"grid", "random"}, "grid") == "random";
         for (const CurveSpec& c : conv_.curves)
             for (int64_t n : conv_.samples) {
                 const int res = cubic_resolution_for_samples(interpolator_lattice(c.spec.interpolator), n);
@@ -171,7 +186,7 @@ private:
     }
 
     AnalyticStudyResult study(const std::string& function, LatticeType type, Int3 res, const ReconstructionSpec& rs,
-                              int probes, double margin) const {
+                              int probes, double margin, int padding = 0, bool random_probes = false) const {
         AnalyticStudySpec s;
         s.function = function;
         s.lattice = type;
@@ -179,6 +194,8 @@ private:
         s.reconstruction = rs;
         s.probes_per_axis = probes;
         s.margin = margin;
+        s.padding = padding;
+        s.random_probes = random_probes;
         s.threads = threads_;
         return run_analytic_study(s);
     }
@@ -227,10 +244,14 @@ private:
             nlohmann::json curve = {{"id", c.id}, {"lattice_type", lattice_type_name(type)}, {"points", nlohmann::json::array()}};
             for (int64_t n : conv_.samples) {
                 const int r = cubic_resolution_for_samples(type, n);
-                const AnalyticStudyResult res = study(conv_.function, type, {r, r, r}, c.spec, conv_.probes_per_axis, conv_.margin);
-                char line[200];
-                std::snprintf(line, sizeof line, "  %-18s %-12s %10s points: RMS %.4e  max %.4e  gradient RMS %.4e\n", c.id.c_str(),
-                              res.lattice.c_str(), with_commas(res.lattice_points).c_str(), res.rms, res.max_abs, res.gradient_rms);
+                const AnalyticStudyResult res =
+                    study(conv_.function, type, {r, r, r}, c.spec, conv_.probes_per_axis, conv_.margin, conv_.padding,
+                          conv_.random_probes);
+                char line[240];
+                std::snprintf(line, sizeof line,
+                              "  %-26s %-12s %10s points: RMS %.4e  max %.4e  gradient RMS %.4e  %6.1f ns/point\n",
+                              c.id.c_str(), res.lattice.c_str(), with_commas(res.lattice_points).c_str(), res.rms, res.max_abs,
+                              res.gradient_rms, res.eval_ns_per_point);
                 log << line;
                 nlohmann::json p = to_json(res);
                 p["samples_requested"] = n;

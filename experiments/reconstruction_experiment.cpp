@@ -11,12 +11,17 @@
 ///   "render": {"size": [512, 512], "views": ["side", "front"], ...}   (harness/config/render_spec.h)
 ///     optional: for every view, the five reconstructions of the thesis's figures (the first
 ///     CC and the first BCC lattice), the mesh reference and the image metrics, as a labelled
-///     grid in the thesis's layout (harness/render/thesis_figure.h) under images/<view>/
+///     grid in the thesis's layout (harness/render/thesis_figure.h) under images/<view>/;
+///     "panels": ["bcc_cubic/true", "bcc_box_quintic", ...] chooses other reconstructions
+///   every reconstruction also records its cost: prepare_seconds (derivative arrays or
+///   prefilter, on the metrics' threads) and eval_ns_per_point (one thread, at the first 2^16
+///   probes, i.e. uniformly random domain probes; time_evaluation in reconstruction.h)
 ///   "thesis_figures": ["5-3", "5-4"]   the thesis figures this study stands for (for reports)
 ///   "output": {"fields": true}   the sampled fields into the run directory, fields/<mesh>-<label>.json
 ///     (docs/field-format.md), so a run holds what it measured, not only the cache's hashes
 /// and the study keys (study_inputs.h) and "reconstructions" (reconstruction_list.h).
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 #include <cstdio>
 #include <filesystem>
@@ -80,12 +85,16 @@ public:
         if (config.has("render")) {
             JsonReader r = config.optional_object("render");
             render_ = parse_render_spec(r);
-            const bool has_cc = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
-                                            [](const LatticeSpec& l) { return l.type == LatticeType::CC; });
-            const bool has_bcc = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
-                                             [](const LatticeSpec& l) { return l.type == LatticeType::BCC; });
-            if (!has_cc || !has_bcc)
-                config.fail("render", "the thesis's figures need a CC and a BCC lattice in \"lattices\"");
+            const FigureOptions figure = figure_options(*render_);
+            for (const FigurePanelSpec& p : figure.panels.empty() ? thesis_figure_panels() : figure.panels) {
+                const bool present = std::any_of(inputs_.lattices.begin(), inputs_.lattices.end(),
+                                                 [&](const LatticeSpec& l) { return l.type == p.lattice; });
+                if (!present)
+                    config.fail("render", std::string(render_->panels.empty() ? "the thesis's figures need" : "the panels need") +
+                                              " a " + (p.lattice == LatticeType::CC ? "CC" : "BCC") +
+                                              " lattice in \"lattices\" (panel " + p.letter + ": " + p.interpolator + "/" +
+                                              p.derivatives + ")");
+            }
         }
         figures_ = config.optional<std::vector<std::string>>("thesis_figures", {}, "an array of figure numbers such as \"5-3\"");
         JsonReader out = config.optional_object("output");
@@ -123,8 +132,10 @@ public:
             std::string views;
             for (const ViewRequest& v : render_->views) views += (views.empty() ? "" : ", ") + v.name;
             lines.push_back("render " + views + " at " + std::to_string(render_->width) + "x" +
-                            std::to_string(render_->height) + " (" + render_->backend +
-                            "): the thesis's five reconstructions" + (render_->reference ? ", the mesh reference and image metrics" : "") +
+                            std::to_string(render_->height) + " (" + render_->backend + "): " +
+                            (render_->panels.empty() ? std::string("the thesis's five reconstructions")
+                                                     : "panels " + panel_list(figure_options(*render_).panels)) +
+                            (render_->reference ? ", the mesh reference and image metrics" : "") +
                             ", one labelled grid per view");
         }
         return lines;
@@ -160,10 +171,13 @@ public:
             fields.push_back(std::move(got.field));
         }
         std::vector<std::unique_ptr<Reconstruction>> recons;
+        std::vector<double> prepare_seconds;
         for (const ReconstructionEntry& e : recons_) {
             ReconstructionSpec spec = e.spec;
             spec.threads = threads_;
+            const auto start = std::chrono::steady_clock::now();
             recons.push_back(std::make_unique<Reconstruction>(fields[e.lattice], spec));
+            prepare_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         }
 
         // Probes with exact values, then the errors of each reconstruction.
@@ -195,7 +209,7 @@ public:
                 "(\"domain_probes\" > 0) or a band that fits inside it (a smaller \"band\")");
         ctx.metrics["regression"]["probes/in_band"] = {{"value", in_band}, {"kind", "exact"}};
         print_header(log, h_ref);
-        for (size_t k = 0; k < recons.size(); ++k) measure(ctx, recons_[k], *recons[k], probes, h_ref);
+        for (size_t k = 0; k < recons.size(); ++k) measure(ctx, recons_[k], *recons[k], probes, h_ref, prepare_seconds[k]);
         if (render_) render_figures(ctx, mesh, fields);
         ctx.metrics["thesis_figures"] = figures_;
     }
@@ -207,25 +221,33 @@ private:
         return s;
     }
 
+    static std::string panel_list(const std::vector<FigurePanelSpec>& panels) {
+        std::string s;
+        for (const FigurePanelSpec& p : panels) s += (s.empty() ? "" : ", ") + p.letter + " " + p.interpolator + "/" + p.derivatives;
+        return s;
+    }
+
     static void print_header(std::ostream& log, double h) {
         char line[256];
-        std::snprintf(line, sizeof line, "  errors in units of h = %.4g (the coarsest spacing):\n  %-44s %10s %10s %10s %10s %8s %8s\n",
-                      h, "reconstruction", "RMS", "max", "band mean", "band RMS", "angle", "p95");
+        std::snprintf(line, sizeof line,
+                      "  errors in units of h = %.4g (the coarsest spacing):\n  %-44s %10s %10s %10s %10s %8s %8s %8s\n", h,
+                      "reconstruction", "RMS", "max", "band mean", "band RMS", "angle", "p95", "ns/point");
         log << line;
     }
 
     void measure(RunContext& ctx, const ReconstructionEntry& e, const Reconstruction& recon, const ProbeSet& probes,
-                 double h) {
+                 double h, double prepare_seconds) {
         const auto got = recon.evaluate(probes.points, threads_);
+        const EvaluationTiming timing = time_evaluation(recon, probes.points);
         const nlohmann::json err = probe_errors(probes, got);
         const nlohmann::json& d = err["domain"];
         const nlohmann::json& b = err["band"];
         char line[256];
-        std::snprintf(line, sizeof line, "  %-44s %10.4g %10.4g %10.4g %10.4g %7.3g° %7.3g°\n",
+        std::snprintf(line, sizeof line, "  %-44s %10.4g %10.4g %10.4g %10.4g %7.3g° %7.3g° %8.1f\n",
                       (e.id + (e.thesis_panel.empty() ? "" : " (" + e.thesis_panel + ")")).c_str(),
                       d["rms"].get<double>() / h, err["max_abs"].get<double>() / h, b["mean_abs"].get<double>() / h,
                       b["rms"].get<double>() / h, b["gradient_angle_mean_deg"].get<double>(),
-                      b["gradient_angle_p95_deg"].get<double>());
+                      b["gradient_angle_p95_deg"].get<double>(), timing.ns_per_point);
         *ctx.log << line;
         ctx.metrics["reconstructions"].push_back({{"id", e.id},
                                                   {"lattice", inputs_.lattice_labels[e.lattice]},
@@ -233,6 +255,9 @@ private:
                                                   {"derivatives", derivative_source_name(e.spec.derivatives)},
                                                   {"description", recon.description()},
                                                   {"thesis_panel", e.thesis_panel},
+                                                  {"prepare_seconds", prepare_seconds},
+                                                  {"eval_ns_per_point", timing.ns_per_point},
+                                                  {"timed_points", timing.points},
                                                   {"errors", err}});
         nlohmann::json& reg = ctx.metrics["regression"];
         auto add = [&](const std::string& name, double v) { reg[e.id + "/" + name] = {{"value", v}, {"kind", "error"}}; };
@@ -244,7 +269,8 @@ private:
         add("gradient_angle_p95_deg", b["gradient_angle_p95_deg"]);
     }
 
-    /// The thesis's grid for every configured view, from the first CC and BCC fields.
+    /// The figure grid for every configured view (the thesis's five panels, or the config's
+    /// "panels"), from the first CC and BCC fields.
     void render_figures(RunContext& ctx, const PreparedMesh& mesh, const std::vector<SampledField>& fields) {
         const SampledField* cc = nullptr;
         const SampledField* bcc = nullptr;
@@ -257,7 +283,7 @@ private:
         for (const ViewRequest& view : render_->views) {
             const CameraSpec camera = resolve_view(view, mesh.vertices(), render_->width, render_->height);
             *ctx.log << "  rendering view " << view.name << " (" << render_->width << "x" << render_->height << ")\n";
-            const ThesisFigure figure = render_thesis_figure(*cc, *bcc, render_->reference ? &mesh : nullptr, camera, options);
+            const ThesisFigure figure = render_thesis_figure(cc, bcc, render_->reference ? &mesh : nullptr, camera, options);
             const std::string dir = ctx.output_dir + "/images/" + view.name;
             std::filesystem::create_directories(dir);
             const std::string grid = write_thesis_figure(dir, mesh.name() + "_" + view.name, figure, provenance);

@@ -54,18 +54,37 @@ struct AnalyticStudySpec {
     ReconstructionSpec reconstruction{kind_of<BccCubic>(), DerivativeSource::FiniteDifferences};
     int probes_per_axis = 256;  ///< probes at the cell centres of a regular grid over the box:
     double margin = 0;          ///< the interpolator's domain() shrunk by margin * h per side
+    /// Extra lattice spacings beyond the box on every side (0: the lattice spans the box).
+    /// The samples counted (lattice, lattice_points) are still those over the box; probes stay
+    /// inside the box. Padding keeps a filter's boundary treatment (the prefilters' mirror
+    /// extension) away from the probes, so that filters are compared on their interior error.
+    int padding = 0;
+    /// probes_per_axis^3 uniformly random probes in the probe box (a fixed counter-based
+    /// sequence: the same points for every filter and thread count) instead of the cell
+    /// centres. A regular probe grid whose spacing is commensurate with the lattice's sits at
+    /// the same few offsets in every cell, and an interpolating filter's error there is not
+    /// its mean: orders measured along a series of lattices then alternate.
+    bool random_probes = false;
     int threads = 0;
 };
 
 struct AnalyticStudyResult {
     std::string description;
-    std::string lattice;       ///< thesis notation
+    std::string lattice;       ///< thesis notation, of the lattice over the box (without padding)
     int64_t lattice_points = 0;
+    int padding = 0;           ///< spacings the sampled lattice extends beyond the box
+    bool random_probes = false;
     int64_t probes = 0;
     double rms = 0, max_abs = 0, mean_abs = 0, l2_norm = 0;
     double rms_255 = 0, l2_norm_255 = 0;
     double gradient_rms = 0;   ///< RMS of |grad error|
     DomainBox<double> probe_box{};
+    /// Cost (time_evaluation in reconstruction.h): building the reconstruction (derivative
+    /// arrays or prefilter, on `threads`), and one thread's time per evaluation at up to 2^16
+    /// probes spread evenly over the probe grid.
+    double prepare_seconds = 0;
+    double eval_ns_per_point = 0;
+    int64_t timed_points = 0;
 };
 
 AnalyticStudyResult run_analytic_study(const AnalyticStudySpec& spec);

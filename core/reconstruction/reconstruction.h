@@ -42,4 +42,18 @@ private:
     LatticeFieldView<double> view_;
 };
 
+/// Evaluation speed as the studies record it: one thread, double, value + gradient, through
+/// the batched evaluate() (one dispatch per batch, as the studies evaluate), at the first
+/// min(points.size(), max_points) points in their given order, in chunks of 1024 points
+/// whose fastest of `repetitions` passes count, so that a loaded machine's interruptions
+/// count less (the figure is the filter's uncontended cost). Speed is recorded, never
+/// asserted.
+struct EvaluationTiming {
+    double ns_per_point = 0;
+    int64_t points = 0;
+    int repetitions = 0;
+};
+EvaluationTiming time_evaluation(const Reconstruction& recon, const std::vector<Vec3d>& points,
+                                 int64_t max_points = int64_t(1) << 16, int repetitions = 5);
+
 }  // namespace sdf

@@ -1,6 +1,7 @@
 #include "experiments/common/reconstruction_list.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace sdf {
 namespace {
@@ -57,12 +58,40 @@ std::string thesis_panel(const ReconstructionSpec& s) {
     }
 }
 
+/// Every filter of the lattice's type in table order, with each derivative source except
+/// fd_weighted (a variant of the fit with its own parameter; name it explicitly).
+std::vector<ReconstructionEntry> every_filter(size_t lattice, const std::string& label, LatticeType type) {
+    std::vector<ReconstructionEntry> out;
+    for (int k = 0; k < kInterpolatorKinds; ++k) {
+        const InterpolatorKind kind = InterpolatorKind(k);
+        if (interpolator_lattice(kind) != type) continue;
+        for (DerivativeSource source : valid_derivative_sources(kind))
+            if (source != DerivativeSource::FiniteDifferencesWeighted) out.push_back(entry(lattice, label, kind, source));
+    }
+    return out;
+}
+
 std::vector<ReconstructionEntry> read_reconstructions(JsonReader& config, const std::vector<LatticeSpec>& lattices,
                                                       const std::vector<std::string>& labels) {
     std::vector<ReconstructionEntry> out;
-    if (!config.has("reconstructions")) {
+    const bool named_set = config.has("reconstructions") && config.json().at("reconstructions").is_string();
+    const std::string set = named_set ? config.choice("reconstructions", {"thesis", "all"}, "thesis") : "thesis";
+    if (!config.has("reconstructions") || named_set) {
         for (size_t i = 0; i < lattices.size(); ++i) {
-            if (lattices[i].type == LatticeType::CC) {
+            if (set == "all") {
+                for (ReconstructionEntry& e : every_filter(i, labels[i], lattices[i].type)) {
+                    Lattice l;
+                    l.type = lattices[i].type;
+                    l.resolution = lattice_spec_resolution(lattices[i]);
+                    try {
+                        validate_reconstruction(e.spec, l, /*field_has_gradient=*/true);
+                    } catch (const std::invalid_argument& err) {
+                        config.fail("reconstructions", "\"all\" includes " + e.id + ", which does not fit lattice \"" +
+                                                           labels[i] + "\": " + err.what() + "; name the reconstructions instead");
+                    }
+                    out.push_back(std::move(e));
+                }
+            } else if (lattices[i].type == LatticeType::CC) {
                 out.push_back(entry(i, labels[i], kind_of<Trilinear>(), DerivativeSource::FiniteDifferences));
                 out.push_back(entry(i, labels[i], kind_of<CatmullRom>(), DerivativeSource::FiniteDifferences));
                 out.push_back(entry(i, labels[i], kind_of<TricubicLekienMarsden>(), DerivativeSource::True));

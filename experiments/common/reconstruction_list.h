@@ -9,9 +9,12 @@
 ///      "sigma2": 0.5, "sigma_units": "lattice"}]
 /// "lattice" is a lattice label (lattice_spec.h) or a type when exactly one lattice has it.
 /// "derivatives" defaults to "true" for interpolators that read derivatives, else "fd".
-/// Without "reconstructions": on every CC lattice trilinear, catmull_rom, tricubic_lm/true,
-/// tricubic_lm/fd; on every BCC lattice bcc_linear, bcc_cubic/true, bcc_cubic/fd: the five
-/// of thesis Figures 5-2..5-11 plus the two linear baselines.
+/// Without "reconstructions" (or "reconstructions": "thesis"): on every CC lattice trilinear,
+/// catmull_rom, tricubic_lm/true, tricubic_lm/fd; on every BCC lattice bcc_linear,
+/// bcc_cubic/true, bcc_cubic/fd: the five of thesis Figures 5-2..5-11 plus the two linear
+/// baselines. "reconstructions": "all": every filter of the interpolator table on every
+/// lattice of its type, with each derivative source but fd_weighted (box splines, B-spline,
+/// bcc_cubic_c0 beside the thesis's set; issue 17).
 #pragma once
 
 #include <string>

@@ -1,5 +1,9 @@
 #include "harness/config/render_spec.h"
 
+#include <stdexcept>
+
+#include "core/reconstruction/reconstruction_spec.h"
+
 namespace sdf {
 namespace {
 
@@ -65,7 +69,39 @@ ViewRequest parse_view(JsonReader& parent, const nlohmann::json& entry, size_t i
     return v;
 }
 
+/// One entry of "panels", with errors naming it.
+RenderPanelRequest parse_panel(JsonReader& r, const nlohmann::json& entry, size_t index) {
+    const std::string key = "panels[" + std::to_string(index) + "]";
+    if (!entry.is_string())
+        r.fail(key, "expected \"interpolator\" or \"interpolator/derivatives\", got " + entry.dump());
+    try {
+        return parse_panel_request(entry.get<std::string>());
+    } catch (const std::invalid_argument& e) {
+        r.fail(key, e.what());
+    }
+}
+
 }  // namespace
+
+RenderPanelRequest parse_panel_request(const std::string& text) {
+    const size_t slash = text.find('/');
+    RenderPanelRequest p;
+    p.interpolator = text.substr(0, slash);
+    try {
+        ReconstructionSpec spec;
+        spec.interpolator = parse_interpolator(p.interpolator);
+        spec.derivatives = slash == std::string::npos ? default_derivative_source(spec.interpolator, true)
+                                                      : parse_derivative_source(text.substr(slash + 1));
+        Lattice probe;  // large enough for every filter: only the names and sources are checked here
+        probe.type = interpolator_lattice(spec.interpolator);
+        probe.resolution = {16, 16, 16};
+        validate_reconstruction(spec, probe, /*field_has_gradient=*/true);
+        p.derivatives = derivative_source_name(spec.derivatives);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("\"" + text + "\": " + e.what());
+    }
+    return p;
+}
 
 RenderSpec parse_render_spec(JsonReader& r) {
     RenderSpec s;
@@ -100,6 +136,22 @@ RenderSpec parse_render_spec(JsonReader& r) {
     s.precision = r.choice("precision", {"float", "double"}, s.precision);
     s.grid_downsample = r.optional<int>("grid_downsample", s.grid_downsample, "an integer factor >= 1");
     if (s.grid_downsample < 1) r.fail("grid_downsample", "expected an integer factor >= 1, got " + std::to_string(s.grid_downsample));
+    if (r.has("panels")) {
+        const nlohmann::json& panels = r.raw("panels");
+        if (!panels.is_array() || panels.empty() || panels.size() > 26)
+            r.fail("panels", "expected an array of 1 to 26 reconstructions (\"interpolator\" or "
+                             "\"interpolator/derivatives\"), got " + panels.dump());
+        nlohmann::json resolved = nlohmann::json::array();
+        for (size_t i = 0; i < panels.size(); ++i) {
+            s.panels.push_back(parse_panel(r, panels[i], i));
+            const std::string id = s.panels.back().interpolator + "/" + s.panels.back().derivatives;
+            for (size_t j = 0; j + 1 < s.panels.size(); ++j)
+                if (s.panels[j].interpolator + "/" + s.panels[j].derivatives == id)
+                    r.fail("panels[" + std::to_string(i) + "]", "\"" + id + "\" is already panel " + std::string(1, char('A' + j)));
+            resolved.push_back(id);
+        }
+        r.record("panels", resolved);
+    }
     r.finish();
     return s;
 }

@@ -16,7 +16,13 @@
 ///     "heat_max_degrees": 20,          // heat-map scale
 ///     "backend": "auto",               // cpu, cuda or auto
 ///     "precision": "float",            // cpu casts in float (as the GPU) or double
-///     "grid_downsample": 1             // grid images reduced by this factor
+///     "grid_downsample": 1,            // grid images reduced by this factor
+///     "panels": ["bcc_cubic/true", "bcc_box_quintic", "cc_bspline3"]
+///                                      // the reconstructions in the grid, in order, three per
+///                                      // row, lettered A, B, ...: "interpolator" (its default
+///                                      // derivatives) or "interpolator/derivatives", any filter
+///                                      // of the interpolator table, on the first lattice of its
+///                                      // type; default: the thesis's five (A..E)
 ///   }
 /// Named views: views.h (front, back, side, right, left, top, bottom, three_quarter,
 /// dragon_side, dragon_front). Every key is optional; unknown keys are rejected.
@@ -30,6 +36,12 @@
 
 namespace sdf {
 
+/// One panel of the figure grid: a filter of the interpolator table and its derivative source
+/// (names as in configs; checked against the table when parsed).
+struct RenderPanelRequest {
+    std::string interpolator, derivatives;
+};
+
 struct RenderSpec {
     int width = 512, height = 512;
     std::vector<ViewRequest> views{named_view("three_quarter")};
@@ -39,7 +51,13 @@ struct RenderSpec {
     std::string backend = "auto";
     std::string precision = "float";
     int grid_downsample = 1;
+    std::vector<RenderPanelRequest> panels;  ///< empty: the thesis's five
 };
+
+/// "interpolator" (its default derivative source: "true" where it reads derivatives, else
+/// "fd") or "interpolator/derivatives", checked against the interpolator table; throws
+/// std::invalid_argument quoting the text and saying what is expected.
+RenderPanelRequest parse_panel_request(const std::string& text);
 
 /// Reads a "render" object (r reads that object, e.g. config.optional_object("render")) and
 /// calls r.finish(). Errors name the file, the key path, the value and what was expected.

@@ -3,8 +3,10 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/reconstruction/reconstruction_spec.h"
 #include "harness/render/heat_map.h"
 #include "harness/render/image_io.h"
 
@@ -55,7 +57,11 @@ std::vector<GridRow> figure_rows(const ThesisFigure& f, const FigureOptions& o) 
                                   fixed(p.metrics.normal_angle_degrees.p95, 1) + " deg, " +
                                   percent(p.metrics.coverage_mismatch_fraction)});
     }
-    std::vector<GridRow> rows{{renders[0], renders[1], renders[2]}, {renders[3], renders[4]}};
+    std::vector<GridRow> rows;
+    for (size_t i = 0; i < renders.size(); ++i) {
+        if (i % kPanelsPerRow == 0) rows.emplace_back();
+        rows.back().push_back(renders[i]);
+    }
     if (o.reference_row && f.has_reference) {
         GridRow r{{reduced(shaded_image(f.reference), o.downsample), "Reference: the mesh, ray-traced"}};
         if (!errors.empty()) {
@@ -85,8 +91,54 @@ std::vector<FigurePanelSpec> thesis_figure_panels() {
             {"E", LatticeType::CC, "tricubic_lm", "fd", "CC tricubic, estimated derivatives (= A)"}};
 }
 
+namespace {
+
+/// Captions by interpolator (and derivative source where it matters); filters without one
+/// are captioned with their name.
+struct CaptionRow {
+    const char* interpolator;
+    const char* derivatives;  ///< "" = any
+    const char* caption;
+};
+constexpr CaptionRow kCaptions[] = {
+    {"trilinear", "", "Trilinear"},
+    {"catmull_rom", "", "Catmull-Rom"},
+    {"tricubic_lm", "true", "CC tricubic, true derivatives"},
+    {"tricubic_lm", "fd", "CC tricubic, estimated derivatives"},
+    {"cc_bspline3", "", "CC cubic B-spline, prefiltered"},
+    {"bcc_linear", "", "BCC linear"},
+    {"bcc_cubic", "true", "BCC cubic, true derivatives"},
+    {"bcc_cubic", "fd", "BCC cubic, estimated derivatives"},
+    {"bcc_cubic", "fd_weighted", "BCC cubic, weighted estimate"},
+    {"bcc_cubic_c0", "true", "BCC cubic C0, true derivatives"},
+    {"bcc_cubic_c0", "fd", "BCC cubic C0, estimated derivatives"},
+    {"bcc_cubic_c0", "fd_weighted", "BCC cubic C0, weighted estimate"},
+    {"bcc_box_linear", "", "BCC linear box spline"},
+    {"bcc_box_quintic", "", "BCC quintic box spline, interpolating"},
+    {"bcc_box_quintic_qi", "", "BCC quintic box spline, quasi-interp."},
+    {"bcc_box_quintic_approx", "", "BCC quintic box spline, approximating"},
+};
+
+}  // namespace
+
+std::string panel_caption(const std::string& interpolator, const std::string& derivatives) {
+    for (const CaptionRow& c : kCaptions)
+        if (interpolator == c.interpolator && (c.derivatives[0] == '\0' || derivatives == c.derivatives)) return c.caption;
+    return interpolator + "/" + derivatives;
+}
+
+std::vector<FigurePanelSpec> figure_panels(const std::vector<RenderPanelRequest>& requests) {
+    if (requests.size() > 26) throw std::invalid_argument("figure panels: at most 26 (letters A..Z), got " + std::to_string(requests.size()));
+    std::vector<FigurePanelSpec> out;
+    for (const RenderPanelRequest& r : requests)
+        out.push_back({std::string(1, char('A' + out.size())), interpolator_lattice(parse_interpolator(r.interpolator)),
+                       r.interpolator, r.derivatives, panel_caption(r.interpolator, r.derivatives)});
+    return out;
+}
+
 FigureOptions figure_options(const RenderSpec& spec) {
     FigureOptions o;
+    o.panels = figure_panels(spec.panels);
     o.render.backend = spec.backend;
     o.render.precision = spec.precision == "double" ? Precision::Double : Precision::Float;
     o.reference_row = spec.reference;
@@ -98,6 +150,11 @@ FigureOptions figure_options(const RenderSpec& spec) {
 
 ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bcc, const PreparedMesh* mesh,
                                   const CameraSpec& camera, const FigureOptions& options) {
+    return render_thesis_figure(&cc, &bcc, mesh, camera, options);
+}
+
+ThesisFigure render_thesis_figure(const SampledField* cc, const SampledField* bcc, const PreparedMesh* mesh,
+                                  const CameraSpec& camera, const FigureOptions& options) {
     ThesisFigure f;
     f.camera = camera;
     f.summary["camera"] = camera_to_json(camera);
@@ -106,11 +163,13 @@ ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bc
         f.has_reference = true;
         f.summary["reference"] = f.reference.info;
     }
-    for (const FigurePanelSpec& spec : thesis_figure_panels()) {
-        const SampledField& field = spec.lattice == LatticeType::CC ? cc : bcc;
-        if (field.lattice.type != spec.lattice)
-            throw std::invalid_argument("thesis figure: panel " + spec.letter + " needs a " +
+    for (const FigurePanelSpec& spec : options.panels.empty() ? thesis_figure_panels() : options.panels) {
+        const SampledField* chosen = spec.lattice == LatticeType::CC ? cc : bcc;
+        if (!chosen || chosen->lattice.type != spec.lattice)
+            throw std::invalid_argument("thesis figure: panel " + spec.letter + " (" + spec.interpolator + "/" +
+                                        spec.derivatives + ") needs a " +
                                         (spec.lattice == LatticeType::CC ? "CC" : "BCC") + " field");
+        const SampledField& field = *chosen;
         FigurePanel p;
         p.spec = spec;
         p.label = panel_label(spec, field.lattice);

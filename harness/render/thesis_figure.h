@@ -9,6 +9,9 @@
 ///   row 3:  the mesh reference, and the heat maps' colour bar         (reference_row)
 ///   row 4:  normal error of A..E against the reference at half size, with mean / p95
 ///           angle and the coverage mismatch as a percentage of the pixels (error_rows)
+///
+/// FigureOptions::panels replaces the five by any reconstructions of the interpolator table
+/// (the config's "render": {"panels": [...]}, render_spec.h), three per row, lettered A, B, ...
 #pragma once
 
 #include <string>
@@ -34,6 +37,16 @@ struct FigurePanelSpec {
 /// The thesis's five panels, in order A..E; row 1 is A-C, row 2 is D-E.
 std::vector<FigurePanelSpec> thesis_figure_panels();
 
+/// Panels for the requested reconstructions, lettered A, B, ... in order, captioned from the
+/// table of captions (the filter's name where it has none), on the lattice of their filter.
+std::vector<FigurePanelSpec> figure_panels(const std::vector<RenderPanelRequest>& requests);
+
+/// "BCC quintic box spline (interpolating)", "CC tricubic, true derivatives", ...
+std::string panel_caption(const std::string& interpolator, const std::string& derivatives);
+
+/// Panels per row of the grid.
+constexpr int kPanelsPerRow = 3;
+
 struct FigureOptions {
     RenderOptions render{};
     MeshRenderOptions mesh{};
@@ -42,6 +55,7 @@ struct FigureOptions {
     double heat_max_degrees = 20;
     std::string title;
     int downsample = 1;          ///< grid images reduced by this factor (1 = full size)
+    std::vector<FigurePanelSpec> panels;  ///< empty: thesis_figure_panels()
 };
 
 /// The options a config's "render" block asks for (backend, precision, rows, heat-map scale,
@@ -67,9 +81,13 @@ struct ThesisFigure {
     nlohmann::json summary;      ///< camera, panels (reconstruction, lattice, timings, metrics)
 };
 
-/// Renders the five reconstructions (cc: a CC field with gradients; bcc: a BCC one) and,
-/// when `mesh` is given, the reference and the metrics; assembles the grid.
+/// Renders the panels (cc: a CC field with gradients; bcc: a BCC one) and, when `mesh` is
+/// given, the reference and the metrics; assembles the grid.
 ThesisFigure render_thesis_figure(const SampledField& cc, const SampledField& bcc, const PreparedMesh* mesh,
+                                  const CameraSpec& camera, const FigureOptions& options);
+/// The same with either field absent (null): only panels whose lattice type is present may be
+/// asked for (std::invalid_argument naming the panel otherwise).
+ThesisFigure render_thesis_figure(const SampledField* cc, const SampledField* bcc, const PreparedMesh* mesh,
                                   const CameraSpec& camera, const FigureOptions& options);
 
 /// Writes into `dir` (which must exist): NAME_grid.png and NAME_grid.exr; per panel

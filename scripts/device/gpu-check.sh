@@ -3,7 +3,7 @@
 # touched kernels: builds with CUDA and warnings as errors, runs every GPU test, every CPU test
 # there too, compute-sanitizer on the GPU tests' split/point-query cases, and the CI smoke study
 # from a portable CPU build (whose field checksums must equal those of any other CPU target).
-#   carry: .gpu-prefix data        steps: build gputest test sanitize portable
+#   carry: .gpu-prefix data        steps: build gputest test sanitize portable bench-filters
 # Output under $OUT: summary.txt and the logs.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -53,6 +53,16 @@ portable)
     rm -rf /tmp/smoke && build-portable/bin/run-experiment configs/ci_smoke.json --output-root /tmp/smoke/results \
         --cache-dir /tmp/smoke/cache --quiet > "$OUT/smoke.log" 2>&1
     (cd /tmp/smoke && find cache -name '*.raw' | sort | xargs sha256sum | sed 's#cache/fields/../##') | tee "$OUT/smoke-portable.sha256" ;;
+bench-filters)
+    # Issue 17: every filter's evaluation speed through the ray caster on the GPU (CUDA events),
+    # and the CPU evaluation benchmark of every filter on this machine's CPU for comparison.
+    log "bench_raycast_filters (GPU), bench_reconstruction (CPU)"
+    $B/tests/benchmarks/bench_raycast_filters --benchmark_filter=/cuda --benchmark_counters_tabular=true \
+        --benchmark_out="$OUT/bench_raycast_filters.json" --benchmark_out_format=json > "$OUT/bench_raycast_filters.txt" 2>&1
+    echo "bench_raycast_filters exit $?" | tee -a "$OUT/summary.txt"
+    $B/tests/benchmarks/bench_reconstruction --benchmark_filter='BM_Evaluate<float>' --benchmark_counters_tabular=true \
+        --benchmark_out="$OUT/bench_reconstruction.json" --benchmark_out_format=json > "$OUT/bench_reconstruction.txt" 2>&1
+    echo "bench_reconstruction exit $?" | tee -a "$OUT/summary.txt" ;;
 *) echo "unknown step $step"; exit 2 ;;
 esac; done
 log done

@@ -20,13 +20,18 @@ def table_4_1(t):
     return table
 
 
+def eval_cost(entry):
+    """One thread's time per evaluation as the harness measured it; n/a in runs before it did."""
+    return number(entry["eval_ns_per_point"], 3) if "eval_ns_per_point" in entry else "n/a"
+
+
 def convergence_table(c):
-    table = Table(["reconstruction", "lattice", "points", "RMS", "max abs error", "gradient RMS"])
+    table = Table(["reconstruction", "lattice", "points", "RMS", "max abs error", "gradient RMS", "eval (ns/point)"])
     for curve in c["curves"]:
         label = reconstruction_label(*split_curve_id(curve["id"]))
         for p in curve["points"]:
             table.add([label, p["lattice"], count(p["lattice_points"]), number(p["rms"]), number(p["max_abs"]),
-                       number(p["gradient_rms"])])
+                       number(p["gradient_rms"]), eval_cost(p)])
     return table
 
 

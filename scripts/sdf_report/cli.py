@@ -5,7 +5,7 @@ import datetime
 import os
 import sys
 
-from . import analytic, overview, peers, plots, reconstruction, sampling, speedup
+from . import analytic, filters, overview, peers, plots, reconstruction, sampling, speedup
 from . import runs as run_loader
 from . import schema as run_schema
 from .document import Document
@@ -28,7 +28,7 @@ directory; --publish writes the committed report, results/report/. docs/harness.
 ("Reports") describes the sections.
 """
 
-SECTIONS = (sampling.section, speedup.section, analytic.section, reconstruction.section, peers.section)
+SECTIONS = (sampling.section, speedup.section, analytic.section, reconstruction.section, filters.section, peers.section)
 
 
 def parse_args(argv):

@@ -5,10 +5,11 @@ for sweeps, and the thesis's image grids with their image metrics."""
 import os
 
 from . import images, plots
+from .analytic import eval_cost
 from .tables import Table, count, distinct_functions, number, percent, reconstruction_label, same_function_as
 
 ERROR_HEADER = ["reconstruction", "thesis panel", "RMS / h", "max / h", "band mean / h", "band RMS / h",
-                "angle mean (deg)", "angle p95 (deg)"]
+                "angle mean (deg)", "angle p95 (deg)", "eval (ns/point)"]
 
 
 def error_table(metrics):
@@ -19,7 +20,8 @@ def error_table(metrics):
         table.add([reconstruction_label(rec["interpolator"], rec["derivatives"], rec["lattice"] + "/"),
                    rec["thesis_panel"] or "-", number(e["domain"]["rms"] / h), number(e["max_abs"] / h),
                    number(e["band"]["mean_abs"] / h), number(e["band"]["rms"] / h),
-                   number(e["band"]["gradient_angle_mean_deg"], 3), number(e["band"]["gradient_angle_p95_deg"], 3)])
+                   number(e["band"]["gradient_angle_mean_deg"], 3), number(e["band"]["gradient_angle_p95_deg"], 3),
+                   eval_cost(rec)])
     return table
 
 
@@ -128,7 +130,9 @@ def grids_section(doc, runs):
     doc.paragraph("Each grid is laid out as the thesis's figures: A Catmull-Rom (CC), B BCC cubic with true derivatives, "
                   "C BCC cubic with estimated derivatives; D CC tricubic with true, E with estimated derivatives (E is "
                   "the same function as A); then the mesh itself (ray-traced) and the normal-error heat maps of A..E "
-                  "against it. Image metrics are against that reference.")
+                  "against it. Image metrics are against that reference. A study whose \"render\" block lists "
+                  "\"panels\" shows those reconstructions instead, lettered in its order (e.g. the thesis's five "
+                  "and then the prefiltered splines).")
     found = grids(runs)
     if not found:
         doc.note("No rendered grids in these results (the studies' \"render\" block renders them).")

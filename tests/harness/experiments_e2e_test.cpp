@@ -213,7 +213,74 @@ TEST_F(E2e, ReconstructionStudyRendersTheThesisGridWithImageMetrics) {
     EXPECT_TRUE(metrics.at("regression").contains("render/front/B_bcc_cubic_true/normal_angle_mean_deg"));
 }
 
+TEST_F(E2e, EveryFilterWithItsCostAndConfiguredGridPanels) {
+    json cfg = tiny_study("all_tiny");
+    cfg["mesh"] = {{"shape", "pawn"}};
+    cfg["lattices"] = {{{"type", "cc"}, {"resolution", {12, 12, 12}}}, {{"type", "bcc"}, {"resolution", {10, 10, 20}}}};
+    cfg["reconstructions"] = "all";
+    cfg["render"] = {{"size", {32, 32}}, {"views", {"front"}}, {"backend", "cpu"},
+                     {"panels", {"bcc_cubic/true", "bcc_box_quintic"}}};
+    write("all.json", cfg.dump());
+    const ShellResult dry = run("all.json --output-root out --dry-run");
+    ASSERT_EQ(dry.code, 0) << dry.err;
+    EXPECT_TRUE(Contains(dry.out, "reconstruct cc-12x12x12/cc_bspline3/fd")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "reconstruct bcc-10x10x20/bcc_box_quintic_approx/fd")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "panels A bcc_cubic/true, B bcc_box_quintic/fd")) << dry.out;
+    const ShellResult r = run("all.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json metrics = read_json(only_run("all_tiny") / "metrics.json");
+    // 5 CC filters (tricubic_lm twice) and 9 BCC ones (bcc_cubic and bcc_cubic_c0 twice)
+    ASSERT_EQ(metrics.at("reconstructions").size(), 14u);
+    const int64_t probes = metrics.at("probes").at("domain").get<int64_t>() + metrics["probes"].at("band_placed").get<int64_t>();
+    for (const json& rec : metrics["reconstructions"]) {
+        EXPECT_GT(rec.at("eval_ns_per_point").get<double>(), 0.0) << rec.at("id");
+        EXPECT_GE(rec.at("prepare_seconds").get<double>(), 0.0) << rec.at("id");
+        EXPECT_EQ(rec.at("timed_points").get<int64_t>(), probes) << rec.at("id");  // every probe (fewer than 2^16)
+        EXPECT_LT(rec.at("errors").at("band").at("rms").get<double>(), 0.5) << rec.at("id");
+    }
+    const json& view = metrics.at("render").at("views").at("front");
+    ASSERT_EQ(view.at("panels").size(), 2u);
+    EXPECT_EQ(view["panels"][1].at("label"), "B  BCC quintic box spline, interpolating (10x10x20)");
+    EXPECT_TRUE(metrics.at("regression").contains("render/front/B_bcc_box_quintic_fd/normal_angle_mean_deg"));
+
+    // Panels on a lattice type the study lacks: refused before anything runs, naming the panel.
+    cfg["lattices"] = {{{"type", "bcc"}, {"resolution", {10, 10, 20}}}};
+    cfg["render"]["panels"] = {"bcc_box_quintic", "cc_bspline3"};
+    write("cc_missing.json", cfg.dump());
+    const ShellResult bad = run("cc_missing.json --output-root out --dry-run");
+    EXPECT_NE(bad.code, 0);
+    EXPECT_TRUE(Contains(bad.err, "the panels need a CC lattice in \"lattices\" (panel B: cc_bspline3/fd)")) << bad.err;
+}
+
 // ---- the other kinds at tiny sizes -------------------------------------------------------------
+
+TEST_F(E2e, AnalyticConvergencePaddedLatticesAndCosts) {
+    write("pad.json", json{{"name", "pad_tiny"},
+                           {"kind", "analytic"},
+                           {"threads", 1},
+                           {"convergence", {{"function", "marschner_lobb"}, {"samples", {4000}},
+                                            {"interpolators", {"cc_bspline3", "bcc_box_quintic", "bcc_linear"}},
+                                            {"probes_per_axis", 8}, {"margin", 0}, {"padding", 4}, {"probes", "random"}}}}
+                          .dump());
+    const ShellResult r = run("pad.json --output-root out --quiet");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json m = read_json(only_run("pad_tiny") / "metrics.json");
+    for (const json& curve : m.at("convergence").at("curves")) {
+        const json& p = curve.at("points").at(0);
+        EXPECT_EQ(p.at("padding_spacings"), 4);
+        EXPECT_EQ(p.at("random_probes"), true);
+        // The samples counted are those over [-1,1]^3 (16^3 CC, 13^3 + 12^3 BCC), not the padding's.
+        EXPECT_EQ(p.at("lattice_points"), curve.at("lattice_type") == "cc" ? 4096 : 3925) << curve.at("id");
+        // Padding beyond the margin: every filter is probed over all of [-1,1]^3.
+        EXPECT_EQ(p.at("probe_box"), json({{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}})) << curve.at("id");
+        EXPECT_GT(p.at("eval_ns_per_point").get<double>(), 0.0);
+        EXPECT_EQ(p.at("timed_points"), 512);
+    }
+    write("pad_bad.json", json{{"name", "b"}, {"kind", "analytic"}, {"convergence", {{"padding", 40}}}}.dump());
+    const ShellResult bad = run("pad_bad.json --dry-run");
+    EXPECT_NE(bad.code, 0);
+    EXPECT_TRUE(Contains(bad.err, "'convergence.padding'")) << bad.err;
+}
 
 TEST_F(E2e, AnalyticKindTinyTable41AndConvergence) {
     write("ml.json", json{{"name", "ml_tiny"},

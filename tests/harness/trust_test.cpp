@@ -494,6 +494,8 @@ TEST_F(Trust, CommandLineErrorsExitWithCode2InEveryTool) {
         {SDF_RENDER_EXE, "shape:box --margin -1"},
         {SDF_RENDER_EXE, "shape:box --threads -2"},
         {SDF_RENDER_EXE, "shape:box --size 0"},
+        {SDF_RENDER_EXE, "shape:box --grid --panels bcc_cubic,bcc_quintic"},       // no such filter
+        {SDF_RENDER_EXE, "shape:box --grid --panels bcc_box_quintic/true"},        // reads no derivatives
         {RUN_EXPERIMENT_EXE, "--no-such-option"},
         {RUN_EXPERIMENT_EXE, ""},
     };

@@ -214,5 +214,46 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     EXPECT_TRUE(fs::exists(dir.at("pawn_B_bcc_cubic_true.metrics.json")));
 }
 
+TEST(ThesisFigure, ConfiguredPanelsOnlyTheBccField) {
+    // The dragon-style comparison of issue 17 at a tiny size: the thesis's BCC cubic beside the
+    // quintic box spline and the linear box spline; no CC field is needed, none is given.
+    const PreparedMesh mesh = prepare_mesh(make_pawn());
+    SamplerOptions so;
+    so.progress = false;
+    auto sampler = make_cpu_brute_force_sampler(so);
+    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {12, 12, 12}, mesh.bounds(), 0.1));
+    FigureOptions options;
+    options.render.progress = false;
+    options.mesh.progress = false;
+    options.panels = figure_panels({{"bcc_cubic", "true"}, {"bcc_box_quintic", "fd"}, {"bcc_box_linear", "fd"},
+                                    {"bcc_box_quintic_qi", "fd"}});
+    const CameraSpec camera = resolve_view(named_view("front"), mesh.bounds(), 24, 32);
+    const ThesisFigure f = render_thesis_figure(nullptr, &bcc, &mesh, camera, options);
+    ASSERT_EQ(f.panels.size(), 4u);
+    EXPECT_EQ(f.panels[0].label, "A  BCC cubic, true derivatives (12x12x24)");
+    EXPECT_EQ(f.panels[1].label, "B  BCC quintic box spline, interpolating (12x12x24)");
+    EXPECT_EQ(f.panels[2].label, "C  BCC linear box spline (12x12x24)");
+    EXPECT_EQ(f.panels[3].label, "D  BCC quintic box spline, quasi-interp. (12x12x24)");
+    EXPECT_EQ(f.summary["panels"][1]["render"]["reconstruction"], "bcc_box_quintic/fd");
+    for (const FigurePanel& p : f.panels) {
+        EXPECT_TRUE(p.has_metrics);
+        EXPECT_GT(p.metrics.hit_both, 50) << p.label;  // the pawn is there in every panel
+    }
+    // Rows: A-C, D, the reference + colour bar, the four heat maps
+    ASSERT_EQ(f.rows.size(), 4u);
+    EXPECT_EQ(f.rows[0].size(), 3u);
+    EXPECT_EQ(f.rows[1].size(), 1u);
+    EXPECT_EQ(f.rows[3].size(), 4u);
+    EXPECT_NE(f.summary["grid"]["labels"].get<std::string>().find("B  BCC quintic box spline"), std::string::npos);
+    // A CC panel without a CC field is refused, naming the panel.
+    options.panels = figure_panels({{"bcc_cubic", "true"}, {"cc_bspline3", "fd"}});
+    try {
+        render_thesis_figure(nullptr, &bcc, nullptr, camera, options);
+        ADD_FAILURE() << "a CC panel rendered without a CC field";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("panel B (cc_bspline3/fd) needs a CC field"), std::string::npos) << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace sdf

@@ -81,5 +81,40 @@ TEST(RenderSpec, ErrorsNameKeyValueAndExpectation) {
     EXPECT_NE(error_of(R"({"views": []})").find("non-empty"), std::string::npos);
 }
 
+TEST(RenderSpec, PanelsChooseAnyReconstructionOfTheTable) {
+    EXPECT_TRUE(parse("{}").panels.empty());  // the thesis's five
+    const RenderSpec s = parse(R"({"panels": ["bcc_cubic/true", "bcc_box_quintic", "cc_bspline3", "tricubic_lm"]})");
+    ASSERT_EQ(s.panels.size(), 4u);
+    EXPECT_EQ(s.panels[1].interpolator, "bcc_box_quintic");
+    EXPECT_EQ(s.panels[1].derivatives, "fd");    // values only: its one source
+    EXPECT_EQ(s.panels[3].derivatives, "true");  // reads derivatives: the field's gradients
+    const FigureOptions o = figure_options(s);
+    ASSERT_EQ(o.panels.size(), 4u);
+    EXPECT_EQ(o.panels[0].letter, "A");
+    EXPECT_EQ(o.panels[0].caption, "BCC cubic, true derivatives");
+    EXPECT_EQ(o.panels[1].letter, "B");
+    EXPECT_EQ(o.panels[1].lattice, LatticeType::BCC);
+    EXPECT_EQ(o.panels[1].caption, "BCC quintic box spline, interpolating");
+    EXPECT_EQ(o.panels[2].lattice, LatticeType::CC);
+    EXPECT_EQ(o.panels[2].caption, "CC cubic B-spline, prefiltered");
+    EXPECT_EQ(o.panels[3].caption, "CC tricubic, true derivatives");
+    // Every filter of the table has a caption of its own (not the name fallback).
+    for (const std::string& name : interpolator_names()) {
+        const std::string source = derivative_source_name(default_derivative_source(parse_interpolator(name), true));
+        EXPECT_NE(panel_caption(name, source), name + "/" + source) << name;
+    }
+}
+
+TEST(RenderSpec, PanelErrorsNameTheEntry) {
+    const std::string unknown = error_of(R"({"panels": ["bcc_cubic", "bcc_quintic"]})");
+    EXPECT_NE(unknown.find("render.panels[1]"), std::string::npos) << unknown;
+    EXPECT_NE(unknown.find("unknown interpolator 'bcc_quintic'"), std::string::npos) << unknown;
+    EXPECT_NE(error_of(R"({"panels": ["bcc_box_quintic/true"]})").find("does not accept derivatives 'true'"), std::string::npos);
+    EXPECT_NE(error_of(R"({"panels": []})").find("1 to 26"), std::string::npos);
+    EXPECT_NE(error_of(R"({"panels": [3]})").find("render.panels[0]"), std::string::npos);
+    const std::string twice = error_of(R"({"panels": ["catmull_rom", "bcc_linear", "catmull_rom/fd"]})");
+    EXPECT_NE(twice.find("\"catmull_rom/fd\" is already panel A"), std::string::npos) << twice;
+}
+
 }  // namespace
 }  // namespace sdf
