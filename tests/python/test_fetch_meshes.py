@@ -86,7 +86,8 @@ def test_every_study_mesh_is_in_the_table():
     """No config names a mesh file that fetch-meshes does not provide."""
     import json
     import re
-    provided = {row[0] for row in load_script().SOURCES}
+    script = load_script()
+    provided = {row[0] for row in script.SOURCES} | set(script.DERIVED)
     named = set()
     for root, _, files in os.walk(os.path.join(REPO, "configs")):
         for f in files:
@@ -95,6 +96,37 @@ def test_every_study_mesh_is_in_the_table():
             named |= set(re.findall(r'"mesh":\s*\{\s*"file":\s*"([^"]+)"', text))
     files = {m for m in named if not m.startswith("shape:")}
     assert files and files <= provided, files - provided
+
+
+def test_a_derived_file_keeps_the_geometry_of_its_source(tmp_path, monkeypatch, capsys):
+    """dragon-legacy.obj from a photon-dragon.obj: header replaced, v/f tokens kept; a source
+    whose geometry differs is not derived."""
+    module = load_script()
+    geometry = "v 1 2 3\nv 4 5 6\nv 7 8 9\nf 1 2 3\n"
+    source_text = "# photon header\nv 1 2 3\nv 4 5 6   \nv 7 8 9\nf 1/1 2/2 3/3\n"
+    digest = hashlib.sha256(geometry.encode()).hexdigest()
+    monkeypatch.setattr(module, "DERIVED", {"legacy.obj": ("src.obj", "# new header\n", digest)})
+    (tmp_path / "src.obj").write_text(source_text)
+    staging = tmp_path / "staging"
+    staging.mkdir()
+    assert module.derive("legacy.obj", str(tmp_path), str(staging)) is None
+    assert (tmp_path / "legacy.obj").read_text() == "# new header\n" + geometry
+    (tmp_path / "src.obj").write_text(source_text.replace("v 7 8 9", "v 7 8 10"))
+    (tmp_path / "legacy.obj").unlink()
+    assert "geometry SHA-256" in module.derive("legacy.obj", str(tmp_path), str(staging))
+    assert not (tmp_path / "legacy.obj").exists()
+
+
+def test_the_thesis_dragon_derivation_matches_the_workplace_copy():
+    """The pinned geometry digest is that of the reference dragon-legacy.obj (where present)."""
+    module = load_script()
+    reference = os.path.join(os.path.dirname(REPO), "shared", "meshes", "dragon-legacy.obj")
+    if not os.path.isfile(reference):
+        pytest.skip("no ../shared/meshes/dragon-legacy.obj on this machine")
+    h = hashlib.sha256()
+    for line in module.geometry_lines(reference):
+        h.update(line.encode())
+    assert h.hexdigest() == module.DERIVED["dragon-legacy.obj"][2]
 
 
 @pytest.mark.skipif(not os.path.isdir(MIRROR), reason="no ../shared/sources mirror on this machine")
