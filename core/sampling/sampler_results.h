@@ -27,6 +27,15 @@ inline SampledField unfilled_field(const Lattice& lattice, Precision precision) 
     return field;
 }
 
+/// The same for the points of one slab of `lattice` (compact: its primary, then secondary planes).
+inline SampledField unfilled_field(const Lattice& lattice, const LatticeSlab& slab, Precision precision) {
+    SampledField field;
+    field.lattice = lattice;
+    field.precision = precision;
+    field.resize(slab_point_count(lattice, slab));
+    return field;
+}
+
 /// Stores one result at lattice index `out`; `triangle` indexes `mesh`'s prepared triangles.
 inline void store_sample(SampledField& field, int64_t out, const PreparedMesh& mesh, double distance,
                          const Vec3d& gradient, int32_t triangle) {

@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Distributed runs under mpirun (docs/distributed.md), small and fast for CI's 2 cores.
+#   mpi_runs.sh bit_identity RUN_EXPERIMENT MPIEXEC
+#       a sampling sweep (brute force and BVH, CC and BCC lattices, a procedural torus) run by
+#       one process and by 2 and 3 ranks: every field file's bytes must be equal, and the
+#       manifest must record the ranks.
+#   mpi_runs.sh failure RUN_EXPERIMENT MPIEXEC
+#       a rank that fails (SDF_MPI_FAIL_RANK) or dies (SDF_MPI_FAIL_MODE=kill) must fail the
+#       run: non-zero exit, a message naming the rank and its host, no run directory, no
+#       cache entry.
+set -euo pipefail
+case_name=$1 tool=$2 mpiexec=$3
+work=$(mktemp -d "${TMPDIR:-/tmp}/sdf-mpi-test.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+# CI runs as root; shared memory only (one machine); more ranks than cores.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_btl=self,vader OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_rmaps_base_oversubscribe=1
+mpi() { local n=$1; shift; "$mpiexec" --oversubscribe -np "$n" "$@"; }
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+cat > "$work/mpi_fields.json" <<'JSON'
+{
+  "name": "mpi_fields",
+  "kind": "sampling",
+  "mesh": {"shape": "torus", "major_segments": 24, "minor_segments": 12},
+  "lattices": [
+    {"type": "cc", "resolution": [11, 9, 13]},
+    {"type": "bcc", "resolution": [8, 7, 18]}
+  ],
+  "sampler": {"backend": "cpu", "progress": false},
+  "output": {"dtype": "float64"},
+  "sweep": {"sampler.method": ["brute_force", "bvh"]}
+}
+JSON
+
+run_dir() {  # the one run directory under $1/mpi_fields
+    local dirs=("$1"/mpi_fields/*/)
+    [ "${#dirs[@]}" -eq 1 ] && [ -d "${dirs[0]}" ] || fail "expected one run directory under $1/mpi_fields"
+    echo "${dirs[0]%/}"
+}
+
+if [ "$case_name" = bit_identity ]; then
+    "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/serial" > "$work/serial.log"
+    serial=$(run_dir "$work/serial")
+    (cd "$serial" && find . -name '*.raw' | sort) > "$work/serial.files"
+    [ "$(wc -l < "$work/serial.files")" -eq 12 ] || fail "expected 12 channel files (2 methods x 2 lattices x 3 channels)"
+    for n in 2 3; do
+        mpi "$n" "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/np$n" > "$work/np$n.log" 2>&1 ||
+            { cat "$work/np$n.log"; fail "mpirun -np $n failed"; }
+        dist=$(run_dir "$work/np$n")
+        (cd "$dist" && find . -name '*.raw' | sort) | diff "$work/serial.files" - || fail "np $n: other files"
+        while read -r f; do
+            cmp "$serial/$f" "$dist/$f" || fail "np $n: $f differs from the single process's"
+        done < "$work/serial.files"
+        grep -q "\"ranks\": $n" "$dist/manifest.json" || fail "np $n: the manifest does not record $n ranks"
+        grep -q '"load_balance"' "$dist/manifest.json" || fail "np $n: no load balance in the manifest"
+        grep -q '"bvh_visits"' "$dist/manifest.json" || fail "np $n: the BVH fields were not planned from BVH visits"
+        echo "np $n: $(wc -l < "$work/serial.files") channel files identical to the single process's"
+    done
+    exit 0
+fi
+
+if [ "$case_name" = failure ]; then
+    # label, failing rank, log; the run must have failed and published nothing. A killed root
+    # may leave its hidden staging directory (the next run removes it), never a run directory.
+    expect_clean_failure() {
+        local label=$1 log=$3
+        [ ! -d "$work/out/mpi_fields" ] || [ -z "$(ls "$work/out/mpi_fields")" ] || fail "$label: a run directory was left: $(ls "$work/out/mpi_fields")"
+        ! find "$work/cache" -name entry.json -not -path '*/.*' 2>/dev/null | grep -q . || fail "$label: the cache holds an entry of the failed run"
+        grep -Eq "rank $2[^0-9].*$(hostname)|$(hostname).*rank $2[^0-9]" "$log" ||
+            grep -Eq "rank $2 .*node" "$log" || { cat "$log"; fail "$label: the message does not name rank $2 and its host"; }
+    }
+    for failing in 1 0; do
+        if SDF_MPI_FAIL_RANK=$failing mpi 2 "$tool" "$work/mpi_fields.json" --quiet --cache-dir "$work/cache" \
+               --output-root "$work/out" > "$work/fail$failing.log" 2>&1; then
+            fail "the run with rank $failing failing succeeded"
+        fi
+        grep -q "injected failure" "$work/fail$failing.log" || { cat "$work/fail$failing.log"; fail "no error message"; }
+        expect_clean_failure "rank $failing errs" "$failing" "$work/fail$failing.log"
+        [ ! -d "$work/out/mpi_fields" ] || [ -z "$(ls -A "$work/out/mpi_fields")" ] || fail "rank $failing errs: staging left behind"
+        echo "rank $failing errs: the run failed cleanly: $(grep -m1 'error:' "$work/fail$failing.log")"
+    done
+    if SDF_MPI_FAIL_RANK=2 SDF_MPI_FAIL_MODE=kill mpi 3 "$tool" "$work/mpi_fields.json" --quiet --cache-dir "$work/cache" \
+           --output-root "$work/out" > "$work/dies.log" 2>&1; then
+        fail "the run with a dying rank succeeded"
+    fi
+    expect_clean_failure "rank 2 dies" 2 "$work/dies.log"
+    echo "rank 2 dies: the run failed cleanly"
+    exit 0
+fi
+fail "unknown case $case_name"
