@@ -44,29 +44,44 @@ if [ "$case_name" = bit_identity ]; then
     serial=$(run_dir "$work/serial")
     (cd "$serial" && find . -name '*.raw' | sort) > "$work/serial.files"
     [ "$(wc -l < "$work/serial.files")" -eq 12 ] || fail "expected 12 channel files (2 methods x 2 lattices x 3 channels)"
+    (cd "$serial" && find . | sort) > "$work/serial.tree"
+    same_fields() {  # label, run directory: the same channel files, byte for byte
+        (cd "$2" && find . -name '*.raw' | sort) | diff "$work/serial.files" - || fail "$1: other files"
+        while read -r f; do
+            cmp "$serial/$f" "$2/$f" || fail "$1: $f differs from the single process's"
+        done < "$work/serial.files"
+    }
     for n in 2 3; do
         mpi "$n" "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/np$n" > "$work/np$n.log" 2>&1 ||
             { cat "$work/np$n.log"; fail "mpirun -np $n failed"; }
         dist=$(run_dir "$work/np$n")
-        (cd "$dist" && find . -name '*.raw' | sort) | diff "$work/serial.files" - || fail "np $n: other files"
-        while read -r f; do
-            cmp "$serial/$f" "$dist/$f" || fail "np $n: $f differs from the single process's"
-        done < "$work/serial.files"
+        same_fields "np $n" "$dist"
         grep -q "\"ranks\": $n" "$dist/manifest.json" || fail "np $n: the manifest does not record $n ranks"
         grep -q '"load_balance"' "$dist/manifest.json" || fail "np $n: no load balance in the manifest"
         grep -q '"bvh_visits"' "$dist/manifest.json" || fail "np $n: the BVH fields were not planned from BVH visits"
         echo "np $n: $(wc -l < "$work/serial.files") channel files identical to the single process's"
     done
+    # A sweep distributed run by run: the same tree, the same fields.
+    mpi 2 "$tool" "$work/mpi_fields.json" --no-cache --quiet --distribute runs --output-root "$work/runs" > "$work/runs.log" 2>&1 ||
+        { cat "$work/runs.log"; fail "mpirun -np 2 --distribute runs failed"; }
+    dist=$(run_dir "$work/runs")
+    (cd "$dist" && find . | sort) | diff "$work/serial.tree" - || fail "--distribute runs: another results tree"
+    same_fields "--distribute runs" "$dist"
+    grep -q '"mode": "runs"' "$dist/manifest.json" || fail "--distribute runs: the manifest does not say so"
+    echo "--distribute runs: the same results tree and channel files"
     exit 0
 fi
 
 if [ "$case_name" = failure ]; then
-    # label, failing rank, log; the run must have failed and published nothing. A killed root
-    # may leave its hidden staging directory (the next run removes it), never a run directory.
+    # label, failing rank, log[, "runs"]; the run must have failed and published nothing. A
+    # killed root may leave its hidden staging directory (the next run removes it), never a run
+    # directory. The injected failures strike at the first slab, so the cache stays empty;
+    # distributed by runs, the root's own run completes, and its fields may be cached.
     expect_clean_failure() {
         local label=$1 log=$3
         [ ! -d "$work/out/mpi_fields" ] || [ -z "$(ls "$work/out/mpi_fields")" ] || fail "$label: a run directory was left: $(ls "$work/out/mpi_fields")"
-        ! find "$work/cache" -name entry.json -not -path '*/.*' 2>/dev/null | grep -q . || fail "$label: the cache holds an entry of the failed run"
+        [ "${4:-}" = runs ] || ! find "$work/cache" -name entry.json -not -path '*/.*' 2>/dev/null | grep -q . ||
+            fail "$label: the cache holds an entry of the failed run"
         grep -Eq "rank $2[^0-9].*$(hostname)|$(hostname).*rank $2[^0-9]" "$log" ||
             grep -Eq "rank $2 .*node" "$log" || { cat "$log"; fail "$label: the message does not name rank $2 and its host"; }
     }
@@ -80,6 +95,13 @@ if [ "$case_name" = failure ]; then
         [ ! -d "$work/out/mpi_fields" ] || [ -z "$(ls -A "$work/out/mpi_fields")" ] || fail "rank $failing errs: staging left behind"
         echo "rank $failing errs: the run failed cleanly: $(grep -m1 'error:' "$work/fail$failing.log")"
     done
+    if SDF_MPI_FAIL_RANK=1 mpi 2 "$tool" "$work/mpi_fields.json" --quiet --cache-dir "$work/cache" --distribute runs \
+           --output-root "$work/out" > "$work/runs.log" 2>&1; then
+        fail "the run by runs with rank 1 failing succeeded"
+    fi
+    expect_clean_failure "--distribute runs, rank 1 errs" 1 "$work/runs.log" runs
+    rm -rf "$work/cache"
+    echo "--distribute runs, rank 1 errs: the run failed cleanly: $(grep -m1 'error:' "$work/runs.log")"
     if SDF_MPI_FAIL_RANK=2 SDF_MPI_FAIL_MODE=kill mpi 3 "$tool" "$work/mpi_fields.json" --quiet --cache-dir "$work/cache" \
            --output-root "$work/out" > "$work/dies.log" 2>&1; then
         fail "the run with a dying rank succeeded"
