@@ -4,6 +4,9 @@
 #       a sampling sweep (brute force and BVH, CC and BCC lattices, a procedural torus) run by
 #       one process and by 2 and 3 ranks: every field file's bytes must be equal, and the
 #       manifest must record the ranks.
+#   mpi_runs.sh ci_smoke RUN_EXPERIMENT MPIEXEC
+#       the CI smoke reconstruction study (configs/ci_smoke.json) on 2 ranks passes its
+#       baseline check: the root's reconstructions and metrics work on distributed fields.
 #   mpi_runs.sh failure RUN_EXPERIMENT MPIEXEC
 #       a rank that fails (SDF_MPI_FAIL_RANK) or dies (SDF_MPI_FAIL_MODE=kill) must fail the
 #       run: non-zero exit, a message naming the rank and its host, no run directory, no
@@ -33,11 +36,12 @@ cat > "$work/mpi_fields.json" <<'JSON'
 }
 JSON
 
-run_dir() {  # the one run directory under $1/mpi_fields
-    local dirs=("$1"/mpi_fields/*/)
-    [ "${#dirs[@]}" -eq 1 ] && [ -d "${dirs[0]}" ] || fail "expected one run directory under $1/mpi_fields"
+run_dir_of() {  # the one run directory under $1/$2
+    local dirs=("$1/$2"/*/)
+    [ "${#dirs[@]}" -eq 1 ] && [ -d "${dirs[0]}" ] || fail "expected one run directory under $1/$2"
     echo "${dirs[0]%/}"
 }
+run_dir() { run_dir_of "$1" mpi_fields; }
 
 if [ "$case_name" = bit_identity ]; then
     "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/serial" > "$work/serial.log"
@@ -69,6 +73,15 @@ if [ "$case_name" = bit_identity ]; then
     same_fields "--distribute runs" "$dist"
     grep -q '"mode": "runs"' "$dist/manifest.json" || fail "--distribute runs: the manifest does not say so"
     echo "--distribute runs: the same results tree and channel files"
+    exit 0
+fi
+
+if [ "$case_name" = ci_smoke ]; then
+    config=$(dirname "$0")/../../configs/ci_smoke.json
+    mpi 2 "$tool" "$config" --no-cache --quiet --check --output-root "$work/smoke" > "$work/smoke.log" 2>&1 ||
+        { cat "$work/smoke.log"; fail "ci_smoke on 2 ranks failed or failed its check"; }
+    grep -q '"ranks": 2' "$(run_dir_of "$work/smoke" ci_smoke)/manifest.json" || fail "ci_smoke: not distributed"
+    grep PASSED "$work/smoke.log"
     exit 0
 fi
 
