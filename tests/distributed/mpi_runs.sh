@@ -95,7 +95,7 @@ if [ "$case_name" = failure ]; then
         [ ! -d "$work/out/mpi_fields" ] || [ -z "$(ls "$work/out/mpi_fields")" ] || fail "$label: a run directory was left: $(ls "$work/out/mpi_fields")"
         [ "${4:-}" = runs ] || ! find "$work/cache" -name entry.json -not -path '*/.*' 2>/dev/null | grep -q . ||
             fail "$label: the cache holds an entry of the failed run"
-        grep -Eq "rank $2[^0-9].*$(hostname)|$(hostname).*rank $2[^0-9]" "$log" ||
+        grep -Eq "rank $2[^0-9].*$(uname -n)|$(uname -n).*rank $2[^0-9]" "$log" ||
             grep -Eq "rank $2 .*node" "$log" || { cat "$log"; fail "$label: the message does not name rank $2 and its host"; }
     }
     for failing in 1 0; do
