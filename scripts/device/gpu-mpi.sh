@@ -14,6 +14,8 @@ PREFIX=$PWD/.gpu-prefix/root/usr
 export LD_LIBRARY_PATH=$PREFIX/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export SDF_DATA_PATH=$PWD/data/meshes
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# One machine: shared memory only (no network probing); no CMA single copy (containers forbid ptrace).
+export OMPI_MCA_btl=self,vader OMPI_MCA_btl_vader_single_copy_mechanism=none
 B=build-gpu-mpi
 log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
 cmake_common=(-G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PREFIX")
