@@ -24,6 +24,7 @@
 
 #include "core/mesh/triangle_mesh.h"
 #include "core/sampling/sampler.h"
+#include "harness/io/field_file.h"
 
 namespace sdf {
 
@@ -60,6 +61,15 @@ std::unique_ptr<Sampler> make_field_sampler(const SamplerOptions& options);
 /// way; call before sampling it. Does nothing without a distributed run.
 void share_mesh_with_workers(const TriangleMesh& mesh);
 
+/// Writes `field`'s files at `header_path` as write_field does. When `field` is the one the
+/// ranks of a distributed run have just sampled (they still hold their slabs), the root
+/// creates the channel files at their final size under temporary names, every rank writes its
+/// own slabs' bytes of every channel with MPI-IO at their offsets, and the root then renames
+/// them into place and writes the header last; the bytes are write_field's. Otherwise the
+/// root writes alone (write_field). Returns "mpi-io" or "root".
+std::string write_sampled_field(const std::string& header_path, const SampledField& field,
+                                const FieldWriteOptions& options);
+
 /// For the manifest: ranks, hosts, local ranks, GPUs, threads, and per sampled field the
 /// slabs, per-rank timings and load balance. Null without a distributed run.
 nlohmann::json distributed_description();
@@ -70,7 +80,8 @@ std::string broadcast_from_root(const std::string& text);
 /// Runs mode: every rank's `mine`, in rank order, on the root; an empty array elsewhere.
 nlohmann::json gather_to_root(const nlohmann::json& mine);
 /// SDF_MPI_FAIL_RANK=r makes rank r fail (throw) here, or die with SDF_MPI_FAIL_MODE=kill:
-/// the failure tests' hook (tests/distributed/mpi_runs.sh). Does nothing otherwise.
+/// the failure tests' hook (tests/distributed/mpi_runs.sh); SDF_MPI_FAIL_STAGE=write moves
+/// the failure to the parallel write of the field files. Does nothing otherwise.
 void fail_here_if_asked();
 /// This rank: rank, host, local_rank, local_size, threads, GPU.
 nlohmann::json this_process();

@@ -7,17 +7,24 @@
 //   worker -> root  kTagData     (when ok) distance, gradient, closest triangle; each as the
 //                                slab's primary part then its secondary part
 //   worker -> root  kTagHello    at start: rank, host, local rank, threads, GPU
+//   root -> worker  kTagCommand  Write: the channel files (temporary names) of the field the
+//                                ranks sampled last; the worker writes its slab into them with
+//                                MPI-IO and answers with a kTagStatus JSON (bytes, seconds, or
+//                                the error). Workers keep their last slab until then.
 // Waiting ranks poll with short sleeps instead of MPI's busy wait, so that an idle worker
 // does not take a core from the ranks that compute.
 #include "harness/distributed/distributed.h"
 
+#include <fcntl.h>
 #include <mpi.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -38,8 +45,11 @@ namespace sdf {
 namespace {
 
 constexpr int kTagCommand = 1, kTagStatus = 2, kTagData = 3, kTagHello = 4, kTagRuns = 5;
-enum class Command : int32_t { Sample = 1, Quit = 2 };
+enum class Command : int32_t { Sample = 1, Quit = 2, Write = 3 };
 constexpr size_t kChunkBytes = size_t(1) << 30;
+/// Points converted to the stored dtype at a time by a parallel write (bounds its buffer:
+/// 96 MiB for a float64 gradient).
+constexpr size_t kWritePoints = size_t(1) << 22;
 
 static_assert(std::is_trivially_copyable_v<Lattice>, "lattices are sent as bytes");
 static_assert(sizeof(Vec3d) == 3 * sizeof(double), "gradients are sent as packed doubles");
@@ -55,6 +65,16 @@ struct Session {
     std::string mesh_sent;  ///< root: SHA-256 of the mesh the workers hold
     bool released = false;  ///< root: workers told to quit
     Distribution distribution = Distribution::LatticeSlabs;
+    /// Root: the field the ranks sampled last, whose slabs the workers still hold for the
+    /// parallel write (write_sampled_field); invalid once written or when another is sampled.
+    struct HeldField {
+        bool valid = false;
+        Lattice lattice;
+        std::vector<LatticeSlab> slabs;
+        nlohmann::json record;             ///< the field's sampler.distributed
+        const double* distance = nullptr;  ///< the field's storage (moving the field keeps it)
+        size_t field_index = 0;            ///< its record in `fields`
+    } held;
 };
 
 Session& session() {
@@ -237,14 +257,26 @@ SamplerOptions options_for_this_rank(SamplerOptions o) {
     return o;
 }
 
-/// SDF_MPI_FAIL_RANK=r makes rank r fail its slab (tests of the failure path);
-/// SDF_MPI_FAIL_MODE=kill makes it die instead, as a crashed or OOM-killed process would.
-void maybe_inject_failure(int rank) {
+/// Whether the tests ask rank `rank` to fail at `stage` (SDF_MPI_FAIL_RANK, SDF_MPI_FAIL_STAGE:
+/// "sample" when unset, "write", or "open": the rank cannot open the files of the parallel
+/// write, as on a node without the shared file system).
+bool failure_asked(int rank, const std::string& stage) {
     const char* target = std::getenv("SDF_MPI_FAIL_RANK");
-    if (target == nullptr || std::atoi(target) != rank) return;
+    if (target == nullptr || std::atoi(target) != rank) return false;
+    const char* wanted = std::getenv("SDF_MPI_FAIL_STAGE");
+    return stage == (wanted != nullptr ? wanted : "sample");
+}
+
+/// SDF_MPI_FAIL_RANK=r makes rank r fail its slab (tests of the failure path), or with
+/// SDF_MPI_FAIL_STAGE=write its part of the parallel write; SDF_MPI_FAIL_MODE=kill makes it
+/// die instead, as a crashed or OOM-killed process would.
+void maybe_inject_failure(int rank, const std::string& stage = "sample") {
+    if (!failure_asked(rank, stage)) return;
+    const std::string target = std::getenv("SDF_MPI_FAIL_RANK");
     const char* mode = std::getenv("SDF_MPI_FAIL_MODE");
     if (mode != nullptr && std::string(mode) == "kill") std::raise(SIGKILL);
-    throw std::runtime_error("injected failure (SDF_MPI_FAIL_RANK=" + std::string(target) + ")");
+    if (stage == "sample") throw std::runtime_error("injected failure (SDF_MPI_FAIL_RANK=" + std::string(target) + ")");
+    throw std::runtime_error("injected failure at the " + stage + " stage (SDF_MPI_FAIL_RANK=" + std::string(target) + ")");
 }
 
 std::string host_name() {
@@ -288,6 +320,118 @@ nlohmann::json describe_part(const SampledField& part, int rank, const std::stri
     return j;
 }
 
+// ---- Parallel writes of field files -------------------------------------------------------
+
+nlohmann::json files_to_json(const std::vector<FieldChannelFile>& files) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const FieldChannelFile& f : files)
+        j.push_back({{"name", f.name}, {"path", f.path}, {"float32", f.dtype == FieldDtype::Float32}, {"components", f.components}});
+    return j;
+}
+
+std::vector<FieldChannelFile> files_from_json(const nlohmann::json& j) {
+    std::vector<FieldChannelFile> files;
+    for (const nlohmann::json& f : j)
+        files.push_back({f.at("name").get<std::string>(), f.at("path").get<std::string>(),
+                         f.at("float32").get<bool>() ? FieldDtype::Float32 : FieldDtype::Float64, f.at("components").get<int>()});
+    return files;
+}
+
+/// One rank's handles on the channel files of a parallel write. Each file is opened on
+/// MPI_COMM_SELF and written with independent MPI_File_write_at calls: no collective call,
+/// so a rank that fails cannot hang the others; its status message to the root, sent after
+/// MPI_File_sync and MPI_File_close, is the barrier.
+class ChannelFiles {
+public:
+    ChannelFiles() = default;
+    ChannelFiles(const ChannelFiles&) = delete;
+    ChannelFiles& operator=(const ChannelFiles&) = delete;
+    ~ChannelFiles() {
+        for (MPI_File& h : handles_) MPI_File_close(&h);  // after a failure: the caller is already failing
+    }
+
+    /// Opens the root's files; false, saying why, when this rank cannot (no shared file
+    /// system) or sees another file of that name (its size is not the root's preallocation).
+    bool open(const std::vector<FieldChannelFile>& files, int64_t points, std::string& why) {
+        files_ = files;
+        for (const FieldChannelFile& f : files) {
+            MPI_File h;
+            int code = MPI_File_open(MPI_COMM_SELF, f.path.c_str(), MPI_MODE_WRONLY, MPI_INFO_NULL, &h);
+            if (code != MPI_SUCCESS) {
+                char text[MPI_MAX_ERROR_STRING];
+                int length = 0;
+                MPI_Error_string(code, text, &length);
+                why = f.path + ": cannot open: " + std::string(text, size_t(length));
+                return false;
+            }
+            handles_.push_back(h);
+            MPI_Offset size = 0;
+            check_mpi(MPI_File_get_size(h, &size), "MPI_File_get_size");
+            if (uint64_t(size) != uint64_t(points) * f.bytes_per_point()) {
+                why = f.path + ": holds " + std::to_string(size) + " bytes, not the root's " +
+                      std::to_string(uint64_t(points) * f.bytes_per_point());
+                return false;
+            }
+        }
+        return true;
+    }
+
+    /// Writes points [first, first + count) of `source` at lattice storage offset `offset`
+    /// of every channel; returns the bytes written.
+    uint64_t write(const SampledField& source, size_t first, size_t count, int64_t offset) {
+        uint64_t total = 0;
+        for (size_t c = 0; c < files_.size(); ++c) {
+            const size_t width = files_[c].bytes_per_point();
+            for (size_t done = 0; done < count; done += kWritePoints) {
+                const size_t n = std::min(kWritePoints, count - done);
+                const std::vector<char> bytes = field_channel_bytes(source, files_[c], first + done, n);
+                MPI_Status status;
+                check_mpi(MPI_File_write_at(handles_[c], MPI_Offset((size_t(offset) + done) * width), bytes.data(),
+                                            int(bytes.size()), MPI_BYTE, &status),
+                          ("MPI_File_write_at " + files_[c].path).c_str());
+                int written = 0;
+                MPI_Get_count(&status, MPI_BYTE, &written);
+                if (size_t(written) != bytes.size())
+                    throw std::runtime_error(files_[c].path + ": wrote " + std::to_string(written) + " of " +
+                                             std::to_string(bytes.size()) + " bytes");
+                total += bytes.size();
+            }
+        }
+        return total;
+    }
+
+    /// Flushes every file to storage and closes it.
+    void close() {
+        for (size_t c = 0; c < handles_.size(); ++c)
+            check_mpi(MPI_File_sync(handles_[c]), ("MPI_File_sync " + files_[c].path).c_str());
+        while (!handles_.empty()) {
+            const std::string path = files_[handles_.size() - 1].path;
+            MPI_File h = handles_.back();
+            handles_.pop_back();
+            check_mpi(MPI_File_close(&h), ("MPI_File_close " + path).c_str());
+        }
+    }
+
+private:
+    std::vector<FieldChannelFile> files_;
+    std::vector<MPI_File> handles_;
+};
+
+/// Writes `slab` of `source` (the whole field, or a rank's part: its primary points, then
+/// its secondary ones) at its storage offsets; returns the bytes written.
+uint64_t write_slab(ChannelFiles& files, const SampledField& source, bool source_is_whole, const Lattice& lattice,
+                    const LatticeSlab& slab) {
+    if (slab.z_end <= slab.z_begin) return 0;
+    uint64_t bytes = 0;
+    int64_t from = 0;
+    for (int p = 0; p < 2; ++p) {
+        const StorageRange r = slab_storage(lattice, slab, p);
+        bytes += files.write(source, size_t(source_is_whole ? r.offset : from), size_t(r.count), r.offset);
+        from += r.count;
+    }
+    return bytes;
+}
+
 // ---- Workers ------------------------------------------------------------------------------
 
 class Worker {
@@ -296,9 +440,10 @@ public:
     void sample(const std::string& request) {
         const Session& s = session();
         nlohmann::json status = {{"ok", true}, {"rank", s.rank}, {"host", s.self["host"]}};
-        SampledField part;
-        LatticeSlab slab;
-        Lattice lattice;
+        release();  // a new field: the last one's slab is no longer wanted
+        SampledField& part = part_;
+        LatticeSlab& slab = slab_;
+        Lattice& lattice = lattice_;
         try {
             ByteReader in(request);
             in.get<int32_t>();  // the command
@@ -336,7 +481,8 @@ public:
             status["error"] = e.what();
         }
         send_string(status.dump(), 0, kTagStatus);
-        if (!status["ok"].get<bool>()) return;
+        if (!status["ok"].get<bool>()) return release();
+        holds_part_ = true;  // for the parallel write of its files
         for (int p = 0; p < 2; ++p) {
             const StorageRange r = slab_storage(lattice, slab, p);
             const size_t first = p == 0 ? 0 : size_t(slab_storage(lattice, slab, 0).count);
@@ -347,7 +493,49 @@ public:
         }
     }
 
+    /// Handles one Write request: writes the slab it holds into the root's channel files.
+    void write(const std::string& request) {
+        const Session& s = session();
+        nlohmann::json status = {{"ok", true}, {"rank", s.rank}, {"host", s.self["host"]}};
+        try {
+            if (!holds_part_) throw std::runtime_error("holds no sampled slab to write (protocol error)");
+            ByteReader in(request);
+            in.get<int32_t>();  // the command
+            const std::vector<FieldChannelFile> files = files_from_json(nlohmann::json::parse(in.get_string()));
+            const auto start = std::chrono::steady_clock::now();
+            ChannelFiles out;
+            std::string why;
+            if (failure_asked(s.rank, "open")) {
+                status["written"] = false;
+                status["why"] = "injected: cannot open the files (SDF_MPI_FAIL_STAGE=open)";
+            } else if (!out.open(files, lattice_.num_points(), why)) {
+                status["written"] = false;  // the root writes this slab
+                status["why"] = why;
+            } else {
+                maybe_inject_failure(s.rank, "write");
+                status["write_bytes"] = write_slab(out, part_, false, lattice_, slab_);
+                out.close();
+                status["written"] = true;
+                status["write_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
+        } catch (const std::exception& e) {
+            status["ok"] = false;
+            status["error"] = e.what();
+        }
+        release();
+        send_string(status.dump(), 0, kTagStatus);
+    }
+
 private:
+    void release() {
+        holds_part_ = false;
+        part_ = SampledField();
+    }
+
+    SampledField part_;  ///< the last slab sampled, kept until its field is written
+    LatticeSlab slab_;
+    Lattice lattice_;
+    bool holds_part_ = false;
     std::optional<PreparedMesh> mesh_;
     std::unique_ptr<Sampler> sampler_;
     std::string sampler_key_;
@@ -371,6 +559,7 @@ public:
     SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
         if (!is_whole_lattice(lattice, slab)) return local_->sample_slab(mesh, lattice, slab);
         Session& s = session();
+        s.held.valid = false;  // the workers drop the last field's slabs on this request
         const auto start = std::chrono::steady_clock::now();
         const SlabPlan plan = plan_slabs(mesh, lattice, options_, s.size);
         send_requests(mesh, lattice, plan);
@@ -412,6 +601,7 @@ public:
         const auto end = std::chrono::steady_clock::now();
         finish_provenance(field, plan, parts, sampler_json, std::chrono::duration<double>(end - start).count(),
                           std::chrono::duration<double>(end - sampling_start).count());
+        s.held = {true, lattice, plan.slabs, field.sampler["distributed"], field.distance.data(), s.fields.size() - 1};
         return field;
     }
 
@@ -577,7 +767,8 @@ int serve_distributed_requests() {
         int32_t command = 0;
         std::memcpy(&command, request.data(), sizeof command);
         if (Command(command) == Command::Quit) return 0;
-        worker.sample(request);
+        if (Command(command) == Command::Write) worker.write(request);
+        else worker.sample(request);
     }
 }
 
@@ -590,6 +781,166 @@ std::unique_ptr<Sampler> make_field_sampler(const SamplerOptions& options) {
 void share_mesh_with_workers(const TriangleMesh& mesh) {
     if (!distributed_active()) return;
     session().meshes.emplace(mesh.content_sha256, mesh);
+}
+
+namespace {
+
+/// The root's temporary channel files of a parallel write, at their final size; removed
+/// unless moved into place.
+class PreallocatedFiles {
+public:
+    PreallocatedFiles(const std::vector<FieldChannelFile>& files, int64_t points) {
+        for (const FieldChannelFile& f : files) {
+            FieldChannelFile t = f;
+            t.path = unique_sibling_name(f.path, "tmp");
+            const int fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+            if (fd < 0) throw std::runtime_error(t.path + ": cannot create: " + std::strerror(errno));
+            temps_.push_back(t);
+            const off_t size = off_t(uint64_t(points) * f.bytes_per_point());
+            const int e = ::ftruncate(fd, size) == 0 ? 0 : errno;
+            ::close(fd);
+            if (e != 0) throw std::runtime_error(t.path + ": cannot size it to " + std::to_string(size) + " bytes: " + std::strerror(e));
+        }
+    }
+    ~PreallocatedFiles() {
+        for (const FieldChannelFile& t : temps_)
+            if (!t.path.empty()) ::unlink(t.path.c_str());
+    }
+    PreallocatedFiles(const PreallocatedFiles&) = delete;
+    PreallocatedFiles& operator=(const PreallocatedFiles&) = delete;
+
+    const std::vector<FieldChannelFile>& files() const { return temps_; }
+
+    /// Moves file i to `final_path` (refused if it exists, unless overwriting is allowed).
+    void move_into_place(size_t i, const std::string& final_path, Overwrite overwrite) {
+        if (overwrite == Overwrite::Forbid) {
+            if (!rename_no_replace(temps_[i].path, final_path))
+                throw std::runtime_error(final_path + ": already exists; refusing to overwrite a field");
+        } else {
+            std::filesystem::rename(temps_[i].path, final_path);
+        }
+        temps_[i].path.clear();
+    }
+
+private:
+    std::vector<FieldChannelFile> temps_;
+};
+
+/// Whether `field` is the one the ranks sampled last and still hold.
+bool held_by_the_ranks(const SampledField& field) {
+    const Session& s = session();
+    const Session::HeldField& h = s.held;
+    return distributed_active() && s.rank == 0 && s.distribution == Distribution::LatticeSlabs && h.valid &&
+           field.distance.data() == h.distance && field.size() == h.lattice.num_points() &&
+           lattice_to_json(field.lattice) == lattice_to_json(h.lattice) && field.sampler.is_object() &&
+           field.sampler.contains("distributed") && field.sampler["distributed"] == h.record;
+}
+
+}  // namespace
+
+std::string write_sampled_field(const std::string& header_path, const SampledField& field,
+                                const FieldWriteOptions& options) {
+    if (!held_by_the_ranks(field)) {
+        write_field(header_path, field, options);
+        return "root";
+    }
+    Session& s = session();
+    const Session::HeldField held = s.held;
+    s.held.valid = false;  // the workers release their slabs with this write, whatever happens
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<FieldChannelFile> files = field_channel_files(header_path, field, options);
+    std::vector<std::string> targets = {header_path};
+    for (const FieldChannelFile& f : files) targets.push_back(f.path);
+    if (options.overwrite == Overwrite::Forbid)
+        for (const std::string& t : targets)
+            if (std::filesystem::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
+    const std::filesystem::path parent = std::filesystem::path(header_path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    PreallocatedFiles staged(files, field.size());
+
+    ByteWriter request;
+    request.put(int32_t(Command::Write));
+    request.put_string(files_to_json(staged.files()).dump());
+    for (int r = 1; r < s.size; ++r) send_bytes(request.bytes().data(), request.bytes().size(), r, kTagCommand);
+
+    // Rank 0 writes its slab; a rank that cannot open the files (no shared file system)
+    // leaves its slab to rank 0, which holds the whole field.
+    std::vector<std::string> errors;
+    nlohmann::json writes = nlohmann::json::array();
+    ChannelFiles mine;
+    bool mine_open = false;
+    const std::string root_host = s.self["host"].get<std::string>();
+    try {
+        const auto t0 = std::chrono::steady_clock::now();
+        std::string why;
+        if (!mine.open(staged.files(), field.size(), why)) throw std::runtime_error(why);
+        mine_open = true;
+        maybe_inject_failure(0, "write");
+        const uint64_t bytes = write_slab(mine, field, true, held.lattice, held.slabs[0]);
+        writes.push_back({{"rank", 0}, {"written_by", 0}, {"write_bytes", bytes},
+                          {"write_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}});
+    } catch (const std::exception& e) {
+        errors.push_back(rank_and_host(0, root_host) + ": " + e.what());
+    }
+    for (int r = 1; r < s.size; ++r) {
+        const nlohmann::json status = nlohmann::json::parse(receive_string(r, kTagStatus));
+        const std::string host = status.value("host", std::string("?"));
+        if (!status.value("ok", false)) {
+            errors.push_back(rank_and_host(r, host) + ": " + status.value("error", std::string("unknown error")));
+        } else if (status.value("written", false)) {
+            writes.push_back({{"rank", r}, {"written_by", r}, {"write_bytes", status["write_bytes"]},
+                              {"write_seconds", status["write_seconds"]}});
+        } else if (mine_open) {
+            try {
+                const auto t0 = std::chrono::steady_clock::now();
+                const uint64_t bytes = write_slab(mine, field, true, held.lattice, held.slabs[size_t(r)]);
+                writes.push_back({{"rank", r}, {"written_by", 0}, {"write_bytes", bytes},
+                                  {"write_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
+                                  {"why", status.value("why", std::string())}});
+            } catch (const std::exception& e) {
+                errors.push_back(rank_and_host(0, root_host) + ", writing the slab of rank " + std::to_string(r) + ": " + e.what());
+            }
+        }
+    }
+    try {
+        mine.close();
+    } catch (const std::exception& e) {
+        errors.push_back(rank_and_host(0, root_host) + ": " + e.what());
+    }
+    if (!errors.empty()) {
+        const std::filesystem::path named(header_path);  // not the staging directory's name
+        std::string text = "parallel write of field " + (named.parent_path().filename() / named.filename()).string() + " failed on " + std::to_string(errors.size()) + " of " +
+                           std::to_string(s.size) + " ranks: ";
+        for (size_t i = 0; i < errors.size(); ++i) text += (i ? "; " : "") + errors[i];
+        throw std::runtime_error(text);
+    }
+    std::vector<std::string> moved;
+    try {
+        for (size_t i = 0; i < files.size(); ++i) {
+            staged.move_into_place(i, files[i].path, options.overwrite);
+            moved.push_back(files[i].path);
+        }
+        write_field_header(header_path, field, files, options.overwrite);
+    } catch (...) {
+        if (options.overwrite == Overwrite::Forbid)
+            for (const std::string& m : moved) ::unlink(m.c_str());  // all new: leave none behind
+        throw;
+    }
+
+    // The manifest's record of the field: how its files were written, by whom.
+    nlohmann::json& record = s.fields[held.field_index];
+    record["write"] = "mpi-io";
+    record["write_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    uint64_t total = 0;
+    for (nlohmann::json& slab : record["slabs"])
+        for (const nlohmann::json& w : writes)
+            if (w["rank"] == slab["rank"]) {
+                for (const char* key : {"written_by", "write_bytes", "write_seconds", "why"})
+                    if (w.contains(key)) slab[key] = w[key];
+                total += w["write_bytes"].get<uint64_t>();
+            }
+    record["write_bytes"] = total;
+    return "mpi-io";
 }
 
 nlohmann::json distributed_description() {
