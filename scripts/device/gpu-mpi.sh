@@ -55,6 +55,11 @@ for p in m.get("points", [{"name": "", "metrics": m}]):
             lb = d["load_balance"]
             line += f"; {ranks}; max/mean {lb['seconds_max_over_mean']:.3f} (estimate {lb['estimate_max_over_mean']:.3f})"
         print(line)
+man = json.load(open(os.path.join(run, "manifest.json")))
+for f in (man.get("distributed") or {}).get("fields", []):
+    if "write" in f:  # the field files written by the ranks (MPI-IO)
+        ranks = ", ".join(f"rank {s['rank']} {s['write_bytes']} B {s['write_seconds']:.3f} s" for s in f["slabs"])
+        print(f"  write {f['lattice']}: {f['write']}, {f['write_bytes']} bytes in {f['write_seconds']:.3f} s; {ranks}")
 PY
 }
 

@@ -2,7 +2,7 @@
 # Distributed runs under mpirun (docs/distributed.md), small and fast for CI's 2 cores.
 #   mpi_runs.sh bit_identity RUN_EXPERIMENT MPIEXEC
 #       a sampling sweep (brute force and BVH, CC and BCC lattices, a procedural torus) run by
-#       one process and by 2 and 3 ranks: every field file's bytes must be equal, and the
+#       one process and by 1, 2 and 3 ranks: every field file's bytes must be equal, and the
 #       manifest must record the ranks and that every rank wrote its own slab's bytes of every
 #       channel file (MPI-IO), and nothing more.
 #   mpi_runs.sh ci_smoke RUN_EXPERIMENT MPIEXEC
@@ -57,6 +57,11 @@ if [ "$case_name" = bit_identity ]; then
             cmp "$serial/$f" "$2/$f" || fail "$1: $f differs from the single process's"
         done < "$work/serial.files"
     }
+    # One rank under mpirun is a single process (no distribution): the same files.
+    mpi 1 "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/np1" > "$work/np1.log" 2>&1 ||
+        { cat "$work/np1.log"; fail "mpirun -np 1 failed"; }
+    same_fields "np 1" "$(run_dir "$work/np1")"
+    echo "np 1: $(wc -l < "$work/serial.files") channel files identical to the single process's"
     for n in 2 3; do
         mpi "$n" "$tool" "$work/mpi_fields.json" --no-cache --quiet --output-root "$work/np$n" > "$work/np$n.log" 2>&1 ||
             { cat "$work/np$n.log"; fail "mpirun -np $n failed"; }
