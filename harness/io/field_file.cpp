@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 #include "core/lattice/lattice_fitting.h"
 #include "harness/config/json_reader.h"
@@ -166,9 +167,13 @@ std::vector<char> field_channel_bytes(const SampledField& field, const FieldChan
     auto store = [&](const auto* values, auto as) {  // values[first*c .. (first+count)*c) as the stored type
         using Stored = decltype(as);
         const size_t c = size_t(channel.components), at = first * c;
-        for (size_t i = 0; i < count * c; ++i) {
-            const Stored v = Stored(values[at + i]);
-            std::memcpy(bytes.data() + i * sizeof(Stored), &v, sizeof(Stored));
+        if constexpr (std::is_same_v<Stored, std::remove_const_t<std::remove_pointer_t<decltype(values)>>>) {
+            if (count > 0) std::memcpy(bytes.data(), values + at, count * c * sizeof(Stored));  // stored as held
+        } else {
+            for (size_t i = 0; i < count * c; ++i) {
+                const Stored v = Stored(values[at + i]);
+                std::memcpy(bytes.data() + i * sizeof(Stored), &v, sizeof(Stored));
+            }
         }
     };
     const double* values = channel.name == "distance" ? field.distance.data()
@@ -204,8 +209,18 @@ void write_field(const std::string& header_path, const SampledField& field, cons
     std::vector<std::string> written;
     try {
         for (const FieldChannelFile& f : files) {
-            const std::vector<char> bytes = field_channel_bytes(field, f, 0, size_t(field.size()));
-            write_file_atomically(f.path, bytes.data(), bytes.size(), options.overwrite);
+            const size_t bytes = size_t(field.size()) * f.bytes_per_point();
+            // Channels stored as held (float64, int32) are written from the field's arrays,
+            // without a copy: the same bytes as field_channel_bytes.
+            if (f.name == "closest_triangle") {
+                write_file_atomically(f.path, field.closest_triangle.data(), bytes, options.overwrite);
+            } else if (f.dtype == FieldDtype::Float64) {
+                const double* values = f.name == "distance" ? field.distance.data() : &field.gradient[0].x;
+                write_file_atomically(f.path, values, bytes, options.overwrite);
+            } else {
+                const std::vector<char> converted = field_channel_bytes(field, f, 0, size_t(field.size()));
+                write_file_atomically(f.path, converted.data(), converted.size(), options.overwrite);
+            }
             written.push_back(f.path);
         }
         write_field_header(header_path, field, files, options.overwrite);
