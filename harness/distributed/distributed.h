@@ -6,7 +6,9 @@
 /// is cut into one slab per rank (slab_plan.h); every rank samples its slab with the
 /// configured sampler on its CPU threads or its GPU (the local rank picks the device) and
 /// sends the points back; the root places them at their offsets, so the field, its files
-/// and its cache entry are those of a single-process run, bit for bit. The other ranks
+/// and its cache entry are those of a single-process run, bit for bit. A sampling run's
+/// field files are then written by every rank, each its own slab, with MPI-IO
+/// (write_sampled_field). The other ranks
 /// (workers) only serve these requests: they receive the mesh once, prepare it as the root
 /// did, and sample. A rank that fails answers with its error; the root then fails the run
 /// naming every failed rank and its host, and nothing is published (the run's staging
