@@ -1,5 +1,6 @@
 // run-experiment CONFIG.json [--output-root DIR] [--dry-run] [--no-cache] [--cache-dir DIR]
-//                            [--check [--baseline PATH]] [--quiet]
+//                            [--check [--baseline PATH]] [--quiet] [--distribute slabs|runs]
+// mpirun -np N run-experiment CONFIG.json ...   (docs/distributed.md)
 // run-experiment --check-run RUN_DIR [--baseline PATH]
 // run-experiment --write-baseline RUN_DIR [--baseline PATH] [--force]
 //
@@ -13,6 +14,7 @@
 #include "core/parallel/progress.h"
 #include "experiments/experiment_registry.h"
 #include "harness/config/mesh_spec.h"
+#include "harness/distributed/distributed.h"
 #include "harness/runner/runner.h"
 
 int main(int argc, char** argv) {
@@ -34,7 +36,19 @@ int main(int argc, char** argv) {
     app.add_option("--write-baseline", make_baseline, "make a baseline from a stored run directory (clean runs only)");
     app.add_flag("--force", force, "with --write-baseline: replace an existing baseline file");
     app.add_flag("--quiet", quiet, "no progress lines");
+    std::string distribute = "slabs";
+    app.add_option("--distribute", distribute,
+                   "under mpirun (docs/distributed.md): 'slabs' cuts every sampled lattice over the ranks; 'runs' gives "
+                   "each rank whole runs of a sweep (needs a file system shared by the ranks)")
+        ->check(CLI::IsMember({"slabs", "runs"}))
+        ->capture_default_str();
     SDF_CLI_PARSE(app, argc, argv);
+    // Under mpirun: rank 0 runs the config, the other ranks sample the slabs it hands out
+    // (docs/distributed.md). Every rank has parsed the same command line by now.
+    sdf::DistributedScope mpi(argc, argv);
+    if (distribute == "runs") sdf::set_distribution(sdf::Distribution::Runs);
+    if (sdf::distributed_rank() != 0 && (distribute == "slabs" || options.config_path.empty()))
+        return distribute == "slabs" ? sdf::serve_distributed_requests() : 0;
     sdf::ProgressReporter::set_globally_enabled(!quiet);
     const int modes = int(!options.config_path.empty()) + int(!check_run.empty()) + int(!make_baseline.empty());
     if (modes != 1) {

@@ -48,6 +48,17 @@ if(SDF_OPENVDB_INCLUDE AND SDF_OPENVDB_LIBRARY AND TBB_FOUND AND Imath_FOUND)
 endif()
 message(STATUS "sdf: OpenVDB ${SDF_HAVE_OPENVDB} (.vdb export and the OpenVDB peer)")
 
+# MPI (Open MPI from Debian) is optional: distributed runs (harness/distributed).
+set(SDF_HAVE_MPI OFF)
+if(NOT SDF_ENABLE_MPI STREQUAL "OFF")
+  find_package(MPI COMPONENTS CXX QUIET)
+  if(MPI_CXX_FOUND)
+    set(SDF_HAVE_MPI ON)
+  elseif(SDF_ENABLE_MPI STREQUAL "ON")
+    message(FATAL_ERROR "SDF_ENABLE_MPI=ON but no MPI (C++) was found; install libopenmpi-dev and openmpi-bin")
+  endif()
+endif()
+
 if(SDF_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

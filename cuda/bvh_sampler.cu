@@ -85,8 +85,8 @@ public:
 
     std::string name() const override { return std::string("cuda/bvh/") + kernel_name(); }
 
-    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
-        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice) : sample_as<double>(mesh, lattice);
+    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
+        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab) : sample_as<double>(mesh, lattice, slab);
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
@@ -176,15 +176,15 @@ private:
     }
 
     template <typename T>
-    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
+    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        SampledField field = unfilled_field(mesh, lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         auto sink = [&](const PieceResults::Host& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
-        const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
+        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0, pieces = 0;
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];

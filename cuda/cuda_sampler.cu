@@ -300,8 +300,8 @@ public:
 
     std::string name() const override { return std::string("cuda/brute_force/") + kernel_name(); }
 
-    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
-        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice) : sample_as<double>(mesh, lattice);
+    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
+        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab) : sample_as<double>(mesh, lattice, slab);
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
@@ -313,14 +313,14 @@ private:
     const char* kernel_name() const { return sdf::kernel_name(kCudaBruteForceKernels, kernel_); }
 
     template <typename T>
-    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
+    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(mesh, lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
-        const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
+        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];

@@ -16,6 +16,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "experiments/common/field_source.h"
 #include "experiments/common/study_inputs.h"
+#include "harness/distributed/distributed.h"
 #include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"
 #include "harness/io/volume_formats.h"
@@ -72,7 +73,8 @@ public:
             const std::string stem = mesh.name() + "-" + inputs_.lattice_labels[i];
             FieldWriteOptions wo;
             wo.dtype = dtype_;
-            write_field(fields_dir + "/" + stem + ".json", field, wo);
+            // In a distributed run, every rank writes its slabs of a field it sampled (MPI-IO).
+            write_sampled_field(fields_dir + "/" + stem + ".json", field, wo);
             if (nrrd_ && lattice.type == LatticeType::CC) export_nrrd(fields_dir + "/" + stem + ".nrrd", field, true);
             if (uint8_) export_uint8(fields_dir + "/" + stem + ".u8.raw", field);
             for (VolumeFormat format : formats_)

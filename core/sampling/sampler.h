@@ -10,6 +10,7 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampled_field.h"
 #include "core/winding/sign_mode.h"
+#include "kernels/lattice/lattice_slab.h"
 #include "kernels/lattice/sampling_grid.h"
 
 namespace sdf {
@@ -45,7 +46,13 @@ public:
     /// e.g. "cpu/brute_force/vectorized"
     virtual std::string name() const = 0;
     /// Samples every point of the lattice.
-    virtual SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) = 0;
+    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) {
+        return sample_slab(mesh, lattice, whole_lattice_slab(lattice));
+    }
+    /// Samples one slab of the lattice (kernels/lattice/lattice_slab.h): the field's arrays
+    /// hold the slab's points only, in its compact order (the whole lattice: every point in
+    /// storage order). A distributed run gives each rank its slabs (harness/distributed).
+    virtual SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) = 0;
     /// Samples arbitrary points, returned in input order.
     virtual std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) = 0;
 };

@@ -19,15 +19,17 @@
 
 namespace sdf {
 
-/// A field on `lattice` with every point unset (distance 0, triangle -1), to be filled;
-/// throws first when the mesh or the lattice is beyond what the search answers
+/// A field for the points of one slab of `lattice` (compact: its primary, then secondary
+/// planes; the whole lattice is one slab), every point unset (distance 0, triangle -1), to be
+/// filled; throws first when the mesh or the lattice is beyond what the search answers
 /// (search_range.h).
-inline SampledField unfilled_field(const PreparedMesh& mesh, const Lattice& lattice, Precision precision) {
+inline SampledField unfilled_field(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab,
+                                   Precision precision) {
     require_search_range(mesh, lattice, precision);
     SampledField field;
     field.lattice = lattice;
     field.precision = precision;
-    field.resize(lattice.num_points());
+    field.resize(slab_point_count(lattice, slab));
     return field;
 }
 

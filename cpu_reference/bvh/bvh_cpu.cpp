@@ -128,9 +128,9 @@ public:
 
     std::string name() const override { return std::string("cpu/bvh/") + kernel_name(); }
 
-    SampledField sample(const PreparedMesh& mesh, const Lattice& lattice) override {
-        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice)
-                                                      : sample_as<double>(mesh, lattice);
+    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
+        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab)
+                                                      : sample_as<double>(mesh, lattice, slab);
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
@@ -158,15 +158,15 @@ private:
     bool seeded() const { return kernel_ != BvhKernel::Unseeded; }
 
     template <typename T>
-    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice) {
+    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
         bool built = false;
         const auto bvh = cache_.get(mesh, built);
         sign_.prepare(mesh, bvh);  // shares the BVH: only the winding moments are added
         const auto query_start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(mesh, lattice, options_.precision);
+        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         GridBlock blocks[2];
-        const int nblocks = sampling_blocks(lattice, options_.bcc_strategy, blocks);
+        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
         QueryCounters counters;
         for (int b = 0; b < nblocks; ++b) {

@@ -8,6 +8,7 @@
 #include "core/sampling/sampler_sign.h"
 #include "experiments/common/study_inputs.h"
 #include "harness/cache/field_cache.h"
+#include "harness/distributed/distributed.h"
 #include "harness/io/field_file.h"
 #include "harness/sampling/sampler_table.h"
 
@@ -32,7 +33,7 @@ FieldSource::~FieldSource() = default;
 Sampler& FieldSource::sampler() {
     if (!sampler_) {
         try {
-            sampler_ = make_sampler(options_);
+            sampler_ = make_field_sampler(options_);  // split over the ranks of a distributed run
         } catch (const std::exception& e) {
             throw std::runtime_error(where_ + ": " + e.what());
         }

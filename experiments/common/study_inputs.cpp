@@ -4,6 +4,7 @@
 
 #include "harness/build_config.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/distributed/distributed.h"
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
@@ -76,7 +77,9 @@ nlohmann::json describe_mesh(const PreparedMesh& m) {
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
     const PreparedMesh mesh = [&] {
         try {
-            return prepare_mesh(load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir));
+            const TriangleMesh loaded = load_mesh(inputs.mesh, inputs.search_path, inputs.base_dir);
+            share_mesh_with_workers(loaded);  // a distributed run's workers prepare it too
+            return prepare_mesh(loaded);
         } catch (const ConfigError&) {
             throw;  // already names the config file and key
         } catch (const std::exception& e) {

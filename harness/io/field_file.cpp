@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 #include "core/lattice/lattice_fitting.h"
 #include "harness/config/json_reader.h"
@@ -29,22 +30,6 @@ std::vector<Out> convert_all(const In* in, size_t n) {
     std::vector<Out> out(n);
     for (size_t i = 0; i < n; ++i) out[i] = Out(in[i]);
     return out;
-}
-
-/// Writes one channel; returns its header entry.
-nlohmann::json write_channel(const std::string& stem, const std::string& name, const double* values, size_t count,
-                             int components, FieldDtype dtype, Overwrite overwrite) {
-    const std::string file = stem + "." + name + ".raw";
-    const size_t n = count * size_t(components);
-    if (dtype == FieldDtype::Float32) {
-        const auto data = convert_all<float>(values, n);
-        write_file_atomically(file, data.data(), n * sizeof(float), overwrite);
-    } else {
-        write_file_atomically(file, values, n * sizeof(double), overwrite);
-    }
-    return {{"file", fs::path(file).filename().string()},
-            {"dtype", dtype == FieldDtype::Float32 ? "float32" : "float64"},
-            {"components", components}};
 }
 
 std::vector<char> read_bytes(const std::string& path, size_t expected, const std::string& header) {
@@ -159,36 +144,86 @@ void remove_quietly(const std::vector<std::string>& files) {
 
 }  // namespace
 
-void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
+size_t FieldChannelFile::bytes_per_point() const {
+    const size_t width = name == "closest_triangle" ? sizeof(int32_t) : dtype == FieldDtype::Float32 ? sizeof(float) : sizeof(double);
+    return width * size_t(components);
+}
+
+std::vector<FieldChannelFile> field_channel_files(const std::string& header_path, const SampledField& field,
+                                                  const FieldWriteOptions& options) {
     const std::string stem = stem_of_header(header_path);
     const size_t n = size_t(field.size());
-    const bool gradient = !field.gradient.empty() && field.gradient.size() == n;
-    const bool triangles = options.closest_triangle && field.closest_triangle.size() == n;
+    std::vector<FieldChannelFile> files = {{"distance", stem + ".distance.raw", options.dtype, 1}};
+    if (!field.gradient.empty() && field.gradient.size() == n)
+        files.push_back({"gradient", stem + ".gradient.raw", options.dtype, 3});
+    if (options.closest_triangle && field.closest_triangle.size() == n)
+        files.push_back({"closest_triangle", stem + ".closest_triangle.raw", options.dtype, 1});
+    return files;
+}
+
+std::vector<char> field_channel_bytes(const SampledField& field, const FieldChannelFile& channel, size_t first,
+                                      size_t count) {
+    std::vector<char> bytes(count * channel.bytes_per_point());
+    auto store = [&](const auto* values, auto as) {  // values[first*c .. (first+count)*c) as the stored type
+        using Stored = decltype(as);
+        const size_t c = size_t(channel.components), at = first * c;
+        if constexpr (std::is_same_v<Stored, std::remove_const_t<std::remove_pointer_t<decltype(values)>>>) {
+            if (count > 0) std::memcpy(bytes.data(), values + at, count * c * sizeof(Stored));  // stored as held
+        } else {
+            for (size_t i = 0; i < count * c; ++i) {
+                const Stored v = Stored(values[at + i]);
+                std::memcpy(bytes.data() + i * sizeof(Stored), &v, sizeof(Stored));
+            }
+        }
+    };
+    const double* values = channel.name == "distance" ? field.distance.data()
+                           : channel.name == "gradient" ? &field.gradient[0].x : nullptr;
+    if (channel.name == "closest_triangle") store(field.closest_triangle.data(), int32_t());
+    else if (values == nullptr) throw std::invalid_argument("field_channel_bytes: unknown channel " + channel.name);
+    else if (channel.dtype == FieldDtype::Float32) store(values, float());
+    else store(values, double());
+    return bytes;
+}
+
+void write_field_header(const std::string& header_path, const SampledField& field,
+                        const std::vector<FieldChannelFile>& files, Overwrite overwrite) {
+    nlohmann::json channels = nlohmann::json::object();
+    for (const FieldChannelFile& f : files) {
+        const std::string dtype = f.name == "closest_triangle" ? "int32" : f.dtype == FieldDtype::Float32 ? "float32" : "float64";
+        channels[f.name] = {{"file", fs::path(f.path).filename().string()}, {"dtype", dtype}, {"components", f.components}};
+    }
+    write_text_atomically(stem_of_header(header_path) + ".json", field_header(field, channels).dump(2) + "\n", overwrite);
+}
+
+void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
+    const std::string stem = stem_of_header(header_path);
+    const std::vector<FieldChannelFile> files = field_channel_files(header_path, field, options);
     // Every target is checked before anything is written, so a refusal leaves no orphan
     // channel behind; a file that appears meanwhile is still refused by the atomic write,
     // and then what this call wrote is removed again.
-    std::vector<std::string> targets = {stem + ".json", stem + ".distance.raw"};
-    if (gradient) targets.push_back(stem + ".gradient.raw");
-    if (triangles) targets.push_back(stem + ".closest_triangle.raw");
+    std::vector<std::string> targets = {stem + ".json"};
+    for (const FieldChannelFile& f : files) targets.push_back(f.path);
     if (options.overwrite == Overwrite::Forbid)
         for (const std::string& t : targets)
             if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
     std::vector<std::string> written;
     try {
-        nlohmann::json channels;
-        channels["distance"] = write_channel(stem, "distance", field.distance.data(), n, 1, options.dtype, options.overwrite);
-        written.push_back(stem + ".distance.raw");
-        if (gradient) {
-            channels["gradient"] = write_channel(stem, "gradient", &field.gradient[0].x, n, 3, options.dtype, options.overwrite);
-            written.push_back(stem + ".gradient.raw");
+        for (const FieldChannelFile& f : files) {
+            const size_t bytes = size_t(field.size()) * f.bytes_per_point();
+            // Channels stored as held (float64, int32) are written from the field's arrays,
+            // without a copy: the same bytes as field_channel_bytes.
+            if (f.name == "closest_triangle") {
+                write_file_atomically(f.path, field.closest_triangle.data(), bytes, options.overwrite);
+            } else if (f.dtype == FieldDtype::Float64) {
+                const double* values = f.name == "distance" ? field.distance.data() : &field.gradient[0].x;
+                write_file_atomically(f.path, values, bytes, options.overwrite);
+            } else {
+                const std::vector<char> converted = field_channel_bytes(field, f, 0, size_t(field.size()));
+                write_file_atomically(f.path, converted.data(), converted.size(), options.overwrite);
+            }
+            written.push_back(f.path);
         }
-        if (triangles) {
-            const std::string file = stem + ".closest_triangle.raw";
-            write_file_atomically(file, field.closest_triangle.data(), n * sizeof(int32_t), options.overwrite);
-            written.push_back(file);
-            channels["closest_triangle"] = {{"file", fs::path(file).filename().string()}, {"dtype", "int32"}, {"components", 1}};
-        }
-        write_text_atomically(stem + ".json", field_header(field, channels).dump(2) + "\n", options.overwrite);
+        write_field_header(header_path, field, files, options.overwrite);
     } catch (...) {
         if (options.overwrite == Overwrite::Forbid) remove_quietly(written);  // all new: leave none behind
         throw;

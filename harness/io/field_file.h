@@ -15,6 +15,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/sampling/sampled_field.h"
 #include "harness/io/atomic_file.h"
@@ -33,6 +34,30 @@ struct FieldWriteOptions {
 /// Channel files are written first and the header last, each atomically, so a header
 /// always describes complete data.
 void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options = {});
+
+/// One channel file of a field as write_field lays it out, for writers that fill the files
+/// by parts (harness/distributed: every rank writes its slabs with MPI-IO at their offsets).
+struct FieldChannelFile {
+    std::string name;   ///< "distance", "gradient" or "closest_triangle"
+    std::string path;   ///< NAME.<name>.raw beside the header
+    FieldDtype dtype = FieldDtype::Float32;  ///< of distance and gradient; closest_triangle is int32
+    int components = 1;
+    size_t bytes_per_point() const;
+};
+
+/// The channel files write_field writes for `field` with `options`, in its order.
+std::vector<FieldChannelFile> field_channel_files(const std::string& header_path, const SampledField& field,
+                                                  const FieldWriteOptions& options);
+
+/// The stored bytes of points [first, first + count) of `channel`, taken from `field`'s
+/// arrays at the same indices: the bytes write_field puts at offset first * bytes_per_point.
+std::vector<char> field_channel_bytes(const SampledField& field, const FieldChannelFile& channel, size_t first,
+                                      size_t count);
+
+/// Writes the header of `field` (atomically), whose channel files are complete: the last
+/// step of write_field, and of writers that fill the channel files by parts.
+void write_field_header(const std::string& header_path, const SampledField& field,
+                        const std::vector<FieldChannelFile>& channels, Overwrite overwrite);
 
 /// Reads a field written by write_field or by a user. The value channel becomes
 /// `distance`; the gradient channel, if any, `gradient`. Errors name the file and key.

@@ -1,8 +1,10 @@
 #include "harness/runner/runner.h"
 
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <regex>
+#include <sstream>
 
 #include "core/mesh/sha256.h"
 #include "harness/experiment/experiment.h"
@@ -11,6 +13,7 @@
 #include "harness/check/regression_check.h"
 #include "harness/config/config_loader.h"
 #include "harness/config/sweep.h"
+#include "harness/distributed/distributed.h"
 #include "harness/io/atomic_file.h"
 #include "harness/provenance/provenance.h"
 
@@ -182,6 +185,7 @@ nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<Plann
                                {"cache", {{"used", !options.no_cache}, {"root", options.no_cache ? "" : cache_root}}},
                                {"provenance", machine_and_build()}};
     manifest["provenance"]["load_average"] = {{"start", load_at_start}, {"end", load_average()}};
+    if (distributed_active()) manifest["distributed"] = distributed_description();
     if (runs.size() == 1) {
         manifest["config"]["resolved"] = *first.resolved;
         manifest["inputs"] = first.context.inputs;
@@ -199,6 +203,83 @@ nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<Plann
     return manifest;
 }
 
+/// Sends the root's staging directory to the workers of a run distributed by runs, or ""
+/// when the root failed before it had one (the workers then stop).
+class StagingAnnouncement {
+public:
+    explicit StagingAnnouncement(bool needed) : needed_(needed) {}
+    void send(const std::string& staging) {
+        if (needed_) broadcast_from_root(staging);
+        needed_ = false;
+    }
+    ~StagingAnnouncement() {
+        try {
+            send("");
+        } catch (...) {  // already failing
+        }
+    }
+
+private:
+    bool needed_;
+};
+
+/// Runs this rank's share of the runs (run i on rank i % ranks) into `staging` (the run's final
+/// name is `run_id`, "<name>/<run-id>"); returns what
+/// the root needs of them: ok or the error, and per run its metrics, inputs and seconds.
+nlohmann::json run_my_share(std::vector<PlannedRun>& runs, const std::string& staging, const std::string& run_id,
+                            std::ostream& log) {
+    const nlohmann::json self = this_process();
+    nlohmann::json mine = {{"ok", true}, {"rank", distributed_rank()}, {"host", self.value("host", std::string("?"))},
+                           {"runs", nlohmann::json::array()}};
+    try {
+        if (!fs::is_directory(staging))
+            throw std::runtime_error("the run's staging directory " + staging +
+                                     " is not visible here: --distribute runs needs a file system shared by every rank");
+        for (size_t i = 0; i < runs.size(); ++i) {
+            if (int(i % size_t(distributed_size())) != distributed_rank()) continue;
+            RunContext& ctx = runs[i].context;
+            ctx.output_dir = runs.size() == 1 ? staging : (fs::path(staging) / runs[i].point.name).string();
+            ctx.run_id = run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
+            ctx.log = &log;
+            log << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump()
+                << std::endl;
+            const auto start = std::chrono::steady_clock::now();
+            fail_here_if_asked();
+            runs[i].experiment->run(ctx);
+            mine["runs"].push_back({{"index", i},
+                                    {"metrics", ctx.metrics},
+                                    {"inputs", ctx.inputs},
+                                    {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}});
+        }
+    } catch (const std::exception& e) {
+        mine["ok"] = false;
+        mine["error"] = e.what();
+    }
+    return mine;
+}
+
+/// The root's side of a run distributed by runs: every rank's results into `runs`; throws
+/// naming each failed rank and its host. Returns the manifest's record of who ran what.
+nlohmann::json collect_shares(std::vector<PlannedRun>& runs, const nlohmann::json& all) {
+    std::string errors;
+    nlohmann::json record = nlohmann::json::array();
+    for (const nlohmann::json& share : all) {
+        const std::string who = "rank " + std::to_string(share.value("rank", -1)) + " (host " + share.value("host", std::string("?")) + ")";
+        if (!share.value("ok", false)) {
+            errors += (errors.empty() ? "" : "; ") + who + ": " + share.value("error", std::string("unknown error"));
+            continue;
+        }
+        for (const nlohmann::json& r : share["runs"]) {
+            PlannedRun& run = runs[r["index"].get<size_t>()];
+            run.context.metrics = r["metrics"];
+            run.context.inputs = r["inputs"];
+            record.push_back({{"name", run.point.name}, {"rank", share["rank"]}, {"host", share["host"]}, {"seconds", r["seconds"]}});
+        }
+    }
+    if (!errors.empty()) throw std::runtime_error("distributed run failed: " + errors);
+    return record;
+}
+
 }  // namespace
 
 int run_experiment(const RunnerOptions& options) {
@@ -212,10 +293,23 @@ int run_experiment(const RunnerOptions& options) {
         configure_runs(config, options, options.no_cache ? nullptr : &fields, options.no_cache ? nullptr : &cache);
     const std::string hash = config_hash(runs);
     const std::string name = JsonReader(config.merged, config.label()).raw("name").get<std::string>();
+    const bool by_runs = distributed_active() && distribution() == Distribution::Runs;
     if (options.dry_run) {
-        print_plan(config, runs, hash, options, cache_root);
+        if (distributed_rank() == 0) print_plan(config, runs, hash, options, cache_root);
         return 0;
     }
+    if (by_runs && distributed_rank() != 0) {
+        // A worker of a run distributed by runs: the root stages, this rank runs its share.
+        // The root sends "<staging directory>\n<name>/<run-id>", or "" when it failed first.
+        const std::string announced = broadcast_from_root("");
+        if (announced.empty()) return 1;  // the root failed first and says why
+        const size_t cut = announced.find('\n');
+        std::ostringstream quiet;
+        const nlohmann::json mine = run_my_share(runs, announced.substr(0, cut), announced.substr(cut + 1), quiet);
+        gather_to_root(mine);
+        return mine["ok"].get<bool>() ? 0 : 1;
+    }
+    StagingAnnouncement announcement(by_runs);  // tells the workers if the root fails from here on
     // Before the run directory exists or anything is sampled (issue 11, class 5).
     require_host_memory(largest_memory_need(runs), config.label());
 
@@ -246,17 +340,24 @@ int run_experiment(const RunnerOptions& options) {
     } unreserve{reservation(reserved_id)};
     StagedDirectory out((parent / run_id).string());
     std::cout << "run " << name << "/" << run_id << " (kind " << runs[0].kind << (runs.size() > 1 ? ", " + std::to_string(runs.size()) + " sweep points" : std::string()) << ")" << std::endl;
-    for (size_t i = 0; i < runs.size(); ++i) {
-        RunContext& ctx = runs[i].context;
-        ctx.output_dir = runs.size() == 1 ? out.path() : (fs::path(out.path()) / runs[i].point.name).string();
-        ctx.run_id = name + "/" + run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
-        if (runs.size() > 1)
-            std::cout << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
-        runs[i].experiment->run(ctx);
+    nlohmann::json ran_by;  // runs mode: which rank ran each run
+    if (by_runs) {
+        announcement.send(out.path() + "\n" + name + "/" + run_id);
+        ran_by = collect_shares(runs, gather_to_root(run_my_share(runs, out.path(), name + "/" + run_id, std::cout)));
+    } else {
+        for (size_t i = 0; i < runs.size(); ++i) {
+            RunContext& ctx = runs[i].context;
+            ctx.output_dir = runs.size() == 1 ? out.path() : (fs::path(out.path()) / runs[i].point.name).string();
+            ctx.run_id = name + "/" + run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
+            if (runs.size() > 1)
+                std::cout << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
+            runs[i].experiment->run(ctx);
+        }
     }
 
     const nlohmann::json metrics = combined_metrics(runs);
     nlohmann::json manifest = make_manifest(config, runs, hash, run_id, started, load_at_start, options, cache_root);
+    if (by_runs) manifest["distributed"]["points"] = ran_by;
     write_text_atomically(out.path() + "/metrics.json", metrics.dump(2) + "\n");
     write_text_atomically(out.path() + "/manifest.json", manifest.dump(2) + "\n");
     // A run of the same config may have taken this id meanwhile: take the next free one.

@@ -72,6 +72,39 @@ protected:
 
 // ---- round trips ------------------------------------------------------------------------
 
+// Writers that fill the channel files by parts (the MPI-IO write of harness/distributed) use
+// field_channel_files and field_channel_bytes: the bytes of any cut of the points, placed at
+// first * bytes_per_point, must be write_field's file, byte for byte.
+TEST_F(FieldFiles, ChannelBytesOfPartsAreTheWrittenFiles) {
+    for (const LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        for (const FieldDtype dtype : {FieldDtype::Float32, FieldDtype::Float64}) {
+            const SampledField f = make_field(type, {5, 4, 3});
+            FieldWriteOptions o;
+            o.dtype = dtype;
+            const std::string header = at(std::string(type == LatticeType::CC ? "cc" : "bcc") +
+                                          (dtype == FieldDtype::Float32 ? "32" : "64") + ".json");
+            write_field(header, f, o);
+            const std::vector<FieldChannelFile> files = field_channel_files(header, f, o);
+            ASSERT_EQ(files.size(), 3u);
+            const json channels = read_json(header)["channels"];
+            const size_t n = size_t(f.size());
+            for (const FieldChannelFile& c : files) {
+                SCOPED_TRACE(c.path);
+                EXPECT_EQ(fs::path(c.path).filename().string(), channels.at(c.name).at("file").get<std::string>());
+                const std::string on_disk = read_text(c.path);
+                ASSERT_EQ(on_disk.size(), n * c.bytes_per_point());
+                std::string parts;
+                for (const auto& [first, count] : {std::pair<size_t, size_t>{0, 7}, {7, n - 20}, {n - 13, 13}}) {
+                    const std::vector<char> bytes = field_channel_bytes(f, c, first, count);
+                    ASSERT_EQ(bytes.size(), count * c.bytes_per_point());
+                    parts.append(bytes.data(), bytes.size());
+                }
+                EXPECT_TRUE(parts == on_disk);
+            }
+        }
+    }
+}
+
 TEST_F(FieldFiles, RoundTripFloat64IsExact) {
     for (LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
         const SampledField f = make_field(type, {4, 5, 3});
