@@ -20,6 +20,7 @@
 
 int main(int argc, char** argv) {
     CLI::App app{"Reconstructs a CC or BCC field file at given points: prints \"f gx gy gz\" per point."};
+    sdf::add_version_flag(app, "sdf-eval");
     std::string field_path, points_path, interpolator, derivatives, sigma_units = "lattice";
     sdf::ReconstructionSpec spec;
     int threads = 0;
