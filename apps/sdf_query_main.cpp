@@ -89,7 +89,8 @@ int main(int argc, char** argv) {
     if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
     try {
         if (options.backend == "auto" && !options.kernel.empty())
-            throw std::invalid_argument("--kernel needs --backend cpu or cuda (auto takes each backend's default kernel)");
+            throw std::invalid_argument("--kernel " + options.kernel +
+                                        ": a kernel needs --backend cpu or cuda (auto takes each backend's default kernel)");
         sdf::point_query_sampler_options(options);  // bad names fail before the mesh is read
         const sdf::PreparedMesh mesh = sdf::prepare_mesh(
             sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
