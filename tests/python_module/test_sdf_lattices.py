@@ -8,6 +8,7 @@ import glob
 import json
 import os
 import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -374,6 +375,19 @@ def test_render_returns_a_shaded_image(box):
 def test_version_matches_the_tools():
     out = run([SDF_QUERY, "--version"]).stdout.strip()
     assert out.startswith(f"sdf-query {sl.__version__} (commit {sl.build_commit}")
+
+
+@pytest.mark.skipif("SDF_BUILD_DIR" not in os.environ, reason="needs the build directory (CTest passes it)")
+def test_cmake_install_puts_an_importable_module(tmp_path):
+    prefix = tmp_path / "prefix"
+    run([os.environ.get("CMAKE_COMMAND", "cmake"), "--install", os.environ["SDF_BUILD_DIR"], "--prefix", str(prefix)])
+    site = prefix / os.environ["SDF_PYTHON_INSTALL_DIR"]
+    env = dict(os.environ, PYTHONPATH=str(site))
+    r = subprocess.run([sys.executable, "-c", "import sdf_lattices as s; print(s.__file__); print(s.__version__)"],
+                       capture_output=True, text=True, env=env, cwd=str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    where, version = r.stdout.split()
+    assert where.startswith(str(site)) and version == sl.__version__
 
 
 def test_docstrings_everywhere():
