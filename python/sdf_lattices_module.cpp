@@ -8,8 +8,9 @@
 // read_field / write_field_file (harness/io) as the tools' files, Reconstruction as sdf-eval,
 // render_reconstruction as sdf-render. Work on arrays runs with the GIL released; no Python
 // code is called per point. C++ errors arrive as Python exceptions with the tools' messages:
-// std::invalid_argument as ValueError, every other std::exception (std::runtime_error,
-// ConfigError) as RuntimeError.
+// std::invalid_argument and ConfigError (sample()'s arguments, read by the config parser) as
+// ValueError, every other std::exception (a file that cannot be read, a backend this machine
+// lacks) as RuntimeError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -459,6 +460,14 @@ sdf-query, sample() equals a run-experiment field, bit for bit. Signed distance 
 inside; gradients are unit vectors; triangles are 0-based in the input's face order.
 Errors raise ValueError (a bad argument) or RuntimeError (a bad file, a missing backend)
 with the tools' messages.)";
+    // sample()'s arguments are read by the config parser: its ConfigError is a bad argument here.
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const ConfigError& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        }
+    });
     m.attr("__version__") = project_version();
     m.attr("build_commit") = build_commit();
 

@@ -125,7 +125,7 @@ def test_load_errors_carry_the_tools_messages(tmp_path):
     r = run([SDF_QUERY, missing, str(points)], check=False)
     assert r.returncode == 1
     assert r.stderr.strip() == "sdf-query: error: " + str(e.value)
-    with pytest.raises(RuntimeError, match="did you mean 'box'"):
+    with pytest.raises(ValueError, match="did you mean .box."):
         sl.load_mesh("shape:bxo")
 
 
@@ -323,10 +323,12 @@ def test_write_and_read_field_round_trip_and_refuse_overwrite(tmp_path, box):
 
 
 def test_sample_arguments_are_checked_by_the_config_parser(box):
-    with pytest.raises(RuntimeError, match="third entry must be even"):
+    with pytest.raises(ValueError, match=r"sample\(\): key 'lattice.resolution': .*third entry must be even"):
         sl.sample(box, lattice="bcc", resolution=(5, 5, 7))
-    with pytest.raises(RuntimeError, match="exactly one of"):
+    with pytest.raises(ValueError, match="exactly one of"):
         sl.sample(box, lattice="cc")
+    with pytest.raises(ValueError, match=r"sample\(\): key 'sampler.kernel'.*did you mean \"brick\"|sampler.kernel"):
+        sl.sample(box, lattice="cc", resolution=4, backend="cpu", kernel="brik")
     with pytest.raises(ValueError, match="lattice: unknown value 'fcc'"):
         sl.sample(box, lattice="fcc", resolution=4)
     f = sl.sample(box, lattice="cc", samples=1000, backend="cpu")
