@@ -547,6 +547,9 @@ check_intersections looks for intersecting triangle pairs (costs about a BVH bui
         }, "The whole preparation report as a dict (every count of core/mesh/prepared_mesh.h's MeshReport).")
         .def("__repr__", &mesh_repr);
 
+    m.def("cuda_available", &cuda_backend_available,
+          "True when this build has the CUDA backend and a GPU is present (what backend=\"auto\" picks).");
+
     m.def("load_mesh", &load_prepared, py::arg("path"), py::arg("weld_tolerance") = 0.0,
           py::arg("check_intersections") = true,
           R"(load_mesh(path, weld_tolerance=0.0, check_intersections=True) -> Mesh
