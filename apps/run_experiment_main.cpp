@@ -20,6 +20,7 @@
 int main(int argc, char** argv) {
     CLI::App app{"Runs an experiment described by a JSON config (docs/harness.md), checks runs against baselines, "
                  "and makes baselines."};
+    sdf::add_version_flag(app, "run-experiment");
     sdf::RunnerOptions options;
     options.experiments = &sdf::experiment_registry();
     bool quiet = false, force = false;

@@ -4,7 +4,8 @@
 // Reconstructs a sampled field (the project's field file: docs/field-format.md, CC or BCC,
 // with or without a gradient channel, any scalar volume) and prints one line per input
 // point, in input order: "f gx gy gz" (value and world-space gradient, %.9g). POINTS has
-// "x y z" per line in world units ('-' = stdin; blank lines and '#' comments are skipped).
+// "x y z" per line in world units ('-' = stdin; blank lines and '#' comments are skipped), or
+// is a .npy file of shape (N, 3).
 // Points outside the interpolator's domain are clamped into it (a warning counts them).
 // docs/reconstruction.md describes the interpolators and derivative sources.
 #include <CLI/CLI.hpp>
@@ -20,11 +21,12 @@
 
 int main(int argc, char** argv) {
     CLI::App app{"Reconstructs a CC or BCC field file at given points: prints \"f gx gy gz\" per point."};
+    sdf::add_version_flag(app, "sdf-eval");
     std::string field_path, points_path, interpolator, derivatives, sigma_units = "lattice";
     sdf::ReconstructionSpec spec;
     int threads = 0;
     app.add_option("field", field_path, "field header (NAME.json, docs/field-format.md)")->required();
-    app.add_option("points", points_path, "file with \"x y z\" per line (world units), or - for stdin")->required();
+    app.add_option("points", points_path, "file with \"x y z\" per line (world units), a .npy file of shape (N, 3), or - for stdin")->required();
     app.add_option("--interpolator", interpolator, sdf::interpolator_help())
         ->required()
         ->check(CLI::IsMember(sdf::interpolator_names()));

@@ -1,33 +1,73 @@
-// sdf-query MESH POINTS [--backend cpu|cuda] [--threads N] [--precision float|double]
-//           [--sign auto|pseudonormal|winding]
+// sdf-query MESH POINTS [--method bvh|brute_force] [--backend auto|cpu|cuda] [--threads N]
+//           [--precision float|double] [--sign auto|pseudonormal|winding] [--out FILE]
 //
-// Prints one line per input point, in input order: "d gx gy gz tri" (signed distance,
-// exact gradient, 0-based closest triangle in the file's face order). MESH is an OBJ file
-// (a relative name is looked up in the current directory, then on the data search path:
-// harness/config/mesh_spec.h) or shape:NAME; POINTS has "x y z" per line ('-' = stdin).
+// One result per input point, in input order: "d gx gy gz tri" (signed distance, exact
+// gradient, 0-based closest triangle in the file's face order). MESH is a mesh file (OBJ,
+// PLY, STL, OFF, optionally gzip-compressed; a relative name is looked up in the current
+// directory, then on the data search path: harness/config/mesh_spec.h) or shape:NAME;
+// POINTS has "x y z" per line ('-' = stdin) or is a .npy file of shape (N, 3). Results go to
+// stdout as text, or to --out: a .npy file of shape (N, 5) float64 (the same five columns,
+// every bit of the double results), any other name a text file. The query itself is
+// harness/sampling/point_query.h, shared with the Python module.
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
 
-#include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <sstream>
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/io/atomic_file.h"
+#include "harness/io/npy_file.h"
 #include "harness/io/points_file.h"
+#include "harness/sampling/point_query.h"
 #include "harness/sampling/sampler_table.h"
+
+namespace {
+
+/// The results as text lines (%.9g for float searches, %.17g for double: every bit).
+std::string results_text(const std::vector<sdf::PointSample>& results, sdf::Precision precision) {
+    const char* fmt = precision == sdf::Precision::Float ? "%.9g %.9g %.9g %.9g %d\n" : "%.17g %.17g %.17g %.17g %d\n";
+    std::string text;
+    char line[160];
+    for (const sdf::PointSample& r : results) {
+        std::snprintf(line, sizeof line, fmt, r.distance, r.gradient.x, r.gradient.y, r.gradient.z, r.triangle);
+        text += line;
+    }
+    return text;
+}
+
+/// (N, 5) float64 rows "d gx gy gz tri" (triangle indices are exact in a double).
+std::vector<double> results_rows(const std::vector<sdf::PointSample>& results) {
+    std::vector<double> rows;
+    rows.reserve(results.size() * 5);
+    for (const sdf::PointSample& r : results)
+        rows.insert(rows.end(), {r.distance, r.gradient.x, r.gradient.y, r.gradient.z, double(r.triangle)});
+    return rows;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"Exact signed distance, gradient and closest triangle of points to a mesh."};
-    std::string mesh_arg, points_path, precision = "float", sign = sdf::kSignModes[0].name;
-    sdf::SamplerOptions options;
-    app.add_option("mesh", mesh_arg, "OBJ file or shape:NAME (sphere, box, torus, pawn, soccer_ball)")->required();
-    app.add_option("points", points_path, "file with \"x y z\" per line, or - for stdin")->required();
-    app.add_option("--backend", options.backend, "sampler backend")
-        ->check(CLI::IsMember(sdf::sampler_backends()))
+    sdf::add_version_flag(app, "sdf-query");
+    std::string mesh_arg, points_path, out_path, precision = "float", sign = sdf::kSignModes[0].name;
+    bool quiet = false, overwrite = false;
+    sdf::PointQueryOptions options;
+    app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME (sphere, box, torus, "
+                                     "pawn, soccer_ball)")
+        ->required();
+    app.add_option("points", points_path, "file with \"x y z\" per line, a .npy file of shape (N, 3), or - for stdin")
+        ->required();
+    app.add_option("--method", options.method, "search: bvh (about log n per point) or brute_force (every triangle)")
+        ->check(CLI::IsMember(sdf::sampler_methods()))
+        ->capture_default_str();
+    app.add_option("--backend", options.backend, "sampler backend (auto: cuda when a GPU is present, else cpu)")
+        ->check(CLI::IsMember(sdf::point_query_backends()))
         ->capture_default_str();
     app.add_option("--kernel", options.kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
     app.add_option("--threads", options.threads, "CPU threads (0 = all)")
@@ -39,22 +79,33 @@ int main(int argc, char** argv) {
                    "the mesh is closed, manifold, oriented, one shell, without self-intersections; winding otherwise)")
         ->check(CLI::IsMember(sdf::sign_mode_names()))
         ->capture_default_str();
+    app.add_option("--out", out_path, "write the results here instead of stdout: .npy = (N, 5) float64, else text");
+    app.add_flag("--overwrite", overwrite, "replace an existing --out file");
+    app.add_flag("--quiet", quiet, "no progress lines on stderr");
     SDF_CLI_PARSE(app, argc, argv);
     options.precision = precision == "float" ? sdf::Precision::Float : sdf::Precision::Double;
     options.sign = sdf::sign_mode_from_name(sign, "--sign");
-    options.progress = false;
-    sdf::ProgressReporter::set_globally_enabled(false);
+    options.progress = !quiet;
+    if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
     try {
-        sdf::check_sampler_kernel(options);
+        if (options.backend == "auto" && !options.kernel.empty())
+            throw std::invalid_argument("--kernel " + options.kernel +
+                                        ": a kernel needs --backend cpu or cuda (auto takes each backend's default kernel)");
+        sdf::point_query_sampler_options(options);  // bad names fail before the mesh is read
         const sdf::PreparedMesh mesh = sdf::prepare_mesh(
             sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-query: warning: " << w << "\n";
         const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
-        const auto results = sdf::make_sampler(options)->query(mesh, points);
-        const char* fmt = options.precision == sdf::Precision::Float ? "%.9g %.9g %.9g %.9g %d\n"
-                                                                     : "%.17g %.17g %.17g %.17g %d\n";
-        for (const sdf::PointSample& r : results)
-            std::printf(fmt, r.distance, r.gradient.x, r.gradient.y, r.gradient.z, r.triangle);
+        const sdf::PointQueryResult result = sdf::query_points(mesh, points, options);
+        const sdf::Overwrite mode = overwrite ? sdf::Overwrite::Allow : sdf::Overwrite::Forbid;
+        if (out_path.empty()) {
+            const std::string text = results_text(result.samples, options.precision);
+            std::fwrite(text.data(), 1, text.size(), stdout);
+        } else if (sdf::is_npy_path(out_path)) {
+            sdf::write_npy(out_path, results_rows(result.samples), {int64_t(result.samples.size()), 5}, mode);
+        } else {
+            sdf::write_text_atomically(out_path, results_text(result.samples, options.precision), mode);
+        }
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "sdf-query: error: " << e.what() << "\n";

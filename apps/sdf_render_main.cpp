@@ -68,17 +68,6 @@ bool is_field_file(const std::string& input) { return fs::path(input).extension(
 
 Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
-/// Bounds of a field's solid: the lattice points with f <= 0, grown by one spacing.
-Bounds3 solid_bounds(const SampledField& f) {
-    Bounds3 b;
-    for (int64_t i = 0; i < f.size(); ++i)
-        if (f.distance[size_t(i)] <= 0) b.extend(f.lattice.position(i));
-    if (b.empty()) throw std::runtime_error("the field has no point with a value <= 0: nothing to frame");
-    b.extend(b.min - Vec3d(f.lattice.spacing));
-    b.extend(b.max + Vec3d(f.lattice.spacing));
-    return b;
-}
-
 SamplerOptions sampler_options(const Options& o) {
     SamplerOptions s;
     s.backend = o.sampler_backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : o.sampler_backend;
@@ -210,7 +199,7 @@ int run_single(const Options& o, const nlohmann::json& resolved) {
         field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
     }
     if (o.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
-    const Bounds3 bounds = mesh ? mesh->bounds() : solid_bounds(field);
+    const Bounds3 bounds = mesh ? mesh->bounds() : field_solid_bounds(field);
     const Reconstruction recon(field, o.interpolator.empty() ? (field.lattice.type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm")
                                                              : o.interpolator,
                                o.derivatives);
@@ -305,6 +294,7 @@ MemoryNeed render_memory_need(const Options& o) {
 
 int main(int argc, char** argv) {
     CLI::App app{"Ray-casts reconstructed distance fields (docs/raycast.md): one image per view, or the thesis grid."};
+    sdf::add_version_flag(app, "sdf-render");
     Options o;
     app.add_option("input", o.input, "field file (NAME.json) or mesh (OBJ on the data path, or shape:NAME)")->required();
     app.add_option("--mesh", o.mesh_file, "field input: the mesh, for --reference and framing");

@@ -82,3 +82,37 @@ if(NOT SDF_ENABLE_CUDA STREQUAL "OFF")
     message(FATAL_ERROR "SDF_ENABLE_CUDA=ON but no CUDA compiler (nvcc) was found")
   endif()
 endif()
+
+# The Python module sdf_lattices (python/): pybind11 and a Python with its headers and NumPy
+# (Debian: pybind11-dev, python3-pybind11, python3-dev, python3-numpy). Optional: without
+# them the module is skipped, like the CUDA backend. The interpreter is the first python3 that
+# imports numpy and has its headers: a python3 first on PATH (pyenv, a virtual environment)
+# may lack them, and the module must be built for the interpreter that will import it
+# (-DPython3_EXECUTABLE=... chooses another).
+set(SDF_BUILD_PYTHON "AUTO" CACHE STRING "Build the Python module: AUTO (when pybind11 and Python are found), ON or OFF")
+set_property(CACHE SDF_BUILD_PYTHON PROPERTY STRINGS AUTO ON OFF)
+set(SDF_HAVE_PYTHON_MODULE OFF)
+if(NOT SDF_BUILD_PYTHON STREQUAL "OFF")
+  if(NOT Python3_EXECUTABLE)
+    find_program(_sdf_path_python3 NAMES python3)
+    foreach(candidate IN ITEMS ${_sdf_path_python3} /usr/bin/python3)
+      execute_process(COMMAND ${candidate} -c
+                        "import numpy, sysconfig, os, sys; sys.exit(0 if os.path.exists(os.path.join(sysconfig.get_paths()['include'], 'Python.h')) else 1)"
+                      RESULT_VARIABLE _sdf_python_ok OUTPUT_QUIET ERROR_QUIET)
+      if(_sdf_python_ok EQUAL 0)
+        set(Python3_EXECUTABLE ${candidate} CACHE FILEPATH "The python3 the module is built for")
+        break()
+      endif()
+    endforeach()
+  endif()
+  find_package(Python3 COMPONENTS Interpreter Development.Module NumPy QUIET)
+  if(Python3_FOUND)
+    find_package(pybind11 CONFIG QUIET)
+  endif()
+  if(Python3_FOUND AND pybind11_FOUND)
+    set(SDF_HAVE_PYTHON_MODULE ON)
+  elseif(SDF_BUILD_PYTHON STREQUAL "ON")
+    message(FATAL_ERROR "SDF_BUILD_PYTHON=ON but pybind11 or a python3 with headers and NumPy was not found "
+                        "(Debian: pybind11-dev python3-pybind11 python3-dev python3-numpy)")
+  endif()
+endif()

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/io/text_file.h"
+#include "harness/io/npy_file.h"
 
 namespace sdf {
 namespace {
@@ -39,6 +40,7 @@ std::vector<Vec3d> read_points(const std::string& text, const std::string& name)
 }  // namespace
 
 std::vector<Vec3d> read_points_file(const std::string& path) {
+    if (is_npy_path(path)) return read_npy_points(path);
     if (path != "-") return read_points(read_text_file(path, "points file"), path);
     std::stringstream all;
     all << std::cin.rdbuf();

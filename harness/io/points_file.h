@@ -1,6 +1,7 @@
 /// @file points_file.h
 /// @brief Query points as the command-line tools read them (sdf-query, sdf-eval): "x y z"
-/// per line in world units, blank lines and '#' comment lines skipped.
+/// per line in world units, blank lines and '#' comment lines skipped; or a NumPy `.npy`
+/// file of shape (N, 3) (harness/io/npy_file.h), chosen by the extension.
 ///
 /// A line that is not exactly three finite numbers is an error naming the file and line
 /// ("points.txt:4: expected three finite numbers ...").

@@ -11,6 +11,16 @@
 #endif
 
 namespace sdf {
+
+Bounds3 field_solid_bounds(const SampledField& f) {
+    Bounds3 b;
+    for (int64_t i = 0; i < f.size(); ++i)
+        if (f.distance[size_t(i)] <= 0) b.extend(f.lattice.position(i));
+    if (b.empty()) throw std::runtime_error("the field has no point with a value <= 0: nothing to frame");
+    b.extend(b.min - Vec3d(f.lattice.spacing));
+    b.extend(b.max + Vec3d(f.lattice.spacing));
+    return b;
+}
 namespace {
 
 double median(std::vector<double> v) {

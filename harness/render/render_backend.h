@@ -25,6 +25,10 @@ struct RenderOptions {
 /// or for "cuda" without the CUDA backend or a GPU.
 std::string resolve_render_backend(const std::string& requested);
 
+/// Bounds of a field's solid, for framing a view without the mesh: the lattice points with
+/// f <= 0, grown by one spacing. Throws when no point has f <= 0 (nothing to frame).
+Bounds3 field_solid_bounds(const SampledField& field);
+
 /// True when this build has the CUDA ray caster and a GPU is present.
 bool cuda_render_available();
 

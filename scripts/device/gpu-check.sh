@@ -3,7 +3,7 @@
 # touched kernels: builds with CUDA and warnings as errors, runs every GPU test, every CPU test
 # there too, compute-sanitizer on the GPU tests' split/point-query cases, and the CI smoke study
 # from a portable CPU build (whose field checksums must equal those of any other CPU target).
-#   carry: .gpu-prefix data        steps: build gputest test sanitize portable bench-filters
+#   carry: .gpu-prefix data        steps: build gputest test python sanitize portable bench-filters
 # Output under $OUT: summary.txt and the logs.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -37,6 +37,16 @@ test)
     log "all tests"
     (cd $B && ctest -j 8 --output-on-failure > "$OUT/ctest-all.log" 2>&1; echo "ctest exit $?") | tee -a "$OUT/summary.txt"
     grep -E "tests passed|\(Failed\)|\(Skipped\)|Not Run" "$OUT/ctest-all.log" | tee -a "$OUT/summary.txt" ;;
+python)
+    log "Python module: query() = sdf-query on the GPU, bit for bit (tests/python_module)"
+    if [ -f $B/CTestTestfile.cmake ] && grep -q "Python module ON" "$OUT/configure.log" 2>/dev/null; then
+        PYTHONPATH=$B/python SDF_QUERY=$B/bin/sdf-query SDF_EVAL=$B/bin/sdf-eval RUN_EXPERIMENT=$B/bin/run-experiment \
+            python3 -m pytest -q -rs -p no:cacheprovider tests/python_module > "$OUT/pytest-module.log" 2>&1
+        echo "pytest tests/python_module exit $?" | tee -a "$OUT/summary.txt"
+        grep -E "passed|failed|SKIPPED" "$OUT/pytest-module.log" | tee -a "$OUT/summary.txt"
+    else
+        echo "no Python module in this build (pybind11, python3-dev or numpy missing)" | tee -a "$OUT/summary.txt"
+    fi ;;
 sanitize)
     log "compute-sanitizer"
     for t in "cuda_sampler_test --gtest_filter=*Splitting*:*PointQueries*" "cuda_bvh_test --gtest_filter=*Slabs*:*PointQueries*" \

@@ -19,6 +19,7 @@
 #include "core/mesh/sha256.h"
 #include "harness/build_config.h"
 #include "harness/io/field_file.h"
+#include "harness/io/npy_file.h"
 
 #ifndef SDF_QUERY_EXE
 #error "SDF_QUERY_EXE must be defined by CMake"
@@ -234,6 +235,30 @@ TEST_F(Cli, QueryBoxDoubleMatchesAnalyticSdf) {
     const ShellResult r = query("shape:box points.txt --precision double --threads 2");
     ASSERT_EQ(r.code, 0) << r.err;
     check_box_answers(pts, r.out, 1e-12, 1e-10);
+}
+
+TEST_F(Cli, QueryReadsAndWritesNpyFilesAndNeverOverwrites) {
+    const std::vector<Vec3d> pts = box_points();
+    std::vector<double> flat;
+    for (const Vec3d& p : pts) flat.insert(flat.end(), {p.x, p.y, p.z});
+    write_npy(at("p.npy"), flat, {int64_t(pts.size()), 3});
+    ASSERT_EQ(query("shape:box p.npy --precision double --out r.npy").code, 0);
+    const NpyArray rows = read_npy(at("r.npy"));
+    ASSERT_EQ(rows.shape, (std::vector<int64_t>{int64_t(pts.size()), 5}));
+    const std::vector<double> r = rows.to_doubles();
+    for (size_t i = 0; i < pts.size(); ++i) EXPECT_NEAR(r[5 * i], box_sdf(pts[i]), 1e-12) << i;
+    // Brute force on request: the same distances, to the last bit.
+    ASSERT_EQ(query("shape:box p.npy --precision double --method brute_force --out brute.npy").code, 0);
+    const NpyArray brute = read_npy(at("brute.npy"));
+    for (size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(brute.to_doubles()[5 * i], r[5 * i]) << i;
+    // Text to a file is what stdout gets; an existing --out file is kept unless --overwrite.
+    const ShellResult out = query("shape:box p.npy --out r.txt");
+    ASSERT_EQ(out.code, 0) << out.err;
+    EXPECT_EQ(read_text(at("r.txt")), query("shape:box p.npy").out);
+    const ShellResult again = query("shape:box p.npy --out r.npy");
+    EXPECT_EQ(again.code, 1);
+    EXPECT_TRUE(Contains(again.err, "r.npy")) << again.err;
+    EXPECT_EQ(query("shape:box p.npy --out r.npy --overwrite").code, 0);
 }
 
 TEST_F(Cli, QueryReadsStdin) {
@@ -730,10 +755,16 @@ TEST_F(Cli, QueryRejectsNegativeThreadCountAndUnknownKernel) {
     const ShellResult r = query("shape:box p.txt --threads -5");
     EXPECT_NE(r.code, 0);
     EXPECT_TRUE(Contains(r.err, "threads"));
-    const ShellResult k = query("shape:box p.txt --kernel tuned");
-    EXPECT_NE(k.code, 0);
-    EXPECT_TRUE(Contains(k.err, "tuned"));
-    EXPECT_EQ(query("shape:box p.txt --kernel eberly").code, 0);
+    for (const std::string backend : {"", " --backend cpu"}) {
+        const ShellResult k = query("shape:box p.txt --kernel tuned" + backend);
+        EXPECT_NE(k.code, 0);
+        EXPECT_TRUE(Contains(k.err, "tuned")) << k.err;
+    }
+    // A kernel belongs to one backend and method: "auto" takes none (as in configs).
+    EXPECT_TRUE(Contains(query("shape:box p.txt --kernel seeded").err, "needs --backend cpu or cuda"));
+    EXPECT_EQ(query("shape:box p.txt --backend cpu --kernel seeded").code, 0);
+    EXPECT_EQ(query("shape:box p.txt --backend cpu --method brute_force --kernel eberly").code, 0);
+    EXPECT_NE(query("shape:box p.txt --backend cpu --kernel eberly").code, 0);  // a brute-force kernel, bvh method
 }
 
 // Relative mesh names: the config's own directory, then its data_path, then $SDF_DATA_PATH;

@@ -1,6 +1,6 @@
 // A deterministic fuzz battery for every reader of outside input (issue 11): mesh files of
-// every format (OBJ, ASCII and binary PLY and STL, OFF, gzip), points files, field headers
-// and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
+// every format (OBJ, ASCII and binary PLY and STL, OFF, gzip), points files (text and .npy),
+// field headers and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
 // are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
 // huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
 // Every input must either parse or throw one of the project's error types (std::runtime_error
@@ -25,6 +25,7 @@
 #include "core/parallel/progress.h"
 #include "experiments/experiment_registry.h"
 #include "harness/io/field_file.h"
+#include "harness/io/npy_file.h"
 #include "harness/io/points_file.h"
 #include "harness/runner/runner.h"
 #include "harness_test_util.h"
@@ -210,6 +211,34 @@ TEST_F(FuzzReaders, PointsFiles) {
         test::write_file(path, bytes);
         read_points_file(path);
     });
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+}
+
+TEST_F(FuzzReaders, NpyFiles) {
+    // Points (N, 3) in each dtype, read as sdf-query and sdf-eval read them, and as arrays.
+    const std::vector<double> d = {0, 0, 0, 0.5, -1, 2.25, 1e-3, 4, 5, 7, 8, 9};
+    const std::vector<float> f(d.begin(), d.end());
+    const std::vector<int32_t> i = {0, 1, 2, 3, -4, 5};
+    const std::vector<int64_t> l = {1, 2, 3};
+    const std::vector<std::pair<std::string, std::string>> seeds = {
+        {"d.npy", npy_bytes(NpyDtype::Float64, {4, 3}, d.data())},
+        {"f.npy", npy_bytes(NpyDtype::Float32, {4, 3}, f.data())},
+        {"i.npy", npy_bytes(NpyDtype::Int32, {2, 3}, i.data())},
+        {"l.npy", npy_bytes(NpyDtype::Int64, {1, 3}, l.data())},
+    };
+    int parsed = 0, refused = 0;
+    for (size_t k = 0; k < seeds.size(); ++k) {
+        const auto [p, r] = fuzz(at(seeds[k].first), seeds[k].second, kPerSeed / 2, 6000 + k,
+                                 [](const std::string& path, const std::string& bytes) {
+                                     test::write_file(path, bytes);
+                                     const NpyArray a = read_npy(path);
+                                     EXPECT_EQ(a.data.size(), size_t(a.count()) * size_t(npy_item_size(a.dtype)));
+                                     read_points_file(path);
+                                 });
+        parsed += p;
+        refused += r;
+    }
     EXPECT_GT(parsed, 0);
     EXPECT_GT(refused, 0);
 }

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "core/mesh/prepared_mesh.h"
 #include "harness/config/json_reader.h"
 #include "harness/io/points_file.h"
+#include "harness/provenance/version.h"
 #include "harness_test_util.h"
 
 #if !defined(SDF_QUERY_EXE) || !defined(SDF_EVAL_EXE) || !defined(SDF_RENDER_EXE) || !defined(RUN_EXPERIMENT_EXE)
@@ -487,6 +489,8 @@ TEST_F(Trust, CommandLineErrorsExitWithCode2InEveryTool) {
         {SDF_QUERY_EXE, "shape:box p.txt --threads -1"},
         {SDF_QUERY_EXE, "shape:box"},
         {SDF_QUERY_EXE, "shape:box p.txt --no-such-option"},
+        {SDF_QUERY_EXE, "shape:box p.txt --method octree"},
+        {SDF_QUERY_EXE, "shape:box p.txt --backend gpu"},
         {SDF_EVAL_EXE, field + " p.txt --interpolator trilinear --threads -1"},
         {SDF_EVAL_EXE, field + " p.txt"},
         {SDF_RENDER_EXE, "shape:box --fov 0"},
@@ -506,6 +510,22 @@ TEST_F(Trust, CommandLineErrorsExitWithCode2InEveryTool) {
     }
     for (const std::string exe : {SDF_QUERY_EXE, SDF_EVAL_EXE, SDF_RENDER_EXE, RUN_EXPERIMENT_EXE})
         EXPECT_EQ(run(exe, "--help").code, 0) << exe;
+}
+
+TEST_F(Trust, EveryToolPrintsItsVersionAndCommit) {
+    const std::vector<std::pair<std::string, std::string>> tools = {
+        {SDF_QUERY_EXE, "sdf-query"}, {SDF_EVAL_EXE, "sdf-eval"}, {SDF_RENDER_EXE, "sdf-render"},
+        {RUN_EXPERIMENT_EXE, "run-experiment"}};
+    const std::regex line(R"(([a-z-]+) (\d+\.\d+\.\d+) \(commit ([0-9a-f]{40}|unknown)(, with uncommitted changes)?\)\n)");
+    for (const auto& [exe, name] : tools) {
+        const ShellResult r = run(exe, "--version");
+        EXPECT_EQ(r.code, 0) << name << ": " << r.err;
+        std::smatch m;
+        ASSERT_TRUE(std::regex_match(r.out, m, line)) << name << ": " << r.out;
+        EXPECT_EQ(m[1].str(), name);
+        EXPECT_EQ(m[2].str(), project_version());
+        EXPECT_EQ(m[3].str(), build_commit());
+    }
 }
 
 TEST_F(Trust, RenderRefusesACameraWithoutADefinedRoll) {
