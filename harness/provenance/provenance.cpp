@@ -32,7 +32,7 @@ std::string run_command(const std::string& cmd, bool* ok) {
     return out;
 }
 
-/// The commit passed in for a tree without .git: SDF_SOURCE_COMMIT from the environment, else
+/// The commit passed in (for a tree without .git, or with a stale one): SDF_SOURCE_COMMIT from the environment, else
 /// from the build (cmake -DSDF_SOURCE_COMMIT=...). "<commit>-dirty" marks uncommitted changes,
 /// as `git describe --dirty` does; a commit without it is taken as clean.
 GitState passed_in_commit() {
@@ -54,6 +54,9 @@ GitState passed_in_commit() {
 GitState git_state() { return git_state_of(SDF_SOURCE_DIR); }
 
 GitState git_state_of(const std::string& source_dir) {
+    // A commit passed in wins: a copy of the tree (the GPU machines') may hold a stale .git
+    // whose HEAD is not what was built (seen: runs recorded an older commit as "git").
+    if (const GitState passed = passed_in_commit(); passed.source == "SDF_SOURCE_COMMIT") return passed;
     GitState g;
     bool ok = false;
     const std::string dir = "git -C '" + source_dir + "' ";

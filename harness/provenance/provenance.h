@@ -20,8 +20,9 @@ struct GitState {
 
 /// The commit of this build's source tree (git_state_of(SDF_SOURCE_DIR)).
 GitState git_state();
-/// The commit of the tree at `source_dir`: git's, or where it has no .git the commit passed
-/// in (SDF_SOURCE_COMMIT, see GitState::source).
+/// The commit of the tree at `source_dir`: the commit passed in when there is one
+/// (SDF_SOURCE_COMMIT, see GitState::source: a copy of the tree may hold a stale .git), else
+/// git's.
 GitState git_state_of(const std::string& source_dir);
 std::string cpu_model();
 /// Build type, compiler and flags baked in at configure time.

@@ -1,5 +1,6 @@
 // Provenance: the source commit of a tree without .git (a copy sent to a GPU machine) is the
-// one passed in as SDF_SOURCE_COMMIT, with "-dirty" read as git describe writes it.
+// one passed in as SDF_SOURCE_COMMIT, with "-dirty" read as git describe writes it; a commit
+// passed in wins over a (possibly stale) .git.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -30,6 +31,22 @@ TEST_F(SourceCommit, ATreeWithoutGitRecordsTheCommitPassedIn) {
     g = git_state_of(dir_.string());
     EXPECT_EQ(g.commit, "0123abcd");
     EXPECT_TRUE(g.dirty);
+}
+
+TEST_F(SourceCommit, ACommitPassedInWinsOverAStaleGitDirectory) {
+    // The GPU machines' copies of the tree held a .git whose HEAD was an older commit, and the
+    // runs recorded that one as their source.
+    const std::string init = "cd '" + dir_.string() + "' && git init -q && git -c user.name=t -c user.email=t@t " +
+                             "commit -q --allow-empty -m stale";
+    ASSERT_EQ(std::system(init.c_str()), 0);
+    unsetenv("SDF_SOURCE_COMMIT");
+    const GitState from_git = git_state_of(dir_.string());
+    if (from_git.source == "SDF_SOURCE_COMMIT") GTEST_SKIP() << "this build was configured with -DSDF_SOURCE_COMMIT";
+    EXPECT_EQ(from_git.source, "git");
+    ASSERT_EQ(setenv("SDF_SOURCE_COMMIT", "0123abcd", 1), 0);
+    const GitState passed = git_state_of(dir_.string());
+    EXPECT_EQ(passed.commit, "0123abcd");
+    EXPECT_EQ(passed.source, "SDF_SOURCE_COMMIT");
 }
 
 TEST_F(SourceCommit, WithNothingPassedInTheCommitIsUnknownAndCountsAsDirty) {
