@@ -15,6 +15,10 @@ namespace sdf {
 
 enum class Precision { Float, Double };
 
+/// closest_triangle of a point outside a narrow band (SamplerOptions::band_width): its
+/// distance is the band's value with the point's sign, its gradient zero. -1 stays "none".
+inline constexpr int32_t kOutsideBandTriangle = -2;
+
 inline const char* precision_name(Precision p) { return p == Precision::Float ? "float" : "double"; }
 
 /// Wall-clock and device timings of one sampling run, in seconds.

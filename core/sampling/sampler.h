@@ -31,6 +31,11 @@ struct SamplerOptions {
     int64_t max_points_per_piece = 0;   ///< lattice points per GPU piece (memory split)
     int max_triangles_per_chunk = 0;    ///< triangles resident on the GPU at a time
     int points_per_thread = 0;          ///< tuned kernel: points per thread (1, 2, 4, 8)
+    /// Narrow band (issue 14): when > 0, only points with |d| <= band_width get exact values;
+    /// every other point gets distance +-band_width with its correct sign, gradient (0,0,0)
+    /// and closest_triangle kOutsideBandTriangle (core/sampling/sampled_field.h). The result
+    /// is a function of the exact field alone, so it is the same for every sampler and split.
+    double band_width = 0;
 };
 
 /// Result for one arbitrary query point.
