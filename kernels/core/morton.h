@@ -30,14 +30,13 @@ SDF_CPU_GPU SDF_INLINE uint64_t morton_key_63(uint32_t ix, uint32_t iy, uint32_t
 }
 
 /// The key of point (x, y, z) in the box [lo, lo + 1/inv_extent): each coordinate quantised
-/// to 2^21 cells and clamped, so points outside the box (or NaN-free far points) still get a
-/// key. Only the order matters: it never changes a result, only which points share a packet.
+/// to 2^21 cells and clamped, so points outside the box (and NaN) still get a key. Only the order matters: it never changes a result, only which points share a packet.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE uint64_t morton_key_of_point(T x, T y, T z, T lo_x, T lo_y, T lo_z, T inv_extent) {
     constexpr T kCells = T(2097151);  // 2^21 - 1
     auto cell = [&](T v, T lo) {
         T c = (v - lo) * inv_extent * kCells;
-        c = c < T(0) ? T(0) : (c > kCells ? kCells : c);
+        c = c > T(0) ? (c < kCells ? c : kCells) : T(0);  // NaN -> 0
         return uint32_t(c);
     };
     return morton_key_63(cell(x, lo_x), cell(y, lo_y), cell(z, lo_z));
