@@ -29,31 +29,65 @@ __device__ SDF_INLINE T warp_max(T v) {
     return v;
 }
 
-template <typename T>
-__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView<T> bvh, GridRangePiece piece,
-                                                                          SlabGeometry slab, int* nearest) {
+/// Where a warp's points come from: thread t owns `count` consecutive piece-local ids from
+/// `first` (count 0: none). A lattice slab gives every warp an 8 x 4 x 4 brick (SlabGeometry);
+/// a point list sorted into Morton order gives it 128 consecutive points, which are then
+/// neighbours in space as well (kernels/core/morton.h).
+struct SlabLayout {
+    GridRangePiece piece;
+    SlabGeometry slab;
+    SDF_CPU_GPU int64_t threads() const { return slab.threads(); }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = 0;
+        if (t >= slab.threads()) return 0;
+        const Int3 s = slab.run_start(t);
+        if (s.x >= slab.resolution.x || s.y >= slab.resolution.y || s.z >= slab.nz) return 0;
+        first = s.x + int64_t(slab.resolution.x) * (s.y + int64_t(slab.resolution.y) * s.z);
+        return min(kRunPoints, slab.resolution.x - s.x);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+
+struct ListLayout {
+    PointListPiece piece;
+    SDF_CPU_GPU int64_t threads() const { return (piece.size() + kRunPoints - 1) / kRunPoints; }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = t * kRunPoints;
+        const int64_t left = piece.size() - first;
+        if (left <= 0) first = 0;
+        return left <= 0 ? 0 : int(left < kRunPoints ? left : kRunPoints);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+
+/// Loads thread t's points into a packet; lanes without points get best = -1, so they never
+/// want a box or a triangle and never hold the warp back.
+template <typename T, typename Layout>
+__device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& first, BvhPacket<T, kRunPoints>& pk) {
+    const int count = layout.points_of(t, first);
+    for (int k = 0; k < kRunPoints; ++k) {
+        const Vec3<T> p(layout.position(first + (k < count ? k : 0)));
+        pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
+        pk.best_q[k] = count > 0 ? T(INFINITY) : T(-1);
+        pk.best_slot[k] = -1;
+        pk.best_triangle[k] = -1;
+    }
+    return count;
+}
+
+template <typename T, typename Layout>
+__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, int* nearest) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
     __shared__ T stack_d2[kWarps][kBvhMaxDepth];
     const int w = threadIdx.x / 32;
 
-    // Every thread stays to the end: the votes and shuffles need the whole warp. Threads
-    // past the slab get best = -1, so they never want a box and never hold the warp back.
+    // Every thread stays to the end: the votes and shuffles need the whole warp.
     const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    Int3 s{0, 0, 0};
-    bool valid = t < slab.threads();
-    if (valid) s = slab.run_start(t);
-    valid = valid && s.x < slab.resolution.x && s.y < slab.resolution.y && s.z < slab.nz;
-    const int count = valid ? min(kRunPoints, slab.resolution.x - s.x) : 0;
-    const int64_t first = s.x + int64_t(slab.resolution.x) * (s.y + int64_t(slab.resolution.y) * s.z);
+    int64_t first = 0;
     BvhPacket<T, kRunPoints> pk;
-    for (int k = 0; k < kRunPoints; ++k) {
-        const Vec3<T> p(valid ? piece.position(first + (k < count ? k : 0)) : piece.position(0));
-        pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
-        pk.best_q[k] = valid ? T(INFINITY) : T(-1);  // -1: never nearer than a box or a triangle
-        pk.best_slot[k] = -1;
-        pk.best_triangle[k] = -1;
-    }
+    const int count = load_packet<T>(layout, t, first, pk);
+    const bool valid = count > 0;
 
     T worst = warp_max(valid ? T(INFINITY) : T(-1));
     int top = 0;  // warp-uniform
