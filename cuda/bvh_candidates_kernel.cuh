@@ -22,20 +22,11 @@
 #pragma once
 
 #include "cuda/bvh_warp_kernel.cuh"
-#include "cuda/finalize_kernel.cuh"
-#include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {
 
 /// Leaf ranges a warp holds before it scans them; more are scanned in rounds (same result).
 constexpr int kCandidateRanges = 96;
-
-/// The narrow band as the search sees it; width 0 = no band.
-struct BandSearch {
-    double width = 0;
-    MeshView<double> mesh{};  ///< for the side of a brick's centre (pseudonormal sign)
-    bool winding_sign = false;
-};
 
 /// Optional counters (nullptr: none): [0] bricks searched, [1] candidate triangles scanned
 /// per point summed over bricks, [2] bricks outside the band, [3] leaf ranges.
@@ -73,39 +64,16 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
     BvhPacket<T, kRunPoints> pk;
     const int count = load_packet<T>(layout, t, first, pk);
 
-    // The brick box over the warp's real points (uniform across the warp from here on).
-    const T inf = T(INFINITY);
-    Vec3<T> lo(inf, inf, inf), hi(-inf, -inf, -inf);
-    for (int k = 0; k < count; ++k) {
-        lo = Vec3<T>(min(lo.x, pk.x[k]), min(lo.y, pk.y[k]), min(lo.z, pk.z[k]));
-        hi = Vec3<T>(max(hi.x, pk.x[k]), max(hi.y, pk.y[k]), max(hi.z, pk.z[k]));
-    }
-    lo = Vec3<T>(warp_min(lo.x), warp_min(lo.y), warp_min(lo.z));
-    hi = Vec3<T>(warp_max(hi.x), warp_max(hi.y), warp_max(hi.z));
+    Vec3<T> lo, hi;
+    warp_brick_box(pk, count, lo, hi);
     if (!(lo.x <= hi.x)) return;  // no point in this warp
     const Vec3<T> c((lo.x + hi.x) / T(2), (lo.y + hi.y) / T(2), (lo.z + hi.z) / T(2));
 
     // The centre's nearest triangle: every lane walks the same path (broadcast loads).
     const BvhHit<T> seed = closest_triangle_bvh(bvh, c);
-
     if (band.width > 0) {
-        T r2 = T(0);
-        for (int k = 0; k < count; ++k) {
-            const T dx = pk.x[k] - c.x, dy = pk.y[k] - c.y, dz = pk.z[k] - c.z;
-            r2 = max(r2, dx * dx + dy * dy + dz * dz);
-        }
-        r2 = warp_max(r2);
-        const double scale = fmax(fmax(fabs(double(c.x)), fabs(double(c.y))), fabs(double(c.z)));
-        const double dc = sqrt(double(seed.distance_squared)), r = sqrt(double(r2));
-        // Rounding allowance: the float search's distances are exact relative to the coordinates.
-        const double slack = 64.0 * double(std::numeric_limits<T>::epsilon()) * (scale + dc + r) + 1e-300;
-        if (dc - r - slack > band.width) {
-            int code = kOutsideBandSignPerPoint;
-            if (!band.winding_sign) {
-                const SignedDistanceSample<double> s =
-                    signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[seed.slot]);
-                code = s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
-            }
+        const int code = brick_band_code(bvh, pk, count, c, seed, band);
+        if (code != 0) {
             for (int k = 0; k < count; ++k) nearest[first + k] = code;
             if (stats && lane == 0) atomicAdd(stats + 2, 1ull);
             return;

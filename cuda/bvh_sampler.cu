@@ -154,6 +154,13 @@ private:
         return int(std::clamp<int64_t>(layers, 1, block.resolution.z));
     }
 
+    /// The band's search parameters (bricks outside it are skipped by "warp" and "candidates";
+    /// the other kernels search everything and finalize_samples() applies the band).
+    template <typename T>
+    BandSearch band_search(const DeviceBvh<T>& dev) const {
+        return {options_.band_width, dev.mesh->view(), dev.winding.view().enabled()};
+    }
+
     template <typename T>
     void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) {
         const int blocks = blocks_for(slab.threads(), kBvhThreads);
@@ -169,12 +176,11 @@ private:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
                 break;
             case BvhGpuKernel::Warp:
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, nearest);
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev), nearest);
                 break;
             case BvhGpuKernel::Candidates:
-                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(
-                    view, SlabLayout{piece, slab}, BandSearch{options_.band_width, dev.mesh->view(), dev.winding.view().enabled()},
-                    nearest, candidate_stats_.get());
+                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),
+                                                                            nearest, candidate_stats_.get());
                 break;
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
@@ -277,7 +283,7 @@ private:
             if (kernel_ == BvhGpuKernel::Candidates)
                 nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
             else
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, r.nearest.get());
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());

@@ -119,9 +119,13 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
             for (Precision precision : {Precision::Float, Precision::Double}) {
                 const Lattice cc = fit_lattice(LatticeType::CC, {40, 41, 42}, mesh.bounds(), 0.3);
                 const Lattice bcc = fit_lattice(LatticeType::BCC, {30, 31, 32}, mesh.bounds(), 0.3);
+                // The two that skip bricks outside the band, one that searches everything
+                // (the band applied by finalize_samples), and the brute force.
+                const std::pair<const char*, const char*> samplers[] = {
+                    {"bvh", "warp"}, {"bvh", "candidates"}, {"bvh", "unseeded"}, {"brute_force", ""}};
                 for (const Lattice& lattice : {cc, bcc})
-                    for (const auto& [kernel, id] : cuda::kCudaBvhKernels) {
-                        SamplerOptions o = options("cuda", "bvh", precision, kernel);
+                    for (const auto& [method, kernel] : samplers) {
+                        SamplerOptions o = options("cuda", method, precision, kernel);
                         o.sign = sign;
                         const SampledField full = make_sampler(o)->sample(mesh, lattice);
                         for (double fraction : {0.02, 0.1}) {
@@ -129,7 +133,7 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
                             o.band_width = w;
                             const SampledField band = make_sampler(o)->sample(mesh, lattice);
                             const SampledField expected = banded(full, w);
-                            const std::string what = meshes[which].name + " " + lattice_notation(lattice) + " " + kernel + " " +
+                            const std::string what = meshes[which].name + " " + lattice_notation(lattice) + " " + method + "/" + kernel + " " +
                                                      precision_name(precision) + (sign == SignMode::Winding ? " winding" : "") +
                                                      " band " + std::to_string(fraction);
                             ASSERT_EQ(band.distance, expected.distance) << what;
@@ -137,6 +141,10 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
                             for (int64_t i = 0; i < band.size(); ++i)
                                 ASSERT_TRUE(band.gradient[size_t(i)] == expected.gradient[size_t(i)]) << what << " point " << i;
                             EXPECT_EQ(band.sampler["band_width"].get<double>(), w);
+                            int64_t in_band = 0;
+                            for (int32_t t : band.closest_triangle) in_band += t != kOutsideBandTriangle;
+                            EXPECT_GT(in_band, 0) << what;
+                            EXPECT_LT(in_band, band.size()) << what;
                             if (std::string(kernel) == "candidates") {
                                 const auto& c = band.sampler["candidates"];
                                 std::printf("%-60s bricks searched %lld, outside the band %lld\n", what.c_str(),
