@@ -10,7 +10,8 @@
 // code is called per point. C++ errors arrive as Python exceptions with the tools' messages:
 // std::invalid_argument and ConfigError (sample()'s arguments, read by the config parser) as
 // ValueError, every other std::exception (a file that cannot be read, a backend this machine
-// lacks) as RuntimeError.
+// lacks) as RuntimeError. Under mpirun, sample() is collective over the ranks
+// (sample_collectively, harness/distributed/distributed.h; docs/distributed.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -16,6 +16,9 @@
 /// reported by mpirun ("process rank 2 ... on node N exited on signal 9"), which ends every
 /// rank.
 ///
+/// The Python module runs the other way round: every rank runs the same script and calls
+/// sample_collectively(), which returns the whole field on every rank (below).
+///
 /// Without MPI in the build, or when not started by mpirun, every function here describes
 /// a single process: distributed_active() is false and nothing changes.
 #pragma once

@@ -11,6 +11,8 @@
 //                                ranks sampled last; the worker writes its slab into them with
 //                                MPI-IO and answers with a kTagStatus JSON (bytes, seconds, or
 //                                the error). Workers keep their last slab until then.
+// Collective sampling (the Python module, every rank calling sample_collectively) uses the
+// same Sample/status/data messages and then kTagOutcome; see its section below.
 // Waiting ranks poll with short sleeps instead of MPI's busy wait, so that an idle worker
 // does not take a core from the ranks that compute.
 #include "harness/distributed/distributed.h"
