@@ -2,7 +2,9 @@
 
     mpi_launch.py abort MPIEXEC
         a rank that ends with an uncaught exception outside sample() (the others waiting in
-        sample() for it) ends the job through MPI_Abort, with its traceback: no hang.
+        sample() for it) ends the job through MPI_Abort, with its traceback: no hang; and a
+        rank that dies in sample() (SDF_MPI_FAIL_MODE=kill) is reported by mpirun, which ends
+        the job.
     mpi_launch.py mpi4py MPIEXEC
         with MPI started by mpi4py (Debian python3-mpi4py, optional: exit 77 = skipped when it
         is missing), the module uses that MPI: sample() is collective, and mpi4py's own
@@ -20,6 +22,13 @@ if sl.distributed()["rank"] == 1:
     raise RuntimeError("a user's error on rank 1")
 sl.sample(mesh, lattice="cc", resolution=[11, 9, 13], backend="cpu")
 print("sampled without rank 1", flush=True)
+"""
+
+KILL_SCRIPT = """
+import sdf_lattices as sl
+mesh = sl.load_mesh("shape:torus")
+sl.sample(mesh, lattice="cc", resolution=[11, 9, 13], backend="cpu")
+print("sampled", flush=True)
 """
 
 MPI4PY_SCRIPT = """
@@ -45,10 +54,10 @@ print("rank", info["rank"], "holds the single-process field", digests[0][:12], f
 """
 
 
-def mpirun(mpiexec, ranks, script):
+def mpirun(mpiexec, ranks, script, env=None):
     start = time.monotonic()
     r = subprocess.run([mpiexec, "--oversubscribe", "-np", str(ranks), sys.executable, "-c", script],
-                       capture_output=True, text=True, timeout=90)
+                       capture_output=True, text=True, timeout=90, env={**os.environ, **(env or {})})
     return r, time.monotonic() - start
 
 
@@ -61,6 +70,12 @@ def main():
         assert "a user's error on rank 1" in out and "MPI_ABORT was invoked on rank 1" in out, out
         assert "sampled without rank 1" not in out, out
         print(f"rank 1's uncaught exception ended the job in {seconds:.1f} s (exit {r.returncode})")
+        r, seconds = mpirun(mpiexec, 3, KILL_SCRIPT, {"SDF_MPI_FAIL_RANK": "2", "SDF_MPI_FAIL_MODE": "kill"})
+        out = r.stdout + r.stderr
+        assert r.returncode != 0, out
+        assert "rank 2" in out and "signal 9" in out, out
+        assert "sampled" not in out, out
+        print(f"rank 2 of 3, killed in sample(), ended the job in {seconds:.1f} s (exit {r.returncode})")
         return 0
     if case == "mpi4py":
         if subprocess.run([sys.executable, "-c", "import mpi4py"], capture_output=True).returncode != 0:
