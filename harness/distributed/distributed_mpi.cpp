@@ -940,12 +940,15 @@ SampledField collective_worker(const PreparedMesh& mesh, const std::function<Sam
     if (status.contains("part")) send_part(part, mine.lattice, slab);
     part = SampledField();
 
+    // The whole field's memory, while the root still gathers (its first touch is not free).
+    SampledField field;
+    if (status.contains("part")) {
+        field.lattice = mine.lattice;
+        field.precision = mine.options.precision;
+        field.resize(mine.lattice.num_points());
+    }
     const nlohmann::json outcome = nlohmann::json::parse(receive_string(0, kTagOutcome));
     if (!outcome.at("ok").get<bool>()) raise_outcome(outcome, setup_error);
-    SampledField field;
-    field.lattice = mine.lattice;
-    field.precision = mine.options.precision;
-    field.resize(mine.lattice.num_points());
     broadcast_field(field);
     field.sampler = outcome.at("sampler");
     field.timings = timings_from_json(outcome.at("timings"));
