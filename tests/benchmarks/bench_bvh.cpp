@@ -100,6 +100,8 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
+    if (f.sampler.contains("candidates"))
+        state.counters["candidate_triangles"] = f.sampler["candidates"]["mean_candidate_triangles"].get<double>();
 }
 
 /// Arbitrary points (issue 14): uniform in the mesh's box (kind 0) or Gaussian around
