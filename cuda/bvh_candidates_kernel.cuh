@@ -71,7 +71,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
 
     // The centre's nearest triangle: every lane walks the same path (broadcast loads).
     const BvhHit<T> seed = closest_triangle_bvh(bvh, c);
-    if (band.width > 0) {
+    if (band.width > 0 && band.skip_bricks) {
         const int code = brick_band_code(bvh, pk, count, c, seed, band);
         if (code != 0) {
             for (int k = 0; k < count; ++k) nearest[first + k] = code;

@@ -10,6 +10,7 @@
 
 #include "core/bvh/bvh_cache.h"
 #include "core/sampling/sampler_results.h"
+#include "core/winding/winding_sign.h"
 #include <cub/device/device_radix_sort.cuh>
 
 #include "cuda/bvh_candidates_kernel.cuh"
@@ -51,8 +52,10 @@ struct DeviceBvh {
     std::unique_ptr<DeviceMesh<double>> mesh;
     DeviceWinding winding;
     BvhView<T> view{};
+    bool solid = false;  ///< auto would sign this mesh by pseudonormals (the narrow band's brick skip)
 
-    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared, const SamplerSign& sign) {
+    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared, const SamplerSign& sign)
+        : solid(choose_sign_mode(prepared.report(), SignMode::Auto).mode == SignMode::Pseudonormal) {
         nodes.upload(bvh.nodes);
         if constexpr (std::is_same_v<T, float>) packed.upload(bvh.packed_float);
         else packed.upload(bvh.packed_double);
@@ -158,7 +161,8 @@ private:
     /// the other kernels search everything and finalize_samples() applies the band).
     template <typename T>
     BandSearch band_search(const DeviceBvh<T>& dev) const {
-        return {options_.band_width, dev.mesh->view(), dev.winding.view().enabled()};
+        const bool winding = dev.winding.view().enabled();
+        return {options_.band_width, dev.mesh->view(), winding, winding || dev.solid};
     }
 
     template <typename T>

@@ -133,11 +133,17 @@ __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunP
     }
 }
 
-/// The narrow band as the search sees it; width 0 = no band.
+/// The narrow band as the search sees it; width 0 = no band, skip_bricks false = every brick
+/// searched (the finalize then applies the band).
 struct BandSearch {
     double width = 0;
     MeshView<double> mesh{};  ///< for the side of a brick's centre (pseudonormal sign)
     bool winding_sign = false;
+    /// The winding sign (each point's own), or the pseudonormal sign on a mesh that auto
+    /// would sign that way (a solid: one side per ball that does not meet the surface). A
+    /// pseudonormal sign forced on an open mesh can change sides away from the surface
+    /// (beyond a rim), so there no brick is skipped.
+    bool skip_bricks = false;
 };
 
 /// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
@@ -192,7 +198,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
     int64_t first = 0;
     BvhPacket<T, kRunPoints> pk;
     const int count = load_packet<T>(layout, t, first, pk);
-    if (band.width > 0) {
+    if (band.width > 0 && band.skip_bricks) {
         Vec3<T> lo, hi;
         warp_brick_box(pk, count, lo, hi);
         if (!(lo.x <= hi.x)) return;  // no point in this warp
