@@ -7,9 +7,10 @@
 ///   "cases": [{"label": "dragon", "mesh": "dragon.obj", "samples": [262144, 2097152]}],
 ///   "threads": [1, 2], "ours": ["brute_cpu", "bvh_cpu", "brute_gpu", "bvh_gpu"],
 ///   "peers": ["cgal", "embree", "open3d", "openvdb"], "brute_cpu_max_points": 4096,
-///   "openvdb_band_voxels": 3, "python": "", "repetitions": 1,
+///   "openvdb_band_voxels": 3, "python": "", "repetitions": 1, "sign": "auto",
 ///   "point_sets": [{"kind": "uniform_box", "count": 1048576},
-///                  {"kind": "gaussian_surface", "count": 1048576, "sigma": 0.01}], "seed": 1
+///                  {"kind": "gaussian_surface", "count": 1048576, "sigma": 0.01}], "seed": 1,
+///   "point_set_meshes": ["dragon"], "point_set_sign": "pseudonormal"
 /// Point sets (issue 14) are arbitrary unordered points around every case's mesh
 /// (core/sampling/point_sets.h): uniform in the margin-expanded box, or Gaussian around
 /// area-weighted surface points, sigma a fraction of the bounding-box diagonal. On them our
@@ -19,7 +20,11 @@
 /// A peer passes the check (row "passes_check") only when its max |distance error| is within
 /// kCheckTolerance x the mesh's bounding-box diagonal and, if it signs, no point farther than
 /// that from the surface has the wrong sign; unsigned peers pass as "exact, unsigned". The
-/// summary names the fastest peer that passes and says whether it signs.
+/// summary names the fastest peer that passes and says whether it signs. "sign" is our
+/// samplers' sign mode (core/winding/sign_mode.h): "auto" takes the winding number on open or
+/// self-intersecting meshes, whose cost near the surface is most of a near-surface query;
+/// "pseudonormal" is the cheap sign of a closed mesh. "point_set_sign" (default: "sign") is
+/// our sign on point sets, "point_set_meshes" the cases that get point sets (default: all).
 /// The lattice is CC, the cube whose point count is nearest to each sample count. The exact
 /// field every method is compared with is our CPU BVH's (equal to brute force: tests/
 /// cpu_reference/bvh); the CPU brute force is timed on "brute_cpu_max_points" evenly strided
@@ -36,6 +41,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/sampling/point_sets.h"
+#include "core/winding/sign_mode.h"
 #include "core/parallel/parallel_for.h"
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
@@ -120,10 +126,18 @@ public:
         if (!(peer_options_.openvdb_band_voxels >= 1.0))
             config.fail("openvdb_band_voxels", "expected at least 1 voxel, got " + std::to_string(peer_options_.openvdb_band_voxels));
         peer_options_.python = config.optional<std::string>("python", "", "a python3 that imports open3d");
+        lattice_sign_ = sign_mode_from_name(config.choice("sign", sign_mode_names(), sign_mode_name(kSignModes[0].mode)), "sign");
+        point_set_sign_ = sign_mode_from_name(config.choice("point_set_sign", sign_mode_names(), sign_mode_name(lattice_sign_)),
+                                              "point_set_sign");
+        sign_ = lattice_sign_;
         repetitions_ = config.optional<int>("repetitions", 1, "a positive count");
         if (repetitions_ < 1) config.fail("repetitions", "expected at least 1, got " + std::to_string(repetitions_));
         const int64_t seed = config.optional<int64_t>("seed", 1, "a non-negative seed for the point sets");
         if (seed < 0) config.fail("seed", "expected a non-negative seed, got " + std::to_string(seed));
+        point_set_meshes_ = config.optional<std::vector<std::string>>("point_set_meshes", {}, "case labels (empty = every case)");
+        for (const std::string& l : point_set_meshes_)
+            if (std::none_of(cases_.begin(), cases_.end(), [&](const MeshCase& c) { return c.label == l; }))
+                config.fail("point_set_meshes", "no case is labelled \"" + l + "\"");
         if (config.has("point_sets"))
             for (JsonReader& ps : config.objects("point_sets")) {
                 PointSetSpec spec;
@@ -163,7 +177,7 @@ public:
                 lines.push_back(c.label + " (" + c.mesh.label() + ") CC " + std::to_string(r) + "^3:" + methods(true));
             }
             for (const PointSetSpec& ps : point_sets_)
-                lines.push_back(c.label + " (" + c.mesh.label() + ") " + point_set_label(ps) + ":" + methods(false));
+                if (point_sets_for(c)) lines.push_back(c.label + " (" + c.mesh.label() + ") " + point_set_label(ps) + ":" + methods(false));
         }
         return lines;
     }
@@ -177,12 +191,17 @@ public:
         ctx.metrics["machine"] = {{"hardware_threads", hardware_threads()}};
         ctx.metrics["check"] = {{"tolerance_relative_to_diagonal", kCheckTolerance},
                                 {"rule", "max |distance error| <= tolerance x bounding-box diagonal, and (signed peers) no wrong sign "
-                                         "farther than that from the surface; unsigned peers pass as exact-unsigned"}};
+                                         "farther than that from the surface; unsigned peers pass as exact-unsigned"},
+                                {"our_sign", sign_mode_name(lattice_sign_)},
+                                {"our_sign_point_sets", sign_mode_name(point_set_sign_)}};
         for (const MeshCase& c : cases_) {
             const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
             ctx.metrics["meshes"][c.label] = describe_mesh(mesh);
+            sign_ = lattice_sign_;
             for (int64_t samples : c.samples) run_lattice_case(ctx, c, mesh, samples);
-            for (const PointSetSpec& ps : point_sets_) run_point_set_case(ctx, c, mesh, ps);
+            sign_ = point_set_sign_;
+            for (const PointSetSpec& ps : point_sets_)
+                if (point_sets_for(c)) run_point_set_case(ctx, c, mesh, ps);
         }
     }
 
@@ -203,6 +222,10 @@ private:
         if (ours == "bvh_cpu_per_point") return !lattice;  // lattices have the seeded kernel's own studies
         if (ours == "brute_gpu") return lattice;           // the GPU brute force samples lattices only
         return true;
+    }
+
+    bool point_sets_for(const MeshCase& c) const {
+        return point_set_meshes_.empty() || std::count(point_set_meshes_.begin(), point_set_meshes_.end(), c.label) > 0;
     }
 
     bool wants(const std::string& ours) const { return std::count(ours_.begin(), ours_.end(), ours) > 0; }
@@ -272,6 +295,7 @@ private:
             SamplerOptions o;
             o.method = "bvh";
             o.threads = t;
+            o.sign = sign_;
             o.progress = false;
             auto sampler = make_sampler(o);
             std::vector<double> query, total;
@@ -307,6 +331,7 @@ private:
             o.method = "bvh";
             o.kernel = kernel;
             o.threads = t;
+            o.sign = sign_;
             o.progress = false;
             auto sampler = make_sampler(o);
             auto start = std::chrono::steady_clock::now();
@@ -331,8 +356,9 @@ private:
             const Errors e = compare(d, reference, {}, true, nullptr, true, tolerance(mesh));
             set_errors(row, e, true);
             set_check(row, e, true, true, tolerance(mesh));
-            row["notes"] = kernel == "brick" ? "Sampler::query: Morton-ordered packets of 16 (reference; checked against brute force below)"
-                                             : "Sampler::query, kernel \"seeded\": one point at a time, seeded with the previous point's triangle";
+            row["notes"] = std::string(kernel == "brick" ? "Sampler::query: Morton-ordered packets of 16 (reference; checked against brute force below)"
+                                                         : "Sampler::query, kernel \"seeded\": one point at a time, seeded with the previous point's triangle") +
+                           "; sign " + sign_mode_name(sign_);
             emit(ctx, row);
         }
     }
@@ -344,6 +370,7 @@ private:
         for (int t : threads_) {
             SamplerOptions o;
             o.threads = t;
+            o.sign = sign_;
             o.progress = false;
             auto sampler = make_sampler(o);
             std::vector<double> secs;
@@ -381,6 +408,7 @@ private:
         SamplerOptions o;
         o.backend = "cuda";
         o.method = name == "bvh_gpu" ? "bvh" : "brute_force";
+        o.sign = sign_;
         o.progress = false;
         auto sampler = make_sampler(o);
         sampler->sample(mesh, lattice);  // warm-up: module load, uploads (and the BVH build)
@@ -414,6 +442,7 @@ private:
         SamplerOptions o;
         o.backend = "cuda";
         o.method = "bvh";
+        o.sign = sign_;
         o.progress = false;
         auto sampler = make_sampler(o);
         auto start = std::chrono::steady_clock::now();
@@ -612,6 +641,9 @@ private:
     int64_t brute_max_points_ = 4096;
     peers::PeerOptions peer_options_;
     int repetitions_ = 1;
+    SignMode sign_ = SignMode::Auto;  ///< our samplers' sign in the current case: lattice_sign_ or point_set_sign_
+    SignMode lattice_sign_ = SignMode::Auto, point_set_sign_ = SignMode::Auto;
+    std::vector<std::string> point_set_meshes_;
     std::vector<peers::PeerEntry> peers_;
 };
 

@@ -81,12 +81,12 @@ public:
             return cuBQL::vec3f(float(p.x), float(p.y), float(p.z));
         };
         for (const Int3& t : mesh.triangles()) host_triangles.emplace_back(vertex(t.x), vertex(t.y), vertex(t.z));
-        DeviceArray<cuBQL::Triangle> d_triangles(size_t(triangles));
+        DeviceArray<cuBQL::Triangle> d_triangles(static_cast<size_t>(triangles));
         check(cudaMemcpy(d_triangles.data, host_triangles.data(), host_triangles.size() * sizeof(cuBQL::Triangle),
                          cudaMemcpyHostToDevice), "triangle upload");
 
         auto build = [&](cuBQL::bvh3f& bvh) {
-            DeviceArray<cuBQL::box3f> boxes(size_t(triangles));
+            DeviceArray<cuBQL::box3f> boxes(static_cast<size_t>(triangles));
             triangle_boxes<<<(triangles + 1023) / 1024, 1024>>>(boxes.data, d_triangles.data, triangles);
             cuBQL::gpuBuilder(bvh, boxes.data, uint32_t(triangles), cuBQL::BuildConfig().enableSAH());
             check(cudaDeviceSynchronize(), "BVH build");
@@ -100,14 +100,14 @@ public:
         r.build_seconds = seconds_since(start);
 
         const int64_t n = int64_t(points.size());
-        std::vector<float3> host_points(size_t(n));
+        std::vector<float3> host_points(static_cast<size_t>(n));
         for (int64_t i = 0; i < n; ++i) {
             const Vec3d& p = points[size_t(i)];
             host_points[size_t(i)] = make_float3(float(p.x), float(p.y), float(p.z));
         }
-        std::vector<float> host_distance(size_t(n));
-        DeviceArray<float3> d_points(size_t(n));
-        DeviceArray<float> d_distance(size_t(n));
+        std::vector<float> host_distance(static_cast<size_t>(n));
+        DeviceArray<float3> d_points(static_cast<size_t>(n));
+        DeviceArray<float> d_distance(static_cast<size_t>(n));
         const unsigned blocks = unsigned((n + kBlock - 1) / kBlock);
         cudaEvent_t begin, end;
         check(cudaEventCreate(&begin), "cudaEventCreate");
