@@ -64,7 +64,8 @@ def summary_table(metrics):
         signed = ("%s (%s)" % (s["fastest_exact_signed_peer"], number(s["query_speedup_vs_signed"]))
                   if "fastest_exact_signed_peer" in s else "-")
         table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), s.get("ours", "bvh_cpu"), _fastest(s, checked),
-                   number(s["query_speedup"]), number(s["total_speedup"]),
+                   number(s["query_speedup"]) + (" (end to end)" if s.get("compared_time") == "end_to_end_seconds" else ""),
+                   number(s["total_speedup"]),
                    number(s["cpu_time_ratio"]) if "cpu_time_ratio" in s else "-", number(s["goal"]), signed])
     return table
 
