@@ -123,6 +123,10 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     });
 }
 
+/// Points per packet of an arbitrary point list: 16, as lattice bricks (8 and 32 measured
+/// slower on the dragon's uniform and near-surface sets: tests/benchmarks/bench_bvh.cpp).
+constexpr int kPointPacket = kBrick;
+
 /// Morton order of arbitrary points: the indices of `points` sorted by the Morton key of
 /// their cell in the points' bounding box (2^10 cells per axis: finer cells change nothing
 /// for packets of 16), ties in input order. An LSD radix sort over the 30 key bits (four
@@ -159,7 +163,7 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
 }
 
 /// Evaluates arbitrary points as Morton-ordered packets: the points are sorted by Morton key,
-/// runs of kBrick consecutive sorted points share one packet traversal (as lattice bricks
+/// runs of kPointPacket consecutive sorted points share one packet traversal (as lattice bricks
 /// do), and each result is written back at its input index. The packet search returns every
 /// lane's own brute-force minimum with the same tie rule (closest_triangles_packet.h), and
 /// the winner is evaluated exactly as the per-point path does, so the samples are bit for bit
@@ -172,18 +176,18 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
     const int64_t n = int64_t(points.size());
     if (n == 0) return;
     const std::vector<uint32_t> order = morton_order(points, threads);
-    const int64_t packets = (n + kBrick - 1) / kBrick;
+    const int64_t packets = (n + kPointPacket - 1) / kPointPacket;
     ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
     parallel_for(packets, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
-        int32_t seed[kBrick];
-        for (int k = 0; k < kBrick; ++k) seed[k] = -1;
+        int32_t seed[kPointPacket];
+        for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
         int64_t done = 0;
         for (int64_t b = begin; b < end; ++b) {
-            const int64_t first = b * kBrick;
-            const int count = int(std::min<int64_t>(kBrick, n - first));
-            BvhPacket<T, kBrick> pk;
-            for (int k = 0; k < kBrick; ++k) {
+            const int64_t first = b * kPointPacket;
+            const int count = int(std::min<int64_t>(kPointPacket, n - first));
+            BvhPacket<T, kPointPacket> pk;
+            for (int k = 0; k < kPointPacket; ++k) {
                 const Vec3d& p = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
                 pk.x[k] = T(p.x);
                 pk.y[k] = T(p.y);
@@ -196,7 +200,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
                 const Vec3d& p = points[size_t(i)];
                 emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[pk.best_slot[k]]), p));
             }
-            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
+            for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;
         }
         counters.nodes += stats.nodes;
