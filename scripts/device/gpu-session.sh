@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the project on a GPU machine without network access and runs the GPU tests,
 # benchmarks and experiments given as arguments. Used with the device tool:
-#   carry: .gpu-prefix (Debian tinyobjloader, CLI11, OpenSSL unpacked) and data (meshes)
+#   carry: .gpu-prefix (Debian tinyobjloader, CLI11, OpenSSL unpacked) and data (meshes; and
+#          data/peers, a copy of ../shared/peers, for the FCPW and cuBQL peers: CMake finds it)
 #   scripts/device/gpu-session.sh build test bench "experiment configs/x.json" ...
 # Everything worth keeping is written under $OUT (default: ./gpu-out).
 # The copy has no .git: pass the commit in, SDF_SOURCE_COMMIT=<sha>[-dirty] scripts/device/...,
