@@ -29,7 +29,7 @@ build() {
     log "configure"
     cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSDF_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 \
         -DCMAKE_PREFIX_PATH="$PREFIX" -DSDF_SOURCE_COMMIT="${SDF_SOURCE_COMMIT:-}" "${extra[@]}" > "$OUT/configure.log" 2>&1 || { tail -40 "$OUT/configure.log"; return 1; }
-    grep -E "sdf:" "$OUT/configure.log"
+    grep -E "sdf:|sdf peers:" "$OUT/configure.log"
     log "build"
     # BUILD_TARGETS (space-separated) limits the build, e.g. to the GPU tests and tools.
     cmake --build "$BUILD" -j "$(nproc)" ${BUILD_TARGETS:+--target $BUILD_TARGETS} > "$OUT/build.log" 2>&1 ||
