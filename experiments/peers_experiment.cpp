@@ -119,6 +119,7 @@ public:
         margin_ = read_domain_margin(config);
         cases_ = read_mesh_cases(config, search_path_, base_dir_);
         threads_ = config.optional<std::vector<int>>("threads", {1, 0}, "thread counts (0 = all cores)");
+        if (threads_.empty()) config.fail("threads", "expected at least one thread count, got []");
         for (int t : threads_)
             if (t < 0) config.fail("threads", "expected thread counts >= 0, got " + std::to_string(t));
         ours_ = read_names(config, "ours", kOurs);
@@ -489,7 +490,7 @@ private:
         }
         const bool gpu = peer.adapter->on_gpu();
         for (size_t ti = 0; ti < (gpu ? size_t(1) : threads_.size()); ++ti) {
-            const int t = threads_[ti];
+            const int t = threads_[ti];  // GPU peers: run once (threads_ is never empty)
             const double cpu0 = process_cpu_seconds();
             const peers::PeerResult r = peer.adapter->run(mesh, lattice, points, resolve_thread_count(t));
             const double cpu = r.cpu_seconds >= 0 ? r.cpu_seconds : process_cpu_seconds() - cpu0;
