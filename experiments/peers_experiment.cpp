@@ -610,7 +610,9 @@ private:
             const bool best_is_signed = (*best).value("signed", false);
             nlohmann::json s = {{"mesh", label}, {"resolution", res}, {"threads", threads}, {"ours", (*ours)["method"]},
                                 {"fastest_exact_peer", (*best)["method"]}, {"fastest_exact_peer_signed", best_is_signed},
-                                {"query_speedup", q}, {"total_speedup", tot}, {"goal", goal}, {"compared_time", time_key}};
+                                {"query_speedup", q}, {"total_speedup", tot}, {"goal", goal}, {"compared_time", time_key},
+                                {"ours_passes_check", (*ours).value("passes_check", false)}};
+            if (!(*ours).value("passes_check", false)) s["ours_check"] = (*ours).value("check", std::string());
             if (!gpu) s["cpu_time_ratio"] = (*best)["cpu_seconds"].get<double>() / (*ours)["cpu_seconds"].get<double>();
             if (best_signed && (*best_signed).contains(time_key)) {
                 s["fastest_exact_signed_peer"] = (*best_signed)["method"];
@@ -625,6 +627,8 @@ private:
                           (*ours)["method"].get<std::string>().c_str(), (*best)["method"].get<std::string>().c_str(),
                           best_is_signed ? "signed" : "UNSIGNED: returns no sign", gpu ? "GPU" : (tkey + " threads").c_str(), q, tot, goal);
             *ctx.log << line;
+            if (!(*ours).value("passes_check", false))
+                *ctx.log << "       (ours fails the check: " << (*ours).value("check", std::string()) << ")\n";
         }
     }
 

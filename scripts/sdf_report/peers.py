@@ -63,7 +63,10 @@ def summary_table(metrics):
     for s in metrics.get("summary", []):
         signed = ("%s (%s)" % (s["fastest_exact_signed_peer"], number(s["query_speedup_vs_signed"]))
                   if "fastest_exact_signed_peer" in s else "-")
-        table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), s.get("ours", "bvh_cpu"), _fastest(s, checked),
+        ours = s.get("ours", "bvh_cpu")
+        if s.get("ours_passes_check") is False:
+            ours += " (fails check: %s)" % s.get("ours_check", "?")
+        table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), ours, _fastest(s, checked),
                    number(s["query_speedup"]) + (" (end to end)" if s.get("compared_time") == "end_to_end_seconds" else ""),
                    number(s["total_speedup"]),
                    number(s["cpu_time_ratio"]) if "cpu_time_ratio" in s else "-", number(s["goal"]), signed])

@@ -146,6 +146,7 @@ def test_peers_point_sets_check_column_and_unsigned_fastest_peer(tmp_path, schem
     assert "| yes (unsigned) |" in md
     assert "| no: max \\|distance error\\| 0.5 > tolerance 0.0001 |" in md
     assert "| dragon uniform_box/1000 | 2 | bvh_cpu | fcpw (unsigned: returns no sign) | 3 | 2.33 | 2.33 | 3 | - |" in md
+    assert "| 1 | bvh_cpu (fails check: 3 wrong signs farther than the tolerance from the surface) | fcpw" in md
     assert "not built: this build has no CUDA backend" in md
 
 
