@@ -276,13 +276,20 @@ private:
     /// The check of every row: "passes_check" and, when it does not pass, why.
     static void set_check(nlohmann::json& row, const Errors& e, bool is_signed, bool exact, double tolerance) {
         std::string why;
-        if (!exact) why = "not an exact method (narrow band)";
-        else if (!(e.max_abs <= tolerance)) {
-            char b[160];
-            std::snprintf(b, sizeof b, "max |distance error| %.3g > tolerance %.3g", e.max_abs, tolerance);
+        // The unsigned distance first, then the signs (a wrong sign also shows as a signed error of 2|d|).
+        char b[160];
+        if (!exact) {
+            why = "not an exact method (narrow band)";
+        } else if (!(e.max_abs_unsigned <= tolerance)) {
+            std::snprintf(b, sizeof b, "max |distance error| %.3g > tolerance %.3g", e.max_abs_unsigned, tolerance);
             why = b;
         } else if (is_signed && e.sign_disagreements_beyond_tolerance > 0) {
-            why = std::to_string(e.sign_disagreements_beyond_tolerance) + " wrong signs farther than the tolerance from the surface";
+            std::snprintf(b, sizeof b, "%lld wrong signs farther than the tolerance %.3g from the surface (max signed error %.3g)",
+                          (long long)e.sign_disagreements_beyond_tolerance, tolerance, e.max_abs);
+            why = b;
+        } else if (!(e.max_abs <= tolerance)) {
+            std::snprintf(b, sizeof b, "max |signed distance error| %.3g > tolerance %.3g", e.max_abs, tolerance);
+            why = b;
         }
         row["passes_check"] = why.empty();
         row["check"] = why.empty() ? (is_signed ? "exact, signed" : "exact, unsigned (no sign returned)") : why;
