@@ -1,8 +1,10 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
+#include <vector>
 
 #include "core/bvh/bvh_cache.h"
 #include "core/parallel/parallel_for.h"
@@ -10,6 +12,7 @@
 #include "core/sampling/sampler_results.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
+#include "kernels/core/morton.h"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf {
@@ -120,6 +123,92 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     });
 }
 
+/// Points per packet of an arbitrary point list: 16, as lattice bricks (8 and 32 measured
+/// slower on the dragon's uniform and near-surface sets: tests/benchmarks/bench_bvh.cpp).
+constexpr int kPointPacket = kBrick;
+
+/// Morton order of arbitrary points: the indices of `points` sorted by the Morton key of
+/// their cell in the points' bounding box (2^10 cells per axis: finer cells change nothing
+/// for packets of 16), ties in input order. An LSD radix sort over the 30 key bits (four
+/// 8-bit passes), stable, so the order is deterministic.
+std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads) {
+    const size_t n = points.size();
+    Vec3d lo = points[0], hi = points[0];
+    for (const Vec3d& p : points) {
+        lo = component_min(lo, p);
+        hi = component_max(hi, p);
+    }
+    const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    const double inv_extent = extent > 0 ? 1.0 / extent : 0.0;
+    // key (top 30 of 63 bits) << 32 | index: sorting the word sorts by key, then by index.
+    std::vector<uint64_t> items(n), scratch(n);
+    parallel_for(int64_t(n), 1 << 14, threads, [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+            const Vec3d& p = points[size_t(i)];
+            const uint64_t key = morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_extent) >> 33;
+            items[size_t(i)] = key << 32 | uint64_t(i);
+        }
+    });
+    for (int pass = 0; pass < 4; ++pass) {
+        const int shift = 32 + 8 * pass;
+        size_t count[257] = {};
+        for (uint64_t v : items) ++count[((v >> shift) & 0xff) + 1];
+        for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
+        for (uint64_t v : items) scratch[count[(v >> shift) & 0xff]++] = v;
+        items.swap(scratch);
+    }
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = uint32_t(items[i]);
+    return order;
+}
+
+/// Evaluates arbitrary points as Morton-ordered packets: the points are sorted by Morton key,
+/// runs of kPointPacket consecutive sorted points share one packet traversal (as lattice bricks
+/// do), and each result is written back at its input index. The packet search returns every
+/// lane's own brute-force minimum with the same tie rule (closest_triangles_packet.h), and
+/// the winner is evaluated exactly as the per-point path does, so the samples are bit for bit
+/// those of evaluate_points; only the work shared between neighbours changes.
+template <typename T, typename EmitFn>
+void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const std::vector<Vec3d>& points,
+                            int threads, bool progress, QueryCounters& counters, EmitFn emit) {
+    const BvhView<T> view = bvh.view<T>();
+    const MeshView<double> exact = mesh.buffers<double>().view();
+    const int64_t n = int64_t(points.size());
+    if (n == 0) return;
+    const std::vector<uint32_t> order = morton_order(points, threads);
+    const int64_t packets = (n + kPointPacket - 1) / kPointPacket;
+    ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
+    parallel_for(packets, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
+        BvhStats stats;
+        int32_t seed[kPointPacket];
+        for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
+        int64_t done = 0;
+        for (int64_t b = begin; b < end; ++b) {
+            const int64_t first = b * kPointPacket;
+            const int count = int(std::min<int64_t>(kPointPacket, n - first));
+            BvhPacket<T, kPointPacket> pk;
+            for (int k = 0; k < kPointPacket; ++k) {
+                const Vec3d& p = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
+                pk.x[k] = T(p.x);
+                pk.y[k] = T(p.y);
+                pk.z[k] = T(p.z);
+            }
+            seed_packet(view, seed, pk);
+            closest_triangles_packet(view, pk, stats);
+            for (int k = 0; k < count; ++k) {
+                const int64_t i = int64_t(order[size_t(first + k)]);
+                const Vec3d& p = points[size_t(i)];
+                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[pk.best_slot[k]]), p));
+            }
+            for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
+            done += count;
+        }
+        counters.nodes += stats.nodes;
+        counters.triangles += stats.triangles;
+        reporter.advance(done);
+    });
+}
+
 class CpuBvhSampler final : public Sampler {
 public:
     explicit CpuBvhSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
@@ -142,11 +231,14 @@ public:
         QueryCounters counters;
         auto run = [&](auto zero) {
             using T = decltype(zero);
-            evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
-                               [&](int64_t i) { return points[size_t(i)]; },
-                               [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
-                               });
+            auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
+                out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
+            };
+            if (kernel_ == BvhKernel::Brick && points.size() < (size_t(1) << 32))  // 32-bit indices in the sort
+                evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, counters, emit);
+            else
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
+                                   [&](int64_t i) { return points[size_t(i)]; }, emit);
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
         return out;
@@ -154,7 +246,8 @@ public:
 
 private:
     const char* kernel_name() const { return sdf::kernel_name(kCpuBvhKernels, kernel_); }
-    /// Point lists have no bricks: "brick" queries them one by one, seeded.
+    /// "seeded" queries point lists one by one, each seeded with the previous point's
+    /// triangle; "brick" sorts them into Morton-ordered packets (evaluate_point_packets).
     bool seeded() const { return kernel_ != BvhKernel::Unseeded; }
 
     template <typename T>

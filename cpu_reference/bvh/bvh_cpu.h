@@ -5,7 +5,9 @@
 /// gradient), so its fields equal brute force to double rounding except at ties.
 ///
 /// Kernels: "brick" (default) queries the 16 points of a lattice brick as one packet that
-/// shares a traversal (kernels/bvh/closest_triangles_packet.h); "seeded" runs the points of a
+/// shares a traversal (kernels/bvh/closest_triangles_packet.h), and arbitrary point lists
+/// (query) as packets of 16 consecutive points in Morton order, scattered back to input
+/// order (the same samples, bit for bit); "seeded" runs the points of a
 /// lattice row in order and seeds each query with the previous point's triangle, whose
 /// distance is an exact upper bound (kernels/bvh/closest_triangle_bvh.h); "unseeded" starts
 /// every query from an infinite radius. Multithreaded with parallel_for; the BVH is built once per mesh and reused.

@@ -1,8 +1,9 @@
 /// @file peer.h
 /// @brief The small interface every peer library adapter implements for the "peers"
 /// experiment: the same lattice points go in, distances (signed where the peer signs them)
-/// and timings come out. One file per peer; each is built only when its Debian package is
-/// present (experiments/peers/CMakeLists.txt), and peer_registry.cpp lists them.
+/// and timings come out. One file per peer; each is built only when its Debian package (or,
+/// for FCPW and cuBQL, its source snapshot in SDF_PEERS_DIR) is present
+/// (experiments/peers/CMakeLists.txt), and peer_registry.cpp lists them.
 #pragma once
 
 #include <cstdint>
@@ -32,11 +33,14 @@ struct PeerResult {
 class PeerAdapter {
 public:
     virtual ~PeerAdapter() = default;
-    virtual std::string name() const = 0;     ///< "cgal", "embree", "open3d", "openvdb"
+    virtual std::string name() const = 0;     ///< "cgal", "embree", "open3d", "openvdb", "fcpw", "cubql"
     virtual std::string version() const = 0;  ///< the library's version string
     /// True when every returned distance is an exact point-triangle minimum (not narrow band).
     virtual bool exact() const = 0;
-    /// Samples `points` (the lattice's points in storage order) with `threads` threads.
+    /// A GPU library: run once per case (not per thread count), its rows say "GPU".
+    virtual bool on_gpu() const { return false; }
+    /// Samples `points` (the lattice's points in storage order, or a point set) with
+    /// `threads` threads (GPU peers ignore it).
     virtual PeerResult run(const PreparedMesh& mesh, const Lattice& lattice, const std::vector<Vec3d>& points,
                            int threads) = 0;
 };

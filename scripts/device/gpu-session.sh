@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the project on a GPU machine without network access and runs the GPU tests,
 # benchmarks and experiments given as arguments. Used with the device tool:
-#   carry: .gpu-prefix (Debian tinyobjloader, CLI11, OpenSSL unpacked) and data (meshes)
+#   carry: .gpu-prefix (Debian tinyobjloader, CLI11, OpenSSL unpacked) and data (meshes; and
+#          data/peers, a copy of ../shared/peers, for the FCPW and cuBQL peers: CMake finds it)
 #   scripts/device/gpu-session.sh build test bench "experiment configs/x.json" ...
 # Everything worth keeping is written under $OUT (default: ./gpu-out).
 # The copy has no .git: pass the commit in, SDF_SOURCE_COMMIT=<sha>[-dirty] scripts/device/...,
@@ -28,7 +29,7 @@ build() {
     log "configure"
     cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSDF_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 \
         -DCMAKE_PREFIX_PATH="$PREFIX" -DSDF_SOURCE_COMMIT="${SDF_SOURCE_COMMIT:-}" "${extra[@]}" > "$OUT/configure.log" 2>&1 || { tail -40 "$OUT/configure.log"; return 1; }
-    grep -E "sdf:" "$OUT/configure.log"
+    grep -E "sdf:|sdf peers:" "$OUT/configure.log"
     log "build"
     # BUILD_TARGETS (space-separated) limits the build, e.g. to the GPU tests and tools.
     cmake --build "$BUILD" -j "$(nproc)" ${BUILD_TARGETS:+--target $BUILD_TARGETS} > "$OUT/build.log" 2>&1 ||

@@ -1,11 +1,21 @@
 """Our samplers (brute force and BVH, CPU and GPU) against the peer libraries (CGAL, Embree,
-Open3D, OpenVDB), from "peers" runs (configs/peers.json, docs/bvh.md)."""
+Open3D, OpenVDB, FCPW, cuBQL), on lattices and on arbitrary point sets, from "peers" runs
+(configs/peers.json, configs/peers_gpu.json, docs/bvh.md)."""
 
 from .overview import machine
 from .tables import Table, count, number, rate
 
-HEADER = ["mesh, lattice", "method", "by", "threads", "build (s)", "query (s)", "CPU (s)", "points/s", "max |d error|",
-          "sign disagreements", "notes"]
+HEADER = ["mesh, points", "method", "by", "threads", "build (s)", "query (s)", "CPU (s)", "points/s", "max |d error|",
+          "sign disagreements", "passes check", "notes"]
+
+
+def _check(row):
+    """The row's check (runs before it was recorded: '-')."""
+    if "passes_check" not in row:
+        return "-"
+    if row["passes_check"]:
+        return "yes" if row.get("signed", True) else "yes (unsigned)"
+    return "no: " + row.get("check", "?")
 
 
 def _notes(row):
@@ -26,21 +36,40 @@ def rows_table(metrics):
         where = "%s %s" % (row["mesh"], row["resolution"])
         method = row["method"] + (" " + row["version"] if "version" in row else "")
         if "status" in row:
-            table.add([where, method, row["by"], "-", "-", "-", "-", "-", "-", "-", row["status"]])
+            table.add([where, method, row["by"], "-", "-", "-", "-", "-", "-", "-", "-", row["status"]])
             continue
         table.add([where, method, row["by"], str(row["threads"]), number(row["build_seconds"]),
                    number(row["query_seconds"]), number(row["cpu_seconds"]) if "cpu_seconds" in row else "-",
                    rate(row["points_per_second"]), number(row["max_abs_error"]), str(row["sign_disagreements"]),
-                   _notes(row)])
+                   _check(row), _notes(row)])
     return table
 
 
+def _fastest(s, checked):
+    """The fastest exact peer, saying when it returns no sign or when exactness was not checked."""
+    name = s["fastest_exact_peer"]
+    if not checked:
+        return name + " (exactness not checked: run before passes_check)"
+    if s.get("fastest_exact_peer_signed") is False:
+        return name + " (unsigned: returns no sign)"
+    return name
+
+
 def summary_table(metrics):
-    table = Table(["mesh, lattice", "threads", "fastest exact peer", "BVH CPU speedup (query)",
-                   "BVH CPU speedup (build + query)", "CPU-time ratio"])
+    """Our BVH against the fastest peer that passes the check (same points, same threads)."""
+    checked = any("passes_check" in row for row in metrics["rows"])
+    table = Table(["mesh, points", "threads", "ours", "fastest exact peer", "speedup (query)", "speedup (build + query)",
+                   "CPU-time ratio", "goal", "fastest exact signed peer (query speedup)"])
     for s in metrics.get("summary", []):
-        table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), s["fastest_exact_peer"],
-                   number(s["query_speedup"]), number(s["total_speedup"]), number(s["cpu_time_ratio"])])
+        signed = ("%s (%s)" % (s["fastest_exact_signed_peer"], number(s["query_speedup_vs_signed"]))
+                  if "fastest_exact_signed_peer" in s else "-")
+        ours = s.get("ours", "bvh_cpu")
+        if s.get("ours_passes_check") is False:
+            ours += " (fails check: %s)" % s.get("ours_check", "?")
+        table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), ours, _fastest(s, checked),
+                   number(s["query_speedup"]) + (" (end to end)" if s.get("compared_time") == "end_to_end_seconds" else ""),
+                   number(s["total_speedup"]),
+                   number(s["cpu_time_ratio"]) if "cpu_time_ratio" in s else "-", number(s["goal"]), signed])
     return table
 
 
@@ -58,8 +87,16 @@ def section(doc, runs):
             summary = summary_table(point.metrics)
             if summary:
                 doc.table(summary)
-    doc.paragraph("Same machine, same run, same lattice points. Errors are against our exact field (the CPU BVH, equal "
-                  "to brute force). CPU (s) = process CPU time of build + query over all threads (robust to other load "
-                  "on a shared machine). GPU rows are CUDA-event times; 'unavailable' = no GPU on the machine of the "
-                  "run; 'not built' = the peer's package was missing when the harness was built. OpenVDB is a "
-                  "narrow-band method; Embree returns unsigned distances. See docs/bvh.md.")
+    doc.paragraph("Same machine, same run, same points: lattices (mesh, lattice) and arbitrary point sets (mesh, "
+                  "uniform_box/N: uniform in the margin-expanded box; gaussian_surface(sigma)/N: area-weighted surface "
+                  "points plus a Gaussian offset, sigma a fraction of the bounding-box diagonal). Errors are against our "
+                  "exact field (the CPU BVH, equal to brute force; on point sets our CPU BVH query, checked against "
+                  "the brute force on strided points). 'passes check' = max |d error| within the run's tolerance "
+                  "(1e-5 x the bounding-box diagonal) and, for signed methods, no wrong sign farther than that from "
+                  "the surface; unsigned peers pass as 'yes (unsigned)', and the summary says when the fastest peer "
+                  "returns no sign. CPU (s) = process CPU time of build + query over all threads (robust to other load "
+                  "on a shared machine). GPU rows are CUDA-event times of the query with the points on the device "
+                  "(our point-set GPU rows: Sampler::query wall time, transfers included; 'end to end' = with "
+                  "transfers); 'unavailable' = no GPU on the machine of the run; 'not built' = the peer's package or "
+                  "source snapshot (FCPW, cuBQL: SDF_PEERS_DIR) was missing when the harness was built. OpenVDB is a "
+                  "narrow-band method; Embree, FCPW and cuBQL return unsigned distances. See docs/bvh.md.")

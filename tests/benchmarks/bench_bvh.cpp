@@ -3,6 +3,9 @@
 //   CPU: 1 thread and all threads; kernels brick (16-point packets), seeded, unseeded; the build.
 //   GPU (when a device is present): manual time from the sampler's CUDA events, the three
 //   BVH kernels in float and double, and the tuned brute force beside them (issue 7's 100x).
+//   Arbitrary points (issue 14): Sampler::query on 1M uniform-box and Gaussian-near-surface
+//   points (core/sampling/point_sets.h), kernel brick (Morton-ordered packets of 16) against
+//   seeded (one point at a time), 1 thread and all threads.
 //   SDF_DATA_PATH=... bench_bvh --benchmark_counters_tabular=true --benchmark_filter=Cpu
 #include <benchmark/benchmark.h>
 
@@ -19,6 +22,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_obj.h"
 #include "core/parallel/parallel_for.h"
+#include "core/sampling/point_sets.h"
 #include "harness/build_config.h"
 #include "harness/sampling/sampler_table.h"
 
@@ -73,6 +77,36 @@ void BM_CpuBvh(benchmark::State& state, const std::string& file) {
     }
     set_counters(state, *mesh, lattice, f);
     state.counters["threads"] = double(resolve_thread_count(o.threads));
+}
+
+/// Args: point set (0 uniform box, 1 Gaussian around the surface, sigma 0.01 of the diagonal),
+/// threads (0 = all), kernel (0 brick = Morton packets, 1 seeded = per point). 2^20 points.
+void BM_CpuBvhPointQuery(benchmark::State& state, const std::string& file) {
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    PointSetSpec spec;
+    spec.kind = state.range(0) ? PointSetKind::GaussianSurface : PointSetKind::UniformBox;
+    spec.count = int64_t(1) << 20;
+    const std::vector<Vec3d> points = make_point_set(*mesh, spec);
+    SamplerOptions o;
+    o.method = "bvh";
+    o.threads = int(state.range(1));
+    o.kernel = kKernels[state.range(2)];
+    o.progress = false;
+    auto sampler = make_cpu_bvh_sampler(o);
+    sampler->query(*mesh, {points[0]});  // builds and caches the BVH
+    for (auto _ : state) benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
+    state.counters["queries/s"] = benchmark::Counter(double(points.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["points"] = double(points.size());
+    state.counters["threads"] = double(resolve_thread_count(o.threads));
+}
+
+void point_query_args(benchmark::internal::Benchmark* b) {
+    for (int set : {0, 1})
+        for (int threads : {1, 0})
+            for (int kernel : {0, 1}) b->Args({set, threads, kernel});
+    b->ArgNames({"gaussian", "threads", "kernel"})->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)
+        ->ReportAggregatesOnly(true);
 }
 
 void BM_BvhBuild(benchmark::State& state, const std::string& file) {
@@ -211,6 +245,8 @@ BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark:
 BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
+BENCHMARK_CAPTURE(BM_CpuBvhPointQuery, bunny, std::string("bunny.obj"))->Apply(point_query_args);
+BENCHMARK_CAPTURE(BM_CpuBvhPointQuery, dragon, std::string("dragon.obj"))->Apply(point_query_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, bunny, std::string("bunny.obj"))->Apply(cuda_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, dragon, std::string("dragon.obj"))->Apply(cuda_args);
 BENCHMARK_CAPTURE(BM_CudaBvhPoints, dragon, std::string("dragon.obj"))

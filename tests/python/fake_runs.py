@@ -192,6 +192,37 @@ def peers_metrics():
             "regression": {"bunny/64x64x64/2/bvh_cpu_vs_fastest_peer": {"value": 5.0, "kind": "speedup"}}}
 
 
+def peers_point_set_metrics():
+    """A point-set run with the check recorded: Open3D fails on signs, FCPW passes unsigned."""
+    base = {"mesh": "dragon", "resolution": "uniform_box/1000", "points": 1000, "triangles": 100000,
+            "point_set": {"kind": "uniform_box", "count": 1000, "sigma": None, "seed": 1}}
+    timing = dict(build_seconds=0.1, query_seconds=0.2, total_seconds=0.3, points_per_second=5000.0, cpu_seconds=0.3,
+                  threads=2, max_abs_error=0.0, max_abs_error_unsigned=0.0, mean_abs_error=0.0, compared_points=1000,
+                  check_tolerance=1e-4)
+    bvh = dict(base, method="bvh_cpu", by="ours", sign_disagreements=0, sign_disagreements_beyond_tolerance=0,
+               passes_check=True, check="exact, signed", signed=True, notes="reference", **timing)
+    fcpw = dict(base, method="fcpw", by="peer", version="snapshot abc", exact=True, sign_disagreements="n/a (unsigned)",
+                passes_check=True, check="exact, unsigned (no sign returned)", signed=False, details={},
+                **dict(timing, query_seconds=0.6, total_seconds=0.7))
+    open3d = dict(base, method="open3d", by="peer", version="0.16.1", exact=True, sign_disagreements=400,
+                  sign_disagreements_beyond_tolerance=400, passes_check=False,
+                  check="max |distance error| 0.5 > tolerance 0.0001", signed=True, details={},
+                  **dict(timing, query_seconds=0.1, total_seconds=0.2, max_abs_error=0.5))
+    cubql = dict(base, method="cubql", by="peer", status="not built: this build has no CUDA backend")
+    return {"peers": {"fcpw": {"version": "snapshot abc", "exact": True, "gpu": False}, "cubql": {"status": "not built"}},
+            "machine": {"hardware_threads": 2}, "meshes": {"dragon": mesh("dragon", "/x/dragon.obj", 100000, 50000)},
+            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh.md", "our_sign": "auto"},
+            "rows": [bvh, fcpw, open3d, cubql],
+            "summary": [{"mesh": "dragon", "resolution": "uniform_box/1000", "threads": 2, "ours": "bvh_cpu",
+                         "fastest_exact_peer": "fcpw", "fastest_exact_peer_signed": False, "query_speedup": 3.0,
+                         "total_speedup": 2.33, "cpu_time_ratio": 2.33, "goal": 3.0, "ours_passes_check": True},
+                        {"mesh": "dragon", "resolution": "uniform_box/1000", "threads": 1, "ours": "bvh_cpu",
+                         "fastest_exact_peer": "fcpw", "fastest_exact_peer_signed": False, "query_speedup": 3.0,
+                         "total_speedup": 2.33, "cpu_time_ratio": 2.33, "goal": 3.0, "ours_passes_check": False,
+                         "ours_check": "3 wrong signs farther than the tolerance from the surface"}],
+            "regression": {"dragon/uniform_box/1000/2/bvh_cpu_vs_fastest_peer": {"value": 3.0, "kind": "speedup"}}}
+
+
 def write_run(results, name, kind, metrics, run_id="r1", **manifest_args):
     """results/<name>/<run_id>/ with manifest.json and metrics.json; returns its path."""
     path = os.path.join(str(results), name, run_id)

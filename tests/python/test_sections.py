@@ -130,12 +130,24 @@ def test_missing_grid_image_is_a_note(tmp_path, schema):
 def test_peers_rows_status_rows_and_summary(tmp_path, schema):
     run = load(tmp_path, schema, "peers", "peers", fake_runs.peers_metrics())
     md = render(peers.section, tmp_path, [run])
-    assert "| bunny 64x64x64 | bvh_cpu | ours | 2 | 0.05 | 0.5 | 1 | 5.24e+05 | 0 | 0 |  |" in md
-    assert "| bunny 64x64x64 | bvh_gpu | ours | - | - | - | - | - | - | - | unavailable (no CUDA device" in md
-    assert "| bunny 64x64x64 | embree 4.0 | peer | 2 | 0.1 | 2.5 | 5 | 1.05e+05 | 1.000e-07 | n/a (unsigned) |  |" in md
+    assert "| bunny 64x64x64 | bvh_cpu | ours | 2 | 0.05 | 0.5 | 1 | 5.24e+05 | 0 | 0 | - |  |" in md
+    assert "| bunny 64x64x64 | bvh_gpu | ours | - | - | - | - | - | - | - | - | unavailable (no CUDA device" in md
+    assert "| bunny 64x64x64 | embree 4.0 | peer | 2 | 0.1 | 2.5 | 5 | 1.05e+05 | 1.000e-07 | n/a (unsigned) | - |  |" in md
     assert "narrow band: max \\|d error\\| 0.001 inside (1,000 points), 0.25 outside" in md
-    assert "| bunny 64x64x64 | 2 | embree | 5 | 4.75 | 5 |" in md
+    # A run from before passes_check: the summary says its fastest peer was not checked.
+    assert ("| bunny 64x64x64 | 2 | bvh_cpu | embree (exactness not checked: run before passes_check) | 5 | 4.75 | 5 | "
+            "1.5 | - |") in md
     assert "No peers run" in render(peers.section, tmp_path, [])
+
+
+def test_peers_point_sets_check_column_and_unsigned_fastest_peer(tmp_path, schema):
+    run = load(tmp_path, schema, "peers", "peers", fake_runs.peers_point_set_metrics())
+    md = render(peers.section, tmp_path, [run])
+    assert "| yes (unsigned) |" in md
+    assert "| no: max \\|distance error\\| 0.5 > tolerance 0.0001 |" in md
+    assert "| dragon uniform_box/1000 | 2 | bvh_cpu | fcpw (unsigned: returns no sign) | 3 | 2.33 | 2.33 | 3 | - |" in md
+    assert "| 1 | bvh_cpu (fails check: 3 wrong signs farther than the tolerance from the surface) | fcpw" in md
+    assert "not built: this build has no CUDA backend" in md
 
 
 def test_a_grid_that_marks_its_twin_briefly_is_labelled_once_in_full():

@@ -70,13 +70,71 @@ TEST(CpuBvh, EqualsBruteForceOnRandomPoints) {
         for (Precision precision : {Precision::Float, Precision::Double}) {
             if (big && precision == Precision::Double) continue;  // covered on lattices above
             const auto brute = make_cpu_brute_force_sampler(options(precision))->query(m.mesh, pts);
-            for (const char* kernel : {"seeded", "unseeded"}) {
+            for (const char* kernel : {"brick", "seeded", "unseeded"}) {
                 const auto bvh = make_cpu_bvh_sampler(options(precision, kernel))->query(m.mesh, pts);
                 test::FieldComparer cmp(m.mesh, test::epsilon_of(precision));
                 const std::string what = m.name + " random " + precision_name(precision) + " " + kernel;
                 cmp.samples(pts, brute, bvh, what);
                 if (HasFatalFailure()) return;
                 print(what, cmp.agreement(), m.mesh);
+            }
+        }
+    }
+}
+
+/// Points drawn as neural-SDF training generators draw them: an area-weighted random
+/// triangle, a uniform point on it, and a Gaussian offset of `sigma` per axis.
+std::vector<Vec3d> gaussian_points_near_surface(const PreparedMesh& mesh, int n, double sigma, unsigned seed) {
+    std::vector<double> area;
+    for (const Int3& t : mesh.triangles()) {
+        const Vec3d a = mesh.vertices()[size_t(t.x)], b = mesh.vertices()[size_t(t.y)], c = mesh.vertices()[size_t(t.z)];
+        area.push_back(0.5 * length(cross(b - a, c - a)));
+    }
+    std::mt19937_64 rng(seed);
+    std::discrete_distribution<size_t> pick(area.begin(), area.end());
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> offset(0.0, sigma);
+    std::vector<Vec3d> pts(static_cast<size_t>(n));
+    for (auto& p : pts) {
+        const Int3 t = mesh.triangles()[pick(rng)];
+        double s = u(rng), r = u(rng);
+        if (s + r > 1) s = 1 - s, r = 1 - r;
+        const Vec3d a = mesh.vertices()[size_t(t.x)], b = mesh.vertices()[size_t(t.y)], c = mesh.vertices()[size_t(t.z)];
+        p = a + (b - a) * s + (c - a) * r + Vec3d{offset(rng), offset(rng), offset(rng)};
+    }
+    return pts;
+}
+
+void expect_identical(const std::vector<PointSample>& a, const std::vector<PointSample>& b, const std::string& what) {
+    ASSERT_EQ(a.size(), b.size()) << what;
+    int64_t differing = 0;
+    for (size_t i = 0; i < a.size(); ++i)
+        differing += a[i].distance != b[i].distance || a[i].triangle != b[i].triangle || a[i].gradient.x != b[i].gradient.x ||
+                     a[i].gradient.y != b[i].gradient.y || a[i].gradient.z != b[i].gradient.z;
+    EXPECT_EQ(differing, 0) << what << ": samples that differ from the per-point query";
+}
+
+// The Morton packet query ("brick" on point lists) returns the per-point query's samples bit
+// for bit (same triangle by the same tie rule, same double evaluation), in input order, on
+// uniform and Gaussian-near-surface point sets, at any thread count; and both equal brute force.
+TEST(CpuBvh, MortonPacketQueryEqualsPerPointQueryBitForBit) {
+    const auto& meshes = test::bvh_test_meshes();
+    for (const size_t which : {size_t(3), size_t(5)}) {  // pawn; a sphere of tiny and sliver triangles
+        const PreparedMesh& mesh = meshes[which].mesh;
+        const double diag = mesh.bounds().diagonal();
+        for (int set = 0; set < 2; ++set) {
+            const auto pts = set == 0 ? random_points_around(mesh, 3001, 5) : gaussian_points_near_surface(mesh, 3001, 0.01 * diag, 6);
+            const std::string what = meshes[which].name + (set == 0 ? " uniform" : " gaussian");
+            for (Precision precision : {Precision::Float, Precision::Double}) {
+                const auto seeded = make_cpu_bvh_sampler(options(precision, "seeded", 1))->query(mesh, pts);
+                const auto packets = make_cpu_bvh_sampler(options(precision, "brick", 2))->query(mesh, pts);
+                expect_identical(seeded, packets, what + " " + precision_name(precision));
+                const auto one_thread = make_cpu_bvh_sampler(options(precision, "brick", 1))->query(mesh, pts);
+                expect_identical(one_thread, packets, what + " 1 vs 2 threads");
+                const auto brute = make_cpu_brute_force_sampler(options(precision))->query(mesh, pts);
+                test::FieldComparer cmp(mesh, test::epsilon_of(precision));
+                cmp.samples(pts, brute, packets, what + " packets vs brute force");
+                if (HasFatalFailure()) return;
             }
         }
     }
