@@ -15,6 +15,7 @@
 #include "core/checked_math.h"
 #include "core/lattice/lattice_fitting.h"
 #include "harness/io/atomic_file.h"
+#include "harness/io/volume_grids.h"
 #include "harness/resources/memory_budget.h"
 
 namespace sdf {
@@ -156,7 +157,7 @@ nlohmann::json StreamPlan::to_json() const {
             {"memory_budget_bytes", memory_budget},
             {"fixed_bytes", fixed_bytes},
             {"peak_estimate_bytes", peak_estimate},
-            {"bytes_per_point_sampled", kStreamBytesPerPoint},
+            {"bytes_per_point_sampled", bytes_per_point},
             {"output_bytes", output_bytes},
             {"channels", names}};
 }
@@ -186,7 +187,11 @@ StreamPlan plan_streamed_sampling(const Lattice& lattice, const StreamOptions& o
     plan.channels = field_channel_files(options.header_path, layout, options.write);
     for (const FieldChannelFile& c : plan.channels)
         plan.output_bytes += uint64_t(checked(checked_mul(plan.points, int64_t(c.bytes_per_point())), c.path));
-    const int64_t plane_bytes = checked(checked_mul(points_per_plane(lattice), int64_t(kStreamBytesPerPoint)), "z-plane bytes");
+    if (options.bytes_per_point == 0 || options.bytes_per_point > 4096)
+        throw std::invalid_argument("streamed sampling: bytes per point must be in [1, 4096], got " +
+                                    std::to_string(options.bytes_per_point));
+    plan.bytes_per_point = options.bytes_per_point;
+    const int64_t plane_bytes = checked(checked_mul(points_per_plane(lattice), int64_t(options.bytes_per_point)), "z-plane bytes");
     const uint64_t least = options.fixed_bytes + 2 * uint64_t(plane_bytes);
     if (options.memory_budget < least)
         throw std::runtime_error("memory budget " + format_bytes(options.memory_budget) + " is too small for " +
@@ -211,10 +216,18 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     result.plan = plan_streamed_sampling(lattice, options);
     const StreamPlan& plan = result.plan;
     std::vector<std::string> targets = {options.header_path};
+    if (!options.vdb_path.empty()) targets.push_back(options.vdb_path);
     for (const FieldChannelFile& c : plan.channels) targets.push_back(c.path);
     if (options.write.overwrite == Overwrite::Forbid)
         for (const std::string& t : targets)
             if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field (--overwrite replaces it)");
+    std::unique_ptr<VdbNarrowBandBuilder> vdb;
+    if (!options.vdb_path.empty()) {
+        if (!(options.vdb_band > 0) || !std::isfinite(options.vdb_band))
+            throw std::invalid_argument(options.vdb_path + ": the OpenVDB band must be a positive width, got " +
+                                        std::to_string(options.vdb_band));
+        vdb = std::make_unique<VdbNarrowBandBuilder>(lattice, options.vdb_band, options.gradient);
+    }
     StagedChannels files(plan.channels, plan.points);
 
     SampledField& header = result.header;
@@ -245,10 +258,14 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         const auto wait_start = Clock::now();
         if (writing.valid()) writing.get();  // rethrows the writer's error; frees its slab
         result.write_wait_seconds += seconds_since(wait_start);
-        writing = std::async(std::launch::async, [&files, &lattice, slab, field] {
+        writing = std::async(std::launch::async, [&files, &vdb, &lattice, slab, field] {
             const StorageRange primary = slab_storage(lattice, slab, 0), secondary = slab_storage(lattice, slab, 1);
             files.write(*field, 0, primary.count, primary.offset);
             files.write(*field, primary.count, secondary.count, secondary.offset);
+            if (vdb) {
+                vdb->add(*field, 0, primary.count, primary.offset);
+                vdb->add(*field, primary.count, secondary.count, secondary.offset);
+            }
         });
         if (options.progress)
             std::cerr << "sdf-sample: slab " << s + 1 << "/" << slabs.size() << " (z-planes " << slab.z_begin << "-"
@@ -258,6 +275,22 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     if (writing.valid()) writing.get();
     result.write_wait_seconds += seconds_since(wait_start);
     files.commit(options.write.overwrite);
+    if (vdb) {
+        const std::string temporary = unique_sibling_name(options.vdb_path, "tmp");
+        try {
+            vdb->write(temporary);
+            if (options.write.overwrite == Overwrite::Allow) fs::rename(temporary, options.vdb_path);
+            else if (!rename_no_replace(temporary, options.vdb_path))
+                throw std::runtime_error(options.vdb_path + ": appeared while sampling; refusing to overwrite it");
+        } catch (...) {
+            std::error_code ec;
+            fs::remove(temporary, ec);
+            if (options.write.overwrite == Overwrite::Forbid)
+                for (const FieldChannelFile& c : plan.channels) ::unlink(c.path.c_str());  // all new: leave none behind
+            throw;
+        }
+        result.vdb_active_points = vdb->active_points();
+    }
     result.seconds = seconds_since(start);
     result.peak_resident_bytes = peak_resident_bytes();
     header.timings.total = result.seconds;
@@ -269,6 +302,10 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     streaming["seconds"] = result.seconds;
     streaming["write_wait_seconds"] = result.write_wait_seconds;
     streaming["peak_resident_bytes"] = result.peak_resident_bytes;
+    if (vdb)
+        streaming["vdb"] = {{"file", fs::path(options.vdb_path).filename().string()},
+                            {"band", options.vdb_band},
+                            {"active_points", result.vdb_active_points}};
     header.sampler["streaming"] = streaming;
     try {
         write_field_header(options.header_path, header, plan.channels, options.write.overwrite);

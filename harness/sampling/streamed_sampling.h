@@ -13,7 +13,7 @@
 ///
 /// Memory: the plan takes the budget, subtracts the fixed part (what the process holds
 /// before sampling, measured, plus the BVH and the write buffers, estimated) and divides the
-/// rest by two slabs' bytes per z-plane (kStreamBytesPerPoint per point); a budget that cannot
+/// rest by two slabs' bytes per z-plane (StreamOptions::bytes_per_point); a budget that cannot
 /// hold two single-plane slabs is refused with the figure it would need.
 #pragma once
 
@@ -30,10 +30,14 @@
 
 namespace sdf {
 
-/// Host bytes per lattice point of a slab being sampled: the field's arrays (distance,
-/// gradient, closest triangle: 36 bytes) and a sampler's float results, as measured for
+/// Host bytes per lattice point of a slab being sampled on the CPU: the field's arrays
+/// (distance, gradient, closest triangle: 36 bytes) and a sampler's results, as measured for
 /// kSamplingBytesPerPoint (harness/resources/memory_budget.h).
 constexpr uint64_t kStreamBytesPerPoint = 64;
+/// The same for the CUDA samplers, estimated (not measured): the field's 36 bytes and the
+/// host copy of a GPU piece's results (distance, gradient, triangle, output index: 44 bytes),
+/// which may be as large as the slab, with headroom.
+constexpr uint64_t kStreamBytesPerPointCuda = 96;
 /// Points converted and written per pwrite (bounds the conversion buffer: 24 bytes a point).
 constexpr int64_t kStreamWriteChunk = int64_t(1) << 18;
 /// Host bytes of the BVH and the winding sign per triangle (generous: nodes, packed float and
@@ -46,8 +50,13 @@ struct StreamOptions {
     bool gradient = true;         ///< write the gradient channel
     uint64_t memory_budget = 0;   ///< bytes the whole process may hold (peak resident)
     uint64_t fixed_bytes = 0;     ///< the part that does not grow with the lattice (estimate_fixed_bytes)
+    uint64_t bytes_per_point = kStreamBytesPerPoint;  ///< host bytes per point of a slab being sampled
     int max_planes_per_slab = 0;  ///< > 0: at most this many z-planes per slab (tests)
     bool progress = true;         ///< one line per slab on stderr
+    /// Also a narrow-band OpenVDB file (harness/io/volume_grids.h: VdbNarrowBandBuilder) built
+    /// as the slabs arrive: points with |d| < vdb_band (world units) active; "" = none.
+    std::string vdb_path;
+    double vdb_band = 0;
 };
 
 /// What the process holds before sampling: its resident memory now (libraries, the mesh)
@@ -60,6 +69,7 @@ struct StreamPlan {
     int planes_per_slab = 0;
     int slabs = 0;
     uint64_t slab_bytes = 0;       ///< host bytes of the largest slab while sampled
+    uint64_t bytes_per_point = 0;  ///< of a slab while sampled
     uint64_t memory_budget = 0, fixed_bytes = 0;
     uint64_t peak_estimate = 0;    ///< fixed + two slabs
     uint64_t output_bytes = 0;     ///< of the channel files
@@ -81,6 +91,7 @@ struct StreamResult {
     double write_wait_seconds = 0;  ///< time the sampler waited for the writer
     uint64_t peak_resident_bytes = 0;
     NarrowBandCounts band;
+    int64_t vdb_active_points = 0;  ///< of the .vdb output, when asked for
 };
 
 /// Samples `lattice` slab by slab with `sampler` and writes the field file of

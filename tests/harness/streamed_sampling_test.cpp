@@ -17,6 +17,11 @@
 #include "harness/sampling/streamed_sampling.h"
 #include "harness_test_util.h"
 
+#if SDF_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+#endif
+#include "harness/io/volume_formats.h"
+
 #ifndef SDF_SAMPLE_EXE
 #error "SDF_SAMPLE_EXE must be defined by CMake"
 #endif
@@ -101,6 +106,69 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
                 }
 }
 
+#if SDF_HAVE_OPENVDB
+/// Every grid of `a` is in `b` with the same background and the same active voxels and values.
+void expect_same_vdb(const std::string& a, const std::string& b, const std::string& what) {
+    openvdb::initialize();
+    openvdb::io::File fa(a), fb(b);
+    fa.open();
+    fb.open();
+    const openvdb::GridPtrVecPtr ga = fa.getGrids(), gb = fb.getGrids();
+    ASSERT_EQ(ga->size(), gb->size()) << what;
+    for (size_t g = 0; g < ga->size(); ++g) {
+        const openvdb::GridBase::Ptr other = fb.readGrid((*ga)[g]->getName());
+        EXPECT_EQ((*ga)[g]->activeVoxelCount(), other->activeVoxelCount()) << what << " " << (*ga)[g]->getName();
+        if (auto fa_grid = openvdb::gridPtrCast<openvdb::FloatGrid>((*ga)[g])) {
+            auto fb_grid = openvdb::gridPtrCast<openvdb::FloatGrid>(other);
+            ASSERT_TRUE(fb_grid) << what;
+            EXPECT_EQ(fa_grid->background(), fb_grid->background()) << what;
+            auto acc = fb_grid->getConstAccessor();
+            for (auto it = fa_grid->cbeginValueOn(); it; ++it) {
+                EXPECT_TRUE(acc.isValueOn(it.getCoord())) << what;
+                EXPECT_EQ(*it, acc.getValue(it.getCoord())) << what;
+            }
+        } else if (auto va = openvdb::gridPtrCast<openvdb::Vec3fGrid>((*ga)[g])) {
+            auto vb = openvdb::gridPtrCast<openvdb::Vec3fGrid>(other);
+            ASSERT_TRUE(vb) << what;
+            auto acc = vb->getConstAccessor();
+            for (auto it = va->cbeginValueOn(); it; ++it) EXPECT_EQ(*it, acc.getValue(it.getCoord())) << what;
+        }
+    }
+}
+
+TEST(StreamedSampling, NarrowBandVdbEqualsTheInMemoryExport) {
+    test::ScratchDir dir("streamed_vdb");
+    const PreparedMesh& mesh = torus();
+    const Lattice cc = fit_lattice(LatticeType::CC, {24, 25, 26}, mesh.bounds(), 0.1);
+    const Lattice bcc = fit_lattice(LatticeType::BCC, {17, 18, 15}, mesh.bounds(), 0.1);
+    int n = 0;
+    for (const Lattice& lattice : {cc, bcc}) {
+        const std::string tag = std::to_string(n++), what = lattice_notation(lattice);
+        const double w = 2.0 * lattice.spacing;
+        const SampledField field = make_cpu_bvh_sampler(sampler_options(w))->sample(mesh, lattice);
+        VolumeWriteOptions v;
+        v.vdb_band = 2.0;
+        write_field_as(field, dir.at("memory" + tag + ".vdb"), VolumeFormat::Vdb, v);
+        StreamOptions stream;
+        stream.header_path = dir.at("streamed" + tag + ".json");
+        stream.fixed_bytes = 1 << 20;
+        stream.memory_budget = 64 << 20;
+        stream.max_planes_per_slab = 3;
+        stream.progress = false;
+        stream.vdb_path = dir.at("streamed" + tag + ".vdb");
+        stream.vdb_band = w;
+        const SamplerOptions options = sampler_options(w);
+        auto sampler = make_cpu_bvh_sampler(options);
+        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {});
+        EXPECT_GE(r.plan.slabs, 5) << what;
+        EXPECT_GT(r.vdb_active_points, 100) << what;
+        EXPECT_LE(r.vdb_active_points, count_narrow_band(field).in_band) << what;
+        expect_same_vdb(dir.at("memory" + tag + ".vdb"), stream.vdb_path, what + " memory vs streamed");
+        expect_same_vdb(stream.vdb_path, dir.at("memory" + tag + ".vdb"), what + " streamed vs memory");
+    }
+}
+#endif
+
 TEST(StreamedSampling, RefusesSmallBudgetsAndExistingOutputs) {
     test::ScratchDir dir("streamed_refusals");
     const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, torus().bounds(), 0.1);
@@ -162,7 +230,7 @@ TEST(StreamedSampling, ToolRefusesBadOptionsWithExitTwoAndWritesWhatItPlans) {
     EXPECT_TRUE(test::Contains(plan.out, "memory: budget"));
     EXPECT_FALSE(fs::exists(dir.at("f.json")));
     const test::ShellResult run = test::run_in(
-        dir.path(), exe + " shape:sphere --resolution 12 --out f.json --memory-budget 40MiB --max-planes-per-slab 3 --quiet");
+        dir.path(), exe + " shape:sphere --resolution 12 --out f.json --memory-budget 256MiB --max-planes-per-slab 3 --quiet");
     EXPECT_EQ(run.code, 0) << run.err;
     EXPECT_TRUE(test::Contains(run.out, "in 4 slabs"));
     EXPECT_EQ(read_field(dir.at("f.json")).distance.size(), 12u * 12u * 12u);
