@@ -14,6 +14,7 @@
 
 #include "core/checked_math.h"
 #include "core/lattice/lattice_fitting.h"
+#include "core/parallel/parallel_for.h"
 #include "harness/io/atomic_file.h"
 #include "harness/io/volume_grids.h"
 #include "harness/resources/memory_budget.h"
@@ -70,15 +71,20 @@ public:
     StagedChannels(const StagedChannels&) = delete;
     StagedChannels& operator=(const StagedChannels&) = delete;
 
-    /// Writes points [first, first + count) of `field` at lattice storage offset `offset`.
+    /// Writes points [first, first + count) of `field` at lattice storage offset `offset`,
+    /// chunk by chunk on kStreamWriteThreads threads (pwrite at distinct offsets): the
+    /// conversion to the stored type, not the disk, limits one thread behind a fast sampler.
     void write(const SampledField& field, int64_t first, int64_t count, int64_t offset) {
         for (size_t c = 0; c < channels_.size(); ++c) {
             const size_t width = channels_[c].bytes_per_point();
-            for (int64_t done = 0; done < count; done += kStreamWriteChunk) {
-                const int64_t n = std::min(kStreamWriteChunk, count - done);
-                const std::vector<char> bytes = field_channel_bytes(field, channels_[c], size_t(first + done), size_t(n));
-                write_at(c, bytes, off_t(size_t(offset + done) * width));
-            }
+            const int64_t chunks = (count + kStreamWriteChunk - 1) / kStreamWriteChunk;
+            parallel_for(chunks, 1, kStreamWriteThreads, [&](int64_t begin, int64_t end) {
+                for (int64_t k = begin; k < end; ++k) {
+                    const int64_t done = k * kStreamWriteChunk, n = std::min(kStreamWriteChunk, count - done);
+                    const std::vector<char> bytes = field_channel_bytes(field, channels_[c], size_t(first + done), size_t(n));
+                    write_at(c, bytes, off_t(size_t(offset + done) * width));
+                }
+            });
         }
     }
 
@@ -137,7 +143,7 @@ void merge_slab_provenance(nlohmann::json& merged, const nlohmann::json& slab) {
 
 uint64_t estimate_fixed_bytes(const PreparedMesh& mesh) {
     return current_resident_bytes() + kStreamBvhBytesPerTriangle * uint64_t(mesh.triangles().size()) +
-           3 * uint64_t(kStreamWriteChunk) * 24;  // a conversion buffer per thread that writes, with room
+           (kStreamWriteThreads + 1) * uint64_t(kStreamWriteChunk) * 24;  // a conversion buffer per writing thread, with room
 }
 
 std::vector<LatticeSlab> StreamPlan::slab_list() const {

@@ -40,6 +40,8 @@ constexpr uint64_t kStreamBytesPerPoint = 64;
 constexpr uint64_t kStreamBytesPerPointCuda = 96;
 /// Points converted and written per pwrite (bounds the conversion buffer: 24 bytes a point).
 constexpr int64_t kStreamWriteChunk = int64_t(1) << 18;
+/// Threads that convert and write a slab's chunks (each with its own buffer).
+constexpr int kStreamWriteThreads = 4;
 /// Host bytes of the BVH and the winding sign per triangle (generous: nodes, packed float and
 /// double triangles, moments).
 constexpr uint64_t kStreamBvhBytesPerTriangle = 512;
