@@ -109,6 +109,8 @@ int main(int argc, char** argv) {
 
     // The command line's values that CLI11 cannot check: exit 2 with what was expected.
     sdf::StreamOptions stream;
+    sdf::LatticeSpec spec;
+    sdf::SamplerOptions options;
     try {
         if (resolution.size() == 2) throw std::invalid_argument("--resolution: expected N or NX NY NZ, got 2 numbers");
         if (!(band >= 0) || !std::isfinite(band)) throw std::invalid_argument("--band: expected a finite width >= 0");
@@ -130,12 +132,7 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("--vdb " + vdb_path + ": expected a file name ending in .vdb");
         if (backend == "auto" && !kernel.empty())
             throw std::invalid_argument("--kernel " + kernel + ": a kernel needs --backend cpu or cuda");
-    } catch (const std::invalid_argument& e) {
-        std::cerr << "sdf-sample: error: " << e.what() << "\n";
-        return sdf::kExitCommandLineError;
-    }
-    if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
-    try {
+        // The lattice and the sampler as the config parser reads them: its checks and messages.
         nlohmann::json lattice_json = {{"type", lattice_type}};
         if (resolution.size() == 1) {
             const int n = resolution[0];
@@ -144,13 +141,19 @@ int main(int argc, char** argv) {
             lattice_json["resolution"] = resolution;
         }
         sdf::JsonReader lattice_reader(lattice_json, "sdf-sample", "--lattice/--resolution");
-        const sdf::LatticeSpec spec = sdf::parse_lattice_spec(lattice_reader);
+        spec = sdf::parse_lattice_spec(lattice_reader);
         nlohmann::json sampler_json = {{"backend", backend}, {"method", method}, {"sign", sign},
                                        {"precision", precision}, {"threads", threads}, {"progress", false}};
         if (!kernel.empty()) sampler_json["kernel"] = kernel;
         sdf::JsonReader sampler_reader(sampler_json, "sdf-sample", "sampler");
-        sdf::SamplerOptions options = sdf::parse_sampler_options(sampler_reader);
+        options = sdf::parse_sampler_options(sampler_reader);
         options.band_width = band;
+    } catch (const std::exception& e) {
+        std::cerr << "sdf-sample: error: " << e.what() << "\n";
+        return sdf::kExitCommandLineError;
+    }
+    if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
+    try {
         stream.header_path = out_path;
         stream.write.dtype = dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64;
         stream.write.overwrite = overwrite ? sdf::Overwrite::Allow : sdf::Overwrite::Forbid;
@@ -170,6 +173,9 @@ int main(int argc, char** argv) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision)
                       << (band > 0 ? ", band " + std::to_string(band) : std::string()) << "\n"
                       << plan.describe() << "out: " << out_path << "\n";
+            if (!vdb_path.empty())
+                std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
+                          << " active (its grids hold the band's points, outside the budget)\n";
             return 0;
         }
         require_output_space(plan, out_path);

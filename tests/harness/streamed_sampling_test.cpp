@@ -220,7 +220,9 @@ TEST(StreamedSampling, ToolRefusesBadOptionsWithExitTwoAndWritesWhatItPlans) {
     for (const std::string& args : {std::string("--resolution 8 8 --out f.json"), std::string("--resolution 8 --out f.npy"),
                                     std::string("--resolution 8 --out f.json --channels gradient"),
                                     std::string("--resolution 8 --out f.json --band -1"),
-                                    std::string("--resolution 0 --out f.json")}) {
+                                    std::string("--resolution 0 --out f.json"),
+                                    std::string("--lattice bcc --resolution 8 8 9 --out f.json"),
+                                    std::string("--resolution 8 --out f.json --channels distance,normals")}) {
         const test::ShellResult r = test::run_in(dir.path(), exe + " shape:sphere " + args);
         EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     }
