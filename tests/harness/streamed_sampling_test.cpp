@@ -22,8 +22,8 @@
 #endif
 #include "harness/io/volume_formats.h"
 
-#ifndef SDF_SAMPLE_EXE
-#error "SDF_SAMPLE_EXE must be defined by CMake"
+#if !defined(SDF_SAMPLE_EXE) || !defined(RUN_EXPERIMENT_EXE)
+#error "SDF_SAMPLE_EXE and RUN_EXPERIMENT_EXE must be defined by CMake"
 #endif
 
 namespace sdf {
@@ -239,6 +239,33 @@ TEST(StreamedSampling, ToolRefusesBadOptionsWithExitTwoAndWritesWhatItPlans) {
     const test::ShellResult again = test::run_in(dir.path(), exe + " shape:sphere --resolution 12 --out f.json --quiet");
     EXPECT_EQ(again.code, 1);
     EXPECT_TRUE(test::Contains(again.err, "already exists"));
+}
+
+TEST(StreamedSampling, ToolEqualsRunExperimentFieldsByteForByte) {
+    test::ScratchDir dir("sdf_sample_vs_run_experiment");
+    dir.write("c.json", R"({"name": "stream_e2e", "kind": "reconstruction", "mesh": {"shape": "torus"},
+        "domain": {"margin": 0.1},
+        "lattices": [{"type": "cc", "resolution": [14, 15, 16]}, {"type": "bcc", "resolution": [11, 11, 22]}],
+        "sampler": {"backend": "cpu", "method": "bvh", "precision": "float", "progress": false},
+        "metrics": {"domain_probes": 10, "band_probes": 10, "band": 1.0, "seed": 1}})");
+    const test::ShellResult run = test::run_in(
+        dir.path(), test::quote(RUN_EXPERIMENT_EXE) + " c.json --output-root results --no-cache --quiet");
+    ASSERT_EQ(run.code, 0) << run.err;
+    fs::path fields;
+    for (const auto& e : fs::directory_iterator(dir.path() / "results" / "stream_e2e")) fields = e.path() / "fields";
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) + " shape:torus --backend cpu --margin 0.1 --memory-budget 256MiB --quiet";
+    const test::ShellResult cc = test::run_in(dir.path(), exe + " --resolution 14 15 16 --max-planes-per-slab 3 --out cc.json");
+    const test::ShellResult bcc = test::run_in(dir.path(), exe + " --lattice bcc --resolution 11 11 22 --max-planes-per-slab 2 --out bcc.json");
+    ASSERT_EQ(cc.code, 0) << cc.err;
+    ASSERT_EQ(bcc.code, 0) << bcc.err;
+    EXPECT_TRUE(test::Contains(cc.out, "in 6 slabs"));
+    EXPECT_TRUE(test::Contains(bcc.out, "in 6 slabs"));
+    for (const char* channel : {"distance", "gradient", "closest_triangle"}) {
+        const std::string c = std::string(".") + channel + ".raw";
+        EXPECT_TRUE(bytes_of((fields / ("torus-cc-14x15x16" + c)).string()) == bytes_of(dir.at("cc" + c))) << channel;
+        EXPECT_TRUE(bytes_of((fields / ("torus-bcc-11x11x22" + c)).string()) == bytes_of(dir.at("bcc" + c))) << channel;
+        EXPECT_GT(bytes_of(dir.at("cc" + c)).size(), 0u);
+    }
 }
 
 }  // namespace
