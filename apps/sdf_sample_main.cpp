@@ -42,6 +42,7 @@ uint64_t default_memory_budget() {
 /// The output directory's free bytes; refuses when the channels do not fit.
 void require_output_space(const sdf::StreamPlan& plan, const std::string& out) {
     const fs::path dir = fs::absolute(out).parent_path();
+    if (!fs::is_directory(dir)) throw std::runtime_error(out + ": the output folder " + dir.string() + " does not exist");
     std::error_code ec;
     const fs::space_info space = fs::space(dir, ec);
     if (ec) throw std::runtime_error(dir.string() + ": cannot read the free space (" + ec.message() + ")");
@@ -140,12 +141,12 @@ int main(int argc, char** argv) {
         } else {
             lattice_json["resolution"] = resolution;
         }
-        sdf::JsonReader lattice_reader(lattice_json, "sdf-sample", "--lattice/--resolution");
+        sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
         spec = sdf::parse_lattice_spec(lattice_reader);
         nlohmann::json sampler_json = {{"backend", backend}, {"method", method}, {"sign", sign},
                                        {"precision", precision}, {"threads", threads}, {"progress", false}};
         if (!kernel.empty()) sampler_json["kernel"] = kernel;
-        sdf::JsonReader sampler_reader(sampler_json, "sdf-sample", "sampler");
+        sdf::JsonReader sampler_reader(sampler_json, "command line", "sampler");
         options = sdf::parse_sampler_options(sampler_reader);
         options.band_width = band;
     } catch (const std::exception& e) {
