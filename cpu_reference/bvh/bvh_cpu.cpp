@@ -5,6 +5,7 @@
 #include <cmath>
 #include <chrono>
 #include <stdexcept>
+#include <vector>
 
 #include "core/bvh/bvh_cache.h"
 #include "core/parallel/parallel_for.h"
@@ -26,6 +27,8 @@ constexpr int64_t kBvhChunk = 256;
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
+/// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
+constexpr int64_t kBandChunkRows = 8;
 
 using BvhKernel = CpuBvhKernel;
 
@@ -135,17 +138,23 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", block.count(), progress);
-    parallel_for(n, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
+    // With a band, chunks are whole rows of bricks (8 rows), so that a brick can reuse the
+    // probe of the brick beside it in x and of the one below it in y (column_ball).
+    const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
+    parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         int32_t seed[kBrick];
         for (int k = 0; k < kBrick; ++k) seed[k] = -1;
         int32_t probe_seed = -1;
         ProbeBall ball;
+        std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
         int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
             done += br.count;
             if (band.enabled()) {
+                ProbeBall& below = column_ball[size_t(b % bricks.x)];
+                if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
                 if (!brick_in_ball(br, ball)) {  // probe at the brick's centre
                     Vec3d c(0.0);
                     for (int k = 0; k < br.count; ++k) c = c + br.position[k];
@@ -157,6 +166,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
                     ball = {c, d - band.width - margin, s.distance < 0};
+                    below = ball;
                     ++probes;
                 }
                 bool skip = brick_in_ball(br, ball);
