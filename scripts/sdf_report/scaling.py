@@ -1,6 +1,6 @@
 """Time and memory against lattice size (issue 14): the runs of scripts/scaling-run, JSON lines
-under results/scaling/<run-id>/scaling.jsonl (one per lattice size, written by sdf-sample's
-streaming), drawn log-log: end-to-end seconds, the sampler's kernel seconds and the disk
+under results/scaling/<run-id>/scaling.jsonl (local) or results/gpu/scaling/<run-id>/ (committed
+runs of the GPU machine), one line per lattice size, drawn log-log: end-to-end seconds, the sampler's kernel seconds and the disk
 baseline (dd writing the same bytes), and the peak resident memory against the budget."""
 
 import glob
@@ -12,10 +12,12 @@ from .tables import Table, count, number
 
 
 def load(results_dir):
-    """{run id: [rows in file order]} of every scaling run under results_dir/scaling; a line
-    that is not JSON is reported by file and line."""
+    """{run id: [rows in file order]} of every scaling run under results_dir/scaling and
+    results_dir/gpu/scaling; a line that is not JSON is reported by file and line."""
     runs = {}
-    for path in sorted(glob.glob(os.path.join(results_dir, "scaling", "*", "scaling.jsonl"))):
+    paths = glob.glob(os.path.join(results_dir, "scaling", "*", "scaling.jsonl")) + \
+        glob.glob(os.path.join(results_dir, "gpu", "scaling", "*", "scaling.jsonl"))
+    for path in sorted(paths, key=lambda p: os.path.basename(os.path.dirname(p))):
         rows = []
         with open(path) as f:
             for i, line in enumerate(f, 1):

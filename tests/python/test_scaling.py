@@ -36,6 +36,14 @@ def test_table_and_plots_from_scaling_lines(tmp_path):
     assert (out / "scaling_memory_2026-11-24T050000Z.png").stat().st_size > 1000
 
 
+def test_committed_gpu_runs_are_found_too(tmp_path):
+    run = tmp_path / "results" / "gpu" / "scaling" / "2026-11-24T060000Z"
+    run.mkdir(parents=True)
+    (run / "scaling.jsonl").write_text(json.dumps(row(64, 0.2, 400 * 2**20)) + "\n")
+    md, _ = render(tmp_path, tmp_path / "results")
+    assert "run 2026-11-24T060000Z" in md
+
+
 def test_note_without_runs_and_bad_lines_named(tmp_path):
     md, _ = render(tmp_path, tmp_path / "empty")
     assert "No scaling run in the results" in md
