@@ -25,6 +25,7 @@
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/io/atomic_file.h"
 #include "harness/resources/memory_budget.h"
 #include "harness/sampling/sampler_table.h"
 #include "harness/sampling/streamed_sampling.h"
@@ -180,6 +181,8 @@ int main(int argc, char** argv) {
             return 0;
         }
         require_output_space(plan, out_path);
+        // Temporaries of an interrupted earlier run in the output folder (their process is gone).
+        sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
         const nlohmann::json mesh_provenance = {{"name", mesh.name()},
                                                 {"source", mesh.source()},
                                                 {"sha256", mesh.content_sha256()},
