@@ -10,8 +10,12 @@
 
 #include "core/bvh/bvh_cache.h"
 #include "core/sampling/sampler_results.h"
+#include <cub/device/device_radix_sort.cuh>
+
+#include "cuda/bvh_candidates_kernel.cuh"
 #include "cuda/bvh_kernel.cuh"
 #include "cuda/bvh_warp_kernel.cuh"
+#include "kernels/core/morton.h"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
@@ -23,6 +27,19 @@ namespace sdf::cuda {
 namespace {
 
 int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
+
+__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, uint64_t* keys, int64_t* identity) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    const Vec3d p = points[i];
+    keys[i] = morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side);
+    identity[i] = i;
+}
+
+__global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t n, Vec3d* sorted) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) sorted[i] = points[order[i]];
+}
 
 /// A BVH and the double mesh on the device, for one precision of the search, with the
 /// winding moments when the sign (prepared for this mesh) is the winding number's.
@@ -137,9 +154,17 @@ private:
         return int(std::clamp<int64_t>(layers, 1, block.resolution.z));
     }
 
+    /// The band's search parameters (bricks outside it are skipped by "warp" and "candidates";
+    /// the other kernels search everything and finalize_samples() applies the band).
     template <typename T>
-    void launch_slab(const BvhView<T>& view, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) const {
+    BandSearch band_search(const DeviceBvh<T>& dev) const {
+        return {options_.band_width, dev.mesh->view(), dev.winding.view().enabled()};
+    }
+
+    template <typename T>
+    void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) {
         const int blocks = blocks_for(slab.threads(), kBvhThreads);
+        const BvhView<T>& view = dev.view;
         switch (kernel_) {
             case BvhGpuKernel::Brick:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Brick><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
@@ -151,7 +176,11 @@ private:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
                 break;
             case BvhGpuKernel::Warp:
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev), nearest);
+                break;
+            case BvhGpuKernel::Candidates:
+                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),
+                                                                            nearest, candidate_stats_.get());
                 break;
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
@@ -165,9 +194,9 @@ private:
         const SlabGeometry slab{block.resolution, z0, nz};
         PieceResults r(piece.count);
         compute.begin();
-        launch_slab<T>(dev.view, piece, slab, r.nearest.get());
+        launch_slab<T>(dev, piece, slab, r.nearest.get());
         launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
-                                r.outputs());
+                                options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
         compute.end();
         download.begin();
@@ -186,6 +215,11 @@ private:
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0, pieces = 0;
+        unsigned long long counts[4] = {0, 0, 0, 0};
+        if (kernel_ == BvhGpuKernel::Candidates) {
+            if (candidate_stats_.size() == 0) candidate_stats_.allocate(4);
+            CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
+        }
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];
             const int layers = layers_per_slab(block);
@@ -205,9 +239,22 @@ private:
         field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
         field.sampler["bvh"] = bvh_info;
         field.sampler["device"] = describe_device(options_.device);
+        if (kernel_ == BvhGpuKernel::Candidates) {
+            candidate_stats_.download(counts, 4);
+            CUDA_CHECK(cudaStreamSynchronize(0));
+            const double bricks = double(counts[0]);
+            field.sampler["candidates"] = {{"bricks_searched", counts[0]},
+                                           {"bricks_outside_band", counts[2]},
+                                           {"mean_candidate_triangles", bricks > 0 ? double(counts[1]) / bricks : 0.0},
+                                           {"mean_leaf_ranges", bricks > 0 ? double(counts[3]) / bricks : 0.0},
+                                           {"points_per_brick", 32 * kRunPoints}};
+        }
         return field;
     }
 
+    /// Point lists: Morton keys in the mesh's box, a device radix sort, then the warp search
+    /// over 128 consecutive sorted points (neighbours in space) and the finalize, whose
+    /// output_index sends every result back to its input position.
     template <typename T>
     std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
         std::vector<PointSample> out(points.size());
@@ -215,24 +262,65 @@ private:
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        DeviceBuffer<Vec3d> device_points;
-        device_points.upload(points);
+        const auto start = std::chrono::steady_clock::now();
         const int64_t n = int64_t(points.size());
+        DeviceBuffer<Vec3d> device_points{size_t(n)};
+        upload.begin();
+        device_points.upload(points);
+        upload.end();
+        DeviceBuffer<Vec3d> sorted_points{size_t(n)};
+        DeviceBuffer<int64_t> order{size_t(n)};
+        compute.begin();
+        sort_into_morton_order(mesh, device_points.get(), n, sorted_points.get(), order.get());
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
         for (int64_t begin = 0; begin < n; begin += step) {
-            const PointListPiece piece{device_points.get(), begin, std::min(step, n - begin)};
+            const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
             PieceResults r(piece.count);
-            nearest_triangle_bvh_points<T><<<blocks_for(piece.count, kBvhThreads), kBvhThreads>>>(dev.view, piece,
-                                                                                                  r.nearest.get());
-            CUDA_CHECK_LAUNCH("nearest_triangle_bvh_points");
+            if (begin > 0) compute.begin();
+            const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
+            const int blocks = blocks_for(layout.threads(), kBvhThreads);
+            if (kernel_ == BvhGpuKernel::Candidates)
+                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
+            else
+                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
+            CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
-                                    dev.winding.view(), r.outputs());
+                                    dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
+            compute.end();
+            download.begin();
             const PieceResults::Host h = r.download(piece.count);
+            download.end();
             scatter_batch(h, mesh, out);
         }
+        query_timings_ = {};
+        query_timings_.upload = upload.seconds();
+        query_timings_.kernel = compute.seconds();
+        query_timings_.download = download.seconds();
+        query_timings_.point_triangle_pairs = double(n) * double(mesh.triangles().size());
+        query_timings_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return out;
+    }
+
+    /// Sorts the points by their Morton keys in the mesh's (cubic) box: `sorted` receives
+    /// the points, `order` their input positions.
+    void sort_into_morton_order(const PreparedMesh& mesh, const Vec3d* points, int64_t n, Vec3d* sorted, int64_t* order) {
+        const Bounds3& box = mesh.bounds();
+        const Vec3d extent = box.extent();
+        const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
+        DeviceBuffer<uint64_t> keys{size_t(n)}, keys_sorted{size_t(n)};
+        DeviceBuffer<int64_t> identity{size_t(n)};
+        morton_keys<<<blocks_for(n, 256), 256>>>(points, n, box.min, 1.0 / side, keys.get(), identity.get());
+        CUDA_CHECK_LAUNCH("morton_keys");
+        size_t temp_bytes = 0;
+        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
+                                                   n, 0, 63));
+        DeviceBuffer<unsigned char> temp{temp_bytes};
+        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
+                                                   n, 0, 63));
+        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted);
+        CUDA_CHECK_LAUNCH("gather_points");
     }
 
     SamplerOptions options_;
@@ -243,6 +331,7 @@ private:
     const TriangleBvh* uploaded_for_ = nullptr;
     std::unique_ptr<DeviceBvh<float>> device_float_;
     std::unique_ptr<DeviceBvh<double>> device_double_;
+    DeviceBuffer<unsigned long long> candidate_stats_;  ///< kernel "candidates": bvh_candidates_kernel.cuh's counters
 };
 
 }  // namespace

@@ -12,6 +12,8 @@
 
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "cuda/bvh_kernel.cuh"
+#include "cuda/finalize_kernel.cuh"
+#include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {
 
@@ -29,32 +31,57 @@ __device__ SDF_INLINE T warp_max(T v) {
     return v;
 }
 
-template <typename T>
-__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView<T> bvh, GridRangePiece piece,
-                                                                          SlabGeometry slab, int* nearest) {
-    constexpr int kWarps = kBvhThreads / 32;
-    __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
-    __shared__ T stack_d2[kWarps][kBvhMaxDepth];
-    const int w = threadIdx.x / 32;
+/// Where a warp's points come from: thread t owns `count` consecutive piece-local ids from
+/// `first` (count 0: none). A lattice slab gives every warp an 8 x 4 x 4 brick (SlabGeometry);
+/// a point list sorted into Morton order gives it 128 consecutive points, which are then
+/// neighbours in space as well (kernels/core/morton.h).
+struct SlabLayout {
+    GridRangePiece piece;
+    SlabGeometry slab;
+    SDF_CPU_GPU int64_t threads() const { return slab.threads(); }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = 0;
+        if (t >= slab.threads()) return 0;
+        const Int3 s = slab.run_start(t);
+        if (s.x >= slab.resolution.x || s.y >= slab.resolution.y || s.z >= slab.nz) return 0;
+        first = s.x + int64_t(slab.resolution.x) * (s.y + int64_t(slab.resolution.y) * s.z);
+        return min(kRunPoints, slab.resolution.x - s.x);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
 
-    // Every thread stays to the end: the votes and shuffles need the whole warp. Threads
-    // past the slab get best = -1, so they never want a box and never hold the warp back.
-    const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    Int3 s{0, 0, 0};
-    bool valid = t < slab.threads();
-    if (valid) s = slab.run_start(t);
-    valid = valid && s.x < slab.resolution.x && s.y < slab.resolution.y && s.z < slab.nz;
-    const int count = valid ? min(kRunPoints, slab.resolution.x - s.x) : 0;
-    const int64_t first = s.x + int64_t(slab.resolution.x) * (s.y + int64_t(slab.resolution.y) * s.z);
-    BvhPacket<T, kRunPoints> pk;
+struct ListLayout {
+    PointListPiece piece;
+    SDF_CPU_GPU int64_t threads() const { return (piece.size() + kRunPoints - 1) / kRunPoints; }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = t * kRunPoints;
+        const int64_t left = piece.size() - first;
+        if (left <= 0) first = 0;
+        return left <= 0 ? 0 : int(left < kRunPoints ? left : kRunPoints);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+
+/// Loads thread t's points into a packet; lanes without points get best = -1, so they never
+/// want a box or a triangle and never hold the warp back.
+template <typename T, typename Layout>
+__device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& first, BvhPacket<T, kRunPoints>& pk) {
+    const int count = layout.points_of(t, first);
     for (int k = 0; k < kRunPoints; ++k) {
-        const Vec3<T> p(valid ? piece.position(first + (k < count ? k : 0)) : piece.position(0));
+        const Vec3<T> p(layout.position(first + (k < count ? k : 0)));
         pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
-        pk.best_q[k] = valid ? T(INFINITY) : T(-1);  // -1: never nearer than a box or a triangle
+        pk.best_q[k] = count > 0 ? T(INFINITY) : T(-1);
         pk.best_slot[k] = -1;
         pk.best_triangle[k] = -1;
     }
+    return count;
+}
 
+/// The warp's shared traversal: completes the nearest triangle of every lane's points.
+/// `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
+template <typename T>
+__device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunPoints>& pk, bool valid, int32_t* stack_node,
+                                       T* stack_d2) {
     T worst = warp_max(valid ? T(INFINITY) : T(-1));
     int top = 0;  // warp-uniform
     int32_t node = 0;
@@ -85,8 +112,8 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
                 next = n.ref[far];
             } else {
                 if (threadIdx.x % 32 == 0) {
-                    stack_node[w][top] = n.ref[far];
-                    stack_d2[w][top] = near ? m0 : m1;  // the nearest point's distance: a bound for all
+                    stack_node[top] = n.ref[far];
+                    stack_d2[top] = near ? m0 : m1;  // the nearest point's distance: a bound for all
                 }
                 ++top;
             }
@@ -99,11 +126,84 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
         __syncwarp();
         while (next < 0 && top > 0) {
             --top;
-            if (may_hold_nearer(stack_d2[w][top], worst)) next = stack_node[w][top];
+            if (may_hold_nearer(stack_d2[top], worst)) next = stack_node[top];
         }
         __syncwarp();
         node = next;
     }
+}
+
+/// The narrow band as the search sees it; width 0 = no band.
+struct BandSearch {
+    double width = 0;
+    MeshView<double> mesh{};  ///< for the side of a brick's centre (pseudonormal sign)
+    bool winding_sign = false;
+};
+
+/// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
+template <typename T>
+__device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, kRunPoints>& pk, int count, Vec3<T>& lo, Vec3<T>& hi) {
+    const T inf = T(INFINITY);
+    lo = Vec3<T>(inf, inf, inf);
+    hi = Vec3<T>(-inf, -inf, -inf);
+    for (int k = 0; k < count; ++k) {
+        lo = Vec3<T>(min(lo.x, pk.x[k]), min(lo.y, pk.y[k]), min(lo.z, pk.z[k]));
+        hi = Vec3<T>(max(hi.x, pk.x[k]), max(hi.y, pk.y[k]), max(hi.z, pk.z[k]));
+    }
+    lo = Vec3<T>(warp_min(lo.x), warp_min(lo.y), warp_min(lo.z));
+    hi = Vec3<T>(warp_max(hi.x), warp_max(hi.y), warp_max(hi.z));
+}
+
+/// Narrow band: by 1-Lipschitz continuity every point p of the brick has |d(p)| >= |d(c)| -
+/// |p - c| for the box's centre c; when that bound (less a rounding allowance relative to the
+/// coordinates: the float search is exact relative to them) exceeds the band's width, the
+/// whole brick lies outside the band. Returns its NearestOutsideBand code (the side of c
+/// with the pseudonormal sign, as the brick does not cross the surface; "per point" with the
+/// winding sign, whose side may change away from the surface), or 0 when the brick must be
+/// searched. `seed` receives c's nearest triangle.
+template <typename T>
+__device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket<T, kRunPoints>& pk, int count, const Vec3<T>& c,
+                                          const BvhHit<T>& seed, const BandSearch& band) {
+    T r2 = T(0);
+    for (int k = 0; k < count; ++k) {
+        const T dx = pk.x[k] - c.x, dy = pk.y[k] - c.y, dz = pk.z[k] - c.z;
+        r2 = max(r2, dx * dx + dy * dy + dz * dz);
+    }
+    r2 = warp_max(r2);
+    const double scale = fmax(fmax(fabs(double(c.x)), fabs(double(c.y))), fabs(double(c.z)));
+    const double dc = sqrt(double(seed.distance_squared)), r = sqrt(double(r2));
+    const double slack = 64.0 * double(std::numeric_limits<T>::epsilon()) * (scale + dc + r) + 1e-300;
+    if (!(dc - r - slack > band.width)) return 0;
+    if (band.winding_sign) return kOutsideBandSignPerPoint;
+    const SignedDistanceSample<double> s = signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[seed.slot]);
+    return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
+}
+
+template <typename T, typename Layout>
+__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band,
+                                                                          int* nearest) {
+    constexpr int kWarps = kBvhThreads / 32;
+    __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
+    __shared__ T stack_d2[kWarps][kBvhMaxDepth];
+    const int w = threadIdx.x / 32;
+
+    // Every thread stays to the end: the votes and shuffles need the whole warp.
+    const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    int64_t first = 0;
+    BvhPacket<T, kRunPoints> pk;
+    const int count = load_packet<T>(layout, t, first, pk);
+    if (band.width > 0) {
+        Vec3<T> lo, hi;
+        warp_brick_box(pk, count, lo, hi);
+        if (!(lo.x <= hi.x)) return;  // no point in this warp
+        const Vec3<T> c((lo.x + hi.x) / T(2), (lo.y + hi.y) / T(2), (lo.z + hi.z) / T(2));
+        const int code = brick_band_code(bvh, pk, count, c, closest_triangle_bvh(bvh, c), band);
+        if (code != 0) {
+            for (int k = 0; k < count; ++k) nearest[first + k] = code;
+            return;
+        }
+    }
+    warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w]);
     for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
 }
 

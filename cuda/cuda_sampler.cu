@@ -220,7 +220,7 @@ private:
         }
         compute_.begin();
         launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
-                                winding_.view(), out.view());
+                                winding_.view(), options_.band_width, out.view());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
         download_.begin();
@@ -264,10 +264,10 @@ private:
         }
         if (winding_.view().enabled())
             finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
-                                                                                                  winding_.view(), out.view());
+                                                                                                  winding_.view(), options_.band_width, out.view());
         else
             finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
-                                                                                                   winding_.view(), out.view());
+                                                                                                   winding_.view(), options_.band_width, out.view());
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
         download_.begin();

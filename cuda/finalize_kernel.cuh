@@ -7,11 +7,20 @@
 /// "winding" the sample then takes the fast winding number's side (winding_sign_kernel.cuh).
 #pragma once
 
+#include "core/sampling/sampled_field.h"
 #include "cuda/point_pieces.h"
 #include "cuda/winding_sign_kernel.cuh"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {
+
+/// What `nearest` holds for a point of a brick wholly outside the band (set by
+/// the search, bvh_candidates_kernel.cuh).
+enum NearestOutsideBand : int {
+    kOutsideBandOutside = -2,        ///< positive side
+    kOutsideBandInside = -3,         ///< negative side
+    kOutsideBandSignPerPoint = -4,   ///< the winding number decides, point by point
+};
 
 /// Per-piece results, downloaded and scattered into the field by the host.
 struct PieceOutputs {
@@ -21,29 +30,56 @@ struct PieceOutputs {
     int64_t* output_index;  ///< -1: padding or discarded
 };
 
+/// Writes sample i, or the band's value when it lies outside a narrow band (width > 0).
+__device__ inline void store_sample(const PieceOutputs& out, int64_t i, const SignedDistanceSample<double>& s, double band_width) {
+    if (band_width > 0 && fabs(s.distance) > band_width) {
+        out.distance[i] = s.distance < 0 ? -band_width : band_width;
+        out.gradient[i] = Vec3d(0.0);
+        out.triangle[i] = kOutsideBandTriangle;
+        return;
+    }
+    out.distance[i] = s.distance;
+    out.gradient[i] = s.gradient;
+    out.triangle[i] = s.triangle;
+}
+
 /// With `Winding` the sample then takes the winding number's side; without it the kernel has
 /// no winding code at all (pseudonormal mode: the kernel as it was before sign modes).
+/// With a narrow band (band_width > 0, SamplerOptions::band_width) a sample with |d| > w
+/// becomes the band's value with its sign, gradient 0 and kOutsideBandTriangle; `nearest`
+/// may then also hold the search's outside-band codes (bvh_candidates_kernel.cuh), whose
+/// points get the same values without a triangle.
 template <typename Piece, bool Winding>
-__global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, PieceOutputs out) {
+__global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
+                                 PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
     const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
     out.output_index[i] = o;
     if (o < 0) return;
     const Vec3d p = piece.position(i);
-    SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, nearest[i]);
-    if constexpr (Winding) s = apply_winding_sign(sign, s, p);
-    out.distance[i] = s.distance;
-    out.gradient[i] = s.gradient;
-    out.triangle[i] = s.triangle;
+    const int n = nearest[i];
+    if (n >= 0) {
+        SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, n);
+        if constexpr (Winding) s = apply_winding_sign(sign, s, p);
+        store_sample(out, i, s, band_width);
+        return;
+    }
+    bool inside = n == kOutsideBandInside;  // a brick wholly outside the band
+    if constexpr (Winding) {
+        if (n == kOutsideBandSignPerPoint) inside = fast_winding_number(sign.view, p, sign.accuracy).value > 0.5;
+    }
+    out.distance[i] = inside ? -band_width : band_width;
+    out.gradient[i] = Vec3d(0.0);
+    out.triangle[i] = kOutsideBandTriangle;
 }
 
 /// Launches finalize_samples with or without the winding sign, as `sign` says.
 template <typename Piece>
 void launch_finalize_samples(int blocks, int threads, MeshView<double> mesh, const Piece& piece, const int* nearest,
-                             const WindingSignView& sign, PieceOutputs out) {
-    if (sign.enabled()) finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, out);
-    else finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, out);
+                             const WindingSignView& sign, double band_width, PieceOutputs out) {
+    if (sign.enabled()) finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+    else finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
 }
 
 }  // namespace sdf::cuda

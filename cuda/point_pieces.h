@@ -70,4 +70,18 @@ struct PointListPiece {
     SDF_CPU_GPU int64_t output_index(int64_t i) const { return begin + i; }
 };
 
+/// Points sorted on the device (e.g. into Morton order): position i of the sorted list,
+/// whose result goes back to the input position original[begin + i].
+struct SortedPointListPiece {
+    const Vec3d* sorted = nullptr;
+    const int64_t* original = nullptr;
+    int64_t begin = 0;
+    int64_t count = 0;
+
+    SDF_CPU_GPU int64_t size() const { return count; }
+    SDF_CPU_GPU int64_t block_local(int64_t i) const { return begin + i; }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return sorted[begin + i]; }
+    SDF_CPU_GPU int64_t output_index(int64_t i) const { return original[begin + i]; }
+};
+
 }  // namespace sdf::cuda

@@ -99,7 +99,7 @@ __global__ void fill_thesis_minima(int64_t n, ThesisMinima<T> m) {
 /// `Winding`: as finalize_samples (finalize_kernel.cuh).
 template <typename T, bool Winding, typename Piece>
 __global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, ThesisMinima<T> minima, WindingSignView sign,
-                                        PieceOutputs out) {
+                                        double band_width, PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
     const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
@@ -108,9 +108,7 @@ __global__ void finalize_thesis_samples(MeshView<double> mesh, Piece piece, Thes
     const Vec3d p = piece.position(i);
     SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, minima.triangle[i]);
     if constexpr (Winding) s = apply_winding_sign(sign, s, p);
-    out.distance[i] = s.distance;
-    out.gradient[i] = s.gradient;
-    out.triangle[i] = s.triangle;
+    store_sample(out, i, s, band_width);
 }
 
 }  // namespace sdf::cuda

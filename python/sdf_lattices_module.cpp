@@ -10,13 +10,15 @@
 // code is called per point. C++ errors arrive as Python exceptions with the tools' messages:
 // std::invalid_argument and ConfigError (sample()'s arguments, read by the config parser) as
 // ValueError, every other std::exception (a file that cannot be read, a backend this machine
-// lacks) as RuntimeError.
+// lacks) as RuntimeError. Under mpirun, sample() is collective over the ranks
+// (sample_collectively, harness/distributed/distributed.h; docs/distributed.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -30,6 +32,7 @@
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/distributed/distributed.h"
 #include "harness/io/field_file.h"
 #include "harness/io/field_output.h"
 #include "harness/provenance/version.h"
@@ -356,21 +359,40 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
 Field sample(const PreparedMesh& mesh, const std::string& lattice, const py::object& resolution, const py::object& samples,
              double margin, const std::string& backend, const std::string& method, const std::string& kernel,
              const std::string& sign, const std::string& precision, int threads, const std::string& bcc_strategy,
-             bool progress) {
-    choose("lattice", lattice, {"cc", "bcc"});
-    if (!(margin >= 0)) throw std::invalid_argument("margin: expected a non-negative fraction of the mesh's largest extent");
-    const LatticeSpec spec = lattice_spec_from_arguments(lattice, resolution, samples, py::none());
-    nlohmann::json s = {{"backend", backend}, {"method", method},   {"sign", sign},
-                        {"precision", precision}, {"threads", threads}, {"bcc_strategy", bcc_strategy},
-                        {"progress", progress}};
-    if (!kernel.empty()) s["kernel"] = kernel;
-    JsonReader reader(s, "sample()", "sampler");
-    const SamplerOptions options = parse_sampler_options(reader);
+             bool progress, bool distributed) {
+    const bool collective = distributed && distributed_active();
+    // Under MPI a bad argument is this rank's failure in the collective exchange, raised on
+    // every rank there (no rank waits for one that gave up); alone, it is raised here.
+    std::function<SamplingRequest()> setup;
+    try {
+        choose("lattice", lattice, {"cc", "bcc"});
+        if (!(margin >= 0)) throw std::invalid_argument("margin: expected a non-negative fraction of the mesh's largest extent");
+        const LatticeSpec spec = lattice_spec_from_arguments(lattice, resolution, samples, py::none());
+        nlohmann::json s = {{"backend", backend}, {"method", method},   {"sign", sign},
+                            {"precision", precision}, {"threads", threads}, {"bcc_strategy", bcc_strategy},
+                            {"progress", progress}};
+        if (!kernel.empty()) s["kernel"] = kernel;
+        JsonReader reader(s, "sample()", "sampler");
+        const SamplerOptions options = parse_sampler_options(reader);
+        setup = [spec, options, margin, &mesh] { return SamplingRequest{build_lattice(spec, mesh.bounds(), margin), options}; };
+    } catch (const py::error_already_set& e) {
+        if (!collective) throw;
+        const auto error = std::make_exception_ptr(std::invalid_argument(e.what()));  // no Python object past the GIL
+        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
+    } catch (...) {
+        if (!collective) throw;
+        const std::exception_ptr error = std::current_exception();
+        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
+    }
     SampledField field;
     {
         py::gil_scoped_release release;
-        const Lattice l = build_lattice(spec, mesh.bounds(), margin);
-        field = make_sampler(options)->sample(mesh, l);
+        if (collective) {
+            field = sample_collectively(mesh, setup);
+        } else {
+            const SamplingRequest request = setup();
+            field = make_sampler(request.options)->sample(mesh, request.lattice);
+        }
     }
     const MeshReport& r = mesh.report();
     field.mesh = {{"name", mesh.name()},
@@ -468,6 +490,27 @@ with the tools' messages.)";
             PyErr_SetString(PyExc_ValueError, e.what());
         }
     });
+    // Under an MPI launcher every rank imports the module: it starts MPI (unless mpi4py or
+    // another library did) and ends it at exit, as run-experiment does in main().
+    if (start_collective_distribution() == "sdf_lattices") {
+        py::module_::import("atexit").attr("register")(py::cpp_function([] {
+            py::gil_scoped_release release;
+            finish_collective_distribution();
+        }));
+        // A rank that ends with an uncaught exception would wait in MPI_Finalize for ranks
+        // that wait for it: after the traceback, it ends every rank (as `python3 -m mpi4py`).
+        if (distributed_active()) {
+            py::module_ sys = py::module_::import("sys");
+            const py::object previous = sys.attr("excepthook");
+            sys.attr("excepthook") = py::cpp_function([previous](py::object type, py::object value, py::object traceback) {
+                previous(type, value, traceback);
+                py::module_ sys = py::module_::import("sys");
+                for (const char* stream : {"stdout", "stderr"})
+                    if (!sys.attr(stream).is_none()) sys.attr(stream).attr("flush")();
+                abort_distributed(1);
+            });
+        }
+    }
     m.attr("__version__") = project_version();
     m.attr("build_commit") = build_commit();
 
@@ -617,7 +660,8 @@ Rx x Ry x 2Rz) is its two CC sub-grids, a tuple (primary (Rz, Ry, Rx), secondary
 
 Writes the field in the format of path's extension: ".json" is the project's field file
 (header plus raw channels, docs/field-format.md; read by sdf-eval, sdf-render and read_field).
-Files are written atomically; an existing file is kept unless overwrite=True.)")
+Files are written atomically; an existing file is kept unless overwrite=True. Under mpirun
+every rank holds the field: write it from one rank (if sl.distributed()["rank"] == 0).)")
         .def("reconstruct", &Field::reconstruct, py::arg("points"), py::arg("interpolator") = "", py::arg("derivatives") = "",
              py::arg("sigma2") = 0.5, py::arg("sigma_units") = "lattice", py::arg("threads") = 0,
              R"(reconstruct(points, interpolator="", derivatives="", sigma2=0.5, sigma_units="lattice", threads=0) -> (values, gradients)
@@ -635,15 +679,34 @@ domain are clamped into it. The last reconstruction is kept for the next call.)"
     m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
           py::arg("samples") = py::none(), py::arg("margin") = 0.1, py::arg("backend") = "auto", py::arg("method") = "bvh",
           py::arg("kernel") = "", py::arg("sign") = "auto", py::arg("precision") = "float", py::arg("threads") = 0,
-          py::arg("bcc_strategy") = "two_grids", py::arg("progress") = false,
-          R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=0.1, backend="auto", method="bvh", kernel="", sign="auto", precision="float", threads=0, bcc_strategy="two_grids", progress=False) -> Field
+          py::arg("bcc_strategy") = "two_grids", py::arg("progress") = false, py::arg("distributed") = true,
+          R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=0.1, backend="auto", method="bvh", kernel="", sign="auto", precision="float", threads=0, bcc_strategy="two_grids", progress=False, distributed=True) -> Field
 
 Samples the exact signed distance on a lattice fitted around the mesh, as run-experiment
 does (its config parser checks these arguments, as the keys "lattice" and "sampler").
 Give resolution or samples: resolution is (nx, ny, nz) for CC, (Rx, Ry, 2Rz) for BCC, or one
 int n for (n, n, n) / (n, n, 2n); samples is a target point count for a cubic lattice.
 margin: the fraction of the mesh's largest extent added on every side (run-experiment's
-"domain": {"margin"}). The GIL is released while sampling.)");
+"domain": {"margin"}). The GIL is released while sampling.
+
+Under `mpirun -np N python3 script.py` (see distributed()), sample() is collective: every rank
+must call it with the same mesh and arguments. Rank 0 cuts the lattice into one slab of
+z-planes per rank, balanced as run-experiment's are, every rank samples its slab, and every
+rank returns the whole field, bit for bit the one a single process samples; its
+sampler["distributed"] records the slabs, hosts and per-rank seconds. A failure on any rank
+(or arguments that differ from rank 0's) raises on every rank. distributed=False samples on
+this rank alone (no other rank takes part).)");
+
+    m.def("distributed", [] { return json_to_python(distributed_info()); },
+          R"(distributed() -> dict
+
+This process's place in an MPI run: mpi (whether the module was built with MPI), started_by
+("sdf_lattices" when the module started MPI, "another library" when it found MPI running,
+e.g. started by mpi4py, None when there is no MPI), rank, size, host, and under MPI
+local_rank, local_size (the ranks on this host), threads (each rank's share of the host's
+cores, used for threads=0), gpus_on_host and gpu; on rank 0 of several, processes: every
+rank's description. The module starts MPI at import when an MPI launcher's environment is
+present (mpirun, mpiexec, srun) and ends it at exit, so every rank must import it.)");
 
     m.def("read_field", &read_field_file, py::arg("path"),
           R"(read_field(path) -> Field

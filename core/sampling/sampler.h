@@ -60,6 +60,12 @@ public:
     virtual SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) = 0;
     /// Samples arbitrary points, returned in input order.
     virtual std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) = 0;
+    /// The timings of the last query() where the sampler measures them (GPU: `kernel` = the
+    /// device's sort, search and finalize, `upload`/`download` the transfers); else zeros.
+    const SamplingTimings& last_query_timings() const { return query_timings_; }
+
+protected:
+    SamplingTimings query_timings_;
 };
 
 /// Names a BCC strategy as in configs ("two_grids" / "double_resolution").

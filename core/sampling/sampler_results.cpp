@@ -16,6 +16,7 @@ nlohmann::json sampler_provenance(const std::string& backend, const std::string&
                         {"points_computed", points_computed},
                         {"sign", sign.provenance()}};
     if (lattice.type == LatticeType::BCC) p["bcc_strategy"] = bcc_strategy_name(options.bcc_strategy);
+    if (options.band_width > 0) p["band_width"] = options.band_width;
     return p;
 }
 

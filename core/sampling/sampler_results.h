@@ -38,12 +38,12 @@ inline void store_sample(SampledField& field, int64_t out, const PreparedMesh& m
                          const Vec3d& gradient, int32_t triangle) {
     field.distance[size_t(out)] = distance;
     field.gradient[size_t(out)] = gradient;
-    field.closest_triangle[size_t(out)] = mesh.source_triangle()[size_t(triangle)];
+    field.closest_triangle[size_t(out)] = triangle < 0 ? triangle : mesh.source_triangle()[size_t(triangle)];  // < 0: no triangle (narrow band)
 }
 
 /// The result of one query point; `triangle` indexes `mesh`'s prepared triangles.
 inline PointSample point_sample(const PreparedMesh& mesh, double distance, const Vec3d& gradient, int32_t triangle) {
-    return {distance, gradient, mesh.source_triangle()[size_t(triangle)]};
+    return {distance, gradient, triangle < 0 ? triangle : mesh.source_triangle()[size_t(triangle)]};
 }
 
 /// Scatters a batch of results (per point: distance, gradient, triangle, output_index) into

@@ -16,11 +16,16 @@
 /// reported by mpirun ("process rank 2 ... on node N exited on signal 9"), which ends every
 /// rank.
 ///
+/// The Python module runs the other way round: every rank runs the same script and calls
+/// sample_collectively(), which returns the whole field on every rank (below).
+///
 /// Without MPI in the build, or when not started by mpirun, every function here describes
 /// a single process: distributed_active() is false and nothing changes.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -90,5 +95,46 @@ nlohmann::json this_process();
 
 /// Whether this build can run distributed (MPI found by CMake).
 bool distributed_build();
+
+// ---- The collective entry (the Python module: every rank runs the same script) ------------
+//
+// Under `mpirun -np N python3 script.py` there is no root that drives and no workers that
+// serve: every rank calls sample() with the same arguments. The root plans the slabs as
+// above, every rank samples its own and returns, and every rank gets the whole field.
+
+/// Starts MPI for a process in which every rank runs the same code: uses MPI when another
+/// library (mpi4py) started it, else starts it (MPI_THREAD_SERIALIZED) when an MPI launcher's
+/// environment is present. Collective: every rank calls it (describing the ranks is).
+/// Returns who started MPI: "sdf_lattices", "another library", or "" (no MPI: one process).
+std::string start_collective_distribution();
+/// MPI_Finalize when start_collective_distribution() started MPI and it still runs (at exit).
+void finish_collective_distribution();
+
+/// Ends every rank (MPI_Abort) when this one runs distributed: a rank that gives up outside
+/// a collective call (an uncaught Python exception) must not leave the others waiting for it.
+void abort_distributed(int code);
+
+/// What a rank samples: the lattice and the sampler, built from its caller's arguments.
+struct SamplingRequest {
+    Lattice lattice;
+    SamplerOptions options;
+};
+
+/// Collective sampling: every rank calls it with the same mesh (same content SHA-256 and
+/// prepared counts) and the same request, which `setup` builds on each rank (an exception
+/// there is that rank's failure). Rank 0 plans the slabs (plan_slabs), every rank samples its
+/// own, rank 0 gathers them and broadcasts the whole field: every rank returns the same
+/// field, bit for bit the one make_sampler(options)->sample(mesh, lattice) gives, with
+/// sampler.distributed recording the slabs, hosts and per-rank seconds. A failure on any rank
+/// (setup, sampling, arguments that differ from rank 0's) makes every rank throw: the
+/// failing ranks' own exception where every rank failed in setup with the same message
+/// (a bad argument: its type is kept), else std::runtime_error naming each failed rank and
+/// its host. Without a distributed run: setup(), then make_sampler(options)->sample().
+SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup);
+
+/// This process for the Python module's distributed(): mpi (the build has it), started_by
+/// (see start_collective_distribution), rank, size, host, local rank and size, threads,
+/// GPU, and on rank 0 of a distributed run every rank's description (processes).
+nlohmann::json distributed_info();
 
 }  // namespace sdf

@@ -11,6 +11,8 @@
 //                                ranks sampled last; the worker writes its slab into them with
 //                                MPI-IO and answers with a kTagStatus JSON (bytes, seconds, or
 //                                the error). Workers keep their last slab until then.
+// Collective sampling (the Python module, every rank calling sample_collectively) uses the
+// same Sample/status/data messages and then kTagOutcome; see its section below.
 // Waiting ranks poll with short sleeps instead of MPI's busy wait, so that an idle worker
 // does not take a core from the ranks that compute.
 #include "harness/distributed/distributed.h"
@@ -26,6 +28,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -44,7 +47,7 @@
 namespace sdf {
 namespace {
 
-constexpr int kTagCommand = 1, kTagStatus = 2, kTagData = 3, kTagHello = 4, kTagRuns = 5;
+constexpr int kTagCommand = 1, kTagStatus = 2, kTagData = 3, kTagHello = 4, kTagRuns = 5, kTagOutcome = 6;
 enum class Command : int32_t { Sample = 1, Quit = 2, Write = 3 };
 constexpr size_t kChunkBytes = size_t(1) << 30;
 /// Points converted to the stored dtype at a time by a parallel write (bounds its buffer:
@@ -57,6 +60,11 @@ static_assert(sizeof(Vec3d) == 3 * sizeof(double), "gradients are sent as packed
 /// This process's part in the run.
 struct Session {
     bool started = false;   ///< MPI_Init was called here
+    bool joined = false;    ///< MPI runs and this rank knows the others (join_ranks)
+    /// Every rank runs the same code and calls sample_collectively (the Python module), so
+    /// there is no workers' loop to end.
+    bool collective = false;
+    std::string started_by;  ///< collective: "sdf_lattices" or "another library"
     int rank = 0, size = 1;
     nlohmann::json self;    ///< rank, host, local_rank, local_size, threads, device, gpu
     nlohmann::json processes = nlohmann::json::array();  ///< root: every rank's `self`
@@ -219,7 +227,8 @@ nlohmann::json options_to_json(const SamplerOptions& o) {
             {"device", o.device},
             {"max_points_per_piece", o.max_points_per_piece},
             {"max_triangles_per_chunk", o.max_triangles_per_chunk},
-            {"points_per_thread", o.points_per_thread}};
+            {"points_per_thread", o.points_per_thread},
+            {"band_width", o.band_width}};
 }
 
 SamplerOptions options_from_json(const nlohmann::json& j) {
@@ -235,6 +244,7 @@ SamplerOptions options_from_json(const nlohmann::json& j) {
     o.max_points_per_piece = j.at("max_points_per_piece").get<int64_t>();
     o.max_triangles_per_chunk = j.at("max_triangles_per_chunk").get<int>();
     o.points_per_thread = j.at("points_per_thread").get<int>();
+    o.band_width = j.at("band_width").get<double>();
     return o;
 }
 
@@ -434,6 +444,8 @@ uint64_t write_slab(ChannelFiles& files, const SampledField& source, bool source
 
 // ---- Workers ------------------------------------------------------------------------------
 
+void send_part(const SampledField& part, const Lattice& lattice, const LatticeSlab& slab);
+
 class Worker {
 public:
     /// Handles one Sample request; the answer goes to the root whatever happens.
@@ -483,14 +495,7 @@ public:
         send_string(status.dump(), 0, kTagStatus);
         if (!status["ok"].get<bool>()) return release();
         holds_part_ = true;  // for the parallel write of its files
-        for (int p = 0; p < 2; ++p) {
-            const StorageRange r = slab_storage(lattice, slab, p);
-            const size_t first = p == 0 ? 0 : size_t(slab_storage(lattice, slab, 0).count);
-            const size_t n = part.size() == 0 ? 0 : size_t(r.count);
-            send_bytes(part.distance.data() + first, n * sizeof(double), 0, kTagData);
-            send_bytes(part.gradient.data() + first, n * sizeof(Vec3d), 0, kTagData);
-            send_bytes(part.closest_triangle.data() + first, n * sizeof(int32_t), 0, kTagData);
-        }
+        send_part(part, lattice, slab);
     }
 
     /// Handles one Write request: writes the slab it holds into the root's channel files.
@@ -541,7 +546,151 @@ private:
     std::string sampler_key_;
 };
 
-// ---- The root's sampler -------------------------------------------------------------------
+// ---- The root's side of a distributed field ----------------------------------------------
+
+/// Copies a rank's part (its slab's primary points, then its secondary ones) to its offsets.
+void place_part(SampledField& field, const Lattice& lattice, const LatticeSlab& slab, const SampledField& part) {
+    if (part.size() == 0) return;
+    int64_t from = 0;
+    for (int p = 0; p < 2; ++p) {
+        const StorageRange r = slab_storage(lattice, slab, p);
+        std::copy_n(part.distance.begin() + from, r.count, field.distance.begin() + r.offset);
+        std::copy_n(part.gradient.begin() + from, r.count, field.gradient.begin() + r.offset);
+        std::copy_n(part.closest_triangle.begin() + from, r.count, field.closest_triangle.begin() + r.offset);
+        from += r.count;
+    }
+}
+
+/// Root: rank `rank`'s part (as send_part sends it) at its offsets.
+void receive_part(SampledField& field, const Lattice& lattice, const LatticeSlab& slab, int rank) {
+    for (int p = 0; p < 2; ++p) {
+        const StorageRange r = slab_storage(lattice, slab, p);
+        const size_t n = size_t(r.count), at = size_t(r.offset);
+        receive_into(field.distance.data() + at, n * sizeof(double), rank, kTagData);
+        receive_into(field.gradient.data() + at, n * sizeof(Vec3d), rank, kTagData);
+        receive_into(field.closest_triangle.data() + at, n * sizeof(int32_t), rank, kTagData);
+    }
+}
+
+/// Worker: its part to the root, per channel its primary points, then its secondary ones.
+void send_part(const SampledField& part, const Lattice& lattice, const LatticeSlab& slab) {
+    for (int p = 0; p < 2; ++p) {
+        const StorageRange r = slab_storage(lattice, slab, p);
+        const size_t first = p == 0 ? 0 : size_t(slab_storage(lattice, slab, 0).count);
+        const size_t n = part.size() == 0 ? 0 : size_t(r.count);
+        send_bytes(part.distance.data() + first, n * sizeof(double), 0, kTagData);
+        send_bytes(part.gradient.data() + first, n * sizeof(Vec3d), 0, kTagData);
+        send_bytes(part.closest_triangle.data() + first, n * sizeof(int32_t), 0, kTagData);
+    }
+}
+
+struct RankFailure {
+    int rank;
+    std::string host, error;
+    bool setup = false;  ///< before sampling: the caller's arguments (collective sampling)
+};
+
+/// What the root gathers of one field: every rank's slab, described; the sampler's
+/// provenance (the root's slab's, or the first worker's when the root's slab is empty); and
+/// the ranks that failed.
+struct Gathered {
+    nlohmann::json parts = nlohmann::json::array();
+    nlohmann::json sampler;
+    std::vector<RankFailure> failures;
+};
+
+/// Root: every worker's answer, its status and, when it sampled its slab, the slab into
+/// `field`. Every worker answers, failed or not, so the exchange ends in step on every rank.
+void receive_answers(Gathered& g, SampledField* field, const Lattice& lattice, const std::vector<LatticeSlab>& slabs) {
+    for (int r = 1; r < session().size; ++r) {
+        const nlohmann::json status = nlohmann::json::parse(receive_string(r, kTagStatus));
+        const std::string host = status.value("host", std::string("?"));
+        if (!status.value("ok", false)) {
+            g.failures.push_back({r, host, status.value("error", std::string("unknown error")), status.value("setup", false)});
+            continue;
+        }
+        if (!status.contains("part") || field == nullptr) continue;  // nothing sampled: the root had failed first
+        receive_part(*field, lattice, slabs[size_t(r)], r);
+        g.parts.push_back(status["part"]);
+        if (!g.sampler.is_object() && status["sampler"].is_object()) g.sampler = status["sampler"];
+    }
+}
+
+/// Root: samples slab 0 (`sample_mine`) into `field` while the workers sample theirs, then
+/// gathers their answers.
+Gathered sample_and_gather(const std::function<SampledField(const LatticeSlab&)>& sample_mine, const Lattice& lattice,
+                           const SlabPlan& plan, SampledField& field) {
+    const std::string host = session().self["host"].get<std::string>();
+    Gathered g;
+    try {
+        const auto t0 = std::chrono::steady_clock::now();
+        maybe_inject_failure(0);
+        const SampledField part = sample_mine(plan.slabs[0]);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        place_part(field, lattice, plan.slabs[0], part);
+        g.parts.push_back(describe_part(part, 0, host, plan.slabs[0], seconds));
+        g.sampler = part.sampler;
+    } catch (const std::exception& e) {
+        g.failures.push_back({0, host, e.what()});
+    }
+    receive_answers(g, &field, lattice, plan.slabs);
+    return g;
+}
+
+/// "distributed sampling of 11x9x13 failed on 1 of 2 ranks: rank 1 (host vm): ..."
+std::string failure_message(const std::string& lattice, const std::vector<RankFailure>& failures) {
+    std::string text = "distributed sampling" + (lattice.empty() ? std::string() : " of " + lattice) + " failed on " +
+                       std::to_string(failures.size()) + " of " + std::to_string(session().size) + " ranks: ";
+    for (size_t i = 0; i < failures.size(); ++i)
+        text += (i ? "; " : "") + rank_and_host(failures[i].rank, failures[i].host) + ": " + failures[i].error;
+    return text;
+}
+
+/// The field's provenance: the gathered sampler with the whole run's counts, and
+/// "distributed" (the slabs, per-rank seconds, the load balance), which it returns.
+nlohmann::json finish_provenance(SampledField& field, const SamplerOptions& options, const SlabPlan& plan,
+                                 const Gathered& gathered, double total_seconds, double sampling_seconds) {
+    const Session& s = session();
+    nlohmann::json parts = gathered.parts, sampler_json = gathered.sampler;
+    std::sort(parts.begin(), parts.end(), [](const nlohmann::json& a, const nlohmann::json& b) { return a["rank"] < b["rank"]; });
+    int64_t computed = 0;
+    double pairs = 0, max_seconds = 0, sum_seconds = 0, upload = 0, download = 0;
+    for (size_t r = 0; r < parts.size(); ++r) {
+        nlohmann::json& p = parts[r];
+        p["estimated_cost"] = plan.slab_cost(int(r));
+        computed += p["points_computed"].get<int64_t>();
+        pairs += p["pairs"].get<double>();
+        max_seconds = std::max(max_seconds, p["seconds"].get<double>());
+        sum_seconds += p["seconds"].get<double>();
+        upload = std::max(upload, p["upload_seconds"].get<double>());
+        download = std::max(download, p["download_seconds"].get<double>());
+    }
+    if (!sampler_json.is_object() || sampler_json.empty())
+        sampler_json = {{"backend", options.backend}, {"method", options.method},
+                        {"kernel", options.kernel}, {"precision", precision_name(options.precision)}};
+    sampler_json["points_computed"] = computed;
+    const double mean = sum_seconds / double(std::max<size_t>(1, parts.size()));
+    nlohmann::json d = {{"ranks", s.size},
+                        {"lattice", lattice_notation(field.lattice)},
+                        {"cost_estimate", plan.estimate},
+                        {"estimate_seconds", plan.estimate_seconds},
+                        {"slabs", parts},
+                        {"load_balance", {{"seconds_max_over_mean", mean > 0 ? max_seconds / mean : 1.0},
+                                          {"estimate_max_over_mean", plan.estimated_max_over_mean()}}},
+                        {"seconds", total_seconds}};
+    if (field.lattice.type == LatticeType::BCC && options.bcc_strategy == BccStrategy::DoubleResolution)
+        d["slab_bcc_strategy"] = "two_grids";  // lattice_slab.h: the same positions, the same samples
+    sampler_json["distributed"] = d;
+    field.sampler = sampler_json;
+    field.timings.total = total_seconds;
+    field.timings.kernel = sampling_seconds;
+    field.timings.upload = upload;
+    field.timings.download = download;
+    field.timings.point_triangle_pairs = pairs;
+    return d;
+}
+
+// ---- The root's sampler (run-experiment: the workers serve) --------------------------------
 
 class DistributedSampler final : public Sampler {
 public:
@@ -566,42 +715,12 @@ public:
         const SlabPlan plan = plan_slabs(mesh, lattice, options_, s.size);
         send_requests(mesh, lattice, plan);
         const auto sampling_start = std::chrono::steady_clock::now();
-
-        std::vector<std::string> errors;
-        nlohmann::json parts = nlohmann::json::array();
-        nlohmann::json sampler_json;
-        try {
-            const auto t0 = std::chrono::steady_clock::now();
-            maybe_inject_failure(0);
-            const SampledField part = sample_part(*local_, mesh, lattice, plan.slabs[0]);
-            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            place_part(field, lattice, plan.slabs[0], part);
-            parts.push_back(describe_part(part, 0, s.self["host"].get<std::string>(), plan.slabs[0], seconds));
-            sampler_json = part.sampler;
-        } catch (const std::exception& e) {
-            errors.push_back(rank_and_host(0, s.self["host"].get<std::string>()) + ": " + e.what());
-        }
-        // Every worker answers, failed or not, so the exchange ends in step on every rank.
-        for (int r = 1; r < s.size; ++r) {
-            const nlohmann::json status = nlohmann::json::parse(receive_string(r, kTagStatus));
-            const std::string host = status.value("host", std::string("?"));
-            if (!status.value("ok", false)) {
-                errors.push_back(rank_and_host(r, host) + ": " + status.value("error", std::string("unknown error")));
-                continue;
-            }
-            receive_part(field, lattice, plan.slabs[size_t(r)], r);
-            parts.push_back(status["part"]);
-            if (!sampler_json.is_object() && status["sampler"].is_object()) sampler_json = status["sampler"];
-        }
-        if (!errors.empty()) {
-            std::string text = "distributed sampling of " + lattice_notation(lattice) + " failed on " +
-                               std::to_string(errors.size()) + " of " + std::to_string(s.size) + " ranks: ";
-            for (size_t i = 0; i < errors.size(); ++i) text += (i ? "; " : "") + errors[i];
-            throw std::runtime_error(text);
-        }
+        const Gathered gathered = sample_and_gather(
+            [&](const LatticeSlab& mine) { return sample_part(*local_, mesh, lattice, mine); }, lattice, plan, field);
+        if (!gathered.failures.empty()) throw std::runtime_error(failure_message(lattice_notation(lattice), gathered.failures));
         const auto end = std::chrono::steady_clock::now();
-        finish_provenance(field, plan, parts, sampler_json, std::chrono::duration<double>(end - start).count(),
-                          std::chrono::duration<double>(end - sampling_start).count());
+        s.fields.push_back(finish_provenance(field, options_, plan, gathered, std::chrono::duration<double>(end - start).count(),
+                                             std::chrono::duration<double>(end - sampling_start).count()));
         s.held = {true, lattice, plan.slabs, field.sampler["distributed"], field.distance.data(), s.fields.size() - 1};
         return field;
     }
@@ -633,74 +752,208 @@ private:
         s.mesh_sent = mesh.content_sha256();
     }
 
-    static void place_part(SampledField& field, const Lattice& lattice, const LatticeSlab& slab, const SampledField& part) {
-        if (part.size() == 0) return;
-        int64_t from = 0;
-        for (int p = 0; p < 2; ++p) {
-            const StorageRange r = slab_storage(lattice, slab, p);
-            std::copy_n(part.distance.begin() + from, r.count, field.distance.begin() + r.offset);
-            std::copy_n(part.gradient.begin() + from, r.count, field.gradient.begin() + r.offset);
-            std::copy_n(part.closest_triangle.begin() + from, r.count, field.closest_triangle.begin() + r.offset);
-            from += r.count;
-        }
-    }
-
-    static void receive_part(SampledField& field, const Lattice& lattice, const LatticeSlab& slab, int rank) {
-        for (int p = 0; p < 2; ++p) {
-            const StorageRange r = slab_storage(lattice, slab, p);
-            const size_t n = size_t(r.count), at = size_t(r.offset);
-            receive_into(field.distance.data() + at, n * sizeof(double), rank, kTagData);
-            receive_into(field.gradient.data() + at, n * sizeof(Vec3d), rank, kTagData);
-            receive_into(field.closest_triangle.data() + at, n * sizeof(int32_t), rank, kTagData);
-        }
-    }
-
-    /// The field's provenance: the root's slab sampler (when its slab was empty, the first
-    /// worker's) with the whole run's counts, and "distributed".
-    void finish_provenance(SampledField& field, const SlabPlan& plan, nlohmann::json parts,
-                           nlohmann::json sampler_json, double total_seconds, double sampling_seconds) {
-        Session& s = session();
-        std::sort(parts.begin(), parts.end(), [](const nlohmann::json& a, const nlohmann::json& b) { return a["rank"] < b["rank"]; });
-        int64_t computed = 0;
-        double pairs = 0, max_seconds = 0, sum_seconds = 0, upload = 0, download = 0;
-        for (size_t r = 0; r < parts.size(); ++r) {
-            nlohmann::json& p = parts[r];
-            p["estimated_cost"] = plan.slab_cost(int(r));
-            computed += p["points_computed"].get<int64_t>();
-            pairs += p["pairs"].get<double>();
-            max_seconds = std::max(max_seconds, p["seconds"].get<double>());
-            sum_seconds += p["seconds"].get<double>();
-            upload = std::max(upload, p["upload_seconds"].get<double>());
-            download = std::max(download, p["download_seconds"].get<double>());
-        }
-        if (!sampler_json.is_object() || sampler_json.empty())
-            sampler_json = {{"backend", options_.backend}, {"method", options_.method},
-                            {"kernel", options_.kernel}, {"precision", precision_name(options_.precision)}};
-        sampler_json["points_computed"] = computed;
-        const double mean = sum_seconds / double(std::max<size_t>(1, parts.size()));
-        nlohmann::json d = {{"ranks", s.size},
-                            {"lattice", lattice_notation(field.lattice)},
-                            {"cost_estimate", plan.estimate},
-                            {"estimate_seconds", plan.estimate_seconds},
-                            {"slabs", parts},
-                            {"load_balance", {{"seconds_max_over_mean", mean > 0 ? max_seconds / mean : 1.0},
-                                              {"estimate_max_over_mean", plan.estimated_max_over_mean()}}},
-                            {"seconds", total_seconds}};
-        if (field.lattice.type == LatticeType::BCC && options_.bcc_strategy == BccStrategy::DoubleResolution)
-            d["slab_bcc_strategy"] = "two_grids";  // lattice_slab.h: the same positions, the same samples
-        sampler_json["distributed"] = d;
-        field.sampler = sampler_json;
-        field.timings.total = total_seconds;
-        field.timings.kernel = sampling_seconds;
-        field.timings.upload = upload;
-        field.timings.download = download;
-        field.timings.point_triangle_pairs = pairs;
-        s.fields.push_back(d);
-    }
-
     SamplerOptions options_;
     std::unique_ptr<Sampler> local_;
 };
+
+// ---- Collective sampling (the Python module: every rank calls sample_collectively) ---------
+//
+//   root -> worker  kTagCommand  Sample: the root's setup error (empty when it is ready), then
+//                                its sampler options, lattice, slabs and mesh fingerprint
+//   worker -> root  kTagStatus   as a worker's answer above (plus "setup": its own arguments
+//                                failed), then kTagData with its slab when it sampled one
+//   root -> worker  kTagOutcome  JSON: ok and the field's provenance, or the error every rank
+//                                raises; when ok, the field's points follow by MPI_Bcast
+// The Sample request and the outcome are waited for politely; the broadcast comes when every
+// rank has answered, so no rank spins in it while others compute.
+
+/// What every rank's mesh must share with the root's.
+std::string mesh_fingerprint(const PreparedMesh& mesh) {
+    return "sha256 " + mesh.content_sha256() + ", " + std::to_string(mesh.vertices().size()) + " vertices and " +
+           std::to_string(mesh.triangles().size()) + " triangles prepared";
+}
+
+void require_same(const std::string& what, const std::string& mine, const std::string& roots) {
+    if (mine != roots)
+        throw std::runtime_error("called with another " + what + " than rank 0 (every rank must pass the same arguments): " +
+                                 mine + " here, " + roots + " on rank 0");
+}
+
+/// The same for a JSON object (a lattice, sampler options), naming the keys that differ.
+void require_same_keys(const std::string& what, const nlohmann::json& mine, const std::string& roots_text) {
+    const nlohmann::json roots = nlohmann::json::parse(roots_text);
+    if (mine == roots) return;
+    std::string mine_keys, roots_keys;
+    for (const auto& [key, value] : mine.items()) {
+        const nlohmann::json theirs = roots.contains(key) ? roots[key] : nlohmann::json(nullptr);
+        if (value == theirs) continue;
+        mine_keys += (mine_keys.empty() ? "" : ", ") + key + " " + value.dump();
+        roots_keys += (roots_keys.empty() ? "" : ", ") + key + " " + theirs.dump();
+    }
+    require_same(what, mine_keys, roots_keys);
+}
+
+/// Every rank: the root's points of `field` (sized alike on every rank), in chunks of at
+/// most 1 GiB.
+void broadcast_field(SampledField& field) {
+    const auto broadcast = [](void* data, size_t bytes) {
+        char* p = static_cast<char*>(data);
+        for (size_t off = 0; off < bytes; off += kChunkBytes)
+            check_mpi(MPI_Bcast(p + off, int(std::min(kChunkBytes, bytes - off)), MPI_BYTE, 0, MPI_COMM_WORLD), "MPI_Bcast");
+    };
+    broadcast(field.distance.data(), field.distance.size() * sizeof(double));
+    broadcast(field.gradient.data(), field.gradient.size() * sizeof(Vec3d));
+    broadcast(field.closest_triangle.data(), field.closest_triangle.size() * sizeof(int32_t));
+}
+
+nlohmann::json timings_to_json(const SamplingTimings& t) {
+    return {{"total", t.total}, {"kernel", t.kernel}, {"upload", t.upload}, {"download", t.download},
+            {"point_triangle_pairs", t.point_triangle_pairs}};
+}
+
+SamplingTimings timings_from_json(const nlohmann::json& j) {
+    SamplingTimings t;
+    t.total = j.at("total").get<double>();
+    t.kernel = j.at("kernel").get<double>();
+    t.upload = j.at("upload").get<double>();
+    t.download = j.at("download").get<double>();
+    t.point_triangle_pairs = j.at("point_triangle_pairs").get<double>();
+    return t;
+}
+
+/// After a failed exchange, on every rank: where every rank failed in its setup with the same
+/// message (the same bad argument everywhere), its own exception, as one process would raise
+/// it; otherwise the message naming every failed rank.
+[[noreturn]] void raise_outcome(const nlohmann::json& outcome, const std::exception_ptr& setup_error) {
+    if (outcome.value("same", false) && setup_error) std::rethrow_exception(setup_error);
+    throw std::runtime_error(outcome.at("error").get<std::string>());
+}
+
+SampledField collective_root(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+    Session& s = session();
+    s.held.valid = false;
+    const std::string host = s.self["host"].get<std::string>();
+    const auto start = std::chrono::steady_clock::now();
+    SamplingRequest mine;
+    SampledField field;
+    SlabPlan plan;
+    std::exception_ptr setup_error;
+    std::string setup_message;
+    try {
+        mine = setup();
+        // The lattice's range check runs on every rank, so a bad one fails everywhere alike.
+        field = unfilled_field(mesh, mine.lattice, whole_lattice_slab(mine.lattice), mine.options.precision);
+        plan = plan_slabs(mesh, mine.lattice, mine.options, s.size);
+    } catch (const std::exception& e) {
+        setup_error = std::current_exception();
+        setup_message = e.what();
+    }
+    ByteWriter request;
+    request.put(int32_t(Command::Sample));
+    request.put_string(setup_message);
+    if (!setup_error) {
+        request.put_string(options_to_json(mine.options).dump());
+        request.put_string(lattice_to_json(mine.lattice).dump());
+        request.put_vector(plan.slabs);
+        request.put_string(mesh_fingerprint(mesh));
+    }
+    for (int r = 1; r < s.size; ++r) send_bytes(request.bytes().data(), request.bytes().size(), r, kTagCommand);
+
+    const auto sampling_start = std::chrono::steady_clock::now();
+    Gathered gathered;
+    if (setup_error) {
+        gathered.failures.push_back({0, host, setup_message, true});
+        receive_answers(gathered, nullptr, mine.lattice, {});
+    } else {
+        gathered = sample_and_gather(
+            [&](const LatticeSlab& slab) {
+                const std::unique_ptr<Sampler> sampler = make_sampler(options_for_this_rank(mine.options));
+                return sample_part(*sampler, mesh, mine.lattice, slab);
+            },
+            mine.lattice, plan, field);
+    }
+
+    nlohmann::json outcome = {{"ok", gathered.failures.empty()}};
+    if (!gathered.failures.empty()) {
+        bool same = int(gathered.failures.size()) == s.size;
+        for (const RankFailure& f : gathered.failures) same = same && f.setup && f.error == gathered.failures[0].error;
+        std::sort(gathered.failures.begin(), gathered.failures.end(),
+                  [](const RankFailure& a, const RankFailure& b) { return a.rank < b.rank; });
+        outcome["same"] = same;
+        outcome["error"] = same ? gathered.failures[0].error
+                                : failure_message(setup_error ? "" : lattice_notation(mine.lattice), gathered.failures);
+    } else {
+        const auto end = std::chrono::steady_clock::now();
+        finish_provenance(field, mine.options, plan, gathered, std::chrono::duration<double>(end - start).count(),
+                          std::chrono::duration<double>(end - sampling_start).count());
+        field.sampler["distributed"]["collective"] = true;  // every rank called sample and holds the field
+        outcome["sampler"] = field.sampler;
+        outcome["timings"] = timings_to_json(field.timings);
+    }
+    for (int r = 1; r < s.size; ++r) send_string(outcome.dump(), r, kTagOutcome);
+    if (!outcome["ok"].get<bool>()) raise_outcome(outcome, setup_error);
+    broadcast_field(field);
+    return field;
+}
+
+SampledField collective_worker(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+    const Session& s = session();
+    const std::string host = s.self["host"].get<std::string>();
+    nlohmann::json status = {{"ok", true}, {"rank", s.rank}, {"host", host}};
+    SamplingRequest mine;
+    std::exception_ptr setup_error;
+    try {
+        mine = setup();
+        require_search_range(mesh, mine.lattice, mine.options.precision);  // as the root's unfilled_field
+    } catch (const std::exception& e) {
+        setup_error = std::current_exception();
+        status = {{"ok", false}, {"rank", s.rank}, {"host", host}, {"error", e.what()}, {"setup", true}};
+    }
+    const std::string request = receive_string(0, kTagCommand);
+    SampledField part;
+    LatticeSlab slab;
+    if (!setup_error) {
+        try {
+            ByteReader in(request);
+            in.get<int32_t>();  // the command
+            if (in.get_string().empty()) {  // the root is ready: sample this rank's slab
+                const std::string options = in.get_string(), lattice = in.get_string();
+                const std::vector<LatticeSlab> slabs = in.get_vector<LatticeSlab>();
+                require_same("mesh", mesh_fingerprint(mesh), in.get_string());
+                require_same_keys("lattice", lattice_to_json(mine.lattice), lattice);
+                require_same_keys("sampler", options_to_json(mine.options), options);
+                if (slabs.size() != size_t(s.size)) throw std::runtime_error("the request holds no slab for this rank");
+                slab = slabs[size_t(s.rank)];
+                const std::unique_ptr<Sampler> sampler = make_sampler(options_for_this_rank(mine.options));
+                const auto t0 = std::chrono::steady_clock::now();
+                maybe_inject_failure(s.rank);
+                part = sample_part(*sampler, mesh, mine.lattice, slab);
+                const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                status["part"] = describe_part(part, s.rank, host, slab, seconds);
+                status["sampler"] = part.sampler;
+            }
+        } catch (const std::exception& e) {
+            status = {{"ok", false}, {"rank", s.rank}, {"host", host}, {"error", e.what()}};
+        }
+    }
+    send_string(status.dump(), 0, kTagStatus);
+    if (status.contains("part")) send_part(part, mine.lattice, slab);
+    part = SampledField();
+
+    // The whole field's memory, while the root still gathers (its first touch is not free).
+    SampledField field;
+    if (status.contains("part")) {
+        field.lattice = mine.lattice;
+        field.precision = mine.options.precision;
+        field.resize(mine.lattice.num_points());
+    }
+    const nlohmann::json outcome = nlohmann::json::parse(receive_string(0, kTagOutcome));
+    if (!outcome.at("ok").get<bool>()) raise_outcome(outcome, setup_error);
+    broadcast_field(field);
+    field.sampler = outcome.at("sampler");
+    field.timings = timings_from_json(outcome.at("timings"));
+    return field;
+}
 
 nlohmann::json describe_this_process(int rank) {
     nlohmann::json self = {{"rank", rank}, {"host", host_name()}};
@@ -725,17 +978,14 @@ nlohmann::json describe_this_process(int rank) {
     return self;
 }
 
-}  // namespace
-
-DistributedScope::DistributedScope(int& argc, char**& argv) {
-    if (!launched_by_mpi()) return;
+/// This rank's place among the ranks of a running MPI; the root collects every rank's
+/// description (kTagHello). Collective.
+void join_ranks() {
     Session& s = session();
-    int provided = 0;
-    check_mpi(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
-    s.started = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &s.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &s.size);
     s.self = describe_this_process(s.rank);
+    s.joined = true;
     if (s.rank != 0) {
         send_string(s.self.dump(), 0, kTagHello);
         return;
@@ -744,10 +994,21 @@ DistributedScope::DistributedScope(int& argc, char**& argv) {
     for (int r = 1; r < s.size; ++r) s.processes.push_back(nlohmann::json::parse(receive_string(r, kTagHello)));
 }
 
+}  // namespace
+
+DistributedScope::DistributedScope(int& argc, char**& argv) {
+    if (!launched_by_mpi()) return;
+    Session& s = session();
+    int provided = 0;
+    check_mpi(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    s.started = true;
+    join_ranks();
+}
+
 DistributedScope::~DistributedScope() {
     Session& s = session();
     if (!s.started) return;
-    if (s.rank == 0 && !s.released && s.distribution == Distribution::LatticeSlabs) {
+    if (s.rank == 0 && !s.released && !s.collective && s.distribution == Distribution::LatticeSlabs) {
         const int32_t quit = int32_t(Command::Quit);
         for (int r = 1; r < s.size; ++r) send_bytes(&quit, sizeof quit, r, kTagCommand);
         s.released = true;
@@ -755,7 +1016,7 @@ DistributedScope::~DistributedScope() {
     MPI_Finalize();
 }
 
-bool distributed_active() { return session().started && session().size > 1; }
+bool distributed_active() { return session().joined && session().size > 1; }
 int distributed_rank() { return session().rank; }
 int distributed_size() { return session().size; }
 bool distributed_build() { return true; }
@@ -977,6 +1238,71 @@ nlohmann::json gather_to_root(const nlohmann::json& mine) {
 }
 
 nlohmann::json this_process() { return session().self; }
+
+std::string start_collective_distribution() {
+    Session& s = session();
+    if (s.joined) return s.started_by;
+    int initialized = 0, finalized = 0;
+    check_mpi(MPI_Initialized(&initialized), "MPI_Initialized");
+    check_mpi(MPI_Finalized(&finalized), "MPI_Finalized");
+    if (finalized) return "";
+    if (initialized) {
+        s.started_by = "another library";  // mpi4py, say: it ends MPI too
+    } else if (launched_by_mpi()) {
+        // Serialized: sample() releases the GIL, so any Python thread may call it (one at a time).
+        int provided = 0;
+        check_mpi(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided), "MPI_Init_thread");
+        s.started = true;
+        s.started_by = "sdf_lattices";
+    } else {
+        return "";
+    }
+    s.collective = true;
+    join_ranks();
+    return s.started_by;
+}
+
+void finish_collective_distribution() {
+    Session& s = session();
+    if (!s.started || !s.collective) return;
+    s.started = false;
+    s.joined = false;
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+}
+
+SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+    if (!distributed_active() || !session().collective) {
+        const SamplingRequest request = setup();
+        return make_sampler(request.options)->sample(mesh, request.lattice);
+    }
+    // One exchange at a time (MPI_THREAD_SERIALIZED; the messages of two would interleave).
+    static std::mutex one_at_a_time;
+    const std::lock_guard<std::mutex> lock(one_at_a_time);
+    return session().rank == 0 ? collective_root(mesh, setup) : collective_worker(mesh, setup);
+}
+
+void abort_distributed(int code) {
+    if (distributed_active()) MPI_Abort(MPI_COMM_WORLD, code);
+}
+
+nlohmann::json distributed_info() {
+    const Session& s = session();
+    nlohmann::json info = {{"mpi", true},
+                           {"started_by", s.started_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.started_by)},
+                           {"rank", s.rank},
+                           {"size", s.size}};
+    if (s.joined) {
+        for (const auto& [key, value] : s.self.items()) info[key] = value;
+        if (s.rank == 0 && s.size > 1) info["processes"] = s.processes;
+    } else {
+        char host[256] = {};
+        if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+        info["host"] = std::string(host);
+    }
+    return info;
+}
 void fail_here_if_asked() { maybe_inject_failure(session().rank); }
 
 }  // namespace sdf

@@ -1,6 +1,8 @@
 // The single-process side of harness/distributed/distributed.h, for builds without MPI.
 #include "harness/distributed/distributed.h"
 
+#include <unistd.h>
+
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
@@ -21,6 +23,18 @@ std::string broadcast_from_root(const std::string& text) { return text; }
 nlohmann::json gather_to_root(const nlohmann::json& mine) { return nlohmann::json::array({mine}); }
 nlohmann::json this_process() { return {{"rank", 0}}; }
 void fail_here_if_asked() {}
+std::string start_collective_distribution() { return ""; }
+void finish_collective_distribution() {}
+void abort_distributed(int) {}
+SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+    const SamplingRequest request = setup();
+    return make_sampler(request.options)->sample(mesh, request.lattice);
+}
+nlohmann::json distributed_info() {
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+    return {{"mpi", false}, {"started_by", nullptr}, {"rank", 0}, {"size", 1}, {"host", std::string(host)}};
+}
 std::string write_sampled_field(const std::string& header_path, const SampledField& field,
                                 const FieldWriteOptions& options) {
     write_field(header_path, field, options);

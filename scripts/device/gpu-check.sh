@@ -49,7 +49,7 @@ python)
     fi ;;
 sanitize)
     log "compute-sanitizer"
-    for t in "cuda_sampler_test --gtest_filter=*Splitting*:*PointQueries*" "cuda_bvh_test --gtest_filter=*Slabs*:*PointQueries*" \
+    for t in "cuda_sampler_test --gtest_filter=*Splitting*:*PointQueries*" "cuda_bvh_test --gtest_filter=*Slabs*:*PointQueries*:*NarrowBand*" \
              "raycast_gpu_test"; do
         compute-sanitizer --tool memcheck --error-exitcode 3 $B/tests/gpu/$t > "$OUT/sanitizer-${t%% *}.txt" 2>&1
         echo "compute-sanitizer ${t%% *}: exit $? $(grep 'ERROR SUMMARY' "$OUT/sanitizer-${t%% *}.txt")" | tee -a "$OUT/summary.txt"

@@ -2,9 +2,11 @@
 # Distributed runs on the GPU machine (docs/distributed.md, issue 15): builds with CUDA and MPI
 # (warnings as errors), runs the MPI tests there, then samples a study on the GPU with one
 # process and with 2 ranks sharing the GPU and compares every field file byte for byte, with
-# the timings of both. Used with the device tool:
-#   carry: .gpu-prefix (as scripts/device/gpu-check.sh)      steps: build test gpu
-#   scripts/device/gpu-mpi.sh build test gpu
+# the timings of both; step python: the Python module's collective sample() on 2 ranks sharing
+# the GPU against one process, bit for bit (when the module is built there). Used with the
+# device tool:
+#   carry: .gpu-prefix (as scripts/device/gpu-check.sh)      steps: build test gpu python
+#   scripts/device/gpu-mpi.sh build test gpu python
 # Output under $OUT: summary.txt, the logs, the manifests of the GPU runs.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -99,6 +101,54 @@ gpu)
     cp "$np2/manifest.json" "$OUT/gpu-np2-manifest.json"; cp "$serial/manifest.json" "$OUT/gpu-serial-manifest.json"
     rm -rf "$W"
     [ "$bad" -eq 0 ] && [ "$n" -eq 12 ] || exit 1 ;;
+python)
+    log "Python: sample() collective on 2 ranks sharing the GPU vs one process"
+    if ! grep -q "Python module ON" "$OUT/configure.log" 2>/dev/null; then
+        echo "the Python module is not built on this machine (pybind11, python3-dev): skipped" | tee -a "$OUT/summary.txt"
+        continue
+    fi
+    cmake --build $B -j "$(nproc)" --target sdf_lattices -- -k 0 > "$OUT/build-python.log" 2>&1 ||
+        { grep -E "error|warning|FAILED" "$OUT/build-python.log" | head -40; exit 1; }
+    (cd $B && ctest -R "python_module_mpi" --output-on-failure > "$OUT/ctest-python-mpi.log" 2>&1; echo "ctest exit $?") | tee -a "$OUT/summary.txt"
+    grep -E "Test +#|tests passed" "$OUT/ctest-python-mpi.log" | tee -a "$OUT/summary.txt"
+    W=$(mktemp -d)
+    cat > "$W/collective.py" <<'PY'
+import time
+import sdf_lattices as sl
+rank = sl.distributed()["rank"]
+mesh = sl.load_mesh("shape:torus")
+def arrays(f):
+    out = []
+    for a in (f.values, f.gradient, f.triangle):
+        out += list(a) if isinstance(a, tuple) else [a]
+    return out
+bad = 0
+for lattice, resolution in [("cc", 128), ("bcc", [100, 100, 200])]:
+    for method in ["brute_force", "bvh"]:
+        args = dict(lattice=lattice, resolution=resolution, method=method, backend="cuda")
+        t = time.perf_counter()
+        field = sl.sample(mesh, **args)
+        together = time.perf_counter() - t
+        if rank != 0:
+            continue  # rank 1 waits in the next collective call while rank 0 samples alone
+        t = time.perf_counter()
+        alone = sl.sample(mesh, distributed=False, **args)
+        one = time.perf_counter() - t
+        same = all(a.tobytes() == b.tobytes() for a, b in zip(arrays(field), arrays(alone)))
+        bad += not same
+        d = field.sampler["distributed"]
+        slabs = ", ".join(f"rank {s['rank']} device {s.get('device')} {s['seconds']:.3f} s" for s in d["slabs"])
+        print(f"{field.notation} {method}: {'identical' if same else 'DIFFERS'}; 2 ranks {together:.3f} s "
+              f"(sampling {field.seconds:.3f} s; {slabs}), one process {one:.3f} s", flush=True)
+if rank == 0:
+    print("collective fields differing from one process's:", bad, flush=True)
+PY
+    python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' $B/CMakeCache.txt)  # the module's interpreter
+    PYTHONPATH=$B/python mpirun --oversubscribe -np 2 "${python:-python3}" "$W/collective.py" > "$OUT/gpu-python.log" 2>&1
+    status=$?
+    tee -a "$OUT/summary.txt" < "$OUT/gpu-python.log"
+    rm -rf "$W"
+    [ "$status" -eq 0 ] && grep -q "differing from one process's: 0" "$OUT/gpu-python.log" || exit 1 ;;
 *) echo "unknown step $step"; exit 2 ;;
 esac; done
 log done

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <random>
 #include <memory>
 #include <sstream>
 
@@ -52,7 +53,7 @@ void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Latti
 }
 
 /// Kernels by argument: 0 brick (packets of 16 lattice points), 1 seeded, 2 unseeded, 3 warp (CUDA).
-const char* const kKernels[] = {"brick", "seeded", "unseeded", "warp"};  // warp: CUDA only
+const char* const kKernels[] = {"brick", "seeded", "unseeded", "warp", "candidates"};  // warp, candidates: CUDA only
 
 /// Args: resolution, threads (0 = all), kernel.
 void BM_CpuBvh(benchmark::State& state, const std::string& file) {
@@ -99,6 +100,77 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
+    if (f.sampler.contains("candidates"))
+        state.counters["candidate_triangles"] = f.sampler["candidates"]["mean_candidate_triangles"].get<double>();
+}
+
+/// Arbitrary points (issue 14): uniform in the mesh's box (kind 0) or Gaussian around
+/// surface points, sigma = 1% of the diagonal (kind 1); the device time of the Morton sort,
+/// search and finalize (Sampler::last_query_timings), float search.
+void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
+    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const int64_t n = state.range(0);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> g(0.0, 0.01 * mesh->bounds().diagonal());
+    const size_t count = size_t(n);
+    std::vector<Vec3d> points(count);
+    const Bounds3& box = mesh->bounds();
+    for (Vec3d& p : points) {
+        if (state.range(1) == 0) {
+            p = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
+        } else {
+            // An area-weighted triangle would be the textbook draw; a uniform triangle is
+            // close on these evenly tessellated scans and keeps set-up cheap.
+            const Int3 t = mesh->triangles()[size_t(rng() % mesh->triangles().size())];
+            double a = u(rng), b = u(rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            const Vec3d& v0 = mesh->vertices()[size_t(t.x)];
+            p = v0 + (mesh->vertices()[size_t(t.y)] - v0) * a + (mesh->vertices()[size_t(t.z)] - v0) * b +
+                Vec3d{g(rng), g(rng), g(rng)};
+        }
+    }
+    SamplerOptions o;
+    o.backend = "cuda";
+    o.method = "bvh";
+    o.kernel = kKernels[state.range(2)];
+    o.progress = false;
+    auto sampler = make_sampler(o);
+    sampler->query(*mesh, points);  // warm-up: BVH upload
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
+        state.SetIterationTime(sampler->last_query_timings().kernel);
+    }
+    const SamplingTimings& t = sampler->last_query_timings();
+    state.counters["points"] = double(n);
+    state.counters["queries_per_second"] = t.kernel > 0 ? double(n) / t.kernel : 0.0;
+    state.counters["end_to_end_seconds"] = t.total;
+}
+
+/// The narrow band on the lattice (kernel "candidates"): band half-width in lattice spacings.
+void BM_CudaBvhBand(benchmark::State& state, const std::string& file) {
+    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o;
+    o.backend = "cuda";
+    o.method = "bvh";
+    o.kernel = "candidates";
+    o.band_width = double(state.range(1)) * lattice.spacing;
+    o.progress = false;
+    auto sampler = make_sampler(o);
+    SampledField f = sampler->sample(*mesh, lattice);
+    for (auto _ : state) {
+        f = sampler->sample(*mesh, lattice);
+        state.SetIterationTime(f.timings.kernel);
+    }
+    set_counters(state, *mesh, lattice, f);
+    int64_t in_band = 0;
+    for (int32_t t : f.closest_triangle) in_band += t != kOutsideBandTriangle;
+    state.counters["points_in_band"] = double(in_band);
 }
 
 /// The tuned CUDA brute force on the same lattices (float), for the BVH's speedup.
@@ -129,8 +201,9 @@ void cpu_args(benchmark::internal::Benchmark* b) {
 
 void cuda_args(benchmark::internal::Benchmark* b) {
     for (int r : {64, 128})
-        for (int kernel : {0, 1, 2, 3})
+        for (int kernel : {0, 1, 2, 3, 4})
             for (int dbl : {0, 1}) b->Args({r, kernel, dbl});
+    for (int kernel : {3, 4}) b->Args({256, kernel, 0});
     b->ArgNames({"res", "kernel", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 }
 
@@ -140,6 +213,11 @@ BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, bunny, std::string("bunny.obj"))->Apply(cuda_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, dragon, std::string("dragon.obj"))->Apply(cuda_args);
+BENCHMARK_CAPTURE(BM_CudaBvhPoints, dragon, std::string("dragon.obj"))
+    ->ArgsProduct({{1 << 20, 1 << 24}, {0, 1}, {3, 4}})
+    ->ArgNames({"points", "gaussian", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);  // each call also transfers and scatters on the host
+BENCHMARK_CAPTURE(BM_CudaBvhBand, dragon, std::string("dragon.obj"))
+    ->ArgsProduct({{256}, {2, 8}})->ArgNames({"res", "band_spacings"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 BENCHMARK_CAPTURE(BM_CudaBrute, bunny, std::string("bunny.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()
     ->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_CudaBrute, dragon, std::string("dragon.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()

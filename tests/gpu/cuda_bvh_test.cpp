@@ -1,12 +1,15 @@
 // The CUDA BVH sampler against the CPU brute force on every BVH test mesh (the procedural
 // shapes, the sliver sphere, the flat slab, bunny and dragon when present), CC and BCC
-// lattices (both strategies), float and double, all three kernels; pieces; point queries.
-// Same triangle: the same double evaluation (1e-12 relative); another triangle: a tie.
+// lattices (both strategies), float and double, every kernel; pieces; point queries (sorted
+// into Morton order on the device); the narrow band (every kernel: the full field banded,
+// bit for bit; "candidates" skips whole bricks). Same triangle: the same double evaluation
+// (1e-12 relative); another triangle: a tie.
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "core/lattice/lattice_fitting.h"
+#include "cuda/bvh_sampler.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
@@ -40,7 +43,7 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
             const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds(), 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
                 const SampledField cpu = make_sampler(options("cpu", "brute_force", precision))->sample(m.mesh, lattice);
-                for (const char* kernel : {"brick", "seeded", "unseeded", "warp"})
+                for (const auto& [kernel, id] : cuda::kCudaBvhKernels)
                     for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                         if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
                         const SampledField gpu = make_sampler(options("cuda", "bvh", precision, kernel, s))->sample(m.mesh, lattice);
@@ -71,17 +74,89 @@ TEST(CudaBvh, SlabsDoNotChangeTheResult) {
 
 TEST(CudaBvh, PointQueriesEqualTheCpu) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
+        // Uniform in the box, then Gaussian around vertices (as training-data generators
+        // draw near the surface): 4001 points, not a multiple of a packet.
         std::mt19937_64 rng(3);
         std::uniform_real_distribution<double> u(-0.75, 0.75);
+        std::normal_distribution<double> g(0.0, 0.01 * m.mesh.bounds().diagonal());
         std::vector<Vec3d> pts(4001);
-        for (auto& p : pts) p = m.mesh.bounds().center() + component_mul(m.mesh.bounds().extent(), Vec3d{u(rng), u(rng), u(rng)});
+        for (size_t i = 0; i < pts.size(); ++i) {
+            if (i % 2 == 0) {
+                pts[i] = m.mesh.bounds().center() + component_mul(m.mesh.bounds().extent(), Vec3d{u(rng), u(rng), u(rng)});
+            } else {
+                const Vec3d& v = m.mesh.vertices()[size_t(rng() % m.mesh.vertices().size())];
+                pts[i] = v + Vec3d{g(rng), g(rng), g(rng)};
+            }
+        }
         for (Precision precision : {Precision::Float, Precision::Double}) {
             const auto cpu = make_sampler(options("cpu", "bvh", precision))->query(m.mesh, pts);
-            const auto gpu = make_sampler(options("cuda", "bvh", precision))->query(m.mesh, pts);
-            test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
-            cmp.samples(pts, cpu, gpu, m.name + " points " + precision_name(precision));
-            if (HasFatalFailure()) return;
+            for (const char* kernel : {"warp", "candidates"}) {
+                const auto gpu = make_sampler(options("cuda", "bvh", precision, kernel))->query(m.mesh, pts);
+                test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
+                cmp.samples(pts, cpu, gpu, m.name + " points " + precision_name(precision) + " " + kernel);
+                if (HasFatalFailure()) return;
+            }
         }
+    }
+}
+
+/// The narrow band applied to a full field (SamplerOptions::band_width's definition).
+SampledField banded(SampledField f, double w) {
+    for (int64_t i = 0; i < f.size(); ++i)
+        if (std::abs(f.distance[size_t(i)]) > w) {
+            f.distance[size_t(i)] = f.distance[size_t(i)] < 0 ? -w : w;
+            f.gradient[size_t(i)] = Vec3d(0.0);
+            f.closest_triangle[size_t(i)] = kOutsideBandTriangle;
+        }
+    return f;
+}
+
+TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
+    const auto& meshes = test::bvh_test_meshes();
+    for (size_t which : {size_t(2), size_t(4)}) {  // torus, soccer ball
+        const PreparedMesh& mesh = meshes[which].mesh;
+        for (SignMode sign : {SignMode::Pseudonormal, SignMode::Winding})
+            for (Precision precision : {Precision::Float, Precision::Double}) {
+                const Lattice cc = fit_lattice(LatticeType::CC, {40, 41, 42}, mesh.bounds(), 0.3);
+                const Lattice bcc = fit_lattice(LatticeType::BCC, {30, 31, 32}, mesh.bounds(), 0.3);
+                // The two that skip bricks outside the band, one that searches everything
+                // (the band applied by finalize_samples), and the brute force.
+                const std::pair<const char*, const char*> samplers[] = {
+                    {"bvh", "warp"}, {"bvh", "candidates"}, {"bvh", "unseeded"}, {"brute_force", ""}};
+                for (const Lattice& lattice : {cc, bcc})
+                    for (const auto& [method, kernel] : samplers) {
+                        SamplerOptions o = options("cuda", method, precision, kernel);
+                        o.sign = sign;
+                        const SampledField full = make_sampler(o)->sample(mesh, lattice);
+                        for (double fraction : {0.02, 0.1}) {
+                            const double w = fraction * mesh.bounds().diagonal();
+                            o.band_width = w;
+                            const SampledField band = make_sampler(o)->sample(mesh, lattice);
+                            const SampledField expected = banded(full, w);
+                            const std::string what = meshes[which].name + " " + lattice_notation(lattice) + " " + method + "/" + kernel + " " +
+                                                     precision_name(precision) + (sign == SignMode::Winding ? " winding" : "") +
+                                                     " band " + std::to_string(fraction);
+                            ASSERT_EQ(band.distance, expected.distance) << what;
+                            ASSERT_EQ(band.closest_triangle, expected.closest_triangle) << what;
+                            for (int64_t i = 0; i < band.size(); ++i)
+                                ASSERT_TRUE(band.gradient[size_t(i)] == expected.gradient[size_t(i)]) << what << " point " << i;
+                            EXPECT_EQ(band.sampler["band_width"].get<double>(), w);
+                            int64_t in_band = 0;
+                            for (int32_t t : band.closest_triangle) in_band += t != kOutsideBandTriangle;
+                            EXPECT_GT(in_band, 0) << what;
+                            EXPECT_LT(in_band, band.size()) << what;
+                            if (std::string(kernel) == "candidates") {
+                                const auto& c = band.sampler["candidates"];
+                                std::printf("%-60s bricks searched %lld, outside the band %lld\n", what.c_str(),
+                                            (long long)c["bricks_searched"].get<int64_t>(),
+                                            (long long)c["bricks_outside_band"].get<int64_t>());
+                                if (fraction < 0.05) {
+                                    EXPECT_GT(c["bricks_outside_band"].get<int64_t>(), 0) << what;
+                                }
+                            }
+                        }
+                    }
+            }
     }
 }
 
