@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <stdexcept>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "core/bvh/bvh_cache.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
+#include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
@@ -26,6 +28,8 @@ constexpr int64_t kBvhChunk = 256;
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
+/// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
+constexpr int64_t kBandChunkRows = 8;
 
 using BvhKernel = CpuBvhKernel;
 
@@ -85,24 +89,100 @@ Brick brick_points(const Lattice& lattice, const GridBlock& block, const Int3& b
     return out;
 }
 
+/// The narrow band's brick skip (SamplerOptions::band_width). The exact distance is
+/// 1-Lipschitz: a probe at c with exact distance D proves |d(p)| >= D - |p - c| for every p,
+/// so every point of a brick within D - w - margin of c lies outside the band and needs no
+/// nearest-triangle search. The margin covers the search's near-ties (D is the distance to
+/// the triangle the T search chose, which may exceed the true minimum by a few ulps of T).
+struct BandSkip {
+    double width = 0;  ///< 0: no band, every brick computed
+    /// The pseudonormal sign of a solid (closed, manifold, oriented, one shell, no
+    /// self-intersections: choose_sign_mode's conditions) is the side of the solid, constant on
+    /// a ball that does not reach the surface: the probe's sign is every point's there.
+    bool probe_sign = false;
+    /// Winding mode: each skipped point gets its own winding number's side, as the full run.
+    const WindingSign* winding = nullptr;
+    double relative_margin = 0;  ///< of D + the coordinates' magnitude
+    double coordinate_scale = 0; ///< largest |coordinate| of the mesh's box
+    bool enabled() const { return width > 0 && (probe_sign || winding != nullptr); }
+};
+
+struct BandCounters {
+    std::atomic<int64_t> probes{0}, bricks_skipped{0}, points_skipped{0};
+};
+
+/// The ball of the last probe of a chunk: points within `clear` of `centre` are outside the band.
+struct ProbeBall {
+    Vec3d centre{};
+    double clear = -1;  ///< D - w - margin; < 0: no ball
+    bool negative = false;
+};
+
+bool brick_in_ball(const Brick& br, const ProbeBall& ball) {
+    if (!(ball.clear > 0)) return false;
+    for (int k = 0; k < br.count; ++k)
+        if (!(length(br.position[k] - ball.centre) < ball.clear)) return false;
+    return true;
+}
+
 /// Evaluates every point of `block` brick by brick (closest_triangles_packet.h); each lane
-/// is seeded with the triangle of the same lane of the previous brick along x.
-template <typename T, typename EmitFn>
+/// is seeded with the triangle of the same lane of the previous brick along x. With a band,
+/// a brick that a probe proves outside it is handed to emit_outside(local, negative) point
+/// by point without a search.
+template <typename T, typename EmitFn, typename OutsideFn>
 void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const Lattice& lattice, const GridBlock& block,
-                     int threads, bool progress, QueryCounters& counters, EmitFn emit) {
+                     int threads, bool progress, const BandSkip& band, QueryCounters& counters, BandCounters& band_counters,
+                     EmitFn emit, OutsideFn emit_outside) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", block.count(), progress);
-    parallel_for(n, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
+    // With a band, chunks are whole rows of bricks (8 rows), so that a brick can reuse the
+    // probe of the brick beside it in x and of the one below it in y (column_ball).
+    const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
+    parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         int32_t seed[kBrick];
         for (int k = 0; k < kBrick; ++k) seed[k] = -1;
-        int64_t done = 0;
+        int32_t probe_seed = -1;
+        ProbeBall ball;
+        std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
+        int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
+            done += br.count;
+            if (band.enabled()) {
+                ProbeBall& below = column_ball[size_t(b % bricks.x)];
+                if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
+                if (!brick_in_ball(br, ball)) {  // probe at the brick's centre
+                    Vec3d c(0.0);
+                    for (int k = 0; k < br.count; ++k) c = c + br.position[k];
+                    c = c * (1.0 / br.count);
+                    const Vec3<T> pt(c);
+                    const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed_hit(view, probe_seed, pt), stats);
+                    probe_seed = hit.slot;
+                    const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
+                    const double d = std::abs(s.distance);
+                    const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
+                    ball = {c, d - band.width - margin, s.distance < 0};
+                    below = ball;
+                    ++probes;
+                }
+                bool skip = brick_in_ball(br, ball);
+                // A solid's inside never leaves its box: a point outside the box in an "inside"
+                // ball means the mesh is not the solid assumed, so the brick is computed.
+                if (skip && band.winding == nullptr && ball.negative)
+                    for (int k = 0; k < br.count; ++k) skip = skip && !exact.outside_box(br.position[k]);
+                if (skip) {
+                    for (int k = 0; k < br.count; ++k)
+                        emit_outside(br.local[k], band.winding ? band.winding->inside(br.position[k]) : ball.negative);
+                    ++skipped_bricks;
+                    skipped_points += br.count;
+                    continue;
+                }
+            }
             BvhPacket<T, kBrick> pk;
             for (int k = 0; k < kBrick; ++k) {
                 pk.x[k] = T(br.position[k].x);
@@ -115,10 +195,12 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]),
                                              br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
-            done += br.count;
         }
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
+        band_counters.probes += probes;
+        band_counters.bricks_skipped += skipped_bricks;
+        band_counters.points_skipped += skipped_points;
         reporter.advance(done);
     });
 }
@@ -260,22 +342,32 @@ private:
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
+        const double w = options_.band_width;
+        const BandSkip band = band_skip(mesh, w);
         int64_t computed = 0;
         QueryCounters counters;
+        BandCounters band_counters;
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                 const int64_t out = block.output_index(lattice, i);
                 if (out < 0) return;  // strategy A: not a BCC point
-                store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
+                if (outside_band(s.distance, w)) store_outside_band(field, out, std::signbit(s.distance), w);
+                else store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
+            };
+            auto emit_outside = [&](int64_t i, bool negative) {
+                const int64_t out = block.output_index(lattice, i);
+                if (out >= 0) store_outside_band(field, out, negative, w);
             };
             if (kernel_ == BvhKernel::Brick)
-                evaluate_bricks<T>(mesh, *bvh, sign_, lattice, block, options_.threads, options_.progress, counters, emit);
+                evaluate_bricks<T>(mesh, *bvh, sign_, lattice, block, options_.threads, options_.progress, band, counters,
+                                   band_counters, emit, emit_outside);
             else
                 evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(), counters,
                                    [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); }, emit);
             computed += block.count();
         }
+        computed -= band_counters.points_skipped;
         const auto now = std::chrono::steady_clock::now();
         field.timings.total = std::chrono::duration<double>(now - start).count();
         field.timings.kernel = std::chrono::duration<double>(now - query_start).count();
@@ -288,7 +380,34 @@ private:
         field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         field.sampler["bvh"] = bvh_info;
+        if (w > 0) {
+            nlohmann::json info = narrow_band_provenance(
+                w, count_narrow_band(field), band.enabled() ? "bricks skipped by the distance bound" : "post-processed");
+            info["probes"] = band_counters.probes.load();
+            info["bricks_skipped"] = band_counters.bricks_skipped.load();
+            info["points_skipped"] = band_counters.points_skipped.load();
+            field.sampler["band"] = info;
+        }
         return field;
+    }
+
+    /// The brick skip of a band of width w: with the winding sign (each point's own), or
+    /// with the pseudonormal sign where the mesh is the solid that makes it one side per
+    /// ball; a pseudonormal sign requested on any other mesh computes every point (and
+    /// bands them afterwards), as does the "seeded"/"unseeded" kernel.
+    BandSkip band_skip(const PreparedMesh& mesh, double w) const {
+        require_band_width(w, "sampler band_width");
+        BandSkip band;
+        band.width = w;
+        if (w <= 0) return band;
+        band.winding = sign_.winding() ? sign_.winding_sign() : nullptr;
+        band.probe_sign = !sign_.winding() && choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal;
+        // Float searches choose among triangles within a few ulps (2^-24) of the minimum.
+        band.relative_margin = options_.precision == Precision::Float ? 1e-5 : 1e-12;
+        const MeshView<double> exact = mesh.buffers<double>().view();
+        for (const Vec3d& v : {exact.box_lo, exact.box_hi})
+            band.coordinate_scale = std::max({band.coordinate_scale, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+        return band;
     }
 
     SamplerOptions options_;

@@ -6,6 +6,7 @@
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
 #include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
 
@@ -83,6 +84,7 @@ private:
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
+        require_band_width(options_.band_width, "sampler band_width");
         sign_.prepare(mesh);
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         GridBlock blocks[2];
@@ -105,6 +107,9 @@ private:
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
+        if (options_.band_width > 0)  // brute force tests every pair anyway: the band by post-processing
+            field.sampler["band"] =
+                narrow_band_provenance(options_.band_width, apply_narrow_band(field, options_.band_width), "post-processed");
         return field;
     }
 

@@ -6,6 +6,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/SignedFloodFill.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "harness/io/volume_grids.h"
@@ -28,49 +29,91 @@ void add_metadata(openvdb::GridBase& grid, const SampledField& field, const Volu
 
 }  // namespace
 
-void write_vdb_file(const SampledField& field, const std::string& path, double band_in_spacings) {
+struct VdbNarrowBandBuilder::Grids {
+    Lattice lattice;
+    std::vector<VolumeGrid> parts;
+    std::vector<openvdb::FloatGrid::Ptr> distance;
+    std::vector<openvdb::Vec3fGrid::Ptr> normals;
+    float band = 0;
+    bool gradient = false;
+};
+
+VdbNarrowBandBuilder::VdbNarrowBandBuilder(const Lattice& lattice, double band, bool gradient) : grids_(new Grids) {
     openvdb::initialize();
+    grids_->lattice = lattice;
+    grids_->parts = volume_grids(lattice);
+    // The background is the band's half-width in world units (OpenVDB's level set
+    // convention): outside the band a voxel reads +band, inside -band.
+    grids_->band = float(band);
+    grids_->gradient = gradient;
+    for (size_t g = 0; g < grids_->parts.size(); ++g) {
+        grids_->distance.push_back(openvdb::FloatGrid::create(grids_->band));
+        grids_->normals.push_back(openvdb::Vec3fGrid::create(openvdb::Vec3f(0.0f)));
+    }
+}
+
+VdbNarrowBandBuilder::~VdbNarrowBandBuilder() = default;
+
+void VdbNarrowBandBuilder::add(const SampledField& part, int64_t from, int64_t count, int64_t offset) {
+    const bool gradient = grids_->gradient && part.gradient.size() == part.distance.size();
+    const float band = grids_->band;
+    for (size_t p = 0; p < grids_->parts.size(); ++p) {
+        const VolumeGrid& g = grids_->parts[p];
+        const int64_t begin = std::max(offset, g.first), end = std::min(offset + count, g.first + g.count());
+        if (begin >= end) continue;
+        auto d_acc = grids_->distance[p]->getAccessor();
+        auto n_acc = grids_->normals[p]->getAccessor();
+        for (int64_t at = begin; at < end; ++at) {
+            const size_t source = size_t(from + (at - offset));
+            const float d = float(part.distance[source]);
+            if (!(std::abs(d) < band)) continue;
+            const int64_t local = at - g.first;
+            const openvdb::Coord c(int(local % g.resolution.x), int((local / g.resolution.x) % g.resolution.y),
+                                   int(local / (int64_t(g.resolution.x) * g.resolution.y)));
+            d_acc.setValue(c, d);
+            ++active_;
+            if (gradient) {
+                const Vec3d& n = part.gradient[source];
+                n_acc.setValue(c, openvdb::Vec3f(float(n.x), float(n.y), float(n.z)));
+            }
+        }
+    }
+}
+
+void VdbNarrowBandBuilder::write(const std::string& path) {
     openvdb::GridPtrVec grids;
-    const bool gradient = field.gradient.size() == field.distance.size();
-    for (const VolumeGrid& g : volume_grids(field.lattice)) {
+    SampledField meta;  // add_metadata reads the lattice type only
+    meta.lattice = grids_->lattice;
+    for (size_t p = 0; p < grids_->parts.size(); ++p) {
+        const VolumeGrid& g = grids_->parts[p];
         const std::string suffix = g.part.empty() ? "" : "_" + g.part;
-        // The background is the band's half-width in world units (OpenVDB's level set
-        // convention): outside the band a voxel reads +band, inside -band.
-        const float band = float(band_in_spacings * g.spacing);
-        openvdb::FloatGrid::Ptr distance = openvdb::FloatGrid::create(band);
-        openvdb::Vec3fGrid::Ptr normals = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.0f));
-        auto d_acc = distance->getAccessor();
-        auto n_acc = normals->getAccessor();
-        for (int k = 0; k < g.resolution.z; ++k)
-            for (int j = 0; j < g.resolution.y; ++j)
-                for (int i = 0; i < g.resolution.x; ++i) {
-                    const size_t at = size_t(g.first + (int64_t(k) * g.resolution.y + j) * g.resolution.x + i);
-                    const float d = float(field.distance[at]);
-                    if (!(std::abs(d) < band)) continue;
-                    d_acc.setValue(openvdb::Coord(i, j, k), d);
-                    if (gradient) {
-                        const Vec3d& n = field.gradient[at];
-                        n_acc.setValue(openvdb::Coord(i, j, k), openvdb::Vec3f(float(n.x), float(n.y), float(n.z)));
-                    }
-                }
+        openvdb::FloatGrid::Ptr distance = grids_->distance[p];
         // Inactive voxels and tiles take the sign of their side (-band inside).
         openvdb::tools::signedFloodFill(distance->tree());
         distance->setTransform(grid_transform(g));
         distance->setGridClass(openvdb::GRID_LEVEL_SET);
         distance->setName("distance" + suffix);
-        add_metadata(*distance, field, g);
+        add_metadata(*distance, meta, g);
         grids.push_back(distance);
-        if (gradient) {
+        if (grids_->gradient) {
+            openvdb::Vec3fGrid::Ptr normals = grids_->normals[p];
             normals->setTransform(grid_transform(g));
             normals->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
             normals->setName("gradient" + suffix);
-            add_metadata(*normals, field, g);
+            add_metadata(*normals, meta, g);
             grids.push_back(normals);
         }
     }
     openvdb::io::File file(path);
     file.write(grids);
     file.close();
+}
+
+void write_vdb_file(const SampledField& field, const std::string& path, double band_in_spacings) {
+    VdbNarrowBandBuilder builder(field.lattice, band_in_spacings * field.lattice.spacing,
+                                 field.gradient.size() == field.distance.size());
+    builder.add(field, 0, field.size(), 0);
+    builder.write(path);
 }
 
 }  // namespace sdf

@@ -352,6 +352,14 @@ std::vector<std::string> write_field_as(const SampledField& field, const std::st
 void write_vdb_file(const SampledField&, const std::string& path, double) {
     throw std::runtime_error(path + ": this build has no OpenVDB support (libopenvdb-dev)");
 }
+
+struct VdbNarrowBandBuilder::Grids {};
+VdbNarrowBandBuilder::VdbNarrowBandBuilder(const Lattice&, double, bool) {
+    throw std::runtime_error(".vdb output: this build has no OpenVDB support (libopenvdb-dev)");
+}
+VdbNarrowBandBuilder::~VdbNarrowBandBuilder() = default;
+void VdbNarrowBandBuilder::add(const SampledField&, int64_t, int64_t, int64_t) {}
+void VdbNarrowBandBuilder::write(const std::string&) {}
 #endif
 
 }  // namespace sdf

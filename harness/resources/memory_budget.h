@@ -33,6 +33,18 @@ constexpr uint64_t kBaseBytes = 512ull << 20;
 /// "1.5 GiB", "512 MiB", "12 KiB", "300 B".
 std::string format_bytes(uint64_t bytes);
 
+/// A size as users write it: a positive number with an optional unit, B, KiB, MiB, GiB, TiB
+/// (powers of 1024; K, M, G, T mean the same) or KB, MB, GB, TB (powers of 1000), any case,
+/// with or without a space: "8GiB", "256 MiB", "1.5G", "1000000". Throws
+/// std::invalid_argument naming `what`, the text and what was expected, for anything else:
+/// no number, a negative, zero or non-finite one, an unknown unit, or a size beyond 2^62 bytes.
+uint64_t parse_byte_size(const std::string& text, const std::string& what);
+
+/// The peak resident memory of this process so far (getrusage), in bytes.
+uint64_t peak_resident_bytes();
+/// The resident memory of this process now (/proc/self/statm), in bytes; 0 when unknown.
+uint64_t current_resident_bytes();
+
 /// Host memory a new allocation can get: $SDF_MEMORY_AVAILABLE (bytes; for tests and to
 /// leave room for other work), else MemAvailable of /proc/meminfo; 0 when unknown.
 uint64_t host_memory_available();

@@ -3,7 +3,7 @@
 # touched kernels: builds with CUDA and warnings as errors, runs every GPU test, every CPU test
 # there too, compute-sanitizer on the GPU tests' split/point-query cases, and the CI smoke study
 # from a portable CPU build (whose field checksums must equal those of any other CPU target).
-#   carry: .gpu-prefix data        steps: build gputest test python sanitize portable bench-filters
+#   carry: .gpu-prefix data        steps: build gputest test python sanitize portable bench-filters stream
 # Output under $OUT: summary.txt and the logs.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -73,6 +73,35 @@ bench-filters)
     $B/tests/benchmarks/bench_reconstruction --benchmark_filter='BM_Evaluate<float>' --benchmark_counters_tabular=true \
         --benchmark_out="$OUT/bench_reconstruction.json" --benchmark_out_format=json > "$OUT/bench_reconstruction.txt" 2>&1
     echo "bench_reconstruction exit $?" | tee -a "$OUT/summary.txt" ;;
+stream)
+    # Issue 14: sdf-sample on the GPU. Many slabs equal one slab byte for byte (CC, BCC, with and
+    # without a band; the mesh as STREAM_MESH, default the dragon), then scripts/scaling-run from
+    # 32^3 to 1024^3 CC (STREAM_MAX) with an 8 GiB budget, fields in STREAM_FIELDS (17 GB at 1024^3).
+    M=${STREAM_MESH:-data/meshes/dragon.obj}
+    S=${STREAM_FIELDS:-/tmp/stream-fields}
+    log "sdf-sample --backend cuda: many slabs = one slab, byte for byte ($M)"
+    rm -rf "$S" && mkdir -p "$S"
+    while read -r lattice res band; do
+        common=("$M" --backend cuda --lattice "$lattice" --resolution "$res" --band "$band" --quiet)
+        $B/bin/sdf-sample "${common[@]}" --out "$S/one.json" >> "$OUT/stream-check.log" 2>&1
+        $B/bin/sdf-sample "${common[@]}" --max-planes-per-slab 7 --memory-budget 4GiB --vdb "$S/many.vdb" --out "$S/many.json" \
+            >> "$OUT/stream-check.log" 2>&1
+        for ch in distance gradient closest_triangle; do
+            cmp -s "$S/one.$ch.raw" "$S/many.$ch.raw" && r=same || r=DIFFERENT
+            echo "$lattice $res band $band $ch: $r" | tee -a "$OUT/summary.txt"
+        done
+        grep -o '"slabs": [0-9]*' "$S/many.json" | head -1 | tee -a "$OUT/summary.txt"
+        rm -f "$S"/one.* "$S"/many.*
+    done <<'LIST'
+cc 128 0
+cc 128 0.004
+bcc 64 0
+bcc 64 0.004
+LIST
+    log "scripts/scaling-run --backend cuda, CC 32^3 .. ${STREAM_MAX:-1024}^3, budget 8 GiB"
+    scripts/scaling-run "$M" --backend cuda --max-resolution "${STREAM_MAX:-1024}" --memory-budget 8GiB \
+        --fields "$S" --results "$OUT/scaling" --sdf-sample $B/bin/sdf-sample 2>&1 | tee -a "$OUT/summary.txt"
+    rm -rf "$S" ;;
 *) echo "unknown step $step"; exit 2 ;;
 esac; done
 log done

@@ -5,7 +5,7 @@ import datetime
 import os
 import sys
 
-from . import analytic, filters, overview, peers, plots, reconstruction, sampling, speedup
+from . import analytic, filters, overview, peers, plots, reconstruction, sampling, scaling, speedup
 from . import runs as run_loader
 from . import schema as run_schema
 from .document import Document
@@ -79,6 +79,7 @@ def build(doc, runs, args, skipped):
     overview.section(doc, runs, REPO)
     for section in SECTIONS:
         section(doc, runs)
+    scaling.section(doc, args.results)  # scripts/scaling-run's JSON lines, not run-experiment runs
 
 
 def main(argv=None):

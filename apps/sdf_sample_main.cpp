@@ -1,0 +1,210 @@
+// sdf-sample MESH --resolution N|NX NY NZ --out NAME.json [--lattice cc|bcc] [--margin F]
+//            [--method bvh|brute_force] [--backend auto|cpu|cuda] [--precision float|double]
+//            [--sign auto|pseudonormal|winding] [--band W] [--memory-budget SIZE]
+//            [--channels distance,gradient,closest_triangle] [--dtype float32|float64]
+//            [--overwrite] [--dry-run] [--quiet]
+//
+// Samples a lattice fitted around the mesh (as run-experiment and the module's sample() fit
+// it) slab by slab, streaming each slab into the field file's channels, so that the host's
+// peak memory stays under the budget whatever the lattice's size
+// (harness/sampling/streamed_sampling.h, docs/large-lattices.md). The channel files equal
+// the in-memory writer's byte for byte. --dry-run prints the plan (slabs, memory, output
+// size) and exits.
+#include <CLI/CLI.hpp>
+
+#include "apps/cli_exit.h"
+
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/parallel/progress.h"
+#include "harness/config/json_reader.h"
+#include "harness/config/lattice_spec.h"
+#include "harness/config/mesh_spec.h"
+#include "harness/config/sampler_spec.h"
+#include "harness/io/atomic_file.h"
+#include "harness/resources/memory_budget.h"
+#include "harness/sampling/sampler_table.h"
+#include "harness/sampling/streamed_sampling.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The default budget: half of the memory available now (8 GiB when unknown).
+uint64_t default_memory_budget() {
+    const uint64_t available = sdf::host_memory_available();
+    return available > 0 ? available / 2 : uint64_t(8) << 30;
+}
+
+/// The output directory's free bytes; refuses when the channels do not fit.
+void require_output_space(const sdf::StreamPlan& plan, const std::string& out) {
+    const fs::path dir = fs::absolute(out).parent_path();
+    if (!fs::is_directory(dir)) throw std::runtime_error(out + ": the output folder " + dir.string() + " does not exist");
+    std::error_code ec;
+    const fs::space_info space = fs::space(dir, ec);
+    if (ec) throw std::runtime_error(dir.string() + ": cannot read the free space (" + ec.message() + ")");
+    if (space.available < plan.output_bytes)
+        throw std::runtime_error(out + ": the output needs " + sdf::format_bytes(plan.output_bytes) + " and " + dir.string() +
+                                 " has " + sdf::format_bytes(space.available) +
+                                 " free; choose fewer --channels, --dtype float32, or another directory");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Samples the exact signed distance of a mesh on a CC or BCC lattice slab by slab, streaming the "
+                 "field file to disk under a memory budget."};
+    sdf::add_version_flag(app, "sdf-sample");
+    std::string mesh_arg, out_path, lattice_type = "cc", method = "bvh", backend = "auto", kernel, precision = "float";
+    std::string sign = sdf::kSignModes[0].name, budget_text, channels_text = "distance,gradient,closest_triangle";
+    std::string dtype = "float32";
+    std::vector<int> resolution;
+    double margin = 0.1, band = 0;
+    int threads = 0, max_planes = 0;
+    bool overwrite = false, dry_run = false, quiet = false;
+    app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME")->required();
+    app.add_option("--lattice", lattice_type, "cc or bcc")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("--resolution", resolution,
+                   "N or NX NY NZ: CC points per axis; BCC in the thesis's notation Rx Ry 2Rz (N: N N 2N)")
+        ->required()
+        ->expected(1, 3)
+        ->check(CLI::PositiveNumber);
+    app.add_option("--margin", margin, "fraction of the mesh's largest extent added on every side")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_option("--method", method, "search: bvh or brute_force")->check(CLI::IsMember(sdf::sampler_methods()))->capture_default_str();
+    app.add_option("--backend", backend, "cpu, cuda, or auto (cuda when a GPU is present)")
+        ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
+        ->capture_default_str();
+    app.add_option("--kernel", kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
+    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
+    app.add_option("--sign", sign, "sign mode: auto, pseudonormal or winding")
+        ->check(CLI::IsMember(sdf::sign_mode_names()))
+        ->capture_default_str();
+    app.add_option("--band", band,
+                   "narrow band width in mesh units: exact values where |d| <= W, elsewhere +-W, gradient 0 and "
+                   "closest_triangle -2 (0: no band)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--memory-budget", budget_text,
+                   "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
+    app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
+        ->capture_default_str();
+    app.add_option("--dtype", dtype, "float32 or float64 for distance and gradient")
+        ->check(CLI::IsMember({"float32", "float64"}))
+        ->capture_default_str();
+    app.add_option("--out", out_path, "the field file's header, NAME.json (channels NAME.<channel>.raw beside it)")->required();
+    std::string vdb_path;
+    app.add_option("--vdb", vdb_path,
+                   "also write a narrow-band OpenVDB level set here (FILE.vdb): points with |d| < the band active (--band W, "
+                   "else 3 spacings), built as the slabs arrive");
+    app.add_option("--max-planes-per-slab", max_planes, "at most this many z-planes per slab (0: from the budget)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--overwrite", overwrite, "replace an existing field of that name");
+    app.add_flag("--dry-run", dry_run, "print the plan (slabs, memory, output size) and exit");
+    app.add_flag("--quiet", quiet, "no progress lines on stderr");
+    SDF_CLI_PARSE(app, argc, argv);
+
+    // The command line's values that CLI11 cannot check: exit 2 with what was expected.
+    sdf::StreamOptions stream;
+    sdf::LatticeSpec spec;
+    sdf::SamplerOptions options;
+    try {
+        if (resolution.size() == 2) throw std::invalid_argument("--resolution: expected N or NX NY NZ, got 2 numbers");
+        if (!(band >= 0) || !std::isfinite(band)) throw std::invalid_argument("--band: expected a finite width >= 0");
+        stream.memory_budget = budget_text.empty() ? default_memory_budget() : sdf::parse_byte_size(budget_text, "--memory-budget");
+        if (out_path.size() < 6 || out_path.compare(out_path.size() - 5, 5, ".json") != 0)
+            throw std::invalid_argument("--out " + out_path + ": expected a field file header NAME.json");
+        std::stringstream names(channels_text);
+        bool has_distance = false;
+        stream.gradient = false;
+        stream.write.closest_triangle = false;
+        for (std::string name; std::getline(names, name, ',');) {
+            if (name == "distance") has_distance = true;
+            else if (name == "gradient") stream.gradient = true;
+            else if (name == "closest_triangle") stream.write.closest_triangle = true;
+            else throw std::invalid_argument("--channels: unknown channel '" + name + "'; expected distance, gradient, closest_triangle");
+        }
+        if (!has_distance) throw std::invalid_argument("--channels: the distance channel is always written; name it");
+        if (!vdb_path.empty() && (vdb_path.size() < 5 || vdb_path.compare(vdb_path.size() - 4, 4, ".vdb") != 0))
+            throw std::invalid_argument("--vdb " + vdb_path + ": expected a file name ending in .vdb");
+        if (backend == "auto" && !kernel.empty())
+            throw std::invalid_argument("--kernel " + kernel + ": a kernel needs --backend cpu or cuda");
+        // The lattice and the sampler as the config parser reads them: its checks and messages.
+        nlohmann::json lattice_json = {{"type", lattice_type}};
+        if (resolution.size() == 1) {
+            const int n = resolution[0];
+            lattice_json["resolution"] = lattice_type == "bcc" ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
+        } else {
+            lattice_json["resolution"] = resolution;
+        }
+        sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
+        spec = sdf::parse_lattice_spec(lattice_reader);
+        nlohmann::json sampler_json = {{"backend", backend}, {"method", method}, {"sign", sign},
+                                       {"precision", precision}, {"threads", threads}, {"progress", false}};
+        if (!kernel.empty()) sampler_json["kernel"] = kernel;
+        sdf::JsonReader sampler_reader(sampler_json, "command line", "sampler");
+        options = sdf::parse_sampler_options(sampler_reader);
+        options.band_width = band;
+    } catch (const std::exception& e) {
+        std::cerr << "sdf-sample: error: " << e.what() << "\n";
+        return sdf::kExitCommandLineError;
+    }
+    if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
+    try {
+        stream.header_path = out_path;
+        stream.write.dtype = dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64;
+        stream.write.overwrite = overwrite ? sdf::Overwrite::Allow : sdf::Overwrite::Forbid;
+        stream.max_planes_per_slab = max_planes;
+        stream.bytes_per_point = options.backend == "cuda" ? sdf::kStreamBytesPerPointCuda : sdf::kStreamBytesPerPoint;
+        stream.progress = !quiet;
+
+        const sdf::PreparedMesh mesh =
+            sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
+        for (const std::string& w : mesh.warnings()) std::cerr << "sdf-sample: warning: " << w << "\n";
+        const sdf::Lattice lattice = sdf::build_lattice(spec, mesh.bounds(), margin);
+        stream.fixed_bytes = sdf::estimate_fixed_bytes(mesh);
+        stream.vdb_path = vdb_path;
+        stream.vdb_band = band > 0 ? band : 3.0 * lattice.spacing;  // the .vdb export's default band: 3 spacings
+        const sdf::StreamPlan plan = sdf::plan_streamed_sampling(lattice, stream);
+        if (dry_run) {
+            std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision)
+                      << (band > 0 ? ", band " + std::to_string(band) : std::string()) << "\n"
+                      << plan.describe() << "out: " << out_path << "\n";
+            if (!vdb_path.empty())
+                std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
+                          << " active (its grids hold the band's points, outside the budget)\n";
+            return 0;
+        }
+        require_output_space(plan, out_path);
+        // Temporaries of an interrupted earlier run in the output folder (their process is gone).
+        sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
+        const nlohmann::json mesh_provenance = {{"name", mesh.name()},
+                                                {"source", mesh.source()},
+                                                {"sha256", mesh.content_sha256()},
+                                                {"vertices", mesh.vertices().size()},
+                                                {"triangles", mesh.triangles().size()},
+                                                {"components", mesh.report().components},
+                                                {"sign_reliable", mesh.report().sign_reliable()}};
+        if (!quiet) std::cerr << plan.describe();
+        auto sampler = sdf::make_sampler(options);
+        const sdf::StreamResult r = sdf::sample_streamed(*sampler, options, mesh, lattice, stream, mesh_provenance);
+        std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
+                  << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
+                  << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds
+                  << " s waiting for the disk); peak resident memory " << sdf::format_bytes(r.peak_resident_bytes)
+                  << " (budget " << sdf::format_bytes(stream.memory_budget) << ")\n";
+        if (!vdb_path.empty())
+            std::cout << "wrote " << vdb_path << ": " << r.vdb_active_points << " active points (|d| < " << stream.vdb_band << ")\n";
+        if (band > 0)
+            std::cout << "band " << band << ": " << r.band.in_band << " points in the band, " << r.band.outside << " outside\n";
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "sdf-sample: error: " << e.what() << "\n";
+        return 1;
+    }
+}

@@ -1,0 +1,39 @@
+#include "core/sampling/narrow_band.h"
+
+#include <stdexcept>
+
+namespace sdf {
+
+void require_band_width(double w, const std::string& what) {
+    if (!(w >= 0) || !std::isfinite(w))
+        throw std::invalid_argument(what + ": expected a finite band width >= 0 in mesh units (0: no band), got " +
+                                    std::to_string(w));
+}
+
+NarrowBandCounts apply_narrow_band(SampledField& field, double w) {
+    require_band_width(w);
+    NarrowBandCounts counts;
+    for (int64_t i = 0; i < field.size(); ++i) {
+        if (field.closest_triangle[size_t(i)] == kOutsideBandTriangle) {
+            ++counts.outside;
+        } else if (outside_band(field.distance[size_t(i)], w)) {
+            store_outside_band(field, i, std::signbit(field.distance[size_t(i)]), w);
+            ++counts.outside;
+        } else {
+            ++counts.in_band;
+        }
+    }
+    return counts;
+}
+
+NarrowBandCounts count_narrow_band(const SampledField& field) {
+    NarrowBandCounts counts;
+    for (int32_t t : field.closest_triangle) (t == kOutsideBandTriangle ? counts.outside : counts.in_band) += 1;
+    return counts;
+}
+
+nlohmann::json narrow_band_provenance(double w, const NarrowBandCounts& counts, const std::string& how) {
+    return {{"width", w}, {"points_in_band", counts.in_band}, {"points_outside", counts.outside}, {"how", how}};
+}
+
+}  // namespace sdf

@@ -1,0 +1,326 @@
+#include "harness/sampling/streamed_sampling.h"
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <future>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "core/checked_math.h"
+#include "core/lattice/lattice_fitting.h"
+#include "core/parallel/parallel_for.h"
+#include "harness/io/atomic_file.h"
+#include "harness/io/volume_grids.h"
+#include "harness/resources/memory_budget.h"
+
+namespace sdf {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+int64_t checked(std::optional<int64_t> v, const std::string& what) {
+    if (!v) throw std::runtime_error(what + ": the size overflows 64 bits");
+    return *v;
+}
+
+/// Points of one z-plane of the slab layout: a primary plane and, on BCC, a secondary one.
+int64_t points_per_plane(const Lattice& l) {
+    const int64_t primary = checked(checked_mul(l.resolution.x, l.resolution.y), "z-plane of " + lattice_notation(l));
+    if (l.secondary_count() == 0) return primary;
+    const Int3 s = l.secondary_resolution();
+    return primary + int64_t(s.x) * s.y;
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+/// The channel files being written: temporaries beside their final names, removed unless
+/// committed.
+class StagedChannels {
+public:
+    StagedChannels(const std::vector<FieldChannelFile>& channels, int64_t points) : channels_(channels) {
+        for (const FieldChannelFile& c : channels_) {
+            const std::string tmp = unique_sibling_name(c.path, "tmp");
+            const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+            if (fd < 0) throw std::runtime_error(tmp + ": cannot create (" + errno_text() + ")");
+            temps_.push_back(tmp);
+            fds_.push_back(fd);
+            const off_t size = off_t(checked(checked_mul(points, int64_t(c.bytes_per_point())), c.path));
+            // Reserve the blocks now, so a full disk fails here rather than after the sampling;
+            // file systems without fallocate get a sparse file of the final size.
+            if (::fallocate(fd, 0, 0, size) != 0) {
+                if (errno == ENOSPC) throw std::runtime_error(c.path + ": no space left for " + format_bytes(uint64_t(size)));
+                if (::ftruncate(fd, size) != 0) throw std::runtime_error(tmp + ": cannot size (" + errno_text() + ")");
+            }
+        }
+    }
+    ~StagedChannels() {
+        close_all();
+        if (!committed_)
+            for (const std::string& t : temps_) ::unlink(t.c_str());
+    }
+    StagedChannels(const StagedChannels&) = delete;
+    StagedChannels& operator=(const StagedChannels&) = delete;
+
+    /// Writes points [first, first + count) of `field` at lattice storage offset `offset`,
+    /// chunk by chunk on kStreamWriteThreads threads (pwrite at distinct offsets): the
+    /// conversion to the stored type, not the disk, limits one thread behind a fast sampler.
+    void write(const SampledField& field, int64_t first, int64_t count, int64_t offset) {
+        for (size_t c = 0; c < channels_.size(); ++c) {
+            const size_t width = channels_[c].bytes_per_point();
+            const int64_t chunks = (count + kStreamWriteChunk - 1) / kStreamWriteChunk;
+            parallel_for(chunks, 1, kStreamWriteThreads, [&](int64_t begin, int64_t end) {
+                for (int64_t k = begin; k < end; ++k) {
+                    const int64_t done = k * kStreamWriteChunk, n = std::min(kStreamWriteChunk, count - done);
+                    const std::vector<char> bytes = field_channel_bytes(field, channels_[c], size_t(first + done), size_t(n));
+                    write_at(c, bytes, off_t(size_t(offset + done) * width));
+                }
+            });
+        }
+    }
+
+    /// fsync, close, and rename every file into place (replacing only with Overwrite::Allow).
+    void commit(Overwrite overwrite) {
+        for (size_t c = 0; c < fds_.size(); ++c)
+            if (::fsync(fds_[c]) != 0) throw std::runtime_error(channels_[c].path + ": fsync failed (" + errno_text() + ")");
+        close_all();
+        for (size_t c = 0; c < temps_.size(); ++c) {
+            if (overwrite == Overwrite::Allow) {
+                fs::rename(temps_[c], channels_[c].path);
+            } else if (!rename_no_replace(temps_[c], channels_[c].path)) {
+                for (size_t k = 0; k < c; ++k) ::unlink(channels_[k].path.c_str());  // ours, just renamed
+                throw std::runtime_error(channels_[c].path + ": appeared while sampling; refusing to overwrite a field");
+            }
+        }
+        committed_ = true;
+    }
+
+private:
+    void write_at(size_t c, const std::vector<char>& bytes, off_t at) {
+        size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t n = ::pwrite(fds_[c], bytes.data() + done, bytes.size() - done, at + off_t(done));
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) throw std::runtime_error(channels_[c].path + ": write failed (" + errno_text() + ")");
+            done += size_t(n);
+        }
+    }
+    void close_all() {
+        for (int fd : fds_) ::close(fd);
+        fds_.clear();
+    }
+
+    std::vector<FieldChannelFile> channels_;
+    std::vector<std::string> temps_;
+    std::vector<int> fds_;
+    bool committed_ = false;
+};
+
+/// The merged sampler provenance of the slabs: the first slab's, with the counts summed.
+void merge_slab_provenance(nlohmann::json& merged, const nlohmann::json& slab) {
+    if (merged.is_null()) {
+        merged = slab;
+        return;
+    }
+    if (merged.contains("points_computed") && slab.contains("points_computed"))
+        merged["points_computed"] = merged["points_computed"].get<int64_t>() + slab["points_computed"].get<int64_t>();
+    if (merged.contains("band") && slab.contains("band"))
+        for (const char* key : {"probes", "bricks_skipped", "points_skipped"})
+            if (merged["band"].contains(key) && slab["band"].contains(key))
+                merged["band"][key] = merged["band"][key].get<int64_t>() + slab["band"][key].get<int64_t>();
+}
+
+}  // namespace
+
+uint64_t estimate_fixed_bytes(const PreparedMesh& mesh) {
+    return current_resident_bytes() + kStreamBvhBytesPerTriangle * uint64_t(mesh.triangles().size()) +
+           (kStreamWriteThreads + 1) * uint64_t(kStreamWriteChunk) * 24;  // a conversion buffer per writing thread, with room
+}
+
+std::vector<LatticeSlab> StreamPlan::slab_list() const {
+    std::vector<LatticeSlab> slabs;
+    for (int z = 0; z < lattice.resolution.z; z += planes_per_slab)
+        slabs.push_back({z, std::min(lattice.resolution.z, z + planes_per_slab)});
+    return slabs;
+}
+
+nlohmann::json StreamPlan::to_json() const {
+    nlohmann::json names = nlohmann::json::array();
+    for (const FieldChannelFile& c : channels) names.push_back(c.name);
+    return {{"points", points},
+            {"slabs", slabs},
+            {"planes_per_slab", planes_per_slab},
+            {"slab_bytes", slab_bytes},
+            {"memory_budget_bytes", memory_budget},
+            {"fixed_bytes", fixed_bytes},
+            {"peak_estimate_bytes", peak_estimate},
+            {"bytes_per_point_sampled", bytes_per_point},
+            {"output_bytes", output_bytes},
+            {"channels", names}};
+}
+
+std::string StreamPlan::describe() const {
+    std::string names;
+    for (const FieldChannelFile& c : channels) names += (names.empty() ? "" : ", ") + c.name;
+    std::string text = "lattice: " + lattice_notation(lattice) + " (" + std::to_string(points) + " points)\n";
+    text += "slabs: " + std::to_string(slabs) + " of up to " + std::to_string(planes_per_slab) + " z-planes (" +
+            format_bytes(slab_bytes) + " each while sampled; two held at a time)\n";
+    text += "memory: budget " + format_bytes(memory_budget) + ", fixed part " + format_bytes(fixed_bytes) +
+            ", estimated peak " + format_bytes(peak_estimate) + "\n";
+    text += "output: " + format_bytes(output_bytes) + " in " + std::to_string(channels.size()) + " channel files (" + names + ")\n";
+    return text;
+}
+
+StreamPlan plan_streamed_sampling(const Lattice& lattice, const StreamOptions& options) {
+    StreamPlan plan;
+    plan.lattice = lattice;
+    plan.points = checked_lattice_points(lattice.type, lattice.resolution);
+    plan.memory_budget = options.memory_budget;
+    plan.fixed_bytes = options.fixed_bytes;
+    SampledField layout;  // one point: the channel layout of write_field for these options
+    layout.lattice = lattice;
+    layout.resize(1);
+    if (!options.gradient) layout.gradient.clear();
+    plan.channels = field_channel_files(options.header_path, layout, options.write);
+    for (const FieldChannelFile& c : plan.channels)
+        plan.output_bytes += uint64_t(checked(checked_mul(plan.points, int64_t(c.bytes_per_point())), c.path));
+    if (options.bytes_per_point == 0 || options.bytes_per_point > 4096)
+        throw std::invalid_argument("streamed sampling: bytes per point must be in [1, 4096], got " +
+                                    std::to_string(options.bytes_per_point));
+    plan.bytes_per_point = options.bytes_per_point;
+    const int64_t plane_bytes = checked(checked_mul(points_per_plane(lattice), int64_t(options.bytes_per_point)), "z-plane bytes");
+    const uint64_t least = options.fixed_bytes + 2 * uint64_t(plane_bytes);
+    if (options.memory_budget < least)
+        throw std::runtime_error("memory budget " + format_bytes(options.memory_budget) + " is too small for " +
+                                 lattice_notation(lattice) + ": the fixed part (libraries, mesh, BVH) takes " +
+                                 format_bytes(options.fixed_bytes) + " and two slabs of one z-plane " +
+                                 format_bytes(2 * uint64_t(plane_bytes)) + "; give at least " + format_bytes(least) + " (" + std::to_string(least) + " bytes)");
+    const uint64_t planes = (options.memory_budget - options.fixed_bytes) / (2 * uint64_t(plane_bytes));
+    plan.planes_per_slab = int(std::min<uint64_t>(planes, uint64_t(lattice.resolution.z)));
+    if (options.max_planes_per_slab > 0) plan.planes_per_slab = std::min(plan.planes_per_slab, options.max_planes_per_slab);
+    plan.slabs = (lattice.resolution.z + plan.planes_per_slab - 1) / plan.planes_per_slab;
+    plan.slab_bytes = uint64_t(plan.planes_per_slab) * uint64_t(plane_bytes);
+    plan.peak_estimate = options.fixed_bytes + 2 * plan.slab_bytes;
+    return plan;
+}
+
+StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
+                             const Lattice& lattice, const StreamOptions& options, const nlohmann::json& mesh_provenance) {
+    const auto start = Clock::now();
+    const double w = sampler_options.band_width;
+    require_band_width(w, "band width");
+    StreamResult result;
+    result.plan = plan_streamed_sampling(lattice, options);
+    const StreamPlan& plan = result.plan;
+    std::vector<std::string> targets = {options.header_path};
+    if (!options.vdb_path.empty()) targets.push_back(options.vdb_path);
+    for (const FieldChannelFile& c : plan.channels) targets.push_back(c.path);
+    if (options.write.overwrite == Overwrite::Forbid)
+        for (const std::string& t : targets)
+            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field (--overwrite replaces it)");
+    std::unique_ptr<VdbNarrowBandBuilder> vdb;
+    if (!options.vdb_path.empty()) {
+        if (!(options.vdb_band > 0) || !std::isfinite(options.vdb_band))
+            throw std::invalid_argument(options.vdb_path + ": the OpenVDB band must be a positive width, got " +
+                                        std::to_string(options.vdb_band));
+        vdb = std::make_unique<VdbNarrowBandBuilder>(lattice, options.vdb_band, options.gradient);
+    }
+    StagedChannels files(plan.channels, plan.points);
+
+    SampledField& header = result.header;
+    header.lattice = lattice;
+    header.precision = sampler_options.precision;
+    header.mesh = mesh_provenance;
+    std::future<void> writing;  // the previous slab's write, overlapping this slab's sampling
+    const std::vector<LatticeSlab> slabs = plan.slab_list();
+    for (size_t s = 0; s < slabs.size(); ++s) {
+        const LatticeSlab slab = slabs[s];
+        const auto slab_start = Clock::now();
+        auto field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
+        if (field->size() != slab_point_count(lattice, slab))
+            throw std::logic_error("sampler returned " + std::to_string(field->size()) + " points for a slab of " +
+                                   std::to_string(slab_point_count(lattice, slab)));
+        if (w > 0) {
+            const NarrowBandCounts c = apply_narrow_band(*field, w);
+            result.band.in_band += c.in_band;
+            result.band.outside += c.outside;
+            if (!field->sampler.contains("band")) field->sampler["band"] = narrow_band_provenance(w, c, "post-processed by sdf-sample");
+        }
+        merge_slab_provenance(header.sampler, field->sampler);
+        header.timings.kernel += field->timings.kernel;
+        header.timings.upload += field->timings.upload;
+        header.timings.download += field->timings.download;
+        header.timings.point_triangle_pairs += field->timings.point_triangle_pairs;
+        const double sampled = seconds_since(slab_start);
+        const auto wait_start = Clock::now();
+        if (writing.valid()) writing.get();  // rethrows the writer's error; frees its slab
+        result.write_wait_seconds += seconds_since(wait_start);
+        writing = std::async(std::launch::async, [&files, &vdb, &lattice, slab, field] {
+            const StorageRange primary = slab_storage(lattice, slab, 0), secondary = slab_storage(lattice, slab, 1);
+            files.write(*field, 0, primary.count, primary.offset);
+            files.write(*field, primary.count, secondary.count, secondary.offset);
+            if (vdb) {
+                vdb->add(*field, 0, primary.count, primary.offset);
+                vdb->add(*field, primary.count, secondary.count, secondary.offset);
+            }
+        });
+        if (options.progress)
+            std::cerr << "sdf-sample: slab " << s + 1 << "/" << slabs.size() << " (z-planes " << slab.z_begin << "-"
+                      << slab.z_end - 1 << "): sampled in " << sampled << " s\n";
+    }
+    const auto wait_start = Clock::now();
+    if (writing.valid()) writing.get();
+    result.write_wait_seconds += seconds_since(wait_start);
+    files.commit(options.write.overwrite);
+    if (vdb) {
+        const std::string temporary = unique_sibling_name(options.vdb_path, "tmp");
+        try {
+            vdb->write(temporary);
+            if (options.write.overwrite == Overwrite::Allow) fs::rename(temporary, options.vdb_path);
+            else if (!rename_no_replace(temporary, options.vdb_path))
+                throw std::runtime_error(options.vdb_path + ": appeared while sampling; refusing to overwrite it");
+        } catch (...) {
+            std::error_code ec;
+            fs::remove(temporary, ec);
+            if (options.write.overwrite == Overwrite::Forbid)
+                for (const FieldChannelFile& c : plan.channels) ::unlink(c.path.c_str());  // all new: leave none behind
+            throw;
+        }
+        result.vdb_active_points = vdb->active_points();
+    }
+    result.seconds = seconds_since(start);
+    result.peak_resident_bytes = peak_resident_bytes();
+    header.timings.total = result.seconds;
+    if (w > 0) {
+        header.sampler["band"]["points_in_band"] = result.band.in_band;
+        header.sampler["band"]["points_outside"] = result.band.outside;
+    }
+    nlohmann::json streaming = plan.to_json();
+    streaming["seconds"] = result.seconds;
+    streaming["write_wait_seconds"] = result.write_wait_seconds;
+    streaming["peak_resident_bytes"] = result.peak_resident_bytes;
+    if (vdb)
+        streaming["vdb"] = {{"file", fs::path(options.vdb_path).filename().string()},
+                            {"band", options.vdb_band},
+                            {"active_points", result.vdb_active_points}};
+    header.sampler["streaming"] = streaming;
+    try {
+        write_field_header(options.header_path, header, plan.channels, options.write.overwrite);
+    } catch (...) {
+        if (options.write.overwrite == Overwrite::Forbid)
+            for (const FieldChannelFile& c : plan.channels) ::unlink(c.path.c_str());  // all new: leave none behind
+        throw;
+    }
+    return result;
+}
+
+}  // namespace sdf

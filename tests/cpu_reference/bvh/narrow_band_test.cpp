@@ -1,0 +1,148 @@
+// The narrow band (SamplerOptions::band_width) of the CPU samplers equals the full field
+// with the band rule applied afterwards (apply_narrow_band), bit for bit: CC and BCC, a closed
+// mesh (pseudonormal sign: one side per skipped ball) and an open one (winding sign: each
+// skipped point's own), float and double, several widths; the BVH sampler skips the bricks a
+// probe proves outside the band, so on a lattice mostly far from the surface few points are
+// computed exactly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/sampling/narrow_band.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+
+namespace sdf {
+namespace {
+
+SamplerOptions options(Precision precision, double band, SignMode sign = SignMode::Auto, const std::string& kernel = "") {
+    SamplerOptions o;
+    o.precision = precision;
+    o.band_width = band;
+    o.sign = sign;
+    o.kernel = kernel;
+    o.progress = false;
+    return o;
+}
+
+/// Half an icosphere: open (winding sign under auto).
+PreparedMesh bowl() {
+    TriangleMesh m = make_icosphere(3, 1.0);
+    std::vector<Int3> kept;
+    for (const Int3& t : m.triangles)
+        if (m.vertices[size_t(t.x)].z + m.vertices[size_t(t.y)].z + m.vertices[size_t(t.z)].z < 0.6) kept.push_back(t);
+    m.triangles = kept;
+    return prepare_mesh(m);
+}
+
+template <typename V>
+bool same_bits(const std::vector<V>& a, const std::vector<V>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
+}
+
+/// `banded` equals `full` with the band rule applied, bit for bit.
+void expect_banded(const SampledField& full, const SampledField& banded, double w, const std::string& what) {
+    SampledField expected = full;
+    const NarrowBandCounts counts = apply_narrow_band(expected, w);
+    EXPECT_TRUE(same_bits(expected.distance, banded.distance)) << what;
+    EXPECT_TRUE(same_bits(expected.gradient, banded.gradient)) << what;
+    EXPECT_TRUE(same_bits(expected.closest_triangle, banded.closest_triangle)) << what;
+    ASSERT_TRUE(banded.sampler.contains("band")) << what;
+    EXPECT_EQ(banded.sampler["band"]["points_in_band"].get<int64_t>(), counts.in_band) << what;
+    EXPECT_EQ(banded.sampler["band"]["points_outside"].get<int64_t>(), counts.outside) << what;
+    EXPECT_GT(counts.in_band, 0) << what;
+    EXPECT_GT(counts.outside, 0) << what;
+}
+
+TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
+    struct Case {
+        std::string name;
+        PreparedMesh mesh;
+        SignMode sign;  ///< what auto resolves to (named, so the tests print no auto warning)
+    };
+    const std::vector<Case> cases = {{"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), SignMode::Auto},
+                                     {"bowl", bowl(), SignMode::Winding}};
+    for (const Case& c : cases) {
+        const Lattice cc = fit_lattice(LatticeType::CC, {21, 22, 23}, c.mesh.bounds(), 0.3);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, {15, 16, 17}, c.mesh.bounds(), 0.3);
+        for (Precision precision : {Precision::Float, Precision::Double})
+            for (const Lattice& lattice : {cc, bcc}) {
+                const SampledField full_bvh = make_cpu_bvh_sampler(options(precision, 0, c.sign))->sample(c.mesh, lattice);
+                const SampledField full_brute = make_cpu_brute_force_sampler(options(precision, 0, c.sign))->sample(c.mesh, lattice);
+                for (double spacings : {0.5, 2.0, 6.0}) {
+                    const double w = spacings * lattice.spacing;
+                    const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
+                                             " w = " + std::to_string(spacings) + " h";
+                    const SampledField bvh = make_cpu_bvh_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
+                    expect_banded(full_bvh, bvh, w, what + " bvh");
+                    EXPECT_EQ(bvh.sampler["band"]["how"], "bricks skipped by the distance bound") << what;
+                    EXPECT_GT(bvh.sampler["band"]["bricks_skipped"].get<int64_t>(), 0) << what;
+                    const SampledField brute = make_cpu_brute_force_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
+                    expect_banded(full_brute, brute, w, what + " brute force");
+                    EXPECT_EQ(brute.sampler["band"]["how"], "post-processed") << what;
+                    if (HasFailure()) return;
+                }
+            }
+    }
+}
+
+TEST(NarrowBand, PseudonormalSignOnAnOpenMeshAndPointKernelsPostProcess) {
+    const PreparedMesh mesh = bowl();
+    const Lattice lattice = fit_lattice(LatticeType::CC, {18, 18, 18}, mesh.bounds(), 0.3);
+    const double w = 1.5 * lattice.spacing;
+    // Forced pseudonormal on an open mesh: its sign may change off the surface, so no brick
+    // is skipped on a probe's sign.
+    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Pseudonormal))->sample(mesh, lattice);
+    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Pseudonormal))->sample(mesh, lattice);
+    expect_banded(full, banded, w, "bowl forced pseudonormal");
+    EXPECT_EQ(banded.sampler["band"]["how"], "post-processed");
+    EXPECT_EQ(banded.sampler["band"]["bricks_skipped"].get<int64_t>(), 0);
+    for (const char* kernel : {"seeded", "unseeded"}) {
+        const SampledField k_full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding, kernel))->sample(mesh, lattice);
+        const SampledField k_band = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding, kernel))->sample(mesh, lattice);
+        expect_banded(k_full, k_band, w, std::string("bowl kernel ") + kernel);
+    }
+}
+
+TEST(NarrowBand, FewPointsAreComputedWhenMostOfTheLatticeIsOutsideTheBand) {
+    const PreparedMesh mesh = prepare_mesh(make_icosphere(3, 1.0));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {64, 64, 64}, mesh.bounds(), 0.5);
+    const double w = lattice.spacing;
+    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0))->sample(mesh, lattice);
+    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w))->sample(mesh, lattice);
+    expect_banded(full, banded, w, "sphere 64^3 w = h");
+    const nlohmann::json& band = banded.sampler["band"];
+    const int64_t computed = banded.sampler["points_computed"].get<int64_t>();
+    const int64_t in_band = band["points_in_band"].get<int64_t>(), probes = band["probes"].get<int64_t>();
+    std::printf("sphere 64^3, w = h: %lld of %lld points in the band, %lld computed exactly, %lld probes, %lld bricks skipped\n",
+                (long long)in_band, (long long)lattice.num_points(), (long long)computed, (long long)probes,
+                (long long)band["bricks_skipped"].get<int64_t>());
+    // The shell |d| <= h of a sphere of radius 1 on this lattice holds about 4 pi r^2 * 2h / h^3 points;
+    // the bricks that touch it hold a few times more; the rest is skipped.
+    EXPECT_LT(computed, 8 * in_band);
+    EXPECT_LT(computed + probes, lattice.num_points() / 5);
+    EXPECT_EQ(computed + band["points_skipped"].get<int64_t>(), lattice.num_points());
+}
+
+TEST(NarrowBand, RefusesBadWidthsByName) {
+    const PreparedMesh mesh = prepare_mesh(make_icosphere(1, 1.0));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {4, 4, 4}, mesh.bounds(), 0.1);
+    for (double w : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+        for (int bvh : {0, 1}) {
+            auto sampler = bvh ? make_cpu_bvh_sampler(options(Precision::Float, w)) : make_cpu_brute_force_sampler(options(Precision::Float, w));
+            try {
+                sampler->sample(mesh, lattice);
+                ADD_FAILURE() << "band width " << w << " accepted";
+            } catch (const std::invalid_argument& e) {
+                EXPECT_NE(std::string(e.what()).find("band_width"), std::string::npos) << e.what();
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace sdf

@@ -1,0 +1,272 @@
+// sdf-sample's streaming (harness/sampling/streamed_sampling.h): a lattice sampled slab by
+// slab under a tiny memory budget writes channel files equal byte for byte to the in-memory
+// writer's (write_field) for the same lattice: CC and BCC, float32 and float64, with and
+// without a narrow band, all channels or some; the plan refuses budgets too small, existing
+// outputs are kept, and the tool's command line refuses bad budget strings with exit 2.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "harness/io/field_file.h"
+#include "harness/resources/memory_budget.h"
+#include "harness/sampling/streamed_sampling.h"
+#include "harness_test_util.h"
+
+#if SDF_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+#endif
+#include "harness/io/volume_formats.h"
+
+#if !defined(SDF_SAMPLE_EXE) || !defined(RUN_EXPERIMENT_EXE)
+#error "SDF_SAMPLE_EXE and RUN_EXPERIMENT_EXE must be defined by CMake"
+#endif
+
+namespace sdf {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string bytes_of(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+SamplerOptions sampler_options(double band) {
+    SamplerOptions o;
+    o.method = "bvh";
+    o.band_width = band;
+    o.progress = false;
+    return o;
+}
+
+const PreparedMesh& torus() {
+    static const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
+    return mesh;
+}
+
+TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
+    test::ScratchDir dir("streamed_sampling");
+    const PreparedMesh& mesh = torus();
+    const Lattice cc = fit_lattice(LatticeType::CC, {13, 14, 15}, mesh.bounds(), 0.1);
+    const Lattice bcc = fit_lattice(LatticeType::BCC, {11, 12, 9}, mesh.bounds(), 0.1);
+    int n = 0;
+    for (const Lattice& lattice : {cc, bcc})
+        for (FieldDtype dtype : {FieldDtype::Float32, FieldDtype::Float64})
+            for (double band : {0.0, 2.0 * lattice.spacing})
+                for (int gradient_and_triangle : {1, 0}) {
+                    const std::string what = lattice_notation(lattice) + (dtype == FieldDtype::Float32 ? " float32" : " float64") +
+                                             " band " + std::to_string(band) + (gradient_and_triangle ? " all channels" : " distance only");
+                    const std::string tag = std::to_string(n++);
+                    SampledField field = make_cpu_bvh_sampler(sampler_options(band))->sample(mesh, lattice);
+                    FieldWriteOptions write;
+                    write.dtype = dtype;
+                    write.closest_triangle = gradient_and_triangle != 0;
+                    if (!gradient_and_triangle) field.gradient.clear();
+                    const std::string memory = dir.at("memory" + tag + ".json"), streamed = dir.at("streamed" + tag + ".json");
+                    write_field(memory, field, write);
+
+                    StreamOptions stream;
+                    stream.header_path = streamed;
+                    stream.write = write;
+                    stream.gradient = gradient_and_triangle != 0;
+                    stream.fixed_bytes = 1 << 20;
+                    // Room for two slabs of 2 z-planes: 7 or 8 slabs.
+                    const int64_t plane = int64_t(lattice.resolution.x) * lattice.resolution.y * 2;
+                    stream.memory_budget = stream.fixed_bytes + 2 * 2 * uint64_t(plane) * kStreamBytesPerPoint;
+                    stream.progress = false;
+                    const SamplerOptions options = sampler_options(band);
+                    auto sampler = make_cpu_bvh_sampler(options);
+                    const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {{"name", "torus"}});
+                    EXPECT_GE(r.plan.slabs, 4) << what;
+                    for (const FieldChannelFile& c : r.plan.channels) {
+                        const std::string mem_file = dir.at("memory" + tag + "." + c.name + ".raw");
+                        ASSERT_TRUE(fs::exists(mem_file)) << what << " " << c.name;
+                        EXPECT_TRUE(bytes_of(mem_file) == bytes_of(c.path)) << what << ": channel " << c.name << " differs";
+                    }
+                    EXPECT_EQ(r.plan.channels.size(), gradient_and_triangle ? 3u : 1u) << what;
+                    const SampledField back = read_field(streamed);
+                    EXPECT_EQ(back.distance.size(), size_t(lattice.num_points())) << what;
+                    const nlohmann::json header = test::read_json(streamed);
+                    EXPECT_EQ(header["sampler"]["streaming"]["slabs"], r.plan.slabs) << what;
+                    EXPECT_GT(header["sampler"]["streaming"]["peak_resident_bytes"].get<uint64_t>(), 0u) << what;
+                    if (band > 0) {
+                        const NarrowBandCounts counts = count_narrow_band(field);
+                        EXPECT_EQ(header["sampler"]["band"]["points_in_band"].get<int64_t>(), counts.in_band) << what;
+                        EXPECT_EQ(header["sampler"]["band"]["points_outside"].get<int64_t>(), counts.outside) << what;
+                    }
+                    // No temporaries left beside the outputs.
+                    for (const auto& e : fs::directory_iterator(dir.path()))
+                        EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
+                    if (HasFailure()) return;
+                }
+}
+
+#if SDF_HAVE_OPENVDB
+/// Every grid of `a` is in `b` with the same background and the same active voxels and values.
+void expect_same_vdb(const std::string& a, const std::string& b, const std::string& what) {
+    openvdb::initialize();
+    openvdb::io::File fa(a), fb(b);
+    fa.open();
+    fb.open();
+    const openvdb::GridPtrVecPtr ga = fa.getGrids(), gb = fb.getGrids();
+    ASSERT_EQ(ga->size(), gb->size()) << what;
+    for (size_t g = 0; g < ga->size(); ++g) {
+        const openvdb::GridBase::Ptr other = fb.readGrid((*ga)[g]->getName());
+        EXPECT_EQ((*ga)[g]->activeVoxelCount(), other->activeVoxelCount()) << what << " " << (*ga)[g]->getName();
+        if (auto fa_grid = openvdb::gridPtrCast<openvdb::FloatGrid>((*ga)[g])) {
+            auto fb_grid = openvdb::gridPtrCast<openvdb::FloatGrid>(other);
+            ASSERT_TRUE(fb_grid) << what;
+            EXPECT_EQ(fa_grid->background(), fb_grid->background()) << what;
+            auto acc = fb_grid->getConstAccessor();
+            for (auto it = fa_grid->cbeginValueOn(); it; ++it) {
+                EXPECT_TRUE(acc.isValueOn(it.getCoord())) << what;
+                EXPECT_EQ(*it, acc.getValue(it.getCoord())) << what;
+            }
+        } else if (auto va = openvdb::gridPtrCast<openvdb::Vec3fGrid>((*ga)[g])) {
+            auto vb = openvdb::gridPtrCast<openvdb::Vec3fGrid>(other);
+            ASSERT_TRUE(vb) << what;
+            auto acc = vb->getConstAccessor();
+            for (auto it = va->cbeginValueOn(); it; ++it) EXPECT_EQ(*it, acc.getValue(it.getCoord())) << what;
+        }
+    }
+}
+
+TEST(StreamedSampling, NarrowBandVdbEqualsTheInMemoryExport) {
+    test::ScratchDir dir("streamed_vdb");
+    const PreparedMesh& mesh = torus();
+    const Lattice cc = fit_lattice(LatticeType::CC, {24, 25, 26}, mesh.bounds(), 0.1);
+    const Lattice bcc = fit_lattice(LatticeType::BCC, {17, 18, 15}, mesh.bounds(), 0.1);
+    int n = 0;
+    for (const Lattice& lattice : {cc, bcc}) {
+        const std::string tag = std::to_string(n++), what = lattice_notation(lattice);
+        const double w = 2.0 * lattice.spacing;
+        const SampledField field = make_cpu_bvh_sampler(sampler_options(w))->sample(mesh, lattice);
+        VolumeWriteOptions v;
+        v.vdb_band = 2.0;
+        write_field_as(field, dir.at("memory" + tag + ".vdb"), VolumeFormat::Vdb, v);
+        StreamOptions stream;
+        stream.header_path = dir.at("streamed" + tag + ".json");
+        stream.fixed_bytes = 1 << 20;
+        stream.memory_budget = 64 << 20;
+        stream.max_planes_per_slab = 3;
+        stream.progress = false;
+        stream.vdb_path = dir.at("streamed" + tag + ".vdb");
+        stream.vdb_band = w;
+        const SamplerOptions options = sampler_options(w);
+        auto sampler = make_cpu_bvh_sampler(options);
+        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {});
+        EXPECT_GE(r.plan.slabs, 5) << what;
+        EXPECT_GT(r.vdb_active_points, 100) << what;
+        EXPECT_LE(r.vdb_active_points, count_narrow_band(field).in_band) << what;
+        expect_same_vdb(dir.at("memory" + tag + ".vdb"), stream.vdb_path, what + " memory vs streamed");
+        expect_same_vdb(stream.vdb_path, dir.at("memory" + tag + ".vdb"), what + " streamed vs memory");
+    }
+}
+#endif
+
+TEST(StreamedSampling, RefusesSmallBudgetsAndExistingOutputs) {
+    test::ScratchDir dir("streamed_refusals");
+    const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, torus().bounds(), 0.1);
+    StreamOptions stream;
+    stream.header_path = dir.at("f.json");
+    stream.fixed_bytes = 10 << 20;
+    stream.memory_budget = 10 << 20;
+    try {
+        plan_streamed_sampling(lattice, stream);
+        ADD_FAILURE() << "a budget below the fixed part was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_TRUE(test::Contains(e.what(), "give at least 10 MiB (10518528 bytes)"));
+    }
+    stream.memory_budget = 64 << 20;
+    stream.progress = false;
+    dir.write("f.distance.raw", "someone's data");
+    const SamplerOptions options = sampler_options(0);
+    auto sampler = make_cpu_bvh_sampler(options);
+    EXPECT_THROW(sample_streamed(*sampler, options, torus(), lattice, stream, {}), std::runtime_error);
+    EXPECT_EQ(test::read_text(dir.at("f.distance.raw")), "someone's data");
+    EXPECT_FALSE(fs::exists(dir.at("f.json")));
+}
+
+TEST(StreamedSampling, ByteSizesParseOrFailByName) {
+    EXPECT_EQ(parse_byte_size("8GiB", "b"), uint64_t(8) << 30);
+    EXPECT_EQ(parse_byte_size("256 MiB", "b"), uint64_t(256) << 20);
+    EXPECT_EQ(parse_byte_size("1.5g", "b"), uint64_t(3) << 29);
+    EXPECT_EQ(parse_byte_size("2GB", "b"), uint64_t(2000000000));
+    EXPECT_EQ(parse_byte_size("1000", "b"), uint64_t(1000));
+    for (const char* bad : {"-1", "1e30GiB", "abc", "", "0", "0.1", ".", "1.2.3G", "5 XB", "9999999TiB"}) {
+        try {
+            parse_byte_size(bad, "--memory-budget");
+            ADD_FAILURE() << "accepted " << bad;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_TRUE(test::Contains(e.what(), "--memory-budget")) << e.what();
+        }
+    }
+}
+
+TEST(StreamedSampling, ToolRefusesBadOptionsWithExitTwoAndWritesWhatItPlans) {
+    test::ScratchDir dir("sdf_sample_cli");
+    const std::string exe = test::quote(SDF_SAMPLE_EXE);
+    for (const char* budget : {"-1", "1e30GiB", "abc"}) {
+        const test::ShellResult r =
+            test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --out f.json --memory-budget " + test::quote(budget));
+        EXPECT_EQ(r.code, 2) << budget << ": " << r.err;
+        EXPECT_TRUE(test::Contains(r.err, "--memory-budget")) << r.err;
+    }
+    for (const std::string& args : {std::string("--resolution 8 8 --out f.json"), std::string("--resolution 8 --out f.npy"),
+                                    std::string("--resolution 8 --out f.json --channels gradient"),
+                                    std::string("--resolution 8 --out f.json --band -1"),
+                                    std::string("--resolution 0 --out f.json"),
+                                    std::string("--lattice bcc --resolution 8 8 9 --out f.json"),
+                                    std::string("--resolution 8 --out f.json --channels distance,normals")}) {
+        const test::ShellResult r = test::run_in(dir.path(), exe + " shape:sphere " + args);
+        EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    }
+    const test::ShellResult plan = test::run_in(dir.path(), exe + " shape:sphere --lattice bcc --resolution 10 --out f.json --dry-run");
+    EXPECT_EQ(plan.code, 0) << plan.err;
+    EXPECT_TRUE(test::Contains(plan.out, "10x10x20"));
+    EXPECT_TRUE(test::Contains(plan.out, "memory: budget"));
+    EXPECT_FALSE(fs::exists(dir.at("f.json")));
+    const test::ShellResult run = test::run_in(
+        dir.path(), exe + " shape:sphere --resolution 12 --out f.json --memory-budget 256MiB --max-planes-per-slab 3 --quiet");
+    EXPECT_EQ(run.code, 0) << run.err;
+    EXPECT_TRUE(test::Contains(run.out, "in 4 slabs"));
+    EXPECT_EQ(read_field(dir.at("f.json")).distance.size(), 12u * 12u * 12u);
+    const test::ShellResult again = test::run_in(dir.path(), exe + " shape:sphere --resolution 12 --out f.json --quiet");
+    EXPECT_EQ(again.code, 1);
+    EXPECT_TRUE(test::Contains(again.err, "already exists"));
+}
+
+TEST(StreamedSampling, ToolEqualsRunExperimentFieldsByteForByte) {
+    test::ScratchDir dir("sdf_sample_vs_run_experiment");
+    dir.write("c.json", R"({"name": "stream_e2e", "kind": "reconstruction", "mesh": {"shape": "torus"},
+        "domain": {"margin": 0.1},
+        "lattices": [{"type": "cc", "resolution": [14, 15, 16]}, {"type": "bcc", "resolution": [11, 11, 22]}],
+        "sampler": {"backend": "cpu", "method": "bvh", "precision": "float", "progress": false},
+        "metrics": {"domain_probes": 10, "band_probes": 10, "band": 1.0, "seed": 1}})");
+    const test::ShellResult run = test::run_in(
+        dir.path(), test::quote(RUN_EXPERIMENT_EXE) + " c.json --output-root results --no-cache --quiet");
+    ASSERT_EQ(run.code, 0) << run.err;
+    fs::path fields;
+    for (const auto& e : fs::directory_iterator(dir.path() / "results" / "stream_e2e")) fields = e.path() / "fields";
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) + " shape:torus --backend cpu --margin 0.1 --memory-budget 256MiB --quiet";
+    const test::ShellResult cc = test::run_in(dir.path(), exe + " --resolution 14 15 16 --max-planes-per-slab 3 --out cc.json");
+    const test::ShellResult bcc = test::run_in(dir.path(), exe + " --lattice bcc --resolution 11 11 22 --max-planes-per-slab 2 --out bcc.json");
+    ASSERT_EQ(cc.code, 0) << cc.err;
+    ASSERT_EQ(bcc.code, 0) << bcc.err;
+    EXPECT_TRUE(test::Contains(cc.out, "in 6 slabs"));
+    EXPECT_TRUE(test::Contains(bcc.out, "in 6 slabs"));
+    for (const char* channel : {"distance", "gradient", "closest_triangle"}) {
+        const std::string c = std::string(".") + channel + ".raw";
+        EXPECT_TRUE(bytes_of((fields / ("torus-cc-14x15x16" + c)).string()) == bytes_of(dir.at("cc" + c))) << channel;
+        EXPECT_TRUE(bytes_of((fields / ("torus-bcc-11x11x22" + c)).string()) == bytes_of(dir.at("bcc" + c))) << channel;
+        EXPECT_GT(bytes_of(dir.at("cc" + c)).size(), 0u);
+    }
+}
+
+}  // namespace
+}  // namespace sdf
