@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/bvh/bvh_cache.h"
+#include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "core/winding/winding_sign.h"
 #include <cub/device/device_radix_sort.cuh>
@@ -211,6 +212,7 @@ private:
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
+        require_band_width(options_.band_width, "sampler band_width");
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
@@ -243,6 +245,12 @@ private:
         field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
         field.sampler["bvh"] = bvh_info;
         field.sampler["device"] = describe_device(options_.device);
+        if (options_.band_width > 0) {
+            const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
+                               (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
+            field.sampler["band"] = narrow_band_provenance(options_.band_width, count_narrow_band(field),
+                                                           skips ? "bricks skipped by the distance bound" : "post-processed");
+        }
         if (kernel_ == BvhGpuKernel::Candidates) {
             candidate_stats_.download(counts, 4);
             CUDA_CHECK(cudaStreamSynchronize(0));

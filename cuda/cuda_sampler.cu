@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
@@ -314,6 +315,7 @@ private:
 
     template <typename T>
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
+        require_band_width(options_.band_width, "sampler band_width");
         const auto start = std::chrono::steady_clock::now();
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         sign_.prepare(mesh);
@@ -353,6 +355,8 @@ private:
         field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["plan"] = engine.plan();
         field.sampler["device"] = describe_device(options_.device);
+        if (options_.band_width > 0)
+            field.sampler["band"] = narrow_band_provenance(options_.band_width, count_narrow_band(field), "post-processed");
         return field;
     }
 
