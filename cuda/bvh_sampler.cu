@@ -280,16 +280,17 @@ private:
         upload.begin();
         device_points.upload(points);
         upload.end();
+        // Every device buffer is allocated before the timed work (allocation is not search).
         DeviceBuffer<Vec3d> sorted_points{size_t(n)};
         DeviceBuffer<int64_t> order{size_t(n)};
-        compute.begin();
-        sort_into_morton_order(mesh, device_points.get(), n, sorted_points.get(), order.get());
+        MortonSort sort(n);
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
+        PieceResults r(step);  // reused by every piece
         for (int64_t begin = 0; begin < n; begin += step) {
+            compute.begin();
+            if (begin == 0) sort.run(mesh, device_points.get(), sorted_points.get(), order.get());
             const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
-            PieceResults r(piece.count);
-            if (begin > 0) compute.begin();
             const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
             const int blocks = blocks_for(layout.threads(), kBvhThreads);
             if (kernel_ == BvhGpuKernel::Candidates)
@@ -315,25 +316,33 @@ private:
         return out;
     }
 
-    /// Sorts the points by their Morton keys in the mesh's (cubic) box: `sorted` receives
-    /// the points, `order` their input positions.
-    void sort_into_morton_order(const PreparedMesh& mesh, const Vec3d* points, int64_t n, Vec3d* sorted, int64_t* order) {
-        const Bounds3& box = mesh.bounds();
-        const Vec3d extent = box.extent();
-        const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
-        DeviceBuffer<uint64_t> keys{size_t(n)}, keys_sorted{size_t(n)};
-        DeviceBuffer<int64_t> identity{size_t(n)};
-        morton_keys<<<blocks_for(n, 256), 256>>>(points, n, box.min, 1.0 / side, keys.get(), identity.get());
-        CUDA_CHECK_LAUNCH("morton_keys");
+    /// Sorts points by their Morton keys in the mesh's (cubic) box; the buffers (keys, CUB's
+    /// temporary storage) are allocated by the constructor.
+    struct MortonSort {
+        int64_t n;
+        DeviceBuffer<uint64_t> keys, keys_sorted;
+        DeviceBuffer<int64_t> identity;
+        DeviceBuffer<unsigned char> temp;
         size_t temp_bytes = 0;
-        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
-                                                   n, 0, 63));
-        DeviceBuffer<unsigned char> temp{temp_bytes};
-        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
-                                                   n, 0, 63));
-        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted);
-        CUDA_CHECK_LAUNCH("gather_points");
-    }
+
+        explicit MortonSort(int64_t count) : n(count), keys{size_t(count)}, keys_sorted{size_t(count)}, identity{size_t(count)} {
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.get(), keys_sorted.get(), identity.get(),
+                                                       identity.get(), n, 0, 63));
+            temp.allocate(temp_bytes);
+        }
+        /// `sorted` receives the points in key order, `order` their input positions.
+        void run(const PreparedMesh& mesh, const Vec3d* points, Vec3d* sorted, int64_t* order) {
+            const Bounds3& box = mesh.bounds();
+            const Vec3d extent = box.extent();
+            const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
+            morton_keys<<<blocks_for(n, 256), 256>>>(points, n, box.min, 1.0 / side, keys.get(), identity.get());
+            CUDA_CHECK_LAUNCH("morton_keys");
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
+                                                       n, 0, 63));
+            gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted);
+            CUDA_CHECK_LAUNCH("gather_points");
+        }
+    };
 
     SamplerOptions options_;
     BvhGpuKernel kernel_ = BvhGpuKernel::Warp;

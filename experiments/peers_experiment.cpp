@@ -457,7 +457,7 @@ private:
         SamplerOptions o;
         o.backend = "cuda";
         o.method = "bvh";
-        o.sign = sign_;
+        o.sign = lattice_sign_;  // on the GPU the exact sign costs little: no faster-signed row there
         o.progress = false;
         auto sampler = make_sampler(o);
         auto start = std::chrono::steady_clock::now();

@@ -96,7 +96,7 @@ def section(doc, runs):
                   "the surface; unsigned peers pass as 'yes (unsigned)', and the summary says when the fastest peer "
                   "returns no sign. CPU (s) = process CPU time of build + query over all threads (robust to other load "
                   "on a shared machine). GPU rows are CUDA-event times of the query with the points on the device "
-                  "(our point-set GPU rows: Sampler::query wall time, transfers included; 'end to end' = with "
+                  "(our point-set GPU rows: the device time of the Morton sort, search and finalize; 'end to end' = with "
                   "transfers); 'unavailable' = no GPU on the machine of the run; 'not built' = the peer's package or "
                   "source snapshot (FCPW, cuBQL: SDF_PEERS_DIR) was missing when the harness was built. OpenVDB is a "
                   "narrow-band method; Embree, FCPW and cuBQL return unsigned distances. See docs/bvh.md.")
