@@ -409,15 +409,19 @@ private:
         }
     }
 
+    /// Whether a CUDA device is there; if not, emits `row` as "unavailable".
+    bool gpu_available(RunContext& ctx, nlohmann::json& row) {
+        if (cuda_backend_available()) return true;
+        row["status"] = "unavailable (no CUDA device or no CUDA backend in this build)";
+        emit(ctx, row);
+        return false;
+    }
+
     /// Our GPU samplers on a lattice (CUDA-event kernel time); "unavailable" without a GPU.
     void run_gpu(RunContext& ctx, const std::string& label, const PreparedMesh& mesh, const Lattice& lattice, const QuerySet& set,
                  const std::vector<double>& reference, const std::string& name) {
         nlohmann::json row = base_row(label, set, mesh, name, "ours");
-        if (!cuda_backend_available()) {
-            row["status"] = "unavailable (no CUDA device or no CUDA backend in this build)";
-            emit(ctx, row);
-            return;
-        }
+        if (!gpu_available(ctx, row)) return;
         SamplerOptions o;
         o.backend = "cuda";
         o.method = name == "bvh_gpu" ? "bvh" : "brute_force";
@@ -449,11 +453,7 @@ private:
     void run_gpu_query(RunContext& ctx, const std::string& label, const PreparedMesh& mesh, const QuerySet& set,
                        const std::vector<Vec3d>& points, const std::vector<double>& reference) {
         nlohmann::json row = base_row(label, set, mesh, "bvh_gpu", "ours");
-        if (!cuda_backend_available()) {
-            row["status"] = "unavailable (no CUDA device or no CUDA backend in this build)";
-            emit(ctx, row);
-            return;
-        }
+        if (!gpu_available(ctx, row)) return;
         SamplerOptions o;
         o.backend = "cuda";
         o.method = "bvh";

@@ -116,17 +116,33 @@ void BM_BvhBuild(benchmark::State& state, const std::string& file) {
     state.counters["triangles"] = double(mesh->triangles().size());
 }
 
-void BM_CudaBvh(benchmark::State& state, const std::string& file) {
-    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
-    const auto mesh = load(file);
-    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
-    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+/// The mesh of a GPU benchmark, or null after marking the benchmark skipped (no device, no file).
+std::shared_ptr<PreparedMesh> load_for_cuda(benchmark::State& state, const std::string& file) {
+    if (!cuda_backend_available()) {
+        state.SkipWithError("no CUDA device");
+        return nullptr;
+    }
+    auto mesh = load(file);
+    if (!mesh) state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str());
+    return mesh;
+}
+
+/// The CUDA BVH sampler's options with `kernel`.
+SamplerOptions cuda_bvh_options(const std::string& kernel) {
     SamplerOptions o;
     o.backend = "cuda";
     o.method = "bvh";
-    o.kernel = kKernels[state.range(1)];
-    o.precision = state.range(2) ? Precision::Double : Precision::Float;
+    o.kernel = kernel;
     o.progress = false;
+    return o;
+}
+
+void BM_CudaBvh(benchmark::State& state, const std::string& file) {
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o = cuda_bvh_options(kKernels[state.range(1)]);
+    o.precision = state.range(2) ? Precision::Double : Precision::Float;
     auto sampler = make_sampler(o);
     SampledField f = sampler->sample(*mesh, lattice);  // warm-up: module load, BVH upload
     for (auto _ : state) {
@@ -142,9 +158,8 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
 /// surface points, sigma = 1% of the diagonal (kind 1); the device time of the Morton sort,
 /// search and finalize (Sampler::last_query_timings), float search.
 void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
-    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
-    const auto mesh = load(file);
-    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
     const int64_t n = state.range(0);
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -166,12 +181,7 @@ void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
                 Vec3d{g(rng), g(rng), g(rng)};
         }
     }
-    SamplerOptions o;
-    o.backend = "cuda";
-    o.method = "bvh";
-    o.kernel = kKernels[state.range(2)];
-    o.progress = false;
-    auto sampler = make_sampler(o);
+    auto sampler = make_sampler(cuda_bvh_options(kKernels[state.range(2)]));
     sampler->query(*mesh, points);  // warm-up: BVH upload
     for (auto _ : state) {
         benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
@@ -183,18 +193,14 @@ void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
     state.counters["end_to_end_seconds"] = t.total;
 }
 
-/// The narrow band on the lattice (kernel "candidates"): band half-width in lattice spacings.
+/// The narrow band on the lattice with the two kernels that skip the bricks outside it (3 warp,
+/// 4 candidates): band half-width in lattice spacings.
 void BM_CudaBvhBand(benchmark::State& state, const std::string& file) {
-    if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
-    const auto mesh = load(file);
-    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
     const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
-    SamplerOptions o;
-    o.backend = "cuda";
-    o.method = "bvh";
-    o.kernel = "candidates";
+    SamplerOptions o = cuda_bvh_options(kKernels[state.range(2)]);
     o.band_width = double(state.range(1)) * lattice.spacing;
-    o.progress = false;
     auto sampler = make_sampler(o);
     SampledField f = sampler->sample(*mesh, lattice);
     for (auto _ : state) {
@@ -253,7 +259,7 @@ BENCHMARK_CAPTURE(BM_CudaBvhPoints, dragon, std::string("dragon.obj"))
     ->ArgsProduct({{1 << 20, 1 << 24}, {0, 1}, {3, 4}})
     ->ArgNames({"points", "gaussian", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);  // each call also transfers and scatters on the host
 BENCHMARK_CAPTURE(BM_CudaBvhBand, dragon, std::string("dragon.obj"))
-    ->ArgsProduct({{256}, {2, 8}})->ArgNames({"res", "band_spacings"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
+    ->ArgsProduct({{256}, {2, 8}, {3, 4}})->ArgNames({"res", "band_spacings", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 BENCHMARK_CAPTURE(BM_CudaBrute, bunny, std::string("bunny.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()
     ->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_CudaBrute, dragon, std::string("dragon.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()

@@ -112,20 +112,10 @@ SampledField banded(SampledField f, double w) {
     return f;
 }
 
-/// Most of an icosphere, open at the top: auto signs it by winding numbers; a pseudonormal
-/// sign forced on it changes sides beyond the rim, away from the surface.
-PreparedMesh open_bowl() {
-    TriangleMesh m = make_icosphere(3, 1.0);
-    std::vector<Int3> kept;
-    for (const Int3& t : m.triangles)
-        if (m.vertices[size_t(t.x)].z + m.vertices[size_t(t.y)].z + m.vertices[size_t(t.z)].z < 0.6) kept.push_back(t);
-    m.triangles = kept;
-    return prepare_mesh(m);
-}
 
 TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
     const auto& meshes = test::bvh_test_meshes();
-    const std::vector<test::NamedMesh> cases = {meshes[2], meshes[4], {"open bowl", open_bowl()}};  // torus, soccer ball
+    const std::vector<test::NamedMesh> cases = {meshes[2], meshes[4], {"open bowl", test::open_bowl()}};  // torus, soccer ball
     for (size_t which = 0; which < cases.size(); ++which) {
         const PreparedMesh& mesh = cases[which].mesh;
         const bool solid = which < 2;

@@ -1,5 +1,5 @@
 """The report renders from the runs committed under results/ (today the published GPU runs,
-results/gpu/*.json): they match the schema, and make a report."""
+results/gpu/*.json; results/gpu/scaling/ holds scaling records, not runs): they match the schema, and make a report."""
 import os
 import subprocess
 
@@ -14,7 +14,9 @@ def committed_runs():
     if r.returncode != 0:
         pytest.skip("not a git work tree: %s" % r.stderr.strip())
     files = r.stdout.split()
-    found = [os.path.join(REPO, f) for f in files if f.startswith("results/gpu/") and f.endswith(".json")]
+    # Published runs lie directly in results/gpu/; its subfolders hold other records (the
+    # scaling runs of results/gpu/scaling/, read by scripts/sdf_report/scaling.py).
+    found = [os.path.join(REPO, f) for f in files if os.path.dirname(f) == "results/gpu" and f.endswith(".json")]
     found += [os.path.join(REPO, os.path.dirname(f)) for f in files if f.endswith("/manifest.json")]
     return sorted(found)
 

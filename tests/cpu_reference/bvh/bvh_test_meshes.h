@@ -107,6 +107,18 @@ struct NamedMesh {
     PreparedMesh mesh;
 };
 
+/// Most of an icosphere, open at the top: auto signs it by winding numbers, and a
+/// pseudonormal sign forced on it changes sides beyond the rim, away from the surface (the
+/// narrow band's tests).
+inline PreparedMesh open_bowl() {
+    TriangleMesh m = make_icosphere(3, 1.0);
+    std::vector<Int3> kept;
+    for (const Int3& t : m.triangles)
+        if (m.vertices[size_t(t.x)].z + m.vertices[size_t(t.y)].z + m.vertices[size_t(t.z)].z < 0.6) kept.push_back(t);
+    m.triangles = kept;
+    return prepare_mesh(m);
+}
+
 /// Every BVH test mesh, prepared once; bunny and dragon only when the data path has them.
 inline const std::vector<NamedMesh>& bvh_test_meshes() {
     static const std::vector<NamedMesh> meshes = [] {

@@ -15,6 +15,7 @@
 #include "core/sampling/narrow_band.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
 namespace {
@@ -29,15 +30,6 @@ SamplerOptions options(Precision precision, double band, SignMode sign = SignMod
     return o;
 }
 
-/// Half an icosphere: open (winding sign under auto).
-PreparedMesh bowl() {
-    TriangleMesh m = make_icosphere(3, 1.0);
-    std::vector<Int3> kept;
-    for (const Int3& t : m.triangles)
-        if (m.vertices[size_t(t.x)].z + m.vertices[size_t(t.y)].z + m.vertices[size_t(t.z)].z < 0.6) kept.push_back(t);
-    m.triangles = kept;
-    return prepare_mesh(m);
-}
 
 template <typename V>
 bool same_bits(const std::vector<V>& a, const std::vector<V>& b) {
@@ -65,7 +57,7 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
         SignMode sign;  ///< what auto resolves to (named, so the tests print no auto warning)
     };
     const std::vector<Case> cases = {{"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), SignMode::Auto},
-                                     {"bowl", bowl(), SignMode::Winding}};
+                                     {"bowl", test::open_bowl(), SignMode::Winding}};
     for (const Case& c : cases) {
         const Lattice cc = fit_lattice(LatticeType::CC, {21, 22, 23}, c.mesh.bounds(), 0.3);
         const Lattice bcc = fit_lattice(LatticeType::BCC, {15, 16, 17}, c.mesh.bounds(), 0.3);
@@ -91,7 +83,7 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
 }
 
 TEST(NarrowBand, PseudonormalSignOnAnOpenMeshAndPointKernelsPostProcess) {
-    const PreparedMesh mesh = bowl();
+    const PreparedMesh mesh = test::open_bowl();
     const Lattice lattice = fit_lattice(LatticeType::CC, {18, 18, 18}, mesh.bounds(), 0.3);
     const double w = 1.5 * lattice.spacing;
     // Forced pseudonormal on an open mesh: its sign may change off the surface, so no brick
