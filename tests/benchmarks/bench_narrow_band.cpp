@@ -35,15 +35,22 @@ const PreparedMesh* dragon() {
     return mesh.get();
 }
 
+/// The CC cube of r^3 points around the mesh (10% margin), and the CPU BVH's options.
+Lattice cube_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds(), 0.1); }
+
+SamplerOptions cpu_bvh_options() {
+    SamplerOptions o;
+    o.method = "bvh";
+    o.progress = false;
+    return o;
+}
+
 /// Args: resolution, band in spacings (0: none).
 void BM_CpuBvhBand(benchmark::State& state) {
     const PreparedMesh* mesh = dragon();
     if (!mesh) { state.SkipWithError("dragon.obj not found: set SDF_DATA_PATH"); return; }
-    const int r = int(state.range(0));
-    const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh->bounds(), 0.1);
-    SamplerOptions o;
-    o.method = "bvh";
-    o.progress = false;
+    const Lattice lattice = cube_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o = cpu_bvh_options();
     o.band_width = double(state.range(1)) * lattice.spacing;
     auto sampler = make_cpu_bvh_sampler(o);
     SampledField f = sampler->sample(*mesh, lattice);  // builds and caches the BVH
@@ -66,11 +73,8 @@ void BM_CpuBvhBand(benchmark::State& state) {
 void BM_StreamedSampling(benchmark::State& state) {
     const PreparedMesh* mesh = dragon();
     if (!mesh) { state.SkipWithError("dragon.obj not found: set SDF_DATA_PATH"); return; }
-    const int r = int(state.range(0));
-    const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh->bounds(), 0.1);
-    SamplerOptions o;
-    o.method = "bvh";
-    o.progress = false;
+    const Lattice lattice = cube_lattice(*mesh, int(state.range(0)));
+    const SamplerOptions o = cpu_bvh_options();
     auto sampler = make_cpu_bvh_sampler(o);
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "bench_narrow_band_stream";
     std::filesystem::create_directories(dir);
