@@ -1,6 +1,7 @@
 // The CUDA BVH sampler: uploads the BVH (nodes, packed triangles in BVH order) and the
 // double mesh, cuts the lattice into slabs of z-layers that fit GPU memory, runs the BVH
-// search and the double-precision finalize on each, and scatters the results.
+// search and the double-precision finalize on each, and scatters the results (or, for the
+// streamed writer, stores them on the device in the field file's bytes: stored_output.cuh).
 #include "cuda/bvh_sampler.h"
 
 #include <algorithm>
@@ -24,6 +25,7 @@
 #include "cuda/device_mesh.h"
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
+#include "cuda/stored_output.cuh"
 
 namespace sdf::cuda {
 namespace {
@@ -50,6 +52,7 @@ struct DeviceBvh {
     DeviceBuffer<BvhNode> nodes;
     DeviceBuffer<PackedTriangle<T>> packed;
     DeviceBuffer<int32_t> triangle_index;
+    DeviceBuffer<int32_t> source_triangle;  ///< prepared -> mesh file face order (stored slabs)
     std::unique_ptr<DeviceMesh<double>> mesh;
     DeviceWinding winding;
     BvhView<T> view{};
@@ -61,6 +64,7 @@ struct DeviceBvh {
         if constexpr (std::is_same_v<T, float>) packed.upload(bvh.packed_float);
         else packed.upload(bvh.packed_double);
         triangle_index.upload(bvh.triangle_index);
+        source_triangle.upload(prepared.source_triangle());
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         winding.upload(sign, mesh->view());
         view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
@@ -79,6 +83,7 @@ struct PieceResults {
     explicit PieceResults(int64_t n)
         : nearest{size_t(n)}, distance{size_t(n)}, gradient{size_t(n)}, triangle{size_t(n)}, output_index{size_t(n)} {}
     PieceOutputs outputs() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
+    PieceOutputs outputs_const() const { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
 
     struct Host {
         std::vector<double> distance;
@@ -108,6 +113,12 @@ public:
 
     SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
         return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab) : sample_as<double>(mesh, lattice, slab);
+    }
+
+    std::optional<StoredSlab> sample_slab_stored(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab,
+                                                 const StoredLayout& layout) override {
+        return options_.precision == Precision::Float ? sample_stored_as<float>(mesh, lattice, slab, layout)
+                                                      : sample_stored_as<double>(mesh, lattice, slab, layout);
     }
 
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
@@ -191,9 +202,11 @@ private:
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
     }
 
+    /// Searches and finalizes z-layers [z0, z0 + nz) of `block`; `sink(results, count)` then
+    /// takes the piece's device results (to download and scatter, or to store on the device).
     template <typename T, typename Sink>
     void run_slab(const DeviceBvh<T>& dev, const Lattice& lattice, const GridBlock& block, int z0, int nz, EventTimer& compute,
-                  EventTimer& download, Sink sink) {
+                  Sink sink) {
         const int64_t layer = int64_t(block.resolution.x) * block.resolution.y;
         const GridRangePiece piece{lattice, block, z0 * layer, nz * layer};
         const SlabGeometry slab{block.resolution, z0, nz};
@@ -204,9 +217,29 @@ private:
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
         compute.end();
-        download.begin();
-        sink(r.download(piece.count));
-        download.end();
+        sink(r, piece.count);
+    }
+
+    /// Runs every piece of the slab's blocks through run_slab; returns the points computed
+    /// and the pieces (GPU memory decides how many z-layers a piece holds).
+    template <typename T, typename Sink>
+    std::pair<int64_t, int64_t> run_blocks(const DeviceBvh<T>& dev, const Lattice& lattice, const LatticeSlab& slab,
+                                           EventTimer& compute, Sink sink) {
+        GridBlock blocks[2];
+        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
+        int64_t computed = 0, pieces = 0;
+        if (kernel_ == BvhGpuKernel::Candidates) {
+            if (candidate_stats_.size() == 0) candidate_stats_.allocate(4);
+            CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
+        }
+        for (int b = 0; b < nblocks; ++b) {
+            const GridBlock block = blocks[b];
+            const int layers = layers_per_slab(block);
+            for (int z0 = 0; z0 < block.resolution.z; z0 += layers, ++pieces)
+                run_slab<T>(dev, lattice, block, z0, std::min(layers, block.resolution.z - z0), compute, sink);
+            computed += block.count();
+        }
+        return {computed, pieces};
     }
 
     template <typename T>
@@ -217,22 +250,61 @@ private:
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
-        auto sink = [&](const PieceResults::Host& h) { scatter_batch(h, mesh, field); };
-        GridBlock blocks[2];
-        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
-        int64_t computed = 0, pieces = 0;
-        unsigned long long counts[4] = {0, 0, 0, 0};
-        if (kernel_ == BvhGpuKernel::Candidates) {
-            if (candidate_stats_.size() == 0) candidate_stats_.allocate(4);
-            CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
-        }
-        for (int b = 0; b < nblocks; ++b) {
-            const GridBlock block = blocks[b];
-            const int layers = layers_per_slab(block);
-            for (int z0 = 0; z0 < block.resolution.z; z0 += layers, ++pieces)
-                run_slab<T>(dev, lattice, block, z0, std::min(layers, block.resolution.z - z0), compute, download, sink);
-            computed += block.count();
-        }
+        auto sink = [&](const PieceResults& r, int64_t count) {
+            download.begin();
+            const PieceResults::Host h = r.download(count);
+            download.end();
+            scatter_batch(h, mesh, field);
+        };
+        const auto [computed, pieces] = run_blocks<T>(dev, lattice, slab, compute, sink);
+        record_provenance(field, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
+        if (options_.band_width > 0) field.sampler["band"] = band_provenance(mesh, count_narrow_band(field));
+        return field;
+    }
+
+    /// sample_as() with the results stored on the device in the field file's bytes
+    /// (stored_output.cuh) and brought to the host in one pinned copy.
+    template <typename T>
+    std::optional<StoredSlab> sample_stored_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab,
+                                               const StoredLayout& layout) {
+        const auto start = std::chrono::steady_clock::now();
+        require_band_width(options_.band_width, "sampler band_width");
+        EventTimer upload, compute, download;
+        bool built = false, uploaded = false;
+        const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
+        StoredSlab stored;
+        require_search_range(mesh, lattice, options_.precision);
+        stored.info.lattice = lattice;
+        stored.info.precision = options_.precision;
+        const int64_t points = slab_point_count(lattice, slab);
+        const auto [computed, pieces] = layout.float32 ? store_blocks<T, float>(dev, lattice, slab, layout, points, compute)
+                                                       : store_blocks<T, double>(dev, lattice, slab, layout, points, compute);
+        download.begin();
+        stored_buffers_.download(points, layout, stored);
+        download.end();
+        record_provenance(stored.info, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
+        if (options_.band_width > 0) stored.info.sampler["band"] = band_provenance(mesh, stored.band);
+        stored.info.sampler["stored_on_device"] = true;
+        return stored;
+    }
+
+    template <typename T, typename F>
+    std::pair<int64_t, int64_t> store_blocks(const DeviceBvh<T>& dev, const Lattice& lattice, const LatticeSlab& slab,
+                                             const StoredLayout& layout, int64_t points, EventTimer& compute) {
+        const StoredChannels<F> out = stored_buffers_.device_channels<F>(points, layout, dev.source_triangle.get());
+        auto sink = [&](const PieceResults& r, int64_t count) {
+            compute.begin();
+            store_piece<F><<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, out);
+            CUDA_CHECK_LAUNCH("store_piece");
+            compute.end();
+        };
+        return run_blocks<T>(dev, lattice, slab, compute, sink);
+    }
+
+    /// Timings and the provenance every slab records (sampler, plan, BVH, device, candidates).
+    void record_provenance(SampledField& field, const PreparedMesh& mesh, const Lattice& lattice, const EventTimer& upload,
+                           const EventTimer& compute, const EventTimer& download, int64_t computed, int64_t pieces, bool built,
+                           bool uploaded, std::chrono::steady_clock::time_point start) {
         field.timings.upload = upload.seconds();
         field.timings.kernel = compute.seconds();
         field.timings.download = download.seconds();
@@ -245,13 +317,8 @@ private:
         field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
         field.sampler["bvh"] = bvh_info;
         field.sampler["device"] = describe_device(options_.device);
-        if (options_.band_width > 0) {
-            const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
-                               (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
-            field.sampler["band"] = narrow_band_provenance(options_.band_width, count_narrow_band(field),
-                                                           skips ? "bricks skipped by the distance bound" : "post-processed");
-        }
         if (kernel_ == BvhGpuKernel::Candidates) {
+            unsigned long long counts[4] = {0, 0, 0, 0};
             candidate_stats_.download(counts, 4);
             CUDA_CHECK(cudaStreamSynchronize(0));
             const double bricks = double(counts[0]);
@@ -261,7 +328,12 @@ private:
                                            {"mean_leaf_ranges", bricks > 0 ? double(counts[3]) / bricks : 0.0},
                                            {"points_per_brick", 32 * kRunPoints}};
         }
-        return field;
+    }
+
+    nlohmann::json band_provenance(const PreparedMesh& mesh, const NarrowBandCounts& counts) const {
+        const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
+                           (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
+        return narrow_band_provenance(options_.band_width, counts, skips ? "bricks skipped by the distance bound" : "post-processed");
     }
 
     /// Point lists: Morton keys in the mesh's box, a device radix sort, then the warp search
@@ -287,6 +359,7 @@ private:
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
         PieceResults r(step);  // reused by every piece
+        DeviceBuffer<PointSample> device_out{size_t(n)};
         for (int64_t begin = 0; begin < n; begin += step) {
             compute.begin();
             if (begin == 0) sort.run(mesh, device_points.get(), sorted_points.get(), order.get());
@@ -301,12 +374,15 @@ private:
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
+            store_point_samples<<<blocks_for(piece.count, 256), 256>>>(r.outputs_const(), piece.count, dev.source_triangle.get(),
+                                                                        device_out.get());
+            CUDA_CHECK_LAUNCH("store_point_samples");
             compute.end();
-            download.begin();
-            const PieceResults::Host h = r.download(piece.count);
-            download.end();
-            scatter_batch(h, mesh, out);
         }
+        // The results are in input order on the device already: one copy, no host scatter.
+        download.begin();
+        device_out.download(out.data(), out.size());
+        download.end();
         query_timings_ = {};
         query_timings_.upload = upload.seconds();
         query_timings_.kernel = compute.seconds();
@@ -352,7 +428,8 @@ private:
     const TriangleBvh* uploaded_for_ = nullptr;
     std::unique_ptr<DeviceBvh<float>> device_float_;
     std::unique_ptr<DeviceBvh<double>> device_double_;
-    DeviceBuffer<unsigned long long> candidate_stats_;  ///< kernel "candidates": bvh_candidates_kernel.cuh's counters
+    DeviceBuffer<unsigned long long> candidate_stats_;
+    StoredSlabBuffers stored_buffers_;  ///< sample_slab_stored(): the slab's device bytes and pinned host copies  ///< kernel "candidates": bvh_candidates_kernel.cuh's counters
 };
 
 }  // namespace

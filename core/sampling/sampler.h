@@ -4,11 +4,13 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampled_field.h"
+#include "core/sampling/stored_slab.h"
 #include "core/winding/sign_mode.h"
 #include "kernels/lattice/lattice_slab.h"
 #include "kernels/lattice/sampling_grid.h"
@@ -58,6 +60,15 @@ public:
     /// hold the slab's points only, in its compact order (the whole lattice: every point in
     /// storage order). A distributed run gives each rank its slabs (harness/distributed).
     virtual SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) = 0;
+    /// The same slab as a field file stores it (core/sampling/stored_slab.h), for samplers
+    /// that produce the stored bytes where they compute (the CUDA BVH sampler, on the
+    /// device); nullopt from the others, whose callers then use sample_slab(). The samples
+    /// are sample_slab()'s with the narrow band of SamplerOptions::band_width applied.
+    virtual std::optional<StoredSlab> sample_slab_stored(const PreparedMesh& mesh, const Lattice& lattice,
+                                                         const LatticeSlab& slab, const StoredLayout& layout) {
+        (void)mesh, (void)lattice, (void)slab, (void)layout;
+        return std::nullopt;
+    }
     /// Samples arbitrary points, returned in input order.
     virtual std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) = 0;
     /// The timings of the last query() where the sampler measures them (GPU: `kernel` = the

@@ -7,6 +7,7 @@
 #include <future>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include <fcntl.h>
@@ -82,10 +83,24 @@ public:
                 for (int64_t k = begin; k < end; ++k) {
                     const int64_t done = k * kStreamWriteChunk, n = std::min(kStreamWriteChunk, count - done);
                     const std::vector<char> bytes = field_channel_bytes(field, channels_[c], size_t(first + done), size_t(n));
-                    write_at(c, bytes, off_t(size_t(offset + done) * width));
+                    write_at(c, bytes.data(), bytes.size(), off_t(size_t(offset + done) * width));
                 }
             });
         }
+    }
+
+    /// Writes `count` points of channel c, already in its stored bytes (`bytes`: count x the
+    /// channel's bytes per point), at lattice storage offset `offset`, chunk by chunk on
+    /// kStreamWriteThreads threads: nothing to convert, only pwrite.
+    void write_bytes(size_t c, const char* bytes, int64_t count, int64_t offset) {
+        const size_t width = channels_[c].bytes_per_point();
+        const int64_t chunks = (count + kStreamWriteChunk - 1) / kStreamWriteChunk;
+        parallel_for(chunks, 1, kStreamWriteThreads, [&](int64_t begin, int64_t end) {
+            for (int64_t k = begin; k < end; ++k) {
+                const int64_t done = k * kStreamWriteChunk, n = std::min(kStreamWriteChunk, count - done);
+                write_at(c, bytes + size_t(done) * width, size_t(n) * width, off_t(size_t(offset + done) * width));
+            }
+        });
     }
 
     /// fsync, close, and rename every file into place (replacing only with Overwrite::Allow).
@@ -105,10 +120,10 @@ public:
     }
 
 private:
-    void write_at(size_t c, const std::vector<char>& bytes, off_t at) {
+    void write_at(size_t c, const char* bytes, size_t size, off_t at) {
         size_t done = 0;
-        while (done < bytes.size()) {
-            const ssize_t n = ::pwrite(fds_[c], bytes.data() + done, bytes.size() - done, at + off_t(done));
+        while (done < size) {
+            const ssize_t n = ::pwrite(fds_[c], bytes + done, size - done, at + off_t(done));
             if (n < 0 && errno == EINTR) continue;
             if (n <= 0) throw std::runtime_error(channels_[c].path + ": write failed (" + errno_text() + ")");
             done += size_t(n);
@@ -137,6 +152,25 @@ void merge_slab_provenance(nlohmann::json& merged, const nlohmann::json& slab) {
         for (const char* key : {"probes", "bricks_skipped", "points_skipped"})
             if (merged["band"].contains(key) && slab["band"].contains(key))
                 merged["band"][key] = merged["band"][key].get<int64_t>() + slab["band"][key].get<int64_t>();
+}
+
+/// The stored bytes the plan's channel files hold, for samplers that produce them
+/// (Sampler::sample_slab_stored).
+StoredLayout stored_layout_of(const StreamPlan& plan, const StreamOptions& options) {
+    StoredLayout layout;
+    layout.float32 = options.write.dtype == FieldDtype::Float32;
+    layout.gradient = options.gradient;
+    layout.closest_triangle = false;
+    for (const FieldChannelFile& c : plan.channels) layout.closest_triangle |= c.name == "closest_triangle";
+    return layout;
+}
+
+/// The bytes of `channel` in a stored slab.
+const char* stored_channel(const StoredSlab& slab, const FieldChannelFile& channel) {
+    if (channel.name == "distance") return slab.distance;
+    if (channel.name == "gradient") return slab.gradient;
+    if (channel.name == "closest_triangle") return slab.closest_triangle;
+    throw std::logic_error("stored slab: no channel " + channel.name);
 }
 
 }  // namespace
@@ -242,9 +276,53 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     header.mesh = mesh_provenance;
     std::future<void> writing;  // the previous slab's write, overlapping this slab's sampling
     const std::vector<LatticeSlab> slabs = plan.slab_list();
+    // Without a .vdb (whose builder reads the values), a sampler that stores the slab in the
+    // files' bytes where it computes (the CUDA BVH sampler) leaves the host only the writes.
+    const std::optional<StoredLayout> stored_layout =
+        vdb ? std::nullopt : std::optional<StoredLayout>(stored_layout_of(plan, options));
+    auto account = [&](const SampledField& info) {
+        merge_slab_provenance(header.sampler, info.sampler);
+        header.timings.kernel += info.timings.kernel;
+        header.timings.upload += info.timings.upload;
+        header.timings.download += info.timings.download;
+        header.timings.point_triangle_pairs += info.timings.point_triangle_pairs;
+    };
+    auto wait_for_writer = [&] {
+        const auto wait_start = Clock::now();
+        if (writing.valid()) writing.get();  // rethrows the writer's error; frees its slab
+        result.write_wait_seconds += seconds_since(wait_start);
+    };
     for (size_t s = 0; s < slabs.size(); ++s) {
         const LatticeSlab slab = slabs[s];
         const auto slab_start = Clock::now();
+        std::optional<StoredSlab> stored;
+        if (stored_layout) stored = sampler.sample_slab_stored(mesh, lattice, slab, *stored_layout);
+        if (stored) {
+            if (stored->points != slab_point_count(lattice, slab))
+                throw std::logic_error("sampler stored " + std::to_string(stored->points) + " points for a slab of " +
+                                       std::to_string(slab_point_count(lattice, slab)));
+            if (w > 0) {
+                result.band.in_band += stored->band.in_band;
+                result.band.outside += stored->band.outside;
+            }
+            account(stored->info);
+            const double sampled = seconds_since(slab_start);
+            wait_for_writer();
+            auto bytes = std::make_shared<StoredSlab>(std::move(*stored));
+            writing = std::async(std::launch::async, [&files, &plan, &lattice, slab, bytes] {
+                const StorageRange primary = slab_storage(lattice, slab, 0), secondary = slab_storage(lattice, slab, 1);
+                for (size_t c = 0; c < plan.channels.size(); ++c) {
+                    const char* data = stored_channel(*bytes, plan.channels[c]);
+                    files.write_bytes(c, data, primary.count, primary.offset);
+                    files.write_bytes(c, data + size_t(primary.count) * plan.channels[c].bytes_per_point(), secondary.count,
+                                      secondary.offset);
+                }
+            });
+            if (options.progress)
+                std::cerr << "sdf-sample: slab " << s + 1 << "/" << slabs.size() << " (z-planes " << slab.z_begin << "-"
+                          << slab.z_end - 1 << "): sampled in " << sampled << " s (stored on the device)\n";
+            continue;
+        }
         auto field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
         if (field->size() != slab_point_count(lattice, slab))
             throw std::logic_error("sampler returned " + std::to_string(field->size()) + " points for a slab of " +
@@ -255,15 +333,9 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
             result.band.outside += c.outside;
             if (!field->sampler.contains("band")) field->sampler["band"] = narrow_band_provenance(w, c, "post-processed by sdf-sample");
         }
-        merge_slab_provenance(header.sampler, field->sampler);
-        header.timings.kernel += field->timings.kernel;
-        header.timings.upload += field->timings.upload;
-        header.timings.download += field->timings.download;
-        header.timings.point_triangle_pairs += field->timings.point_triangle_pairs;
+        account(*field);
         const double sampled = seconds_since(slab_start);
-        const auto wait_start = Clock::now();
-        if (writing.valid()) writing.get();  // rethrows the writer's error; frees its slab
-        result.write_wait_seconds += seconds_since(wait_start);
+        wait_for_writer();
         writing = std::async(std::launch::async, [&files, &vdb, &lattice, slab, field] {
             const StorageRange primary = slab_storage(lattice, slab, 0), secondary = slab_storage(lattice, slab, 1);
             files.write(*field, 0, primary.count, primary.offset);
@@ -277,9 +349,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
             std::cerr << "sdf-sample: slab " << s + 1 << "/" << slabs.size() << " (z-planes " << slab.z_begin << "-"
                       << slab.z_end - 1 << "): sampled in " << sampled << " s\n";
     }
-    const auto wait_start = Clock::now();
-    if (writing.valid()) writing.get();
-    result.write_wait_seconds += seconds_since(wait_start);
+    wait_for_writer();
     files.commit(options.write.overwrite);
     if (vdb) {
         const std::string temporary = unique_sibling_name(options.vdb_path, "tmp");

@@ -1,7 +1,8 @@
 // sdf-sample's streaming (harness/sampling/streamed_sampling.h): a lattice sampled slab by
 // slab under a tiny memory budget writes channel files equal byte for byte to the in-memory
 // writer's (write_field) for the same lattice: CC and BCC, float32 and float64, with and
-// without a narrow band, all channels or some; the plan refuses budgets too small, existing
+// without a narrow band, all channels or some, from a sampler's fields or from its stored
+// slabs (the bytes path the CUDA BVH sampler takes, here from a CPU stand-in); the plan refuses budgets too small, existing
 // outputs are kept, and the tool's command line refuses bad budget strings with exit 2.
 #include <gtest/gtest.h>
 
@@ -44,6 +45,47 @@ SamplerOptions sampler_options(double band) {
     return o;
 }
 
+/// A CPU sampler that also gives its slabs as stored bytes (Sampler::sample_slab_stored), made
+/// by the field writer's own conversion: the streamed writer's bytes path, tested without a GPU.
+class StoringSampler final : public Sampler {
+public:
+    StoringSampler(std::unique_ptr<Sampler> inner, double band) : inner_(std::move(inner)), band_(band) {}
+    std::string name() const override { return inner_->name(); }
+    SampledField sample_slab(const PreparedMesh& m, const Lattice& l, const LatticeSlab& s) override {
+        return inner_->sample_slab(m, l, s);
+    }
+    std::vector<PointSample> query(const PreparedMesh& m, const std::vector<Vec3d>& p) override { return inner_->query(m, p); }
+    std::optional<StoredSlab> sample_slab_stored(const PreparedMesh& m, const Lattice& l, const LatticeSlab& s,
+                                                 const StoredLayout& layout) override {
+        auto field = std::make_shared<SampledField>(inner_->sample_slab(m, l, s));
+        const NarrowBandCounts counts = apply_narrow_band(*field, band_);
+        const FieldDtype dtype = layout.float32 ? FieldDtype::Float32 : FieldDtype::Float64;
+        auto bytes = std::make_shared<std::vector<std::vector<char>>>();
+        const size_t n = size_t(field->size());
+        bytes->push_back(field_channel_bytes(*field, {"distance", "", dtype, 1}, 0, n));
+        bytes->push_back(field_channel_bytes(*field, {"gradient", "", dtype, 3}, 0, n));
+        bytes->push_back(field_channel_bytes(*field, {"closest_triangle", "", dtype, 1}, 0, n));
+        StoredSlab stored;
+        stored.points = field->size();
+        stored.distance = (*bytes)[0].data();
+        stored.gradient = layout.gradient ? (*bytes)[1].data() : nullptr;
+        stored.closest_triangle = layout.closest_triangle ? (*bytes)[2].data() : nullptr;
+        stored.band = counts;
+        field->distance.clear();
+        field->gradient.clear();
+        field->closest_triangle.clear();
+        stored.info = *field;
+        stored.storage = bytes;
+        ++stored_slabs;
+        return stored;
+    }
+    int stored_slabs = 0;
+
+private:
+    std::unique_ptr<Sampler> inner_;
+    double band_;
+};
+
 const PreparedMesh& torus() {
     static const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
     return mesh;
@@ -58,52 +100,56 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
     for (const Lattice& lattice : {cc, bcc})
         for (FieldDtype dtype : {FieldDtype::Float32, FieldDtype::Float64})
             for (double band : {0.0, 2.0 * lattice.spacing})
-                for (int gradient_and_triangle : {1, 0}) {
-                    const std::string what = lattice_notation(lattice) + (dtype == FieldDtype::Float32 ? " float32" : " float64") +
-                                             " band " + std::to_string(band) + (gradient_and_triangle ? " all channels" : " distance only");
-                    const std::string tag = std::to_string(n++);
-                    SampledField field = make_cpu_bvh_sampler(sampler_options(band))->sample(mesh, lattice);
-                    FieldWriteOptions write;
-                    write.dtype = dtype;
-                    write.closest_triangle = gradient_and_triangle != 0;
-                    if (!gradient_and_triangle) field.gradient.clear();
-                    const std::string memory = dir.at("memory" + tag + ".json"), streamed = dir.at("streamed" + tag + ".json");
-                    write_field(memory, field, write);
+                for (int gradient_and_triangle : {1, 0})
+                    for (bool stored_slabs : {false, true}) {
+                        const std::string what = lattice_notation(lattice) + (dtype == FieldDtype::Float32 ? " float32" : " float64") +
+                                                 " band " + std::to_string(band) + (gradient_and_triangle ? " all channels" : " distance only") +
+                                                 (stored_slabs ? ", stored slabs" : ", fields");
+                        const std::string tag = std::to_string(n++);
+                        SampledField field = make_cpu_bvh_sampler(sampler_options(band))->sample(mesh, lattice);
+                        FieldWriteOptions write;
+                        write.dtype = dtype;
+                        write.closest_triangle = gradient_and_triangle != 0;
+                        if (!gradient_and_triangle) field.gradient.clear();
+                        const std::string memory = dir.at("memory" + tag + ".json"), streamed = dir.at("streamed" + tag + ".json");
+                        write_field(memory, field, write);
 
-                    StreamOptions stream;
-                    stream.header_path = streamed;
-                    stream.write = write;
-                    stream.gradient = gradient_and_triangle != 0;
-                    stream.fixed_bytes = 1 << 20;
-                    // Room for two slabs of 2 z-planes: 7 or 8 slabs.
-                    const int64_t plane = int64_t(lattice.resolution.x) * lattice.resolution.y * 2;
-                    stream.memory_budget = stream.fixed_bytes + 2 * 2 * uint64_t(plane) * kStreamBytesPerPoint;
-                    stream.progress = false;
-                    const SamplerOptions options = sampler_options(band);
-                    auto sampler = make_cpu_bvh_sampler(options);
-                    const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {{"name", "torus"}});
-                    EXPECT_GE(r.plan.slabs, 4) << what;
-                    for (const FieldChannelFile& c : r.plan.channels) {
-                        const std::string mem_file = dir.at("memory" + tag + "." + c.name + ".raw");
-                        ASSERT_TRUE(fs::exists(mem_file)) << what << " " << c.name;
-                        EXPECT_TRUE(bytes_of(mem_file) == bytes_of(c.path)) << what << ": channel " << c.name << " differs";
+                        StreamOptions stream;
+                        stream.header_path = streamed;
+                        stream.write = write;
+                        stream.gradient = gradient_and_triangle != 0;
+                        stream.fixed_bytes = 1 << 20;
+                        // Room for two slabs of 2 z-planes: 7 or 8 slabs.
+                        const int64_t plane = int64_t(lattice.resolution.x) * lattice.resolution.y * 2;
+                        stream.memory_budget = stream.fixed_bytes + 2 * 2 * uint64_t(plane) * kStreamBytesPerPoint;
+                        stream.progress = false;
+                        const SamplerOptions options = sampler_options(band);
+                        std::unique_ptr<Sampler> sampler = make_cpu_bvh_sampler(options);
+                        if (stored_slabs) sampler = std::make_unique<StoringSampler>(std::move(sampler), band);
+                        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {{"name", "torus"}});
+                        EXPECT_GE(r.plan.slabs, 4) << what;
+                        if (stored_slabs) EXPECT_EQ(static_cast<StoringSampler&>(*sampler).stored_slabs, r.plan.slabs) << what;
+                        for (const FieldChannelFile& c : r.plan.channels) {
+                            const std::string mem_file = dir.at("memory" + tag + "." + c.name + ".raw");
+                            ASSERT_TRUE(fs::exists(mem_file)) << what << " " << c.name;
+                            EXPECT_TRUE(bytes_of(mem_file) == bytes_of(c.path)) << what << ": channel " << c.name << " differs";
+                        }
+                        EXPECT_EQ(r.plan.channels.size(), gradient_and_triangle ? 3u : 1u) << what;
+                        const SampledField back = read_field(streamed);
+                        EXPECT_EQ(back.distance.size(), size_t(lattice.num_points())) << what;
+                        const nlohmann::json header = test::read_json(streamed);
+                        EXPECT_EQ(header["sampler"]["streaming"]["slabs"], r.plan.slabs) << what;
+                        EXPECT_GT(header["sampler"]["streaming"]["peak_resident_bytes"].get<uint64_t>(), 0u) << what;
+                        if (band > 0) {
+                            const NarrowBandCounts counts = count_narrow_band(field);
+                            EXPECT_EQ(header["sampler"]["band"]["points_in_band"].get<int64_t>(), counts.in_band) << what;
+                            EXPECT_EQ(header["sampler"]["band"]["points_outside"].get<int64_t>(), counts.outside) << what;
+                        }
+                        // No temporaries left beside the outputs.
+                        for (const auto& e : fs::directory_iterator(dir.path()))
+                            EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
+                        if (HasFailure()) return;
                     }
-                    EXPECT_EQ(r.plan.channels.size(), gradient_and_triangle ? 3u : 1u) << what;
-                    const SampledField back = read_field(streamed);
-                    EXPECT_EQ(back.distance.size(), size_t(lattice.num_points())) << what;
-                    const nlohmann::json header = test::read_json(streamed);
-                    EXPECT_EQ(header["sampler"]["streaming"]["slabs"], r.plan.slabs) << what;
-                    EXPECT_GT(header["sampler"]["streaming"]["peak_resident_bytes"].get<uint64_t>(), 0u) << what;
-                    if (band > 0) {
-                        const NarrowBandCounts counts = count_narrow_band(field);
-                        EXPECT_EQ(header["sampler"]["band"]["points_in_band"].get<int64_t>(), counts.in_band) << what;
-                        EXPECT_EQ(header["sampler"]["band"]["points_outside"].get<int64_t>(), counts.outside) << what;
-                    }
-                    // No temporaries left beside the outputs.
-                    for (const auto& e : fs::directory_iterator(dir.path()))
-                        EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
-                    if (HasFailure()) return;
-                }
 }
 
 #if SDF_HAVE_OPENVDB
