@@ -23,6 +23,7 @@
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
 #include "cuda/device_mesh.h"
+#include "cuda/device_points.cuh"
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
 #include "cuda/stored_output.cuh"
@@ -124,6 +125,18 @@ public:
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
         require_search_range(mesh, points, options_.precision);
         return options_.precision == Precision::Float ? query_as<float>(mesh, points) : query_as<double>(mesh, points);
+    }
+
+    bool query_device(const PreparedMesh& mesh, const DevicePoints& points, const DeviceQueryResults& results) override {
+        if (points.device != options_.device)
+            throw std::invalid_argument("CUDA BVH sampler: the points are on CUDA device " + std::to_string(points.device) +
+                                        ", the sampler on device " + std::to_string(options_.device));
+        if (points.count < 0 || (points.count > 0 && points.xyz == nullptr))
+            throw std::invalid_argument("CUDA BVH sampler: no device points (count " + std::to_string(points.count) + ")");
+        if (points.count == 0) return true;
+        if (options_.precision == Precision::Float) query_device_as<float>(mesh, points, results);
+        else query_device_as<double>(mesh, points, results);
+        return true;
     }
 
 private:
@@ -352,6 +365,71 @@ private:
         upload.begin();
         device_points.upload(points);
         upload.end();
+        DeviceBuffer<PointSample> device_out{size_t(n)};
+        search_points<T>(mesh, dev, device_points.get(), n, compute, [&](const PieceResults& r, int64_t count) {
+            store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(),
+                                                                  device_out.get());
+            CUDA_CHECK_LAUNCH("store_point_samples");
+        });
+        // The results are in input order on the device already: one copy, no host scatter.
+        download.begin();
+        device_out.download(out.data(), out.size());
+        download.end();
+        record_query_timings(mesh, n, upload, compute, download, start);
+        return out;
+    }
+
+    /// query_as() for points already on the device, results written to the caller's device
+    /// arrays (core/sampling/device_query.h); no host copy of either.
+    template <typename T>
+    void query_device_as(const PreparedMesh& mesh, const DevicePoints& points, const DeviceQueryResults& results) {
+        require_search_range(mesh, options_.precision);
+        EventTimer upload, compute, download;
+        bool built = false, uploaded = false;
+        const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
+        const auto start = std::chrono::steady_clock::now();
+        const int64_t n = points.count;
+        // Work already queued on the caller's stream (that made the points) comes first.
+        CUDA_CHECK(cudaStreamSynchronize(static_cast<cudaStream_t>(points.stream)));
+        DeviceBuffer<Vec3d> device_points{size_t(n)};
+        read_points(points, device_points.get());
+        search_points<T>(mesh, dev, device_points.get(), n, compute, [&](const PieceResults& r, int64_t count) {
+            store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(), results);
+            CUDA_CHECK_LAUNCH("store_point_columns");
+        });
+        CUDA_CHECK(cudaStreamSynchronize(0));
+        record_query_timings(mesh, n, upload, compute, download, start);
+    }
+
+    /// The caller's points as doubles in `out`, refused (naming the first) where a point is
+    /// not finite or beyond the search's range: only that point is copied to the host.
+    void read_points(const DevicePoints& points, Vec3d* out) {
+        DeviceBuffer<unsigned long long> first_bad{1};
+        const unsigned long long none = ~0ull;
+        CUDA_CHECK(cudaMemcpy(first_bad.get(), &none, sizeof none, cudaMemcpyHostToDevice));
+        const double limit = largest_search_coordinate(options_.precision);
+        const int blocks = blocks_for(points.count, 256);
+        if (points.float32)
+            read_device_points<<<blocks, 256>>>(static_cast<const float*>(points.xyz), points.count, points.row_stride,
+                                                points.column_stride, limit, out, first_bad.get());
+        else
+            read_device_points<<<blocks, 256>>>(static_cast<const double*>(points.xyz), points.count, points.row_stride,
+                                                points.column_stride, limit, out, first_bad.get());
+        CUDA_CHECK_LAUNCH("read_device_points");
+        unsigned long long bad = none;
+        CUDA_CHECK(cudaMemcpy(&bad, first_bad.get(), sizeof bad, cudaMemcpyDeviceToHost));
+        if (bad != none) {
+            Vec3d p;
+            CUDA_CHECK(cudaMemcpy(&p, out + bad, sizeof p, cudaMemcpyDeviceToHost));
+            require_query_point_in_range(p, int64_t(bad), options_.precision);
+        }
+    }
+
+    /// Morton sort, warp (or candidates) search and finalize of n device points, piece by
+    /// piece; `store(results, count)` takes each piece's results to their input positions.
+    template <typename T, typename Store>
+    void search_points(const PreparedMesh& mesh, const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n,
+                       EventTimer& compute, Store store) {
         // Every device buffer is allocated before the timed work (allocation is not search).
         DeviceBuffer<Vec3d> sorted_points{size_t(n)};
         DeviceBuffer<int64_t> order{size_t(n)};
@@ -359,10 +437,9 @@ private:
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
         PieceResults r(step);  // reused by every piece
-        DeviceBuffer<PointSample> device_out{size_t(n)};
         for (int64_t begin = 0; begin < n; begin += step) {
             compute.begin();
-            if (begin == 0) sort.run(mesh, device_points.get(), sorted_points.get(), order.get());
+            if (begin == 0) sort.run(mesh, device_points, sorted_points.get(), order.get());
             const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
             const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
             const int blocks = blocks_for(layout.threads(), kBvhThreads);
@@ -374,22 +451,19 @@ private:
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
-            store_point_samples<<<blocks_for(piece.count, 256), 256>>>(r.outputs_const(), piece.count, dev.source_triangle.get(),
-                                                                        device_out.get());
-            CUDA_CHECK_LAUNCH("store_point_samples");
+            store(r, piece.count);
             compute.end();
         }
-        // The results are in input order on the device already: one copy, no host scatter.
-        download.begin();
-        device_out.download(out.data(), out.size());
-        download.end();
+    }
+
+    void record_query_timings(const PreparedMesh& mesh, int64_t n, const EventTimer& upload, const EventTimer& compute,
+                              const EventTimer& download, std::chrono::steady_clock::time_point start) {
         query_timings_ = {};
         query_timings_.upload = upload.seconds();
         query_timings_.kernel = compute.seconds();
         query_timings_.download = download.seconds();
         query_timings_.point_triangle_pairs = double(n) * double(mesh.triangles().size());
         query_timings_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return out;
     }
 
     /// Sorts points by their Morton keys in the mesh's (cubic) box; the buffers (keys, CUB's

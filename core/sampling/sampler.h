@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/mesh/prepared_mesh.h"
+#include "core/sampling/device_query.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/stored_slab.h"
 #include "core/winding/sign_mode.h"
@@ -71,6 +72,14 @@ public:
     }
     /// Samples arbitrary points, returned in input order.
     virtual std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) = 0;
+    /// Samples points that are in GPU memory, writing the results there (core/sampling/
+    /// device_query.h); false from samplers that do not run on a GPU. The numbers equal
+    /// query()'s for the same points. Returns when the results are written (and the caller's
+    /// stream may use them).
+    virtual bool query_device(const PreparedMesh& mesh, const DevicePoints& points, const DeviceQueryResults& results) {
+        (void)mesh, (void)points, (void)results;
+        return false;
+    }
     /// The timings of the last query() where the sampler measures them (GPU: `kernel` = the
     /// device's sort, search and finalize, `upload`/`download` the transfers); else zeros.
     const SamplingTimings& last_query_timings() const { return query_timings_; }

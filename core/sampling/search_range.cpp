@@ -78,4 +78,10 @@ void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& po
             require_point_in_range(points[i], precision, "query point " + std::to_string(i + 1));
 }
 
+void require_search_range(const PreparedMesh& mesh, Precision precision) { require_mesh_in_range(mesh, precision); }
+
+void require_query_point_in_range(const Vec3d& p, int64_t index, Precision precision) {
+    require_point_in_range(p, precision, "query point " + std::to_string(index + 1));
+}
+
 }  // namespace sdf

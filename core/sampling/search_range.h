@@ -34,5 +34,9 @@ void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Prec
 /// Throws std::invalid_argument unless the mesh and every point are in range (and finite),
 /// naming the first point that is not.
 void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision);
+/// Throws std::invalid_argument unless the mesh is in range.
+void require_search_range(const PreparedMesh& mesh, Precision precision);
+/// Throws std::invalid_argument naming query point `index` (0-based) unless p is finite and in range.
+void require_query_point_in_range(const Vec3d& p, int64_t index, Precision precision);
 
 }  // namespace sdf
