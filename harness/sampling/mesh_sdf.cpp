@@ -45,6 +45,13 @@ std::vector<PointSample> MeshSdf::query(const std::vector<Vec3d>& points) const 
     return samples;
 }
 
+void MeshSdf::query_device(const DevicePoints& points, const DeviceQueryResults& results) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!sampler_->query_device(*mesh_, points, results))
+        throw std::invalid_argument("points on a GPU need an SDF whose backend is cuda; this one's sampler is '" +
+                                    sampler_name_ + "'");
+}
+
 SampledField MeshSdf::sample(const Lattice& lattice) const {
     std::lock_guard<std::mutex> lock(mutex_);
     SampledField field = sampler_->sample(*mesh_, lattice);

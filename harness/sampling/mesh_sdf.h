@@ -53,6 +53,11 @@ public:
 
     /// Samples arbitrary points, returned in input order. Thread-safe (calls are serialised).
     std::vector<PointSample> query(const std::vector<Vec3d>& points) const;
+    /// Samples points in GPU memory, writing the results there in input order
+    /// (core/sampling/device_query.h): bit for bit query()'s, with no host copy of either.
+    /// Throws std::invalid_argument unless the bound sampler runs on a GPU. The distance is
+    /// the signed one even with unsigned_distance (the caller takes |d| on its device).
+    void query_device(const DevicePoints& points, const DeviceQueryResults& results) const;
     /// Samples every point of the lattice; with unsigned_distance, |d| everywhere.
     SampledField sample(const Lattice& lattice) const;
 

@@ -3,7 +3,7 @@
 Meshes (load_mesh, Mesh), a mesh bound to its sampler and queried many times (SDF), exact
 queries of arbitrary points (query, and the one-liner sdf), sampled fields (sample,
 read_field, Field), their reconstruction (Field.reconstruct) and ray-cast images (render),
-all with NumPy arrays. The same code as the command-line tools: query() equals sdf-query,
+all with NumPy arrays, or with GPU tensors (PyTorch, CuPy, JAX) that stay on the GPU. The same code as the command-line tools: query() equals sdf-query,
 sample() equals a run-experiment field, bit for bit. Signed distance is negative inside;
 gradients are unit vectors; triangles are 0-based in the input's face order.
 
@@ -23,3 +23,9 @@ from ._core import __version__, build_commit  # noqa: F401
 from ._adapters import as_mesh  # noqa: F401
 from ._fields import read_field  # noqa: F401
 from ._warnings import MeshWarning, SdfWarning  # noqa: F401
+from . import _gpu
+from ._gpu import DeviceQueryResult  # noqa: F401
+
+# GPU tensors (PyTorch, CuPy, JAX) in and out without copies: SDF.query, query and sdf take
+# them (sdf_lattices._gpu).
+query, sdf = _gpu.install(_core)

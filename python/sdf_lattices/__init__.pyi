@@ -51,6 +51,15 @@ class QueryResult:
     sampler: str
     def __len__(self) -> int: ...
 
+class DeviceQueryResult:
+    """Results of GPU points: arrays of the input's library (torch, cupy, jax) on its device."""
+    distance: Any
+    gradient: Any
+    triangle: Any
+    sign: str
+    sampler: str
+    def __len__(self) -> int: ...
+
 class Field:
     def __init__(self, values: Union[npt.ArrayLike, Tuple[npt.ArrayLike, npt.ArrayLike]], origin: Sequence[float],
                  spacing: float, lattice: str = "cc", gradient: Any = None, triangle: Any = None) -> None: ...
@@ -83,7 +92,10 @@ class SDF:
     sign_reason: str
     precision: str
     build_seconds: float
-    def query(self, points: npt.ArrayLike, winding: bool = False, progress: Progress = None) -> QueryResult: ...
+    backend: str
+    device: int
+    def query(self, points: Any, winding: bool = False, progress: Progress = None,
+              differentiable: bool = False) -> Union[QueryResult, DeviceQueryResult]: ...
     def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
                margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
                spacing: Optional[float] = None, origin: Optional[Sequence[float]] = None,
@@ -92,10 +104,10 @@ class SDF:
 def as_mesh(mesh: MeshLike) -> Mesh: ...
 def cuda_available() -> bool: ...
 def load_mesh(path: str, weld_tolerance: float = 0.0, check_intersections: bool = True) -> Mesh: ...
-def query(mesh: MeshLike, points: npt.ArrayLike, backend: str = "auto", method: str = "bvh", sign: str = "auto",
+def query(mesh: MeshLike, points: Any, backend: str = "auto", method: str = "bvh", sign: str = "auto",
           precision: str = "float", kernel: str = "", threads: int = 0, progress: Progress = None,
-          winding: bool = False) -> QueryResult: ...
-def sdf(mesh: MeshLike, points: npt.ArrayLike, sign: str = "auto", backend: str = "auto") -> ArrayF: ...
+          winding: bool = False) -> Union[QueryResult, DeviceQueryResult]: ...
+def sdf(mesh: MeshLike, points: Any, sign: str = "auto", backend: str = "auto") -> Any: ...
 def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
            samples: Optional[int] = None, margin: Optional[float] = None,
            bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,

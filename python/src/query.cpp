@@ -190,6 +190,22 @@ total). Ctrl-C stops a long query within a fraction of a second (KeyboardInterru
 
 Samples the lattice framed by the arguments (as sdf_lattices.sample, which see) on this
 process, with the bound sampler.)")
+        .def("_query_device",
+             [](const MeshSdf& s, uintptr_t xyz, int64_t count, bool float32, int64_t row, int64_t column, int device,
+                uintptr_t stream, uintptr_t distance, uintptr_t gradient, uintptr_t triangle) {
+                 DevicePoints points{reinterpret_cast<const void*>(xyz), float32, count, row, column, device,
+                                     reinterpret_cast<void*>(stream)};
+                 DeviceQueryResults results{reinterpret_cast<double*>(distance), reinterpret_cast<double*>(gradient),
+                                            reinterpret_cast<int32_t*>(triangle)};
+                 py::gil_scoped_release release;
+                 s.query_device(points, results);
+             },
+             py::arg("xyz"), py::arg("count"), py::arg("float32"), py::arg("row_stride"), py::arg("column_stride"),
+             py::arg("device"), py::arg("stream"), py::arg("distance"), py::arg("gradient"), py::arg("triangle"),
+             "Device pointers in and out (sdf_lattices._gpu calls it for GPU tensors; not for direct use).")
+        .def_property_readonly("backend", [](const MeshSdf& s) { return s.options().backend; },
+                               "The bound sampler's backend, 'cpu' or 'cuda'.")
+        .def_property_readonly("device", [](const MeshSdf& s) { return s.options().device; }, "The CUDA device ordinal.")
         .def_property_readonly("mesh", [](const MeshSdf& s) { return std::const_pointer_cast<PreparedMesh>(s.shared_mesh()); },
                                "The Mesh it was built for.")
         .def_property_readonly("sampler", &MeshSdf::sampler_name, "The bound sampler, e.g. 'cpu/bvh/brick'.")
