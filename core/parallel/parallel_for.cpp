@@ -1,13 +1,13 @@
 #include "core/parallel/parallel_for.h"
 
-#include "core/parallel/task_monitor.h"
-
 #include <algorithm>
 #include <atomic>
 #include <exception>
 #include <mutex>
 #include <thread>
 #include <vector>
+
+#include "core/parallel/task_monitor.h"
 
 namespace sdf {
 

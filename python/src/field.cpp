@@ -175,10 +175,10 @@ Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::obj
     return field_for_mesh(std::move(field), sdf.mesh());
 }
 
-py::tuple Field::reconstruct(const DoubleArray& points_in, const std::string& interpolator, const std::string& derivatives,
+py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
                              double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
     choose("outside", outside, {"nan", "clamp", "error"});
-    const std::vector<Vec3d> points = points_from_array(points_in, "points");
+    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
     const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
     TaskOptions task;
     task.total = int64_t(points.size());

@@ -114,7 +114,7 @@ public:
     }
 
     /// Values and gradients at points; outside the domain: "nan", "clamp" or "error".
-    py::tuple reconstruct(const DoubleArray& points, const std::string& interpolator, const std::string& derivatives,
+    py::tuple reconstruct(const py::object& points, const std::string& interpolator, const std::string& derivatives,
                           double sigma2, const std::string& sigma_units, int threads, const std::string& outside);
 
     /// World positions of the lattice points, per grid, shape [nz, ny, nx, 3].

@@ -72,8 +72,8 @@ struct QueryOutput {
     std::vector<double> winding;
 };
 
-QueryResult query_bound(const MeshSdf& sdf, const DoubleArray& points_in, bool winding, const py::object& progress) {
-    const std::vector<Vec3d> points = points_from_array(points_in, "points");
+QueryResult query_bound(const MeshSdf& sdf, const py::object& points_in, bool winding, const py::object& progress) {
+    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
     TaskOptions task;
     task.total = int64_t(points.size());
     task.label = "querying '" + sdf.mesh().name() + "'";
@@ -173,7 +173,7 @@ bit. Thread-safe (calls on one object run one at a time).)")
              py::arg("mesh"), py::arg("backend") = "auto", py::arg("method") = "bvh", py::arg("sign") = "auto",
              py::arg("precision") = "float", py::arg("kernel") = "", py::arg("threads") = 0,
              py::arg("bcc_strategy") = "two_grids")
-        .def("query", [](const MeshSdf& s, const DoubleArray& points, bool winding, const py::object& progress) {
+        .def("query", [](const MeshSdf& s, const py::object& points, bool winding, const py::object& progress) {
                  return query_bound(s, points, winding, progress);
              },
              py::arg("points"), py::arg("winding") = false, py::arg("progress") = py::none(),
@@ -218,7 +218,7 @@ process, with the bound sampler.)")
                                "Wall time of the build (BVH, winding data, upload), seconds.")
         .def("__repr__", &sdf_repr);
 
-    m.def("query", [](const py::object& mesh, const DoubleArray& points, const std::string& backend, const std::string& method,
+    m.def("query", [](const py::object& mesh, const py::object& points, const std::string& backend, const std::string& method,
                       const std::string& sign, const std::string& precision, const std::string& kernel, int threads,
                       const py::object& progress, bool winding) {
               const SdfHolder s = bind_mesh_sdf(mesh, backend, method, sign, precision, kernel, threads, "two_grids");
@@ -240,7 +240,7 @@ an Open3D TriangleMesh. backend: "auto" (cuda when a GPU is present, else cpu), 
 winner is always evaluated in double). progress: True or a callable progress(done, total);
 winding=True adds the winding number. The GIL is released while computing; Ctrl-C stops it.)");
 
-    m.def("sdf", [](const py::object& mesh, const DoubleArray& points, const std::string& sign, const std::string& backend) {
+    m.def("sdf", [](const py::object& mesh, const py::object& points, const std::string& sign, const std::string& backend) {
               const SdfHolder s = bind_mesh_sdf(mesh, backend, "bvh", sign, "float", "", 0, "two_grids");
               return query_bound(*s, points, false, py::none()).distance;
           },

@@ -365,6 +365,10 @@ def test_exception_types():
         sl.query("shape:box", np.zeros((2, 2)))
     with pytest.raises(RuntimeError):
         sl.load_mesh("/no/such/mesh.obj")
+    with pytest.raises(TypeError, match="points: expected an \\(N, 3\\) array of numbers, got str"):
+        sl.query("shape:box", "not points")
+    with pytest.raises(TypeError, match="points: expected an \\(N, 3\\) array of numbers, got ndarray of dtype complex128"):
+        sl.SDF("shape:box").query(np.zeros((2, 3), dtype=complex))
 
 
 def test_type_stubs_name_every_public_symbol():
