@@ -16,6 +16,11 @@ B=build-gpu
 log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
 # The copy has no .git: SDF_SOURCE_COMMIT=<sha>[-dirty] is recorded as the runs' commit.
 cmake_common=(-G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PREFIX" -DSDF_SOURCE_COMMIT="${SDF_SOURCE_COMMIT:-}")
+# The lent machines' python3 (with PyTorch, CuPy, JAX) has pybind11 from pip, not Debian's CMake
+# package: point CMake at it, so that the module and its GPU-tensor tests are built there.
+if python3 -m pybind11 --cmakedir > /dev/null 2>&1; then
+    cmake_common+=(-Dpybind11_DIR="$(python3 -m pybind11 --cmakedir)" -DPython3_EXECUTABLE="$(command -v python3)")
+fi
 [ -f /usr/include/openssl/evp.h ] || cmake_common+=(-DOPENSSL_ROOT_DIR="$PREFIX" -DOPENSSL_INCLUDE_DIR="$PREFIX/include"
     -DOPENSSL_CRYPTO_LIBRARY="$PREFIX/lib/x86_64-linux-gnu/libcrypto.so.3"
     -DCMAKE_CXX_FLAGS="-isystem $PREFIX/include/x86_64-linux-gnu" -DCMAKE_CUDA_FLAGS="-isystem $PREFIX/include/x86_64-linux-gnu")
