@@ -12,8 +12,7 @@
 #include "core/parallel/progress.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
-#include "kernels/bvh/closest_triangle_bvh.h"
-#include "kernels/bvh/closest_triangles_packet.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
 #include "kernels/core/morton.h"
 #include "kernels/distance/signed_distance.h"
 
@@ -23,9 +22,9 @@ namespace {
 /// Points per parallel_for chunk: long enough that most seeds come from the x-neighbour.
 constexpr int64_t kBvhChunk = 256;
 
-/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (16 float lanes: one
-/// AVX-512 register, or two AVX2 registers, per coordinate in the leaf loop).
+/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
+static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
 /// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
@@ -45,6 +44,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                      int64_t n, QueryCounters& counters, PositionFn pos, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
+    const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the widest ISA the CPU has
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
@@ -53,7 +53,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             const Vec3d p = pos(i);
             const Vec3<T> pt(p);
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
-            const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed, stats);
+            const BvhHit<T> hit = closest_triangle(view, pt, seed, stats);
             previous = hit.slot;
             emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[hit.slot]), p));
         }
@@ -135,6 +135,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                      EmitFn emit, OutsideFn emit_outside) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
+    const CpuKernels<T>& kernels = cpu_kernels<T>();  // the widest ISA the CPU has
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
@@ -161,7 +162,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     for (int k = 0; k < br.count; ++k) c = c + br.position[k];
                     c = c * (1.0 / br.count);
                     const Vec3<T> pt(c);
-                    const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed_hit(view, probe_seed, pt), stats);
+                    const BvhHit<T> hit = kernels.closest_triangle(view, pt, seed_hit(view, probe_seed, pt), stats);
                     probe_seed = hit.slot;
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
@@ -190,7 +191,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 pk.z[k] = T(br.position[k].z);
             }
             seed_packet(view, seed, pk);
-            closest_triangles_packet(view, pk, stats);
+            kernels.closest_triangles_packet(view, pk, stats);
             for (int k = 0; k < br.count; ++k)
                 emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]),
                                              br.position[k]));
@@ -258,6 +259,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
     const int64_t n = int64_t(points.size());
     if (n == 0) return;
     const std::vector<uint32_t> order = morton_order(points, threads);
+    const auto closest_triangles = cpu_kernels<T>().closest_triangles_packet;  // the widest ISA the CPU has
     const int64_t packets = (n + kPointPacket - 1) / kPointPacket;
     ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
     parallel_for(packets, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
@@ -276,7 +278,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
                 pk.z[k] = T(p.z);
             }
             seed_packet(view, seed, pk);
-            closest_triangles_packet(view, pk, stats);
+            closest_triangles(view, pk, stats);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
@@ -295,6 +297,7 @@ class CpuBvhSampler final : public Sampler {
 public:
     explicit CpuBvhSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCpuBvhKernels, options.kernel, "CPU BVH");
+        active_cpu_kernels();  // a bad SDF_CPU_ISA is reported here, before any work
     }
 
     std::string name() const override { return std::string("cpu/bvh/") + kernel_name(); }

@@ -5,7 +5,7 @@
 
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
-#include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
@@ -27,6 +27,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
     const MeshView<T> view = buffers.view();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const TriangleSoA<T> soa(buffers.packed);
+    const auto nearest_triangles = cpu_kernels<T>().nearest_triangles;  // the widest ISA the CPU has
     ProgressReporter reporter("sampling " + mesh.name(), n, progress);
     parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
         const int count = int(end - begin);
@@ -37,7 +38,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
             px[k] = p.x; py[k] = p.y; pz[k] = p.z;
         }
         if (kernel == CpuKernel::Vectorized) {
-            nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q);
+            nearest_triangles(soa, count, px, py, pz, best, best_q);
         } else {
             for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
@@ -53,6 +54,7 @@ class CpuBruteForceSampler final : public Sampler {
 public:
     explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
         kernel_ = kernel_from_name(kCpuBruteForceKernels, options.kernel, "CPU brute-force");
+        active_cpu_kernels();  // a bad SDF_CPU_ISA is reported here, before any work
     }
 
     std::string name() const override { return std::string("cpu/brute_force/") + kernel_name(); }

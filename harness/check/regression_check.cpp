@@ -16,8 +16,9 @@ std::string num(double v) {
 }
 
 std::string machine_text(const nlohmann::json& kind) {
+    const std::string kernels = kind.contains("cpu_kernels") ? ", kernels " + kind.value("cpu_kernels", std::string()) : "";
     return "CPU \"" + kind.value("cpu", std::string("unknown")) + "\" (build target \"" +
-           kind.value("cpu_target", std::string("unrecorded")) + "\"), GPU " +
+           kind.value("cpu_target", std::string("unrecorded")) + "\"" + kernels + "), GPU " +
            (kind["gpu"].is_string() ? "\"" + kind["gpu"].get<std::string>() + "\"" : std::string("none"));
 }
 

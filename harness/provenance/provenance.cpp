@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "core/parallel/parallel_for.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
 #include "harness/build_config.h"
 #include "harness/sampling/sampler_table.h"
 #if SDF_HAVE_CUDA
@@ -77,10 +78,14 @@ std::string cpu_model() {
 }
 
 nlohmann::json build_info() {
+    // The hot search loops run at the widest level the CPU supports (cpu_kernels.h), which can
+    // be wider than the build's target: both are recorded.
+    const CpuKernelChoice kernels = cpu_kernel_choice();
     return {{"build_type", SDF_BUILD_TYPE},
             {"cxx_compiler", SDF_CXX_COMPILER},
             {"cxx_flags", SDF_CXX_FLAGS},
             {"cpu_target", {{"option", SDF_CPU_TARGET}, {"march", SDF_CPU_MARCH}, {"isa", SDF_CPU_ISA}}},
+            {"cpu_kernels", {{"isa", kernels.isa}, {"chosen_by", kernels.chosen_by}, {"built", kernels.built}}},
             {"fp_contract", "off"},
             {"cuda_flags", SDF_HAVE_CUDA ? SDF_CUDA_FLAGS : ""},
             {"cuda", SDF_HAVE_CUDA ? true : false},
@@ -119,6 +124,9 @@ nlohmann::json machine_kind(const nlohmann::json& provenance) {
     const nlohmann::json build = provenance.value("build", nlohmann::json());
     if (build.is_object() && build.contains("cpu_target") && build["cpu_target"].is_object())
         kind["cpu_target"] = build["cpu_target"].value("march", std::string("unrecorded"));
+    // ... and so does the ISA its dispatched kernels ran at (recorded since run-time dispatch).
+    if (build.is_object() && build.contains("cpu_kernels") && build["cpu_kernels"].is_object())
+        kind["cpu_kernels"] = build["cpu_kernels"].value("isa", std::string("unrecorded"));
     const nlohmann::json gpu = provenance.value("gpu", nlohmann::json());
     if (gpu.is_object() && gpu.contains("name")) kind["gpu"] = gpu["name"];
     return kind;

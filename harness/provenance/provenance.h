@@ -34,7 +34,8 @@ std::string utc_timestamp();
 /// "20261121T134501.123Z" (for run ids: UTC, milliseconds)
 std::string compact_utc_timestamp();
 /// The machine a result was measured on, from a provenance object (machine_and_build()):
-/// {"cpu": model, "gpu": name or null}. Timings are comparable only between equal kinds.
+/// {"cpu": model, "gpu": name or null, "cpu_target": -march, "cpu_kernels": the ISA level of
+/// the dispatched CPU kernels, where recorded}. Timings are comparable only between equal kinds.
 nlohmann::json machine_kind(const nlohmann::json& provenance);
 /// The 1-, 5- and 15-minute load averages (/proc/loadavg), or null where unknown: timings
 /// taken on a loaded machine are not comparable.

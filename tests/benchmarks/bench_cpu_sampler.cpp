@@ -1,12 +1,14 @@
 // Single-thread point-triangle pairs per second of the CPU brute-force kernels.
 //   bench_cpu_sampler --benchmark_counters_tabular=true
+// The vectorised kernel runs at the ISA level the samplers use (cpu_reference/dispatch):
+// SDF_CPU_ISA=v2|v3|v4 chooses another.
 #include <benchmark/benchmark.h>
 
 #include <random>
 
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
-#include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf {
@@ -33,8 +35,10 @@ void BM_NearestTriangleVectorized(benchmark::State& state) {
     T px[kPointTile], py[kPointTile], pz[kPointTile], q[kPointTile];
     int best[kPointTile];
     for (int k = 0; k < kPointTile; ++k) { px[k] = T(pts[k].x); py[k] = T(pts[k].y); pz[k] = T(pts[k].z); }
+    const auto nearest_triangles = cpu_kernels<T>().nearest_triangles;
+    state.SetLabel(active_cpu_kernels().isa);
     for (auto _ : state) {
-        nearest_triangles_vectorized(soa, kPointTile, px, py, pz, best, q);
+        nearest_triangles(soa, kPointTile, px, py, pz, best, q);
         benchmark::DoNotOptimize(best);
     }
     const double pairs = double(state.iterations()) * kPointTile * soa.size();

@@ -1,10 +1,13 @@
 // Provenance: the source commit of a tree without .git (a copy sent to a GPU machine) is the
 // one passed in as SDF_SOURCE_COMMIT, with "-dirty" read as git describe writes it; a commit
-// passed in wins over a (possibly stale) .git.
+// passed in wins over a (possibly stale) .git. The build record names the ISA level the CPU
+// kernels ran at, and the machine identity of speedup checks includes it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 
+#include "cpu_reference/dispatch/cpu_kernels.h"
 #include "harness/provenance/provenance.h"
 #include "harness_test_util.h"
 
@@ -56,6 +59,21 @@ TEST_F(SourceCommit, WithNothingPassedInTheCommitIsUnknownAndCountsAsDirty) {
     EXPECT_EQ(g.commit, "unknown");
     EXPECT_TRUE(g.dirty);
     EXPECT_EQ(g.source, "none");
+}
+
+TEST(Provenance, TheBuildRecordNamesTheKernelsThatRan) {
+    const nlohmann::json build = build_info();
+    ASSERT_TRUE(build.contains("cpu_kernels")) << build.dump();
+    const nlohmann::json& k = build["cpu_kernels"];
+    EXPECT_EQ(k.at("isa").get<std::string>(), active_cpu_kernels().isa);
+    const std::vector<std::string> built = k.at("built").get<std::vector<std::string>>();
+    EXPECT_NE(std::find(built.begin(), built.end(), k.at("isa").get<std::string>()), built.end()) << k.dump();
+    const nlohmann::json kind = machine_kind(machine_and_build());
+    EXPECT_EQ(kind.at("cpu_kernels"), k.at("isa"));
+    // A manifest written before dispatch has no record: its identity has no such key.
+    nlohmann::json old = machine_and_build();
+    old["build"].erase("cpu_kernels");
+    EXPECT_FALSE(machine_kind(old).contains("cpu_kernels"));
 }
 
 }  // namespace
