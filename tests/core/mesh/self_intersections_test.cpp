@@ -41,6 +41,14 @@ TEST(TrianglesIntersect, SeparateTrianglesCrossingOrNot) {
     EXPECT_TRUE(intersect(kFlat, kFlatIds, touching_corner, other));
     EXPECT_TRUE(intersect(kFlat, kFlatIds, coplanar_overlap, other));
     EXPECT_FALSE(intersect(kFlat, kFlatIds, coplanar_apart, other));
+    // T-junctions: a corner on the other's edge (no shared vertex id) counts, as in CGAL:
+    // the closed triangles have a common point.
+    const Vec3d t_coplanar[3] = {{1, 0, 0}, {1, -1, 0}, {2, -1, 0}};
+    const Vec3d t_across[3] = {{1, 0, 0}, {1, -1, 1}, {1, -1, -1}};
+    const Vec3d t_near[3] = {{1, -1e-12, 0}, {1, -1, 0}, {2, -1, 0}};
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, t_coplanar, other));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, t_across, other));
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, t_near, other));
 }
 
 TEST(TrianglesIntersect, SharedEdgeOnlyWhenFoldedOntoEachOther) {
