@@ -7,6 +7,13 @@ find_package(tinyobjloader REQUIRED)
 find_package(OpenSSL REQUIRED)            # SHA-256 of inputs for provenance
 find_package(ZLIB REQUIRED)               # gzip-compressed mesh files
 find_package(Threads REQUIRED)
+# Exact predicates of the mesh report (core/mesh/exact_predicates.h): CGAL 5 is header-only;
+# its kernel brings GMP and MPFR for the exact fallback.
+find_package(CGAL 5 QUIET)
+if(NOT CGAL_FOUND)
+  message(FATAL_ERROR "CGAL 5 was not found: the mesh report's exact predicates need it; install Debian's "
+                      "libcgal-dev (scripts/install-deps)")
+endif()
 
 # OpenImageIO writes PNG/EXR images; it is optional so that GPU machines without it can
 # still build and run the samplers (images are then written as PFM/PPM).

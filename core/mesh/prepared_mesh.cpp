@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "core/bvh/triangle_bvh.h"
+#include "core/mesh/exact_predicates.h"
 #include "core/mesh/self_intersections.h"
 
 namespace sdf {
@@ -125,8 +126,9 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         const Int3 t = mesh.triangles[i];
         const Int3 w{remap[size_t(t.x)], remap[size_t(t.y)], remap[size_t(t.z)]};
         const bool repeated = w.x == w.y || w.y == w.z || w.z == w.x;
-        if (repeated || length_squared(cross(welded[size_t(w.y)] - welded[size_t(w.x)],
-                                              welded[size_t(w.z)] - welded[size_t(w.x)])) == 0.0) {
+        // Exactly collinear, decided in exact arithmetic (a rounded cross product of collinear
+        // points need not be 0): the intersection predicates need a plane per triangle.
+        if (repeated || exact::collinear(welded[size_t(w.x)], welded[size_t(w.y)], welded[size_t(w.z)])) {
             ++rep.degenerate_triangles;
             continue;
         }
@@ -234,6 +236,18 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         rep.overlapping_shells = found.overlapping_shell_pairs;
     }
     return out;
+}
+
+std::string MeshReport::sign_unreliable_reason() const {
+    if (boundary_edges > 0) return "the mesh is open (" + std::to_string(boundary_edges) + " boundary edges)";
+    if (nonmanifold_edges > 0) return "the mesh has " + std::to_string(nonmanifold_edges) + " non-manifold edges";
+    if (inconsistent_edges > 0)
+        return "the mesh is not consistently oriented (" + std::to_string(inconsistent_edges) + " edges)";
+    if (components > 1) return "the mesh has " + std::to_string(components) + " shells";
+    if (!intersections_checked) return "self-intersections were not checked";
+    if (self_intersecting_pairs > 0)
+        return "the mesh intersects itself (" + std::to_string(self_intersecting_pairs) + " triangle pairs)";
+    return "";
 }
 
 std::vector<std::string> PreparedMesh::warnings() const {

@@ -44,8 +44,13 @@ struct MeshReport {
     int overlapping_shells = 0;          ///< pairs of shells that intersect
     bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
     bool consistently_oriented() const { return inconsistent_edges == 0; }
-    /// True when signs from pseudonormals are trustworthy everywhere.
-    bool sign_reliable() const { return closed() && consistently_oriented(); }
+    /// Why pseudonormal signs are not trustworthy everywhere, "" when they are: the first of
+    /// open, non-manifold, inconsistently oriented, several shells, intersections unchecked,
+    /// self-intersecting. The one rule behind sign_reliable() and `auto`'s sign
+    /// (choose_sign_mode), so that the two never disagree.
+    std::string sign_unreliable_reason() const;
+    /// True when signs from pseudonormals are trustworthy everywhere: `auto` keeps them.
+    bool sign_reliable() const { return sign_unreliable_reason().empty(); }
 };
 
 /// Float or double copies of a PreparedMesh's arrays, owning what a MeshView points to.

@@ -27,10 +27,37 @@ bool boxes_overlap(const Child& a, const Child& b) {
     return true;
 }
 
+/// A triangle's box in double: its corners' min and max, exact.
+struct TriangleBox {
+    double lo[3], hi[3];
+};
+
+bool boxes_overlap(const TriangleBox& a, const TriangleBox& b) {
+    for (int k = 0; k < 3; ++k)
+        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+    return true;
+}
+
+/// The boxes of the triangles in BVH slot order.
+std::vector<TriangleBox> triangle_boxes(const PreparedMesh& mesh, const TriangleBvh& bvh) {
+    std::vector<TriangleBox> boxes(bvh.triangle_index.size());
+    for (size_t s = 0; s < boxes.size(); ++s) {
+        const Int3 t = mesh.triangles()[size_t(bvh.triangle_index[s])];
+        const Vec3d& a = mesh.vertices()[size_t(t.x)];
+        const Vec3d& b = mesh.vertices()[size_t(t.y)];
+        const Vec3d& c = mesh.vertices()[size_t(t.z)];
+        for (int k = 0; k < 3; ++k) {
+            boxes[s].lo[k] = std::min({a[k], b[k], c[k]});
+            boxes[s].hi[k] = std::max({a[k], b[k], c[k]});
+        }
+    }
+    return boxes;
+}
+
 class PairDescent {
 public:
     PairDescent(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<std::pair<int, int>>& pairs)
-        : mesh_(mesh), bvh_(bvh), pairs_(pairs) {}
+        : mesh_(mesh), bvh_(bvh), boxes_(triangle_boxes(mesh, bvh)), pairs_(pairs) {}
 
     /// Pairs within the subtree of `c`.
     void within(const Child& c) {
@@ -68,7 +95,10 @@ private:
         return double(c.hi[0] - c.lo[0]) * double(c.hi[1] - c.lo[1]) * double(c.hi[2] - c.lo[2]);
     }
 
+    /// The exact test, for triangles whose own boxes overlap (a leaf's box holds several, and
+    /// triangles with disjoint boxes cannot meet: the box test is exact and closed).
     void test(int32_t slot_a, int32_t slot_b) {
+        if (!boxes_overlap(boxes_[size_t(slot_a)], boxes_[size_t(slot_b)])) return;
         const int ta = bvh_.triangle_index[size_t(slot_a)], tb = bvh_.triangle_index[size_t(slot_b)];
         const Int3 ia = mesh_.triangles()[size_t(ta)], ib = mesh_.triangles()[size_t(tb)];
         const Vec3d a[3] = {mesh_.vertices()[size_t(ia.x)], mesh_.vertices()[size_t(ia.y)], mesh_.vertices()[size_t(ia.z)]};
@@ -78,6 +108,7 @@ private:
 
     const PreparedMesh& mesh_;
     const TriangleBvh& bvh_;
+    const std::vector<TriangleBox> boxes_;
     std::vector<std::pair<int, int>>& pairs_;
 };
 

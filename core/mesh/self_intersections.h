@@ -2,7 +2,9 @@
 /// @brief Triangle pairs of a prepared mesh that intersect other than along shared edges
 /// and vertices: self-intersections within a shell, and overlaps between shells. Found by
 /// descending the mesh's BVH (core/bvh/triangle_bvh.h) in pairs of children whose
-/// boxes overlap, then testing candidate pairs with triangles_intersect().
+/// boxes overlap, then testing the pairs of triangles whose own boxes overlap with
+/// triangles_intersect() (exact predicates, CGAL's rules: the counts equal CGAL's
+/// Polygon_mesh_processing::self_intersections).
 #pragma once
 
 #include <utility>

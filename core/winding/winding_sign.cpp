@@ -30,17 +30,10 @@ SignMode sign_mode_from_name(const std::string& name, const std::string& where) 
 
 SignModeChoice choose_sign_mode(const MeshReport& r, SignMode requested) {
     if (requested != SignMode::Auto) return {requested, std::string(sign_mode_name(requested)) + " requested"};
-    const auto winding = [](const std::string& why) {
-        return SignModeChoice{SignMode::Winding, why + ": pseudonormal signs are not reliable there; using the winding number"};
-    };
-    if (r.boundary_edges > 0) return winding("the mesh is open (" + std::to_string(r.boundary_edges) + " boundary edges)");
-    if (r.nonmanifold_edges > 0) return winding("the mesh has " + std::to_string(r.nonmanifold_edges) + " non-manifold edges");
-    if (r.inconsistent_edges > 0)
-        return winding("the mesh is not consistently oriented (" + std::to_string(r.inconsistent_edges) + " edges)");
-    if (r.components > 1) return winding("the mesh has " + std::to_string(r.components) + " shells");
-    if (!r.intersections_checked) return winding("self-intersections were not checked");
-    if (r.self_intersecting_pairs > 0)
-        return winding("the mesh intersects itself (" + std::to_string(r.self_intersecting_pairs) + " triangle pairs)");
+    // The report's one rule (MeshReport::sign_unreliable_reason), which sign_reliable() shares.
+    const std::string why = r.sign_unreliable_reason();
+    if (!why.empty())
+        return {SignMode::Winding, why + ": pseudonormal signs are not reliable there; using the winding number"};
     return {SignMode::Pseudonormal,
             "closed, manifold, consistently oriented, one shell, no self-intersections: pseudonormal signs are exact"};
 }

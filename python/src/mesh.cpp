@@ -134,7 +134,7 @@ check_intersections looks for intersecting triangle pairs (costs about a BVH bui
         .def_property_readonly("components", [](const PreparedMesh& p) { return p.report().components; },
                                "Number of edge-connected pieces (shells).")
         .def_property_readonly("sign_reliable", [](const PreparedMesh& p) { return p.report().sign_reliable(); },
-                               "True when pseudonormal signs are exact everywhere (closed and consistently oriented).")
+                               "True when pseudonormal signs are exact everywhere, the rule sign='auto' follows: closed, manifold, consistently oriented, one shell, self-intersections checked and none.")
         .def_property_readonly("warnings", &PreparedMesh::warnings,
                                "The preparation's warnings (open, non-manifold, inconsistent, flipped, intersecting), as the tools print them.")
         .def_property_readonly("report", [](const PreparedMesh& p) {

@@ -1,11 +1,15 @@
 // Self-intersection and overlapping-shell detection: the triangle-pair predicate on
 // constructed pairs (crossing, touching, sharing an edge or a corner, folded), the BVH
 // search on closed shapes (none), overlapping and nested shells, and dragon-legacy.obj
-// (25 intersecting pairs, as counted for the issue).
+// (25 intersecting pairs, as counted for the issue); edges on one line (exact predicates);
+// no reported pair with disjoint boxes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <sstream>
 
 #include "core/mesh/load_mesh.h"
@@ -37,6 +41,14 @@ TEST(TrianglesIntersect, SeparateTrianglesCrossingOrNot) {
     EXPECT_TRUE(intersect(kFlat, kFlatIds, touching_corner, other));
     EXPECT_TRUE(intersect(kFlat, kFlatIds, coplanar_overlap, other));
     EXPECT_FALSE(intersect(kFlat, kFlatIds, coplanar_apart, other));
+    // T-junctions: a corner on the other's edge (no shared vertex id) counts, as in CGAL:
+    // the closed triangles have a common point.
+    const Vec3d t_coplanar[3] = {{1, 0, 0}, {1, -1, 0}, {2, -1, 0}};
+    const Vec3d t_across[3] = {{1, 0, 0}, {1, -1, 1}, {1, -1, -1}};
+    const Vec3d t_near[3] = {{1, -1e-12, 0}, {1, -1, 0}, {2, -1, 0}};
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, t_coplanar, other));
+    EXPECT_TRUE(intersect(kFlat, kFlatIds, t_across, other));
+    EXPECT_FALSE(intersect(kFlat, kFlatIds, t_near, other));
 }
 
 TEST(TrianglesIntersect, SharedEdgeOnlyWhenFoldedOntoEachOther) {
@@ -58,6 +70,42 @@ TEST(TrianglesIntersect, SharedCornerOnlyWhenTheOppositeEdgePierces) {
     EXPECT_FALSE(intersect(kFlat, kFlatIds, fan, ids));
     EXPECT_TRUE(intersect(kFlat, kFlatIds, through, ids));
     EXPECT_TRUE(intersect(kFlat, kFlatIds, coplanar_inside, ids));
+}
+
+/// Triangles with an edge on one line, exactly: points a + k d with a, d and the off-line
+/// directions on a 2^-36 grid, so that every point is a double (collinear in exact
+/// arithmetic) while the products in the orientation determinants round. Rounded
+/// determinants call such pairs crossing (the CAD model of issue 22: collinear edges of
+/// fans); exact ones see two segments of a line that are apart, touch or overlap.
+struct CollinearEdges {
+    Vec3d a, d, e, f;
+    Vec3d at(double k, const Vec3d& off = {}) const { return a + d * k + off; }
+    /// (a, a + 2d, a + d + e) and the triangle whose edge spans [from, from + 2] on the line,
+    /// with its third corner off the line along f.
+    bool meet(double from) const {
+        const Vec3d t1[3] = {at(0), at(2), at(1, e)}, t2[3] = {at(from), at(from + 2), at(from + 1, f)};
+        return intersect(t1, {0, 1, 2}, t2, {3, 4, 5});
+    }
+};
+
+TEST(TrianglesIntersect, EdgesOnOneLineAreJudgedExactly) {
+    std::mt19937_64 random(22);
+    auto on_grid = [&](double lo, double hi) {
+        const double x = std::uniform_real_distribution<double>(lo, hi)(random);
+        return std::ldexp(std::round(std::ldexp(x, 36)), -36);
+    };
+    auto vec = [&](double lo, double hi) { return Vec3d{on_grid(lo, hi), on_grid(lo, hi), on_grid(lo, hi)}; };
+    int apart = 0, touching = 0, overlapping = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const double base = i % 2 ? 1e4 : 1.0;
+        const CollinearEdges c{vec(base, 2 * base), vec(-1, 1), vec(-1, 1), vec(-1, 1)};
+        apart += c.meet(3);        // the edges [0, 2] and [3, 5]: a gap between them
+        touching += c.meet(2);     // [0, 2] and [2, 4]: a corner on the other's corner
+        overlapping += c.meet(1);  // [0, 2] and [1, 3]
+    }
+    EXPECT_EQ(apart, 0);
+    EXPECT_EQ(touching, 2000);
+    EXPECT_EQ(overlapping, 2000);
 }
 
 TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b) {
@@ -93,11 +141,26 @@ TEST(SelfIntersections, OverlappingShellsAreCountedApartFromSelfIntersections) {
     EXPECT_EQ(nested.report().shell_intersecting_pairs, 0);
 }
 
+/// Every reported pair's triangles have overlapping boxes (triangles with disjoint boxes
+/// cannot meet); returns how many pairs were checked.
+size_t expect_boxes_overlap(const PreparedMesh& m) {
+    auto box = [&](int t, int k, bool hi) {
+        const Int3 v = m.triangles()[size_t(t)];
+        const double a = m.vertices()[size_t(v.x)][k], b = m.vertices()[size_t(v.y)][k], c = m.vertices()[size_t(v.z)][k];
+        return hi ? std::max({a, b, c}) : std::min({a, b, c});
+    };
+    for (const auto& [s, t] : m.intersecting_triangles())
+        for (int k = 0; k < 3; ++k)
+            EXPECT_TRUE(box(s, k, false) <= box(t, k, true) && box(t, k, false) <= box(s, k, true)) << s << " " << t;
+    return m.intersecting_triangles().size();
+}
+
 TEST(SelfIntersections, OneShellFoldedThroughItself) {
     // A torus whose tube is thicker than its hole: the inner side crosses itself.
     const PreparedMesh m = prepare_mesh(make_torus(0.3, 0.5, 32, 16));
     EXPECT_EQ(m.report().components, 1);
     EXPECT_GT(m.report().self_intersecting_pairs, 0);
+    EXPECT_GT(expect_boxes_overlap(m), 0u);
     bool warned = false;
     for (const std::string& w : m.warnings()) warned = warned || w.find("intersects itself") != std::string::npos;
     EXPECT_TRUE(warned);
@@ -121,6 +184,7 @@ TEST(SelfIntersectionsData, DragonLegacyHas25IntersectingPairs) {
     EXPECT_EQ(m.report().shell_intersecting_pairs, 0);
     // Two of them by file face index (1-based OBJ faces 5324/25178 and 48018/99756).
     EXPECT_EQ(m.source_triangle()[size_t(m.intersecting_triangles().front().first)], 5323);
+    EXPECT_EQ(expect_boxes_overlap(m), 25u);
     const PreparedMesh dragon = prepare_mesh(load_mesh_file(find_data_file("dragon.obj")));
     EXPECT_EQ(dragon.report().self_intersecting_pairs, 0);
 }
