@@ -371,7 +371,8 @@ sampled one.)")
                                "h: the distance between neighbouring primary points along an axis.")
         .def_property_readonly("resolution", [](const Field& f) {
             const Int3 r = f.lattice().resolution;
-            return f.lattice().type == LatticeType::BCC ? py::make_tuple(r.x, r.y, 2 * r.z) : py::make_tuple(r.x, r.y, r.z);
+            const int nz = f.lattice().type == LatticeType::BCC ? 2 * r.z : r.z;
+            return py::make_tuple(r.x, r.y, nz);
         }, "(nx, ny, nz) for CC; (Rx, Ry, 2Rz), the thesis's notation, for BCC.")
         .def_property_readonly("notation", [](const Field& f) { return lattice_notation(f.lattice()); },
                                "'32x32x32' or, BCC, '26x26x52'.")

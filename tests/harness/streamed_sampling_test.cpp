@@ -128,7 +128,9 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
                         if (stored_slabs) sampler = std::make_unique<StoringSampler>(std::move(sampler), band);
                         const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {{"name", "torus"}});
                         EXPECT_GE(r.plan.slabs, 4) << what;
-                        if (stored_slabs) EXPECT_EQ(static_cast<StoringSampler&>(*sampler).stored_slabs, r.plan.slabs) << what;
+                        if (stored_slabs) {
+                            EXPECT_EQ(static_cast<StoringSampler&>(*sampler).stored_slabs, r.plan.slabs) << what;
+                        }
                         for (const FieldChannelFile& c : r.plan.channels) {
                             const std::string mem_file = dir.at("memory" + tag + "." + c.name + ".raw");
                             ASSERT_TRUE(fs::exists(mem_file)) << what << " " << c.name;
