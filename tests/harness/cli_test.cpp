@@ -808,7 +808,9 @@ TEST_F(Cli, ManifestRecordsTheResolvedConfig) {
     const json cfg = read_json(dir_ / "out/tiny" / runs[0] / "manifest.json").at("config");
     const json resolved = cfg.at("resolved");
     EXPECT_EQ(resolved.at("sampler").at("precision"), "float");
-    EXPECT_EQ(resolved.at("sampler").at("backend"), "cpu");
+    // The defaults (issue 23): the BVH on "auto", recorded as the backend that ran.
+    EXPECT_EQ(resolved.at("sampler").at("backend"), cuda_backend_available() ? "cuda" : "cpu");
+    EXPECT_EQ(resolved.at("sampler").at("method"), "bvh");
     EXPECT_EQ(resolved.at("domain").at("margin"), 0.1);
     EXPECT_EQ(resolved.at("kind"), "sampling");
     EXPECT_EQ(resolved.at("mesh").at("half_extent"), json({1.0, 1.0, 1.0}));

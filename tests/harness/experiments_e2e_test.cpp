@@ -54,7 +54,8 @@ json tiny_study(const std::string& name) {
             {"kind", "reconstruction"},
             {"mesh", {{"shape", "sphere"}, {"subdivisions", 1}}},
             {"lattices", {{{"type", "cc"}, {"resolution", {6, 6, 6}}}, {{"type", "bcc"}, {"resolution", {5, 5, 10}}}}},
-            {"sampler", {{"threads", 1}, {"progress", false}}},
+            // The CPU named: the dry-run lines below name the sampler (the default is "auto").
+            {"sampler", {{"backend", "cpu"}, {"threads", 1}, {"progress", false}}},
             {"metrics", {{"domain_probes", 200}, {"band_probes", 200}}}};
 }
 
