@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/sampler_cli.h"
 
 #include <cstdio>
 #include <iostream>
@@ -55,43 +56,36 @@ std::vector<double> results_rows(const std::vector<sdf::PointSample>& results) {
 int main(int argc, char** argv) {
     CLI::App app{"Exact signed distance, gradient and closest triangle of points to a mesh."};
     sdf::add_version_flag(app, "sdf-query");
-    std::string mesh_arg, points_path, out_path, precision = "float", sign = sdf::kSignModes[0].name;
+    std::string mesh_arg, points_path, out_path;
     bool quiet = false, overwrite = false;
-    sdf::PointQueryOptions options;
+    sdf::SamplerCli sampler;
     app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME (sphere, box, torus, "
                                      "pawn, soccer_ball)")
         ->required();
     app.add_option("points", points_path, "file with \"x y z\" per line, a .npy file of shape (N, 3), or - for stdin")
         ->required();
-    app.add_option("--method", options.method, "search: bvh (about log n per point) or brute_force (every triangle)")
-        ->check(CLI::IsMember(sdf::sampler_methods()))
-        ->capture_default_str();
-    app.add_option("--backend", options.backend, "sampler backend (auto: cuda when a GPU is present, else cpu)")
-        ->check(CLI::IsMember(sdf::point_query_backends()))
-        ->capture_default_str();
-    app.add_option("--kernel", options.kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
-    app.add_option("--threads", options.threads, "CPU threads (0 = all)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
-    app.add_option("--sign", sign,
-                   "sign mode: pseudonormal, winding (generalized winding number > 1/2), or auto (pseudonormal where "
-                   "the mesh is closed, manifold, oriented, one shell, without self-intersections; winding otherwise)")
-        ->check(CLI::IsMember(sdf::sign_mode_names()))
-        ->capture_default_str();
+    sampler.add(app, "--method", "method", "search: bvh (about log n per point) or brute_force (every triangle)");
+    sampler.add(app, "--backend", "backend", "sampler backend (auto: cuda when a GPU is present, else cpu)");
+    sampler.add(app, "--kernel", "kernel", "backend kernel (" + sdf::sampler_kernels_help() + ")");
+    sampler.add(app, "--threads", "threads", "CPU threads (0 = all)");
+    sampler.add(app, "--precision", "precision", "float or double");
+    sampler.add(app, "--sign", "sign",
+                "sign mode: pseudonormal, winding (generalized winding number > 1/2), or auto (pseudonormal where "
+                "the mesh is closed, manifold, oriented, one shell, without self-intersections; winding otherwise)");
     app.add_option("--out", out_path, "write the results here instead of stdout: .npy = (N, 5) float64, else text");
     app.add_flag("--overwrite", overwrite, "replace an existing --out file");
     app.add_flag("--quiet", quiet, "no progress lines on stderr");
     SDF_CLI_PARSE(app, argc, argv);
-    options.precision = precision == "float" ? sdf::Precision::Float : sdf::Precision::Double;
-    options.sign = sdf::sign_mode_from_name(sign, "--sign");
-    options.progress = !quiet;
+    sdf::SamplerOptions options;
+    try {  // bad names and values fail before the mesh is read, as command-line errors
+        options = sampler.options({{"progress", !quiet}});
+        sdf::point_query_sampler_options(options);
+    } catch (const std::exception& e) {
+        std::cerr << "sdf-query: error: " << e.what() << "\n";
+        return sdf::kExitCommandLineError;
+    }
     if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
     try {
-        if (options.backend == "auto" && !options.kernel.empty())
-            throw std::invalid_argument("--kernel " + options.kernel +
-                                        ": a kernel needs --backend cpu or cuda (auto takes each backend's default kernel)");
-        sdf::point_query_sampler_options(options);  // bad names fail before the mesh is read
         const sdf::PreparedMesh mesh = sdf::prepare_mesh(
             sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-query: warning: " << w << "\n";

@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/sampler_cli.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -27,15 +28,15 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
-#include "core/sampling/sampler_sign.h"
+#include "experiments/common/field_source.h"
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"
 #include "harness/provenance/provenance.h"
 #include "harness/render/image_io.h"
+#include "harness/render/render_backend.h"
 #include "harness/resources/memory_budget.h"
 #include "harness/render/thesis_figure.h"
-#include "harness/sampling/sampler_table.h"
 
 namespace {
 
@@ -61,45 +62,25 @@ struct Options {
     int downsample = 1;
     double heat_max = 20;
     std::string out = "render.png", out_dir = ".", name, title, cache_dir;
-    std::string sampler_backend = "auto", sampler_method = "brute_force", sign = kSignModes[0].name;
+    SamplerCli sampler;  ///< mesh input: --sampler-backend, --sampler-method, --sign (the codec's defaults)
 };
 
 bool is_field_file(const std::string& input) { return fs::path(input).extension() == ".json"; }
 
 Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
-SamplerOptions sampler_options(const Options& o) {
-    SamplerOptions s;
-    s.backend = o.sampler_backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : o.sampler_backend;
-    s.method = o.sampler_method;
-    s.precision = Precision::Float;
-    s.sign = sign_mode_from_name(o.sign, "--sign");
-    s.progress = !o.quiet;
-    return s;
-}
+SamplerOptions sampler_options(const Options& o) { return o.sampler.options({{"progress", !o.quiet}}); }
 
-/// The field of `mesh` on `lattice`, from the field cache or sampled (and stored there).
+/// The field of `mesh` on `lattice`: from the field cache when it holds it, else sampled and
+/// stored there, by the experiments' FieldSource (the same key, log and sign warning).
 SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, const Options& o) {
-    const SamplerOptions s = sampler_options(o);
     const std::optional<FieldCache> cache =
         o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
-    const nlohmann::json key = field_cache_key(mesh.content_sha256(), lattice, s);
-    if (cache) {
-        if (std::optional<SampledField> f = cache->load(key)) {
-            std::fprintf(stderr, "field %s %s: from the cache %s\n", mesh.name().c_str(), lattice_notation(lattice).c_str(),
-                         cache->entry_path(key).c_str());
-            const std::string sign_warning = auto_sign_warning(f->sampler, mesh);
-            if (!sign_warning.empty()) std::fprintf(stderr, "warning: %s\n", sign_warning.c_str());
-            return *f;
-        }
-    }
-    std::fprintf(stderr, "field %s %s: sampling %lld points x %zu triangles (%s/%s)\n", mesh.name().c_str(),
-                 lattice_notation(lattice).c_str(), static_cast<long long>(lattice.num_points()), mesh.triangles().size(),
-                 s.backend.c_str(), s.method.c_str());
-    SampledField f = make_sampler(s)->sample(mesh, lattice);
-    std::fprintf(stderr, "  sampled in %.1f s\n", f.timings.total);
-    if (cache) cache->store(key, f);
-    return f;
+    RunContext context;
+    context.config_path = "sdf-render";
+    context.fields = cache ? &*cache : nullptr;
+    FieldSource source(context, sampler_options(o));
+    return source.get(mesh, lattice, "field " + mesh.name(), std::cerr).field;
 }
 
 Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const std::vector<int>& res, double margin) {
@@ -335,7 +316,7 @@ int main(int argc, char** argv) {
         ->expected(1, 2)
         ->check(CLI::Range(1, 16384))
         ->capture_default_str();
-    app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember({"cpu", "cuda", "auto"}))->capture_default_str();
+    app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember(render_backend_choices()))->capture_default_str();
     app.add_option("--precision", o.precision, "cpu casting precision")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
     app.add_option("--threads", o.threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--repeat", o.repeat, "timed renders (cuda: kernel launches after a warm-up); the median is printed")
@@ -365,17 +346,11 @@ int main(int argc, char** argv) {
                 return std::string(e.what());
             }
         });
-    app.add_option("--sampler-backend", o.sampler_backend, "mesh input: sampler backend")
-        ->check(CLI::IsMember([] { auto b = sampler_backends(); b.emplace_back("auto"); return b; }()))
-        ->capture_default_str();
-    app.add_option("--sampler-method", o.sampler_method, "mesh input: sampler method")
-        ->check(CLI::IsMember(sampler_methods()))
-        ->capture_default_str();
-    app.add_option("--sign", o.sign,
-                   "mesh input: sign mode: pseudonormal, winding (generalized winding number), or auto (winding "
-                   "where the mesh report says pseudonormal signs are not exact)")
-        ->check(CLI::IsMember(sign_mode_names()))
-        ->capture_default_str();
+    o.sampler.add(app, "--sampler-backend", "backend", "mesh input: sampler backend");
+    o.sampler.add(app, "--sampler-method", "method", "mesh input: sampler method");
+    o.sampler.add(app, "--sign", "sign",
+                  "mesh input: sign mode: pseudonormal, winding (generalized winding number), or auto (winding "
+                  "where the mesh report says pseudonormal signs are not exact)");
     app.add_option("--cache-dir", o.cache_dir, "field cache (default $SDF_CACHE_DIR or <repo>/cache)");
     app.add_flag("--no-cache", o.no_cache, "sample again; neither read nor fill the field cache");
     app.add_flag("--overwrite", o.overwrite, "replace existing output files");

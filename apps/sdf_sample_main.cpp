@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--method", method, "search: bvh or brute_force")->check(CLI::IsMember(sdf::sampler_methods()))->capture_default_str();
     app.add_option("--backend", backend, "cpu, cuda, or auto (cuda when a GPU is present)")
-        ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
+        ->check(CLI::IsMember(sdf::sampler_backend_choices()))
         ->capture_default_str();
     app.add_option("--kernel", kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
     app.add_option("--threads", threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -145,11 +145,11 @@ int main(int argc, char** argv) {
         sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
         spec = sdf::parse_lattice_spec(lattice_reader);
         nlohmann::json sampler_json = {{"backend", backend}, {"method", method}, {"sign", sign},
-                                       {"precision", precision}, {"threads", threads}, {"progress", false}};
+                                       {"precision", precision}, {"threads", threads}, {"progress", false},
+                                       {"band_width", band}};
         if (!kernel.empty()) sampler_json["kernel"] = kernel;
         sdf::JsonReader sampler_reader(sampler_json, "command line", "sampler");
         options = sdf::parse_sampler_options(sampler_reader);
-        options.band_width = band;
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return sdf::kExitCommandLineError;
@@ -160,7 +160,7 @@ int main(int argc, char** argv) {
         stream.write.dtype = dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64;
         stream.write.overwrite = overwrite ? sdf::Overwrite::Allow : sdf::Overwrite::Forbid;
         stream.max_planes_per_slab = max_planes;
-        stream.bytes_per_point = options.backend == "cuda" ? sdf::kStreamBytesPerPointCuda : sdf::kStreamBytesPerPoint;
+        stream.bytes_per_point = sdf::sampler_kind(options).stream_bytes_per_point;
         stream.progress = !quiet;
 
         const sdf::PreparedMesh mesh =

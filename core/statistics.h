@@ -1,6 +1,7 @@
 /// @file statistics.h
-/// @brief Summary statistics of repeated measurements in the experiments: timings are
-/// reported as the median of their repetitions (docs: STYLE.md, "Measuring").
+/// @brief Summary statistics of repeated measurements: timings (experiments, the ray casters)
+/// are reported as the median of their repetitions, which one slow outlier (a page fault, a
+/// context switch on a shared machine) does not move. The one median of the project.
 #pragma once
 
 #include <algorithm>

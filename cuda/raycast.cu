@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/statistics.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
 #include "kernels/raycast/cast_pixel.h"
@@ -67,12 +68,6 @@ std::vector<double> launch_timed(const RaycastScene<float>& scene, PixelRecord* 
     return seconds;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
-
 }  // namespace
 
 RenderedImage render_field_view_cuda(const LatticeFieldView<float>& view, InterpolatorKind kind,
@@ -108,7 +103,7 @@ RenderedImage render_field_view_cuda(const LatticeFieldView<float>& view, Interp
                   {"device", describe_device(options.device)},
                   {"interpolator", name},
                   {"repetitions", options.repetitions},
-                  {"kernel_seconds", median(kernel)},
+                  {"kernel_seconds", median_of(kernel)},
                   {"kernel_seconds_min", *std::min_element(kernel.begin(), kernel.end())},
                   {"kernel_seconds_all", kernel},
                   {"upload_seconds", upload.seconds()},

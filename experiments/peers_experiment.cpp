@@ -304,6 +304,7 @@ private:
                      std::vector<double>& reference) {
         for (int t : threads_) {
             SamplerOptions o;
+            o.backend = "cpu";
             o.method = "bvh";
             o.threads = t;
             o.sign = sign_;
@@ -339,6 +340,7 @@ private:
                            const std::vector<Vec3d>& points, const std::string& kernel, std::vector<double>& reference) {
         for (int t : threads_) {
             SamplerOptions o;
+            o.backend = "cpu";
             o.method = "bvh";
             o.kernel = kernel;
             o.threads = t;
@@ -382,6 +384,8 @@ private:
         const int64_t n = set.count;
         for (int t : threads_) {
             SamplerOptions o;
+            o.backend = "cpu";
+            o.method = "brute_force";
             o.threads = t;
             o.sign = sign_;
             o.progress = false;
@@ -565,6 +569,7 @@ private:
             // pseudonormals are unreliable), so a faster point_set_sign is checked like a peer;
             // its time, at all threads, is the row "bvh_cpu_exact_sign".
             SamplerOptions o;
+            o.backend = "cpu";
             o.method = "bvh";
             o.threads = 0;
             o.sign = lattice_sign_;

@@ -74,6 +74,11 @@ public:
             if (spec.max_points < 0) b.fail("max_points", "expected 0 (all) or a positive count, got " + std::to_string(spec.max_points));
             spec.options = parse_sampler_options(b);  // reads the sampler keys and finishes
             spec.options.progress = false;
+            // Scaling a subset's time to the lattice is right only where every point costs the same.
+            if (spec.max_points > 0 && sampler_kind(spec.options).cost != CostModel::PerPoint)
+                b.fail("max_points", "times a subset and scales it, which needs a sampler whose points all cost the "
+                                     "same; \"" + spec.options.method + "\" does not: name \"method\": \"brute_force\" "
+                                     "or drop max_points");
             backends_.push_back(spec);
         }
         reference_ = config.optional<std::string>("reference", backends_[0].name,
@@ -96,7 +101,7 @@ public:
                     for (const BackendSpec& b : backends_) {
                         line += " " + b.name + " x" + std::to_string(repetitions_);
                         if (b.max_points > 0) line += " (on " + with_commas(b.max_points) + " points, scaled)";
-                        if (b.options.backend == "cuda" && !cuda_backend_available()) line += " [unavailable here: reported, not run]";
+                        if (sampler_kind(b.options).on_gpu && !cuda_backend_available()) line += " [unavailable here: reported, not run]";
                         line += ";";
                     }
                     lines.push_back(line + " speedups vs " + reference_ + "; never from the cache");
@@ -137,7 +142,7 @@ private:
             return t;
         }
         t.points_timed = n;
-        if (b.options.backend == "cuda") sampler->sample(mesh, lattice);  // warm-up: module load, first allocations
+        if (sampler_kind(b.options).on_gpu) sampler->sample(mesh, lattice);  // warm-up: module load, first allocations
         for (int r = 0; r < repetitions_; ++r) {
             const SampledField f = sampler->sample(mesh, lattice);
             t.seconds.push_back(f.timings.kernel);
@@ -168,7 +173,7 @@ private:
         std::vector<double> reference_distance;
         for (const BackendSpec& b : backends_) {
             nlohmann::json entry = {{"name", b.name}, {"sampler", sampler_options_to_json(b.options)}};
-            if (b.options.backend == "cuda" && !cuda_backend_available()) {
+            if (sampler_kind(b.options).on_gpu && !cuda_backend_available()) {
                 entry["status"] = "unavailable (no CUDA device or no CUDA backend in this build)";
                 row["backends"].push_back(entry);
                 continue;

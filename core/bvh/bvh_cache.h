@@ -13,8 +13,10 @@ namespace sdf {
 
 class BvhCache {
 public:
-    /// The BVH of `mesh`; `built` tells whether this call built it.
-    std::shared_ptr<const TriangleBvh> get(const PreparedMesh& mesh, bool& built, const BvhBuildOptions& options = {}) {
+    /// The BVH of `mesh` (a PreparedMesh: a template only so that core/bvh needs no include of
+    /// core/mesh); `built` tells whether this call built it.
+    template <class Mesh>
+    std::shared_ptr<const TriangleBvh> get(const Mesh& mesh, bool& built, const BvhBuildOptions& options = {}) {
         std::lock_guard<std::mutex> lock(mutex_);
         built = false;
         if (!bvh_ || mesh_ != &mesh || sha_ != mesh.content_sha256() || triangles_ != mesh.triangles().size() ||
@@ -34,7 +36,7 @@ private:
 
     std::mutex mutex_;
     std::shared_ptr<const TriangleBvh> bvh_;
-    const PreparedMesh* mesh_ = nullptr;
+    const void* mesh_ = nullptr;
     std::string sha_;
     size_t triangles_ = 0;
     Bounds3 bounds_;

@@ -163,12 +163,12 @@ private:
     std::vector<BvhNode>& nodes_;
 };
 
-std::vector<BuildRef> build_refs(const PreparedMesh& mesh) {
-    std::vector<BuildRef> refs(mesh.triangles().size());
+std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
+    std::vector<BuildRef> refs(mesh.triangles.size());
     for (size_t i = 0; i < refs.size(); ++i) {
-        const Int3 t = mesh.triangles()[i];
+        const Int3 t = mesh.triangles[i];
         Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(mesh.vertices()[size_t(t[k])]);
+        for (int k = 0; k < 3; ++k) b.extend(mesh.vertices[size_t(t[k])]);
         refs[i] = {b, b.center(), int32_t(i)};
     }
     return refs;
@@ -226,8 +226,10 @@ BvhView<double> TriangleBvh::view<double>() const {
     return {nodes.data(), packed_double.data(), triangle_index.data(), int(nodes.size()), int(triangle_index.size())};
 }
 
-TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& options) {
-    if (mesh.triangles().empty()) throw std::invalid_argument("BVH build: mesh '" + mesh.name() + "' has no triangles");
+TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions& options) {
+    if (mesh.triangles.empty()) throw std::invalid_argument("BVH build: mesh '" + mesh.name + "' has no triangles");
+    if (mesh.packed_float.size() != mesh.triangles.size() || mesh.packed_double.size() != mesh.triangles.size())
+        throw std::invalid_argument("BVH build: mesh '" + mesh.name + "': one packed triangle per triangle expected");
     if (options.max_leaf_size < 1 || options.bins < 2 || options.bins > kMaxBins)
         throw std::invalid_argument("BVH build: max_leaf_size must be >= 1 and bins in [2, 64], got " +
                                     std::to_string(options.max_leaf_size) + " and " + std::to_string(options.bins));
@@ -248,8 +250,8 @@ TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& 
     }
     bvh.triangle_index.resize(size_t(n));
     for (int i = 0; i < n; ++i) bvh.triangle_index[size_t(i)] = refs[size_t(i)].triangle;
-    const auto& pf = mesh.buffers<float>().packed;
-    const auto& pd = mesh.buffers<double>().packed;
+    const auto& pf = mesh.packed_float;
+    const auto& pd = mesh.packed_double;
     bvh.packed_float.resize(size_t(n));
     bvh.packed_double.resize(size_t(n));
     for (int i = 0; i < n; ++i) {

@@ -1,17 +1,20 @@
 /// @file triangle_bvh.h
-/// @brief A BVH over a prepared mesh's triangles, built on the CPU with binned SAH (Wald,
+/// @brief A BVH over a mesh's triangles, built on the CPU with binned SAH (Wald,
 /// "On fast Construction of SAH-based Bounding Volume Hierarchies", IEEE RT 2007) into the
 /// flat layout of kernels/bvh/bvh_node.h, with the search constants of every triangle
 /// stored in BVH order for the float and the double query.
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "core/mesh/prepared_mesh.h"
+#include "core/bounds3.h"
 #include "kernels/bvh/bvh_view.h"
+#include "kernels/core/vec3.h"
+#include "kernels/distance/packed_triangle.h"
 
 namespace sdf {
 
@@ -41,8 +44,28 @@ public:
     BvhView<T> view() const;
 };
 
-/// Builds the BVH of `mesh` (throws std::invalid_argument for an empty mesh).
-TriangleBvh build_triangle_bvh(const PreparedMesh& mesh, const BvhBuildOptions& options = {});
+/// What the build reads of a mesh: its triangles and their search constants (a PreparedMesh's
+/// arrays, core/mesh/prepared_mesh.h). A view of plain arrays, so that core/bvh sits below
+/// core/mesh, which builds a BVH to find self-intersections (scripts/check-layers).
+struct BvhBuildInput {
+    const std::vector<Vec3d>& vertices;
+    const std::vector<Int3>& triangles;
+    const std::vector<PackedTriangle<float>>& packed_float;    ///< one per triangle, in triangle order
+    const std::vector<PackedTriangle<double>>& packed_double;
+    const std::string& name;  ///< for messages
+};
+
+/// Builds the BVH of the triangles (throws std::invalid_argument for an empty mesh).
+TriangleBvh build_triangle_bvh(const BvhBuildInput& input, const BvhBuildOptions& options = {});
+
+/// The BVH of a PreparedMesh (or anything with its vertices(), triangles(), buffers<T>() and
+/// name()); a template only so that this layer needs no include of core/mesh.
+template <class Mesh>
+TriangleBvh build_triangle_bvh(const Mesh& mesh, const BvhBuildOptions& options = {}) {
+    return build_triangle_bvh(BvhBuildInput{mesh.vertices(), mesh.triangles(), mesh.template buffers<float>().packed,
+                                            mesh.template buffers<double>().packed, mesh.name()},
+                              options);
+}
 
 /// The same box, rounded outward from double to float so that it still contains the input.
 float round_down_to_float(double x);

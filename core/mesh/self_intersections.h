@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/bvh/triangle_bvh.h"
+#include "core/mesh/prepared_mesh.h"
 
 namespace sdf {
 

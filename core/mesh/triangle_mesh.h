@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/bounds3.h"
 #include "kernels/core/vec3.h"
 
 namespace sdf {
@@ -21,16 +22,6 @@ struct TriangleMesh {
 };
 
 /// Axis-aligned bounds of the vertices referenced by triangles.
-struct Bounds3 {
-    Vec3d min{1e300, 1e300, 1e300};
-    Vec3d max{-1e300, -1e300, -1e300};
-    void extend(const Vec3d& p) { min = component_min(min, p); max = component_max(max, p); }
-    Vec3d extent() const { return max - min; }
-    Vec3d center() const { return (min + max) * 0.5; }
-    double diagonal() const { return length(max - min); }
-    bool empty() const { return min.x > max.x; }
-};
-
 Bounds3 triangle_bounds(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles);
 
 /// SHA-256 over the binary vertex and index arrays (for meshes without a file).

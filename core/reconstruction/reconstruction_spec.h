@@ -2,16 +2,20 @@
 /// @brief What a reconstruction is made of: an interpolator (by config name), the source of
 /// its derivative data, and the checks that reject meaningless combinations.
 ///
-/// Interpolators: "trilinear", "catmull_rom", "tricubic_lm" (CC); "bcc_linear", "bcc_cubic",
-/// "bcc_cubic_c0" (BCC). Derivative sources, per interpolator:
-///   trilinear, catmull_rom, bcc_linear: values only; the one valid source is "fd" (for
-///     Catmull-Rom it names the implied central differences; the others read no
-///     derivatives). "true" and "fd_weighted" are rejected.
-///   tricubic_lm: "true" = fx, fy, fz from the sampled gradients, fxy, fxz, fyz, fxyz from
-///     central differences of those gradients; "fd" = all 7 derivatives by central
-///     differences of the values (cc_finite_differences.h; equals catmull_rom).
-///     "fd_weighted" is rejected: the Gaussian weighting belongs to the BCC least-squares fit.
-///   bcc_cubic, bcc_cubic_c0: "true" = first derivatives from the sampled gradients, second
+/// Interpolators: every filter of the one table, AllInterpolators in
+/// kernels/reconstruction/interpolators.h (interpolator_names(); `sdf-eval --help` lists
+/// them). The derivative sources a filter accepts follow from its static interface
+/// (valid_derivative_sources):
+///   a filter that reads no derivative data (uses_first() false: trilinear, bcc_linear, the
+///     box splines, ...): "fd" only (for catmull_rom it names the implied central
+///     differences). "true" and "fd_weighted" are rejected.
+///   a CC filter that reads derivatives: "true" or "fd". tricubic_lm: "true" = fx, fy, fz
+///     from the sampled gradients, fxy, fxz, fyz, fxyz from central differences of those
+///     gradients; "fd" = all 7 derivatives by central differences of the values
+///     (cc_finite_differences.h; equals catmull_rom). "fd_weighted" is rejected: the
+///     Gaussian weighting belongs to the BCC least-squares fit.
+///   a BCC filter that reads derivatives: "true", "fd" or "fd_weighted". bcc_cubic,
+///     bcc_cubic_c0: "true" = first derivatives from the sampled gradients, second
 ///     derivatives from the plain 27-point least-squares fit; "fd" = all from the plain fit;
 ///     "fd_weighted" = all from the Gaussian-weighted fit (eq. 4-15; at interior points the
 ///     first derivatives are the same as "fd", only the second ones change).

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/quoted_alternatives.h"
+
 namespace sdf {
 
 template <typename Kernel>
@@ -22,14 +24,6 @@ std::vector<std::string> kernel_names(const NamedKernel<Kernel> (&table)[N]) {
     std::vector<std::string> names;
     for (const NamedKernel<Kernel>& k : table) names.emplace_back(k.name);
     return names;
-}
-
-/// "a", "b" or "c"
-inline std::string quoted_alternatives(const std::vector<std::string>& names) {
-    std::string s;
-    for (size_t i = 0; i < names.size(); ++i)
-        s += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + ("\"" + names[i] + "\"");
-    return s;
 }
 
 /// The kernel `name` names ("" = the default, the table's first entry); throws naming the

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/quoted_alternatives.h"
+
 namespace sdf {
 namespace {
 
@@ -41,12 +43,12 @@ const char* point_set_kind_name(PointSetKind kind) {
 }
 
 PointSetKind point_set_kind_from_name(const std::string& name) {
-    std::string list;
+    std::vector<std::string> names;
     for (const auto& k : kPointSetKinds) {
         if (name == k.name) return k.kind;
-        list += (list.empty() ? "\"" : ", \"") + std::string(k.name) + "\"";
+        names.emplace_back(k.name);
     }
-    throw std::invalid_argument("unknown point set kind \"" + name + "\"; expected one of " + list);
+    throw std::invalid_argument("unknown point set kind \"" + name + "\"; expected one of " + quoted_alternatives(names));
 }
 
 std::string point_set_label(const PointSetSpec& spec) {

@@ -1,6 +1,7 @@
 /// @file sampler.h
-/// @brief The interface every sampling backend implements (CPU threads, CUDA), and the
-/// options that select one. A sampler knows a PreparedMesh and a Lattice, never a config.
+/// @brief The interface every sampling backend implements (CPU threads, CUDA); the options
+/// that select one are core/sampling/sampler_options.h. A sampler knows a PreparedMesh and a
+/// Lattice, never a config.
 #pragma once
 
 #include <memory>
@@ -11,35 +12,13 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/device_query.h"
 #include "core/sampling/sampled_field.h"
+#include "core/sampling/sampler_options.h"
 #include "core/sampling/stored_slab.h"
 #include "core/winding/sign_mode.h"
 #include "kernels/lattice/lattice_slab.h"
 #include "kernels/lattice/sampling_grid.h"
 
 namespace sdf {
-
-struct SamplerOptions {
-    std::string backend = "cpu";        ///< "cpu" or "cuda"
-    std::string method = "brute_force"; ///< "brute_force" (later "bvh")
-    std::string kernel;                 ///< backend-specific variant; empty = backend default
-    Precision precision = Precision::Float;
-    /// How the sign is decided (core/winding/sign_mode.h); auto is resolved per mesh by the
-    /// sampler from the mesh's report (core/sampling/sampler_sign.h).
-    SignMode sign = SignMode::Auto;
-    int threads = 0;                    ///< CPU threads; 0 = all
-    BccStrategy bcc_strategy = BccStrategy::TwoGrids;
-    bool progress = true;
-    int device = 0;                     ///< CUDA device ordinal
-    // GPU work sizes; 0 = chosen from the device's memory and multiprocessor count.
-    int64_t max_points_per_piece = 0;   ///< lattice points per GPU piece (memory split)
-    int max_triangles_per_chunk = 0;    ///< triangles resident on the GPU at a time
-    int points_per_thread = 0;          ///< tuned kernel: points per thread (1, 2, 4, 8)
-    /// Narrow band (issue 14): when > 0, only points with |d| <= band_width get exact values;
-    /// every other point gets distance +-band_width with its correct sign, gradient (0,0,0)
-    /// and closest_triangle kOutsideBandTriangle (core/sampling/sampled_field.h). The result
-    /// is a function of the exact field alone, so it is the same for every sampler and split.
-    double band_width = 0;
-};
 
 /// Result for one arbitrary query point.
 struct PointSample {
@@ -87,8 +66,5 @@ public:
 protected:
     SamplingTimings query_timings_;
 };
-
-/// Names a BCC strategy as in configs ("two_grids" / "double_resolution").
-const char* bcc_strategy_name(BccStrategy s);
 
 }  // namespace sdf

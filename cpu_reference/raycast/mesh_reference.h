@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "core/bvh/triangle_bvh.h"
+#include "core/mesh/prepared_mesh.h"
 #include "core/raycast/rendered_image.h"
 #include "core/raycast/views.h"
 

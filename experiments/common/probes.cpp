@@ -8,6 +8,7 @@
 #include <random>
 
 #include "harness/cache/content_cache.h"
+#include "harness/config/sampler_spec.h"
 #include "harness/io/atomic_file.h"
 
 namespace sdf {
@@ -32,7 +33,9 @@ nlohmann::json cache_key(const PreparedMesh& mesh, const DomainBox<double>& box,
             {"domain_probes", spec.domain_probes},
             {"band_probes", spec.band_probes},
             {"seed", spec.seed},
-            {"sampler", {{"method", o.method}, {"kernel", o.kernel}, {"precision", precision_name(o.precision)}}}};
+            // The options that decide exact values, from the codec (the sign included): the
+            // same rule as the field cache's key. Probes are points, not a lattice.
+            {"sampler", sampler_result_identity(o, LatticeType::CC)}};
 }
 
 std::vector<Vec3d> place_probes(const PreparedMesh& mesh, const DomainBox<double>& box, double w, const ProbeSpec& spec) {
@@ -125,11 +128,6 @@ double angle_degrees(const Vec3d& exact_gradient, const Vec3d& got) {
 }
 
 }  // namespace
-
-bool probes_cached(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
-                   const SamplerOptions& o, const ContentCache* cache) {
-    return cache && cache->has_entry("probes", cache_key(mesh, box, band_width, spec, o));
-}
 
 ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
                      Sampler& sampler, const SamplerOptions& o, const ContentCache* cache, std::string* log_line) {

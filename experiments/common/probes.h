@@ -50,10 +50,6 @@ ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, dou
                      Sampler& sampler, const SamplerOptions& sampler_options, const ContentCache* cache,
                      std::string* log_line);
 
-/// Whether make_probes would find the set in the cache.
-bool probes_cached(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
-                   const SamplerOptions& sampler_options, const ContentCache* cache);
-
 /// Error figures of reconstructed samples against the exact values at the probes:
 ///   domain: rms, max_abs, mean_abs over the domain probes;
 ///   band: rms, max_abs, mean_abs over every probe in the band, and the angle between the

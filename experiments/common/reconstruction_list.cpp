@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "core/quoted_alternatives.h"
+
 namespace sdf {
 namespace {
 
@@ -14,8 +16,7 @@ size_t find_lattice(JsonReader& r, const std::string& name, const std::vector<La
     for (size_t i = 0; i < lattices.size(); ++i)
         if ((name == "cc" && lattices[i].type == LatticeType::CC) || (name == "bcc" && lattices[i].type == LatticeType::BCC))
             of_type.push_back(i);
-    std::string list;
-    for (const auto& l : labels) list += (list.empty() ? "\"" : ", \"") + l + "\"";
+    const std::string list = quoted_alternatives(labels);
     if (of_type.size() == 1) return of_type[0];
     if (of_type.size() > 1)
         r.fail("lattice", "\"" + name + "\" is ambiguous: " + std::to_string(of_type.size()) + " lattices have that type; name one of " + list);

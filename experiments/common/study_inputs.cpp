@@ -23,7 +23,7 @@ double read_domain_margin(JsonReader& config) {
 }
 
 void require_backend(const SamplerOptions& options, const JsonReader& config, const std::string& key) {
-    if (options.backend == "cuda" && !cuda_backend_available())
+    if (sampler_kind(options).on_gpu && !cuda_backend_available())
         config.fail(key + ".backend", std::string("\"cuda\" is not available here: ") +
                                           (SDF_HAVE_CUDA ? "no CUDA device is present"
                                                                : "this build has no CUDA backend") +

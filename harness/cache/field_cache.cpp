@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "harness/config/json_reader.h"
+#include "harness/config/sampler_spec.h"
 #include "harness/io/field_file.h"
 #include "harness/provenance/provenance.h"
 
@@ -30,12 +31,9 @@ nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l,
                          {"origin", {exact(l.origin.x), exact(l.origin.y), exact(l.origin.z)}},
                          {"spacing", exact(l.spacing)},
                          {"resolution", {l.resolution.x, l.resolution.y, l.resolution.z}}}},
-            {"sampler", {{"method", o.method},
-                         {"kernel", o.kernel},
-                         {"precision", precision_name(o.precision)},
-                         // The requested mode: auto resolves from the mesh, which mesh_sha256 fixes.
-                         {"sign", sign_mode_name(o.sign)},
-                         {"bcc_strategy", bcc ? bcc_strategy_name(o.bcc_strategy) : "-"}}}};
+            // Every option of role Result, from the codec's table (the sign as requested: auto
+            // resolves from the mesh, which mesh_sha256 fixes).
+            {"sampler", sampler_result_identity(o, l.type)}};
 }
 
 std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {

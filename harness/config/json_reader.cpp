@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/io/text_file.h"
+#include "core/quoted_alternatives.h"
 
 namespace sdf {
 namespace {
@@ -116,8 +117,7 @@ JsonReader JsonReader::child(const nlohmann::json& v, const std::string& path,
 
 std::string JsonReader::choice(const std::string& key, const std::vector<std::string>& choices,
                                const std::string& fallback) {
-    std::string list;
-    for (const auto& c : choices) list += (list.empty() ? "\"" : ", \"") + c + "\"";
+    const std::string list = quoted_alternatives(choices);
     const std::string value = optional<std::string>(key, fallback, "one of " + list);
     if (std::find(choices.begin(), choices.end(), value) == choices.end()) {
         const std::string near = nearest_match(value, choices);

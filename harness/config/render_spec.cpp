@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/reconstruction/reconstruction_spec.h"
+#include "harness/render/render_backend.h"
 
 namespace sdf {
 namespace {
@@ -132,7 +133,7 @@ RenderSpec parse_render_spec(JsonReader& r) {
     s.error_maps = r.optional<bool>("error_maps", s.error_maps, "true or false");
     s.heat_max_degrees = r.optional<double>("heat_max_degrees", s.heat_max_degrees, "a positive angle in degrees");
     if (!(s.heat_max_degrees > 0)) r.fail("heat_max_degrees", "expected a positive angle in degrees, got " + std::to_string(s.heat_max_degrees));
-    s.backend = r.choice("backend", {"auto", "cpu", "cuda"}, s.backend);
+    s.backend = r.choice("backend", render_backend_choices(), s.backend);
     s.precision = r.choice("precision", {"float", "double"}, s.precision);
     s.grid_downsample = r.optional<int>("grid_downsample", s.grid_downsample, "an integer factor >= 1");
     if (s.grid_downsample < 1) r.fail("grid_downsample", "expected an integer factor >= 1, got " + std::to_string(s.grid_downsample));

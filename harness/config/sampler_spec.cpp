@@ -1,10 +1,143 @@
 #include "harness/config/sampler_spec.h"
 
 #include <algorithm>
+#include <cmath>
+#include <type_traits>
+#include <utility>
 
+#include "core/sampling/kernel_table.h"
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
+
+namespace {
+
+// ---- the table covers the struct --------------------------------------------------------
+
+/// Converts to any member type: brace-initializing an aggregate with n of these compiles
+/// exactly when it has at least n fields.
+struct AnyField {
+    template <class T>
+    operator T() const;
+};
+
+template <class T, class... A>
+constexpr auto braces_accept(int) -> decltype(void(T{std::declval<A>()...}), true) {
+    return true;
+}
+template <class T, class... A>
+constexpr bool braces_accept(...) {
+    return false;
+}
+
+template <class T, class... A>
+constexpr std::size_t aggregate_field_count() {
+    if constexpr (braces_accept<T, A..., AnyField>(0))
+        return aggregate_field_count<T, A..., AnyField>();
+    else
+        return sizeof...(A);
+}
+
+static_assert(aggregate_field_count<SamplerOptions>() == kSamplerOptionFields,
+              "SamplerOptions has a field for_each_sampler_option does not visit (or kSamplerOptionFields is stale): "
+              "add its row in core/sampling/sampler_options.h so configs, the wire and the cache key know it");
+
+// ---- enums by name ----------------------------------------------------------------------
+
+std::vector<std::string> names_of(Precision) {
+    std::vector<std::string> n;
+    for (const auto& p : kPrecisions) n.emplace_back(p.name);
+    return n;
+}
+std::vector<std::string> names_of(BccStrategy) {
+    std::vector<std::string> n;
+    for (const auto& b : kBccStrategies) n.emplace_back(b.name);
+    return n;
+}
+std::vector<std::string> names_of(SignMode) { return sign_mode_names(); }
+
+const char* name_of(Precision v) { return precision_name(v); }
+const char* name_of(BccStrategy v) { return bcc_strategy_name(v); }
+const char* name_of(SignMode v) { return sign_mode_name(v); }
+
+/// `name` is one of names_of(out) (checked by the reader before).
+void set_from_name(const std::string& name, Precision& out) {
+    for (const auto& p : kPrecisions)
+        if (name == p.name) out = p.value;
+}
+void set_from_name(const std::string& name, BccStrategy& out) {
+    for (const auto& b : kBccStrategies)
+        if (name == b.name) out = b.value;
+}
+void set_from_name(const std::string& name, SignMode& out) { out = sign_mode_from_name(name, "sampler.sign"); }
+
+template <class T>
+nlohmann::json encode(const T& v) {
+    if constexpr (std::is_enum_v<T>)
+        return name_of(v);
+    else
+        return v;
+}
+
+// ---- reading ----------------------------------------------------------------------------
+
+/// Reads one field into `v`, whose value on entry (the struct's default) is the fallback.
+struct FieldReader {
+    JsonReader& r;
+
+    void operator()(const OptionField& f, std::string& v) const {
+        switch (f.domain) {
+            case OptionDomain::Backend: v = r.choice(f.name, sampler_backend_choices(), v); break;
+            case OptionDomain::Method: v = r.choice(f.name, sampler_methods(), v); break;
+            default:  // the kernel: checked against its row once backend and method are known
+                v = r.optional<std::string>(f.name, v, std::string(f.expected) + " (" + sampler_kernels_help() + ")");
+        }
+    }
+
+    template <class T>
+    void operator()(const OptionField& f, T& v) const {
+        if constexpr (std::is_enum_v<T>) {
+            set_from_name(r.choice(f.name, names_of(v), name_of(v)), v);
+        } else if constexpr (std::is_same_v<T, bool>) {
+            v = r.optional<bool>(f.name, v, f.expected);
+        } else {
+            v = r.optional<T>(f.name, v, f.expected);
+            check(f, v);
+        }
+    }
+
+    template <class T>
+    void check(const OptionField& f, T v) const {
+        const auto got = [&] { return ", got " + r.raw(f.name).dump(); };
+        switch (f.domain) {
+            case OptionDomain::Count:
+                if (v < 0) r.fail(f.name, "expected " + std::string(f.expected) + ": 0 or a positive number" + got());
+                break;
+            case OptionDomain::PointsPerThread:
+                if (v != 0 && v != 1 && v != 2 && v != 4 && v != 8) r.fail(f.name, "expected 0, 1, 2, 4 or 8" + got());
+                break;
+            case OptionDomain::Width:
+                if (!(v >= 0) || !std::isfinite(double(v)))
+                    r.fail(f.name, "expected " + std::string(f.expected) + ": a finite number >= 0" + got());
+                break;
+            default: break;
+        }
+    }
+};
+
+void check_kernel(const JsonReader& r, const SamplerOptions& o, bool backend_was_auto) {
+    if (o.kernel.empty()) return;
+    if (backend_was_auto)
+        r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +
+                             "\": a kernel needs the backend cpu or cuda");
+    const std::vector<std::string>& kernels = sampler_kind(o.backend, o.method).kernels;
+    if (std::find(kernels.begin(), kernels.end(), o.kernel) != kernels.end()) return;
+    const std::string near = nearest_match(o.kernel, kernels);
+    r.fail("kernel", "unknown " + o.backend + " " + o.method + " kernel \"" + o.kernel + "\"; expected one of " +
+                         quoted_alternatives(kernels) + (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+}
+
+}  // namespace
 
 std::string sampler_kernels_help() {
     std::string help;
@@ -16,61 +149,51 @@ std::string sampler_kernels_help() {
 }
 
 SamplerOptions parse_sampler_options(JsonReader& r) {
-    SamplerOptions o;
-    std::vector<std::string> backends = sampler_backends();
-    backends.emplace_back("auto");
-    const std::string backend = r.choice("backend", backends, "cpu");
-    o.backend = backend == "auto" ? (cuda_backend_available() ? "cuda" : "cpu") : backend;
-    o.method = r.choice("method", sampler_methods(), "brute_force");
-    o.kernel = r.optional<std::string>("kernel", "", "a kernel name (" + sampler_kernels_help() + ")");
-    const std::vector<std::string> kernels = sampler_kind(o.backend, o.method).kernels;
-    if (backend == "auto" && !o.kernel.empty())
-        r.fail("kernel", "\"backend\": \"auto\" takes no kernel (each backend uses its default); got \"" + o.kernel +
-                             "\": name the backend to choose a kernel");
-    if (!o.kernel.empty() && std::find(kernels.begin(), kernels.end(), o.kernel) == kernels.end()) {
-        std::string list;
-        for (const auto& k : kernels) list += (list.empty() ? "\"" : ", \"") + k + "\"";
-        const std::string near = nearest_match(o.kernel, kernels);
-        r.fail("kernel", "unknown " + o.backend + (o.method == "bvh" ? " bvh" : "") + " kernel \"" + o.kernel + "\"; expected one of " + list +
-                             (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
-    }
-    o.threads = r.optional<int>("threads", 0, "a thread count (0 = all cores)");
-    if (o.threads < 0) r.fail("threads", "expected 0 (all cores) or a positive count, got " + std::to_string(o.threads));
-    o.precision = r.choice("precision", {"float", "double"}, "float") == "float" ? Precision::Float : Precision::Double;
-    o.sign = sign_mode_from_name(r.choice("sign", sign_mode_names(), sign_mode_name(kSignModes[0].mode)), "sampler.sign");
-    o.bcc_strategy = r.choice("bcc_strategy", {"two_grids", "double_resolution"}, "two_grids") == "two_grids"
-                         ? BccStrategy::TwoGrids
-                         : BccStrategy::DoubleResolution;
-    o.progress = r.optional<bool>("progress", true, "true or false");
-    o.device = r.optional<int>("device", 0, "a CUDA device ordinal");
-    if (o.device < 0) r.fail("device", "expected a CUDA device ordinal >= 0, got " + std::to_string(o.device));
-    o.max_points_per_piece = r.optional<int64_t>("max_points_per_piece", 0, "a point count (0 = automatic)");
-    if (o.max_points_per_piece < 0)
-        r.fail("max_points_per_piece", "expected 0 (automatic) or a positive count, got " + std::to_string(o.max_points_per_piece));
-    o.max_triangles_per_chunk = r.optional<int>("max_triangles_per_chunk", 0, "a triangle count (0 = automatic)");
-    if (o.max_triangles_per_chunk < 0)
-        r.fail("max_triangles_per_chunk",
-               "expected 0 (automatic) or a positive count, got " + std::to_string(o.max_triangles_per_chunk));
-    o.points_per_thread = r.optional<int>("points_per_thread", 0, "1, 2, 4 or 8 (0 = automatic)");
-    if (o.points_per_thread != 0 && o.points_per_thread != 1 && o.points_per_thread != 2 && o.points_per_thread != 4 &&
-        o.points_per_thread != 8)
-        r.fail("points_per_thread", "expected 0, 1, 2, 4 or 8, got " + std::to_string(o.points_per_thread));
+    SamplerOptions o;  // the defaults
+    for_each_sampler_option(o, FieldReader{r});
+    const bool backend_was_auto = o.backend == "auto";
+    o.backend = resolve_sampler_backend(o.backend);
+    r.record("backend", o.backend);  // the manifest names the backend that ran
+    check_kernel(r, o, backend_was_auto);
     r.finish();
     return o;
 }
 
+SamplerOptions sampler_options_from_json(const nlohmann::json& j, const std::string& source) {
+    JsonReader r(j, source, "sampler");
+    return parse_sampler_options(r);
+}
+
 nlohmann::json sampler_options_to_json(const SamplerOptions& o) {
-    return {{"backend", o.backend},
-            {"method", o.method},
-            {"kernel", o.kernel},
-            {"threads", o.threads},
-            {"precision", precision_name(o.precision)},
-            {"sign", sign_mode_name(o.sign)},
-            {"bcc_strategy", bcc_strategy_name(o.bcc_strategy)},
-            {"device", o.device},
-            {"max_points_per_piece", o.max_points_per_piece},
-            {"max_triangles_per_chunk", o.max_triangles_per_chunk},
-            {"points_per_thread", o.points_per_thread}};
+    nlohmann::json j = nlohmann::json::object();
+    for_each_sampler_option(o, [&](const OptionField& f, const auto& v) { j[f.name] = encode(v); });
+    return j;
+}
+
+nlohmann::json sampler_result_identity(const SamplerOptions& o, LatticeType lattice_type) {
+    nlohmann::json j = nlohmann::json::object();
+    for_each_sampler_option(o, [&](const OptionField& f, const auto& v) {
+        if (f.role == OptionRole::Result) j[f.name] = encode(v);
+    });
+    if (lattice_type != LatticeType::BCC) j["bcc_strategy"] = "-";
+    return j;
+}
+
+std::vector<std::string> sampler_option_choices(const std::string& key) {
+    std::vector<std::string> choices;
+    SamplerOptions o;
+    for_each_sampler_option(o, [&](const OptionField& f, auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if (key != f.name) return;
+        if constexpr (std::is_enum_v<T>) {
+            choices = names_of(v);
+        } else if (f.domain == OptionDomain::Backend) {
+            choices = sampler_backend_choices();
+        } else if (f.domain == OptionDomain::Method) {
+            choices = sampler_methods();
+        }
+    });
+    return choices;
 }
 
 }  // namespace sdf

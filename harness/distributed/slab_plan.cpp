@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/bvh/triangle_bvh.h"
+#include "harness/sampling/sampler_table.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 
 namespace sdf {
@@ -58,7 +59,7 @@ double SlabPlan::estimated_max_over_mean() const {
 
 std::vector<double> plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const SamplerOptions& options,
                                 std::string& estimate) {
-    if (options.method == "bvh" && !mesh.triangles().empty()) {
+    if (sampler_kind(options).cost == CostModel::BvhVisits && !mesh.triangles().empty()) {
         estimate = "bvh_visits";
         return options.precision == Precision::Float ? bvh_plane_costs<float>(mesh, lattice)
                                                      : bvh_plane_costs<double>(mesh, lattice);

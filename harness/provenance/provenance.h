@@ -1,6 +1,7 @@
 /// @file provenance.h
-/// @brief Everything needed to say how a result was made (STYLE.md, "Measuring"): git commit
-/// and dirty flag, build type and flags, CPU and GPU model, driver and CUDA versions, time.
+/// @brief Everything needed to say how a result was made, so that a number can be traced and
+/// made again: git commit and dirty flag, build type and flags, CPU and GPU model, driver and
+/// CUDA versions, time.
 #pragma once
 
 #include <string>

@@ -1,7 +1,7 @@
 /// @file version.h
 /// @brief The project's version and the git commit this build was made from, for every
 /// tool's `--version` and the Python module's `__version__` (the header behind it is written
-/// at build time by cmake/WriteVersionHeader.cmake; -DSDF_GIT_COMMIT=... names the commit of a
+/// at build time by cmake/WriteVersionHeader.cmake; -DSDF_SOURCE_COMMIT=... names the commit of a
 /// tree without .git).
 #pragma once
 
@@ -11,7 +11,7 @@ namespace sdf {
 
 /// "0.1.0" (CMakeLists.txt's project version).
 std::string project_version();
-/// The full commit hash, "unknown" when neither git nor SDF_GIT_COMMIT could tell.
+/// The full commit hash, "unknown" when neither git nor SDF_SOURCE_COMMIT could tell.
 std::string build_commit();
 /// True when the tree had uncommitted changes to tracked files at build time (or is unknown).
 bool build_dirty();

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "core/quoted_alternatives.h"
+#include "core/statistics.h"
 #include "harness/sampling/sampler_table.h"
 
 #if SDF_HAVE_CUDA_RAYCAST
@@ -23,23 +25,17 @@ Bounds3 field_solid_bounds(const SampledField& f) {
 }
 namespace {
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+RenderedImage render_cpu(const Reconstruction& r, const CameraSpec& camera, const RenderOptions& o) {
+    CpuRenderOptions c;
+    c.threads = o.threads;
+    c.progress = o.progress;
+    c.precision = o.precision;
+    c.march = o.march;
+    return render_reconstruction_cpu(r, camera, c);
 }
 
-RenderedImage render_once(const Reconstruction& r, const CameraSpec& camera, const RenderOptions& o,
-                          const std::string& backend) {
-    if (backend == "cpu") {
-        CpuRenderOptions c;
-        c.threads = o.threads;
-        c.progress = o.progress;
-        c.precision = o.precision;
-        c.march = o.march;
-        return render_reconstruction_cpu(r, camera, c);
-    }
 #if SDF_HAVE_CUDA_RAYCAST
+RenderedImage render_cuda(const Reconstruction& r, const CameraSpec& camera, const RenderOptions& o) {
     cuda::CudaRaycastOptions c;
     c.device = o.device;
     c.repetitions = o.repetitions;
@@ -50,12 +46,26 @@ RenderedImage render_once(const Reconstruction& r, const CameraSpec& camera, con
     image.info["camera"] = camera_to_json(camera);
     image.info["march"] = march_statistics(image);
     return image;
-#else
-    throw std::invalid_argument("render backend '" + backend + "': this build has no CUDA backend");
-#endif
 }
+#else
+constexpr RenderedImage (*render_cuda)(const Reconstruction&, const CameraSpec&, const RenderOptions&) = nullptr;
+#endif
 
 }  // namespace
+
+const std::vector<RenderBackend>& render_backend_table() {
+    static const std::vector<RenderBackend> table = {
+        {"cpu", false, false, render_cpu},
+        {"cuda", true, true, render_cuda},
+    };
+    return table;
+}
+
+std::vector<std::string> render_backend_choices() {
+    std::vector<std::string> names = {"auto"};
+    for (const RenderBackend& b : render_backend_table()) names.emplace_back(b.name);
+    return names;
+}
 
 bool cuda_render_available() {
 #if SDF_HAVE_CUDA_RAYCAST
@@ -65,36 +75,35 @@ bool cuda_render_available() {
 #endif
 }
 
-std::string resolve_render_backend(const std::string& requested) {
-    if (requested == "cpu") return "cpu";
-    if (requested == "auto") return cuda_render_available() ? "cuda" : "cpu";
-    if (requested == "cuda") {
-        if (!cuda_render_available())
-            throw std::invalid_argument(std::string("render backend 'cuda': ") +
-                                        (SDF_HAVE_CUDA_RAYCAST ? "no CUDA device on this machine"
-                                                               : "this build has no CUDA backend") +
-                                        "; use 'cpu' or 'auto'");
-        return "cuda";
-    }
-    throw std::invalid_argument("render backend '" + requested + "': expected cpu, cuda or auto");
+const RenderBackend& resolve_render_backend(const std::string& requested) {
+    const std::vector<RenderBackend>& table = render_backend_table();
+    const std::string name = requested == "auto" ? (cuda_render_available() ? "cuda" : "cpu") : requested;
+    const auto row = std::find_if(table.begin(), table.end(), [&](const RenderBackend& b) { return name == b.name; });
+    if (row == table.end())
+        throw std::invalid_argument("render backend '" + requested + "': expected " +
+                                    quoted_alternatives(render_backend_choices()));
+    if (row->render == nullptr || (row->on_gpu && !cuda_render_available()))
+        throw std::invalid_argument("render backend '" + name + "': " +
+                                    (row->render ? "no CUDA device on this machine" : "this build has no CUDA backend") +
+                                    "; use 'cpu' or 'auto'");
+    return *row;
 }
 
 RenderedImage render_reconstruction(const Reconstruction& reconstruction, const CameraSpec& camera,
                                     const RenderOptions& options) {
     if (options.repetitions < 1)
         throw std::invalid_argument("render: repetitions must be >= 1, got " + std::to_string(options.repetitions));
-    const std::string backend = resolve_render_backend(options.backend);
-    // The CUDA launcher repeats the kernel itself; the CPU renders repeat here
-    const int calls = backend == "cpu" ? options.repetitions : 1;
+    const RenderBackend& backend = resolve_render_backend(options.backend);
+    const int calls = backend.times_own_repetitions ? 1 : options.repetitions;
     std::vector<double> seconds;
     RenderedImage image;
     for (int i = 0; i < calls; ++i) {
         const auto start = std::chrono::steady_clock::now();
-        image = render_once(reconstruction, camera, options, backend);
-        if (backend == "cpu") image.info["cast_seconds"] = image.info["seconds"];  // the pixel loop alone
+        image = backend.render(reconstruction, camera, options);
+        if (!backend.times_own_repetitions) image.info["cast_seconds"] = image.info["seconds"];  // the pixel loop alone
         seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
-    image.info["seconds"] = median(seconds);
+    image.info["seconds"] = median_of(seconds);
     image.info["seconds_all"] = seconds;
     return image;
 }

@@ -1,11 +1,13 @@
 /// @file render_backend.h
-/// @brief The one place that maps a render backend name to an implementation (as
-/// harness/sampling/sampler_table.h does for samplers): "cpu" (cpu_reference/raycast/render_cpu.h, all
-/// cores), "cuda" (cuda/raycast.h; this build must have the CUDA backend and the
-/// machine a GPU), or "auto" (cuda when available, else cpu). Both run cast_pixel.
+/// @brief The one table of ray casters (as harness/sampling/sampler_table.h is for samplers):
+/// "cpu" (cpu_reference/raycast/render_cpu.h, all cores) and "cuda" (cuda/raycast.h; this build
+/// must have the CUDA backend and the machine a GPU); a request may also say "auto" (cuda when
+/// available, else cpu). Both run cast_pixel. Configs, the tools and the module take their
+/// choices from render_backend_choices().
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cpu_reference/raycast/render_cpu.h"
 
@@ -21,9 +23,24 @@ struct RenderOptions {
     MarchSettings<double> march{};
 };
 
-/// "cpu" or "cuda" for a requested name; throws std::invalid_argument for an unknown name
-/// or for "cuda" without the CUDA backend or a GPU.
-std::string resolve_render_backend(const std::string& requested);
+struct RenderBackend {
+    const char* name;  ///< "cpu", "cuda"
+    bool on_gpu;       ///< needs a CUDA device
+    /// Repeats and times its launches itself (CUDA events after a warm-up), so it is called
+    /// once; the others are called once per repetition and timed here.
+    bool times_own_repetitions;
+    /// Null: not in this build.
+    RenderedImage (*render)(const Reconstruction&, const CameraSpec&, const RenderOptions&);
+};
+
+const std::vector<RenderBackend>& render_backend_table();
+
+/// "auto" first, then every name of the table: the choices of configs, tools and the module.
+std::vector<std::string> render_backend_choices();
+
+/// The row a requested name selects ("auto": cuda when available, else cpu); throws
+/// std::invalid_argument for an unknown name or for "cuda" without the CUDA backend or a GPU.
+const RenderBackend& resolve_render_backend(const std::string& requested);
 
 /// Bounds of a field's solid, for framing a view without the mesh: the lattice points with
 /// f <= 0, grown by one spacing. Throws when no point has f <= 0 (nothing to frame).

@@ -5,27 +5,11 @@
 
 namespace sdf {
 
-std::vector<std::string> point_query_backends() {
-    std::vector<std::string> names = {"auto"};
-    for (const std::string& b : sampler_backends()) names.push_back(b);
-    return names;
-}
-
-std::string resolve_backend(const std::string& backend) {
-    if (backend != "auto") return backend;
-    return cuda_backend_available() ? "cuda" : "cpu";
-}
+std::vector<std::string> point_query_backends() { return sampler_backend_choices(); }
 
 SamplerOptions point_query_sampler_options(const PointQueryOptions& options) {
-    SamplerOptions s;
-    s.backend = resolve_backend(options.backend);
-    s.method = options.method;
-    s.kernel = options.kernel;
-    s.precision = options.precision;
-    s.sign = options.sign;
-    s.threads = options.threads;
-    s.progress = options.progress;
-    s.device = options.device;
+    SamplerOptions s = options;
+    s.backend = resolve_sampler_backend(options.backend);
     check_sampler_kernel(s);  // also checks the backend and the method against the table
     return s;
 }

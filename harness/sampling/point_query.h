@@ -3,9 +3,9 @@
 /// path that `sdf-query` and the Python module's `query()` take, so that both give the same
 /// numbers to the last bit for the same options.
 ///
-/// Backends and methods are the sampler table's (harness/sampling/sampler_table.h), plus the
-/// backend "auto": cuda when this build has the CUDA backend and a GPU is present, else cpu.
-/// The method defaults to "bvh" (about log n per point; "brute_force" on request).
+/// A query takes the sampler's own options (core/sampling/sampler_options.h: the exact BVH on
+/// the backend "auto" unless others are named); its lattice-only fields (BCC strategy,
+/// narrow band) do not apply to points.
 #pragma once
 
 #include <string>
@@ -15,25 +15,16 @@
 
 namespace sdf {
 
-struct PointQueryOptions {
-    std::string backend = "auto";  ///< "auto", or a backend of the sampler table
-    std::string method = "bvh";    ///< a method of the sampler table
-    std::string kernel;            ///< "" = the row's default kernel
-    Precision precision = Precision::Float;
-    SignMode sign = SignMode::Auto;
-    int threads = 0;               ///< CPU threads; 0 = all
-    bool progress = true;          ///< progress lines on stderr for long queries
-    int device = 0;                ///< CUDA device
-};
+/// The options of a query are the sampler's (one type, one codec: harness/config/sampler_spec.h).
+using PointQueryOptions = SamplerOptions;
 
-/// The backend names a query accepts: "auto" first, then the sampler table's.
+/// The backend names a query accepts: "auto" first, then the sampler table's
+/// (sampler_backend_choices(), harness/sampling/sampler_table.h).
 std::vector<std::string> point_query_backends();
 
-/// "cuda" or "cpu" for "auto", else `backend` unchanged.
-std::string resolve_backend(const std::string& backend);
-
-/// The sampler options of a query ("auto" resolved); throws std::invalid_argument for an
-/// unknown backend, method or kernel, naming the alternatives (as the config parser does).
+/// The sampler options of a query ("auto" resolved by resolve_sampler_backend); throws
+/// std::invalid_argument for an unknown backend, method or kernel, naming the alternatives
+/// (as the config parser does).
 SamplerOptions point_query_sampler_options(const PointQueryOptions& options);
 
 struct PointQueryResult {

@@ -9,6 +9,7 @@
 #include "cuda/bvh_sampler.h"
 #include "cuda/cuda_sampler.h"
 #include "harness/build_config.h"
+#include "harness/sampling/streamed_sampling.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
 #endif
@@ -31,10 +32,14 @@ void add_unique(std::vector<std::string>& list, const char* name) {
 
 const std::vector<SamplerKind>& sampler_table() {
     static const std::vector<SamplerKind> table = {
-        {"cpu", "brute_force", kernel_names(kCpuBruteForceKernels), make_cpu_brute_force_sampler},
-        {"cpu", "bvh", kernel_names(kCpuBvhKernels), make_cpu_bvh_sampler},
-        {"cuda", "brute_force", kernel_names(cuda::kCudaBruteForceKernels), kCudaBruteForce},
-        {"cuda", "bvh", kernel_names(cuda::kCudaBvhKernels), kCudaBvh},
+        {"cpu", "brute_force", kernel_names(kCpuBruteForceKernels), make_cpu_brute_force_sampler,
+         false, kStreamBytesPerPoint, CostModel::PerPoint},
+        {"cpu", "bvh", kernel_names(kCpuBvhKernels), make_cpu_bvh_sampler,
+         false, kStreamBytesPerPoint, CostModel::BvhVisits},
+        {"cuda", "brute_force", kernel_names(cuda::kCudaBruteForceKernels), kCudaBruteForce,
+         true, kStreamBytesPerPointCuda, CostModel::PerPoint},
+        {"cuda", "bvh", kernel_names(cuda::kCudaBvhKernels), kCudaBvh,
+         true, kStreamBytesPerPointCuda, CostModel::BvhVisits},
     };
     return table;
 }
@@ -42,6 +47,17 @@ const std::vector<SamplerKind>& sampler_table() {
 std::vector<std::string> sampler_backends() {
     std::vector<std::string> names;
     for (const SamplerKind& k : sampler_table()) add_unique(names, k.backend);
+    return names;
+}
+
+std::string resolve_sampler_backend(const std::string& backend) {
+    if (backend != "auto") return backend;
+    return cuda_backend_available() ? "cuda" : "cpu";
+}
+
+std::vector<std::string> sampler_backend_choices() {
+    std::vector<std::string> names = {"auto"};
+    for (const std::string& b : sampler_backends()) names.push_back(b);
     return names;
 }
 
@@ -62,13 +78,17 @@ const SamplerKind& sampler_kind(const std::string& backend, const std::string& m
                                 quoted_alternatives(sampler_methods()));
 }
 
+const SamplerKind& sampler_kind(const SamplerOptions& options) {
+    return sampler_kind(resolve_sampler_backend(options.backend), options.method);
+}
+
 void check_sampler_kernel(const SamplerOptions& options) {
-    const SamplerKind& kind = sampler_kind(options.backend, options.method);
+    const SamplerKind& kind = sampler_kind(options);
     if (options.kernel.empty() ||
         std::find(kind.kernels.begin(), kind.kernels.end(), options.kernel) != kind.kernels.end())
         return;
-    throw std::invalid_argument("sampler.kernel: unknown " + options.backend + " " + options.method + " kernel '" +
-                                options.kernel + "'; expected " + quoted_alternatives(kind.kernels));
+    throw std::invalid_argument("sampler.kernel: unknown " + std::string(kind.backend) + " " + kind.method +
+                                " kernel '" + options.kernel + "'; expected " + quoted_alternatives(kind.kernels));
 }
 
 bool cuda_backend_available() {
@@ -80,15 +100,17 @@ bool cuda_backend_available() {
 }
 
 std::unique_ptr<Sampler> make_sampler(const SamplerOptions& options) {
-    const SamplerKind& kind = sampler_kind(options.backend, options.method);
-    check_sampler_kernel(options);
+    SamplerOptions resolved = options;
+    resolved.backend = resolve_sampler_backend(options.backend);
+    const SamplerKind& kind = sampler_kind(resolved);
+    check_sampler_kernel(resolved);
     if (kind.make == nullptr)
-        throw std::runtime_error("sampler.backend \"" + options.backend +
+        throw std::runtime_error("sampler.backend \"" + resolved.backend +
                                  "\": this build has no CUDA backend (configure with nvcc available and "
                                  "SDF_ENABLE_CUDA=AUTO or ON)");
-    if (options.backend == "cuda" && !cuda_backend_available())
-        throw std::runtime_error("sampler.backend \"cuda\": no CUDA device is present on this machine");
-    return kind.make(options);
+    if (kind.on_gpu && !cuda_backend_available())
+        throw std::runtime_error("sampler.backend \"" + resolved.backend + "\": no CUDA device is present on this machine");
+    return kind.make(resolved);
 }
 
 }  // namespace sdf

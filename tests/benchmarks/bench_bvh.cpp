@@ -221,6 +221,7 @@ void BM_CudaBrute(benchmark::State& state, const std::string& file) {
     const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
     SamplerOptions o;
     o.backend = "cuda";
+    o.method = "brute_force";
     o.progress = false;
     auto sampler = make_sampler(o);
     SampledField f = sampler->sample(*mesh, lattice);  // warm-up

@@ -22,6 +22,7 @@ struct Case {
 void run(benchmark::State& state, const Case& c, const std::string& kernel, int points_per_thread) {
     SamplerOptions o;
     o.backend = "cuda";
+    o.method = "brute_force";
     o.kernel = kernel;
     o.points_per_thread = points_per_thread;
     o.progress = false;

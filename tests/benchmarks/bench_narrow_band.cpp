@@ -40,6 +40,7 @@ Lattice cube_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(Latti
 
 SamplerOptions cpu_bvh_options() {
     SamplerOptions o;
+    o.backend = "cpu";
     o.method = "bvh";
     o.progress = false;
     return o;

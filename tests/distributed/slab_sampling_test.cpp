@@ -44,6 +44,7 @@ TEST(LatticeSlab, SlabsOfAPlanTileEveryPointOnce) {
     for (const Lattice& lattice : test_lattices(mesh))
         for (int parts : {1, 2, 3, 5, 20}) {
             SamplerOptions o;
+            o.backend = "cpu";
             o.method = "bvh";
             const SlabPlan plan = plan_slabs(mesh, lattice, o, parts);
             ASSERT_EQ(int(plan.slabs.size()), parts);
@@ -95,6 +96,7 @@ TEST(LatticeSlab, EverySamplerSamplesASlabAsTheWholeLattice) {
             for (Precision precision : {Precision::Float, Precision::Double})
                 for (BccStrategy strategy : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                     SamplerOptions o;
+                    o.backend = kind.backend;
                     o.method = kind.method;
                     o.kernel = kernel;
                     o.precision = precision;

@@ -97,6 +97,7 @@ SampledField sample(const PreparedMesh& mesh, const Lattice& lattice, const std:
                     BccStrategy strategy = BccStrategy::TwoGrids, Precision precision = Precision::Float) {
     SamplerOptions o;
     o.backend = backend;
+    o.method = "brute_force";
     o.kernel = kernel;
     o.bcc_strategy = strategy;
     o.precision = precision;
@@ -143,6 +144,7 @@ TEST(CudaSampler, SplittingLatticesAndMeshesDoesNotChangeTheResult) {
         const SampledField whole = sample(mesh, lattice, "cuda", kernel);
         SamplerOptions o;
         o.backend = "cuda";
+        o.method = "brute_force";
         o.kernel = kernel;
         o.progress = false;
         o.max_points_per_piece = 1000;       // many pieces (thesis: one 32^3 region per piece)
@@ -162,6 +164,8 @@ TEST(CudaSampler, PointQueriesMatchTheCpu) {
     std::vector<Vec3d> pts(5001);
     for (auto& p : pts) p = mesh.bounds().center() + Vec3d{u(rng), u(rng), u(rng)};
     SamplerOptions o;
+    o.backend = "cpu";
+    o.method = "brute_force";
     o.progress = false;
     const auto cpu = make_sampler(o)->query(mesh, pts);
     o.backend = "cuda";
@@ -177,6 +181,7 @@ TEST(CudaSampler, PointQueriesMatchTheCpu) {
 TEST(CudaSampler, ErrorsNameTheKernel) {
     SamplerOptions o;
     o.backend = "cuda";
+    o.method = "brute_force";
     o.kernel = "fastest";
     try {
         make_sampler(o);

@@ -735,9 +735,10 @@ TEST_F(Cli, DryRunValidatesTheSampler) {
         EXPECT_TRUE(Contains(r.err, "c.json")) << r.err;
         EXPECT_TRUE(Contains(r.err, c.key)) << r.err;
     }
-    config("c.json", {{"sampler", {{"threads", 1}, {"kernel", "eberly"}}}});
+    // A kernel belongs to a backend: it needs the backend named (the default, auto, takes none).
+    config("c.json", {{"sampler", {{"threads", 1}, {"backend", "cpu"}, {"method", "brute_force"}, {"kernel", "eberly"}}}});
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
-    config("c.json", {{"sampler", {{"threads", 1}, {"method", "bvh"}, {"kernel", "brick"}}}});
+    config("c.json", {{"sampler", {{"threads", 1}, {"backend", "cpu"}, {"method", "bvh"}, {"kernel", "brick"}}}});
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
     config("c.json", {{"sampler", {{"backend", "auto"}, {"threads", 1}}}});
     EXPECT_EQ(experiment("c.json --output-root out --dry-run").code, 0);
@@ -761,7 +762,9 @@ TEST_F(Cli, QueryRejectsNegativeThreadCountAndUnknownKernel) {
         EXPECT_TRUE(Contains(k.err, "tuned")) << k.err;
     }
     // A kernel belongs to one backend and method: "auto" takes none (as in configs).
-    EXPECT_TRUE(Contains(query("shape:box p.txt --kernel seeded").err, "needs --backend cpu or cuda"));
+    const ShellResult auto_kernel = query("shape:box p.txt --kernel seeded");
+    EXPECT_EQ(auto_kernel.code, 2);  // a command-line error
+    EXPECT_TRUE(Contains(auto_kernel.err, "a kernel needs the backend cpu or cuda")) << auto_kernel.err;
     EXPECT_EQ(query("shape:box p.txt --backend cpu --kernel seeded").code, 0);
     EXPECT_EQ(query("shape:box p.txt --backend cpu --method brute_force --kernel eberly").code, 0);
     EXPECT_NE(query("shape:box p.txt --backend cpu --kernel eberly").code, 0);  // a brute-force kernel, bvh method
@@ -805,7 +808,9 @@ TEST_F(Cli, ManifestRecordsTheResolvedConfig) {
     const json cfg = read_json(dir_ / "out/tiny" / runs[0] / "manifest.json").at("config");
     const json resolved = cfg.at("resolved");
     EXPECT_EQ(resolved.at("sampler").at("precision"), "float");
-    EXPECT_EQ(resolved.at("sampler").at("backend"), "cpu");
+    // The defaults (issue 23): the BVH on "auto", recorded as the backend that ran.
+    EXPECT_EQ(resolved.at("sampler").at("backend"), cuda_backend_available() ? "cuda" : "cpu");
+    EXPECT_EQ(resolved.at("sampler").at("method"), "bvh");
     EXPECT_EQ(resolved.at("domain").at("margin"), 0.1);
     EXPECT_EQ(resolved.at("kind"), "sampling");
     EXPECT_EQ(resolved.at("mesh").at("half_extent"), json({1.0, 1.0, 1.0}));

@@ -17,6 +17,7 @@
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
+#include "harness/sampling/sampler_table.h"
 #include "harness_test_util.h"
 
 namespace sdf {
@@ -247,10 +248,13 @@ TEST(FitLattice, RejectsTinyResolutionAndEmptyBounds) {
 
 // ---- parse_sampler_options ---------------------------------------------------------------
 
+// Issue 23: the fast defaults, the same for configs, tools and Python: the exact BVH on the
+// backend "auto", resolved when the options are read.
 TEST(SamplerSpec, Defaults) {
     const SamplerOptions o = sampler(json::object());
-    EXPECT_EQ(o.backend, "cpu");
-    EXPECT_EQ(o.method, "brute_force");
+    EXPECT_EQ(o.backend, cuda_backend_available() ? "cuda" : "cpu");
+    EXPECT_EQ(o.method, "bvh");
+    EXPECT_EQ(o.band_width, 0.0);
     EXPECT_EQ(o.kernel, "");
     EXPECT_EQ(o.threads, 0);
     EXPECT_EQ(o.precision, Precision::Float);
@@ -266,7 +270,7 @@ TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
     const json j = {{"backend", "cuda"},        {"method", "brute_force"},  {"kernel", "tuned"},
                     {"threads", 3},             {"precision", "double"},    {"bcc_strategy", "double_resolution"},
                     {"progress", false},        {"device", 1},              {"max_points_per_piece", 5000000000LL},
-                    {"max_triangles_per_chunk", 4096}, {"points_per_thread", 4}};
+                    {"max_triangles_per_chunk", 4096}, {"points_per_thread", 4}, {"band_width", 0.125}};
     const SamplerOptions o = sampler(j);
     EXPECT_EQ(o.backend, "cuda");
     EXPECT_EQ(o.kernel, "tuned");
@@ -286,6 +290,12 @@ TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
     EXPECT_EQ(back.at("max_points_per_piece"), 5000000000LL);
     EXPECT_EQ(back.at("points_per_thread"), 4);
     EXPECT_EQ(back.at("sign"), "auto");  // the default
+    EXPECT_EQ(back.at("band_width"), 0.125);
+    EXPECT_EQ(back.at("progress"), false);
+    // The codec reads back what it writes: every field of the table, nothing lost.
+    JsonReader again(back, "wire", "sampler");
+    EXPECT_EQ(sampler_options_to_json(parse_sampler_options(again)), back);
+    EXPECT_EQ(back.size(), kSamplerOptionFields);
 }
 
 TEST(SamplerSpec, SignModeIsReadAndWritten) {
@@ -302,15 +312,21 @@ TEST(SamplerSpec, BadValuesNameTheKey) {
         std::string key, expect;
     };
     const std::vector<Case> cases = {
-        {{{"threads", -1}}, "'sampler.threads'", "0 (all cores) or a positive count"},
+        {{{"threads", -1}}, "'sampler.threads'", "0 or a positive number, got -1"},
+        {{{"device", -2}}, "'sampler.device'", "a CUDA device ordinal"},
+        {{{"band_width", -0.5}}, "'sampler.band_width'", "a finite number >= 0, got -0.5"},
+        {{{"band_width", "wide"}}, "'sampler.band_width'", "a band width"},
+        {{{"method", "octree"}}, "'sampler.method'", "\"brute_force\" or \"bvh\""},
+        {{{"backend", "auto"}, {"kernel", "brick"}}, "'sampler.kernel'", "\"auto\" takes no kernel"},
+        {{{"backend", "cpu"}, {"kernel", "eberly"}}, "'sampler.kernel'", "unknown cpu bvh kernel \"eberly\""},
         {{{"threads", "2"}}, "'sampler.threads'", "\"2\""},
         {{{"threads", 1.5}}, "'sampler.threads'", "a thread count"},
         {{{"precision", "doubel"}}, "'sampler.precision'", "did you mean \"double\""},
         {{{"bcc_strategy", "two_grid"}}, "'sampler.bcc_strategy'", "did you mean \"two_grids\""},
         {{{"sign", "windng"}}, "'sampler.sign'", "did you mean \"winding\""},
-        {{{"sign", "parity"}}, "'sampler.sign'", "\"auto\", \"pseudonormal\", \"winding\""},
+        {{{"sign", "parity"}}, "'sampler.sign'", "\"auto\", \"pseudonormal\" or \"winding\""},
         {{{"sign", true}}, "'sampler.sign'", "one of \"auto\""},
-        {{{"backend", "opencl"}}, "'sampler.backend'", "\"cpu\", \"cuda\""},
+        {{{"backend", "opencl"}}, "'sampler.backend'", "\"auto\", \"cpu\" or \"cuda\""},
         {{{"points_per_thread", 3}}, "'sampler.points_per_thread'", "0, 1, 2, 4 or 8, got 3"},
         {{{"progress", 1}}, "'sampler.progress'", "true or false"},
         {{{"thread", 2}}, "unknown key 'sampler.thread'", "did you mean 'threads'?"},

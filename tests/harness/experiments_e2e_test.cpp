@@ -54,7 +54,8 @@ json tiny_study(const std::string& name) {
             {"kind", "reconstruction"},
             {"mesh", {{"shape", "sphere"}, {"subdivisions", 1}}},
             {"lattices", {{{"type", "cc"}, {"resolution", {6, 6, 6}}}, {{"type", "bcc"}, {"resolution", {5, 5, 10}}}}},
-            {"sampler", {{"threads", 1}, {"progress", false}}},
+            // The CPU named: the dry-run lines below name the sampler (the default is "auto").
+            {"sampler", {{"backend", "cpu"}, {"threads", 1}, {"progress", false}}},
             {"metrics", {{"domain_probes", 200}, {"band_probes", 200}}}};
 }
 
@@ -121,8 +122,8 @@ TEST_F(E2e, FieldsAreCachedAcrossRunsAndKindsAndNoCacheResamples) {
     ASSERT_EQ(run("s.json --output-root out --quiet").code, 0);
     const ShellResult dry = run("a.json --output-root out --dry-run");
     ASSERT_EQ(dry.code, 0) << dry.err;
-    EXPECT_TRUE(Contains(dry.out, "field cc-6x6x6: cc 6x6x6, 216 points, cpu/brute_force: to sample")) << dry.out;
-    EXPECT_TRUE(Contains(dry.out, "field bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: cached")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "field cc-6x6x6: cc 6x6x6, 216 points, cpu/bvh: to sample")) << dry.out;
+    EXPECT_TRUE(Contains(dry.out, "field bcc-5x5x10: bcc 5x5x10, 189 points, cpu/bvh: cached")) << dry.out;
     const ShellResult first = run("a.json --output-root out --quiet");
     ASSERT_EQ(first.code, 0) << first.err;
     EXPECT_TRUE(Contains(first.out, "cc-6x6x6 (6x6x6, 216 points): sampled")) << first.out;
@@ -149,7 +150,7 @@ TEST_F(E2e, FieldsAreCachedAcrossRunsAndKindsAndNoCacheResamples) {
     EXPECT_EQ(m1.at("regression"), m3.at("regression"));
     EXPECT_FALSE(read_json(only_run("a", "out3") / "manifest.json").at("cache").at("used").get<bool>());
     // --cache-dir chooses another cache: nothing there yet.
-    EXPECT_TRUE(Contains(run("a.json --dry-run --cache-dir " + quote(at("other"))).out, "bcc-5x5x10: bcc 5x5x10, 189 points, cpu/brute_force: to sample"));
+    EXPECT_TRUE(Contains(run("a.json --dry-run --cache-dir " + quote(at("other"))).out, "bcc-5x5x10: bcc 5x5x10, 189 points, cpu/bvh: to sample"));
 }
 
 // ---- sweeps and inheritance ------------------------------------------------------------------
@@ -317,9 +318,9 @@ TEST_F(E2e, SpeedupKindReportsGpuBackendsAsUnavailableWithoutAGpu) {
                           {"kind", "speedup"},
                           {"cases", {{{"label", "bunny"}, {"mesh", {{"shape", "sphere"}, {"subdivisions", 1}}}, {"samples", {64}}}}},
                           {"lattice_types", {"cc", "bcc"}},
-                          {"backends", {{{"name", "cpu_1"}, {"backend", "cpu"}, {"threads", 1}, {"max_points", 16}},
-                                        {{"name", "cpu_all"}, {"backend", "cpu"}},
-                                        {{"name", "gpu_tuned"}, {"backend", "cuda"}, {"kernel", "tuned"}}}},
+                          {"backends", {{{"name", "cpu_1"}, {"backend", "cpu"}, {"method", "brute_force"}, {"threads", 1}, {"max_points", 16}},
+                                        {{"name", "cpu_all"}, {"backend", "cpu"}, {"method", "brute_force"}},
+                                        {{"name", "gpu_tuned"}, {"backend", "cuda"}, {"method", "brute_force"}, {"kernel", "tuned"}}}},
                           {"repetitions", 1}}
                          .dump());
     const ShellResult r = run("sp.json --output-root out --quiet");

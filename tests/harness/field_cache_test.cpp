@@ -11,10 +11,13 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "core/mesh/sha256.h"
 #include "harness/cache/content_cache.h"
 #include "harness/config/json_reader.h"
+#include "harness/config/sampler_spec.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/atomic_file.h"
 #include "harness_test_util.h"
@@ -102,6 +105,52 @@ TEST(FieldCacheKey, EverythingThatChangesTheFieldIsPartOfTheKey) {
     // The BCC strategy does not matter for a CC lattice.
     const Lattice cc = lattice(LatticeType::CC, {4, 4, 4});
     EXPECT_EQ(field_cache_key("abc", cc, o), field_cache_key("abc", cc, s));
+}
+
+/// `v` changed to another value of its type (an enum: its next enumerator).
+template <class T>
+void change(T& v) {
+    if constexpr (std::is_same_v<T, std::string>) v += "_changed";
+    else if constexpr (std::is_same_v<T, bool>) v = !v;
+    else if constexpr (std::is_enum_v<T>) v = T(int(v) + 1);
+    else v = T(v + 1);
+}
+
+// Every field of the options' table: one of role Result changes the key (on a BCC lattice,
+// where every one matters), one of role Execution does not; and the Execution fields are
+// exactly those that must not key a field. A new option is keyed once it has its row (the
+// codec does not compile while the struct has a field without one).
+TEST(FieldCacheKey, EveryResultOptionChangesTheKeyAndNoOtherDoes) {
+    const Lattice l = lattice(LatticeType::BCC, {4, 4, 4});
+    const SamplerOptions base;
+    const json key = field_cache_key("abc", l, base);
+    std::vector<std::string> execution;
+    size_t visited = 0;
+    for_each_sampler_option(base, [&](const OptionField& f, const auto& member) {
+        ++visited;
+        SamplerOptions changed = base;
+        for_each_sampler_option(changed, [&](const OptionField& g, auto& m) {
+            if constexpr (std::is_same_v<std::decay_t<decltype(m)>, std::decay_t<decltype(member)>>)
+                if (std::string(g.name) == f.name) change(m);
+        });
+        ASSERT_NE(sampler_options_to_json(changed), sampler_options_to_json(base)) << f.name << " was not changed";
+        const bool keyed = field_cache_key("abc", l, changed) != key;
+        EXPECT_EQ(keyed, f.role == OptionRole::Result) << f.name;
+        if (f.role == OptionRole::Execution) execution.push_back(f.name);
+    });
+    EXPECT_EQ(visited, kSamplerOptionFields);
+    const std::vector<std::string> must_not_key = {"backend", "threads", "progress", "device", "max_points_per_piece",
+                                                   "max_triangles_per_chunk", "points_per_thread"};
+    EXPECT_EQ(execution, must_not_key);
+}
+
+// Issue 25: the narrow band was missing from the key, so a banded field could be served for
+// a full one.
+TEST(FieldCacheKey, TheNarrowBandIsPartOfTheKey) {
+    const Lattice l = lattice(LatticeType::CC, {4, 4, 4});
+    SamplerOptions banded;
+    banded.band_width = 0.25;
+    EXPECT_NE(field_cache_key("abc", l, SamplerOptions{}), field_cache_key("abc", l, banded));
 }
 
 TEST_F(Cache, StoreThenLoadIsExactAndNeverReplaces) {

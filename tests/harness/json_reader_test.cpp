@@ -290,14 +290,14 @@ TEST(JsonReader, ChoiceRejectsUnknownValueWithSuggestion) {
     const std::string msg = config_error([&] { r.choice("precision", {"float", "double"}, "float"); });
     EXPECT_TRUE(Contains(msg, "cfg.json: key 'sampler.precision'"));
     EXPECT_TRUE(Contains(msg, "\"doubel\""));
-    EXPECT_TRUE(Contains(msg, "\"float\", \"double\""));
+    EXPECT_TRUE(Contains(msg, "\"float\" or \"double\""));
     EXPECT_TRUE(Contains(msg, "did you mean \"double\""));
     const std::string far = config_error([&] { r.choice("strategy", {"two_grids", "double_resolution"}, "two_grids"); });
-    EXPECT_TRUE(Contains(far, "expected one of \"two_grids\", \"double_resolution\""));
+    EXPECT_TRUE(Contains(far, "expected one of \"two_grids\" or \"double_resolution\""));
     EXPECT_FALSE(Contains(far, "did you mean"));
     const std::string not_string = config_error([&] { r.choice("n", {"a", "b"}, "a"); });
     EXPECT_TRUE(Contains(not_string, "'sampler.n'"));
-    EXPECT_TRUE(Contains(not_string, "one of \"a\", \"b\""));
+    EXPECT_TRUE(Contains(not_string, "one of \"a\" or \"b\""));
 }
 
 // ---- finish -----------------------------------------------------------------------------

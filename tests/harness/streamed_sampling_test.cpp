@@ -39,6 +39,7 @@ std::string bytes_of(const std::string& path) {
 
 SamplerOptions sampler_options(double band) {
     SamplerOptions o;
+    o.backend = "cpu";
     o.method = "bvh";
     o.band_width = band;
     o.progress = false;

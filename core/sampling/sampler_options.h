@@ -1,0 +1,118 @@
+/// @file sampler_options.h
+/// @brief What a sampler is asked to do (SamplerOptions), with the one table of its fields.
+///
+/// The defaults below are the defaults of every config, tool and Python call (docs/harness.md,
+/// "Defaults"): the exact BVH search on the backend "auto" (cuda when this build has the CUDA
+/// backend and a GPU is present, else cpu; resolved once, by resolve_sampler_backend in
+/// harness/sampling/sampler_table.h). Brute force runs only where it is named.
+///
+/// for_each_sampler_option() visits every field with its name and role. The JSON codec
+/// (harness/config/sampler_spec.h: configs, the tools' options, the MPI wire, the Python
+/// module's keywords) and the field cache's key (harness/cache/field_cache.h) are generated
+/// from it, so a new option is read, written and keyed once it has its row; the codec
+/// refuses to compile while SamplerOptions has a field the table does not visit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "core/sampling/sampled_field.h"
+#include "core/winding/sign_mode.h"
+#include "kernels/lattice/sampling_grid.h"
+
+namespace sdf {
+
+struct SamplerOptions {
+    std::string backend = "auto";  ///< "auto", or a backend of the sampler table ("cpu", "cuda")
+    std::string method = "bvh";    ///< a method of the sampler table ("bvh", "brute_force")
+    std::string kernel;            ///< backend-specific variant; empty = the row's default
+    Precision precision = Precision::Float;
+    /// How the sign is decided (core/winding/sign_mode.h); auto is resolved per mesh by the
+    /// sampler from the mesh's report (core/sampling/sampler_sign.h).
+    SignMode sign = SignMode::Auto;
+    int threads = 0;               ///< CPU threads; 0 = all
+    BccStrategy bcc_strategy = BccStrategy::TwoGrids;
+    bool progress = true;
+    int device = 0;                ///< CUDA device ordinal
+    // GPU work sizes; 0 = chosen from the device's memory and multiprocessor count.
+    int64_t max_points_per_piece = 0;  ///< lattice points per GPU piece (memory split)
+    int max_triangles_per_chunk = 0;   ///< triangles resident on the GPU at a time
+    int points_per_thread = 0;         ///< tuned kernel: points per thread (1, 2, 4, 8)
+    /// Narrow band (issue 14): when > 0, only points with |d| <= band_width get exact values;
+    /// every other point gets distance +-band_width with its correct sign, gradient (0,0,0)
+    /// and closest_triangle kOutsideBandTriangle (core/sampling/sampled_field.h). The result
+    /// is a function of the exact field alone, so it is the same for every sampler and split.
+    double band_width = 0;
+};
+
+/// Whether a field decides the sampled values.
+enum class OptionRole {
+    Result,     ///< changes the field: part of the field cache key
+    Execution,  ///< where and how fast only (every backend computes the same field): not keyed
+};
+
+/// What values a field takes; the codec validates each kind once.
+enum class OptionDomain {
+    Backend,          ///< "auto" or a backend of the sampler table
+    Method,           ///< a method of the sampler table
+    Kernel,           ///< "" or a kernel of the (backend, method) row
+    Named,            ///< an enum, read and written by its name
+    Count,            ///< an integer >= 0 (0 = automatic / all)
+    PointsPerThread,  ///< 0, 1, 2, 4 or 8
+    Flag,             ///< true or false
+    Width,            ///< a finite length >= 0 in mesh units
+};
+
+struct OptionField {
+    const char* name;      ///< the JSON key (configs, wire, Python keyword)
+    OptionRole role;
+    OptionDomain domain;
+    const char* expected;  ///< for messages and help texts: "a thread count (0 = all cores)"
+};
+
+/// The number of rows below; the codec checks it against the struct's field count.
+inline constexpr std::size_t kSamplerOptionFields = 13;
+
+/// Calls f(OptionField, member) for every field of `o`, in the order above. `O` is
+/// SamplerOptions or const SamplerOptions.
+template <class O, class F>
+void for_each_sampler_option(O& o, F&& f) {
+    using R = OptionRole;
+    using D = OptionDomain;
+    f(OptionField{"backend", R::Execution, D::Backend, "a backend"}, o.backend);
+    f(OptionField{"method", R::Result, D::Method, "a method"}, o.method);
+    f(OptionField{"kernel", R::Result, D::Kernel, "a kernel name"}, o.kernel);
+    f(OptionField{"precision", R::Result, D::Named, "a precision"}, o.precision);
+    f(OptionField{"sign", R::Result, D::Named, "a sign mode"}, o.sign);
+    f(OptionField{"threads", R::Execution, D::Count, "a thread count (0 = all cores)"}, o.threads);
+    f(OptionField{"bcc_strategy", R::Result, D::Named, "a BCC strategy"}, o.bcc_strategy);
+    f(OptionField{"progress", R::Execution, D::Flag, "true or false"}, o.progress);
+    f(OptionField{"device", R::Execution, D::Count, "a CUDA device ordinal"}, o.device);
+    f(OptionField{"max_points_per_piece", R::Execution, D::Count, "a point count (0 = automatic)"},
+      o.max_points_per_piece);
+    f(OptionField{"max_triangles_per_chunk", R::Execution, D::Count, "a triangle count (0 = automatic)"},
+      o.max_triangles_per_chunk);
+    f(OptionField{"points_per_thread", R::Execution, D::PointsPerThread, "1, 2, 4 or 8 (0 = automatic)"},
+      o.points_per_thread);
+    f(OptionField{"band_width", R::Result, D::Width, "a band width in mesh units (0 = no band)"}, o.band_width);
+}
+
+/// Names of the enums a sampler option takes (the first is the default of a new struct).
+struct NamedPrecision {
+    const char* name;
+    Precision value;
+};
+inline constexpr NamedPrecision kPrecisions[] = {{"float", Precision::Float}, {"double", Precision::Double}};
+
+struct NamedBccStrategy {
+    const char* name;
+    BccStrategy value;
+};
+inline constexpr NamedBccStrategy kBccStrategies[] = {{"two_grids", BccStrategy::TwoGrids},
+                                                      {"double_resolution", BccStrategy::DoubleResolution}};
+
+/// Names a BCC strategy as in configs ("two_grids" / "double_resolution").
+const char* bcc_strategy_name(BccStrategy s);
+
+}  // namespace sdf
