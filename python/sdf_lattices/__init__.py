@@ -1,0 +1,16 @@
+"""Exact signed distance fields of triangle meshes on CC and BCC lattices.
+
+Meshes (load_mesh, Mesh), exact queries of arbitrary points (query), sampled fields
+(sample, read_field, Field), their reconstruction (Field.reconstruct) and ray-cast images
+(render), all with NumPy arrays. The same code as the command-line tools: query() equals
+sdf-query, sample() equals a run-experiment field, bit for bit. Signed distance is negative
+inside; gradients are unit vectors; triangles are 0-based in the input's face order.
+Errors raise ValueError (a bad argument) or RuntimeError (a bad file, a missing backend)
+with the tools' messages.
+
+The package is the compiled extension sdf_lattices._core (every name re-exported here) and
+pure-Python parts beside it.
+"""
+from . import _core
+from ._core import *  # noqa: F401,F403  (every public name of the extension)
+from ._core import __version__, build_commit  # noqa: F401

@@ -1,0 +1,57 @@
+#include "python/src/common.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sdf {
+
+std::string quoted_list(const std::vector<std::string>& names) {
+    std::string s;
+    for (const std::string& n : names) s += (s.empty() ? "'" : ", '") + n + "'";
+    return s;
+}
+
+const std::string& choose(const std::string& argument, const std::string& value, const std::vector<std::string>& choices) {
+    if (std::find(choices.begin(), choices.end(), value) == choices.end())
+        throw std::invalid_argument(argument + ": unknown value '" + value + "'; expected one of " + quoted_list(choices));
+    return value;
+}
+
+Precision precision_from_name(const std::string& name) {
+    return choose("precision", name, {"float", "double"}) == "float" ? Precision::Float : Precision::Double;
+}
+
+std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument) {
+    if (a.ndim() != 2 || a.shape(1) != 3) {
+        std::string shape = "(";
+        for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+        throw std::invalid_argument(argument + ": expected an array of shape (N, 3), got shape " + shape +
+                                    (a.ndim() == 1 ? ",)" : ")"));
+    }
+    const auto v = a.unchecked<2>();
+    std::vector<Vec3d> points(size_t(a.shape(0)));
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+        points[size_t(i)] = {v(i, 0), v(i, 1), v(i, 2)};
+        if (!std::isfinite(v(i, 0)) || !std::isfinite(v(i, 1)) || !std::isfinite(v(i, 2)))
+            throw std::invalid_argument(argument + ": row " + std::to_string(i) + " is not three finite numbers");
+    }
+    return points;
+}
+
+py::array_t<double> vec3_array(const Vec3d* v, size_t n, std::vector<py::ssize_t> shape) {
+    shape.push_back(3);
+    return new_array<double>(shape, [&](double* out) {
+        for (size_t i = 0; i < n; ++i) {
+            out[3 * i] = v[i].x;
+            out[3 * i + 1] = v[i].y;
+            out[3 * i + 2] = v[i].z;
+        }
+    });
+}
+
+py::object json_to_python(const nlohmann::json& j) {
+    return py::module_::import("json").attr("loads")(j.dump());
+}
+
+}  // namespace sdf

@@ -1,0 +1,144 @@
+/// @file field.h
+/// @brief sdf_lattices.Field: a sampled (or read) field with the reconstruction last asked
+/// for, kept for repeated calls (reconstruct, render).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/reconstruction/reconstruction.h"
+#include "core/reconstruction/reconstruction_spec.h"
+#include "harness/io/field_output.h"
+#include "core/sampling/sampled_field.h"
+#include "python/src/common.h"
+
+namespace sdf {
+
+class Field {
+public:
+    explicit Field(SampledField field) : field_(std::make_shared<const SampledField>(std::move(field))) {}
+
+    const SampledField& field() const { return *field_; }
+    const Lattice& lattice() const { return field_->lattice; }
+
+    /// The CC sub-grids, each {shape (nz, ny, nx), first storage index}: one for CC, the
+    /// primary and the secondary grid for BCC.
+    struct Grid {
+        Int3 resolution;
+        int64_t first;
+    };
+    std::vector<Grid> grids() const {
+        std::vector<Grid> g = {{lattice().resolution, 0}};
+        if (lattice().type == LatticeType::BCC) g.push_back({lattice().secondary_resolution(), lattice().primary_count()});
+        return g;
+    }
+
+    /// One array per grid (a tuple for BCC), each [nz, ny, nx] + `inner`.
+    template <typename Make>
+    py::object per_grid(Make make) const {
+        std::vector<py::object> arrays;
+        for (const Grid& g : grids()) arrays.push_back(make(g, std::vector<py::ssize_t>{g.resolution.z, g.resolution.y, g.resolution.x}));
+        if (arrays.size() == 1) return arrays[0];
+        return py::make_tuple(arrays[0], arrays[1]);
+    }
+
+    py::object values() const {
+        return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
+            const double* src = field_->distance.data() + g.first;
+            const int64_t n = int64_t(g.resolution.x) * g.resolution.y * g.resolution.z;
+            return new_array<double>(shape, [&](double* out) { std::copy(src, src + n, out); });
+        });
+    }
+    py::object gradient() const {
+        if (field_->gradient.empty()) return py::none();
+        return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
+            const size_t n = size_t(g.resolution.x) * size_t(g.resolution.y) * size_t(g.resolution.z);
+            return vec3_array(field_->gradient.data() + g.first, n, shape);
+        });
+    }
+    py::object triangle() const {
+        if (field_->closest_triangle.empty()) return py::none();
+        return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
+            const int32_t* src = field_->closest_triangle.data() + g.first;
+            const int64_t n = int64_t(g.resolution.x) * g.resolution.y * g.resolution.z;
+            return new_array<int32_t>(shape, [&](int32_t* out) { std::copy(src, src + n, out); });
+        });
+    }
+    py::object grid_origins() const {
+        std::vector<py::object> origins;
+        for (const Grid& g : grids()) {
+            const Vec3d o = lattice().position(g.first);
+            origins.push_back(py::make_tuple(o.x, o.y, o.z));
+        }
+        return origins.size() == 1 ? origins[0] : py::make_tuple(origins[0], origins[1]);
+    }
+
+    void write(const std::string& path, const std::string& dtype, bool overwrite, bool closest_triangle) const {
+        FieldWriteOptions o;
+        o.dtype = choose("dtype", dtype, {"float32", "float64"}) == "float32" ? FieldDtype::Float32 : FieldDtype::Float64;
+        o.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
+        o.closest_triangle = closest_triangle;
+        py::gil_scoped_release release;
+        write_field_file(path, *field_, o);
+    }
+
+    /// The reconstruction of these names (sdf-eval's defaults for an empty `derivatives`).
+    std::shared_ptr<const Reconstruction> reconstruction(const std::string& interpolator_in, const std::string& derivatives,
+                                                         double sigma2, const std::string& sigma_units, int threads) {
+        const std::string interpolator =
+            interpolator_in.empty() ? (lattice().type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm") : interpolator_in;
+        ReconstructionSpec spec;
+        spec.interpolator = parse_interpolator(interpolator);
+        spec.derivatives = derivatives.empty() ? default_derivative_source(spec.interpolator, !field_->gradient.empty())
+                                               : parse_derivative_source(derivatives);
+        spec.sigma2 = sigma2;
+        spec.sigma_units = choose("sigma_units", sigma_units, {"lattice", "spacing"}) == "lattice" ? SigmaUnits::LatticeUnits
+                                                                                                    : SigmaUnits::Spacing;
+        if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
+        spec.threads = threads;
+        const std::string key = describe(spec);
+        if (!recon_ || recon_key_ != key) {
+            std::shared_ptr<const SampledField> f = field_;
+            std::shared_ptr<const Reconstruction> r;
+            {
+                py::gil_scoped_release release;
+                r = std::make_shared<const Reconstruction>(*f, spec);
+            }
+            recon_ = r;
+            recon_key_ = key;
+        }
+        return recon_;
+    }
+
+    py::tuple reconstruct(const DoubleArray& points_in, const std::string& interpolator, const std::string& derivatives,
+                          double sigma2, const std::string& sigma_units, int threads) {
+        const std::vector<Vec3d> points = points_from_array(points_in, "points");
+        const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
+        std::vector<ReconstructedSample<double>> samples;
+        {
+            py::gil_scoped_release release;
+            samples = r->evaluate(points, threads);
+        }
+        const size_t n = samples.size();
+        auto values = new_array<double>({py::ssize_t(n)}, [&](double* v) {
+            for (size_t i = 0; i < n; ++i) v[i] = samples[i].value;
+        });
+        auto gradients = new_array<double>({py::ssize_t(n), 3}, [&](double* g) {
+            for (size_t i = 0; i < n; ++i) {
+                g[3 * i] = samples[i].gradient.x;
+                g[3 * i + 1] = samples[i].gradient.y;
+                g[3 * i + 2] = samples[i].gradient.z;
+            }
+        });
+        return py::make_tuple(values, gradients);
+    }
+
+private:
+    std::shared_ptr<const SampledField> field_;
+    std::shared_ptr<const Reconstruction> recon_;
+    std::string recon_key_;
+};
+
+}  // namespace sdf
