@@ -14,3 +14,5 @@ pure-Python parts beside it.
 from . import _core
 from ._core import *  # noqa: F401,F403  (every public name of the extension)
 from ._core import __version__, build_commit  # noqa: F401
+from . import data  # noqa: F401  (ML training data: sdf_lattices.data.sample_near_surface, ...)
+from ._build_info import build_info  # noqa: F401  (what the build found: CUDA, MPI, OpenVDB, OpenImageIO)

@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _core
+import sdf_lattices as _sl   # the package (partly initialised while it imports this module): names resolve at call time
 
 # DeepSDF's two variances, 0.0025 and 0.00025 on the unit sphere, are standard deviations 0.05
 # and 0.016; on the unit cube (half the length) 0.025 and 0.008. 6% of the points uniform in
@@ -124,12 +124,12 @@ class Normalization(NamedTuple):
 
 def as_mesh(mesh):
     """A Mesh from a Mesh, a path or "shape:NAME" (load_mesh), or a (vertices, faces) pair."""
-    if isinstance(mesh, _core.Mesh):
+    if isinstance(mesh, _sl.Mesh):
         return mesh
     if isinstance(mesh, (str, os.PathLike)):
-        return _core.load_mesh(os.fspath(mesh))
+        return _sl.load_mesh(os.fspath(mesh))
     if isinstance(mesh, tuple) and len(mesh) == 2:
-        return _core.Mesh(*mesh)
+        return _sl.Mesh(*mesh)
     raise ValueError(f"mesh: expected a Mesh, a file name or (vertices, faces), got {type(mesh).__name__}")
 
 
@@ -150,7 +150,7 @@ def normalize_to_unit_cube(mesh, padding=0.0):
         raise ValueError("normalize_to_unit_cube: the mesh's bounding box is a point")
     center = 0.5 * (lo + hi)
     scale = extent / (1.0 - 2.0 * padding)
-    unit = _core.Mesh((mesh.vertices - center) / scale, mesh.triangles, name=_mesh_name(mesh))
+    unit = _sl.Mesh((mesh.vertices - center) / scale, mesh.faces, name=_mesh_name(mesh))
     return unit, Normalization(center, scale)
 
 
@@ -224,8 +224,8 @@ def _group_counts(count, sigmas, uniform_fraction, surface_fraction):
 
 def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_fraction=DEFAULT_UNIFORM_FRACTION,
                         surface_fraction=0.0, box=None, margin=0.1, seed=0, normalize=True, padding=0.0,
-                        dtype="float64", sign="auto", backend="auto", method="bvh", precision="float", threads=0):
-    """sample_near_surface(mesh, count=250000, *, sigmas=(0.025, 0.008), uniform_fraction=0.06, surface_fraction=0.0, box=None, margin=0.1, seed=0, normalize=True, padding=0.0, dtype="float64", sign="auto", backend="auto", method="bvh", precision="float", threads=0) -> Samples
+                        dtype="float64", sign="auto", backend="auto", method="bvh", precision="double", threads=0):
+    """sample_near_surface(mesh, count=250000, *, sigmas=(0.025, 0.008), uniform_fraction=0.06, surface_fraction=0.0, box=None, margin=0.1, seed=0, normalize=True, padding=0.0, dtype="float64", sign="auto", backend="auto", method="bvh", precision="double", threads=0) -> Samples
 
     count points with exact signed distance, occupancy and normals: surface_fraction of them
     on the surface, uniform_fraction uniform in the box, the rest near the surface, split
@@ -236,7 +236,10 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
     bounding box whose side is the largest extent plus margin of it on each side
     ([-0.6, 0.6]^3 for a normalised mesh). seed: the same seed gives the same points.
     dtype "float32" rounds the points to float32 before they are queried, so that the values
-    are exact for the points as stored. sign, backend, method, precision, threads: as query().
+    are exact for the points as stored. sign, backend, method, precision, threads: as query();
+    precision "double" (the default here) searches in double: a float search may pick a
+    triangle up to ~1e-4 (relative) farther than the nearest near an edge where two are
+    almost as near (its distance is still evaluated in double).
     """
     mesh = as_mesh(mesh)
     count, seed = _check_count(count), _check_seed(seed)
@@ -258,7 +261,7 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
 
     n_surface, n_near, n_uniform = _group_counts(count, sigmas, uniform_fraction, surface_fraction)
     seeds = _group_seeds(seed, 2 + len(sigmas))
-    vertices, triangles = mesh.vertices, mesh.triangles
+    vertices, triangles = mesh.vertices, mesh.faces
     groups, parts, on_surface = [], [], None
     if n_surface:
         on_surface, on_surface_tri = surface_gaussian(vertices, triangles, n_surface, 0.0, seeds[0])
@@ -274,7 +277,7 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
     group = np.concatenate([np.full(len(p), g, dtype=np.int8) for g, p in enumerate(parts)]) if parts else np.zeros(0, np.int8)
     points = np.concatenate(parts).astype(dtype) if parts else np.zeros((0, 3), dtype)
 
-    result = _core.query(mesh, points.astype(np.float64), backend=backend, method=method, sign=sign,
+    result = _sl.query(mesh, points.astype(np.float64), backend=backend, method=method, sign=sign,
                          precision=precision, threads=threads)
     sdf, normals, triangle = result.distance, np.array(result.gradient), np.array(result.triangle)
     if on_surface is not None:   # on their triangle (up to rounding): its normal, not the gradient's
