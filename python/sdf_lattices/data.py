@@ -43,12 +43,16 @@ _CHUNK = 1 << 20   # points per block of random numbers (bounds the generator's 
 def _splitmix64(seed, start, count):
     """Outputs start .. start+count-1 of SplitMix64 seeded with seed (output k comes from the
     state seed + (k+1) * golden, so any stretch of the stream is computed directly)."""
-    k = np.arange(start + 1, start + count + 1, dtype=np.uint64)
-    with np.errstate(over="ignore"):
-        z = np.uint64(seed) + k * _GOLDEN
-        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    return z ^ (z >> np.uint64(31))
+    z = np.arange(start + 1, start + count + 1, dtype=np.uint64)
+    with np.errstate(over="ignore"):   # uint64 arithmetic wraps, as in C++ (in place: 1 array)
+        z *= _GOLDEN
+        z += np.uint64(seed)
+        z ^= z >> np.uint64(30)
+        z *= np.uint64(0xBF58476D1CE4E5B9)
+        z ^= z >> np.uint64(27)
+        z *= np.uint64(0x94D049BB133111EB)
+        z ^= z >> np.uint64(31)
+    return z
 
 
 def _uniform(seed, start, count):
