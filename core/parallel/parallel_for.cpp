@@ -7,6 +7,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/parallel/task_monitor.h"
+
 namespace sdf {
 
 int hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
@@ -17,8 +19,16 @@ void parallel_for(int64_t n, int64_t chunk, int threads, const std::function<voi
     if (n <= 0) return;
     chunk = std::max<int64_t>(1, chunk);
     threads = int(std::min<int64_t>(resolve_thread_count(threads), (n + chunk - 1) / chunk));
+    // A caller's stop request (task_monitor.h) is honoured between chunks.
+    const TaskMonitor* monitor = current_task_monitor();
+    const auto stop = [monitor] {
+        if (monitor && monitor->stop_requested()) throw TaskStopped();
+    };
     if (threads <= 1) {
-        for (int64_t b = 0; b < n; b += chunk) fn(b, std::min(n, b + chunk));
+        for (int64_t b = 0; b < n; b += chunk) {
+            stop();
+            fn(b, std::min(n, b + chunk));
+        }
         return;
     }
     std::atomic<int64_t> next{0};
@@ -26,7 +36,10 @@ void parallel_for(int64_t n, int64_t chunk, int threads, const std::function<voi
     std::mutex error_mutex;
     auto worker = [&] {
         try {
-            for (int64_t b; (b = next.fetch_add(chunk)) < n;) fn(b, std::min(n, b + chunk));
+            for (int64_t b; (b = next.fetch_add(chunk)) < n;) {
+                stop();
+                fn(b, std::min(n, b + chunk));
+            }
         } catch (...) {
             std::lock_guard<std::mutex> lock(error_mutex);
             if (!error) error = std::current_exception();

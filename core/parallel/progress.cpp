@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "core/parallel/task_monitor.h"
+
 namespace sdf {
 namespace {
 std::atomic<bool> g_enabled{true};
@@ -12,12 +14,13 @@ bool ProgressReporter::globally_enabled() { return g_enabled; }
 
 ProgressReporter::ProgressReporter(std::string label, int64_t total, bool enabled, double interval_seconds)
     : label_(std::move(label)), total_(total), enabled_(enabled && g_enabled), interval_(interval_seconds),
-      start_(Clock::now()) {}
+      start_(Clock::now()), monitor_(current_task_monitor()) {}
 
 ProgressReporter::~ProgressReporter() { finish(); }
 
 void ProgressReporter::advance(int64_t items) {
     const int64_t done = done_.fetch_add(items) + items;
+    if (monitor_) monitor_->advance(items);
     if (!enabled_) return;
     const auto now = Clock::now();
     const auto since_last = [&] {

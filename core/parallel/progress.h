@@ -11,6 +11,9 @@
 
 namespace sdf {
 
+class TaskMonitor;
+
+/// Items done are also counted on the monitor of the constructing thread (task_monitor.h).
 class ProgressReporter {
 public:
     ProgressReporter(std::string label, int64_t total, bool enabled, double interval_seconds = 2.0);
@@ -35,6 +38,7 @@ private:
     /// it before deciding whether to take the mutex.
     std::atomic<Clock::rep> last_{0};
     std::mutex mutex_;
+    TaskMonitor* monitor_;
     bool printed_ = false;
     bool finished_ = false;
 };

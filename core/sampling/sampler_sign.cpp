@@ -1,6 +1,6 @@
 #include "core/sampling/sampler_sign.h"
 
-#include <iostream>
+#include "core/parallel/task_monitor.h"
 
 namespace sdf {
 namespace {
@@ -18,7 +18,7 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
     if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
-        std::cerr << "warning: " << auto_sign_text(mesh, choice_.reason) << "\n";
+        report_warning(auto_sign_text(mesh, choice_.reason));
     if (choice_.mode == SignMode::Winding) {
         winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
                        : std::make_shared<const WindingSign>(mesh, winding_options());

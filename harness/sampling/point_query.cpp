@@ -1,5 +1,6 @@
 #include "harness/sampling/point_query.h"
 
+#include "harness/sampling/mesh_sdf.h"
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
@@ -31,10 +32,13 @@ SamplerOptions point_query_sampler_options(const PointQueryOptions& options) {
 
 PointQueryResult query_points(const PreparedMesh& mesh, const std::vector<Vec3d>& points,
                               const PointQueryOptions& options) {
-    const std::unique_ptr<Sampler> sampler = make_sampler(point_query_sampler_options(options));
+    // The caller owns the mesh for the call: the bound object borrows it.
+    const MeshSdf sdf(std::shared_ptr<const PreparedMesh>(&mesh, [](const PreparedMesh*) {}),
+                      point_query_sampler_options(options));
     PointQueryResult result;
-    result.sampler = sampler->name();
-    result.samples = sampler->query(mesh, points);
+    result.sampler = sdf.sampler_name();
+    result.sign = sdf.sign_mode();
+    result.samples = sdf.query(points);
     return result;
 }
 

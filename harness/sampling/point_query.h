@@ -39,9 +39,11 @@ SamplerOptions point_query_sampler_options(const PointQueryOptions& options);
 struct PointQueryResult {
     std::vector<PointSample> samples;  ///< in input order
     std::string sampler;               ///< the sampler's name, e.g. "cpu/bvh/brick"
+    std::string sign;                  ///< the sign mode used, "pseudonormal" or "winding"
 };
 
-/// Queries every point; throws std::runtime_error when the chosen backend cannot run here.
+/// Queries every point through a MeshSdf bound for this call (mesh_sdf.h: hold one to
+/// query a mesh many times); throws std::runtime_error when the chosen backend cannot run here.
 PointQueryResult query_points(const PreparedMesh& mesh, const std::vector<Vec3d>& points,
                               const PointQueryOptions& options);
 

@@ -126,17 +126,6 @@ class Normalization(NamedTuple):
     scale: float
 
 
-def as_mesh(mesh):
-    """A Mesh from a Mesh, a path or "shape:NAME" (load_mesh), or a (vertices, faces) pair."""
-    if isinstance(mesh, _sl.Mesh):
-        return mesh
-    if isinstance(mesh, (str, os.PathLike)):
-        return _sl.load_mesh(os.fspath(mesh))
-    if isinstance(mesh, tuple) and len(mesh) == 2:
-        return _sl.Mesh(*mesh)
-    raise ValueError(f"mesh: expected a Mesh, a file name or (vertices, faces), got {type(mesh).__name__}")
-
-
 def normalize_to_unit_cube(mesh, padding=0.0):
     """normalize_to_unit_cube(mesh, padding=0.0) -> (Mesh, Normalization)
 
@@ -145,7 +134,7 @@ def normalize_to_unit_cube(mesh, padding=0.0):
     the new Mesh (its triangles are the prepared mesh's, in the same order) and the
     Normalization that maps back: world = unit * scale + center.
     """
-    mesh = as_mesh(mesh)
+    mesh = _sl.as_mesh(mesh)
     if not (0.0 <= padding < 0.5):
         raise ValueError(f"padding: expected a value in [0, 0.5), got {padding!r}")
     lo, hi = (np.array(corner) for corner in mesh.bounds)
@@ -233,10 +222,10 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
 
     count points with exact signed distance, occupancy and normals: surface_fraction of them
     on the surface, uniform_fraction uniform in the box, the rest near the surface, split
-    evenly over sigmas (a Gaussian offset of standard deviation sigma per axis). mesh: a Mesh,
-    a file name, "shape:NAME" or (vertices, faces). normalize: first move the mesh into the
-    unit cube (normalize_to_unit_cube, with padding); sigmas, box and the points are then in
-    its units. box: ((x0, y0, z0), (x1, y1, z1)); by default the cube around the mesh's
+    evenly over sigmas (a Gaussian offset of standard deviation sigma per axis). mesh: what
+    sdf_lattices.as_mesh takes (a Mesh, a file name, "shape:NAME", (vertices, faces), a
+    trimesh or Open3D mesh). normalize: first move the mesh into the unit cube
+    (normalize_to_unit_cube, with padding); sigmas, box and the points are then in its units. box: ((x0, y0, z0), (x1, y1, z1)); by default the cube around the mesh's
     bounding box whose side is the largest extent plus margin of it on each side
     ([-0.6, 0.6]^3 for a normalised mesh). seed: the same seed gives the same points.
     dtype "float32" rounds the points to float32 before they are queried, so that the values
@@ -245,7 +234,7 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
     triangle up to ~1e-4 (relative) farther than the nearest near an edge where two are
     almost as near (its distance is still evaluated in double).
     """
-    mesh = as_mesh(mesh)
+    mesh = _sl.as_mesh(mesh)
     count, seed = _check_count(count), _check_seed(seed)
     if dtype not in ("float32", "float64", np.float32, np.float64):
         raise ValueError(f"dtype: expected \"float32\" or \"float64\", got {dtype!r}")

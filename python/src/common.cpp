@@ -22,6 +22,19 @@ Precision precision_from_name(const std::string& name) {
     return choose("precision", name, {"float", "double"}) == "float" ? Precision::Float : Precision::Double;
 }
 
+DoubleArray points_argument(const py::object& value) {
+    const bool is_array = py::isinstance<py::array>(value);
+    const auto refuse = [&] {
+        return py::type_error("points: expected an (N, 3) array of numbers, got " +
+                              std::string(py::str(py::type::of(value).attr("__name__"))) +
+                              (is_array ? " of dtype " + std::string(py::str(py::array(value).dtype())) : ""));
+    };
+    if (is_array && std::string("biuf").find(py::array(value).dtype().kind()) == std::string::npos) throw refuse();
+    DoubleArray a = DoubleArray::ensure(value);
+    if (!a) throw refuse();
+    return a;
+}
+
 std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument) {
     if (a.ndim() != 2 || a.shape(1) != 3) {
         std::string shape = "(";

@@ -27,6 +27,10 @@ const std::string& choose(const std::string& argument, const std::string& value,
 
 Precision precision_from_name(const std::string& name);
 
+/// `value` as a float64 array (NumPy arrays of any numeric dtype, nested sequences);
+/// TypeError naming the argument "points" and the type otherwise.
+DoubleArray points_argument(const py::object& value);
+
 /// An (N, 3) array of finite doubles as points; ValueError naming `argument` otherwise.
 std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument);
 

@@ -1,5 +1,9 @@
 // Fields: sdf_lattices.Field, sample (as run-experiment samples a lattice) and read_field.
+#include <algorithm>
+#include <cmath>
 #include <functional>
+#include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,6 +16,8 @@
 #include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
+#include "python/src/mesh.h"
+#include "python/src/task.h"
 
 namespace sdf {
 namespace {
@@ -39,44 +45,113 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
     return spec;
 }
 
-Field sample(const PreparedMesh& mesh, const std::string& lattice, const py::object& resolution, const py::object& samples,
-             double margin, const std::string& backend, const std::string& method, const std::string& kernel,
-             const std::string& sign, const std::string& precision, int threads, const std::string& bcc_strategy,
-             bool progress, bool distributed) {
-    const bool collective = distributed && distributed_active();
-    // Under MPI a bad argument is this rank's failure in the collective exchange, raised on
-    // every rank there (no rank waits for one that gave up); alone, it is raised here.
-    std::function<SamplingRequest()> setup;
+/// Three finite numbers named `argument`.
+Vec3d vec3_argument(const py::object& value, const std::string& argument) {
+    std::vector<double> v;
     try {
-        choose("lattice", lattice, {"cc", "bcc"});
-        if (!(margin >= 0)) throw std::invalid_argument("margin: expected a non-negative fraction of the mesh's largest extent");
-        const LatticeSpec spec = lattice_spec_from_arguments(lattice, resolution, samples, py::none());
-        nlohmann::json s = {{"backend", backend}, {"method", method},   {"sign", sign},
-                            {"precision", precision}, {"threads", threads}, {"bcc_strategy", bcc_strategy},
-                            {"progress", progress}};
-        if (!kernel.empty()) s["kernel"] = kernel;
-        JsonReader reader(s, "sample()", "sampler");
-        const SamplerOptions options = parse_sampler_options(reader);
-        setup = [spec, options, margin, &mesh] { return SamplingRequest{build_lattice(spec, mesh.bounds(), margin), options}; };
-    } catch (const py::error_already_set& e) {
-        if (!collective) throw;
-        const auto error = std::make_exception_ptr(std::invalid_argument(e.what()));  // no Python object past the GIL
-        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
-    } catch (...) {
-        if (!collective) throw;
-        const std::exception_ptr error = std::current_exception();
-        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
+        v = value.cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+        throw py::type_error(argument + ": expected 3 numbers");
     }
-    SampledField field;
-    {
-        py::gil_scoped_release release;
-        if (collective) {
-            field = sample_collectively(mesh, setup);
-        } else {
-            const SamplingRequest request = setup();
-            field = make_sampler(request.options)->sample(mesh, request.lattice);
-        }
+    if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+        throw std::invalid_argument(argument + ": expected 3 finite numbers");
+    return {v[0], v[1], v[2]};
+}
+
+/// ((xmin, ymin, zmin), (xmax, ymax, zmax)) with min < max on every axis.
+Bounds3 bounds_argument(const py::object& value) {
+    std::vector<py::object> corners;
+    try {
+        corners = value.cast<std::vector<py::object>>();
+    } catch (const py::cast_error&) {
+        throw py::type_error("bounds: expected ((xmin, ymin, zmin), (xmax, ymax, zmax))");
     }
+    if (corners.size() != 2) throw std::invalid_argument("bounds: expected ((xmin, ymin, zmin), (xmax, ymax, zmax))");
+    Bounds3 b;
+    b.min = vec3_argument(corners[0], "bounds[0]");
+    b.max = vec3_argument(corners[1], "bounds[1]");
+    if (!(b.min.x < b.max.x && b.min.y < b.max.y && b.min.z < b.max.z))
+        throw std::invalid_argument("bounds: expected min < max on every axis");
+    return b;
+}
+
+/// The lattice of `type` with origin bounds.min and `spacing` whose points cover `bounds`:
+/// ceil(extent / h) + 1 points per axis (the primary grid for BCC).
+Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing) {
+    Lattice l;
+    l.type = type;
+    l.origin = bounds.min;
+    l.spacing = spacing;
+    const Vec3d extent = bounds.max - bounds.min;
+    const double cells[3] = {extent.x / spacing, extent.y / spacing, extent.z / spacing};
+    int n[3];
+    for (int k = 0; k < 3; ++k) {
+        // 1e-9: an extent that is a whole number of spacings up to rounding gets no extra point.
+        const double points = std::ceil(cells[k] * (1 - 1e-9)) + 1;
+        if (!(points <= double(1 << 30)))
+            throw std::invalid_argument("spacing: " + std::to_string(spacing) + " gives more than 2^30 points along an axis");
+        n[k] = std::max(2, int(points));
+    }
+    l.resolution = {n[0], n[1], n[2]};
+    checked_lattice_points(type, l.resolution);
+    return l;
+}
+
+}  // namespace
+
+Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
+    const LatticeType type = choose("lattice", a.type, {"cc", "bcc"}) == "bcc" ? LatticeType::BCC : LatticeType::CC;
+    const bool framed = !a.bounds.is_none() || !a.spacing.is_none() || !a.origin.is_none();
+    const double margin = a.margin.is_none() ? 0.1 : a.margin.cast<double>();
+    if (!(margin >= 0)) throw std::invalid_argument("margin: expected a non-negative fraction of the mesh's largest extent");
+    if (!framed) return build_lattice(lattice_spec_from_arguments(a.type, a.resolution, a.samples, py::none()), mesh_bounds, margin);
+    // A lattice framed by the caller: bounds and spacing or resolution, or origin, spacing
+    // and resolution; spacing alone covers the mesh's box grown by the margin.
+    if (!a.samples.is_none()) throw std::invalid_argument("samples: not with bounds, spacing or origin (give resolution or spacing)");
+    if (!a.bounds.is_none() && !a.margin.is_none())
+        throw std::invalid_argument("margin: not with bounds (bounds frame the lattice as given)");
+    if (!a.spacing.is_none() && !(a.spacing.cast<double>() > 0 && std::isfinite(a.spacing.cast<double>())))
+        throw std::invalid_argument("spacing: expected a finite distance > 0");
+    Int3 resolution{};
+    if (!a.resolution.is_none()) resolution = lattice_spec_from_arguments(a.type, a.resolution, py::none(), py::none()).resolution;
+    if (!a.origin.is_none()) {
+        if (!a.bounds.is_none()) throw std::invalid_argument("origin: not with bounds (the origin is bounds[0])");
+        if (a.spacing.is_none() || a.resolution.is_none())
+            throw std::invalid_argument("origin: needs spacing and resolution as well");
+        Lattice l;
+        l.type = type;
+        l.origin = vec3_argument(a.origin, "origin");
+        l.spacing = a.spacing.cast<double>();
+        l.resolution = resolution;
+        checked_lattice_points(type, resolution);
+        return l;
+    }
+    Bounds3 box;
+    if (!a.bounds.is_none()) {
+        box = bounds_argument(a.bounds);
+    } else {
+        const Vec3d e = mesh_bounds.max - mesh_bounds.min;
+        const double grow = margin * std::max({e.x, e.y, e.z});
+        box.min = mesh_bounds.min - Vec3d(grow);
+        box.max = mesh_bounds.max + Vec3d(grow);
+    }
+    if (a.spacing.is_none() == a.resolution.is_none())
+        throw std::invalid_argument("bounds: give exactly one of spacing and resolution");
+    if (!a.spacing.is_none()) return lattice_covering(type, box, a.spacing.cast<double>());
+    if (resolution.x < 2 || resolution.y < 2 || resolution.z < 2)
+        throw std::invalid_argument("resolution: expected at least 2 points per axis with bounds");
+    // The widest axis decides the (isotropic) spacing; the lattice starts at bounds[0].
+    const Vec3d e = box.max - box.min;
+    const double h = std::max({e.x / (resolution.x - 1), e.y / (resolution.y - 1), e.z / (resolution.z - 1)});
+    Lattice l;
+    l.type = type;
+    l.origin = box.min;
+    l.spacing = h;
+    l.resolution = resolution;
+    return l;
+}
+
+Field field_for_mesh(SampledField field, const PreparedMesh& mesh) {
     const MeshReport& r = mesh.report();
     field.mesh = {{"name", mesh.name()},
                   {"source", mesh.source()},
@@ -88,9 +163,185 @@ Field sample(const PreparedMesh& mesh, const std::string& lattice, const py::obj
     return Field(std::move(field));
 }
 
+Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::object& resolution, const py::object& samples,
+                   const py::object& margin, const py::object& bounds, const py::object& spacing, const py::object& origin,
+                   const py::object& progress) {
+    const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, sdf.mesh().bounds());
+    TaskOptions task;
+    task.total = l.num_points();
+    task.label = "sampling '" + sdf.mesh().name() + "'";
+    task.progress = progress;
+    SampledField field = run_task([&] { return sdf.sample(l); }, task);
+    return field_for_mesh(std::move(field), sdf.mesh());
+}
+
+py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
+                             double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
+    choose("outside", outside, {"nan", "clamp", "error"});
+    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
+    const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
+    TaskOptions task;
+    task.total = int64_t(points.size());
+    task.label = "reconstructing";
+    const std::vector<ReconstructedSample<double>> samples = run_task([&] { return r->evaluate(points, threads); }, task);
+    const size_t n = samples.size();
+    if (outside == "error")
+        for (size_t i = 0; i < n; ++i)
+            if (!samples[i].inside) {
+                const DomainBox<double> d = r->domain();
+                std::ostringstream m;
+                m << "points: row " << i << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z
+                  << ") lies outside the field's domain [" << d.lo.x << ", " << d.hi.x << "] x [" << d.lo.y << ", " << d.hi.y
+                  << "] x [" << d.lo.z << ", " << d.hi.z << "] (outside=\"nan\" gives NaN there, \"clamp\" the nearest value inside)";
+                throw std::invalid_argument(m.str());
+            }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const bool to_nan = outside == "nan";
+    auto values = new_array<double>({py::ssize_t(n)}, [&](double* v) {
+        for (size_t i = 0; i < n; ++i) v[i] = to_nan && !samples[i].inside ? nan : samples[i].value;
+    });
+    auto gradients = new_array<double>({py::ssize_t(n), 3}, [&](double* g) {
+        for (size_t i = 0; i < n; ++i) {
+            const bool blank = to_nan && !samples[i].inside;
+            g[3 * i] = blank ? nan : samples[i].gradient.x;
+            g[3 * i + 1] = blank ? nan : samples[i].gradient.y;
+            g[3 * i + 2] = blank ? nan : samples[i].gradient.z;
+        }
+    });
+    return py::make_tuple(values, gradients);
+}
+
+py::object Field::points() const {
+    return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
+        const size_t n = size_t(g.resolution.x) * size_t(g.resolution.y) * size_t(g.resolution.z);
+        std::vector<Vec3d> p(n);
+        for (size_t i = 0; i < n; ++i) p[i] = lattice().position(g.first + int64_t(i));
+        return vec3_array(p.data(), n, shape);
+    });
+}
+
+namespace {
+
+/// A Field from arrays: values (and optionally gradient and triangle) per grid, as Field's
+/// arrays are shaped, on the lattice of origin and spacing.
+Field field_from_arrays(const py::object& values, const py::object& origin, double spacing, const std::string& lattice,
+                        const py::object& gradient, const py::object& triangle) {
+    const bool bcc = choose("lattice", lattice, {"cc", "bcc"}) == "bcc";
+    if (!(spacing > 0 && std::isfinite(spacing))) throw std::invalid_argument("spacing: expected a finite distance > 0");
+    // Every channel as a list of C-order arrays, one per grid.
+    const auto grids_of = [&](const py::object& channel, const std::string& name) {
+        std::vector<py::object> out;
+        if (bcc) {
+            if (!py::isinstance<py::tuple>(channel) && !py::isinstance<py::list>(channel))
+                throw py::type_error(name + ": a BCC field takes (primary, secondary) arrays");
+            for (const py::handle h : channel) out.push_back(py::reinterpret_borrow<py::object>(h));
+            if (out.size() != 2) throw std::invalid_argument(name + ": a BCC field takes (primary, secondary) arrays");
+        } else {
+            out.push_back(channel);
+        }
+        return out;
+    };
+    const std::vector<py::object> v = grids_of(values, "values");
+    std::vector<DoubleArray> va;
+    for (const py::object& o : v) va.push_back(DoubleArray::ensure(o));
+    for (size_t k = 0; k < va.size(); ++k)
+        if (!va[k] || va[k].ndim() != 3)
+            throw std::invalid_argument("values: expected 3-D arrays of shape (nz, ny, nx)" + std::string(bcc ? " per grid" : ""));
+    SampledField f;
+    f.lattice.type = bcc ? LatticeType::BCC : LatticeType::CC;
+    f.lattice.spacing = spacing;
+    f.lattice.resolution = {int(va[0].shape(2)), int(va[0].shape(1)), int(va[0].shape(0))};
+    checked_lattice_points(f.lattice.type, f.lattice.resolution);
+    if (bcc) {
+        const Int3 s = f.lattice.secondary_resolution();
+        if (va[1].shape(0) != s.z || va[1].shape(1) != s.y || va[1].shape(2) != s.x)
+            throw std::invalid_argument("values: the secondary grid must have shape (nz-1, ny-1, nx-1) of the primary's (nz, ny, nx)");
+    }
+    const py::tuple o = py::tuple(py::module_::import("builtins").attr("tuple")(origin));
+    if (o.size() != 3) throw std::invalid_argument("origin: expected 3 numbers");
+    f.lattice.origin = {o[0].cast<double>(), o[1].cast<double>(), o[2].cast<double>()};
+    for (const DoubleArray& a : va) f.distance.insert(f.distance.end(), a.data(), a.data() + a.size());
+    if (!gradient.is_none()) {
+        const std::vector<py::object> g = grids_of(gradient, "gradient");
+        for (size_t k = 0; k < g.size(); ++k) {
+            const DoubleArray a = DoubleArray::ensure(g[k]);
+            if (!a || a.ndim() != 4 || a.shape(3) != 3 || a.shape(0) != va[k].shape(0) || a.shape(1) != va[k].shape(1) ||
+                a.shape(2) != va[k].shape(2))
+                throw std::invalid_argument("gradient: expected the values' shape + (3,)");
+            for (py::ssize_t i = 0; i < a.size() / 3; ++i) f.gradient.push_back({a.data()[3 * i], a.data()[3 * i + 1], a.data()[3 * i + 2]});
+        }
+    }
+    if (!triangle.is_none()) {
+        const std::vector<py::object> t = grids_of(triangle, "triangle");
+        for (size_t k = 0; k < t.size(); ++k) {
+            const auto a = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(t[k]);
+            if (!a || a.ndim() != 3 || a.shape(0) != va[k].shape(0) || a.shape(1) != va[k].shape(1) || a.shape(2) != va[k].shape(2))
+                throw std::invalid_argument("triangle: expected integer arrays of the values' shape");
+            f.closest_triangle.insert(f.closest_triangle.end(), a.data(), a.data() + a.size());
+        }
+    }
+    f.precision = Precision::Double;
+    f.sampler = {{"source", "arrays"}};
+    f.mesh = nlohmann::json::object();
+    return Field(std::move(f));
+}
+
+Field sample(const py::object& mesh_in, const std::string& lattice, const py::object& resolution, const py::object& samples,
+             const py::object& margin, const py::object& bounds, const py::object& spacing, const py::object& origin,
+             const std::string& backend, const std::string& method, const std::string& kernel, const std::string& sign,
+             const std::string& precision, int threads, const std::string& bcc_strategy, const py::object& progress,
+             bool distributed) {
+    const MeshHolder mesh = mesh_argument(mesh_in);
+    const bool collective = distributed && distributed_active();
+    const bool unsigned_distance = sign == "none";
+    // Under MPI a bad argument is this rank's failure in the collective exchange, raised on
+    // every rank there (no rank waits for one that gave up); alone, it is raised here.
+    std::function<SamplingRequest()> setup;
+    try {
+        const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, mesh->bounds());
+        nlohmann::json s = {{"backend", backend}, {"method", method},   {"sign", unsigned_distance ? "pseudonormal" : sign},
+                            {"precision", precision}, {"threads", threads}, {"bcc_strategy", bcc_strategy},
+                            {"progress", false}};
+        if (!kernel.empty()) s["kernel"] = kernel;
+        JsonReader reader(s, "sample()", "sampler");
+        const SamplerOptions options = parse_sampler_options(reader);
+        setup = [l, options] { return SamplingRequest{l, options}; };
+    } catch (const py::error_already_set& e) {
+        if (!collective) throw;
+        const auto error = std::make_exception_ptr(std::invalid_argument(e.what()));  // no Python object past the GIL
+        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
+    } catch (...) {
+        if (!collective) throw;
+        const std::exception_ptr error = std::current_exception();
+        setup = [error]() -> SamplingRequest { std::rethrow_exception(error); };
+    }
+    if (!collective) {
+        const SamplingRequest request = setup();
+        TaskOptions task;
+        task.total = request.lattice.num_points();
+        task.label = "sampling '" + mesh->name() + "'";
+        task.progress = progress;
+        SampledField field = run_task([&] { return MeshSdf(mesh, request.options, unsigned_distance).sample(request.lattice); }, task);
+        return field_for_mesh(std::move(field), *mesh);
+    }
+    TaskOptions task;
+    task.background = false;  // MPI stays on the thread that started it
+    SampledField field = run_task([&] {
+        SampledField f = sample_collectively(*mesh, setup);
+        if (unsigned_distance) {
+            make_unsigned(f);
+            f.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
+        }
+        return f;
+    }, task);
+    return field_for_mesh(std::move(field), *mesh);
+}
+
 Field read_field_file(const std::string& path) {
-    py::gil_scoped_release release;
-    return Field(read_field(path));
+    TaskOptions task;
+    task.total = kBackgroundItems;
+    task.label = "reading " + path;
+    return run_task([&] { return Field(read_field(path)); }, task);
 }
 
 }  // namespace
@@ -100,7 +351,16 @@ void bind_field(py::module_& m) {
 closest triangle at every lattice point, with the lattice and provenance. Arrays are copies
 in z, y, x order: CC values have shape (nz, ny, nx); a BCC field (thesis notation
 Rx x Ry x 2Rz) is its two CC sub-grids, a tuple (primary (Rz, Ry, Rx), secondary
-(Rz-1, Ry-1, Rx-1)), the secondary grid's origin h/2 further along every axis.)")
+(Rz-1, Ry-1, Rx-1)), the secondary grid's origin h/2 further along every axis.
+
+Field(values, origin, spacing, lattice="cc", gradient=None, triangle=None) makes a field of
+your own arrays, shaped as above (BCC: (primary, secondary) tuples), on the lattice of
+origin (the first primary point) and spacing h: it reconstructs, renders and writes as a
+sampled one.)")
+        .def(py::init(&field_from_arrays), py::arg("values"), py::arg("origin"), py::arg("spacing"), py::arg("lattice") = "cc",
+             py::arg("gradient") = py::none(), py::arg("triangle") = py::none())
+        .def("points", &Field::points,
+             "points() -> array or (primary, secondary): the world position of every lattice point, shape (nz, ny, nx, 3) per grid.")
         .def_property_readonly("lattice", [](const Field& f) { return f.lattice().type == LatticeType::BCC ? "bcc" : "cc"; },
                                "'cc' or 'bcc'.")
         .def_property_readonly("origin", [](const Field& f) {
@@ -138,31 +398,42 @@ Writes the field in the format of path's extension: ".json" is the project's fie
 Files are written atomically; an existing file is kept unless overwrite=True. Under mpirun
 every rank holds the field: write it from one rank (if sl.distributed()["rank"] == 0).)")
         .def("reconstruct", &Field::reconstruct, py::arg("points"), py::arg("interpolator") = "", py::arg("derivatives") = "",
-             py::arg("sigma2") = 0.5, py::arg("sigma_units") = "lattice", py::arg("threads") = 0,
-             R"(reconstruct(points, interpolator="", derivatives="", sigma2=0.5, sigma_units="lattice", threads=0) -> (values, gradients)
+             py::arg("sigma2") = 0.5, py::arg("sigma_units") = "lattice", py::arg("threads") = 0, py::arg("outside") = "nan",
+             R"(reconstruct(points, interpolator="", derivatives="", sigma2=0.5, sigma_units="lattice", threads=0, outside="nan") -> (values, gradients)
 
 The reconstruction at points ((N, 3) array), as sdf-eval computes it: values (N,) and world
 gradients (N, 3). interpolator: a name of docs/reconstruction.md (default bcc_cubic for BCC,
 tricubic_lm for CC); derivatives: "true", "fd" or "fd_weighted" (default: "true" where the
-interpolator uses derivatives and the field has gradients, else "fd"). Points outside the
-domain are clamped into it. The last reconstruction is kept for the next call.)")
+interpolator uses derivatives and the field has gradients, else "fd"). outside: what points
+outside the lattice's domain get: "nan" (the default: NaN value and gradient), "clamp" (the
+reconstruction at the nearest point of the domain, as sdf-eval gives) or "error"
+(ValueError naming the first such point). The last reconstruction is kept for the next call.)")
         .def("__repr__", [](const Field& f) {
             return "<sdf_lattices.Field " + std::string(f.lattice().type == LatticeType::BCC ? "bcc " : "cc ") +
                    lattice_notation(f.lattice()) + ", " + std::to_string(f.lattice().num_points()) + " points>";
         });
 
     m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
-          py::arg("samples") = py::none(), py::arg("margin") = 0.1, py::arg("backend") = "auto", py::arg("method") = "bvh",
-          py::arg("kernel") = "", py::arg("sign") = "auto", py::arg("precision") = "float", py::arg("threads") = 0,
-          py::arg("bcc_strategy") = "two_grids", py::arg("progress") = false, py::arg("distributed") = true,
-          R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=0.1, backend="auto", method="bvh", kernel="", sign="auto", precision="float", threads=0, bcc_strategy="two_grids", progress=False, distributed=True) -> Field
+          py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
+          py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("backend") = "auto",
+          py::arg("method") = "bvh", py::arg("kernel") = "", py::arg("sign") = "auto", py::arg("precision") = "float",
+          py::arg("threads") = 0, py::arg("bcc_strategy") = "two_grids", py::arg("progress") = py::none(),
+          py::arg("distributed") = true,
+          R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=None, bounds=None, spacing=None, origin=None, backend="auto", method="bvh", kernel="", sign="auto", precision="float", threads=0, bcc_strategy="two_grids", progress=None, distributed=True) -> Field
 
-Samples the exact signed distance on a lattice fitted around the mesh, as run-experiment
-does (its config parser checks these arguments, as the keys "lattice" and "sampler").
-Give resolution or samples: resolution is (nx, ny, nz) for CC, (Rx, Ry, 2Rz) for BCC, or one
-int n for (n, n, n) / (n, n, 2n); samples is a target point count for a cubic lattice.
-margin: the fraction of the mesh's largest extent added on every side (run-experiment's
-"domain": {"margin"}). The GIL is released while sampling.
+Samples the exact signed distance on a CC or BCC lattice. Fitted around the mesh, as
+run-experiment does (its config parser checks these arguments, as the keys "lattice" and
+"sampler"): give resolution or samples; resolution is (nx, ny, nz) for CC, (Rx, Ry, 2Rz)
+for BCC, or one int n for (n, n, n) / (n, n, 2n); samples is a target point count for a
+cubic lattice; margin (default 0.1): the fraction of the mesh's largest extent added on
+every side (run-experiment's "domain": {"margin"}), the lattice centred on the grown box.
+Framed by you: bounds=((xmin, ymin, zmin), (xmax, ymax, zmax)) with spacing=h (the first
+point at bounds[0], enough points per axis to reach bounds[1]) or with resolution (the
+widest axis decides h, the first point at bounds[0]); spacing alone frames the mesh's box
+grown by margin; origin, spacing and resolution give the lattice exactly. BCC's spacing is
+its primary grid's. mesh: anything SDF takes. sign: as query()'s ("none": unsigned).
+progress: True (tqdm when installed, else lines on sys.stderr) or a callable progress(done,
+total). The GIL is released while sampling; Ctrl-C stops it within a fraction of a second.
 
 Under `mpirun -np N python3 script.py` (see distributed()), sample() is collective: every rank
 must call it with the same mesh and arguments. Rank 0 cuts the lattice into one slab of
@@ -173,11 +444,12 @@ sampler["distributed"] records the slabs, hosts and per-rank seconds. A failure 
 this rank alone (no other rank takes part).)");
 
 
-    m.def("read_field", &read_field_file, py::arg("path"),
-          R"(read_field(path) -> Field
+    m.def("read_field_file", &read_field_file, py::arg("path"),
+          R"(read_field_file(path) -> Field
 
 Reads a field file (NAME.json and its channels, docs/field-format.md): CC or BCC, with or
-without gradient and closest-triangle channels.)");
+without gradient and closest-triangle channels. sdf_lattices.read_field reads every format
+Field.write writes.)");
 
 }
 

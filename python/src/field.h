@@ -12,6 +12,7 @@
 #include "core/reconstruction/reconstruction_spec.h"
 #include "harness/io/field_output.h"
 #include "core/sampling/sampled_field.h"
+#include "harness/sampling/mesh_sdf.h"
 #include "python/src/common.h"
 
 namespace sdf {
@@ -112,33 +113,36 @@ public:
         return recon_;
     }
 
-    py::tuple reconstruct(const DoubleArray& points_in, const std::string& interpolator, const std::string& derivatives,
-                          double sigma2, const std::string& sigma_units, int threads) {
-        const std::vector<Vec3d> points = points_from_array(points_in, "points");
-        const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
-        std::vector<ReconstructedSample<double>> samples;
-        {
-            py::gil_scoped_release release;
-            samples = r->evaluate(points, threads);
-        }
-        const size_t n = samples.size();
-        auto values = new_array<double>({py::ssize_t(n)}, [&](double* v) {
-            for (size_t i = 0; i < n; ++i) v[i] = samples[i].value;
-        });
-        auto gradients = new_array<double>({py::ssize_t(n), 3}, [&](double* g) {
-            for (size_t i = 0; i < n; ++i) {
-                g[3 * i] = samples[i].gradient.x;
-                g[3 * i + 1] = samples[i].gradient.y;
-                g[3 * i + 2] = samples[i].gradient.z;
-            }
-        });
-        return py::make_tuple(values, gradients);
-    }
+    /// Values and gradients at points; outside the domain: "nan", "clamp" or "error".
+    py::tuple reconstruct(const py::object& points, const std::string& interpolator, const std::string& derivatives,
+                          double sigma2, const std::string& sigma_units, int threads, const std::string& outside);
+
+    /// World positions of the lattice points, per grid, shape [nz, ny, nx, 3].
+    py::object points() const;
 
 private:
     std::shared_ptr<const SampledField> field_;
     std::shared_ptr<const Reconstruction> recon_;
     std::string recon_key_;
 };
+
+/// A lattice as sample()'s arguments frame it (Python objects; None where not given).
+struct LatticeArguments {
+    std::string type;  ///< "cc" or "bcc"
+    py::object resolution, samples, margin, bounds, spacing, origin;
+};
+
+/// The lattice of `arguments`: fitted around `mesh_bounds` (resolution or samples, and
+/// margin, as run-experiment fits it), or framed by the caller (bounds with spacing or
+/// resolution; spacing alone around the mesh's box; origin, spacing and resolution).
+Lattice frame_lattice(const LatticeArguments& arguments, const Bounds3& mesh_bounds);
+
+/// `field` with its mesh's description, as a Field.
+Field field_for_mesh(SampledField field, const PreparedMesh& mesh);
+
+/// SDF.sample(): the lattice of the arguments, sampled by the bound sampler.
+Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::object& resolution, const py::object& samples,
+                   const py::object& margin, const py::object& bounds, const py::object& spacing, const py::object& origin,
+                   const py::object& progress);
 
 }  // namespace sdf

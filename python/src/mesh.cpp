@@ -8,29 +8,39 @@
 #include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/mesh.h"
+#include "python/src/task.h"
 
 namespace sdf {
 namespace {
 
-PreparedMesh prepare(const TriangleMesh& mesh, double weld_tolerance, bool check_intersections) {
+/// Prepares `mesh` as sdf-query does, with the GIL released (Ctrl-C stops the intersection
+/// check of a large mesh); the preparation's warnings are raised as MeshWarning.
+MeshHolder prepare(TriangleMesh mesh, double weld_tolerance, bool check_intersections) {
     MeshPreparationOptions o;
     o.weld_tolerance = weld_tolerance;
     o.detect_intersections = check_intersections;
     if (!(weld_tolerance >= 0)) throw std::invalid_argument("weld_tolerance: expected a distance >= 0");
-    py::gil_scoped_release release;
-    return prepare_mesh(mesh, o);
-}
-
-PreparedMesh load_prepared(const std::string& path, double weld_tolerance, bool check_intersections) {
-    TriangleMesh m;
-    {
-        py::gil_scoped_release release;
-        m = load_mesh(mesh_spec_from_argument(path), data_search_path(), ".");
+    TaskOptions task;
+    task.total = int64_t(mesh.triangles.size());
+    task.label = "preparing '" + mesh.name + "'";
+    MeshHolder prepared = run_task([&] { return std::make_shared<PreparedMesh>(prepare_mesh(mesh, o)); }, task);
+    const std::vector<std::string> warnings = prepared->warnings();
+    if (!warnings.empty()) {
+        const py::object category = py::module_::import("sdf_lattices._warnings").attr("MeshWarning");
+        for (const std::string& w : warnings) py::module_::import("warnings").attr("warn")(w, category, 2);
     }
-    return prepare(m, weld_tolerance, check_intersections);
+    return prepared;
 }
 
-PreparedMesh mesh_from_arrays(const py::array& vertices_in, const py::array& faces_in, const std::string& name,
+MeshHolder load_prepared(const std::string& path, double weld_tolerance, bool check_intersections) {
+    TaskOptions task;
+    task.total = kBackgroundItems;  // a file of any size: Ctrl-C stays honoured
+    task.label = "loading " + path;
+    TriangleMesh m = run_task([&] { return load_mesh(mesh_spec_from_argument(path), data_search_path(), "."); }, task);
+    return prepare(std::move(m), weld_tolerance, check_intersections);
+}
+
+MeshHolder mesh_from_arrays(const py::array& vertices_in, const py::array& faces_in, const std::string& name,
                               double weld_tolerance, bool check_intersections) {
     const char kind = faces_in.dtype().kind();
     if (kind != 'i' && kind != 'u')
@@ -57,7 +67,7 @@ PreparedMesh mesh_from_arrays(const py::array& vertices_in, const py::array& fac
             (&m.triangles[size_t(i)].x)[c] = int(f(i, c));
         }
     m.content_sha256 = geometry_sha256(m);
-    return prepare(m, weld_tolerance, check_intersections);
+    return prepare(std::move(m), weld_tolerance, check_intersections);
 }
 
 std::string mesh_repr(const PreparedMesh& m) {
@@ -69,6 +79,11 @@ std::string mesh_repr(const PreparedMesh& m) {
 }
 
 }  // namespace
+
+MeshHolder mesh_argument(const py::handle& mesh) {
+    if (py::isinstance<PreparedMesh>(mesh)) return mesh.cast<MeshHolder>();
+    return py::module_::import("sdf_lattices._adapters").attr("as_mesh")(mesh).cast<MeshHolder>();
+}
 
 void bind_mesh(py::module_& m) {
     py::class_<PreparedMesh, MeshHolder>(m, "Mesh", R"(A triangle mesh prepared for exact signed distance: welded, cleaned

@@ -12,4 +12,10 @@ namespace sdf {
 
 using MeshHolder = std::shared_ptr<PreparedMesh>;
 
+/// The Mesh a `mesh` argument stands for: a Mesh itself, or whatever
+/// sdf_lattices._adapters.as_mesh turns into one (a file path, (vertices, faces) arrays, a
+/// trimesh-like object with vertices and faces, an Open3D TriangleMesh, legacy or tensor);
+/// TypeError naming what is accepted otherwise.
+MeshHolder mesh_argument(const py::handle& mesh);
+
 }  // namespace sdf

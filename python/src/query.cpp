@@ -1,83 +1,239 @@
-// Queries: sdf_lattices.query and its QueryResult, the one point-query path of sdf-query
-// (harness/sampling/point_query.h).
+// Queries: sdf_lattices.SDF, the bound object (harness/sampling/mesh_sdf.h: a mesh with its
+// BVH, winding data and device upload, built once and queried many times), query() and
+// its QueryResult, and sdf(), the one-liner. query() takes the path of sdf-query
+// (point_query.h): the same sampler, bit for bit.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/parallel/parallel_for.h"
+#include "harness/sampling/mesh_sdf.h"
 #include "harness/sampling/point_query.h"
 #include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
+#include "python/src/field.h"
+#include "python/src/mesh.h"
+#include "python/src/task.h"
 
 namespace sdf {
 namespace {
 
+using SdfHolder = std::shared_ptr<const MeshSdf>;
+
 struct QueryResult {
-    py::array_t<double> distance, gradient;
+    py::array_t<double> distance, gradient, closest_point, barycentric;
     py::array_t<int32_t> triangle;
-    std::string sampler;
+    py::object winding = py::none();
+    std::string sampler, sign;
 };
 
-QueryResult query(const PreparedMesh& mesh, const DoubleArray& points_in, const std::string& backend,
-                  const std::string& method, const std::string& sign, const std::string& precision,
-                  const std::string& kernel, int threads, bool progress) {
+/// The sign names a query takes: the sign modes' table, and "none" (unsigned distance).
+std::vector<std::string> query_sign_names() {
+    std::vector<std::string> names = sign_mode_names();
+    names.push_back("none");
+    return names;
+}
+
+/// Binds `mesh` for the options of query()/SDF(); the build runs as a task (Ctrl-C).
+SdfHolder bind_mesh_sdf(const py::handle& mesh_in, const std::string& backend, const std::string& method,
+                        const std::string& sign, const std::string& precision, const std::string& kernel, int threads,
+                        const std::string& bcc_strategy) {
+    const MeshHolder mesh = mesh_argument(mesh_in);
     PointQueryOptions o;
     o.backend = choose("backend", backend, point_query_backends());
     o.method = choose("method", method, sampler_methods());
     o.kernel = kernel;
-    o.sign = sign_mode_from_name(sign, "sign");
+    const bool unsigned_distance = choose("sign", sign, query_sign_names()) == "none";
+    o.sign = unsigned_distance ? SignMode::Pseudonormal : sign_mode_from_name(sign, "sign");
     o.precision = precision_from_name(precision);
     if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
     o.threads = threads;
-    o.progress = progress;
+    o.progress = false;  // progress goes to the Python callback (task.h)
     if (backend == "auto" && !kernel.empty())
         throw std::invalid_argument("kernel: needs backend 'cpu' or 'cuda' (auto takes each backend's default kernel)");
-    const std::vector<Vec3d> points = points_from_array(points_in, "points");
-    PointQueryResult r;
-    {
-        py::gil_scoped_release release;
-        r = query_points(mesh, points, o);
-    }
+    SamplerOptions s = point_query_sampler_options(o);
+    s.bcc_strategy = choose("bcc_strategy", bcc_strategy, {"two_grids", "double_resolution"}) == "two_grids"
+                         ? BccStrategy::TwoGrids
+                         : BccStrategy::DoubleResolution;
+    TaskOptions task;
+    task.total = int64_t(mesh->triangles().size());
+    task.label = "building '" + mesh->name() + "'";
+    return run_task([&] { return std::make_shared<const MeshSdf>(mesh, s, unsigned_distance); }, task);
+}
+
+struct QueryOutput {
+    std::vector<PointSample> samples;
+    std::vector<ClosestPointOnMesh> closest;
+    std::vector<double> winding;
+};
+
+QueryResult query_bound(const MeshSdf& sdf, const py::object& points_in, bool winding, const py::object& progress) {
+    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
+    TaskOptions task;
+    task.total = int64_t(points.size());
+    task.label = "querying '" + sdf.mesh().name() + "'";
+    task.progress = progress;
+    QueryOutput r = run_task([&] {
+        QueryOutput out;
+        out.samples = sdf.query(points);
+        out.closest.resize(points.size());
+        parallel_for(int64_t(points.size()), 1024, sdf.options().threads, [&](int64_t b, int64_t e) {
+            for (int64_t i = b; i < e; ++i) out.closest[size_t(i)] = sdf.closest_point(points[size_t(i)], out.samples[size_t(i)].triangle);
+        });
+        if (winding) out.winding = sdf.winding_numbers(points, sdf.options().threads);
+        return out;
+    }, task);
     const size_t n = r.samples.size();
-    QueryResult out;
-    out.sampler = r.sampler;
-    out.distance = new_array<double>({py::ssize_t(n)}, [&](double* d) {
+    const py::ssize_t rows = py::ssize_t(n);
+    QueryResult q;
+    q.sampler = sdf.sampler_name();
+    q.sign = sdf.sign_mode();
+    q.distance = new_array<double>({rows}, [&](double* d) {
         for (size_t i = 0; i < n; ++i) d[i] = r.samples[i].distance;
     });
-    out.gradient = new_array<double>({py::ssize_t(n), 3}, [&](double* g) {
-        for (size_t i = 0; i < n; ++i) {
-            g[3 * i] = r.samples[i].gradient.x;
-            g[3 * i + 1] = r.samples[i].gradient.y;
-            g[3 * i + 2] = r.samples[i].gradient.z;
-        }
-    });
-    out.triangle = new_array<int32_t>({py::ssize_t(n)}, [&](int32_t* t) {
+    std::vector<Vec3d> v(n);
+    for (size_t i = 0; i < n; ++i) v[i] = r.samples[i].gradient;
+    q.gradient = vec3_array(v.data(), n, {rows});
+    for (size_t i = 0; i < n; ++i) v[i] = r.closest[i].point;
+    q.closest_point = vec3_array(v.data(), n, {rows});
+    for (size_t i = 0; i < n; ++i) v[i] = r.closest[i].barycentric;
+    q.barycentric = vec3_array(v.data(), n, {rows});
+    q.triangle = new_array<int32_t>({rows}, [&](int32_t* t) {
         for (size_t i = 0; i < n; ++i) t[i] = r.samples[i].triangle;
     });
-    return out;
+    if (winding) q.winding = new_array<double>({rows}, [&](double* w) { std::copy(r.winding.begin(), r.winding.end(), w); });
+    return q;
+}
+
+std::string query_repr(const QueryResult& r) {
+    std::ostringstream s;
+    s << "<sdf_lattices.QueryResult: " << r.distance.size() << " point" << (r.distance.size() == 1 ? "" : "s")
+      << ", sign '" << r.sign << "', sampler '" << r.sampler << "'";
+    if (r.distance.size() > 0) {
+        const double* d = r.distance.data();
+        const auto [lo, hi] = std::minmax_element(d, d + r.distance.size());
+        s << ", distance in [" << *lo << ", " << *hi << "]";
+    }
+    s << (r.winding.is_none() ? "" : ", with winding numbers") << ">";
+    return s.str();
+}
+
+std::string sdf_repr(const MeshSdf& s) {
+    std::ostringstream o;
+    o << "<sdf_lattices.SDF of mesh '" << s.mesh().name() << "' (" << s.mesh().triangles().size() << " triangles): sampler '"
+      << s.sampler_name() << "', sign '" << s.sign_mode() << "', precision " << precision_name(s.options().precision)
+      << ", built in " << s.build_seconds() << " s>";
+    return o.str();
 }
 
 }  // namespace
 
 void bind_query(py::module_& m) {
-    py::class_<QueryResult>(m, "QueryResult", "Exact results of query(), one row per point, in input order.")
-        .def_readonly("distance", &QueryResult::distance, "(N,) float64: signed distance, negative inside.")
-        .def_readonly("gradient", &QueryResult::gradient, "(N, 3) float64: the exact unit gradient.")
-        .def_readonly("triangle", &QueryResult::triangle, "(N,) int32: the closest triangle, 0-based, in the input's face order.")
+    py::class_<QueryResult>(m, "QueryResult", "Exact results of a query, one row per point, in input order.")
+        .def_readonly("distance", &QueryResult::distance,
+                      "(N,) float64: signed distance, negative inside (sign='none': the unsigned distance).")
+        .def_readonly("gradient", &QueryResult::gradient,
+                      "(N, 3) float64: the exact unit gradient (sign='none': pointing away from the surface).")
+        .def_readonly("triangle", &QueryResult::triangle,
+                      "(N,) int32: the closest triangle, 0-based, in the caller's face order (the faces given to Mesh, or the file's).")
+        .def_readonly("closest_point", &QueryResult::closest_point, "(N, 3) float64: the closest point on the mesh.")
+        .def_readonly("barycentric", &QueryResult::barycentric,
+                      "(N, 3) float64: the closest point's weights of the closest face's three vertices, in the "
+                      "caller's order: closest_point = sum_k barycentric[:, k] * vertices[faces[triangle, k]].")
+        .def_readonly("winding", &QueryResult::winding,
+                      "(N,) float64: the generalized winding number (about 1 inside, 0 outside); None unless "
+                      "asked for with winding=True.")
+        .def_readonly("sign", &QueryResult::sign,
+                      "The sign mode actually used: 'pseudonormal', 'winding' (sign='auto' resolved for the mesh) or 'none'.")
         .def_readonly("sampler", &QueryResult::sampler, "The sampler that computed them, e.g. 'cpu/bvh/brick'.")
-        .def("__len__", [](const QueryResult& r) { return r.distance.size(); });
+        .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
+        .def("__repr__", &query_repr);
 
-    m.def("query", &query, py::arg("mesh"), py::arg("points"), py::arg("backend") = "auto", py::arg("method") = "bvh",
+    py::class_<MeshSdf, std::shared_ptr<MeshSdf>>(m, "SDF", R"(A mesh bound to a sampler: built once, queried many times.
+
+SDF(mesh, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0, bcc_strategy="two_grids")
+
+Building it prepares everything a query of the mesh needs (its BVH, the winding data when
+the sign is the winding number's, the GPU upload), so that query() and sample() only
+search: a query of one point costs microseconds. mesh: an sdf_lattices.Mesh, a mesh file
+path, (vertices, faces) arrays, an object with vertices and faces arrays (trimesh), or an
+Open3D TriangleMesh (legacy or tensor). sign: "auto", "pseudonormal", "winding" or "none"
+(unsigned distance). Results equal query()'s and sample()'s with the same options, bit for
+bit. Thread-safe (calls on one object run one at a time).)")
+        .def(py::init([](const py::object& mesh, const std::string& backend, const std::string& method, const std::string& sign,
+                         const std::string& precision, const std::string& kernel, int threads, const std::string& bcc_strategy) {
+                 return std::const_pointer_cast<MeshSdf>(
+                     bind_mesh_sdf(mesh, backend, method, sign, precision, kernel, threads, bcc_strategy));
+             }),
+             py::arg("mesh"), py::arg("backend") = "auto", py::arg("method") = "bvh", py::arg("sign") = "auto",
+             py::arg("precision") = "float", py::arg("kernel") = "", py::arg("threads") = 0,
+             py::arg("bcc_strategy") = "two_grids")
+        .def("query", [](const MeshSdf& s, const py::object& points, bool winding, const py::object& progress) {
+                 return query_bound(s, points, winding, progress);
+             },
+             py::arg("points"), py::arg("winding") = false, py::arg("progress") = py::none(),
+             R"(query(points, winding=False, progress=None) -> QueryResult
+
+Distance, gradient, closest triangle, closest point and barycentric coordinates of points
+((N, 3) array), and with winding=True the generalized winding number. progress: True (a
+tqdm bar when tqdm is installed, else lines on sys.stderr), or a callable progress(done,
+total). Ctrl-C stops a long query within a fraction of a second (KeyboardInterrupt).)")
+        .def("sample", &sample_bound, py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
+             py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
+             py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
+             R"(sample(lattice="cc", resolution=None, samples=None, margin=None, bounds=None, spacing=None, origin=None, progress=None) -> Field
+
+Samples the lattice framed by the arguments (as sdf_lattices.sample, which see) on this
+process, with the bound sampler.)")
+        .def_property_readonly("mesh", [](const MeshSdf& s) { return std::const_pointer_cast<PreparedMesh>(s.shared_mesh()); },
+                               "The Mesh it was built for.")
+        .def_property_readonly("sampler", &MeshSdf::sampler_name, "The bound sampler, e.g. 'cpu/bvh/brick'.")
+        .def_property_readonly("sign", &MeshSdf::sign_mode,
+                               "The sign mode used: 'pseudonormal', 'winding' or 'none' ('auto' resolved for the mesh).")
+        .def_property_readonly("sign_reason", &MeshSdf::sign_reason, "Why that sign mode (auto's reason).")
+        .def_property_readonly("precision", [](const MeshSdf& s) { return precision_name(s.options().precision); },
+                               "The search precision, 'float' or 'double'.")
+        .def_property_readonly("build_seconds", &MeshSdf::build_seconds,
+                               "Wall time of the build (BVH, winding data, upload), seconds.")
+        .def("__repr__", &sdf_repr);
+
+    m.def("query", [](const py::object& mesh, const py::object& points, const std::string& backend, const std::string& method,
+                      const std::string& sign, const std::string& precision, const std::string& kernel, int threads,
+                      const py::object& progress, bool winding) {
+              const SdfHolder s = bind_mesh_sdf(mesh, backend, method, sign, precision, kernel, threads, "two_grids");
+              return query_bound(*s, points, winding, progress);
+          },
+          py::arg("mesh"), py::arg("points"), py::arg("backend") = "auto", py::arg("method") = "bvh",
           py::arg("sign") = "auto", py::arg("precision") = "float", py::arg("kernel") = "", py::arg("threads") = 0,
-          py::arg("progress") = false,
-          R"(query(mesh, points, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0, progress=False) -> QueryResult
+          py::arg("progress") = py::none(), py::arg("winding") = false,
+          R"(query(mesh, points, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0, progress=None, winding=False) -> QueryResult
 
-Exact signed distance, gradient and closest triangle of points ((N, 3) array), computed as
-`sdf-query` computes them (the same function; equal to the last bit for the same options).
-backend: "auto" (cuda when a GPU is present, else cpu), "cpu" or "cuda"; method: "bvh" or
-"brute_force"; sign: "auto", "pseudonormal" or "winding" (docs/winding.md); precision: the
-search's, "float" or "double" (the winner is always evaluated in double). The GIL is
-released while computing.)");
+Exact signed distance, gradient, closest triangle, closest point and barycentric
+coordinates of points ((N, 3) array), computed as `sdf-query` computes them (the same
+sampler; equal to the last bit for the same options). It builds an SDF(mesh, ...) for the
+call: to query one mesh many times, build the SDF once. mesh: an sdf_lattices.Mesh, a mesh
+file path, (vertices, faces) arrays, an object with vertices and faces arrays (trimesh), or
+an Open3D TriangleMesh. backend: "auto" (cuda when a GPU is present, else cpu), "cpu" or
+"cuda"; method: "bvh" or "brute_force"; sign: "auto", "pseudonormal", "winding"
+(docs/winding.md) or "none" (unsigned); precision: the search's, "float" or "double" (the
+winner is always evaluated in double). progress: True or a callable progress(done, total);
+winding=True adds the winding number. The GIL is released while computing; Ctrl-C stops it.)");
 
+    m.def("sdf", [](const py::object& mesh, const py::object& points, const std::string& sign, const std::string& backend) {
+              const SdfHolder s = bind_mesh_sdf(mesh, backend, "bvh", sign, "float", "", 0, "two_grids");
+              return query_bound(*s, points, false, py::none()).distance;
+          },
+          py::arg("mesh"), py::arg("points"), py::arg("sign") = "auto", py::arg("backend") = "auto",
+          R"(sdf(mesh, points, sign="auto", backend="auto") -> numpy.ndarray
+
+The signed distance of points ((N, 3) array) to mesh, (N,) float64: the one-liner
+SDF(mesh, sign=sign, backend=backend).query(points).distance. mesh: anything SDF takes
+(an sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D).)");
 }
 
 }  // namespace sdf

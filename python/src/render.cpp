@@ -9,6 +9,8 @@
 #include "harness/render/render_backend.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
+#include "python/src/mesh.h"
+#include "python/src/task.h"
 
 namespace sdf {
 namespace {
@@ -16,7 +18,8 @@ namespace {
 py::array_t<float> render(Field& field, const std::string& view, const py::object& size, const std::string& interpolator,
                           const std::string& derivatives, const std::string& backend, const std::string& precision,
                           const py::object& eye, const py::object& target, const std::vector<double>& up, double fov,
-                          const PreparedMesh* mesh, int threads, bool progress) {
+                          const py::object& mesh_in, int threads, const py::object& progress) {
+    const MeshHolder mesh = mesh_in.is_none() ? nullptr : mesh_argument(mesh_in);
     int width = 512, height = 512;
     if (py::isinstance<py::int_>(size)) {
         width = height = size.cast<int>();
@@ -49,15 +52,17 @@ py::array_t<float> render(Field& field, const std::string& view, const py::objec
     RenderOptions o;
     o.backend = choose("backend", backend, {"auto", "cpu", "cuda"});
     o.threads = threads;
-    o.progress = progress;
+    o.progress = false;  // to the Python callback (task.h)
     o.precision = precision_from_name(precision);
-    ImageRgb image;
-    {
-        py::gil_scoped_release release;
+    TaskOptions task;
+    task.total = int64_t(width) * height;
+    task.label = "rendering";
+    task.progress = progress;
+    const ImageRgb image = run_task([&] {
         const CameraSpec camera = mesh ? resolve_view(v, mesh->vertices(), width, height)
                                        : resolve_view(v, field_solid_bounds(field.field()), width, height);
-        image = shaded_image(render_reconstruction(*recon, camera, o));
-    }
+        return shaded_image(render_reconstruction(*recon, camera, o));
+    }, task);
     return new_array<float>({height, width, 3}, [&](float* out) { std::copy(image.data.begin(), image.data.end(), out); });
 }
 
@@ -67,9 +72,9 @@ void bind_render(py::module_& m) {
     m.def("render", &render, py::arg("field"), py::arg("view") = "three_quarter", py::arg("size") = 512,
           py::arg("interpolator") = "", py::arg("derivatives") = "", py::arg("backend") = "auto",
           py::arg("precision") = "float", py::arg("eye") = py::none(), py::arg("target") = py::none(),
-          py::arg("up") = std::vector<double>{0, 1, 0}, py::arg("fov") = 30.0, py::arg("mesh") = nullptr,
-          py::arg("threads") = 0, py::arg("progress") = false,
-          R"(render(field, view="three_quarter", size=512, interpolator="", derivatives="", backend="auto", precision="float", eye=None, target=None, up=(0, 1, 0), fov=30, mesh=None, threads=0, progress=False) -> image
+          py::arg("up") = std::vector<double>{0, 1, 0}, py::arg("fov") = 30.0, py::arg("mesh") = py::none(),
+          py::arg("threads") = 0, py::arg("progress") = py::none(),
+          R"(render(field, view="three_quarter", size=512, interpolator="", derivatives="", backend="auto", precision="float", eye=None, target=None, up=(0, 1, 0), fov=30, mesh=None, threads=0, progress=None) -> image
 
 Ray-casts the field's reconstruction as sdf-render does and returns the shaded image, float32
 of shape (height, width, 3), values in [0, 1], row 0 at the top. view: a named view

@@ -1,0 +1,106 @@
+#include "harness/sampling/mesh_sdf.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/parallel/parallel_for.h"
+#include "core/sampling/sampler_sign.h"
+#include "harness/sampling/sampler_table.h"
+#include "kernels/distance/closest_point_on_triangle.h"
+
+namespace sdf {
+
+MeshSdf::MeshSdf(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, bool unsigned_distance)
+    : mesh_(std::move(mesh)), options_(options), unsigned_distance_(unsigned_distance) {
+    if (!mesh_) throw std::invalid_argument("MeshSdf: no mesh");
+    const auto start = std::chrono::steady_clock::now();
+    if (unsigned_distance_) options_.sign = SignMode::Pseudonormal;  // magnitudes are every mode's
+    sampler_ = make_sampler(options_);
+    sampler_name_ = sampler_->name();
+    if (unsigned_distance_) {
+        sign_mode_ = "none";
+        sign_reason_ = "unsigned distance requested";
+    } else {
+        const SignModeChoice choice = choose_sign_mode(mesh_->report(), options_.sign);  // as SamplerSign::prepare
+        sign_mode_ = sign_mode_name(choice.mode);
+        sign_reason_ = choice.reason;
+    }
+    // One query builds everything the sampler keeps for this mesh (BVH, winding data,
+    // device upload); an empty one would not reach the GPU's upload.
+    const Bounds3& b = mesh_->bounds();
+    sampler_->query(*mesh_, {(b.min + b.max) * 0.5});
+    prepared_of_input_.assign(size_t(mesh_->report().input_triangles), -1);
+    const std::vector<int>& source = mesh_->source_triangle();
+    for (size_t t = 0; t < source.size(); ++t) prepared_of_input_[size_t(source[t])] = int32_t(t);
+    build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+MeshSdf::~MeshSdf() = default;
+
+std::vector<PointSample> MeshSdf::query(const std::vector<Vec3d>& points) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<PointSample> samples = sampler_->query(*mesh_, points);
+    if (unsigned_distance_) make_unsigned(samples);
+    return samples;
+}
+
+SampledField MeshSdf::sample(const Lattice& lattice) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SampledField field = sampler_->sample(*mesh_, lattice);
+    if (unsigned_distance_) {
+        make_unsigned(field);
+        field.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", sign_reason_}};
+    }
+    return field;
+}
+
+ClosestPointOnMesh MeshSdf::closest_point(const Vec3d& p, int32_t triangle) const {
+    if (triangle < 0 || size_t(triangle) >= prepared_of_input_.size() || prepared_of_input_[size_t(triangle)] < 0)
+        throw std::invalid_argument("closest_point: " + std::to_string(triangle) + " is not a face of the prepared mesh");
+    const int32_t t = prepared_of_input_[size_t(triangle)];
+    const Int3 tri = mesh_->triangles()[size_t(t)];
+    const std::vector<Vec3d>& v = mesh_->vertices();
+    // The sampler's own evaluation of the winner (signed_distance_to_triangle), in double.
+    const TriangleClosestPoint<double> cp = closest_point_on_triangle(p, v[size_t(tri.x)], v[size_t(tri.y)], v[size_t(tri.z)]);
+    ClosestPointOnMesh out;
+    out.point = cp.point;
+    const double w0 = 1.0 - cp.s - cp.t, w1 = cp.s, w2 = cp.t;
+    // Preparation keeps each face's corners in order, except that flipping an inward mesh
+    // swaps the second and third (prepared_mesh.cpp).
+    out.barycentric = mesh_->report().flipped ? Vec3d{w0, w2, w1} : Vec3d{w0, w1, w2};
+    return out;
+}
+
+std::vector<double> MeshSdf::winding_numbers(const std::vector<Vec3d>& points, int threads) const {
+    std::shared_ptr<const WindingSign> winding;
+    {
+        std::lock_guard<std::mutex> lock(winding_mutex_);
+        if (!winding_) winding_ = std::make_shared<const WindingSign>(*mesh_, SamplerSign::winding_options());
+        winding = winding_;
+    }
+    std::vector<double> w(points.size());
+    parallel_for(int64_t(points.size()), 256, threads, [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) w[size_t(i)] = winding->estimate(points[size_t(i)]).value;
+    });
+    return w;
+}
+
+void make_unsigned(std::vector<PointSample>& samples) {
+    for (PointSample& s : samples)
+        if (std::signbit(s.distance)) {
+            s.distance = -s.distance;
+            s.gradient = -s.gradient;
+        }
+}
+
+void make_unsigned(SampledField& field) {
+    const bool gradient = field.gradient.size() == field.distance.size();
+    for (size_t i = 0; i < field.distance.size(); ++i)
+        if (std::signbit(field.distance[i])) {
+            field.distance[i] = -field.distance[i];
+            if (gradient) field.gradient[i] = -field.gradient[i];
+        }
+}
+
+}  // namespace sdf

@@ -1,0 +1,85 @@
+/// @file mesh_sdf.h
+/// @brief Build once, query many times: a prepared mesh bound to one sampler. Making the
+/// object builds what every query of the mesh needs, the BVH, the winding data (when the
+/// sign is the winding number's) and on the GPU the device upload, as fcpw's Scene::build()
+/// and NanoVDB's MeshToGrid do; query() and sample() then only search. `sdf-query`
+/// (point_query.h) and the Python module's SDF class both use it, and the numbers are the
+/// sampler's own: bit for bit those of Sampler::query() and Sampler::sample().
+///
+/// Beyond the sampler's distance, gradient and closest triangle it gives what users of a
+/// distance query expect: the closest point with its barycentric coordinates on the closest
+/// triangle (in the input's face and vertex order), the unsigned distance (sign "none"),
+/// and the generalized winding number (occupancy).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/sampling/sampler.h"
+#include "core/winding/winding_sign.h"
+
+namespace sdf {
+
+/// The closest point of a query point on its closest triangle.
+struct ClosestPointOnMesh {
+    Vec3d point{};        ///< on the prepared (welded) triangle
+    /// Weights of the input face's three vertices, in the input's order: point =
+    /// sum_k barycentric[k] * vertex(face[k]); each in [0, 1], summing to 1 up to rounding.
+    Vec3d barycentric{};
+};
+
+class MeshSdf {
+public:
+    /// Binds `mesh` to the sampler of `options` (backend "cpu" or "cuda": resolve "auto"
+    /// first, point_query.h) and builds its BVH, winding data and device upload. With
+    /// `unsigned_distance`, the sign step is skipped: distances are |d| and gradients point
+    /// away from the surface (the sampler runs with the pseudonormal sign, whose magnitudes
+    /// are every mode's). Throws std::invalid_argument for options the sampler table refuses.
+    MeshSdf(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, bool unsigned_distance = false);
+    ~MeshSdf();
+
+    const PreparedMesh& mesh() const { return *mesh_; }
+    const std::shared_ptr<const PreparedMesh>& shared_mesh() const { return mesh_; }
+    const SamplerOptions& options() const { return options_; }
+    const std::string& sampler_name() const { return sampler_name_; }
+    /// The sign actually used: "pseudonormal", "winding" (auto resolved by the mesh's
+    /// report, choose_sign_mode) or "none"; and why.
+    const std::string& sign_mode() const { return sign_mode_; }
+    const std::string& sign_reason() const { return sign_reason_; }
+    /// Wall time of the construction (BVH, winding data, upload), seconds.
+    double build_seconds() const { return build_seconds_; }
+
+    /// Samples arbitrary points, returned in input order. Thread-safe (calls are serialised).
+    std::vector<PointSample> query(const std::vector<Vec3d>& points) const;
+    /// Samples every point of the lattice; with unsigned_distance, |d| everywhere.
+    SampledField sample(const Lattice& lattice) const;
+
+    /// The closest point of p on input face `triangle` (a query's PointSample::triangle).
+    ClosestPointOnMesh closest_point(const Vec3d& p, int32_t triangle) const;
+
+    /// The generalized winding number of every point (Jacobson et al. 2013): about 1 inside a
+    /// closed outward mesh, 0 outside, fractional near holes. The fast evaluation with the
+    /// winding sign's accuracy (SamplerSign::winding_options), whose side of 1/2 is the
+    /// winding sign; its data are built on the first call.
+    std::vector<double> winding_numbers(const std::vector<Vec3d>& points, int threads) const;
+
+private:
+    std::shared_ptr<const PreparedMesh> mesh_;
+    SamplerOptions options_;
+    bool unsigned_distance_;
+    std::unique_ptr<Sampler> sampler_;
+    std::string sampler_name_, sign_mode_, sign_reason_;
+    double build_seconds_ = 0;
+    std::vector<int32_t> prepared_of_input_;  ///< input face -> prepared triangle (-1: dropped)
+    mutable std::mutex mutex_;                ///< the sampler keeps per-call state
+    mutable std::mutex winding_mutex_;
+    mutable std::shared_ptr<const WindingSign> winding_;
+};
+
+/// Unsigned distance in place: |d|, and the gradient turned to point away from the surface.
+void make_unsigned(std::vector<PointSample>& samples);
+void make_unsigned(SampledField& field);
+
+}  // namespace sdf

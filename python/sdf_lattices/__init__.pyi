@@ -1,0 +1,111 @@
+# Type stubs of the package sdf_lattices (the extension sdf_lattices._core and its pure-Python
+# parts), so that editors complete the API. tests/python_module/test_python_api.py checks that
+# every public name and member is here.
+import os
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+build_commit: str
+
+Vec3 = Tuple[float, float, float]
+ArrayF = npt.NDArray[np.float64]
+ArrayI = npt.NDArray[np.int32]
+Progress = Union[None, bool, Callable[[int, int], Any]]
+MeshLike = Union["Mesh", str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike], Any]
+"""An sdf_lattices.Mesh, a mesh file path, (vertices, faces), an Open3D TriangleMesh or any
+object with vertices and faces arrays (trimesh)."""
+Grids = Union[ArrayF, Tuple[ArrayF, ArrayF]]
+
+class SdfWarning(UserWarning): ...
+class MeshWarning(SdfWarning): ...
+
+class Mesh:
+    def __init__(self, vertices: npt.ArrayLike, faces: npt.ArrayLike, name: str = "mesh", weld_tolerance: float = 0.0,
+                 check_intersections: bool = True) -> None: ...
+    name: str
+    source: str
+    sha256: str
+    vertices: ArrayF
+    faces: ArrayI
+    source_triangle: ArrayI
+    bounds: Tuple[Vec3, Vec3]
+    closed: bool
+    consistently_oriented: bool
+    orientation: str
+    components: int
+    sign_reliable: bool
+    warnings: List[str]
+    report: Dict[str, Any]
+
+class QueryResult:
+    distance: ArrayF
+    gradient: ArrayF
+    triangle: ArrayI
+    closest_point: ArrayF
+    barycentric: ArrayF
+    winding: Optional[ArrayF]
+    sign: str
+    sampler: str
+    def __len__(self) -> int: ...
+
+class Field:
+    def __init__(self, values: Union[npt.ArrayLike, Tuple[npt.ArrayLike, npt.ArrayLike]], origin: Sequence[float],
+                 spacing: float, lattice: str = "cc", gradient: Any = None, triangle: Any = None) -> None: ...
+    lattice: str
+    origin: Vec3
+    spacing: float
+    resolution: Tuple[int, int, int]
+    notation: str
+    num_points: int
+    grid_origins: Union[Vec3, Tuple[Vec3, Vec3]]
+    lattice_info: Dict[str, Any]
+    values: Grids
+    gradient: Optional[Grids]
+    triangle: Optional[Union[ArrayI, Tuple[ArrayI, ArrayI]]]
+    precision: str
+    sampler: Dict[str, Any]
+    mesh: Dict[str, Any]
+    seconds: float
+    def points(self) -> Grids: ...
+    def write(self, path: str, dtype: str = "float32", overwrite: bool = False, closest_triangle: bool = True) -> None: ...
+    def reconstruct(self, points: npt.ArrayLike, interpolator: str = "", derivatives: str = "", sigma2: float = 0.5,
+                    sigma_units: str = "lattice", threads: int = 0, outside: str = "nan") -> Tuple[ArrayF, ArrayF]: ...
+
+class SDF:
+    def __init__(self, mesh: MeshLike, backend: str = "auto", method: str = "bvh", sign: str = "auto",
+                 precision: str = "float", kernel: str = "", threads: int = 0, bcc_strategy: str = "two_grids") -> None: ...
+    mesh: Mesh
+    sampler: str
+    sign: str
+    sign_reason: str
+    precision: str
+    build_seconds: float
+    def query(self, points: npt.ArrayLike, winding: bool = False, progress: Progress = None) -> QueryResult: ...
+    def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
+               margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+               spacing: Optional[float] = None, origin: Optional[Sequence[float]] = None,
+               progress: Progress = None) -> Field: ...
+
+def as_mesh(mesh: MeshLike) -> Mesh: ...
+def cuda_available() -> bool: ...
+def load_mesh(path: str, weld_tolerance: float = 0.0, check_intersections: bool = True) -> Mesh: ...
+def query(mesh: MeshLike, points: npt.ArrayLike, backend: str = "auto", method: str = "bvh", sign: str = "auto",
+          precision: str = "float", kernel: str = "", threads: int = 0, progress: Progress = None,
+          winding: bool = False) -> QueryResult: ...
+def sdf(mesh: MeshLike, points: npt.ArrayLike, sign: str = "auto", backend: str = "auto") -> ArrayF: ...
+def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
+           samples: Optional[int] = None, margin: Optional[float] = None,
+           bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,
+           origin: Optional[Sequence[float]] = None, backend: str = "auto", method: str = "bvh", kernel: str = "",
+           sign: str = "auto", precision: str = "float", threads: int = 0, bcc_strategy: str = "two_grids",
+           progress: Progress = None, distributed: bool = True) -> Field: ...
+def read_field(path: Union[str, os.PathLike]) -> Field: ...
+def read_field_file(path: str) -> Field: ...
+def render(field: Field, view: str = "three_quarter", size: Union[int, Tuple[int, int]] = 512, interpolator: str = "",
+           derivatives: str = "", backend: str = "auto", precision: str = "float", eye: Optional[Sequence[float]] = None,
+           target: Optional[Sequence[float]] = None, up: Sequence[float] = (0, 1, 0), fov: float = 30.0,
+           mesh: Optional[MeshLike] = None, threads: int = 0, progress: Progress = None) -> npt.NDArray[np.float32]: ...
+def distributed() -> Dict[str, Any]: ...

@@ -1,0 +1,17 @@
+#include "python/src/task.h"
+
+namespace sdf {
+
+py::object progress_reporter(const py::object& progress, const std::string& label, int64_t total) {
+    if (progress.is_none() || (py::isinstance<py::bool_>(progress) && !progress.cast<bool>())) return py::none();
+    return py::module_::import("sdf_lattices._progress").attr("reporter")(progress, label, total);
+}
+
+void raise_warnings(const std::vector<std::string>& warnings) {
+    if (warnings.empty()) return;
+    const py::object category = py::module_::import("sdf_lattices._warnings").attr("SdfWarning");
+    const py::object warn = py::module_::import("warnings").attr("warn");
+    for (const std::string& text : warnings) warn(text, category, 3);
+}
+
+}  // namespace sdf

@@ -1,0 +1,139 @@
+// MeshSdf (harness/sampling/mesh_sdf.h), the bound object of issue 23: its queries and
+// fields are the sampler's own, bit for bit, however many calls follow one build; closest
+// points and barycentrics satisfy their definitions; unsigned distance is |d|; the winding
+// number is occupancy. And the task monitor (core/parallel/task_monitor.h): a stop request
+// ends parallel_for between chunks, and warnings go to the monitor instead of stderr.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/parallel/parallel_for.h"
+#include "core/parallel/task_monitor.h"
+#include "harness/sampling/mesh_sdf.h"
+#include "harness/sampling/sampler_table.h"
+
+namespace sdf {
+namespace {
+
+std::shared_ptr<const PreparedMesh> torus() {
+    static const auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(make_torus(1.0, 0.35, 48, 24)));
+    return mesh;
+}
+
+std::vector<Vec3d> random_points(size_t n, double lo, double hi, unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(lo, hi);
+    std::vector<Vec3d> p(n);
+    for (Vec3d& q : p) q = {u(rng), u(rng), u(rng)};
+    return p;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+SamplerOptions cpu(const std::string& method, SignMode sign) {
+    SamplerOptions o;
+    o.backend = "cpu";
+    o.method = method;
+    o.sign = sign;
+    o.progress = false;
+    return o;
+}
+
+TEST(MeshSdf, QueriesEqualTheSamplersBitForBitCallAfterCall) {
+    const auto points = random_points(3000, -1.6, 1.6, 3);
+    for (const std::string method : {"bvh", "brute_force"})
+        for (SignMode sign : {SignMode::Auto, SignMode::Pseudonormal, SignMode::Winding}) {
+            const MeshSdf bound(torus(), cpu(method, sign));
+            const std::vector<PointSample> ref = make_sampler(cpu(method, sign))->query(*torus(), points);
+            for (int call = 0; call < 3; ++call) {
+                const std::vector<PointSample> got = bound.query(points);
+                ASSERT_EQ(got.size(), ref.size());
+                for (size_t i = 0; i < got.size(); ++i) {
+                    ASSERT_TRUE(same_bits(got[i].distance, ref[i].distance)) << method << " point " << i;
+                    ASSERT_TRUE(same_bits(got[i].gradient.x, ref[i].gradient.x) && same_bits(got[i].gradient.z, ref[i].gradient.z));
+                    ASSERT_EQ(got[i].triangle, ref[i].triangle);
+                }
+            }
+            EXPECT_EQ(bound.sign_mode(), sign == SignMode::Winding ? "winding" : "pseudonormal");
+        }
+}
+
+TEST(MeshSdf, FieldsEqualTheSamplersBitForBit) {
+    const Lattice lattice = fit_lattice(LatticeType::BCC, {9, 8, 7}, torus()->bounds(), 0.1);
+    const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto));
+    const SampledField a = bound.sample(lattice);
+    const SampledField b = make_sampler(cpu("bvh", SignMode::Auto))->sample(*torus(), lattice);
+    ASSERT_EQ(a.distance.size(), b.distance.size());
+    for (size_t i = 0; i < a.distance.size(); ++i) {
+        ASSERT_TRUE(same_bits(a.distance[i], b.distance[i])) << i;
+        ASSERT_EQ(a.closest_triangle[i], b.closest_triangle[i]);
+    }
+}
+
+TEST(MeshSdf, ClosestPointsAndBarycentricsMeetTheirDefinitions) {
+    const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto));
+    const auto points = random_points(500, -1.6, 1.6, 5);
+    const std::vector<PointSample> s = bound.query(points);
+    const PreparedMesh& m = *torus();
+    for (size_t i = 0; i < points.size(); ++i) {
+        const ClosestPointOnMesh c = bound.closest_point(points[i], s[i].triangle);
+        EXPECT_NEAR(length(points[i] - c.point), std::abs(s[i].distance), 1e-12);
+        // The torus is not flipped and not welded: input face t is prepared triangle t.
+        const Int3 f = m.triangles()[size_t(s[i].triangle)];
+        const Vec3d from_weights = m.vertices()[size_t(f.x)] * c.barycentric.x + m.vertices()[size_t(f.y)] * c.barycentric.y +
+                                   m.vertices()[size_t(f.z)] * c.barycentric.z;
+        EXPECT_NEAR(length(from_weights - c.point), 0.0, 1e-12);
+        EXPECT_NEAR(c.barycentric.x + c.barycentric.y + c.barycentric.z, 1.0, 1e-12);
+    }
+    EXPECT_THROW(bound.closest_point(points[0], -1), std::invalid_argument);
+}
+
+TEST(MeshSdf, UnsignedDistanceAndWindingNumbers) {
+    const auto points = random_points(800, -1.6, 1.6, 7);
+    const MeshSdf signed_sdf(torus(), cpu("bvh", SignMode::Auto));
+    const MeshSdf unsigned_sdf(torus(), cpu("bvh", SignMode::Auto), true);
+    EXPECT_EQ(unsigned_sdf.sign_mode(), "none");
+    const auto s = signed_sdf.query(points), u = unsigned_sdf.query(points);
+    const std::vector<double> w = signed_sdf.winding_numbers(points, 0);
+    for (size_t i = 0; i < points.size(); ++i) {
+        EXPECT_TRUE(same_bits(u[i].distance, std::abs(s[i].distance)));
+        if (s[i].distance < -1e-3) {
+            EXPECT_NEAR(w[i], 1.0, 0.05);
+        } else if (s[i].distance > 1e-3) {
+            EXPECT_NEAR(w[i], 0.0, 0.05);
+        }
+    }
+}
+
+TEST(TaskMonitor, AStopRequestEndsParallelForBetweenChunks) {
+    TaskMonitor monitor;
+    ScopedTaskMonitor scope(&monitor);
+    std::atomic<int64_t> chunks{0};
+    EXPECT_THROW(parallel_for(1000, 10, 2,
+                              [&](int64_t, int64_t) {
+                                  if (++chunks == 5) monitor.request_stop();
+                              }),
+                 TaskStopped);
+    EXPECT_LT(chunks.load(), 100);  // stopped long before the 100 chunks
+}
+
+TEST(TaskMonitor, WarningsGoToTheMonitor) {
+    TaskMonitor monitor;
+    {
+        ScopedTaskMonitor scope(&monitor);
+        report_warning("first");
+        report_warning("second");
+    }
+    EXPECT_EQ(monitor.take_warnings(), (std::vector<std::string>{"first", "second"}));
+    EXPECT_TRUE(monitor.take_warnings().empty());
+    EXPECT_EQ(current_task_monitor(), nullptr);
+}
+
+}  // namespace
+}  // namespace sdf
