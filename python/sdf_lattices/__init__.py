@@ -29,3 +29,6 @@ from ._gpu import DeviceQueryResult  # noqa: F401
 # GPU tensors (PyTorch, CuPy, JAX) in and out without copies: SDF.query, query and sdf take
 # them (sdf_lattices._gpu).
 query, sdf = _gpu.install(_core)
+
+from . import data  # noqa: E402,F401  (ML training data: sdf_lattices.data.sample_near_surface, ...)
+from ._build_info import build_info  # noqa: E402,F401  (what the build found: CUDA, MPI, OpenVDB, OpenImageIO)

@@ -2,6 +2,7 @@
 # parts), so that editors complete the API. tests/python_module/test_python_api.py checks that
 # every public name and member is here.
 import os
+import types
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -121,3 +122,7 @@ def render(field: Field, view: str = "three_quarter", size: Union[int, Tuple[int
            target: Optional[Sequence[float]] = None, up: Sequence[float] = (0, 1, 0), fov: float = 30.0,
            mesh: Optional[MeshLike] = None, threads: int = 0, progress: Progress = None) -> npt.NDArray[np.float32]: ...
 def distributed() -> Dict[str, Any]: ...
+
+# sdf_lattices.data (data.py, typed inline): ML training samples with exact values.
+data: types.ModuleType
+def build_info() -> Dict[str, Any]: ...
