@@ -5,11 +5,13 @@
 #include <cmath>
 #include <chrono>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "core/bvh/bvh_cache.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
@@ -35,6 +37,55 @@ using BvhKernel = CpuBvhKernel;
 
 struct QueryCounters {
     std::atomic<int64_t> nodes{0}, triangles{0};
+    CertificateCounters certificate;
+};
+
+/// The certified float search's context (search_certificate.h): the slack of every point of
+/// the run and the double constants for re-ranking. `T` double: the search is the reference.
+template <typename T>
+struct Certifier {
+    static constexpr bool kActive = std::is_same_v<T, float>;
+    SearchSlack<float> slack;
+    BvhView<double> exact;
+
+    Certifier(const PreparedMesh& mesh, const TriangleBvh& bvh, double point_coordinate) : exact(bvh.view<double>()) {
+        if constexpr (kActive) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
+    }
+
+    /// Every candidate, without a limit: the fallback when a point has more than fit.
+    struct AllNear {
+        static constexpr bool kKeeps = true;
+        SearchSlack<float> slack;
+        std::vector<int32_t> slot;
+        std::vector<float> q;
+        float radius(float v) const { return slack.radius(v); }
+        void offer(int32_t s, float v) {
+            slot.push_back(s);
+            q.push_back(v);
+        }
+    };
+
+    /// The double search's winner (BVH slot) at p from the float search's winner and its
+    /// candidates; counts what it took.
+    template <int N>
+    int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
+                    const NearCandidates<float, N>& near, CertificateCounters& counters) const {
+        auto index_of = [&](int32_t s) { return view.triangle_index[s]; };
+        Rerank r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, slack.radius(best_q), near);
+        if (r.overflow) {
+            AllNear all{slack, {}, {}};
+            const Vec3f pt(p);
+            NoBvhStats none;
+            const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed_hit(view, winner, pt), none, all);
+            r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, hit.slot, slack.radius(hit.distance_squared),
+                                 all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
+            r.reranked = true;
+            ++counters.full_double;
+        }
+        ++counters.points;
+        if (r.reranked) ++counters.reranked;
+        return r.slot;
+    }
 };
 
 /// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
@@ -42,9 +93,10 @@ struct QueryCounters {
 /// a valid seed: its distance only bounds the search radius).
 template <typename T, typename PositionFn, typename EmitFn>
 void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, bool seeded, int threads, bool progress,
-                     int64_t n, QueryCounters& counters, PositionFn pos, EmitFn emit) {
+                     int64_t n, double point_coordinate, QueryCounters& counters, PositionFn pos, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
+    const Certifier<T> certifier(mesh, bvh, point_coordinate);
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
@@ -53,14 +105,38 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             const Vec3d p = pos(i);
             const Vec3<T> pt(p);
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
-            const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed, stats);
-            previous = hit.slot;
-            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[hit.slot]), p));
+            int32_t slot;
+            if constexpr (Certifier<T>::kActive) {
+                CertifiedNear<float> near{certifier.slack, {}};
+                const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed, stats, near);
+                previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
+                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, counters.certificate);
+            } else {
+                slot = previous = closest_triangle_bvh(view, pt, seed, stats).slot;
+            }
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
         }
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(end - begin);
     });
+}
+
+/// One packet search (closest_triangles_packet.h): `slot` receives the winner of each of the
+/// first `count` lanes, certified for float (`position`: the lanes' exact points).
+template <typename T, int K>
+void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
+                   BvhPacket<T, K>& pk, BvhStats& stats, CertificateCounters& counters, int32_t* slot) {
+    if constexpr (Certifier<T>::kActive) {
+        PacketCertifiedNear<float, K> near;
+        near.slack = certifier.slack;
+        closest_triangles_packet(view, pk, stats, near);
+        for (int k = 0; k < count; ++k)
+            slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
+    } else {
+        closest_triangles_packet(view, pk, stats);
+        for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];
+    }
 }
 
 /// The points of one brick of `block`: block-local indices and positions; lanes beyond
@@ -135,6 +211,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                      EmitFn emit, OutsideFn emit_outside) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
+    const Certifier<T> certifier(mesh, bvh, largest_lattice_coordinate(lattice));
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
@@ -163,6 +240,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const Vec3<T> pt(c);
                     const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed_hit(view, probe_seed, pt), stats);
                     probe_seed = hit.slot;
+                    // The probe needs only a distance bound, which its margin covers: not certified.
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
@@ -190,9 +268,10 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 pk.z[k] = T(br.position[k].z);
             }
             seed_packet(view, seed, pk);
-            closest_triangles_packet(view, pk, stats);
+            int32_t slot[kBrick];
+            search_packet(view, certifier, br.position, br.count, pk, stats, counters.certificate, slot);
             for (int k = 0; k < br.count; ++k)
-                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]),
+                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]),
                                              br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
         }
@@ -252,11 +331,12 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
 /// those of evaluate_points; only the work shared between neighbours changes.
 template <typename T, typename EmitFn>
 void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const std::vector<Vec3d>& points,
-                            int threads, bool progress, QueryCounters& counters, EmitFn emit) {
+                            int threads, bool progress, double point_coordinate, QueryCounters& counters, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const int64_t n = int64_t(points.size());
     if (n == 0) return;
+    const Certifier<T> certifier(mesh, bvh, point_coordinate);
     const std::vector<uint32_t> order = morton_order(points, threads);
     const int64_t packets = (n + kPointPacket - 1) / kPointPacket;
     ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
@@ -269,18 +349,20 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             const int64_t first = b * kPointPacket;
             const int count = int(std::min<int64_t>(kPointPacket, n - first));
             BvhPacket<T, kPointPacket> pk;
+            Vec3d position[kPointPacket];
             for (int k = 0; k < kPointPacket; ++k) {
-                const Vec3d& p = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
-                pk.x[k] = T(p.x);
-                pk.y[k] = T(p.y);
-                pk.z[k] = T(p.z);
+                position[k] = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
+                pk.x[k] = T(position[k].x);
+                pk.y[k] = T(position[k].y);
+                pk.z[k] = T(position[k].z);
             }
             seed_packet(view, seed, pk);
-            closest_triangles_packet(view, pk, stats);
+            int32_t slot[kPointPacket];
+            search_packet(view, certifier, position, count, pk, stats, counters.certificate, slot);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
-                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[pk.best_slot[k]]), p));
+                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), p));
             }
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;
@@ -316,13 +398,16 @@ public:
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                 out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
             };
+            double coordinate = 0;
+            for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
             if (kernel_ == BvhKernel::Brick && points.size() < (size_t(1) << 32))  // 32-bit indices in the sort
-                evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, counters, emit);
+                evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, coordinate, counters, emit);
             else
-                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
-                                   [&](int64_t i) { return points[size_t(i)]; }, emit);
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()),
+                                   coordinate, counters, [&](int64_t i) { return points[size_t(i)]; }, emit);
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
+        record_certificate(query_timings_, counters.certificate);
         return out;
     }
 
@@ -363,7 +448,8 @@ private:
                 evaluate_bricks<T>(mesh, *bvh, sign_, lattice, block, options_.threads, options_.progress, band, counters,
                                    band_counters, emit, emit_outside);
             else
-                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(), counters,
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(),
+                                   largest_lattice_coordinate(lattice), counters,
                                    [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); }, emit);
             computed += block.count();
         }
@@ -380,6 +466,9 @@ private:
         field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         field.sampler["bvh"] = bvh_info;
+        record_certificate(field.timings, counters.certificate);
+        field.sampler["search_certificate"] =
+            certificate_provenance(options_.precision == Precision::Float, true, counters.certificate);
         if (w > 0) {
             nlohmann::json info = narrow_band_provenance(
                 w, count_narrow_band(field), band.enabled() ? "bricks skipped by the distance bound" : "post-processed");
