@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/bvh/bvh_cache.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "core/winding/winding_sign.h"
@@ -17,6 +18,7 @@
 #include "cuda/bvh_candidates_kernel.cuh"
 #include "cuda/bvh_kernel.cuh"
 #include "cuda/bvh_warp_kernel.cuh"
+#include "cuda/certify_kernel.cuh"
 #include "kernels/core/morton.h"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
@@ -54,6 +56,7 @@ struct DeviceBvh {
     DeviceWinding winding;
     BvhView<T> view{};
     bool solid = false;  ///< auto would sign this mesh by pseudonormals (the narrow band's brick skip)
+    std::unique_ptr<DeviceCertifier> certifier;  ///< float only (certify_kernel.cuh)
 
     DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared, const SamplerSign& sign)
         : solid(choose_sign_mode(prepared.report(), SignMode::Auto).mode == SignMode::Pseudonormal) {
@@ -64,8 +67,27 @@ struct DeviceBvh {
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         winding.upload(sign, mesh->view());
         view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        if constexpr (std::is_same_v<T, float>) certifier = std::make_unique<DeviceCertifier>(bvh, prepared);
     }
 };
+
+/// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
+template <typename T, typename Piece>
+void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->certify(piece, point_coordinate, nearest);
+}
+
+/// Zeroes the certifier's counters.
+template <typename T>
+void reset_certificate(const DeviceBvh<T>& dev) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->reset();
+}
+
+/// Reads them into `counters`.
+template <typename T>
+void read_certificate(const DeviceBvh<T>& dev, CertificateCounters& counters) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->read(counters);
+}
 
 /// Per-piece results on the device, and their download.
 struct PieceResults {
@@ -200,6 +222,7 @@ private:
         PieceResults r(piece.count);
         compute.begin();
         launch_slab<T>(dev, piece, slab, r.nearest.get());
+        certify(dev, piece, largest_lattice_coordinate(lattice), r.nearest.get());
         launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
@@ -222,6 +245,7 @@ private:
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0, pieces = 0;
         unsigned long long counts[4] = {0, 0, 0, 0};
+        reset_certificate(dev);
         if (kernel_ == BvhGpuKernel::Candidates) {
             if (candidate_stats_.size() == 0) candidate_stats_.allocate(4);
             CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
@@ -245,6 +269,10 @@ private:
         field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
         field.sampler["bvh"] = bvh_info;
         field.sampler["device"] = describe_device(options_.device);
+        CertificateCounters certificate;
+        read_certificate(dev, certificate);
+        record_certificate(field.timings, certificate);
+        field.sampler["search_certificate"] = certificate_provenance(std::is_same_v<T, float>, true, certificate);
         if (options_.band_width > 0) {
             const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
                                (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
@@ -287,6 +315,9 @@ private:
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
         PieceResults r(step);  // reused by every piece
+        double coordinate = 0;
+        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        reset_certificate(dev);
         for (int64_t begin = 0; begin < n; begin += step) {
             compute.begin();
             if (begin == 0) sort.run(mesh, device_points.get(), sorted_points.get(), order.get());
@@ -298,6 +329,7 @@ private:
             else
                 nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
+            certify(dev, piece, coordinate, r.nearest.get());
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
@@ -313,6 +345,9 @@ private:
         query_timings_.download = download.seconds();
         query_timings_.point_triangle_pairs = double(n) * double(mesh.triangles().size());
         query_timings_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        CertificateCounters certificate;
+        read_certificate(dev, certificate);
+        record_certificate(query_timings_, certificate);
         return out;
     }
 
