@@ -40,6 +40,16 @@ struct QueryCounters {
     CertificateCounters certificate;
 };
 
+/// A thread's counts of certified points, added to the run's CertificateCounters at the end.
+struct LocalCertificate {
+    int64_t points = 0, reranked = 0, full_double = 0;
+    void add_to(CertificateCounters& c) const {
+        c.points += points;
+        c.reranked += reranked;
+        c.full_double += full_double;
+    }
+};
+
 /// The certified float search's context (search_certificate.h): the slack of every point of
 /// the run and the double constants for re-ranking. `T` double: the search is the reference.
 template <typename T>
@@ -65,11 +75,23 @@ struct Certifier {
         }
     };
 
+    /// Starts loading the double constants of the candidates (three cache lines each, in an
+    /// array apart from the float ones): a packet's lanes then wait for memory together.
+    template <int N>
+    void prefetch(const NearCandidates<float, N>& near) const {
+        for (int i = 0; i < near.count; ++i) {
+            const char* at = reinterpret_cast<const char*>(exact.packed + near.slot[i]);
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + 64);
+            __builtin_prefetch(at + 128);
+        }
+    }
+
     /// The double search's winner (BVH slot) at p from the float search's winner and its
     /// candidates; counts what it took.
     template <int N>
     int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
-                    const NearCandidates<float, N>& near, CertificateCounters& counters) const {
+                    const NearCandidates<float, N>& near, LocalCertificate& counters) const {
         auto index_of = [&](int32_t s) { return view.triangle_index[s]; };
         Rerank r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, slack.radius(best_q), near);
         if (r.overflow) {
@@ -83,7 +105,7 @@ struct Certifier {
             ++counters.full_double;
         }
         ++counters.points;
-        if (r.reranked) ++counters.reranked;
+        counters.reranked += r.reranked;
         return r.slot;
     }
 };
@@ -100,6 +122,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t previous = -1;
         for (int64_t i = begin; i < end; ++i) {
             const Vec3d p = pos(i);
@@ -110,12 +133,14 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 CertifiedNear<float> near{certifier.slack, {}};
                 const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed, stats, near);
                 previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
-                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, counters.certificate);
+                certifier.prefetch(near.near);
+                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified);
             } else {
                 slot = previous = closest_triangle_bvh(view, pt, seed, stats).slot;
             }
             emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(end - begin);
@@ -126,11 +151,12 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
 /// first `count` lanes, certified for float (`position`: the lanes' exact points).
 template <typename T, int K>
 void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
-                   BvhPacket<T, K>& pk, BvhStats& stats, CertificateCounters& counters, int32_t* slot) {
+                   BvhPacket<T, K>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
     if constexpr (Certifier<T>::kActive) {
         PacketCertifiedNear<float, K> near;
         near.slack = certifier.slack;
         closest_triangles_packet(view, pk, stats, near);
+        for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
         for (int k = 0; k < count; ++k)
             slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
     } else {
@@ -221,6 +247,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
     parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t seed[kBrick];
         for (int k = 0; k < kBrick; ++k) seed[k] = -1;
         int32_t probe_seed = -1;
@@ -269,12 +296,13 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             }
             seed_packet(view, seed, pk);
             int32_t slot[kBrick];
-            search_packet(view, certifier, br.position, br.count, pk, stats, counters.certificate, slot);
+            search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < br.count; ++k)
                 emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]),
                                              br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         band_counters.probes += probes;
@@ -342,6 +370,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
     ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
     parallel_for(packets, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t seed[kPointPacket];
         for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
         int64_t done = 0;
@@ -358,7 +387,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             }
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
-            search_packet(view, certifier, position, count, pk, stats, counters.certificate, slot);
+            search_packet(view, certifier, position, count, pk, stats, certified, slot);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
@@ -367,6 +396,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(done);

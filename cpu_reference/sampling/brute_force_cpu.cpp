@@ -19,9 +19,9 @@ using CpuKernel = CpuBruteForceKernel;
 
 /// The double search's winner at p from the certified float search's winner and candidates
 /// (search_certificate.h); with too many candidates, every triangle within the radius is
-/// collected by one more float pass and re-ranked.
+/// collected by one more float pass and re-ranked. counts: points, re-ranked, full pass.
 int certify_brute_force(const TriangleSoA<float>& soa, const PackedTriangle<double>* exact, const Vec3d& p, int winner,
-                        float best_q, const CertifiedNear<float>& near, CertificateCounters& counters) {
+                        float best_q, const CertifiedNear<float>& near, int64_t* counts) {
     auto index_of = [](int32_t s) { return s; };
     const float radius = near.radius(best_q);
     Rerank r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, near.near);
@@ -39,10 +39,10 @@ int certify_brute_force(const TriangleSoA<float>& soa, const PackedTriangle<doub
         }
         r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, slot.data(), q.data(), int(slot.size()), NAN);
         r.reranked = true;
-        ++counters.full_double;
+        ++counts[2];
     }
-    ++counters.points;
-    if (r.reranked) ++counters.reranked;
+    ++counts[0];
+    counts[1] += r.reranked;
     return r.slot;
 }
 
@@ -77,8 +77,12 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
                 CertifiedNear<float> near[kPointTile];
                 for (int k = 0; k < count; ++k) near[k].slack = slack;
                 nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q, near);
+                int64_t counts[3] = {0, 0, 0};
                 for (int k = 0; k < count; ++k)
-                    best[k] = certify_brute_force(soa, exact.packed, pos(begin + k), best[k], best_q[k], near[k], counters);
+                    best[k] = certify_brute_force(soa, exact.packed, pos(begin + k), best[k], best_q[k], near[k], counts);
+                counters.points += counts[0];
+                counters.reranked += counts[1];
+                counters.full_double += counts[2];
             } else {
                 nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q);
             }
