@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
 #include "core/bvh/bvh_cache.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "core/winding/winding_sign.h"
@@ -18,6 +20,7 @@
 #include "cuda/bvh_candidates_kernel.cuh"
 #include "cuda/bvh_kernel.cuh"
 #include "cuda/bvh_warp_kernel.cuh"
+#include "cuda/certify_kernel.cuh"
 #include "kernels/core/morton.h"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
@@ -56,6 +59,7 @@ struct DeviceBvh {
     DeviceBuffer<int32_t> source_triangle;  ///< prepared -> mesh file face order (stored slabs)
     std::unique_ptr<DeviceMesh<double>> mesh;
     DeviceWinding winding;
+    std::unique_ptr<DeviceCertifier> certifier;  ///< float only (certify_kernel.cuh)
     BvhView<T> view{};
     bool solid = false;  ///< auto would sign this mesh by pseudonormals (the narrow band's brick skip)
 
@@ -69,8 +73,27 @@ struct DeviceBvh {
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         winding.upload(sign, mesh->view());
         view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        if constexpr (std::is_same_v<T, float>) certifier = std::make_unique<DeviceCertifier>(bvh, prepared);
     }
 };
+
+/// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
+template <typename T, typename Piece>
+void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->certify(piece, point_coordinate, nearest);
+}
+
+/// Zeroes the certifier's counters.
+template <typename T>
+void reset_certificate(const DeviceBvh<T>& dev) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->reset();
+}
+
+/// Reads them into `counters`.
+template <typename T>
+void read_certificate(const DeviceBvh<T>& dev, CertificateCounters& counters) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->read(counters);
+}
 
 /// Per-piece results on the device, and their download.
 struct PieceResults {
@@ -226,6 +249,7 @@ private:
         PieceResults r(piece.count);
         compute.begin();
         launch_slab<T>(dev, piece, slab, r.nearest.get());
+        certify(dev, piece, largest_lattice_coordinate(lattice), r.nearest.get());
         launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
@@ -241,6 +265,7 @@ private:
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0, pieces = 0;
+        reset_certificate(dev);
         if (kernel_ == BvhGpuKernel::Candidates) {
             if (candidate_stats_.size() == 0) candidate_stats_.allocate(4);
             CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
@@ -271,6 +296,7 @@ private:
         };
         const auto [computed, pieces] = run_blocks<T>(dev, lattice, slab, compute, sink);
         record_provenance(field, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
+        record_search_certificate(dev, field);
         if (options_.band_width > 0) field.sampler["band"] = band_provenance(mesh, count_narrow_band(field));
         return field;
     }
@@ -296,6 +322,7 @@ private:
         stored_buffers_.download(points, layout, stored);
         download.end();
         record_provenance(stored.info, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
+        record_search_certificate(dev, stored.info);
         if (options_.band_width > 0) stored.info.sampler["band"] = band_provenance(mesh, stored.band);
         stored.info.sampler["stored_on_device"] = true;
         return stored;
@@ -343,6 +370,16 @@ private:
         }
     }
 
+    /// The certificate's counters of the float search (certify_kernel.cuh) in the timings and
+    /// the provenance; double searches are the reference and record themselves as such.
+    template <typename T>
+    void record_search_certificate(const DeviceBvh<T>& dev, SampledField& field) const {
+        CertificateCounters certificate;
+        read_certificate(dev, certificate);
+        record_certificate(field.timings, certificate);
+        field.sampler["search_certificate"] = certificate_provenance(std::is_same_v<T, float>, true, certificate);
+    }
+
     nlohmann::json band_provenance(const PreparedMesh& mesh, const NarrowBandCounts& counts) const {
         const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
                            (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
@@ -366,7 +403,9 @@ private:
         device_points.upload(points);
         upload.end();
         DeviceBuffer<PointSample> device_out{size_t(n)};
-        search_points<T>(mesh, dev, device_points.get(), n, compute, [&](const PieceResults& r, int64_t count) {
+        double coordinate = 0;
+        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const CertificateCounters certificate = search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, [&](const PieceResults& r, int64_t count) {
             store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(),
                                                                   device_out.get());
             CUDA_CHECK_LAUNCH("store_point_samples");
@@ -376,6 +415,7 @@ private:
         device_out.download(out.data(), out.size());
         download.end();
         record_query_timings(mesh, n, upload, compute, download, start);
+        record_certificate(query_timings_, certificate);
         return out;
     }
 
@@ -392,21 +432,24 @@ private:
         // Work already queued on the caller's stream (that made the points) comes first.
         CUDA_CHECK(cudaStreamSynchronize(static_cast<cudaStream_t>(points.stream)));
         DeviceBuffer<Vec3d> device_points{size_t(n)};
-        read_points(points, device_points.get());
-        search_points<T>(mesh, dev, device_points.get(), n, compute, [&](const PieceResults& r, int64_t count) {
+        const double coordinate = read_points(points, device_points.get());
+        const CertificateCounters certificate = search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, [&](const PieceResults& r, int64_t count) {
             store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(), results);
             CUDA_CHECK_LAUNCH("store_point_columns");
         });
         CUDA_CHECK(cudaStreamSynchronize(0));
         record_query_timings(mesh, n, upload, compute, download, start);
+        record_certificate(query_timings_, certificate);
     }
 
     /// The caller's points as doubles in `out`, refused (naming the first) where a point is
     /// not finite or beyond the search's range: only that point is copied to the host.
-    void read_points(const DevicePoints& points, Vec3d* out) {
-        DeviceBuffer<unsigned long long> first_bad{1};
-        const unsigned long long none = ~0ull;
-        CUDA_CHECK(cudaMemcpy(first_bad.get(), &none, sizeof none, cudaMemcpyHostToDevice));
+    /// Returns their largest |coordinate| (the certified search's bound needs it).
+    double read_points(const DevicePoints& points, Vec3d* out) {
+        DeviceBuffer<unsigned long long> first_bad{2};  // [0]: first bad index, [1]: largest |coordinate|'s bits
+        const unsigned long long init[2] = {~0ull, 0ull};
+        const unsigned long long none = init[0];
+        CUDA_CHECK(cudaMemcpy(first_bad.get(), init, sizeof init, cudaMemcpyHostToDevice));
         const double limit = largest_search_coordinate(options_.precision);
         const int blocks = blocks_for(points.count, 256);
         if (points.float32)
@@ -416,20 +459,24 @@ private:
             read_device_points<<<blocks, 256>>>(static_cast<const double*>(points.xyz), points.count, points.row_stride,
                                                 points.column_stride, limit, out, first_bad.get());
         CUDA_CHECK_LAUNCH("read_device_points");
-        unsigned long long bad = none;
-        CUDA_CHECK(cudaMemcpy(&bad, first_bad.get(), sizeof bad, cudaMemcpyDeviceToHost));
-        if (bad != none) {
+        unsigned long long result[2] = {none, 0};
+        CUDA_CHECK(cudaMemcpy(result, first_bad.get(), sizeof result, cudaMemcpyDeviceToHost));
+        if (result[0] != none) {
             Vec3d p;
-            CUDA_CHECK(cudaMemcpy(&p, out + bad, sizeof p, cudaMemcpyDeviceToHost));
-            require_query_point_in_range(p, int64_t(bad), options_.precision);
+            CUDA_CHECK(cudaMemcpy(&p, out + result[0], sizeof p, cudaMemcpyDeviceToHost));
+            require_query_point_in_range(p, int64_t(result[0]), options_.precision);
         }
+        double largest = 0;
+        std::memcpy(&largest, &result[1], sizeof largest);
+        return largest;
     }
 
     /// Morton sort, warp (or candidates) search and finalize of n device points, piece by
     /// piece; `store(results, count)` takes each piece's results to their input positions.
     template <typename T, typename Store>
-    void search_points(const PreparedMesh& mesh, const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n,
-                       EventTimer& compute, Store store) {
+    CertificateCounters search_points(const PreparedMesh& mesh, const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n,
+                                      double coordinate, EventTimer& compute, Store store) {
+        reset_certificate(dev);
         // Every device buffer is allocated before the timed work (allocation is not search).
         DeviceBuffer<Vec3d> sorted_points{size_t(n)};
         DeviceBuffer<int64_t> order{size_t(n)};
@@ -448,12 +495,16 @@ private:
             else
                 nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
+            certify(dev, piece, coordinate, r.nearest.get());
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
             store(r, piece.count);
             compute.end();
         }
+        CertificateCounters certificate;
+        read_certificate(dev, certificate);
+        return certificate;
     }
 
     void record_query_timings(const PreparedMesh& mesh, int64_t n, const EventTimer& upload, const EventTimer& compute,

@@ -71,6 +71,7 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
         const Vec3<T> p(layout.position(first + (k < count ? k : 0)));
         pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
         pk.best_q[k] = count > 0 ? T(INFINITY) : T(-1);
+        pk.radius[k] = pk.best_q[k];
         pk.best_slot[k] = -1;
         pk.best_triangle[k] = -1;
     }

@@ -7,8 +7,11 @@
 #include <functional>
 #include <string>
 
+#include "core/bvh/bvh_cache.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
+#include "cuda/certify_kernel.cuh"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
@@ -84,6 +87,13 @@ public:
         num_triangles_ = int(host_.triangles.size());
         if (kernel_ == CudaKernel::Tuned) plan_triangle_chunks();
         else prepare_thesis_chunks();
+    }
+
+    /// Certifies the tuned float search with `certifier` (certify_kernel.cuh) for points of
+    /// largest |coordinate| `point_coordinate`.
+    void certify_with(const DeviceCertifier* certifier, double point_coordinate) {
+        certifier_ = certifier;
+        point_coordinate_ = point_coordinate;
     }
 
     /// Runs every point of `piece`-shaped work [0, total) through the kernel, in pieces that
@@ -220,6 +230,7 @@ private:
             compute_.end();
         }
         compute_.begin();
+        if (certifier_) certifier_->certify(piece, point_coordinate_, best_i.get());
         launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
                                 winding_.view(), options_.band_width, out.view());
         CUDA_CHECK_LAUNCH("finalize_samples");
@@ -287,6 +298,8 @@ private:
     std::vector<T> thesis_triangles_;
     EventTimer upload_, compute_, download_;
     int sms_ = 1, max_threads_per_sm_ = 1024;
+    const DeviceCertifier* certifier_ = nullptr;
+    double point_coordinate_ = 0;
     size_t budget_ = 0;
     int num_triangles_ = 0, chunk_size_ = 0, resident_chunk_ = -1;
     int points_per_thread_ = 0, splits_ = 1;
@@ -320,6 +333,7 @@ private:
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
+        const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, largest_lattice_coordinate(lattice), engine);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
@@ -355,6 +369,10 @@ private:
         field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["plan"] = engine.plan();
         field.sampler["device"] = describe_device(options_.device);
+        CertificateCounters certificate;
+        if (certifier) certifier->read(certificate);
+        record_certificate(field.timings, certificate);
+        field.sampler["search_certificate"] = certificate_provenance(std::is_same_v<T, float>, certifier != nullptr, certificate);
         if (options_.band_width > 0)
             field.sampler["band"] = narrow_band_provenance(options_.band_width, count_narrow_band(field), "post-processed");
         return field;
@@ -366,6 +384,9 @@ private:
         if (points.empty()) return out;
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
+        double coordinate = 0;
+        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, coordinate, engine);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
         auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, out); };
@@ -378,12 +399,30 @@ private:
             for (int64_t begin = 0; begin < n; begin += step)
                 engine.run_thesis(PointListPiece{device_points.get(), begin, std::min(step, n - begin)}, sink);
         }
+        query_timings_ = {};
+        if (certifier) {
+            CertificateCounters certificate;
+            certifier->read(certificate);
+            record_certificate(query_timings_, certificate);
+        }
         return out;
+    }
+
+    /// The tuned float search is certified through the mesh's BVH (certify_kernel.cuh); the
+    /// thesis's kernel stays as the thesis wrote it (uncertified), double is the reference.
+    template <typename T>
+    std::unique_ptr<DeviceCertifier> certifier_for(const PreparedMesh& mesh, double point_coordinate, Engine<T>& engine) {
+        if (!std::is_same_v<T, float> || kernel_ != CudaKernel::Tuned) return nullptr;
+        bool built = false;
+        auto certifier = std::make_unique<DeviceCertifier>(*bvh_cache_.get(mesh, built), mesh);
+        engine.certify_with(certifier.get(), point_coordinate);
+        return certifier;
     }
 
     SamplerOptions options_;
     CudaKernel kernel_ = CudaKernel::Tuned;
     SamplerSign sign_;
+    BvhCache bvh_cache_;  ///< the certified tuned search's BVH
 };
 
 }  // namespace

@@ -12,8 +12,10 @@
 
 namespace sdf::cuda {
 
-/// points[i] = the caller's point i as doubles; `first_bad` takes (atomicMin) the smallest
-/// index of a point that is not finite or has a coordinate beyond `limit` (the search's range).
+/// points[i] = the caller's point i as doubles; `first_bad[0]` takes (atomicMin) the smallest
+/// index of a point that is not finite or has a coordinate beyond `limit` (the search's range),
+/// `first_bad[1]` (atomicMax on the bits: non-negative doubles order as their bit patterns)
+/// the largest |coordinate| of the points in range, which the certified search's bound takes.
 template <typename F>
 __global__ void read_device_points(const F* xyz, int64_t n, int64_t row, int64_t col, double limit, Vec3d* points,
                                    unsigned long long* first_bad) {
@@ -23,7 +25,12 @@ __global__ void read_device_points(const F* xyz, int64_t n, int64_t row, int64_t
     const Vec3d q{double(p[0]), double(p[col]), double(p[2 * col])};
     points[i] = q;
     // !(|x| <= limit) is true for NaN too.
+    const double m = fmax(fabs(q.x), fmax(fabs(q.y), fabs(q.z)));
     if (!(fabs(q.x) <= limit) || !(fabs(q.y) <= limit) || !(fabs(q.z) <= limit)) atomicMin(first_bad, (unsigned long long)i);
+    else {
+        const unsigned long long bits = (unsigned long long)__double_as_longlong(m);
+        if (bits > *(volatile unsigned long long*)(first_bad + 1)) atomicMax(first_bad + 1, bits);  // few atomics
+    }
 }
 
 /// Moves point-list results [0, n) to the caller's arrays at their input positions

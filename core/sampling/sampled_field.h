@@ -28,6 +28,9 @@ struct SamplingTimings {
     double upload = 0;       ///< host -> device transfers (GPU only)
     double download = 0;     ///< device -> host transfers (GPU only)
     double point_triangle_pairs = 0;  ///< points evaluated x triangles
+    /// Certified float search (kernels/distance/search_certificate.h): points searched, of
+    /// them re-ranked in double (several candidates) and sent to the full double search.
+    int64_t certified_points = 0, reranked_points = 0, full_double_points = 0;
     double pairs_per_second() const { return kernel > 0 ? point_triangle_pairs / kernel : 0.0; }
 };
 

@@ -9,11 +9,14 @@
 /// nearest triangle is lost (distances off by factors of 1-2). The float search is therefore
 /// limited to coordinates of magnitude at most 2^60 (squared distances at most 2^124) and to
 /// meshes at least 2^-40 across (squared distances of a millionth of the mesh still 2^-120
-/// and normal); double to 2^500 and 2^-450. Within these ranges the search picks the nearest
-/// triangle up to the precision's rounding of the coordinates, and the winner is evaluated in
-/// double, so the distance is exact for it; the sign of a point outside the mesh's bounding
-/// box is "outside" (MeshView::box_lo), which far from the mesh is where the search cannot
-/// tell the nearest triangle from one on the far side.
+/// and normal); double to 2^500 and 2^-450. Within these ranges a double search returns the
+/// double argmin of squared_distance() (ties to the smaller index), and a certified float
+/// search (kernels/distance/search_certificate.h: every sampler but the thesis's CUDA kernel
+/// and the CPU "eberly" kernel) returns that same triangle; the winner is evaluated in double,
+/// so distance, sign and gradient are bit for bit the double run's (docs/architecture.md,
+/// "Precision contract"). The sign of a point outside the mesh's bounding box is "outside"
+/// (MeshView::box_lo), which far from the mesh is where the search cannot tell the nearest
+/// triangle from one on the far side.
 #pragma once
 
 #include <string>

@@ -5,14 +5,18 @@
 #include <cmath>
 #include <chrono>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "core/bvh/bvh_cache.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
-#include "cpu_reference/dispatch/cpu_kernels.h"
+#include "kernels/bvh/closest_triangle_bvh.h"
+#include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/core/morton.h"
 #include "kernels/distance/signed_distance.h"
 
@@ -22,9 +26,9 @@ namespace {
 /// Points per parallel_for chunk: long enough that most seeds come from the x-neighbour.
 constexpr int64_t kBvhChunk = 256;
 
-/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
+/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (16 float lanes: one
+/// AVX-512 register, or two AVX2 registers, per coordinate in the leaf loop).
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
-static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
 /// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
@@ -34,6 +38,77 @@ using BvhKernel = CpuBvhKernel;
 
 struct QueryCounters {
     std::atomic<int64_t> nodes{0}, triangles{0};
+    CertificateCounters certificate;
+};
+
+/// A thread's counts of certified points, added to the run's CertificateCounters at the end.
+struct LocalCertificate {
+    int64_t points = 0, reranked = 0, full_double = 0;
+    void add_to(CertificateCounters& c) const {
+        c.points += points;
+        c.reranked += reranked;
+        c.full_double += full_double;
+    }
+};
+
+/// The certified float search's context (search_certificate.h): the slack of every point of
+/// the run and the double constants for re-ranking. `T` double: the search is the reference.
+template <typename T>
+struct Certifier {
+    static constexpr bool kActive = std::is_same_v<T, float>;
+    SearchSlack<float> slack;
+    BvhView<double> exact;
+
+    Certifier(const PreparedMesh& mesh, const TriangleBvh& bvh, double point_coordinate) : exact(bvh.view<double>()) {
+        if constexpr (kActive) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
+    }
+
+    /// Every candidate, without a limit: the fallback when a point has more than fit.
+    struct AllNear {
+        static constexpr bool kKeeps = true;
+        SearchSlack<float> slack;
+        std::vector<int32_t> slot;
+        std::vector<float> q;
+        float radius(float v) const { return slack.radius(v); }
+        void offer(int32_t s, float v) {
+            slot.push_back(s);
+            q.push_back(v);
+        }
+    };
+
+    /// Starts loading the double constants of the candidates (three cache lines each, in an
+    /// array apart from the float ones): a packet's lanes then wait for memory together.
+    template <int N>
+    void prefetch(const NearCandidates<float, N>& near) const {
+        for (int i = 0; i < near.count; ++i) {
+            const char* at = reinterpret_cast<const char*>(exact.packed + near.slot[i]);
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + 64);
+            __builtin_prefetch(at + 128);
+        }
+    }
+
+    /// The double search's winner (BVH slot) at p from the float search's winner and its
+    /// candidates; counts what it took.
+    template <int N>
+    int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
+                    const NearCandidates<float, N>& near, LocalCertificate& counters) const {
+        auto index_of = [&](int32_t s) { return view.triangle_index[s]; };
+        Rerank r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, slack.radius(best_q), near);
+        if (r.overflow) {
+            AllNear all{slack, {}, {}};
+            const Vec3f pt(p);
+            NoBvhStats none;
+            const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed_hit(view, winner, pt), none, all);
+            r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, hit.slot, slack.radius(hit.distance_squared),
+                                 all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
+            r.reranked = true;
+            ++counters.full_double;
+        }
+        ++counters.points;
+        counters.reranked += r.reranked;
+        return r.slot;
+    }
 };
 
 /// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
@@ -41,26 +116,54 @@ struct QueryCounters {
 /// a valid seed: its distance only bounds the search radius).
 template <typename T, typename PositionFn, typename EmitFn>
 void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, bool seeded, int threads, bool progress,
-                     int64_t n, QueryCounters& counters, PositionFn pos, EmitFn emit) {
+                     int64_t n, double point_coordinate, QueryCounters& counters, PositionFn pos, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
-    const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the widest ISA the CPU has
+    const Certifier<T> certifier(mesh, bvh, point_coordinate);
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t previous = -1;
         for (int64_t i = begin; i < end; ++i) {
             const Vec3d p = pos(i);
             const Vec3<T> pt(p);
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
-            const BvhHit<T> hit = closest_triangle(view, pt, seed, stats);
-            previous = hit.slot;
-            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[hit.slot]), p));
+            int32_t slot;
+            if constexpr (Certifier<T>::kActive) {
+                CertifiedNear<float> near{certifier.slack, {}};
+                const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed, stats, near);
+                previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
+                certifier.prefetch(near.near);
+                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified);
+            } else {
+                slot = previous = closest_triangle_bvh(view, pt, seed, stats).slot;
+            }
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(end - begin);
     });
+}
+
+/// One packet search (closest_triangles_packet.h): `slot` receives the winner of each of the
+/// first `count` lanes, certified for float (`position`: the lanes' exact points).
+template <typename T, int K>
+void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
+                   BvhPacket<T, K>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
+    if constexpr (Certifier<T>::kActive) {
+        PacketCertifiedNear<float, K> near;
+        near.slack = certifier.slack;
+        closest_triangles_packet(view, pk, stats, near);
+        for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
+        for (int k = 0; k < count; ++k)
+            slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
+    } else {
+        closest_triangles_packet(view, pk, stats);
+        for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];
+    }
 }
 
 /// The points of one brick of `block`: block-local indices and positions; lanes beyond
@@ -135,7 +238,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                      EmitFn emit, OutsideFn emit_outside) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
-    const CpuKernels<T>& kernels = cpu_kernels<T>();  // the widest ISA the CPU has
+    const Certifier<T> certifier(mesh, bvh, largest_lattice_coordinate(lattice));
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
@@ -145,6 +248,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
     parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t seed[kBrick];
         for (int k = 0; k < kBrick; ++k) seed[k] = -1;
         int32_t probe_seed = -1;
@@ -162,8 +266,9 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     for (int k = 0; k < br.count; ++k) c = c + br.position[k];
                     c = c * (1.0 / br.count);
                     const Vec3<T> pt(c);
-                    const BvhHit<T> hit = kernels.closest_triangle(view, pt, seed_hit(view, probe_seed, pt), stats);
+                    const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed_hit(view, probe_seed, pt), stats);
                     probe_seed = hit.slot;
+                    // The probe needs only a distance bound, which its margin covers: not certified.
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
@@ -191,12 +296,14 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 pk.z[k] = T(br.position[k].z);
             }
             seed_packet(view, seed, pk);
-            kernels.closest_triangles_packet(view, pk, stats);
+            int32_t slot[kBrick];
+            search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < br.count; ++k)
-                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[pk.best_slot[k]]),
+                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]),
                                              br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         band_counters.probes += probes;
@@ -253,17 +360,18 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
 /// those of evaluate_points; only the work shared between neighbours changes.
 template <typename T, typename EmitFn>
 void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const std::vector<Vec3d>& points,
-                            int threads, bool progress, QueryCounters& counters, EmitFn emit) {
+                            int threads, bool progress, double point_coordinate, QueryCounters& counters, EmitFn emit) {
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const int64_t n = int64_t(points.size());
     if (n == 0) return;
+    const Certifier<T> certifier(mesh, bvh, point_coordinate);
     const std::vector<uint32_t> order = morton_order(points, threads);
-    const auto closest_triangles = cpu_kernels<T>().closest_triangles_packet;  // the widest ISA the CPU has
     const int64_t packets = (n + kPointPacket - 1) / kPointPacket;
     ProgressReporter reporter("querying " + mesh.name() + " (bvh)", n, progress);
     parallel_for(packets, kBrickChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
+        LocalCertificate certified;
         int32_t seed[kPointPacket];
         for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
         int64_t done = 0;
@@ -271,22 +379,25 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             const int64_t first = b * kPointPacket;
             const int count = int(std::min<int64_t>(kPointPacket, n - first));
             BvhPacket<T, kPointPacket> pk;
+            Vec3d position[kPointPacket];
             for (int k = 0; k < kPointPacket; ++k) {
-                const Vec3d& p = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
-                pk.x[k] = T(p.x);
-                pk.y[k] = T(p.y);
-                pk.z[k] = T(p.z);
+                position[k] = points[order[size_t(first + (k < count ? k : 0))]];  // spare lanes repeat lane 0
+                pk.x[k] = T(position[k].x);
+                pk.y[k] = T(position[k].y);
+                pk.z[k] = T(position[k].z);
             }
             seed_packet(view, seed, pk);
-            closest_triangles(view, pk, stats);
+            int32_t slot[kPointPacket];
+            search_packet(view, certifier, position, count, pk, stats, certified, slot);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
-                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[pk.best_slot[k]]), p));
+                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), p));
             }
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;
         }
+        certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(done);
@@ -319,13 +430,16 @@ public:
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                 out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
             };
+            double coordinate = 0;
+            for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
             if (kernel_ == BvhKernel::Brick && points.size() < (size_t(1) << 32))  // 32-bit indices in the sort
-                evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, counters, emit);
+                evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, coordinate, counters, emit);
             else
-                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()), counters,
-                                   [&](int64_t i) { return points[size_t(i)]; }, emit);
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()),
+                                   coordinate, counters, [&](int64_t i) { return points[size_t(i)]; }, emit);
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
+        record_certificate(query_timings_, counters.certificate);
         return out;
     }
 
@@ -366,7 +480,8 @@ private:
                 evaluate_bricks<T>(mesh, *bvh, sign_, lattice, block, options_.threads, options_.progress, band, counters,
                                    band_counters, emit, emit_outside);
             else
-                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(), counters,
+                evaluate_points<T>(mesh, *bvh, sign_, seeded(), options_.threads, options_.progress, block.count(),
+                                   largest_lattice_coordinate(lattice), counters,
                                    [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); }, emit);
             computed += block.count();
         }
@@ -383,6 +498,9 @@ private:
         field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
         field.sampler["bvh"] = bvh_info;
+        record_certificate(field.timings, counters.certificate);
+        field.sampler["search_certificate"] =
+            certificate_provenance(options_.precision == Precision::Float, true, counters.certificate);
         if (w > 0) {
             nlohmann::json info = narrow_band_provenance(
                 w, count_narrow_band(field), band.enabled() ? "bricks skipped by the distance bound" : "post-processed");

@@ -2,10 +2,13 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <type_traits>
 
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
+#include "cpu_reference/sampling/nearest_triangle_cpu.h"
+#include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
@@ -15,19 +18,52 @@ namespace {
 
 using CpuKernel = CpuBruteForceKernel;
 
+/// The double search's winner at p from the certified float search's winner and candidates
+/// (search_certificate.h); with too many candidates, every triangle within the radius is
+/// collected by one more float pass and re-ranked. counts: points, re-ranked, full pass.
+int certify_brute_force(const TriangleSoA<float>& soa, const PackedTriangle<double>* exact, const Vec3d& p, int winner,
+                        float best_q, const CertifiedNear<float>& near, int64_t* counts) {
+    auto index_of = [](int32_t s) { return s; };
+    const float radius = near.radius(best_q);
+    Rerank r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, near.near);
+    if (r.overflow) {
+        std::vector<int32_t> slot;
+        std::vector<float> q;
+        const Vec3f pf(p);
+        for (int i = 0; i < soa.size(); ++i) {
+            const PackedTriangle<float> t = soa[i];
+            const float d = squared_distance(t, pf) - sliver_excess(t);
+            if (d <= radius) {
+                slot.push_back(i);
+                q.push_back(d);
+            }
+        }
+        r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, slot.data(), q.data(), int(slot.size()), NAN);
+        r.reranked = true;
+        ++counts[2];
+    }
+    ++counts[0];
+    counts[1] += r.reranked;
+    return r.slot;
+}
+
 /// Evaluates n points: pos(i) gives the position, emit(i, sample) receives the result.
 /// The nearest triangle is searched in precision T; the winner is then evaluated in double
-/// (closest point, sign, gradient) at the exact double position, so a float run differs
-/// from a double run only where the float search resolved a near-tie differently. In
-/// winding mode `sign` then gives each sample the winding number's side.
+/// (closest point, sign, gradient) at the exact double position. The vectorized float search
+/// is certified (search_certificate.h), so its triangle is the double search's; the Eberly
+/// kernel's float search is not (it ranks by its own formula), so a float run of it differs
+/// from a double run where it resolved a near-tie differently. In winding mode `sign` then
+/// gives each sample the winding number's side.
 template <typename T, typename PositionFn, typename EmitFn>
 void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSign& sign, int threads, bool progress,
-                     int64_t n, PositionFn pos, EmitFn emit) {
+                     int64_t n, double point_coordinate, CertificateCounters& counters, PositionFn pos, EmitFn emit) {
     const MeshBuffers<T>& buffers = mesh.buffers<T>();
     const MeshView<T> view = buffers.view();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const TriangleSoA<T> soa(buffers.packed);
-    const auto nearest_triangles = cpu_kernels<T>().nearest_triangles;  // the widest ISA the CPU has
+    constexpr bool kCertify = std::is_same_v<T, float>;
+    SearchSlack<float> slack;
+    if constexpr (kCertify) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
     ProgressReporter reporter("sampling " + mesh.name(), n, progress);
     parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
         const int count = int(end - begin);
@@ -38,7 +74,19 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
             px[k] = p.x; py[k] = p.y; pz[k] = p.z;
         }
         if (kernel == CpuKernel::Vectorized) {
-            nearest_triangles(soa, count, px, py, pz, best, best_q);
+            if constexpr (kCertify) {
+                CertifiedNear<float> near[kPointTile];
+                for (int k = 0; k < count; ++k) near[k].slack = slack;
+                nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q, near);
+                int64_t counts[3] = {0, 0, 0};
+                for (int k = 0; k < count; ++k)
+                    best[k] = certify_brute_force(soa, exact.packed, pos(begin + k), best[k], best_q[k], near[k], counts);
+                counters.points += counts[0];
+                counters.reranked += counts[1];
+                counters.full_double += counts[2];
+            } else {
+                nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q);
+            }
         } else {
             for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
@@ -68,15 +116,19 @@ public:
         require_search_range(mesh, points, options_.precision);
         std::vector<PointSample> out(points.size());
         sign_.prepare(mesh);
+        CertificateCounters counters;
+        double coordinate = 0;
+        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
         auto run = [&](auto zero) {
             using T = decltype(zero);
-            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()),
-                               [&](int64_t i) { return points[size_t(i)]; },
+            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()), coordinate,
+                               counters, [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
                                });
         };
         if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
+        record_certificate(query_timings_, counters);
         return out;
     }
 
@@ -92,9 +144,11 @@ private:
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
+        CertificateCounters counters;
+        const double coordinate = largest_lattice_coordinate(lattice);
         for (int b = 0; b < nblocks; ++b) {
             const GridBlock block = blocks[b];
-            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, block.count(),
+            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, block.count(), coordinate, counters,
                                [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    const int64_t out = block.output_index(lattice, i);
@@ -109,6 +163,9 @@ private:
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed, sign_);
         field.sampler["threads"] = resolve_thread_count(options_.threads);
+        record_certificate(field.timings, counters);
+        field.sampler["search_certificate"] =
+            certificate_provenance(options_.precision == Precision::Float, kernel_ == CpuKernel::Vectorized, counters);
         if (options_.band_width > 0)  // brute force tests every pair anyway: the band by post-processing
             field.sampler["band"] =
                 narrow_band_provenance(options_.band_width, apply_narrow_band(field, options_.band_width), "post-processed");

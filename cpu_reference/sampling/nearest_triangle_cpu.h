@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "cpu_reference/sampling/triangle_soa.h"
+#include "kernels/bvh/closest_triangle_bvh.h"
 
 namespace sdf {
 
@@ -16,10 +17,12 @@ constexpr int kTriangleBlock = 256;
 constexpr int kPointTile = 16;
 
 /// For each of the `count` points (at most kPointTile), the index of the triangle with the
-/// smallest squared distance (lowest index on ties) and that squared distance.
-template <typename T>
+/// smallest squared distance (lowest index on ties) and that squared distance. `near[p]`
+/// (PlainNear, or CertifiedNear for the certified float search) receives every triangle
+/// within point p's radius; a block is looked at again only when its minimum is within it.
+template <typename T, typename Near>
 void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T* px, const T* py, const T* pz,
-                                  int* best_index, T* best_q) {
+                                  int* best_index, T* best_q, Near* near) {
     const T* __restrict f[TriangleSoA<T>::kFields];
     for (int k = 0; k < TriangleSoA<T>::kFields; ++k) f[k] = soa.field(k);
     for (int p = 0; p < count; ++p) {
@@ -27,13 +30,14 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
         best_q[p] = std::numeric_limits<T>::infinity();
     }
     alignas(64) T q[kTriangleBlock];
+    alignas(64) T ranked[kTriangleBlock];  ///< q less sliver_excess(): what candidates are ranked by
     const int n = soa.size();
     for (int start = 0; start < n; start += kTriangleBlock) {
         const int len = std::min(kTriangleBlock, n - start);
         for (int p = 0; p < count; ++p) {
             const T x = px[p], y = py[p], z = pz[p];
-            T block_min = std::numeric_limits<T>::infinity();
-#pragma omp simd reduction(min : block_min)
+            T block_min = std::numeric_limits<T>::infinity(), block_ranked = block_min;
+#pragma omp simd reduction(min : block_min, block_ranked)
             for (int i = 0; i < len; ++i) {
                 const int j = start + i;
                 const PackedTriangle<T> t{f[0][j],  f[1][j],  f[2][j],  f[3][j],  f[4][j],  f[5][j],
@@ -43,6 +47,11 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
                 const T d = squared_distance(t, x, y, z);
                 q[i] = d;
                 block_min = d < block_min ? d : block_min;
+                if constexpr (Near::kKeeps) {
+                    const T r = d - sliver_excess(t);
+                    ranked[i] = r;
+                    block_ranked = r < block_ranked ? r : block_ranked;
+                }
             }
             if (block_min < best_q[p]) {
                 int i = 0;
@@ -50,8 +59,21 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
                 best_q[p] = block_min;
                 best_index[p] = start + i;
             }
+            if constexpr (Near::kKeeps) {
+                const T radius = near[p].radius(best_q[p]);  // shrinks block by block: earlier blocks kept more
+                if (block_ranked <= radius)
+                    for (int i = 0; i < len; ++i)
+                        if (ranked[i] <= radius) near[p].offer(start + i, ranked[i]);
+            }
         }
     }
+}
+
+template <typename T>
+void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T* px, const T* py, const T* pz,
+                                  int* best_index, T* best_q) {
+    PlainNear plain[kPointTile];
+    nearest_triangles_vectorized(soa, count, px, py, pz, best_index, best_q, plain);
 }
 
 }  // namespace sdf

@@ -14,16 +14,23 @@
 /// triangles, is farther than the best triangle so far (by more than the rounding of the two
 /// distances: may_hold_nearer), so no triangle that could be strictly nearer is skipped:
 /// the result is the brute-force minimum of squared_distance()
-/// (up to ties, and in float up to the rounding of the box and triangle distances, which
-/// brute force shares). A query may be seeded with any triangle (e.g. the winner of a
+/// (up to ties, and up to the rounding of the box and triangle distances, which brute force
+/// shares). A query may be seeded with any triangle (e.g. the winner of a
 /// neighbouring lattice point): its distance is a true upper bound, so the seed only
 /// shrinks the initial radius and never changes which distance is found.
+///
+/// Certified float search (search_certificate.h). A `Near` policy sets the pruning radius
+/// from the best Q and receives every triangle within it: PlainNear (radius = best, keeps
+/// nothing) is the search above; CertifiedNear widens the radius by the float error bound
+/// and keeps the candidates, which rerank_in_double() turns into the double search's
+/// winner.
 #pragma once
 
 #include <limits>
 
 #include "kernels/bvh/aabb_distance.h"
 #include "kernels/bvh/bvh_view.h"
+#include "kernels/distance/search_certificate.h"
 
 namespace sdf {
 
@@ -75,24 +82,62 @@ SDF_CPU_GPU SDF_INLINE bool wins_tie(int32_t triangle, int32_t best_triangle) {
     return best_triangle < 0 || triangle < best_triangle;
 }
 
-/// Scans leaf triangles [first, first + count) and keeps the nearest in `best`.
-template <typename T>
+/// The plain search: the radius is the best squared distance; nothing is kept.
+struct PlainNear {
+    static constexpr bool kKeeps = false;
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE T radius(T q) const { return q; }
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE void offer(int32_t, T) {}
+};
+
+/// The certified float search: the radius is the best plus twice the error bound, and every
+/// triangle within it is kept as a candidate (search_certificate.h).
+template <typename T, int N = kNearCandidates>
+struct CertifiedNear {
+    static constexpr bool kKeeps = true;
+    SearchSlack<T> slack;
+    NearCandidates<T, N> near;
+    SDF_CPU_GPU SDF_INLINE T radius(T q) const { return slack.radius(q); }
+    SDF_CPU_GPU SDF_INLINE void offer(int32_t slot, T q) { near.offer(slot, q); }
+};
+
+/// Scans leaf triangles [first, first + count), keeps the nearest in `best` and offers every
+/// triangle within `radius` to `near`, which shrinks `radius` as `best` improves.
+template <typename T, typename Near>
 SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int32_t count, const Vec3<T>& p,
-                                      BvhHit<T>& best) {
+                                      BvhHit<T>& best, T& radius, Near& near) {
     for (int32_t j = first; j < first + count; ++j) {
-        const T q = squared_distance(bvh.packed[j], p);
+        const PackedTriangle<T>& tri = bvh.packed[j];
+        const T q = squared_distance(tri, p);
+        if constexpr (Near::kKeeps) {
+            const T ranked = q - sliver_excess(tri);
+            if (ranked <= radius) near.offer(j, ranked);
+        }
         if (q < best.distance_squared ||
             (q == best.distance_squared &&
              wins_tie(bvh.triangle_index[j], best.slot < 0 ? -1 : bvh.triangle_index[best.slot]))) {
             best.distance_squared = q;
             best.slot = j;
+            radius = near.radius(q);
         }
     }
 }
 
-/// Nearest triangle to p, starting from `best` (an empty hit or a seed).
-template <typename T, typename Stats>
-SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats) {
+template <typename T>
+SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int32_t count, const Vec3<T>& p,
+                                      BvhHit<T>& best) {
+    PlainNear plain;
+    T radius = best.distance_squared;
+    scan_leaf(bvh, first, count, p, best, radius, plain);
+}
+
+/// Nearest triangle to p, starting from `best` (an empty hit or a seed); every triangle
+/// within the final radius is offered to `near`.
+template <typename T, typename Stats, typename Near>
+SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats,
+                                           Near& near) {
+    T radius = near.radius(best.distance_squared);
     int32_t stack_node[kBvhMaxDepth];
     T stack_d2[kBvhMaxDepth];
     int top = 0;
@@ -101,23 +146,23 @@ SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>&
         stats.visit_node();
         const BvhNode n = bvh.nodes[node];
         const T d0 = child_box_distance_squared(n, 0, p), d1 = child_box_distance_squared(n, 1, p);
-        const int near = d1 < d0 ? 1 : 0;
-        const T d_near = near ? d1 : d0, d_far = near ? d0 : d1;
+        const int nearer = d1 < d0 ? 1 : 0;
+        const T d_near = nearer ? d1 : d0, d_far = nearer ? d0 : d1;
         int32_t next = -1;
         // Nearer child first: scanning a leaf shrinks the radius before the farther test.
-        if (may_hold_nearer(d_near, best.distance_squared)) {
-            if (bvh_child_is_leaf(n, near)) {
-                stats.test_triangles(n.count[near]);
-                scan_leaf(bvh, n.ref[near], n.count[near], p, best);
+        if (may_hold_nearer(d_near, radius)) {
+            if (bvh_child_is_leaf(n, nearer)) {
+                stats.test_triangles(n.count[nearer]);
+                scan_leaf(bvh, n.ref[nearer], n.count[nearer], p, best, radius, near);
             } else {
-                next = n.ref[near];
+                next = n.ref[nearer];
             }
         }
-        if (may_hold_nearer(d_far, best.distance_squared)) {
-            const int far = 1 - near;
+        if (may_hold_nearer(d_far, radius)) {
+            const int far = 1 - nearer;
             if (bvh_child_is_leaf(n, far)) {
                 stats.test_triangles(n.count[far]);
-                scan_leaf(bvh, n.ref[far], n.count[far], p, best);
+                scan_leaf(bvh, n.ref[far], n.count[far], p, best, radius, near);
             } else if (next < 0) {
                 next = n.ref[far];
             } else {
@@ -130,11 +175,17 @@ SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>&
         // Pop the next subtree still inside the (shrunken) radius.
         while (next < 0 && top > 0) {
             --top;
-            if (may_hold_nearer(stack_d2[top], best.distance_squared)) next = stack_node[top];
+            if (may_hold_nearer(stack_d2[top], radius)) next = stack_node[top];
         }
         node = next;
     }
     return best;
+}
+
+template <typename T, typename Stats>
+SDF_CPU_GPU SDF_INLINE BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats) {
+    PlainNear plain;
+    return closest_triangle_bvh(bvh, p, best, stats, plain);
 }
 
 template <typename T>

@@ -13,6 +13,12 @@
 /// same minimum as its own query would (up to ties and the rounding of T). Leaves test all
 /// K points against each triangle: on the CPU that loop over points vectorises (K lanes).
 /// Children are entered nearer-first by their nearest lane.
+///
+/// As closest_triangle_bvh() does with its `Near` policy, a packet search prunes with each
+/// lane's radius (PacketPlainNear: its best; PacketCertifiedNear: its best plus the float
+/// error bound, search_certificate.h) and offers every triangle within it to the lane's
+/// candidates. Radii are refreshed after each leaf: a stale one is larger, so it only keeps
+/// more candidates.
 #pragma once
 
 #include "kernels/bvh/closest_triangle_bvh.h"
@@ -28,6 +34,27 @@ struct BvhPacket {
     T best_q[K];
     int32_t best_slot[K];
     int32_t best_triangle[K];  ///< triangle index of best_slot (-1: none), for the tie rule
+    T radius[K];               ///< pruning radius: best_q, or more for a certified search
+};
+
+/// The plain packet search: each lane's radius is its best; nothing is kept.
+struct PacketPlainNear {
+    static constexpr bool kKeeps = false;
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE T radius(T q) const { return q; }
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE void offer(int, int32_t, T) {}
+};
+
+/// The certified packet search: one error bound for the packet (its largest |coordinate|)
+/// and N candidates per lane.
+template <typename T, int K, int N = kNearCandidates>
+struct PacketCertifiedNear {
+    static constexpr bool kKeeps = true;
+    SearchSlack<T> slack;
+    NearCandidates<T, N> near[K];
+    SDF_CPU_GPU SDF_INLINE T radius(T q) const { return slack.radius(q); }
+    SDF_CPU_GPU SDF_INLINE void offer(int lane, int32_t slot, T q) { near[lane].offer(slot, q); }
 };
 
 namespace detail {
@@ -46,22 +73,38 @@ SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacke
     for (int k = 0; k < K; ++k) {
         const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
         const T d = gx * gx + gy * gy + gz * gz;
-        wanted |= int(may_hold_nearer(d, pk.best_q[k]));
+        wanted |= int(may_hold_nearer(d, pk.radius[k]));
         m = d < m ? d : m;
     }
     min_d2 = m;
     return wanted != 0;
 }
 
-/// Tests every point of the packet against leaf triangles [first, first + count); returns
-/// the new largest best squared distance of the packet.
-template <typename T, int K>
-SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk) {
+/// Sets every lane's radius from its best; returns the largest.
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
+#if !SDF_IS_GPU_CODE
+#pragma omp simd
+#endif
+    for (int k = 0; k < K; ++k) pk.radius[k] = near.radius(pk.best_q[k]);
+    T worst = pk.radius[0];
+    for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
+    return worst;
+}
+
+/// Tests every point of the packet against leaf triangles [first, first + count), offering
+/// those within a lane's radius to `near`; returns the new largest radius of the packet.
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
+                                          Near& near) {
     for (int32_t j = first; j < first + count; ++j) {
         const PackedTriangle<T> tri = bvh.packed[j];
         const int32_t triangle = bvh.triangle_index[j];
+        const T excess = Near::kKeeps ? sliver_excess(tri) : T(0);
+        T qs[K];
+        int within = 0;
 #if !SDF_IS_GPU_CODE
-#pragma omp simd
+#pragma omp simd reduction(| : within)
 #endif
         for (int k = 0; k < K; ++k) {
             const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
@@ -71,11 +114,24 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, 
             pk.best_q[k] = better ? q : pk.best_q[k];
             pk.best_slot[k] = better ? j : pk.best_slot[k];
             pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
+            if constexpr (Near::kKeeps) {
+                qs[k] = q - excess;
+                within |= int(qs[k] <= pk.radius[k]);
+            }
+        }
+        if constexpr (Near::kKeeps) {
+            if (within)
+                for (int k = 0; k < K; ++k)
+                    if (qs[k] <= pk.radius[k]) near.offer(k, j, qs[k]);
         }
     }
-    T worst = pk.best_q[0];
-    for (int k = 1; k < K; ++k) worst = worst > pk.best_q[k] ? worst : pk.best_q[k];
-    return worst;
+    return refresh_radii(pk, near);
+}
+
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk) {
+    PacketPlainNear plain;
+    return scan_leaf_packet(bvh, first, count, pk, plain);
 }
 
 }  // namespace detail
@@ -88,14 +144,15 @@ SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* se
         pk.best_triangle[k] = seed[k] >= 0 ? bvh.triangle_index[seed[k]] : -1;
         pk.best_q[k] = seed[k] >= 0 ? squared_distance(bvh.packed[seed[k]], pk.x[k], pk.y[k], pk.z[k])
                                     : std::numeric_limits<T>::infinity();
+        pk.radius[k] = pk.best_q[k];  // the plain search's; a certified one widens it
     }
 }
 
-/// Completes the nearest triangle of every lane of `pk` (seeded or with infinite radii).
-template <typename T, int K, typename Stats>
-SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats) {
-    T worst = pk.best_q[0];
-    for (int k = 1; k < K; ++k) worst = worst > pk.best_q[k] ? worst : pk.best_q[k];
+/// Completes the nearest triangle of every lane of `pk` (seeded or with infinite radii),
+/// offering every triangle within a lane's final radius to `near`.
+template <typename T, int K, typename Stats, typename Near>
+SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats, Near& near) {
+    T worst = detail::refresh_radii(pk, near);
     int32_t stack_node[kBvhMaxDepth];
     T stack_d2[kBvhMaxDepth];
     int top = 0;
@@ -105,23 +162,23 @@ SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>
         const BvhNode n = bvh.nodes[node];
         T d0, d1;
         const bool want0 = detail::child_wanted(n, 0, pk, d0), want1 = detail::child_wanted(n, 1, pk, d1);
-        const int near = d1 < d0 ? 1 : 0;
-        const bool want_near = near ? want1 : want0, want_far = near ? want0 : want1;
+        const int nearer = d1 < d0 ? 1 : 0;
+        const bool want_near = nearer ? want1 : want0, want_far = nearer ? want0 : want1;
         int32_t next = -1;
         if (want_near) {
-            if (bvh_child_is_leaf(n, near)) {
-                stats.test_triangles(n.count[near] * K);
-                worst = detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk);
+            if (bvh_child_is_leaf(n, nearer)) {
+                stats.test_triangles(n.count[nearer] * K);
+                worst = detail::scan_leaf_packet(bvh, n.ref[nearer], n.count[nearer], pk, near);
             } else {
-                next = n.ref[near];
+                next = n.ref[nearer];
             }
         }
         if (want_far) {
-            const int far = 1 - near;
-            const T d_far = near ? d0 : d1;
+            const int far = 1 - nearer;
+            const T d_far = nearer ? d0 : d1;
             if (bvh_child_is_leaf(n, far)) {
                 stats.test_triangles(n.count[far] * K);
-                worst = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk);
+                worst = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk, near);
             } else if (next < 0) {
                 next = n.ref[far];
             } else {
@@ -138,6 +195,12 @@ SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>
         }
         node = next;
     }
+}
+
+template <typename T, int K, typename Stats>
+SDF_CPU_GPU SDF_INLINE void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats) {
+    PacketPlainNear plain;
+    closest_triangles_packet(bvh, pk, stats, plain);
 }
 
 }  // namespace sdf

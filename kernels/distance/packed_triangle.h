@@ -12,8 +12,9 @@
 /// closest_point_on_triangle() in double for the closest point, feature and exact distance.
 ///
 /// Precision. In float the edge terms expand |B - P|^2, so Q carries a rounding error of
-/// about 1e-7 |B - P|^2: two triangles closer than that may be ranked either way (a float
-/// near-tie; the exact re-evaluation then reports the chosen one's true distance). Slivers
+/// about 1e-7 |B - P|^2, not 1e-7 Q: two triangles closer than that may be ranked either way.
+/// The certified search (search_certificate.h) bounds this error rigorously and re-ranks the
+/// triangles within it in double, so float searches return the double search's triangle. Slivers
 /// (smallest angle below ~0.6 degrees, sin^2 < kSliverSin2) are searched by their edges only,
 /// because (s, t) loses all accuracy there; their interior lies within the inradius of an
 /// edge, so Q over-estimates by at most the squared inradius.
@@ -30,6 +31,12 @@ namespace sdf {
 
 /// Triangles with sin^2 of an angle below this are searched by their edges only.
 constexpr double kSliverSin2 = 1e-4;
+/// The float search also searches triangles with sin^2 of an angle below this by their edges
+/// only: its (s, t) are off by about 2^-24 |B - P| / sin^2, and a wrong inside/outside choice
+/// costs the square of that, far more than the rest of the rounding for angles below ~6
+/// degrees. Edges only over-estimates by at most the squared inradius instead, which the
+/// certified search's bound counts (search_certificate.h). Double keeps kSliverSin2.
+constexpr double kFloatSliverSin2 = 1e-2;
 
 /// 24 scalars (96 bytes in float): six 16-byte loads on the GPU.
 template <typename T>
@@ -38,7 +45,8 @@ struct alignas(16) PackedTriangle {
     T e0x, e0y, e0z;     ///< 2 E0 = 2 (V1 - V0)
     T e1x, e1y, e1z;     ///< 2 E1 = 2 (V2 - V0)
     T nx, ny, nz;        ///< unit normal
-    T sa, sb, ta, tb;    ///< s = sa 2d + sb 2e, t = ta 2d + tb 2e (Eberly's region-0 minimiser); NaN = never inside
+    T sa, sb, ta, tb;    ///< s = sa 2d + sb 2e, t = ta 2d + tb 2e (Eberly's region-0 minimiser); sb..tb NaN =
+                         ///< never inside, and then sa = the over-estimate bound (sliver_excess)
     T a, c;              ///< E0.E0, E1.E1
     T k01, k20;          ///< -1 / (2a), -1 / (2c): edge parameters from 2d and 2e
     T k12, m12;          ///< 1 / (2g), (c - b) / g with g = a - 2b + c, b = E0.E1: edge V2 -> V1
@@ -56,15 +64,22 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     // sin^2 of the angle at V0 is det / (a c); the smallest angle matters, and with the
     // edge lengths it is at most that one's, so test all three corners.
     const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
-    const bool interior = det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= kSliverSin2;
+    const double sliver = sizeof(T) < sizeof(double) ? kFloatSliverSin2 : kSliverSin2;
+    const bool interior = det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= sliver;
     const T nan = std::numeric_limits<T>::quiet_NaN();  // NaN >= 0 is false: never inside
+    // A triangle only float searches by its edges over-estimates there by at most its squared
+    // inradius (2 area / perimeter)^2: kept in sa, which s = sa 2d + NaN 2e no longer needs.
+    const bool float_only_sliver =
+        sizeof(T) < sizeof(double) && det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= kSliverSin2 && !interior;
+    const double inradius = float_only_sliver ? std::sqrt(det) / (std::sqrt(a) + std::sqrt(c) + std::sqrt(g)) : 0.0;
+    const T excess = std::nextafter(T(inradius * inradius * 1.001), T(INFINITY));
     PackedTriangle<T> t{};
     t.bx = T(v0.x); t.by = T(v0.y); t.bz = T(v0.z);
     t.e0x = T(2 * e0.x); t.e0y = T(2 * e0.y); t.e0z = T(2 * e0.z);
     t.e1x = T(2 * e1.x); t.e1y = T(2 * e1.y); t.e1z = T(2 * e1.z);
     t.nx = T(n.x); t.ny = T(n.y); t.nz = T(n.z);
     // s = (b e - c d) / det, t = (b d - a e) / det with d = 2d / 2, e = 2e / 2.
-    t.sa = interior ? T(-c / (2 * det)) : nan;
+    t.sa = interior ? T(-c / (2 * det)) : (sizeof(T) < sizeof(double) ? (float_only_sliver ? excess : T(0)) : nan);
     t.sb = interior ? T(b / (2 * det)) : nan;
     t.ta = interior ? T(b / (2 * det)) : nan;
     t.tb = interior ? T(-a / (2 * det)) : nan;
@@ -76,6 +91,14 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     t.g = T(g);
     t.w12 = T(2 * (b - c));
     return t;
+}
+
+/// How much squared_distance() may over-estimate the double search's Q of this triangle
+/// because float searches it by its edges only (kFloatSliverSin2): the certified search
+/// (search_certificate.h) ranks candidates by Q - sliver_excess. 0 for every other triangle.
+template <typename T>
+SDF_CPU_GPU SDF_INLINE T sliver_excess(const PackedTriangle<T>& tri) {
+    return tri.sb != tri.sb ? tri.sa : T(0);  // sb NaN: never inside; sa holds the bound
 }
 
 template <typename T>

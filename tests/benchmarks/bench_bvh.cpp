@@ -50,6 +50,11 @@ void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Latti
     state.counters["queries/s"] = benchmark::Counter(points * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["points"] = points;
     state.counters["triangles"] = double(mesh.triangles().size());
+    // Certified float search: the fraction of points re-ranked in double (several candidates).
+    if (f.timings.certified_points > 0) {
+        state.counters["reranked"] = double(f.timings.reranked_points) / double(f.timings.certified_points);
+        state.counters["full_dbl"] = double(f.timings.full_double_points) / double(f.timings.certified_points);
+    }
     if (f.sampler.contains("bvh") && f.sampler["bvh"].contains("node_visits_per_point")) {
         state.counters["nodes/pt"] = f.sampler["bvh"]["node_visits_per_point"].get<double>();
         state.counters["tris/pt"] = f.sampler["bvh"]["point_triangle_tests_per_point"].get<double>();

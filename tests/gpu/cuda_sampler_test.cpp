@@ -3,6 +3,10 @@
 // except at ties, gradients within 1e-4.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
+#include "core/sampling/adversarial_cases.h"
+
 #include <random>
 
 #include "core/lattice/lattice_fitting.h"
@@ -188,6 +192,65 @@ TEST(CudaSampler, ErrorsNameTheKernel) {
         FAIL() << "an unknown kernel must be rejected";
     } catch (const std::exception& e) {
         EXPECT_NE(std::string(e.what()).find("fastest"), std::string::npos);
+    }
+}
+
+
+/// The certified float search (kernels/distance/search_certificate.h) on the GPU: on the
+/// adversarial cases (core/sampling/adversarial_cases.h) every certified float kernel returns
+/// bit for bit the distance, gradient and triangle of the CPU double brute force, for point
+/// queries and for a lattice hugging the cube's top face 1e-4 above it.
+TEST(CudaSampler, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
+    auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    for (const AdversarialCase& c : adversarial_cases(2026, 1500)) {
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        SamplerOptions ref;
+        ref.backend = "cpu";
+        ref.method = "brute_force";
+        ref.precision = Precision::Double;
+        ref.progress = false;
+        const std::vector<PointSample> want = make_sampler(ref)->query(mesh, c.points);
+        for (const char* kernel : {"tuned"}) {
+            SamplerOptions o = ref;
+            o.backend = "cuda";
+            o.method = "brute_force";
+            o.precision = Precision::Float;
+            o.kernel = kernel;
+            auto sampler = make_sampler(o);
+            const std::vector<PointSample> got = sampler->query(mesh, c.points);
+            int64_t bad = 0;
+            for (size_t i = 0; i < got.size(); ++i)
+                bad += !(got[i].triangle == want[i].triangle && same(got[i].distance, want[i].distance) &&
+                         same(got[i].gradient.x, want[i].gradient.x) && same(got[i].gradient.y, want[i].gradient.y) &&
+                         same(got[i].gradient.z, want[i].gradient.z));
+            std::printf("%-32s %-10s re-ranked %lld of %lld, full double %lld\n", c.mesh.name.c_str(), kernel,
+                        (long long)sampler->last_query_timings().reranked_points,
+                        (long long)sampler->last_query_timings().certified_points,
+                        (long long)sampler->last_query_timings().full_double_points);
+            EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
+            EXPECT_EQ(sampler->last_query_timings().certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
+        }
+        if (c.mesh.name != "cube") continue;
+        Lattice lattice;  // 40 x 40 x 3 points, the lowest layer 1e-4 above the top face
+        lattice.type = LatticeType::CC;
+        lattice.origin = {-0.5123, -0.5077, 0.5 + 1e-4};
+        lattice.spacing = 1.0 / 37.0;
+        lattice.resolution = {40, 40, 3};
+        const SampledField want_field = make_sampler(ref)->sample(mesh, lattice);
+        for (const char* kernel : {"tuned"}) {
+            SamplerOptions o = ref;
+            o.backend = "cuda";
+            o.method = "brute_force";
+            o.precision = Precision::Float;
+            o.kernel = kernel;
+            const SampledField got = make_sampler(o)->sample(mesh, lattice);
+            ASSERT_EQ(got.distance.size(), want_field.distance.size());
+            int64_t bad = 0;
+            for (size_t i = 0; i < got.distance.size(); ++i)
+                bad += !(got.closest_triangle[i] == want_field.closest_triangle[i] && same(got.distance[i], want_field.distance[i]));
+            EXPECT_EQ(bad, 0) << "cube lattice " << kernel;
+            EXPECT_EQ(got.sampler["search_certificate"]["certified"], true) << kernel;
+        }
     }
 }
 

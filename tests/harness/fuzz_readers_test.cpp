@@ -6,10 +6,13 @@
 // Every input must either parse or throw one of the project's error types (std::runtime_error
 // or std::invalid_argument, ConfigError included) with a message naming the file: never a
 // crash (the test would die), never another exception type (a library's own, bad_alloc,
-// length_error), never a nameless message. Meshes that load are prepared too.
+// length_error), never a nameless message. Meshes that load are prepared too. And the certified
+// float search (issue 22) on fresh adversarial points (core/sampling/adversarial_cases.h,
+// another fixed seed): bit for bit the double brute force.
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <iostream>
 #include <typeinfo>
@@ -23,6 +26,8 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/parallel/progress.h"
+#include "core/sampling/adversarial_cases.h"
+#include "harness/sampling/sampler_table.h"
 #include "experiments/experiment_registry.h"
 #include "harness/io/field_file.h"
 #include "harness/io/npy_file.h"
@@ -298,6 +303,28 @@ TEST_F(FuzzReaders, ConfigsReadValidatedAndPlanned) {
     EXPECT_GT(parsed, 0);
     EXPECT_GT(refused, 0);
     EXPECT_FALSE(fs::exists(out));
+}
+
+
+TEST(FuzzSearch, CertifiedFloatSearchOnAdversarialCases) {
+    for (const AdversarialCase& c : adversarial_cases(0x5eed22, 400)) {
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        SamplerOptions o;
+        o.backend = "cpu";
+        o.method = "brute_force";
+        o.precision = Precision::Double;
+        o.progress = false;
+        const std::vector<PointSample> want = make_sampler(o)->query(mesh, c.points);
+        o.precision = Precision::Float;
+        for (const char* method : {"brute_force", "bvh"}) {
+            o.method = method;
+            const std::vector<PointSample> got = make_sampler(o)->query(mesh, c.points);
+            for (size_t i = 0; i < got.size(); ++i)
+                ASSERT_TRUE(got[i].triangle == want[i].triangle && got[i].distance == want[i].distance &&
+                            std::signbit(got[i].distance) == std::signbit(want[i].distance))
+                    << c.mesh.name << " " << method << " point " << i;
+        }
+    }
 }
 
 }  // namespace

@@ -1,0 +1,137 @@
+// The certified float search (kernels/distance/search_certificate.h) as a property: on the
+// adversarial cases (core/sampling/adversarial_cases.h: a cube's face diagonals, a CAD-like
+// fan plate, slivers, meshes 1e3 and 1e5 from the origin, nested and overlapping parts at
+// tiny gaps) every CPU float search (brute force; BVH brick packets, seeded, unseeded; point
+// queries and lattices) returns bit for bit the distance, gradient and triangle of the double
+// brute force. Also checks the error bound itself pair by pair, and that double runs did not
+// change (the double BVH equals the double brute force on these points).
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "core/sampling/adversarial_cases.h"
+#include "core/sampling/certified_search.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+
+namespace sdf {
+namespace {
+
+SamplerOptions options(Precision precision, const std::string& kernel) {
+    SamplerOptions o;
+    o.precision = precision;
+    o.kernel = kernel;
+    o.progress = false;
+    return o;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// Number of points where `got` differs from `want` in any bit of distance or gradient, or in
+/// the triangle; prints the first few.
+int64_t differences(const std::string& what, const std::vector<Vec3d>& points, const std::vector<PointSample>& got,
+                    const std::vector<PointSample>& want) {
+    int64_t bad = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+        const PointSample &g = got[i], &w = want[i];
+        const bool same = g.triangle == w.triangle && same_bits(g.distance, w.distance) && same_bits(g.gradient.x, w.gradient.x) &&
+                          same_bits(g.gradient.y, w.gradient.y) && same_bits(g.gradient.z, w.gradient.z);
+        if (!same && bad++ < 3)
+            std::printf("  %s: point %zu (%.17g %.17g %.17g): triangle %d d %.17g, double brute force %d d %.17g\n", what.c_str(),
+                        i, points[i].x, points[i].y, points[i].z, g.triangle, g.distance, w.triangle, w.distance);
+    }
+    return bad;
+}
+
+std::vector<PointSample> query(const std::string& method, Precision precision, const std::string& kernel,
+                               const PreparedMesh& mesh, const std::vector<Vec3d>& points, SamplingTimings* timings = nullptr) {
+    const SamplerOptions o = options(precision, kernel);
+    auto sampler = method == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
+    std::vector<PointSample> out = sampler->query(mesh, points);
+    if (timings) *timings = sampler->last_query_timings();
+    return out;
+}
+
+TEST(CertifiedSearch, FloatEqualsDoubleBruteForceOnAdversarialPoints) {
+    for (const AdversarialCase& c : adversarial_cases(2026, 1500)) {
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        const std::vector<PointSample> want = query("brute_force", Precision::Double, "vectorized", mesh, c.points);
+        struct Run { const char* method; const char* kernel; };
+        for (const Run r : {Run{"brute_force", "vectorized"}, Run{"bvh", "brick"}, Run{"bvh", "seeded"}, Run{"bvh", "unseeded"}}) {
+            SamplingTimings t;
+            const std::vector<PointSample> got = query(r.method, Precision::Float, r.kernel, mesh, c.points, &t);
+            const std::string what = c.mesh.name + " float " + r.method + "/" + r.kernel;
+            std::printf("%-45s %6zu points: re-ranked in double %lld, full double search %lld\n", what.c_str(), c.points.size(),
+                        (long long)t.reranked_points, (long long)t.full_double_points);
+            EXPECT_EQ(differences(what, c.points, got, want), 0) << what;
+            EXPECT_EQ(t.certified_points, int64_t(c.points.size())) << what;
+        }
+        const std::vector<PointSample> bvh_double = query("bvh", Precision::Double, "brick", mesh, c.points);
+        EXPECT_EQ(differences(c.mesh.name + " double bvh", c.points, bvh_double, want), 0);
+    }
+}
+
+/// The bound of search_certificate.h holds pair by pair: Q_d - E <= Q_f <= Q_d + E (+ the
+/// sliver excess of float-only slivers) for every point and triangle of the cases.
+TEST(CertifiedSearch, ErrorBoundHoldsForEveryPair) {
+    for (const AdversarialCase& c : adversarial_cases(7, 300)) {
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        const FloatSearchBound b = float_search_bound(mesh);
+        ASSERT_TRUE(b.usable) << c.mesh.name;
+        const auto& pf = mesh.buffers<float>().packed;
+        const auto& pd = mesh.buffers<double>().packed;
+        double worst = 0;
+        for (const Vec3d& p : c.points) {
+            const double d0 = std::sqrt(3.0) * 0x1p-24 * (b.coordinate + largest_coordinate(p));
+            for (size_t t = 0; t < pf.size(); ++t) {
+                const double qd = squared_distance(pd[t], p.x, p.y, p.z);
+                const double qf = squared_distance(pf[t], float(p.x), float(p.y), float(p.z));
+                const double x = sliver_excess(pf[t]);  // float-only sliver: Q_f over-estimates by up to x
+                const double m = std::sqrt(qd) + b.two_l;  // M for this pair, as the bound's comment bounds it
+                const double e = (b.rho * m + 2.0 * d0) * m + d0 * d0;
+                worst = std::max({worst, (qf - x - qd) / e, (qd - qf) / e});
+            }
+        }
+        std::printf("%-32s largest error / E: %.3g\n", c.mesh.name.c_str(), worst);
+        EXPECT_LE(worst, 1.0) << c.mesh.name;
+    }
+}
+
+
+/// Lattices take the same path with bricks (packets) and per-point seeds: a lattice hugging
+/// the cube's top face 1e-4 above it, and the fan plate's whole box.
+TEST(CertifiedSearch, FloatLatticesEqualDoubleBruteForce) {
+    const auto cases = adversarial_cases(2026, 10);
+    for (const AdversarialCase& c : cases) {
+        if (c.mesh.name != "cube" && c.mesh.name != "fan_plate") continue;
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        Lattice lattice;
+        lattice.type = LatticeType::CC;
+        if (c.mesh.name == "cube") {  // 40 x 40 x 3 points, the lowest layer 1e-4 above the top face
+            lattice.origin = {-0.5123, -0.5077, 0.5 + 1e-4};
+            lattice.spacing = 1.0 / 37.0;
+            lattice.resolution = {40, 40, 3};
+        } else {
+            lattice.origin = {-1.1, -1.1, -0.2};
+            lattice.spacing = 2.2 / 23.0;
+            lattice.resolution = {24, 24, 6};
+        }
+        const SampledField want = make_cpu_brute_force_sampler(options(Precision::Double, "vectorized"))->sample(mesh, lattice);
+        for (const char* kernel : {"brick", "seeded", "unseeded"}) {
+            const SampledField got = make_cpu_bvh_sampler(options(Precision::Float, kernel))->sample(mesh, lattice);
+            int64_t bad = 0;
+            for (size_t i = 0; i < got.distance.size(); ++i)
+                bad += !(got.closest_triangle[i] == want.closest_triangle[i] && same_bits(got.distance[i], want.distance[i]));
+            EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
+            EXPECT_EQ(got.sampler["search_certificate"]["certified"], true);
+            std::printf("%-10s lattice %-9s re-ranked %lld of %lld points\n", c.mesh.name.c_str(), kernel,
+                        (long long)got.timings.reranked_points, (long long)got.timings.certified_points);
+        }
+        const SampledField brute = make_cpu_brute_force_sampler(options(Precision::Float, "vectorized"))->sample(mesh, lattice);
+        for (size_t i = 0; i < brute.distance.size(); ++i)
+            ASSERT_TRUE(brute.closest_triangle[i] == want.closest_triangle[i] && same_bits(brute.distance[i], want.distance[i])) << i;
+    }
+}
+
+}  // namespace
+}  // namespace sdf
