@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/cli_validators.h"
 
 #include <cstdio>
 #include <iostream>
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--kernel", options.kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
     app.add_option("--threads", options.threads, "CPU threads (0 = all)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(sdf::kNonNegativeNumber)
         ->capture_default_str();
     app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
     app.add_option("--sign", sign,

@@ -64,6 +64,8 @@ public:
           key_(p.size(), -1.0) {
         const int n = int(p.size());
         for (int i = 0; i < n; ++i) { prev_[size_t(i)] = (i + n - 1) % n; next_[size_t(i)] = (i + 1) % n; }
+        for (int i = 0; i < n; ++i)
+            if (!convex(i)) reflex_.push_back(i);
         left_ = n;
     }
 
@@ -97,8 +99,15 @@ private:
         next_[size_t(a)] = c;
         prev_[size_t(c)] = a;
         --left_;
+        for (const int corner : {a, c})
+            if (!convex(corner)) reflex_.push_back(corner);  // in a polygon that is not simple, a corner may turn
         update(a);
         update(c);
+    }
+
+    /// Strictly convex: turns the polygon's way (a collinear corner does not).
+    bool convex(int i) const {
+        return proj_.orient(p_[size_t(prev_[size_t(i)])], p_[size_t(i)], p_[size_t(next_[size_t(i)])]) > 0;
     }
 
     /// The triangle (a, b, c), turned to start at the corner that comes first in the face.
@@ -111,14 +120,17 @@ private:
     bool is_ear(int i) const {
         const int a = prev_[size_t(i)], c = next_[size_t(i)];
         const Vec3d &pa = p_[size_t(a)], &pi = p_[size_t(i)], &pc = p_[size_t(c)];
-        if (!(proj_.orient(pa, pi, pc) > 0)) return false;
+        if (!convex(i)) return false;
         // prepare_mesh() drops a triangle whose cross product is exactly 0 in double (from
         // whichever corner comes first); a "convex" corner whose triangle it would drop (a
         // rounding artefact of near-collinear corners) is no ear either.
         if (length_squared(cross(pi - pa, pc - pa)) == 0.0 || length_squared(cross(pc - pi, pa - pi)) == 0.0 ||
             length_squared(cross(pa - pc, pi - pc)) == 0.0)
             return false;
-        for (int j = next_[size_t(c)]; j != a; j = next_[size_t(j)]) {
+        // Only corners that are not strictly convex need a look: a triangle that holds a
+        // corner of a simple polygon holds a reflex (or collinear) one (Eberly 2002).
+        for (const int j : reflex_) {
+            if (!alive_[size_t(j)] || j == a || j == i || j == c || convex(j)) continue;
             const Vec3d& q = p_[size_t(j)];
             if (q == pa || q == pi || q == pc) continue;  // a corner visited twice (a keyhole) blocks nothing
             if (proj_.orient(pa, pi, q) >= 0 && proj_.orient(pi, pc, q) >= 0 && proj_.orient(pc, pa, q) >= 0) return false;
@@ -165,6 +177,7 @@ private:
     std::vector<Int3>& out_;
     std::vector<int> prev_, next_;
     std::vector<bool> alive_;
+    std::vector<int> reflex_;              ///< corners not strictly convex when last seen (some may be by now)
     std::vector<double> key_;              ///< squared cut length of each corner that is an ear, else -1
     std::set<std::pair<double, int>> ears_;  ///< (squared cut length, rank): shortest cut first
     int left_ = 0;

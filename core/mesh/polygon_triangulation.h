@@ -25,8 +25,9 @@
 /// Ear clipping (Meisters 1975) is a few dozen lines here and needs no dependency: no C++
 /// earcut or polygon triangulator is packaged in Debian 12 apart from CGAL, whose
 /// constrained Delaunay triangulation would bring Boost, GMP and MPFR for faces that
-/// are mostly quads. Cost: O(n^2) per polygon of n corners (each ear test scans the
-/// polygon), fine for faces of up to thousands of corners.
+/// are mostly quads. Cost: each ear test scans the corners that are not convex, so O(n r)
+/// for a polygon of n corners, r of them reflex: linear for the convex caps of CAD
+/// cylinders, whatever their size.
 #pragma once
 
 #include <vector>

@@ -106,6 +106,12 @@ TEST(TriangulatePolygon, RandomStarShapedPolygonsInTiltedPlanes) {
     }
 }
 
+TEST(TriangulatePolygon, ConvexCapOfThousandsOfCorners) {
+    std::vector<std::pair<double, double>> uv;
+    for (int i = 0; i < 5000; ++i) uv.push_back({std::cos(2 * kPi * i / 5000), std::sin(2 * kPi * i / 5000)});
+    expect_valid_triangulation(place(uv, {1e3, 2e3, -3e3}, {0, 1, 0}, {0, 0, 1}), "circle");
+}
+
 TEST(TriangulatePolygon, CombWithManyReflexCornersAndReversedOrientation) {
     // A comb of 8 teeth (24 reflex-heavy corners), written clockwise in the xz plane.
     std::vector<std::pair<double, double>> uv = {{0, 0}, {16, 0}};
