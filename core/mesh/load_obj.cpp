@@ -156,7 +156,10 @@ TriangleMesh mesh_from_parse(const ParsedObj& parsed, std::vector<Vec3d> vertice
                                              ", but the file has " + std::to_string(mesh.vertices.size()) + " vertices");
                 polygon[k] = v;
             }
-            if (n >= 3) triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);
+            if (n < 3)  // tinyobjloader warns of these ("Degenerated face"), refused above
+                throw std::runtime_error(path + ": face " + std::to_string(f) + " of shape '" + shape.name + "' has " +
+                                         std::to_string(n) + " vertices; expected 3 or more");
+            triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);
             offset += n;
         }
     }
