@@ -354,13 +354,11 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
     nlohmann::json j = {{"type", type}};
     if (!resolution.is_none()) {
         std::vector<int64_t> r;
-        if (PyIndex_Check(resolution.ptr())) {
-            const int64_t n = integer_argument(resolution, "resolution");
-            r = type == "bcc" ? std::vector<int64_t>{n, n, 2 * n} : std::vector<int64_t>{n, n, n};
-        } else if (py::isinstance<py::sequence>(resolution) && !py::isinstance<py::str>(resolution)) {
+        if (py::isinstance<py::sequence>(resolution) && !py::isinstance<py::str>(resolution)) {  // NumPy arrays too
             for (const py::handle item : resolution) r.push_back(integer_argument(item, "resolution[" + std::to_string(r.size()) + "]"));
         } else {
-            integer_argument(resolution, "resolution (an integer or a sequence of 3)");
+            const int64_t n = integer_argument(resolution, "resolution");
+            r = type == "bcc" ? std::vector<int64_t>{n, n, 2 * n} : std::vector<int64_t>{n, n, n};
         }
         j["resolution"] = r;
     }
