@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/cli_validators.h"
 
 #include <cstdio>
 #include <iostream>
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
     app.add_option("--sigma-units", sigma_units, "unit of sigma: lattice (h/2, thesis Figure 4-2) or spacing (h)")
         ->check(CLI::IsMember({"lattice", "spacing"}))
         ->capture_default_str();
-    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(sdf::kNonNegativeNumber)->capture_default_str();
     SDF_CLI_PARSE(app, argc, argv);
     try {
         const sdf::SampledField field = sdf::read_field(field_path);

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/cli_validators.h"
 #include "apps/sampler_cli.h"
 
 #include <cstdio>

@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/cli_validators.h"
 #include "apps/sampler_cli.h"
 
 #include <cstdio>
@@ -287,7 +288,7 @@ int main(int argc, char** argv) {
     app.add_option("--bcc-resolution", o.bcc_resolution, "BCC resolution Rx,Ry,2Rz (grid, and the default for --lattice bcc)")
         ->delimiter(',')->expected(3)->capture_default_str();
     app.add_option("--margin", o.margin, "mesh input: lattice margin, fraction of the largest extent")
-        ->check(CLI::NonNegativeNumber)
+        ->check(sdf::kNonNegativeNumber)
         ->capture_default_str();
     app.add_option("--interpolator", o.interpolator, interpolator_help() + "; default: bcc_cubic (BCC) or tricubic_lm (CC)")
         ->check(CLI::IsMember(interpolator_names()));
@@ -318,9 +319,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--backend", o.backend, "ray caster backend")->check(CLI::IsMember(render_backend_choices()))->capture_default_str();
     app.add_option("--precision", o.precision, "cpu casting precision")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
-    app.add_option("--threads", o.threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--threads", o.threads, "CPU threads (0 = all)")->check(sdf::kNonNegativeNumber)->capture_default_str();
     app.add_option("--repeat", o.repeat, "timed renders (cuda: kernel launches after a warm-up); the median is printed")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(sdf::kPositiveNumber)->capture_default_str();
     app.add_option("--device", o.device, "CUDA device")->capture_default_str();
     app.add_flag("--reference", o.reference, "single images: also ray-trace the mesh and write metrics");
     app.add_option("--out", o.out, "single images: output image (.png, .exr, .ppm, .pfm)")->capture_default_str();
@@ -331,8 +332,8 @@ int main(int argc, char** argv) {
     app.add_option("--title", o.title, "grid: title line (default: mesh, view and lattices)");
     app.add_flag("--no-reference", o.no_reference, "grid: no reference row (and no heat maps)");
     app.add_flag("--no-error-maps", o.no_error_maps, "grid: no heat-map rows");
-    app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--heat-max", o.heat_max, "grid: heat-map scale, degrees")->check(sdf::kPositiveNumber)->capture_default_str();
+    app.add_option("--downsample", o.downsample, "grid: reduce the grid's images by this factor")->check(sdf::kPositiveNumber)->capture_default_str();
     app.add_option("--panels", o.panels,
                    "grid: the reconstructions shown, in order (default: the thesis's five), e.g. "
                    "bcc_cubic/true,bcc_box_quintic,cc_bspline3; each INTERPOLATOR or INTERPOLATOR/DERIVATIVES of: " +

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
+#include "apps/cli_validators.h"
 
 #include <filesystem>
 #include <iostream>
@@ -72,16 +73,16 @@ int main(int argc, char** argv) {
                    "N or NX NY NZ: CC points per axis; BCC in the thesis's notation Rx Ry 2Rz (N: N N 2N)")
         ->required()
         ->expected(1, 3)
-        ->check(CLI::PositiveNumber);
+        ->check(sdf::kPositiveNumber);
     app.add_option("--margin", margin, "fraction of the mesh's largest extent added on every side")
-        ->check(CLI::NonNegativeNumber)
+        ->check(sdf::kNonNegativeNumber)
         ->capture_default_str();
     app.add_option("--method", method, "search: bvh or brute_force")->check(CLI::IsMember(sdf::sampler_methods()))->capture_default_str();
     app.add_option("--backend", backend, "cpu, cuda, or auto (cuda when a GPU is present)")
         ->check(CLI::IsMember(sdf::sampler_backend_choices()))
         ->capture_default_str();
     app.add_option("--kernel", kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
-    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(sdf::kNonNegativeNumber)->capture_default_str();
     app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
     app.add_option("--sign", sign, "sign mode: auto, pseudonormal or winding")
         ->check(CLI::IsMember(sdf::sign_mode_names()))
@@ -89,7 +90,7 @@ int main(int argc, char** argv) {
     app.add_option("--band", band,
                    "narrow band width in mesh units: exact values where |d| <= W, elsewhere +-W, gradient 0 and "
                    "closest_triangle -2 (0: no band)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(sdf::kNonNegativeNumber);
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
     app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
@@ -103,7 +104,7 @@ int main(int argc, char** argv) {
                    "also write a narrow-band OpenVDB level set here (FILE.vdb): points with |d| < the band active (--band W, "
                    "else 3 spacings), built as the slabs arrive");
     app.add_option("--max-planes-per-slab", max_planes, "at most this many z-planes per slab (0: from the budget)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(sdf::kNonNegativeNumber);
     app.add_flag("--overwrite", overwrite, "replace an existing field of that name");
     app.add_flag("--dry-run", dry_run, "print the plan (slabs, memory, output size) and exit");
     app.add_flag("--quiet", quiet, "no progress lines on stderr");

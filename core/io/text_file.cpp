@@ -1,5 +1,6 @@
 #include "core/io/text_file.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -46,6 +47,18 @@ void reject_wide_encodings(std::string_view bytes, const std::string& path, cons
     if (encoding)
         throw std::runtime_error(path + ": " + what + " is encoded as " + encoding +
                                  " (byte-order mark); expected ASCII or UTF-8 text");
+    // Without a mark, UTF-16 text of ASCII characters has a NUL byte beside every character.
+    const auto nul_beside = [&](size_t first_nul) {
+        if (bytes.size() < 4) return false;
+        for (size_t i = 0; i < std::min<size_t>(bytes.size() & ~size_t(1), 16); i += 2)
+            if (bytes[i + first_nul] != '\0' || bytes[i + 1 - first_nul] == '\0') return false;
+        return true;
+    };
+    const char* unmarked = nul_beside(1) ? "UTF-16LE" : nul_beside(0) ? "UTF-16BE" : nullptr;
+    if (unmarked)
+        throw std::runtime_error(path + ": " + what + " looks like " + unmarked +
+                                 " text without a byte-order mark (a NUL byte beside every character); expected ASCII "
+                                 "or UTF-8 text");
 }
 
 std::string read_text_file(const std::string& path, const std::string& what, uint64_t max_bytes) {

@@ -26,8 +26,9 @@ inline std::string_view without_utf8_bom(std::string_view text) {
     return text;
 }
 
-/// Throws naming `path` if `bytes` start with a UTF-16 or UTF-32 byte-order mark: such a
-/// file would otherwise read as garbage or, worse, as fewer lines than it has.
+/// Throws naming `path` if `bytes` start with a UTF-16 or UTF-32 byte-order mark, or look
+/// like UTF-16 without one (NUL bytes beside the first characters): such a file would
+/// otherwise read as garbage or, worse, as fewer lines than it has.
 void reject_wide_encodings(std::string_view bytes, const std::string& path, const std::string& what);
 
 /// The whole text file `path` (a WHAT, for messages) without its UTF-8 byte-order mark; a

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <new>
 
 #include "core/io/text_file.h"
 #include "core/mesh/load_obj.h"
@@ -35,17 +36,16 @@ std::string name_of(const std::string& path) {
     return p.stem().string();
 }
 
-bool first_token_is(const std::string& bytes, bool (*test)(std::string_view)) {
-    TextCursor words(std::string_view(bytes).substr(0, 4096));
+bool first_token_is(std::string_view bytes, bool (*test)(std::string_view)) {
+    TextCursor words(bytes.substr(0, 4096));
     std::string_view w;
     return words.next(w) && test(w);
 }
 
 bool is_ply_magic(std::string_view w) { return w == "ply"; }
 bool is_off_magic(std::string_view w) { return w.size() >= 3 && w.size() <= 7 && w.substr(w.size() - 3) == "OFF"; }
-bool is_solid(std::string_view w) { return w == "solid"; }
 
-bool is_binary_stl(const std::string& bytes) {
+bool is_binary_stl(std::string_view bytes) {
     if (bytes.size() < 84) return false;
     uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);
@@ -60,14 +60,68 @@ bool looks_like_obj(const std::string& bytes) {
     return words.next(w) && (w == "v" || w == "vn" || w == "vt" || w == "f" || w == "o" || w == "g" || w == "mtllib" || w == "s");
 }
 
+/// The line (1-based) of byte `at`, for messages.
+int64_t line_of(std::string_view bytes, size_t at) {
+    return 1 + std::count(bytes.begin(), bytes.begin() + std::ptrdiff_t(std::min(at, bytes.size())), '\n');
+}
+
+/// What load_mesh_file() can tell from the content while it is still being read: a file
+/// that holds binary data where every reader expects text is refused at once (a gzip of
+/// zeros after its first megabyte), and a binary STL may not outgrow its declared size.
+ContentCheck content_check(const std::string& path) {
+    return [path, ext = inner_extension(path)](std::string_view so_far, size_t new_from) -> uint64_t {
+        const size_t bom = so_far.size() - without_utf8_bom(so_far).size();
+        if (first_token_is(so_far.substr(bom), is_ply_magic)) {
+            // Text up to "end_header", binary data after it in binary PLY.
+            if (new_from > 0) return kMaxMeshFileBytes;
+            const std::string_view header = so_far.substr(0, so_far.find("end_header"));
+            if (const size_t nul = header.find('\0'); nul != std::string_view::npos)
+                throw_mesh_error(path, "PLY header line " + std::to_string(line_of(so_far, nul)),
+                                 "byte " + std::to_string(nul) + " is a NUL byte; expected a text header");
+            return kMaxMeshFileBytes;
+        }
+        const bool off = first_token_is(so_far.substr(bom), is_off_magic);
+        if (!off && so_far.size() >= 84 && ext != "obj" && ext != "off" && ext != "ply" &&
+            (holds_binary_bytes(so_far) || (ext == "stl" && !is_ascii_stl_start(so_far)))) {
+            uint32_t n = 0;
+            std::memcpy(&n, so_far.data() + 80, 4);
+            return 84 + 50 * uint64_t(n);  // binary STL, or nothing readable
+        }
+        if (new_from == 0) reject_wide_encodings(so_far, path, "mesh file");
+        if (const size_t nul = so_far.find('\0', new_from); nul != std::string_view::npos)
+            throw_mesh_error(path, "line " + std::to_string(line_of(so_far, nul)),
+                             "byte " + std::to_string(nul) +
+                                 " is a NUL byte; expected text (OBJ, OFF and ASCII STL are text): is the file binary, "
+                                 "or UTF-16?");
+        return kMaxMeshFileBytes;
+    };
+}
+
+/// Classic Mac OS line ends (a lone CR) become LF in place, so that every text reader
+/// counts lines alike; `end` limits it to a binary PLY's text header.
+void lone_cr_to_lf(std::string& bytes, size_t end) {
+    end = std::min(end, bytes.size());
+    for (size_t i = 0; i < end; ++i)
+        if (bytes[i] == '\r' && (i + 1 == bytes.size() || bytes[i + 1] != '\n')) bytes[i] = '\n';
+}
+
+/// Where lone CRs may be line ends: all of a text format, a PLY's header (all of an ascii PLY).
+size_t text_end(const std::string& bytes, MeshFormat format) {
+    if (format == MeshFormat::Stl && !is_ascii_stl_start(bytes)) return 0;
+    if (format != MeshFormat::Ply) return bytes.size();
+    const size_t header_end = bytes.find("end_header");
+    if (header_end == std::string::npos) return bytes.size();
+    const bool ascii = std::string_view(bytes).substr(0, header_end).find("format ascii") != std::string_view::npos;
+    return ascii ? bytes.size() : header_end + std::strlen("end_header") + 1;
+}
+
 }  // namespace
 
 MeshFormat detect_mesh_format(const std::string& path, const std::string& bytes) {
     if (first_token_is(bytes, is_ply_magic)) return MeshFormat::Ply;
     if (first_token_is(bytes, is_off_magic)) return MeshFormat::Off;
     if (is_binary_stl(bytes)) return MeshFormat::Stl;
-    const bool solid = first_token_is(bytes, is_solid);
-    if (solid && bytes.find("facet", 0) != std::string::npos) return MeshFormat::Stl;
+    if (is_ascii_stl_start(bytes)) return MeshFormat::Stl;
     const std::string ext = inner_extension(path);
     if (ext == "obj") return MeshFormat::Obj;
     if (ext == "ply") return MeshFormat::Ply;
@@ -81,7 +135,7 @@ MeshFormat detect_mesh_format(const std::string& path, const std::string& bytes)
 }
 
 TriangleMesh load_mesh_file(const std::string& path) {
-    MeshFileBytes file = read_mesh_file_bytes(path);
+    MeshFileBytes file = read_mesh_file_bytes(path, content_check(path));
     // Editors put a byte-order mark before text (OBJ, ASCII PLY/STL, OFF); a binary STL's
     // 80-byte header may begin with anything, so it keeps its bytes.
     if (!is_binary_stl(file.bytes)) {
@@ -90,12 +144,19 @@ TriangleMesh load_mesh_file(const std::string& path) {
         file.bytes.erase(0, bom);
     }
     const MeshFormat format = detect_mesh_format(path, file.bytes);
+    lone_cr_to_lf(file.bytes, text_end(file.bytes, format));
     TriangleMesh mesh;
-    switch (format) {
-        case MeshFormat::Obj: mesh = load_obj_text(file.bytes, path); break;
-        case MeshFormat::Ply: mesh = read_ply(file.bytes, path); break;
-        case MeshFormat::Stl: mesh = read_stl(file.bytes, path); break;
-        case MeshFormat::Off: mesh = read_off(file.bytes, path); break;
+    try {
+        switch (format) {
+            case MeshFormat::Obj: mesh = load_obj_text(file.bytes, path); break;
+            case MeshFormat::Ply: mesh = read_ply(file.bytes, path); break;
+            case MeshFormat::Stl: mesh = read_stl(file.bytes, path); break;
+            case MeshFormat::Off: mesh = read_off(file.bytes, path); break;
+        }
+    } catch (const std::bad_alloc&) {
+        throw_mesh_error(path, "", std::string("not enough memory to read the ") + mesh_format_name(format) + " mesh (" +
+                                       std::to_string(file.bytes.size()) + " bytes" + (file.gzip ? " decompressed" : "") +
+                                       ")");
     }
     mesh.name = name_of(path);
     mesh.source = path;

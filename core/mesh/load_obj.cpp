@@ -2,17 +2,22 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <cmath>
+#include <istream>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <streambuf>
+#include <string_view>
 #include <stdexcept>
 #include <vector>
 
 #include "core/io/text_file.h"
 #include "core/mesh/mesh_file_bytes.h"
+#include "core/mesh/polygon_triangulation.h"
 #include "core/mesh/sha256.h"
 #include "core/mesh/text_cursor.h"
 
@@ -23,30 +28,35 @@ namespace {
 /// about half of all decimal coordinates 1 to 3 ulp away from the nearest double (its own
 /// mantissa-times-power parser; measured on the project's meshes). So every `v` line is
 /// read here with strtod (correctly rounded): three finite numbers, or an error naming the
-/// line; these positions replace tinyobjloader's.
+/// line; these positions replace tinyobjloader's. (std::from_chars: correctly rounded like
+/// strtod, without its locale.)
 ///
 /// Its face indices are read with a 32-bit atoi: "1.5" reads as 1, 4294967297 wraps to 1,
 /// both valid vertices. So every `f` line's vertex indices are checked here too: whole
 /// decimal integers, not 0, negative ones (relative: -1 is the last vertex so far) within
 /// the vertices before the line, positive ones within the file's vertices; an error quotes
 /// the index as written and names the line.
-std::vector<Vec3d> read_vertex_lines(std::istream& in, const std::string& path) {
+std::vector<Vec3d> read_vertex_lines(std::string_view text, const std::string& path) {
     std::vector<Vec3d> vertices;
-    std::string line;
     struct FaceReference {
         int line;
         int64_t index;
         std::string token;
     };
     std::vector<FaceReference> largest_positive;  // one entry: the largest positive index seen
-    for (int number = 1; std::getline(in, line); ++number) {
-        std::istringstream ss(line);
-        std::string tag;
-        if (!(ss >> tag)) continue;
+    int number = 0;
+    for (size_t at = 0; at < text.size();) {
+        // A line ends at "\n", "\r\n" or a lone "\r" (classic Mac OS), as tinyobjloader reads it.
+        const size_t end = std::min(text.find_first_of("\r\n", at), text.size());
+        TextCursor ss(text.substr(at, end - at));
+        at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+        ++number;
+        std::string_view tag;
+        if (!ss.next(tag)) continue;
         if (tag == "f") {
-            std::string token;
-            while (ss >> token) {
-                const std::string_view index_part = std::string_view(token).substr(0, token.find('/'));
+            std::string_view token;
+            while (ss.next(token)) {
+                const std::string_view index_part = token.substr(0, token.find('/'));
                 int64_t index = 0;
                 const auto fail = [&](const std::string& why) {
                     throw std::runtime_error(path + ":" + std::to_string(number) + ": face vertex " + sdf::quoted(token) +
@@ -58,20 +68,19 @@ std::vector<Vec3d> read_vertex_lines(std::istream& in, const std::string& path) 
                     fail("counts back further than the " + std::to_string(vertices.size()) +
                          " vertices before this line");
                 if (index > 0 && (largest_positive.empty() || index > largest_positive[0].index))
-                    largest_positive.assign(1, FaceReference{number, index, token});
+                    largest_positive.assign(1, FaceReference{number, index, std::string(token)});
             }
             continue;
         }
         if (tag != "v") continue;
         Vec3d p;
         for (int k = 0; k < 3; ++k) {
-            std::string token;
-            char* end = nullptr;
-            const bool present = bool(ss >> token);
-            const double value = present ? std::strtod(token.c_str(), &end) : 0.0;
-            if (!present || end != token.c_str() + token.size() || !std::isfinite(value))
+            std::string_view token;
+            const bool present = ss.next(token);
+            double value = 0.0;
+            if (!present || !parse_double(token, value) || !std::isfinite(value))
                 throw std::runtime_error(path + ":" + std::to_string(number) + ": " +
-                                         (present ? "non-finite or malformed vertex coordinate '" + token + "'"
+                                         (present ? "non-finite or malformed vertex coordinate " + sdf::quoted(token)
                                                   : std::string("missing vertex coordinate")) +
                                          "; expected three finite numbers after 'v'");
             p[k] = value;
@@ -100,47 +109,63 @@ void reject_dropped_faces(const std::string& path, const std::string& warnings) 
 
 std::string stem_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
-/// The mesh tinyobjloader parsed, with the index checks of load_obj().
-TriangleMesh mesh_from_reader(const tinyobj::ObjReader& reader, std::vector<Vec3d> vertices, const std::string& path) {
-    reject_dropped_faces(path, reader.Warning());
+/// Reads OBJ text in place: tinyobjloader's ParseFromString would copy the text into a
+/// stringstream, one more copy of a file that may be gigabytes.
+class MemoryStreamBuffer : public std::streambuf {
+public:
+    explicit MemoryStreamBuffer(std::string_view text) {
+        char* begin = const_cast<char*>(text.data());  // read only: the get area is never written
+        setg(begin, begin, begin + text.size());
+    }
+};
+
+/// What tinyobjloader parsed, polygons left whole.
+struct ParsedObj {
+    tinyobj::attrib_t attrib;
+    std::vector<tinyobj::shape_t> shapes;
+    std::string warnings;
+};
+
+/// The mesh tinyobjloader parsed, with the index checks of load_obj() and every polygon
+/// triangulated by polygon_triangulation.h (as PLY, OFF and STL polygons are).
+TriangleMesh mesh_from_parse(const ParsedObj& parsed, std::vector<Vec3d> vertices, const std::string& path) {
+    reject_dropped_faces(path, parsed.warnings);
 
     TriangleMesh mesh;
     mesh.name = stem_of(path);
     mesh.source = path;
-    if (reader.GetAttrib().vertices.size() != 3 * vertices.size())
-        throw std::runtime_error(path + ": tinyobjloader found " + std::to_string(reader.GetAttrib().vertices.size() / 3) +
+    if (parsed.attrib.vertices.size() != 3 * vertices.size())
+        throw std::runtime_error(path + ": tinyobjloader found " + std::to_string(parsed.attrib.vertices.size() / 3) +
                                  " vertices but the file has " + std::to_string(vertices.size()) + " `v` lines");
     mesh.vertices = std::move(vertices);
 
-    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    std::vector<int> polygon;
+    for (const tinyobj::shape_t& shape : parsed.shapes) {
         const auto& faces = shape.mesh.num_face_vertices;
         size_t offset = 0;
         for (size_t f = 0; f < faces.size(); ++f) {
-            const int n = faces[f];
-            if (n == 3) {
-                Int3 t{shape.mesh.indices[offset].vertex_index, shape.mesh.indices[offset + 1].vertex_index,
-                       shape.mesh.indices[offset + 2].vertex_index};
-                for (int k = 0; k < 3; ++k)
-                    if (t[k] < 0 || size_t(t[k]) >= mesh.vertices.size())
-                        throw std::runtime_error(path + ": face " + std::to_string(mesh.triangles.size()) +
-                                                 " refers to vertex " + std::to_string(t[k] + 1) +
-                                                 ", but the file has " +
-                                                 std::to_string(mesh.vertices.size()) + " vertices");
-                mesh.triangles.push_back(t);
+            const size_t n = faces[f];
+            if (offset + n > shape.mesh.indices.size())
+                throw std::runtime_error(path + ": tinyobjloader's face list of shape '" + shape.name + "' is inconsistent");
+            polygon.resize(n);
+            for (size_t k = 0; k < n; ++k) {
+                const int v = shape.mesh.indices[offset + k].vertex_index;
+                if (v < 0 || size_t(v) >= mesh.vertices.size())
+                    throw std::runtime_error(path + ": face " + std::to_string(f) + " of shape '" + shape.name +
+                                             "' refers to vertex " + std::to_string(int64_t(v) + 1) +
+                                             ", but the file has " + std::to_string(mesh.vertices.size()) + " vertices");
+                polygon[k] = v;
             }
-            offset += size_t(n);
+            if (n < 3)  // tinyobjloader warns of these ("Degenerated face"), refused above
+                throw std::runtime_error(path + ": face " + std::to_string(f) + " of shape '" + shape.name + "' has " +
+                                         std::to_string(n) + " vertices; expected 3 or more");
+            triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);
+            offset += n;
         }
     }
     if (mesh.triangles.empty())
         throw std::runtime_error(path + ": no triangles found (expected `f` lines with 3 or more vertices)");
     return mesh;
-}
-
-tinyobj::ObjReaderConfig triangulating_config() {
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = true;
-    config.vertex_color = false;
-    return config;
 }
 
 }  // namespace
@@ -154,13 +179,21 @@ TriangleMesh load_obj(const std::string& path) {
 TriangleMesh load_obj_text(const std::string& bytes, const std::string& path) {
     // A byte-order mark would glue itself to the first `v` and shift every index by one.
     reject_wide_encodings(bytes, path, "OBJ file");
-    const std::string text(without_utf8_bom(bytes));
-    std::istringstream in(text);
-    std::vector<Vec3d> vertices = read_vertex_lines(in, path);
-    tinyobj::ObjReader reader;
-    if (!reader.ParseFromString(text, "", triangulating_config()))
-        throw std::runtime_error(path + ": cannot parse OBJ: " + reader.Error());
-    return mesh_from_reader(reader, std::move(vertices), path);
+    const std::string_view text = without_utf8_bom(bytes);
+    std::vector<Vec3d> vertices = read_vertex_lines(text, path);
+    ParsedObj parsed;
+    MemoryStreamBuffer buffer(text);
+    std::istream in(&buffer);
+    std::string error;
+    // Polygons untriangulated: tinyobjloader would cut them its own way (and keep a
+    // zero-area triangle of three collinear corners).
+    std::vector<tinyobj::material_t> materials;
+    std::istringstream no_materials;  // mtllib files are not read (as ParseFromString with no material text)
+    tinyobj::MaterialStreamReader material_reader(no_materials);
+    if (!tinyobj::LoadObj(&parsed.attrib, &parsed.shapes, &materials, &parsed.warnings, &error, &in, &material_reader,
+                          /*triangulate=*/false, /*default_vcols_fallback=*/false))
+        throw std::runtime_error(path + ": cannot parse OBJ: " + error);
+    return mesh_from_parse(parsed, std::move(vertices), path);
 }
 
 }  // namespace sdf

@@ -1,5 +1,6 @@
 /// @file load_obj.h
-/// @brief Wavefront OBJ loading through tinyobjloader (double precision, polygons triangulated).
+/// @brief Wavefront OBJ loading through tinyobjloader (double precision; polygons triangulated
+/// by polygon_triangulation.h, as in every other format).
 #pragma once
 
 #include <string>
@@ -8,8 +9,9 @@
 
 namespace sdf {
 
-/// Loads every face of every shape in file order; polygons are triangulated by tinyobjloader
-/// (quads along their shorter diagonal, larger polygons as fans).
+/// Loads every face of every shape in file order; polygons are triangulated by
+/// polygon_triangulation.h (ear clipping in the polygon's plane, shortest cut first: a quad
+/// along its shorter diagonal).
 /// Throws std::runtime_error naming the file (and the line where known) when the file is
 /// missing, unparsable, holds no triangles, or has non-finite coordinates.
 TriangleMesh load_obj(const std::string& path);

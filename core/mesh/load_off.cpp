@@ -6,6 +6,7 @@
 
 #include "core/mesh/mesh_file_bytes.h"
 #include "core/mesh/mesh_readers.h"
+#include "core/mesh/polygon_triangulation.h"
 #include "core/mesh/text_cursor.h"
 
 namespace sdf {
@@ -55,8 +56,12 @@ public:
             if (uint64_t(n) > text_.bytes_left() + 64) fail("face " + std::to_string(f) + " declares " + std::to_string(n) + " vertices, more than the file holds");
             polygon.resize(size_t(n));
             for (int& v : polygon) v = index(f, vertices);
-            for (size_t j = 1; j + 1 < polygon.size(); ++j) mesh.triangles.push_back({polygon[0], polygon[j], polygon[j + 1]});
+            triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);
         }
+        // Geomview writes no edge lines (the edge count is informational), so nothing may follow.
+        if (next_line(w))
+            fail("data continues after the " + std::to_string(faces) + " faces the header declares (found " + quoted(w) +
+                 "; is the face count too small?)");
         check_loaded_mesh(mesh, path_, "OFF file");
         return mesh;
     }

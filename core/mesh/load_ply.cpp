@@ -1,5 +1,5 @@
 // PLY reader: the header grammar of Turk's "The PLY Polygon File Format" (1994), the three
-// encodings, fan triangulation of polygon faces. Sizes in the header are checked against
+// encodings; polygon faces triangulated by polygon_triangulation.h. Sizes in the header are checked against
 // the bytes that follow before anything is allocated.
 #include <algorithm>
 #include <climits>
@@ -8,6 +8,7 @@
 
 #include "core/mesh/mesh_file_bytes.h"
 #include "core/mesh/mesh_readers.h"
+#include "core/mesh/polygon_triangulation.h"
 #include "core/mesh/text_cursor.h"
 
 namespace sdf {
@@ -174,6 +175,30 @@ public:
 
     bool trailing_data() { return encoding_ == PlyEncoding::Ascii ? !text_.at_end() : pos_ != bytes_.size(); }
 
+    /// Ascii PLY writes one element per line; reading each on its own line turns a wrong
+    /// count in the header into a message at the line where it shows (a vertex line with
+    /// a face's values), not at a later, unrelated element.
+    void begin_element(uint64_t index) {
+        index_ = index;
+        element_line_ = -1;
+        values_ = 0;
+    }
+    void end_element(const PlyElement& e) {
+        std::string_view w;
+        int line = 0;
+        if (encoding_ == PlyEncoding::Ascii && text_.peek(w, line) && line == element_line_)
+            throw_mesh_error(path_, "PLY element '" + element_ + "' " + std::to_string(index_) + " (line " + std::to_string(line) + ")",
+                             "the line has more values than the element's properties (" + property_names(e) + ") take: " +
+                                 quoted(w) + " follows the " + std::to_string(values_) +
+                                 " read (is the header's count of '" + element_ + "' elements too large?)");
+    }
+
+    static std::string property_names(const PlyElement& e) {
+        std::string names;
+        for (const PlyProperty& p : e.properties) names += (names.empty() ? "" : " ") + p.name + (p.is_list ? "[]" : "");
+        return names;
+    }
+
     std::string element_, where_;  ///< set by the reader for errors raised here
     uint64_t index_ = 0;
 
@@ -183,6 +208,13 @@ private:
     double ascii_value(PlyType type) {
         std::string_view token;
         if (!text_.next(token)) fail("file ends early (truncated?); expected a value");
+        if (element_line_ < 0) element_line_ = text_.line();
+        if (text_.line() != element_line_)
+            throw_mesh_error(path_, "PLY element '" + element_ + "' " + std::to_string(index_) + " (line " +
+                                        std::to_string(element_line_) + ")",
+                             "the line ends after " + std::to_string(values_) +
+                                 " values; expected the rest of the element on it (one element per line)");
+        ++values_;
         double v = 0;
         if (is_integer(type)) {
             int64_t i = 0;
@@ -225,6 +257,8 @@ private:
     size_t pos_;
     TextCursor text_;
     const std::string& path_;
+    int element_line_ = -1;  ///< line of the element being read (ascii)
+    uint64_t values_ = 0;    ///< values of it read so far
 };
 
 /// Fewest bytes one element can take: binary sizes, or one character and a separator per ascii value.
@@ -261,6 +295,7 @@ struct Reader {
     TriangleMesh& mesh;
     uint64_t vertex_count = 0;
     std::vector<double> scratch;
+    PolygonList polygons;  ///< triangulated once every vertex is read (elements may come in any order)
 
     void read_vertices(const PlyElement& e) {
         VertexLayout at;
@@ -275,8 +310,9 @@ struct Reader {
         mesh.vertices.reserve(size_t(e.count));
         scratch.resize(e.properties.size());
         for (uint64_t i = 0; i < e.count; ++i) {
-            values.index_ = i;
+            values.begin_element(i);
             read_element(e);
+            values.end_element(e);
             mesh.vertices.push_back({scratch[size_t(at.x)], scratch[size_t(at.y)], scratch[size_t(at.z)]});
         }
     }
@@ -286,10 +322,14 @@ struct Reader {
         for (size_t k = 0; k < e.properties.size(); ++k) {
             const PlyProperty& p = e.properties[k];
             if (!p.is_list) { scratch[k] = values.value(p.type); continue; }
-            const double n = values.value(p.count_type);
-            if (n < 0 || n > double(values.bytes_left())) fail(e, "list '" + p.name + "' has " + std::to_string(int64_t(n)) + " items");
-            for (int64_t j = 0; j < int64_t(n); ++j) values.value(p.type);
+            skip_list(e, p);
         }
+    }
+
+    void skip_list(const PlyElement& e, const PlyProperty& p) {
+        const double n = values.value(p.count_type);
+        if (n < 0 || n > double(values.bytes_left())) fail(e, "list '" + p.name + "' has " + std::to_string(int64_t(n)) + " items");
+        for (int64_t j = 0; j < int64_t(n); ++j) values.value(p.type);
     }
 
     void read_faces(const PlyElement& e) {
@@ -302,15 +342,15 @@ struct Reader {
             throw_mesh_error(path, "PLY header", "face indices must have an integer type");
         std::vector<int> polygon;
         for (uint64_t i = 0; i < e.count; ++i) {
-            values.index_ = i;
+            values.begin_element(i);
             for (size_t k = 0; k < e.properties.size(); ++k) {
                 const PlyProperty& p = e.properties[k];
                 if (int(k) == list) read_polygon(e, p, polygon);
                 else if (!p.is_list) values.value(p.type);
-                else for (int64_t j = 0, n = int64_t(values.value(p.count_type)); j < n; ++j) values.value(p.type);
+                else skip_list(e, p);
             }
-            // Fan triangulation (0, j, j+1), as the OBJ path does for polygons of 5+ vertices.
-            for (size_t j = 1; j + 1 < polygon.size(); ++j) mesh.triangles.push_back({polygon[0], polygon[j], polygon[j + 1]});
+            values.end_element(e);
+            polygons.add(polygon);
         }
     }
 
@@ -332,7 +372,11 @@ struct Reader {
 
     void skip(const PlyElement& e) {
         scratch.resize(e.properties.size());
-        for (uint64_t i = 0; i < e.count; ++i) { values.index_ = i; read_element(e); }
+        for (uint64_t i = 0; i < e.count; ++i) {
+            values.begin_element(i);
+            read_element(e);
+            values.end_element(e);
+        }
     }
 
     [[noreturn]] void fail(const PlyElement& e, const std::string& what) const {
@@ -364,6 +408,8 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& path) {
     if (!have_faces) throw_mesh_error(path, "PLY header", "no element 'face' (a point cloud has no surface)");
     if (values.trailing_data())
         throw_mesh_error(path, "PLY data (" + values.place() + ")", "data continues after the last declared element (wrong counts?)");
+    check_finite_vertices(mesh, path);
+    reader.polygons.triangulate_into(mesh);
     check_loaded_mesh(mesh, path, "PLY file");
     return mesh;
 }

@@ -2,7 +2,9 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
+#include <new>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,38 +24,77 @@ std::string read_plain(const std::string& path, uint64_t size) {
     return bytes;
 }
 
-/// gzread in growing chunks; the final size is unknown until the stream ends.
-std::string read_gzip(const std::string& path) {
-    gzFile file = gzopen(path.c_str(), "rb");
-    if (!file) throw_mesh_error(path, "", "cannot open gzip file");
-    std::string bytes;
-    std::vector<char> chunk(size_t(1) << 20);
+/// The gzip trailer's ISIZE (the last member's size mod 2^32): a guess of the decompressed
+/// size, so that a single-member file under 4 GiB is decompressed into a buffer reserved
+/// at its exact size, with no copy while it grows.
+uint64_t gzip_size_hint(const std::string& compressed) {
+    if (compressed.size() < 18) return 0;
+    const auto* b = reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
+    return uint64_t(b[0]) | uint64_t(b[1]) << 8 | uint64_t(b[2]) << 16 | uint64_t(b[3]) << 24;
+}
+
+/// Inflates the gzip members in `compressed` (zlib, in memory), asking `check` after each
+/// megabyte how much the content may grow to.
+std::string gunzip(const std::string& compressed, const std::string& path, const ContentCheck& check) {
+    z_stream z{};
+    if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) throw_mesh_error(path, "", "cannot start gzip decompression");
+    struct End { z_stream* z; ~End() { inflateEnd(z); } } end{&z};
+    constexpr size_t kStep = size_t(1) << 20;     // the check's granularity
+    constexpr size_t kMaxFeed = size_t(1) << 30;  // zlib counts in 32-bit unsigned
+    uint64_t limit = kMaxMeshFileBytes;
+    std::string limit_reason = "the largest mesh file read";
+    const uint64_t hint = gzip_size_hint(compressed);
+    std::string out;
+    size_t in_at = 0, have = 0, checked = 0;
+    const auto over = [&] {
+        throw_mesh_error(path, "", "decompresses to more than " + std::to_string(limit) + " bytes (" + limit_reason + ")");
+    };
     for (;;) {
-        const int got = gzread(file, chunk.data(), unsigned(chunk.size()));
-        if (got < 0) {
-            int code = 0;
-            const std::string message = gzerror(file, &code);
-            gzclose(file);
-            throw_mesh_error(path, "", "corrupt gzip stream (" + message + ")");
+        if (have == out.size()) {
+            // A megabyte more at a time (resize touches what it adds); the capacity is
+            // reserved once the content check has had its say, so the hint is not trusted
+            // before the check has seen the first megabyte.
+            if (checked > 0 && out.capacity() < hint && hint <= limit) out.reserve(size_t(hint));
+            out.resize(size_t(std::min<uint64_t>(limit + 1, uint64_t(have) + kStep)));
         }
-        if (got == 0) break;
-        if (uint64_t(bytes.size()) + uint64_t(got) > kMaxMeshFileBytes) {
-            gzclose(file);
-            throw_mesh_error(path, "", "decompresses to more than " + std::to_string(kMaxMeshFileBytes) +
-                                           " bytes (the largest mesh file read)");
+        const size_t feed = std::min(compressed.size() - in_at, kMaxFeed);
+        z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data() + in_at));
+        z.avail_in = uInt(feed);
+        z.next_out = reinterpret_cast<Bytef*>(out.data() + have);
+        z.avail_out = uInt(std::min(out.size() - have, std::min(kStep, kMaxFeed)));
+        const uInt out_before = z.avail_out;
+        const int code = inflate(&z, Z_NO_FLUSH);
+        in_at += feed - z.avail_in;
+        have += out_before - z.avail_out;
+        if (code == Z_DATA_ERROR || code == Z_NEED_DICT)
+            throw_mesh_error(path, "", std::string("corrupt gzip stream (") + (z.msg ? z.msg : "invalid data") + ")");
+        if (code == Z_MEM_ERROR) throw std::bad_alloc();
+        const bool stream_end = code == Z_STREAM_END;
+        if (check && (have - checked >= kStep || stream_end)) {
+            const uint64_t allowed = check(std::string_view(out.data(), have), checked);
+            checked = have;
+            if (allowed < limit) { limit = allowed; limit_reason = "what its content declares"; }
         }
-        bytes.append(chunk.data(), size_t(got));
+        if (have > limit) over();
+        if (stream_end) {
+            if (in_at == compressed.size()) break;
+            // Another member (concatenated .gz files), or data that does not belong to the stream.
+            if (compressed.size() - in_at < 2 || uint8_t(compressed[in_at]) != 0x1f || uint8_t(compressed[in_at + 1]) != 0x8b)
+                throw_mesh_error(path, "", "data after the end of the gzip stream (byte " + std::to_string(in_at) + " of " +
+                                               std::to_string(compressed.size()) + ")");
+            inflateReset(&z);
+            continue;
+        }
+        if (code == Z_BUF_ERROR && in_at == compressed.size()) throw_mesh_error(path, "", "truncated gzip stream");
+        if (code != Z_OK && code != Z_BUF_ERROR) throw_mesh_error(path, "", "corrupt gzip stream (zlib error " + std::to_string(code) + ")");
     }
-    // gzread returns 0 at a truncated end too; gzclose reports it as Z_BUF_ERROR.
-    const int closed = gzclose(file);
-    if (closed != Z_OK)
-        throw_mesh_error(path, "", closed == Z_BUF_ERROR ? "truncated gzip stream" : "corrupt gzip stream");
-    return bytes;
+    out.resize(have);
+    return out;
 }
 
 }  // namespace
 
-MeshFileBytes read_mesh_file_bytes(const std::string& path) {
+MeshFileBytes read_mesh_file_bytes(const std::string& path, const ContentCheck& check) {
     namespace fs = std::filesystem;
     require_regular_file(path, "mesh file");
     const uint64_t size = fs::file_size(path);
@@ -61,10 +102,16 @@ MeshFileBytes read_mesh_file_bytes(const std::string& path) {
         throw_mesh_error(path, "", "file has " + std::to_string(size) + " bytes, more than the largest mesh file read (" +
                                        std::to_string(kMaxMeshFileBytes) + ")");
     MeshFileBytes out;
-    out.bytes = read_plain(path, size);
-    out.file_sha256 = sha256_hex(out.bytes.data(), out.bytes.size());
-    out.gzip = out.bytes.size() >= 2 && uint8_t(out.bytes[0]) == 0x1f && uint8_t(out.bytes[1]) == 0x8b;
-    if (out.gzip) out.bytes = read_gzip(path);
+    try {
+        out.bytes = read_plain(path, size);
+        out.file_sha256 = sha256_hex(out.bytes.data(), out.bytes.size());
+        out.gzip = out.bytes.size() >= 2 && uint8_t(out.bytes[0]) == 0x1f && uint8_t(out.bytes[1]) == 0x8b;
+        if (out.gzip) out.bytes = gunzip(out.bytes, path, check);
+        else if (check) check(out.bytes, 0);
+    } catch (const std::bad_alloc&) {
+        throw_mesh_error(path, "", "not enough memory to read the mesh file (" + std::to_string(size) + " bytes" +
+                                       (out.gzip ? ", gzip-compressed" : "") + ")");
+    }
     return out;
 }
 
@@ -80,13 +127,17 @@ int ExactVertexWelder::id_of(const Vec3d& p) {
     return it->second;
 }
 
-void check_loaded_mesh(const TriangleMesh& mesh, const std::string& path, const std::string& what) {
-    if (mesh.triangles.empty()) throw_mesh_error(path, "", what + " holds no triangles (no faces with 3 or more vertices)");
+void check_finite_vertices(const TriangleMesh& mesh, const std::string& path) {
     for (size_t i = 0; i < mesh.vertices.size(); ++i) {
         const Vec3d& p = mesh.vertices[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             throw_mesh_error(path, "vertex " + std::to_string(i), "non-finite coordinate; expected three finite numbers");
     }
+}
+
+void check_loaded_mesh(const TriangleMesh& mesh, const std::string& path, const std::string& what) {
+    if (mesh.triangles.empty()) throw_mesh_error(path, "", what + " holds no triangles (no faces with 3 or more vertices)");
+    check_finite_vertices(mesh, path);
     const size_t n = mesh.vertices.size();
     for (size_t f = 0; f < mesh.triangles.size(); ++f)
         for (int k = 0; k < 3; ++k)

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -24,10 +26,18 @@ struct MeshFileBytes {
     std::string file_sha256;  ///< of the file's bytes as stored (compressed or not)
 };
 
-/// Reads `path` whole, gunzipping it when it starts with the gzip magic (1f 8b).
-/// Throws std::runtime_error naming the file when it is missing, unreadable, a corrupt or
-/// truncated gzip stream, or larger than kMaxMeshFileBytes once decompressed.
-MeshFileBytes read_mesh_file_bytes(const std::string& path);
+/// What the content read so far allows, asked while a gzip file is decompressed (after
+/// each megabyte, with the bytes so far and where the new ones begin): the most bytes the
+/// whole content may have (e.g. a binary STL's declared size), or it throws (e.g. a NUL
+/// byte in a text format). So a gzip bomb is refused after its first megabyte, not after
+/// it has filled the memory.
+using ContentCheck = std::function<uint64_t(std::string_view so_far, size_t new_from)>;
+
+/// Reads `path` whole, gunzipping it when it starts with the gzip magic (1f 8b), at most
+/// kMaxMeshFileBytes and what `check` allows. Throws std::runtime_error naming the file
+/// when it is missing, unreadable, a corrupt or truncated gzip stream, has data after the
+/// stream, is larger than allowed once decompressed, or does not fit in memory.
+MeshFileBytes read_mesh_file_bytes(const std::string& path, const ContentCheck& check = {});
 
 /// A reader's error: "<path>: <where>: <what>", e.g. "a.ply: header line 3: ...".
 [[noreturn]] inline void throw_mesh_error(const std::string& path, const std::string& where, const std::string& what) {
@@ -48,6 +58,9 @@ private:
     std::vector<Vec3d>& vertices_;
     std::unordered_map<Vec3d, int, Hash> ids_;
 };
+
+/// Throws naming the first vertex with a non-finite coordinate.
+void check_finite_vertices(const TriangleMesh& mesh, const std::string& path);
 
 /// Checks the finished mesh as every reader must leave it: at least one triangle, every
 /// index in range, every coordinate finite. `what` names the format in the message.

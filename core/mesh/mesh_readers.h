@@ -1,11 +1,12 @@
 /// @file mesh_readers.h
 /// @brief The readers behind load_mesh_file(), one per format, each from the file's bytes
 /// (already gunzipped). Every one returns the file's own vertices (exactly, in double) and
-/// its faces triangulated as fans in file order, and throws std::runtime_error naming the
+/// its faces in file order, polygons triangulated by polygon_triangulation.h, and throws std::runtime_error naming the
 /// file and the header line, element or byte offset of what it could not read.
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "core/mesh/triangle_mesh.h"
 
@@ -20,6 +21,14 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& path);
 /// size even when the header starts with "solid") or ASCII. STL repeats each corner per
 /// triangle: vertices with equal coordinates are welded exactly, in order of first use.
 TriangleMesh read_stl(const std::string& bytes, const std::string& path);
+
+/// Whether `bytes` begin as ASCII STL: first word "solid" (in any case) and no control
+/// bytes (binary data) in the first records.
+bool is_ascii_stl_start(std::string_view bytes);
+
+/// Whether the first records of `bytes` hold control bytes other than white space, as
+/// binary data does and text does not.
+bool holds_binary_bytes(std::string_view bytes);
 
 /// OFF (Geomview): header OFF, COFF, NOFF, CNOFF, STOFF, ... (extra per-vertex columns
 /// skipped), counts, vertex lines, face lines "n i_0 ... i_(n-1) [colour]"; `#` comments.

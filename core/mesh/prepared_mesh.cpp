@@ -116,6 +116,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     MeshReport& rep = out.report_;
     rep.input_vertices = int(mesh.vertices.size());
     rep.input_triangles = int(mesh.triangles.size());
+    rep.polygons = mesh.polygon_stats;
 
     // Weld, then drop triangles with a repeated vertex or exactly zero area.
     std::vector<Vec3d> welded;
@@ -275,6 +276,20 @@ std::vector<std::string> PreparedMesh::warnings() const {
                     std::to_string(report_.shell_intersecting_pairs) +
                     " intersecting triangle pairs); pseudonormal signs are wrong where one shell is inside another "
                     "(use the winding-number sign).");
+    if (report_.polygons.non_planar > 0) {
+        std::ostringstream deviation;
+        deviation.precision(2);
+        deviation << report_.polygons.max_non_planarity;
+        w.push_back(who + " has " + std::to_string(report_.polygons.non_planar) +
+                    " non-planar polygons (corners up to " + deviation.str() +
+                    " of a polygon's size off its best-fit plane). Each was cut into triangles in its best-fit "
+                    "plane, shortest cut first; near them the surface, and so distances and signs, depend on "
+                    "that choice.");
+    }
+    if (report_.polygons.not_simple > 0)
+        w.push_back(who + " has " + std::to_string(report_.polygons.not_simple) +
+                    " polygons that cross themselves or have no area in their best-fit plane; their triangles "
+                    "may overlap.");
     if (report_.flipped)
         w.push_back(who + " was oriented inward (negative signed volume); all triangles were flipped.");
     if (report_.degenerate_triangles > 0)

@@ -42,6 +42,7 @@ struct MeshReport {
     int self_intersecting_pairs = 0;     ///< intersecting triangle pairs within one shell
     int shell_intersecting_pairs = 0;    ///< intersecting triangle pairs from two shells
     int overlapping_shells = 0;          ///< pairs of shells that intersect
+    PolygonStats polygons;               ///< what triangulating the input's polygon faces found
     bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
     bool consistently_oriented() const { return inconsistent_edges == 0; }
     /// Why pseudonormal signs are not trustworthy everywhere, "" when they are: the first of

@@ -38,6 +38,14 @@ public:
         return rest;
     }
 
+    /// The next token without moving past it, and its line; false at the end of the text.
+    bool peek(std::string_view& token, int& line) const {
+        TextCursor copy = *this;
+        if (!copy.next(token)) return false;
+        line = copy.line();
+        return true;
+    }
+
     /// Line of the last token returned.
     int line() const { return token_line_; }
     /// Line the cursor stands on.
@@ -79,9 +87,28 @@ inline bool parse_int(std::string_view token, int64_t& value) {
     return ec == std::errc() && end == token.data() + token.size();
 }
 
-/// A token quoted for a message, cut to 40 characters.
+/// A token quoted for a message, cut to 40 characters; bytes other than printable ASCII are
+/// written as \xNN, so that binary data neither garbles the terminal nor cuts the message
+/// (a NUL would end what() there).
 inline std::string quoted(std::string_view token) {
-    return "'" + std::string(token.substr(0, 40)) + (token.size() > 40 ? "...'" : "'");
+    static const char* const hex = "0123456789abcdef";
+    std::string out = "'";
+    for (const char c : token.substr(0, 40)) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte < 0x7f) out += c;
+        else out += std::string("\\x") + hex[byte >> 4] + hex[byte & 15];
+    }
+    return out + (token.size() > 40 ? "...'" : "'");
+}
+
+/// ASCII case-insensitive equality of a token and a lower-case keyword.
+inline bool equals_keyword(std::string_view token, std::string_view keyword) {
+    if (token.size() != keyword.size()) return false;
+    for (size_t i = 0; i < token.size(); ++i) {
+        const char c = token[i] >= 'A' && token[i] <= 'Z' ? char(token[i] - 'A' + 'a') : token[i];
+        if (c != keyword[i]) return false;
+    }
+    return true;
 }
 
 }  // namespace sdf

@@ -5,6 +5,7 @@
 /// everything downstream sees a TriangleMesh and then a PreparedMesh.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -13,12 +14,21 @@
 
 namespace sdf {
 
+/// What triangulating a file's polygon faces found (polygon_triangulation.h).
+struct PolygonStats {
+    int64_t polygons = 0;            ///< faces of more than 3 corners
+    int64_t non_planar = 0;          ///< of those, with a corner off the best-fit plane (kNonPlanarTolerance)
+    double max_non_planarity = 0.0;  ///< largest corner distance from the plane / polygon size, over all
+    int64_t not_simple = 0;          ///< crossing themselves or without area in their plane
+};
+
 struct TriangleMesh {
     std::string name;              ///< short name for reports ("dragon", "sphere")
     std::string source;            ///< file path or procedural description
     std::string content_sha256;    ///< of the file's bytes, or of the generated geometry
     std::vector<Vec3d> vertices;
-    std::vector<Int3> triangles;   ///< in file order (polygons triangulated as fans)
+    std::vector<Int3> triangles;   ///< in file order (polygons by polygon_triangulation.h)
+    PolygonStats polygon_stats;    ///< of the file's faces of more than 3 corners
 };
 
 /// Axis-aligned bounds of the vertices referenced by triangles.

@@ -22,22 +22,36 @@
 namespace sdf {
 namespace {
 
+/// An integer argument given as any Python or NumPy integer (anything with __index__, not
+/// bool), else a TypeError or ValueError naming it. The config parser checks its range.
+int64_t integer_argument(const py::handle& value, const std::string& what) {
+    if (PyBool_Check(value.ptr()) || !PyIndex_Check(value.ptr()))
+        throw py::type_error("sample(): " + what + " must be an integer (Python or NumPy), got " +
+                             std::string(py::str(value.get_type().attr("__name__"))) + " " + std::string(py::repr(value)));
+    const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+    if (!index) throw py::error_already_set();
+    int overflow = 0;
+    const long long n = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+    if (overflow != 0) throw py::value_error("sample(): " + what + " " + std::string(py::repr(value)) + " is out of range");
+    return n;
+}
+
 /// The "lattice" object of a config, from sample()'s arguments, parsed by the config's own
 /// parser: the same checks and messages as run-experiment's, key path "sample(): lattice".
 LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::object& resolution, const py::object& samples,
                                         const py::object& margin) {
     nlohmann::json j = {{"type", type}};
     if (!resolution.is_none()) {
-        std::vector<int> r;
-        if (py::isinstance<py::int_>(resolution)) {
-            const int n = resolution.cast<int>();
-            r = type == "bcc" ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
+        std::vector<int64_t> r;
+        if (py::isinstance<py::sequence>(resolution) && !py::isinstance<py::str>(resolution)) {  // NumPy arrays too
+            for (const py::handle item : resolution) r.push_back(integer_argument(item, "resolution[" + std::to_string(r.size()) + "]"));
         } else {
-            r = resolution.cast<std::vector<int>>();
+            const int64_t n = integer_argument(resolution, "resolution");
+            r = type == "bcc" ? std::vector<int64_t>{n, n, 2 * n} : std::vector<int64_t>{n, n, n};
         }
         j["resolution"] = r;
     }
-    if (!samples.is_none()) j["samples"] = samples.cast<int64_t>();
+    if (!samples.is_none()) j["samples"] = integer_argument(samples, "samples");
     if (!margin.is_none()) j["margin"] = margin.cast<double>();
     JsonReader reader(j, "sample()", "lattice");
     LatticeSpec spec = parse_lattice_spec(reader);

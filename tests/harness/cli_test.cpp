@@ -307,6 +307,14 @@ TEST_F(Cli, QueryErrorsAreClear) {
     const ShellResult precision = query("shape:box p.txt --precision half");
     EXPECT_NE(precision.code, 0);
     EXPECT_TRUE(Contains(precision.err, "half"));
+    // Number options say what they expect, without printing DBL_MAX's 309 digits, and refuse nan.
+    const ShellResult threads = query("shape:box p.txt --threads -1");
+    EXPECT_EQ(threads.code, 2);
+    EXPECT_TRUE(Contains(threads.err, "--threads: '-1' is out of range; expected a finite number >= 0")) << threads.err;
+    EXPECT_FALSE(std::regex_search(threads.err, std::regex("[0-9]{20}"))) << threads.err;
+    const ShellResult nan = query("shape:box p.txt --threads nan");
+    EXPECT_EQ(nan.code, 2);
+    EXPECT_TRUE(Contains(nan.err, "'nan' is not finite")) << nan.err;
 }
 
 TEST_F(Cli, QueryCudaBackendWithoutGpuFailsClearly) {

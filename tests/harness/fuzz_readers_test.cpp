@@ -1,5 +1,6 @@
 // A deterministic fuzz battery for every reader of outside input (issue 11): mesh files of
-// every format (OBJ, ASCII and binary PLY and STL, OFF, gzip), points files (text and .npy),
+// every format (OBJ, ASCII and binary PLY and STL, OFF, gzip; polygon faces, ASCII STL in
+// capitals and on one line, classic Mac line ends, gzip members: issue 26), points files (text and .npy),
 // field headers and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
 // are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
 // huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
@@ -208,6 +209,52 @@ TEST_F(FuzzReaders, MeshFilesOfEveryFormat) {
     const std::string gz = test::read_text(at("z.obj.gz"));
     total += fuzz(at("z.obj.gz"), gz, kPerSeed / 3, 2000, load_and_prepare).second > 0;
     EXPECT_GE(total, int(seeds.size()) * kPerSeed);
+}
+
+/// An L-shaped prism with concave hexagon caps and quad sides, as polygon faces in OBJ, OFF
+/// or ASCII PLY: the seeds of the shared polygon triangulation (polygon_triangulation.h).
+std::string polygon_prism(const std::string& format) {
+    const double ring[6][2] = {{2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}, {0, 0}};
+    std::vector<std::vector<int>> faces = {{0, 5, 4, 3, 2, 1}, {6, 7, 8, 9, 10, 11}};
+    for (int k = 0; k < 6; ++k) faces.push_back({k, (k + 1) % 6, 6 + (k + 1) % 6, 6 + k});
+    std::string vertices, polygons;
+    for (int z = 0; z < 2; ++z)
+        for (const auto& xy : ring)
+            vertices += (format == "obj" ? "v " : "") + std::to_string(xy[0]) + " " + std::to_string(xy[1]) + " " +
+                        std::to_string(z) + "\n";
+    for (const auto& f : faces) {
+        polygons += format == "obj" ? "f" : std::to_string(f.size());
+        for (int i : f) polygons += " " + std::to_string(format == "obj" ? i + 1 : i);
+        polygons += "\n";
+    }
+    if (format == "obj") return vertices + polygons;
+    if (format == "off") return "OFF\n12 8 0\n" + vertices + polygons;
+    return "ply\nformat ascii 1.0\nelement vertex 12\nproperty double x\nproperty double y\nproperty double z\n"
+           "element face 8\nproperty list uchar int vertex_indices\nend_header\n" + vertices + polygons;
+}
+
+// The reader rules of issue 26: polygons, ASCII STL in capitals or on one line, classic Mac
+// line ends, a binary STL whose header begins with "solid", gzip members.
+TEST_F(FuzzReaders, MeshFilesUnderTheReaderRules) {
+    const TriangleMesh box = make_box({1.0, 0.5, 0.25});
+    std::string upper = test::stl_ascii_text(box);
+    for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+    std::string one_line = test::stl_ascii_text(box);
+    for (char& c : one_line) c = c == '\n' ? ' ' : c;
+    std::string cr = test::off_text(box);
+    for (char& c : cr) c = c == '\n' ? '\r' : c;
+    const std::vector<std::pair<std::string, std::string>> seeds = {
+        {"p.obj", polygon_prism("obj")}, {"p.off", polygon_prism("off")}, {"p.ply", polygon_prism("ply")},
+        {"upper.stl", upper}, {"line.stl", one_line}, {"cr.off", cr}, {"solid.stl", test::stl_binary_text(box)},
+    };
+    for (size_t k = 0; k < seeds.size(); ++k) {
+        const auto [parsed, refused] = fuzz(at(seeds[k].first), seeds[k].second, kPerSeed, 7000 + k, load_and_prepare);
+        EXPECT_GT(refused, 0) << seeds[k].first;
+    }
+    test::write_gzip(at("a.gz"), polygon_prism("ply").substr(0, 100));
+    test::write_gzip(at("b.gz"), polygon_prism("ply").substr(100));
+    const std::string members = test::read_text(at("a.gz")) + test::read_text(at("b.gz"));
+    fuzz(at("m.ply.gz"), members, kPerSeed / 3, 7100, load_and_prepare);
 }
 
 TEST_F(FuzzReaders, PointsFiles) {

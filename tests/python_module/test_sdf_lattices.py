@@ -319,6 +319,21 @@ def test_bcc_field_is_two_cc_subgrids_half_a_spacing_apart(box):
     assert abs(secondary[k, j, i] - d[0]) < 1e-14
 
 
+def test_resolution_and_samples_take_numpy_integers(box):
+    want = sl.sample(box, lattice="bcc", resolution=6, backend="cpu", precision="double")
+    for resolution in (np.int64(6), np.uint8(6), np.array([6, 6, 12]), (np.int32(6), 6, np.int16(12))):
+        f = sl.sample(box, lattice="bcc", resolution=resolution, backend="cpu", precision="double")
+        assert f.resolution == (6, 6, 12)
+        assert same_bits(f.values[0], want.values[0])
+    assert sl.sample(box, lattice="cc", samples=np.int64(64), backend="cpu").num_points > 0
+    with pytest.raises(TypeError, match=r"resolution must be an integer \(Python or NumPy\), got float 6.0"):
+        sl.sample(box, lattice="cc", resolution=6.0, backend="cpu")
+    with pytest.raises(TypeError, match=r"resolution\[1\] must be an integer"):
+        sl.sample(box, lattice="cc", resolution=[6, 6.5, 6], backend="cpu")
+    with pytest.raises(ValueError, match="out of range"):
+        sl.sample(box, lattice="cc", resolution=2**70, backend="cpu")
+
+
 def test_write_and_read_field_round_trip_and_refuse_overwrite(tmp_path, box):
     f = sl.sample(box, lattice="bcc", resolution=(5, 5, 8), backend="cpu")
     path = str(tmp_path / "box.json")

@@ -5,6 +5,9 @@
 // Malformed files of each format get errors that name the file and the place.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
@@ -172,9 +175,100 @@ TEST_F(LoadMeshErrors, Stl) {
     binary.replace(0, 5, "xxxxx");  // no "solid": cannot be ASCII either
     expect_error("truncated.stl", binary, "binary STL header: declares 576 triangles");
     expect_error("keyword.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertx 1 0 0\n", "ASCII STL line 5: expected 'vertex' or 'endloop', found 'vertx'");
-    expect_error("nan.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n", "line 5: non-finite coordinate 'nan'");
-    expect_error("open.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "file ends early");
+    expect_error("nan.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n", "line 5: non-finite vertex coordinate 'nan'");
+    expect_error("open.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "file ends inside facet 0");
     expect_error("empty.stl", "solid s\nendsolid s\n", "no triangles");
+}
+
+const char* kTriangleFacet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+
+/// Every byte of `message` printable (no raw binary data, no NUL cutting it short).
+bool printable(const std::string& message) {
+    for (const char c : message)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) return false;
+    return true;
+}
+
+TEST_F(LoadMeshErrors, StlPromises) {
+    // A file cut after a complete facet is not complete.
+    expect_error("cut.stl", std::string("solid s\n") + kTriangleFacet, "ASCII STL line 8: file ends after 1 facets without 'endsolid'");
+    // A binary STL whose header begins with "solid" and whose size is wrong: named as binary, bytes escaped.
+    std::string binary = test::stl_binary_text(test_shape(true));
+    binary.resize(binary.size() - 10);
+    const std::string path = write("solid-binary.stl", binary);
+    try {
+        load_mesh_file(path);
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("binary STL header: declares 576 triangles"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("begins with 'solid'"), std::string::npos) << e.what();
+        EXPECT_TRUE(printable(e.what())) << e.what();
+    }
+    expect_error("normal.stl", "solid s\nfacet normal 0 x 1\n", "line 2: expected a facet normal component");
+    expect_error("garbage.stl", std::string("solid s\n") + kTriangleFacet + "\x80\x81" "endsolid\n", "found '\\x80\\x81endsolid'");
+}
+
+TEST_F(LoadMeshErrors, StlKeywordsInAnyCaseOnAnyLinesAndNanNormals) {
+    const std::vector<std::pair<std::string, std::string>> files = {
+        {"upper.stl", "SOLID PART\nFACET NORMAL 0 0 1\nOUTER LOOP\nVERTEX 0 0 0\nVERTEX 1 0 0\nVERTEX 0 1 0\nENDLOOP\nENDFACET\nENDSOLID PART\n"},
+        {"one-line.stl", "solid my part facet normal 0 0 1 outer loop vertex 0 0 0 vertex 1 0 0 vertex 0 1 0 endloop endfacet endsolid my part"},
+        {"nan-normal.stl", "solid s\nfacet normal nan nan nan\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n"},
+        {"mixed.stl", "Solid s\nFacet Normal -inf 0 0\nOuter Loop\nVertex 0 0 0\nVertex 1 0 0\nVertex 0 1 0\nEndLoop\nEndFacet\nEndSolid\n"}};
+    for (const auto& [name, text] : files) {
+        const TriangleMesh m = load_mesh_file(write(name, text));
+        ASSERT_EQ(m.triangles.size(), 1u) << name;
+        EXPECT_EQ(m.vertices[size_t(m.triangles[0].y)], (Vec3d{1, 0, 0})) << name;
+    }
+}
+
+TEST_F(LoadMeshErrors, OffAndPlyCountsThatDoNotMatchTheData) {
+    expect_error("extra.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n",
+                 "OFF line 7: data continues after the 1 faces the header declares");
+    std::string one_too_many = kTrianglePly;
+    one_too_many.replace(one_too_many.find("vertex 3"), 8, "vertex 4");
+    expect_error("vertices.ply", one_too_many,
+                 "PLY element 'vertex' 3 (line 13): the line has more values than the element's properties (x y z)");
+    std::string short_line = kTrianglePly;
+    short_line.replace(short_line.find("1 0 0\n"), 6, "1 0\n");
+    expect_error("short.ply", short_line, "PLY element 'vertex' 1 (line 11): the line ends after 2 values");
+}
+
+TEST_F(LoadMeshErrors, Utf16WithoutByteOrderMarkIsNamed) {
+    std::string utf16;
+    for (const char c : std::string("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")) { utf16 += c; utf16 += '\0'; }
+    expect_error("wide.obj", utf16, "looks like UTF-16LE text without a byte-order mark");
+    expect_error("wide.off", std::string("\0O\0F\0F\0\n", 8), "looks like UTF-16BE text without a byte-order mark");
+}
+
+TEST_F(LoadMeshErrors, NulBytesInTextAreNamedByByteAndLine) {
+    const char obj[] = "v 0 0 0\nv 1 0 0\nv 0 1\0 0\nf 1 2 3\n";
+    expect_error("nul.obj", std::string(obj, sizeof obj - 1), "line 3: byte 21 is a NUL byte");
+    const char ply[] = "ply\nformat ascii 1.0\ncomment \0\nend_header\n";
+    expect_error("nul.ply", std::string(ply, sizeof ply - 1), "PLY header line 3: byte 29 is a NUL byte");
+}
+
+// Classic Mac OS line ends (a lone CR) read like LF, in every text format and a binary PLY's header.
+TEST_F(LoadMeshErrors, CarriageReturnLineEnds) {
+    const TriangleMesh shape = test_shape(false);
+    const auto cr = [](std::string s, size_t end = std::string::npos) {
+        for (size_t i = 0; i < std::min(end, s.size()); ++i)
+            if (s[i] == '\n') s[i] = '\r';
+        return s;
+    };
+    const std::string binary_ply = test::ply_text(shape, PlyEncoding::BinaryLittleEndian);
+    const std::vector<std::pair<std::string, std::string>> files = {
+        {"cr.obj", cr(test::obj_text(shape))}, {"cr.off", cr(test::off_text(shape))},
+        {"cr.ply", cr(test::ply_text(shape, PlyEncoding::Ascii))}, {"crb.ply", cr(binary_ply, binary_ply.find("end_header") + 11)},
+        {"cr.stl", cr(test::stl_ascii_text(shape))}};
+    const TriangleMesh reference = load_obj(write("reference.obj", test::obj_text(shape)));
+    for (const auto& [name, text] : files) {
+        const TriangleMesh m = load_mesh_file(write(name, text));
+        ASSERT_EQ(m.triangles.size(), reference.triangles.size()) << name;
+        for (size_t i = 0; i < m.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k)
+                ASSERT_EQ(m.vertices[size_t(m.triangles[i][k])], reference.vertices[size_t(reference.triangles[i][k])]) << name;
+    }
+    expect_error("cr-error.off", "OFF\r3 1 0\r0 0 0\r1 0\r0 1 0\r3 0 1 2\r", "OFF line 4: vertex line has fewer than 3 coordinates");
 }
 
 TEST_F(LoadMeshErrors, Off) {
@@ -193,6 +287,44 @@ TEST_F(LoadMeshErrors, OffAcceptsColoursCommentsAndCountsOnTheKeywordLine) {
     ASSERT_EQ(m.triangles.size(), 3u);  // the quad as a fan, then the triangle
     EXPECT_EQ(m.triangles[1], (Int3{0, 2, 3}));
     EXPECT_EQ(m.vertices[2], (Vec3d{1, 1, 0}));
+}
+
+/// `zeros` zero bytes gzip-compressed into `path`, written a megabyte at a time.
+void write_gzip_zeros(const std::string& path, size_t zeros, const std::string& prefix = "") {
+    gzFile f = gzopen(path.c_str(), "wb1");
+    gzwrite(f, prefix.data(), unsigned(prefix.size()));
+    const std::string chunk(size_t(1) << 20, '\0');
+    for (size_t done = 0; done < zeros; done += chunk.size()) gzwrite(f, chunk.data(), unsigned(std::min(chunk.size(), zeros - done)));
+    gzclose(f);
+}
+
+long peak_rss_kib() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_maxrss;
+}
+
+// A gzip bomb is refused from its first decompressed megabyte, whatever its size: here 256
+// MiB of zeros (1 MB compressed) as OBJ (text: a NUL byte), as STL (binary: more than its
+// header declares) and as a binary STL followed by zeros. Peak memory grows by a few MiB.
+TEST_F(LoadMeshErrors, GzipIsDecompressedOnlyAsFarAsTheContentAllows) {
+    const size_t zeros = size_t(256) << 20;
+    write_gzip_zeros(at("zeros.obj.gz"), zeros);
+    write_gzip_zeros(at("zeros.stl.gz"), zeros);
+    write_gzip_zeros(at("tail.stl.gz"), zeros, test::stl_binary_text(test_shape(true)));
+    const long before = peak_rss_kib();
+    expect_error("zeros.obj.gz", test::read_text(at("zeros.obj.gz")), "line 1: byte 0 is a NUL byte");
+    expect_error("zeros.stl.gz", test::read_text(at("zeros.stl.gz")), "decompresses to more than 84 bytes (what its content declares)");
+    expect_error("tail.stl.gz", test::read_text(at("tail.stl.gz")), "decompresses to more than 28884 bytes");
+    EXPECT_LT(peak_rss_kib() - before, 64 * 1024) << "KiB";
+}
+
+TEST_F(LoadMeshErrors, GzipMembersConcatenatedAndDataAfterTheStream) {
+    test::write_gzip(at("a.gz"), std::string(kTrianglePly).substr(0, 40));
+    test::write_gzip(at("b.gz"), std::string(kTrianglePly).substr(40));
+    const std::string two = test::read_text(at("a.gz")) + test::read_text(at("b.gz"));
+    EXPECT_EQ(load_mesh_file(write("two-members.ply.gz", two)).triangles.size(), 1u);
+    expect_error("trailing.ply.gz", two + "junk", "data after the end of the gzip stream (byte " + std::to_string(two.size()));
 }
 
 TEST_F(LoadMeshErrors, Gzip) {

@@ -56,8 +56,8 @@ TEST_F(LoadObj, ReadsOneBasedIndicesAndExactCoordinates) {
     EXPECT_EQ(mesh.content_sha256.size(), 64u);
 }
 
-// tinyobjloader splits a quad along its shorter diagonal; with the 0-2 diagonal shorter that
-// is the fan (0 1 2) (0 2 3). Faces keep their file order.
+// A quad is split along its shorter diagonal (polygon_triangulation.h); with the 0-2
+// diagonal shorter that is the fan (0 1 2) (0 2 3). Faces keep their file order.
 TEST_F(LoadObj, QuadBecomesTwoTrianglesInFileOrder) {
     const std::string path = write("kite.obj",
                                    "v 0 0 0\n"
@@ -76,14 +76,14 @@ TEST_F(LoadObj, QuadBecomesTwoTrianglesInFileOrder) {
     EXPECT_EQ(mesh.triangles[3], (Int3{1, 2, 4}));
 }
 
-// With the 1-3 diagonal shorter the quad is cut along it: (0 1 3) (1 2 3), both still
-// counter-clockwise like the quad.
+// With the 1-3 diagonal shorter the quad is cut along it: (1 2 3) (0 1 3), both still
+// counter-clockwise like the quad (polygon_triangulation.h: the ear at corner 2 first).
 TEST_F(LoadObj, QuadIsCutAlongItsShorterDiagonal) {
     const std::string path = write("flat.obj", "v 0 0 0\nv 2 -0.5 0\nv 4 0 0\nv 2 0.5 0\nf 1 2 3 4\n");
     const TriangleMesh mesh = load_obj(path);
     ASSERT_EQ(mesh.triangles.size(), 2u);
-    EXPECT_EQ(mesh.triangles[0], (Int3{0, 1, 3}));
-    EXPECT_EQ(mesh.triangles[1], (Int3{1, 2, 3}));
+    EXPECT_EQ(mesh.triangles[0], (Int3{1, 2, 3}));
+    EXPECT_EQ(mesh.triangles[1], (Int3{0, 1, 3}));
 }
 
 TEST_F(LoadObj, MissingFileThrowsWithItsPath) {
