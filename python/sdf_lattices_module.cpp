@@ -36,6 +36,7 @@
 #include "harness/io/field_file.h"
 #include "harness/io/field_output.h"
 #include "harness/provenance/version.h"
+#include "harness/resources/memory_budget.h"
 #include "harness/render/image_buffer.h"
 #include "harness/render/render_backend.h"
 #include "harness/sampling/point_query.h"
@@ -374,7 +375,12 @@ Field sample(const PreparedMesh& mesh, const std::string& lattice, const py::obj
         if (!kernel.empty()) s["kernel"] = kernel;
         JsonReader reader(s, "sample()", "sampler");
         const SamplerOptions options = parse_sampler_options(reader);
-        setup = [spec, options, margin, &mesh] { return SamplingRequest{build_lattice(spec, mesh.bounds(), margin), options}; };
+        setup = [spec, options, margin, &mesh] {
+            SamplingRequest request{build_lattice(spec, mesh.bounds(), margin), options};
+            // The memory plan of run-experiment: refused with the figures, before anything is allocated.
+            require_host_memory(whole_lattice_sampling_need(request.lattice, mesh.name()), "sample()");
+            return request;
+        };
     } catch (const py::error_already_set& e) {
         if (!collective) throw;
         const auto error = std::make_exception_ptr(std::invalid_argument(e.what()));  // no Python object past the GIL
@@ -387,11 +393,15 @@ Field sample(const PreparedMesh& mesh, const std::string& lattice, const py::obj
     SampledField field;
     {
         py::gil_scoped_release release;
-        if (collective) {
-            field = sample_collectively(mesh, setup);
-        } else {
-            const SamplingRequest request = setup();
-            field = make_sampler(request.options)->sample(mesh, request.lattice);
+        try {
+            if (collective) {
+                field = sample_collectively(mesh, setup);
+            } else {
+                const SamplingRequest request = setup();
+                field = make_sampler(request.options)->sample(mesh, request.lattice);
+            }
+        } catch (const std::bad_alloc&) {
+            throw std::runtime_error(out_of_memory_message("sample() of " + mesh.name() + " on a " + lattice + " lattice", 0));
         }
     }
     const MeshReport& r = mesh.report();
