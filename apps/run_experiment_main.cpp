@@ -75,7 +75,9 @@ int main(int argc, char** argv) {
         // Ranks that disagree would wait for each other's messages forever: stop them all now.
         sdf::require_same_settings_on_every_rank(run_settings(options, distribute, check_run, make_baseline, force, quiet));
     } catch (const std::exception& e) {
-        std::cerr << "run-experiment: error: rank " << sdf::distributed_rank() << ": " << e.what() << "\n";
+        // Rank 0 names every option that differs and the ranks; the others say why they stop.
+        if (sdf::distributed_rank() == 0) std::cerr << "run-experiment: error: " << e.what() << "\n";
+        else std::cerr << "run-experiment: rank " << sdf::distributed_rank() << " stops: rank 0 found options that differ\n";
         return 1;
     }
     if (distribute == "runs") sdf::set_distribution(sdf::Distribution::Runs);

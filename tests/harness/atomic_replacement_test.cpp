@@ -208,6 +208,52 @@ TEST_F(AtomicReplacement, ChannelNamesOfAFieldAreRecognised) {
     EXPECT_FALSE(is_field_channel_name("a/f.json", "f.distance.w12.raw"));
 }
 
+SampledField small_field(double value) {
+    SampledField f;
+    f.lattice.type = LatticeType::CC;
+    f.lattice.resolution = {2, 2, 2};
+    f.lattice.spacing = 1;
+    f.resize(8);
+    for (double& d : f.distance) d = value;
+    return f;
+}
+
+// write_field replaces a field the same way: the old channel files go once the new header is
+// in place; a header written by hand keeps the files it names that are not this field's.
+TEST_F(AtomicReplacement, WriteFieldReplacesInOneStepAndRemovesOnlyTheOldFieldsFiles) {
+    FieldWriteOptions allow;
+    allow.overwrite = Overwrite::Allow;
+    write_field(at("f.json"), small_field(1), allow);
+    write_field(at("f.json"), small_field(2), allow);  // the old header names the plain names
+    EXPECT_EQ(read_field(at("f.json")).distance[0], 2);
+    EXPECT_EQ(entries(dir_).size(), 4u);  // header and 3 channels, now tagged
+    EXPECT_FALSE(fs::exists(at("f.distance.raw")));
+    write_field(at("f.json"), small_field(3), allow);  // back to the plain names
+    EXPECT_EQ(entries(dir_), (std::set<std::string>{"f.closest_triangle.raw", "f.distance.raw", "f.gradient.raw", "f.json"}));
+    EXPECT_EQ(read_field(at("f.json")).distance[0], 3);
+    // A user's header naming a file of another pattern: replaced, the file kept.
+    write("u.mine.raw", std::string(32, '\0'));
+    write("u.json", R"({"format": "sdf-lattice-field", "version": 1,
+        "lattice": {"type": "cc", "origin": [0, 0, 0], "spacing": 1, "resolution": [2, 2, 2]},
+        "channels": {"value": {"file": "u.mine.raw"}}})");
+    write_field(at("u.json"), small_field(4), allow);
+    EXPECT_EQ(read_field(at("u.json")).distance[0], 4);
+    EXPECT_TRUE(fs::exists(at("u.mine.raw")));
+}
+
+// A finite value beyond float32's range would be stored as inf: refused, naming the file,
+// and nothing is left behind.
+TEST_F(AtomicReplacement, ValuesBeyondFloat32AreRefused) {
+    const std::string msg = test::error_of([&] { write_field(at("big.json"), small_field(1e39)); });
+    EXPECT_TRUE(test::Contains(msg, "big.distance.raw")) << msg;
+    EXPECT_TRUE(test::Contains(msg, "beyond float32's range")) << msg;
+    EXPECT_TRUE(entries(dir_).empty());
+    FieldWriteOptions f64;
+    f64.dtype = FieldDtype::Float64;
+    write_field(at("big.json"), small_field(1e39), f64);
+    EXPECT_EQ(read_field(at("big.json")).distance[0], 1e39);
+}
+
 // Values the output cannot hold: a band below float32's smallest normal value would be stored
 // as +-0 (a field of zeros), one beyond its largest as +-inf.
 TEST_F(AtomicReplacement, BandsTheOutputCannotHoldAreRefused) {
