@@ -144,7 +144,7 @@ std::string out_of_memory_message(const std::string& what, uint64_t bytes) {
     return "out of memory while " + what + (bytes ? " (about " + format_bytes(bytes) + ")" : std::string()) + ": this process holds " +
            format_bytes(current_resident_bytes()) + " (peak " + format_bytes(peak_resident_bytes()) + "); " +
            (available ? format_bytes(available) + " available" : std::string("available memory unknown")) +
-           ". Use a smaller lattice, a smaller --memory-budget, or a machine with more memory";
+           ". Use a smaller lattice (or a smaller budget), or a machine with more memory";
 }
 
 std::string describe_memory_need(const MemoryNeed& need) {

@@ -24,8 +24,8 @@
 #include "harness/io/field_replacement.h"
 #include "harness_test_util.h"
 
-#if !defined(SDF_SAMPLE_EXE)
-#error "SDF_SAMPLE_EXE must be defined by CMake"
+#if !defined(SDF_SAMPLE_EXE) || !defined(RUN_EXPERIMENT_EXE)
+#error "SDF_SAMPLE_EXE and RUN_EXPERIMENT_EXE must be defined by CMake"
 #endif
 
 namespace sdf {
@@ -304,6 +304,20 @@ TEST_F(AtomicReplacement, OutOfMemoryNamesTheInputAndTheSize) {
     EXPECT_TRUE(test::Contains(failed.err, "400x400x400")) << failed.err;
     EXPECT_FALSE(test::Contains(failed.err, "std::bad_alloc")) << failed.err;
     EXPECT_FALSE(fs::exists(at("f.json")));
+    // run-experiment: its plan refuses the lattice under the limit; past the plan, the
+    // sampling's allocation names the mesh, the lattice and the size.
+    write("c.json", R"({"name": "oom", "kind": "sampling", "mesh": {"shape": "sphere"},
+        "lattices": [{"type": "cc", "resolution": [400, 400, 400]}],
+        "sampler": {"backend": "cpu", "method": "bvh", "threads": 1, "progress": false}})");
+    const std::string experiment = test::quote(RUN_EXPERIMENT_EXE) + " c.json --no-cache --quiet --output-root out";
+    const test::ShellResult refused = test::run_in(dir_, "ulimit -v 2000000 && " + experiment);
+    EXPECT_EQ(refused.code, 1) << refused.err;
+    EXPECT_TRUE(test::Contains(refused.err, "needs about 4.31 GiB of host memory")) << refused.err;
+    const test::ShellResult oom =
+        test::run_in(dir_, "ulimit -v 2000000 && SDF_MEMORY_AVAILABLE=100000000000 " + experiment);
+    EXPECT_EQ(oom.code, 1) << oom.err;
+    EXPECT_TRUE(test::Contains(oom.err, "out of memory while sampling sphere on 400x400x400 (64000000 points)")) << oom.err;
+    EXPECT_TRUE(test::Contains(oom.err, "(about 4.31 GiB)")) << oom.err;
 }
 
 }  // namespace
