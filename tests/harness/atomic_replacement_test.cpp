@@ -101,6 +101,7 @@ TEST_F(AtomicReplacement, FailureOrKillAtEveryStepLeavesTheOldFieldOrTheNewOneWh
         // The old field as a first write left it (plain names), and as a replacement left it
         // (names with a writer's tag): both must be replaced atomically.
         for (int generation : {1, 2}) {
+            if (generation == 2 && c.label != "same lattice") continue;  // the tagged layout once: it does not depend on the lattice
             const fs::path seed = dir_ / ("seed_" + std::to_string(references_) + "_" + std::to_string(generation));
             fs::create_directories(seed);
             if (generation == 2) {
