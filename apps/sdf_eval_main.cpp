@@ -19,6 +19,7 @@
 #include "core/reconstruction/reconstruction.h"
 #include "harness/io/field_file.h"
 #include "harness/io/points_file.h"
+#include "harness/resources/memory_budget.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Reconstructs a CC or BCC field file at given points: prints \"f gx gy gz\" per point."};
@@ -41,8 +42,12 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--threads", threads, "CPU threads (0 = all)")->check(sdf::kNonNegativeNumber)->capture_default_str();
     SDF_CLI_PARSE(app, argc, argv);
+    std::string doing = "reading the field " + field_path;  // for an out-of-memory message
+    uint64_t bytes = 0;
     try {
         const sdf::SampledField field = sdf::read_field(field_path);
+        doing = "reconstructing " + field_path + " (" + std::to_string(field.size()) + " lattice points) at " + points_path;
+        bytes = uint64_t(field.size()) * sdf::kReconstructionBytesPerPoint;
         spec.interpolator = sdf::parse_interpolator(interpolator);
         spec.derivatives = derivatives.empty()
                                ? sdf::default_derivative_source(spec.interpolator, !field.gradient.empty())
@@ -66,6 +71,9 @@ int main(int argc, char** argv) {
                          box.lo.y, box.lo.z, box.hi.x, box.hi.y, box.hi.z);
         }
         return 0;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "sdf-eval: error: " << sdf::out_of_memory_message(doing, bytes) << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "sdf-eval: error: " << e.what() << "\n";
         return 1;

@@ -26,6 +26,7 @@
 #include "harness/io/atomic_file.h"
 #include "harness/io/npy_file.h"
 #include "harness/io/points_file.h"
+#include "harness/resources/memory_budget.h"
 #include "harness/sampling/point_query.h"
 #include "harness/sampling/sampler_table.h"
 
@@ -102,6 +103,9 @@ int main(int argc, char** argv) {
             sdf::write_text_atomically(out_path, results_text(result.samples, options.precision), mode);
         }
         return 0;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "sdf-query: error: " << sdf::out_of_memory_message("querying " + mesh_arg + " at " + points_path, 0) << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "sdf-query: error: " << e.what() << "\n";
         return 1;

@@ -365,6 +365,9 @@ int main(int argc, char** argv) {
         // "config" whose SHA-256 is the images' config_hash
         const nlohmann::json resolved = app.config_to_str(true, false);
         return o.grid ? run_grid(o, resolved) : run_single(o, resolved);
+    } catch (const std::bad_alloc&) {
+        std::cerr << "sdf-render: error: " << sdf::out_of_memory_message("rendering " + o.input, 0) << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "sdf-render: error: " << e.what() << "\n";
         return 1;

@@ -151,11 +151,17 @@ int main(int argc, char** argv) {
         if (!kernel.empty()) sampler_json["kernel"] = kernel;
         sdf::JsonReader sampler_reader(sampler_json, "command line", "sampler");
         options = sdf::parse_sampler_options(sampler_reader);
+        // Values the output cannot hold: a band whose +-W the stored type would round to 0 or inf.
+        sdf::require_representable_band(band, dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64,
+                                        "--band");
+        if (!vdb_path.empty()) sdf::require_representable_band(band, sdf::FieldDtype::Float32, "--band (the .vdb stores float32)");
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return sdf::kExitCommandLineError;
     }
     if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
+    std::string doing = "loading " + mesh_arg;  // for an out-of-memory message: what, and how much
+    uint64_t planned_bytes = 0;
     try {
         stream.header_path = out_path;
         stream.write.dtype = dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64;
@@ -164,6 +170,11 @@ int main(int argc, char** argv) {
         stream.bytes_per_point = sdf::sampler_kind(options).stream_bytes_per_point;
         stream.progress = !quiet;
 
+        // Every target is checked before the mesh is even loaded (and again before sampling).
+        if (!dry_run) {
+            sdf::require_writable_target(out_path, stream.write.overwrite);
+            if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
+        }
         const sdf::PreparedMesh mesh =
             sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-sample: warning: " << w << "\n";
@@ -172,6 +183,8 @@ int main(int argc, char** argv) {
         stream.vdb_path = vdb_path;
         stream.vdb_band = band > 0 ? band : 3.0 * lattice.spacing;  // the .vdb export's default band: 3 spacings
         const sdf::StreamPlan plan = sdf::plan_streamed_sampling(lattice, stream);
+        doing = "sampling " + mesh_arg + " on " + sdf::lattice_notation(lattice) + ", " + std::to_string(plan.points) + " points";
+        planned_bytes = plan.peak_estimate;
         if (dry_run) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision)
                       << (band > 0 ? ", band " + std::to_string(band) : std::string()) << "\n"
@@ -181,6 +194,7 @@ int main(int argc, char** argv) {
                           << " active (its grids hold the band's points, outside the budget)\n";
             return 0;
         }
+        sdf::require_plan_fits_machine(plan.peak_estimate, stream.memory_budget, "--memory-budget");
         require_output_space(plan, out_path);
         // Temporaries of an interrupted earlier run in the output folder (their process is gone).
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
@@ -204,6 +218,9 @@ int main(int argc, char** argv) {
         if (band > 0)
             std::cout << "band " << band << ": " << r.band.in_band << " points in the band, " << r.band.outside << " outside\n";
         return 0;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "sdf-sample: error: " << sdf::out_of_memory_message(doing, planned_bytes) << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return 1;

@@ -10,6 +10,7 @@
 #include "harness/cache/field_cache.h"
 #include "harness/distributed/distributed.h"
 #include "harness/io/field_file.h"
+#include "harness/resources/memory_budget.h"
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
@@ -64,7 +65,12 @@ ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice,
         }
     }
     log << "  " << what << ": sampling with " << sampler().name() << " ..." << std::endl;
-    out.field = sampler().sample(mesh, lattice);
+    try {
+        out.field = sampler().sample(mesh, lattice);
+    } catch (const std::bad_alloc&) {  // a limit the memory plan could not see: name what and how much
+        const MemoryNeed need = whole_lattice_sampling_need(lattice, mesh.name());
+        throw std::runtime_error(out_of_memory_message(need.what + " for " + label, need.host_bytes));
+    }
     char line[160];
     std::snprintf(line, sizeof line, "  %s: sampled in %.2f s (%.3g pairs/s)", what.c_str(), out.field.timings.total,
                   out.field.timings.pairs_per_second());

@@ -56,6 +56,14 @@ bool distributed_active();
 int distributed_rank();  ///< 0 without MPI
 int distributed_size();  ///< 1 without MPI
 
+/// Every rank's `settings` (a JSON object: what its command line and environment chose)
+/// compared with rank 0's before any work, so that ranks started with different options stop
+/// instead of waiting for messages that never come. Collective: every rank calls it right
+/// after DistributedScope. Where any key differs, every rank throws std::runtime_error naming
+/// each differing key, rank 0's value and the ranks that have another (and theirs); the root
+/// then ends the run without the workers' loop. Does nothing without a distributed run.
+void require_same_settings_on_every_rank(const nlohmann::json& settings);
+
 /// A worker's life (rank > 0): serve the root's sampling requests until it ends the run.
 /// Returns the process exit code.
 int serve_distributed_requests();

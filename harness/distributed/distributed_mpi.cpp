@@ -7,6 +7,8 @@
 //   worker -> root  kTagData     (when ok) distance, gradient, closest triangle; each as the
 //                                slab's primary part then its secondary part
 //   worker -> root  kTagHello    at start: rank, host, local rank, threads, GPU
+//   worker -> root  kTagSettings then its command line's settings (JSON); the root answers
+//   root -> worker  kTagSettings with "" (the same as rank 0's) or the message every rank raises
 //   root -> worker  kTagCommand  Write: the channel files (temporary names) of the field the
 //                                ranks sampled last; the worker writes its slab into them with
 //                                MPI-IO and answers with a kTagStatus JSON (bytes, seconds, or
@@ -39,6 +41,7 @@
 #include "core/sampling/sampler_results.h"
 #include "harness/build_config.h"
 #include "harness/distributed/slab_plan.h"
+#include "harness/io/field_replacement.h"
 #include "harness/sampling/sampler_table.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
@@ -47,7 +50,8 @@
 namespace sdf {
 namespace {
 
-constexpr int kTagCommand = 1, kTagStatus = 2, kTagData = 3, kTagHello = 4, kTagRuns = 5, kTagOutcome = 6;
+constexpr int kTagCommand = 1, kTagStatus = 2, kTagData = 3, kTagHello = 4, kTagRuns = 5, kTagOutcome = 6,
+              kTagSettings = 7;
 enum class Command : int32_t { Sample = 1, Quit = 2, Write = 3 };
 constexpr size_t kChunkBytes = size_t(1) << 30;
 /// Points converted to the stored dtype at a time by a parallel write (bounds its buffer:
@@ -1021,6 +1025,58 @@ int distributed_rank() { return session().rank; }
 int distributed_size() { return session().size; }
 bool distributed_build() { return true; }
 
+namespace {
+
+/// Rank 0: what differs between every rank's settings (in rank order) and its own, one
+/// clause per key: "--distribute: rank 0 has \"slabs\", rank 1 has \"runs\"". Empty when
+/// every rank agrees.
+std::string settings_differences(const std::vector<nlohmann::json>& settings) {
+    const nlohmann::json& root = settings[0];
+    std::vector<std::string> keys;
+    for (const nlohmann::json& s : settings)
+        for (const auto& [key, value] : s.items())
+            if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+    std::string text;
+    for (const std::string& key : keys) {
+        const auto value_of = [&](const nlohmann::json& s) { return s.contains(key) ? s[key].dump() : std::string("nothing"); };
+        std::map<std::string, std::vector<int>> others;  // value -> ranks
+        for (size_t r = 1; r < settings.size(); ++r)
+            if (value_of(settings[r]) != value_of(root)) others[value_of(settings[r])].push_back(int(r));
+        if (others.empty()) continue;
+        std::string clause = key + ": rank 0 has " + value_of(root);
+        for (const auto& [value, ranks] : others) {
+            std::string list;
+            for (int r : ranks) list += (list.empty() ? "" : ", ") + std::to_string(r);
+            clause += ", rank" + std::string(ranks.size() > 1 ? "s " : " ") + list + " ha" + (ranks.size() > 1 ? "ve " : "s ") + value;
+        }
+        text += (text.empty() ? "" : "; ") + clause;
+    }
+    return text;
+}
+
+}  // namespace
+
+void require_same_settings_on_every_rank(const nlohmann::json& settings) {
+    Session& s = session();
+    if (!distributed_active()) return;
+    std::string verdict;
+    if (s.rank != 0) {
+        send_string(settings.dump(), 0, kTagSettings);
+        verdict = receive_string(0, kTagSettings);
+    } else {
+        std::vector<nlohmann::json> all = {settings};
+        for (int r = 1; r < s.size; ++r) all.push_back(nlohmann::json::parse(receive_string(r, kTagSettings), nullptr, false));
+        const std::string differences = settings_differences(all);
+        if (!differences.empty())
+            verdict = "the ranks were started with different options (every rank must get the same command line and "
+                      "environment); nothing was run: " + differences;
+        for (int r = 1; r < s.size; ++r) send_string(verdict, r, kTagSettings);
+    }
+    if (verdict.empty()) return;
+    s.released = true;  // no worker waits for a command: each stops here
+    throw std::runtime_error(verdict);
+}
+
 int serve_distributed_requests() {
     Worker worker;
     for (;;) {
@@ -1073,14 +1129,9 @@ public:
 
     const std::vector<FieldChannelFile>& files() const { return temps_; }
 
-    /// Moves file i to `final_path` (refused if it exists, unless overwriting is allowed).
-    void move_into_place(size_t i, const std::string& final_path, Overwrite overwrite) {
-        if (overwrite == Overwrite::Forbid) {
-            if (!rename_no_replace(temps_[i].path, final_path))
-                throw std::runtime_error(final_path + ": already exists; refusing to overwrite a field");
-        } else {
-            std::filesystem::rename(temps_[i].path, final_path);
-        }
+    /// Renames file i to its final name (FieldReplacement::place).
+    void place(FieldReplacement& replacement, size_t i) {
+        replacement.place(i, temps_[i].path);
         temps_[i].path.clear();
     }
 
@@ -1110,14 +1161,12 @@ std::string write_sampled_field(const std::string& header_path, const SampledFie
     const Session::HeldField held = s.held;
     s.held.valid = false;  // the workers release their slabs with this write, whatever happens
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<FieldChannelFile> files = field_channel_files(header_path, field, options);
-    std::vector<std::string> targets = {header_path};
-    for (const FieldChannelFile& f : files) targets.push_back(f.path);
-    if (options.overwrite == Overwrite::Forbid)
-        for (const std::string& t : targets)
-            if (std::filesystem::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
     const std::filesystem::path parent = std::filesystem::path(header_path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
+    require_storable(field, options, header_path);
+    // Every target checked and the channels' final names chosen (field_replacement.h).
+    FieldReplacement replacement(header_path, field_channel_files(header_path, field, options), options.overwrite);
+    const std::vector<FieldChannelFile>& files = replacement.channels();
     PreallocatedFiles staged(files, field.size());
 
     ByteWriter request;
@@ -1176,18 +1225,8 @@ std::string write_sampled_field(const std::string& header_path, const SampledFie
         for (size_t i = 0; i < errors.size(); ++i) text += (i ? "; " : "") + errors[i];
         throw std::runtime_error(text);
     }
-    std::vector<std::string> moved;
-    try {
-        for (size_t i = 0; i < files.size(); ++i) {
-            staged.move_into_place(i, files[i].path, options.overwrite);
-            moved.push_back(files[i].path);
-        }
-        write_field_header(header_path, field, files, options.overwrite);
-    } catch (...) {
-        if (options.overwrite == Overwrite::Forbid)
-            for (const std::string& m : moved) ::unlink(m.c_str());  // all new: leave none behind
-        throw;
-    }
+    for (size_t i = 0; i < files.size(); ++i) staged.place(replacement, i);
+    replacement.commit(field);  // the header: the commit point
 
     // The manifest's record of the field: how its files were written, by whom.
     nlohmann::json& record = s.fields[held.field_index];

@@ -13,6 +13,7 @@ bool distributed_active() { return false; }
 int distributed_rank() { return 0; }
 int distributed_size() { return 1; }
 int serve_distributed_requests() { return 0; }
+void require_same_settings_on_every_rank(const nlohmann::json&) {}
 std::unique_ptr<Sampler> make_field_sampler(const SamplerOptions& options) { return make_sampler(options); }
 void share_mesh_with_workers(const TriangleMesh&) {}
 nlohmann::json distributed_description() { return nullptr; }

@@ -8,8 +8,11 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <regex>
 #include <stdexcept>
 
@@ -52,12 +55,56 @@ std::string normalised(const std::string& path) {
 
 }  // namespace
 
+void fault_point(const std::string& step) {
+    static const long at = [] {
+        const char* v = std::getenv("SDF_FAULT_AT");
+        return v && *v ? std::strtol(v, nullptr, 10) : 0L;
+    }();
+    if (at <= 0) return;
+    static std::atomic<long> calls{0};
+    if (calls.fetch_add(1) + 1 != at) return;
+    const char* mode = std::getenv("SDF_FAULT_MODE");
+    if (mode && std::string(mode) == "kill") ::raise(SIGKILL);
+    throw std::runtime_error("injected failure at step " + std::to_string(at) + ": " + step);
+}
+
+void sync_file(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw std::runtime_error(path + ": cannot open to sync (" + errno_text(errno) + ")");
+    const int e = ::fsync(fd) == 0 ? 0 : errno;
+    ::close(fd);
+    if (e != 0) throw std::runtime_error(path + ": fsync failed (" + errno_text(e) + ")");
+}
+
+void require_writable_target(const std::string& path, Overwrite overwrite) {
+    const fs::path target = fs::absolute(path);
+    const fs::path dir = target.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist (or is not a folder)");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw std::runtime_error(path + ": the folder " + dir.string() + " is not writable (" + errno_text(errno) + ")");
+    if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a folder; expected a file name");
+    if (overwrite == Overwrite::Forbid && fs::exists(target, ec))
+        throw std::runtime_error(path + ": already exists; refusing to overwrite it");
+}
+
 std::string unique_sibling_name(const std::string& path, const std::string& tag) {
     static std::atomic<unsigned long> counter{0};
     const fs::path p(path);
     const std::string name = "." + p.filename().string() + "." + tag + "." + std::to_string(::getpid()) + "." +
                              std::to_string(counter.fetch_add(1));
     return (p.parent_path() / name).string();
+}
+
+bool process_is_running(long pid) {
+    if (pid <= 0) return false;
+    if (::kill(pid_t(pid), 0) != 0 && errno != EPERM) return false;
+    // "pid (comm) S ...": the state follows the last ')' (comm may hold spaces and parentheses).
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    const size_t close = text.rfind(')');
+    return close == std::string::npos || close + 2 >= text.size() || text[close + 2] != 'Z';
 }
 
 int remove_stale_staging(const std::string& dir) {
@@ -70,7 +117,7 @@ int remove_stale_staging(const std::string& dir) {
         const std::string name = e.path().filename().string();
         if (!std::regex_match(name, m, pattern)) continue;
         const pid_t pid = pid_t(std::stol(m[2].str()));
-        if (::kill(pid, 0) == 0 || errno == EPERM) continue;  // still running
+        if (process_is_running(pid)) continue;
         std::error_code rm;
         fs::remove_all(e.path(), rm);
         if (!rm) ++removed;
@@ -120,6 +167,7 @@ void write_file_atomically(const std::string& path, const void* data, size_t siz
         throw std::runtime_error(path + ": write failed: " + errno_text(e));
     }
     try {
+        fault_point("rename " + path + " into place");
         if (overwrite == Overwrite::Forbid) {
             if (!rename_no_replace(tmp, path)) throw refuse();
         } else if (::rename(tmp.c_str(), path.c_str()) != 0) {

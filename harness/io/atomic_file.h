@@ -53,6 +53,10 @@ private:
     bool committed_ = false;
 };
 
+/// Whether process `pid` still runs: it exists and is not a zombie (a killed process whose
+/// parent has not reaped it yet has written its last byte).
+bool process_is_running(long pid);
+
 /// Removes what interrupted writers left in `dir`: temporaries and staging directories
 /// (unique_sibling_name) whose process is no longer running. Returns how many were removed.
 int remove_stale_staging(const std::string& dir);
@@ -60,5 +64,21 @@ int remove_stale_staging(const std::string& dir);
 /// A name for a temporary file or directory beside `path`: ".<name>.<tag>.<pid>.<n>" with n
 /// unique within this process (so threads never collide).
 std::string unique_sibling_name(const std::string& path, const std::string& tag);
+
+/// fsync of a complete file written by another writer (a library's), before it is renamed
+/// into place. Throws naming `path` when it fails.
+void sync_file(const std::string& path);
+
+/// Checks, before any work, that `path` can be written: its folder exists and is writable,
+/// `path` is not a folder, and it does not exist unless overwriting is allowed. Throws
+/// std::runtime_error naming `path` and what is wrong.
+void require_writable_target(const std::string& path, Overwrite overwrite);
+
+/// The crash-safety tests' hook (tests/harness/atomic_replacement_test.cpp): every step of a
+/// commit that another step must not be separated from calls it. With SDF_FAULT_AT=k in the
+/// environment, the k-th call of the process (1-based) throws std::runtime_error("injected
+/// failure at step k: `step`"), or with SDF_FAULT_MODE=kill ends the process with SIGKILL, as
+/// a crash or the OOM killer would. Without SDF_FAULT_AT it does nothing.
+void fault_point(const std::string& step);
 
 }  // namespace sdf

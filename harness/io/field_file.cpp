@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -10,6 +12,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "harness/config/json_reader.h"
+#include "harness/io/field_replacement.h"
 
 namespace sdf {
 namespace fs = std::filesystem;
@@ -134,14 +137,6 @@ nlohmann::json field_header(const SampledField& field, const nlohmann::json& cha
     return header;
 }
 
-/// Removes `files`, ignoring errors: the caller is already failing.
-void remove_quietly(const std::vector<std::string>& files) {
-    for (const std::string& f : files) {
-        std::error_code ec;
-        fs::remove(f, ec);
-    }
-}
-
 }  // namespace
 
 size_t FieldChannelFile::bytes_per_point() const {
@@ -171,6 +166,11 @@ std::vector<char> field_channel_bytes(const SampledField& field, const FieldChan
             if (count > 0) std::memcpy(bytes.data(), values + at, count * c * sizeof(Stored));  // stored as held
         } else {
             for (size_t i = 0; i < count * c; ++i) {
+                if constexpr (std::is_same_v<Stored, float>)
+                    if (std::abs(values[at + i]) > double(std::numeric_limits<float>::max()) && std::isfinite(values[at + i]))
+                        throw std::range_error(channel.path + ": value " + std::to_string(values[at + i]) + " of point " +
+                                               std::to_string((at + i) / c) + " is beyond float32's range (3.40282e38); "
+                                               "write float64");
                 const Stored v = Stored(values[at + i]);
                 std::memcpy(bytes.data() + i * sizeof(Stored), &v, sizeof(Stored));
             }
@@ -196,38 +196,49 @@ void write_field_header(const std::string& header_path, const SampledField& fiel
 }
 
 void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options) {
-    const std::string stem = stem_of_header(header_path);
-    const std::vector<FieldChannelFile> files = field_channel_files(header_path, field, options);
-    // Every target is checked before anything is written, so a refusal leaves no orphan
-    // channel behind; a file that appears meanwhile is still refused by the atomic write,
-    // and then what this call wrote is removed again.
-    std::vector<std::string> targets = {stem + ".json"};
-    for (const FieldChannelFile& f : files) targets.push_back(f.path);
-    if (options.overwrite == Overwrite::Forbid)
-        for (const std::string& t : targets)
-            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field");
-    std::vector<std::string> written;
-    try {
-        for (const FieldChannelFile& f : files) {
-            const size_t bytes = size_t(field.size()) * f.bytes_per_point();
-            // Channels stored as held (float64, int32) are written from the field's arrays,
-            // without a copy: the same bytes as field_channel_bytes.
-            if (f.name == "closest_triangle") {
-                write_file_atomically(f.path, field.closest_triangle.data(), bytes, options.overwrite);
-            } else if (f.dtype == FieldDtype::Float64) {
-                const double* values = f.name == "distance" ? field.distance.data() : &field.gradient[0].x;
-                write_file_atomically(f.path, values, bytes, options.overwrite);
-            } else {
-                const std::vector<char> converted = field_channel_bytes(field, f, 0, size_t(field.size()));
-                write_file_atomically(f.path, converted.data(), converted.size(), options.overwrite);
-            }
-            written.push_back(f.path);
+    const std::string header = stem_of_header(header_path) + ".json";
+    const fs::path parent = fs::path(header).parent_path();
+    if (!parent.empty()) fs::create_directories(parent);
+    // Every target is checked, and the channels' names chosen, before anything is written
+    // (field_replacement.h): the header is written last, over the old one in one step.
+    require_storable(field, options, header);
+    FieldReplacement replacement(header, field_channel_files(header_path, field, options), options.overwrite);
+    for (size_t i = 0; i < replacement.channels().size(); ++i) {
+        const FieldChannelFile& f = replacement.channels()[i];
+        const size_t bytes = size_t(field.size()) * f.bytes_per_point();
+        // Channels stored as held (float64, int32) are written from the field's arrays,
+        // without a copy: the same bytes as field_channel_bytes. The names are new: no replace.
+        if (f.name == "closest_triangle") {
+            write_file_atomically(f.path, field.closest_triangle.data(), bytes, Overwrite::Forbid);
+        } else if (f.dtype == FieldDtype::Float64) {
+            const double* values = f.name == "distance" ? field.distance.data() : &field.gradient[0].x;
+            write_file_atomically(f.path, values, bytes, Overwrite::Forbid);
+        } else {
+            const std::vector<char> converted = field_channel_bytes(field, f, 0, size_t(field.size()));
+            write_file_atomically(f.path, converted.data(), converted.size(), Overwrite::Forbid);
         }
-        write_field_header(header_path, field, files, options.overwrite);
-    } catch (...) {
-        if (options.overwrite == Overwrite::Forbid) remove_quietly(written);  // all new: leave none behind
-        throw;
+        replacement.placed(i);
     }
+    replacement.commit(field);
+}
+
+void require_representable_band(double w, FieldDtype dtype, const std::string& what) {
+    if (w == 0) return;
+    const bool f32 = dtype == FieldDtype::Float32;
+    const double least = f32 ? double(std::numeric_limits<float>::min()) : std::numeric_limits<double>::min();
+    const double most = f32 ? double(std::numeric_limits<float>::max()) : std::numeric_limits<double>::max();
+    if (w >= least && w <= most) return;
+    char text[160];
+    std::snprintf(text, sizeof text, "%.6g cannot be stored in %s (its positive normal values are %.6g to %.6g)", w,
+                  f32 ? "float32" : "float64", least, most);
+    throw std::invalid_argument(what + ": " + text + (f32 ? "; choose a band in that range, or float64 output" : ""));
+}
+
+void require_storable(const SampledField& field, const FieldWriteOptions& options, const std::string& header_path) {
+    const nlohmann::json& s = field.sampler;
+    if (s.is_object() && s.contains("band") && s["band"].is_object() && s["band"].contains("width") &&
+        s["band"]["width"].is_number())
+        require_representable_band(s["band"]["width"].get<double>(), options.dtype, header_path + ": the narrow band width");
 }
 
 SampledField read_field(const std::string& header_path) {

@@ -31,8 +31,10 @@ struct FieldWriteOptions {
 };
 
 /// Writes NAME.json and its channel files next to it (NAME = header path without ".json").
-/// Channel files are written first and the header last, each atomically, so a header
-/// always describes complete data.
+/// Channel files are written first and the header last, each atomically; an existing field is
+/// replaced (Overwrite::Allow) in one atomic step, the header's rename (field_replacement.h), so
+/// NAME.json describes the old field whole or the new one whole at every instant. Values the
+/// stored type cannot hold (a finite value beyond float32's range) are refused, naming the channel.
 void write_field(const std::string& header_path, const SampledField& field, const FieldWriteOptions& options = {});
 
 /// One channel file of a field as write_field lays it out, for writers that fill the files
@@ -58,6 +60,15 @@ std::vector<char> field_channel_bytes(const SampledField& field, const FieldChan
 /// step of write_field, and of writers that fill the channel files by parts.
 void write_field_header(const std::string& header_path, const SampledField& field,
                         const std::vector<FieldChannelFile>& channels, Overwrite overwrite);
+
+/// Refuses (std::invalid_argument naming `what`) a narrow band width w > 0 that `dtype`
+/// cannot hold: below its smallest positive normal value (float32: 1.17549e-38; the band's
+/// +-w would be stored as 0 or lose its digits) or beyond its largest (float32: 3.40282e38).
+void require_representable_band(double w, FieldDtype dtype, const std::string& what);
+
+/// The checks of write_field before anything is written: a narrow band (the field's
+/// sampler.band.width) that options.dtype cannot hold is refused, naming `header_path`.
+void require_storable(const SampledField& field, const FieldWriteOptions& options, const std::string& header_path);
 
 /// Reads a field written by write_field or by a user. The value channel becomes
 /// `distance`; the gradient channel, if any, `gradient`. Errors name the file and key.

@@ -1,5 +1,8 @@
 #include "harness/resources/memory_budget.h"
 
+#include "core/lattice/lattice_fitting.h"
+
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
@@ -66,6 +69,40 @@ uint64_t current_resident_bytes() {
     return resident * uint64_t(sysconf(_SC_PAGESIZE));
 }
 
+namespace {
+
+/// The first number in the file at `path`; 0 when it is missing or not a number ("max").
+uint64_t number_in(const char* path) {
+    std::ifstream in(path);
+    uint64_t v = 0;
+    return in >> v ? v : 0;
+}
+
+/// What this process's memory limits leave: the cgroup's (v2, else v1) limit less its usage,
+/// and the address-space limit (ulimit -v) less the address space in use; ~0 when unlimited.
+uint64_t memory_left_by_limits() {
+    uint64_t left = ~uint64_t(0);
+    for (const auto& [limit_file, usage_file] : {std::pair{"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
+                                                 std::pair{"/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                                                           "/sys/fs/cgroup/memory/memory.usage_in_bytes"}}) {
+        const uint64_t limit = number_in(limit_file);
+        if (limit == 0 || limit >= (uint64_t(1) << 60)) continue;  // none, "max", or v1's "unlimited"
+        const uint64_t used = number_in(usage_file);
+        left = std::min(left, limit > used ? limit - used : 0);
+    }
+    rlimit as{};
+    if (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) {
+        std::ifstream statm("/proc/self/statm");
+        uint64_t pages = 0;
+        statm >> pages;
+        const uint64_t used = pages * uint64_t(sysconf(_SC_PAGESIZE));
+        left = std::min<uint64_t>(left, as.rlim_cur > used ? as.rlim_cur - used : 0);
+    }
+    return left;
+}
+
+}  // namespace
+
 uint64_t host_memory_available() {
     if (const char* env = std::getenv("SDF_MEMORY_AVAILABLE"); env && *env) {
         char* end = nullptr;
@@ -74,14 +111,40 @@ uint64_t host_memory_available() {
             throw std::runtime_error(std::string("SDF_MEMORY_AVAILABLE: expected a number of bytes, got \"") + env + "\"");
         return v;
     }
+    uint64_t available = 0;
     std::ifstream meminfo("/proc/meminfo");
     for (std::string line; std::getline(meminfo, line);) {
         std::istringstream fields(line);
         std::string name;
         uint64_t kib = 0;
-        if (fields >> name >> kib && name == "MemAvailable:") return kib * 1024;
+        if (fields >> name >> kib && name == "MemAvailable:") available = kib * 1024;
     }
-    return 0;
+    const uint64_t limited = memory_left_by_limits();
+    return available == 0 ? (limited == ~uint64_t(0) ? 0 : limited) : std::min(available, limited);
+}
+
+uint64_t host_memory_physical() {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : 0;
+}
+
+void require_plan_fits_machine(uint64_t peak, uint64_t budget, const std::string& what) {
+    const uint64_t available = host_memory_available();
+    if (available == 0 || peak <= available) return;
+    const uint64_t physical = host_memory_physical();
+    throw std::runtime_error(what + ": the plan's estimated peak, " + format_bytes(peak) + " (budget " + format_bytes(budget) +
+                             "), exceeds the " + format_bytes(available) + " of memory available to this process" +
+                             (physical ? " (the machine has " + format_bytes(physical) + ")" : std::string()) +
+                             "; give a budget of at most " + format_bytes(available) +
+                             " (SDF_MEMORY_AVAILABLE overrides the figure, in bytes)");
+}
+
+std::string out_of_memory_message(const std::string& what, uint64_t bytes) {
+    const uint64_t available = host_memory_available();
+    return "out of memory while " + what + (bytes ? " (about " + format_bytes(bytes) + ")" : std::string()) + ": this process holds " +
+           format_bytes(current_resident_bytes()) + " (peak " + format_bytes(peak_resident_bytes()) + "); " +
+           (available ? format_bytes(available) + " available" : std::string("available memory unknown")) +
+           ". Use a smaller lattice (or a smaller budget), or a machine with more memory";
 }
 
 std::string describe_memory_need(const MemoryNeed& need) {
@@ -91,6 +154,15 @@ std::string describe_memory_need(const MemoryNeed& need) {
                        (available ? format_bytes(available) + " available" : "available memory unknown");
     if (available && need.host_bytes > available) text += " (the run would be refused)";
     return text;
+}
+
+MemoryNeed whole_lattice_sampling_need(const Lattice& lattice, const std::string& mesh) {
+    const uint64_t points = uint64_t(lattice.num_points());
+    const uint64_t most = (~uint64_t(0) - kBaseBytes) / kSamplingBytesPerPoint;
+    MemoryNeed need;
+    need.host_bytes = kBaseBytes + std::min(points, most) * kSamplingBytesPerPoint;
+    need.what = "sampling " + mesh + " on " + lattice_notation(lattice) + " (" + std::to_string(points) + " points)";
+    return need;
 }
 
 void require_host_memory(const MemoryNeed& need, const std::string& where) {

@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <string>
 
+#include "kernels/lattice/lattice.h"
+
 namespace sdf {
 
 struct MemoryNeed {
@@ -46,11 +48,28 @@ uint64_t peak_resident_bytes();
 uint64_t current_resident_bytes();
 
 /// Host memory a new allocation can get: $SDF_MEMORY_AVAILABLE (bytes; for tests and to
-/// leave room for other work), else MemAvailable of /proc/meminfo; 0 when unknown.
+/// leave room for other work), else MemAvailable of /proc/meminfo, lowered to what this
+/// process's limits leave (a cgroup's memory limit, `ulimit -v`); 0 when unknown.
 uint64_t host_memory_available();
+/// The machine's physical memory (sysconf); 0 when unknown.
+uint64_t host_memory_physical();
+
+/// Refuses (std::runtime_error naming `what`, the peak, the budget, the memory available and
+/// the machine's) a memory plan whose estimated peak exceeds host_memory_available(): a
+/// budget beyond the machine is not trusted.
+void require_plan_fits_machine(uint64_t peak, uint64_t budget, const std::string& what);
+
+/// The message for a std::bad_alloc caught while doing `what` ("sampling MESH on LATTICE"):
+/// `what`, the size being allocated when known (bytes > 0), this process's resident memory and
+/// the memory available.
+std::string out_of_memory_message(const std::string& what, uint64_t bytes);
 
 /// "about 1.2 GiB of host memory for sampling cc ...; 20 GiB available" (or "unknown").
 std::string describe_memory_need(const MemoryNeed& need);
+
+/// What sampling all of `lattice` at once needs (the module's sample(), as run-experiment's
+/// plan counts it): kBaseBytes plus kSamplingBytesPerPoint a point, saturating.
+MemoryNeed whole_lattice_sampling_need(const Lattice& lattice, const std::string& mesh);
 
 /// Throws std::runtime_error naming `where` (when not empty), the step, what it needs and what is available,
 /// when the need is known and exceeds what is available.

@@ -17,6 +17,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/parallel/parallel_for.h"
 #include "harness/io/atomic_file.h"
+#include "harness/io/field_replacement.h"
 #include "harness/io/volume_grids.h"
 #include "harness/resources/memory_budget.h"
 
@@ -66,8 +67,8 @@ public:
     }
     ~StagedChannels() {
         close_all();
-        if (!committed_)
-            for (const std::string& t : temps_) ::unlink(t.c_str());
+        for (const std::string& t : temps_)
+            if (!t.empty()) ::unlink(t.c_str());
     }
     StagedChannels(const StagedChannels&) = delete;
     StagedChannels& operator=(const StagedChannels&) = delete;
@@ -103,20 +104,15 @@ public:
         });
     }
 
-    /// fsync, close, and rename every file into place (replacing only with Overwrite::Allow).
-    void commit(Overwrite overwrite) {
+    /// fsync and close every file, then rename each to its final name (FieldReplacement).
+    void place_all(FieldReplacement& replacement) {
         for (size_t c = 0; c < fds_.size(); ++c)
             if (::fsync(fds_[c]) != 0) throw std::runtime_error(channels_[c].path + ": fsync failed (" + errno_text() + ")");
         close_all();
         for (size_t c = 0; c < temps_.size(); ++c) {
-            if (overwrite == Overwrite::Allow) {
-                fs::rename(temps_[c], channels_[c].path);
-            } else if (!rename_no_replace(temps_[c], channels_[c].path)) {
-                for (size_t k = 0; k < c; ++k) ::unlink(channels_[k].path.c_str());  // ours, just renamed
-                throw std::runtime_error(channels_[c].path + ": appeared while sampling; refusing to overwrite a field");
-            }
+            replacement.place(c, temps_[c]);
+            temps_[c].clear();  // renamed: the replacement owns it now
         }
-        committed_ = true;
     }
 
 private:
@@ -137,7 +133,17 @@ private:
     std::vector<FieldChannelFile> channels_;
     std::vector<std::string> temps_;
     std::vector<int> fds_;
-    bool committed_ = false;
+};
+
+/// A file removed when it goes out of scope, unless its path was cleared (renamed into place).
+struct TemporaryFile {
+    explicit TemporaryFile(std::string p) : path(std::move(p)) {}
+    ~TemporaryFile() {
+        if (!path.empty()) ::unlink(path.c_str());
+    }
+    TemporaryFile(const TemporaryFile&) = delete;
+    TemporaryFile& operator=(const TemporaryFile&) = delete;
+    std::string path;
 };
 
 /// The merged sampler provenance of the slabs: the first slab's, with the counts summed.
@@ -255,20 +261,20 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     StreamResult result;
     result.plan = plan_streamed_sampling(lattice, options);
     const StreamPlan& plan = result.plan;
-    std::vector<std::string> targets = {options.header_path};
-    if (!options.vdb_path.empty()) targets.push_back(options.vdb_path);
-    for (const FieldChannelFile& c : plan.channels) targets.push_back(c.path);
-    if (options.write.overwrite == Overwrite::Forbid)
-        for (const std::string& t : targets)
-            if (fs::exists(t)) throw std::runtime_error(t + ": already exists; refusing to overwrite a field (--overwrite replaces it)");
+    // Every target is checked before sampling: the field's header and channels (whose
+    // final names are chosen now: field_replacement.h) and the .vdb.
+    require_representable_band(w, options.write.dtype, "band width");
+    FieldReplacement replacement(options.header_path, plan.channels, options.write.overwrite);
     std::unique_ptr<VdbNarrowBandBuilder> vdb;
     if (!options.vdb_path.empty()) {
+        require_writable_target(options.vdb_path, options.write.overwrite);
         if (!(options.vdb_band > 0) || !std::isfinite(options.vdb_band))
             throw std::invalid_argument(options.vdb_path + ": the OpenVDB band must be a positive width, got " +
                                         std::to_string(options.vdb_band));
+        require_representable_band(options.vdb_band, FieldDtype::Float32, options.vdb_path + ": the OpenVDB band");
         vdb = std::make_unique<VdbNarrowBandBuilder>(lattice, options.vdb_band, options.gradient);
     }
-    StagedChannels files(plan.channels, plan.points);
+    StagedChannels files(replacement.channels(), plan.points);
 
     SampledField& header = result.header;
     header.lattice = lattice;
@@ -296,7 +302,15 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         const LatticeSlab slab = slabs[s];
         const auto slab_start = Clock::now();
         std::optional<StoredSlab> stored;
-        if (stored_layout) stored = sampler.sample_slab_stored(mesh, lattice, slab, *stored_layout);
+        try {
+            if (stored_layout) stored = sampler.sample_slab_stored(mesh, lattice, slab, *stored_layout);
+        } catch (const std::bad_alloc&) {
+            throw std::runtime_error(out_of_memory_message(
+                "sampling z-planes " + std::to_string(slab.z_begin) + "-" + std::to_string(slab.z_end - 1) + " of " +
+                    lattice_notation(lattice) + " (" + std::to_string(slab_point_count(lattice, slab)) + " points) for " +
+                    options.header_path,
+                uint64_t(slab_point_count(lattice, slab)) * plan.bytes_per_point));
+        }
         if (stored) {
             if (stored->points != slab_point_count(lattice, slab))
                 throw std::logic_error("sampler stored " + std::to_string(stored->points) + " points for a slab of " +
@@ -305,6 +319,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
                 result.band.in_band += stored->band.in_band;
                 result.band.outside += stored->band.outside;
             }
+            fault_point("sampled slab " + std::to_string(s + 1) + " of " + std::to_string(slabs.size()));
             account(stored->info);
             const double sampled = seconds_since(slab_start);
             wait_for_writer();
@@ -323,7 +338,16 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
                           << slab.z_end - 1 << "): sampled in " << sampled << " s (stored on the device)\n";
             continue;
         }
-        auto field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
+        std::shared_ptr<SampledField> field;
+        try {
+            field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
+        } catch (const std::bad_alloc&) {
+            throw std::runtime_error(out_of_memory_message(
+                "sampling z-planes " + std::to_string(slab.z_begin) + "-" + std::to_string(slab.z_end - 1) + " of " +
+                    lattice_notation(lattice) + " (" + std::to_string(slab_point_count(lattice, slab)) + " points) for " +
+                    options.header_path,
+                uint64_t(slab_point_count(lattice, slab)) * plan.bytes_per_point));
+        }
         if (field->size() != slab_point_count(lattice, slab))
             throw std::logic_error("sampler returned " + std::to_string(field->size()) + " points for a slab of " +
                                    std::to_string(slab_point_count(lattice, slab)));
@@ -333,6 +357,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
             result.band.outside += c.outside;
             if (!field->sampler.contains("band")) field->sampler["band"] = narrow_band_provenance(w, c, "post-processed by sdf-sample");
         }
+        fault_point("sampled slab " + std::to_string(s + 1) + " of " + std::to_string(slabs.size()));
         account(*field);
         const double sampled = seconds_since(slab_start);
         wait_for_writer();
@@ -350,21 +375,14 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
                       << slab.z_end - 1 << "): sampled in " << sampled << " s\n";
     }
     wait_for_writer();
-    files.commit(options.write.overwrite);
+    fault_point("wrote the channels of " + options.header_path);
+    files.place_all(replacement);
+    // The .vdb is written whole under a temporary name before the field's commit, and renamed
+    // over the old one right after it: each file is old or new whole at every instant.
+    TemporaryFile vdb_file(vdb ? unique_sibling_name(options.vdb_path, "tmp") : std::string());
     if (vdb) {
-        const std::string temporary = unique_sibling_name(options.vdb_path, "tmp");
-        try {
-            vdb->write(temporary);
-            if (options.write.overwrite == Overwrite::Allow) fs::rename(temporary, options.vdb_path);
-            else if (!rename_no_replace(temporary, options.vdb_path))
-                throw std::runtime_error(options.vdb_path + ": appeared while sampling; refusing to overwrite it");
-        } catch (...) {
-            std::error_code ec;
-            fs::remove(temporary, ec);
-            if (options.write.overwrite == Overwrite::Forbid)
-                for (const FieldChannelFile& c : plan.channels) ::unlink(c.path.c_str());  // all new: leave none behind
-            throw;
-        }
+        vdb->write(vdb_file.path);
+        sync_file(vdb_file.path);
         result.vdb_active_points = vdb->active_points();
     }
     result.seconds = seconds_since(start);
@@ -383,12 +401,14 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
                             {"band", options.vdb_band},
                             {"active_points", result.vdb_active_points}};
     header.sampler["streaming"] = streaming;
-    try {
-        write_field_header(options.header_path, header, plan.channels, options.write.overwrite);
-    } catch (...) {
-        if (options.write.overwrite == Overwrite::Forbid)
-            for (const FieldChannelFile& c : plan.channels) ::unlink(c.path.c_str());  // all new: leave none behind
-        throw;
+    replacement.commit(header);  // the commit point: the header names the new channels
+    if (vdb) {
+        fault_point("rename " + vdb_file.path + " to " + options.vdb_path);
+        if (options.write.overwrite == Overwrite::Allow) fs::rename(vdb_file.path, options.vdb_path);
+        else if (!rename_no_replace(vdb_file.path, options.vdb_path))
+            throw std::runtime_error(options.vdb_path + ": appeared while sampling; refusing to overwrite it (the field " +
+                                     options.header_path + " was written)");
+        vdb_file.path.clear();
     }
     return result;
 }

@@ -7,9 +7,11 @@
 /// A slab's samples are the whole lattice's, bit for bit, and each slab's points go to the
 /// same byte offsets the in-memory writer gives them (the offsets of harness/distributed's
 /// MPI-IO write, with pwrite), so the channel files equal write_field()'s byte for byte.
-/// Channel files are written under temporary names beside their final ones and renamed into
-/// place at the end, then the header: a header always describes complete data, and nothing
-/// is overwritten without Overwrite::Allow.
+/// Every target is checked before sampling. Channel files are written under temporary names
+/// beside their final ones and renamed at the end to names the old header does not use; the
+/// header's rename then replaces the old field in one step (harness/io/field_replacement.h):
+/// the header describes the old field whole or the new one whole at every instant, and
+/// nothing is overwritten without Overwrite::Allow.
 ///
 /// Memory: the plan takes the budget, subtracts the fixed part (what the process holds
 /// before sampling, measured, plus the BVH and the write buffers, estimated) and divides the
@@ -99,7 +101,8 @@ struct StreamResult {
 /// Samples `lattice` slab by slab with `sampler` and writes the field file of
 /// options.header_path. `mesh_provenance` becomes the header's "mesh". With
 /// options.band_width > 0 in the sampler, each slab is banded (apply_narrow_band, which leaves
-/// a sampler's own band alone). Refuses existing targets first unless overwriting.
+/// a sampler's own band alone). Refuses existing targets first unless overwriting, and a band
+/// the output's dtype cannot hold (require_representable_band).
 StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
                              const Lattice& lattice, const StreamOptions& options, const nlohmann::json& mesh_provenance);
 

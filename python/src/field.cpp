@@ -13,6 +13,7 @@
 #include "harness/config/sampler_spec.h"
 #include "harness/distributed/distributed.h"
 #include "harness/io/field_file.h"
+#include "harness/resources/memory_budget.h"
 #include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
@@ -177,15 +178,29 @@ Field field_for_mesh(SampledField field, const PreparedMesh& mesh) {
     return Field(std::move(field));
 }
 
+/// sample(), with a std::bad_alloc turned into a message naming the mesh, the lattice and the
+/// bytes it needed.
+template <typename Work>
+SampledField sample_reporting_memory(const std::string& mesh, const Lattice& lattice, Work work) {
+    try {
+        return work();
+    } catch (const std::bad_alloc&) {
+        throw std::runtime_error(out_of_memory_message("sample() of " + mesh + " on " + lattice_notation(lattice),
+                                                       whole_lattice_sampling_need(lattice, mesh).host_bytes));
+    }
+}
+
 Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::object& resolution, const py::object& samples,
                    const py::object& margin, const py::object& bounds, const py::object& spacing, const py::object& origin,
                    const py::object& progress) {
     const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, sdf.mesh().bounds());
+    // The memory plan of run-experiment: refused with the figures, before anything is allocated.
+    require_host_memory(whole_lattice_sampling_need(l, sdf.mesh().name()), "SDF.sample()");
     TaskOptions task;
     task.total = l.num_points();
     task.label = "sampling '" + sdf.mesh().name() + "'";
     task.progress = progress;
-    SampledField field = run_task([&] { return sdf.sample(l); }, task);
+    SampledField field = sample_reporting_memory(sdf.mesh().name(), l, [&] { return run_task([&] { return sdf.sample(l); }, task); });
     return field_for_mesh(std::move(field), sdf.mesh());
 }
 
@@ -319,7 +334,11 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         if (!kernel.empty()) s["kernel"] = kernel;
         JsonReader reader(s, "sample()", "sampler");
         const SamplerOptions options = parse_sampler_options(reader);
-        setup = [l, options] { return SamplingRequest{l, options}; };
+        setup = [l, options, name = mesh->name()] {
+            // The memory plan of run-experiment: refused with the figures, before anything is allocated.
+            require_host_memory(whole_lattice_sampling_need(l, name), "sample()");
+            return SamplingRequest{l, options};
+        };
     } catch (const py::error_already_set& e) {
         if (!collective) throw;
         const auto error = std::make_exception_ptr(std::invalid_argument(e.what()));  // no Python object past the GIL
@@ -335,7 +354,9 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         task.total = request.lattice.num_points();
         task.label = "sampling '" + mesh->name() + "'";
         task.progress = progress;
-        SampledField field = run_task([&] { return MeshSdf(mesh, request.options, unsigned_distance).sample(request.lattice); }, task);
+        SampledField field = sample_reporting_memory(mesh->name(), request.lattice, [&] {
+            return run_task([&] { return MeshSdf(mesh, request.options, unsigned_distance).sample(request.lattice); }, task);
+        });
         return field_for_mesh(std::move(field), *mesh);
     }
     TaskOptions task;

@@ -8,6 +8,10 @@
 #   mpi_runs.sh ci_smoke RUN_EXPERIMENT MPIEXEC
 #       the CI smoke reconstruction study (configs/ci_smoke.json) on 2 ranks passes its
 #       baseline check: the root's reconstructions and metrics work on distributed fields.
+#   mpi_runs.sh mismatch RUN_EXPERIMENT MPIEXEC
+#       ranks started with different options (mpirun's "A : B" form) or different configs
+#       stop, every one of them, within seconds, with a message naming the option and the
+#       ranks; nothing is run or published.
 #   mpi_runs.sh failure RUN_EXPERIMENT MPIEXEC
 #       a rank that fails (SDF_MPI_FAIL_RANK) or dies (SDF_MPI_FAIL_MODE=kill) must fail the
 #       run: non-zero exit, a message naming the rank and its host, no run directory, no
@@ -120,6 +124,29 @@ if [ "$case_name" = ci_smoke ]; then
         { cat "$work/smoke.log"; fail "ci_smoke on 2 ranks failed or failed its check"; }
     grep -q '"ranks": 2' "$(run_dir_of "$work/smoke" ci_smoke)/manifest.json" || fail "ci_smoke: not distributed"
     grep PASSED "$work/smoke.log"
+    exit 0
+fi
+
+if [ "$case_name" = mismatch ]; then
+    # expect_refusal LABEL PATTERN -- MPIEXEC ARGS: fails within 60 s, names PATTERN, runs nothing.
+    expect_refusal() {
+        local label=$1 pattern=$2 status=0
+        shift 3
+        timeout -s KILL 60 "$mpiexec" --oversubscribe "$@" > "$work/mismatch.log" 2>&1 || status=$?
+        [ "$status" -ne 0 ] || { cat "$work/mismatch.log"; fail "$label: the run succeeded"; }
+        [ "$status" -ne 137 ] || { cat "$work/mismatch.log"; fail "$label: the ranks hung (killed after 60 s)"; }
+        grep -qF -- "$pattern" "$work/mismatch.log" || { cat "$work/mismatch.log"; fail "$label: no message naming $pattern"; }
+        [ ! -d "$work/mm/mpi_fields" ] || [ -z "$(ls "$work/mm/mpi_fields")" ] || fail "$label: a run directory was left"
+        echo "$label: every rank stopped: $(grep -m1 'error:' "$work/mismatch.log")"
+    }
+    common=(--no-cache --quiet --output-root "$work/mm")
+    expect_refusal "--distribute slabs on rank 0, runs on ranks 1 and 2" \
+        '--distribute: rank 0 has "slabs", ranks 1, 2 have "runs"' -- \
+        -np 1 "$tool" "$work/mpi_fields.json" "${common[@]}" : -np 2 "$tool" "$work/mpi_fields.json" "${common[@]}" --distribute runs
+    sed 's/"bvh"/"brute_force"/' "$work/mpi_fields.json" > "$work/other.json"
+    cp "$work/other.json" "$work/mpi_fields_copy.json"
+    expect_refusal "another config on rank 1" 'config: rank 0 has' -- \
+        -np 1 "$tool" "$work/mpi_fields.json" "${common[@]}" : -np 1 "$tool" "$work/mpi_fields_copy.json" "${common[@]}"
     exit 0
 fi
 

@@ -458,3 +458,11 @@ def test_docstrings_everywhere():
         for attr, value in vars(cls).items():
             if not attr.startswith("_"):
                 assert (value.__doc__ or "").strip(), f"{cls.__name__}.{attr}"
+
+
+def test_sample_refuses_a_lattice_beyond_the_available_memory(box, monkeypatch):
+    """sample() has run-experiment's memory plan: refused up front, with the figures (issue 26)."""
+    monkeypatch.setenv("SDF_MEMORY_AVAILABLE", str(600 << 20))
+    with pytest.raises(RuntimeError, match=r"sample\(\): sampling box on 400x400x400 .* needs about .* available"):
+        sl.sample(box, resolution=400, backend="cpu")
+    assert sl.sample(box, resolution=8, backend="cpu").num_points == 512  # a lattice that fits
