@@ -405,7 +405,8 @@ private:
         DeviceBuffer<PointSample> device_out{size_t(n)};
         double coordinate = 0;
         for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
-        const CertificateCounters certificate = search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, [&](const PieceResults& r, int64_t count) {
+        CertificateCounters certificate;
+        search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
             store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(),
                                                                   device_out.get());
             CUDA_CHECK_LAUNCH("store_point_samples");
@@ -433,7 +434,8 @@ private:
         CUDA_CHECK(cudaStreamSynchronize(static_cast<cudaStream_t>(points.stream)));
         DeviceBuffer<Vec3d> device_points{size_t(n)};
         const double coordinate = read_points(points, device_points.get());
-        const CertificateCounters certificate = search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, [&](const PieceResults& r, int64_t count) {
+        CertificateCounters certificate;
+        search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
             store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(), results);
             CUDA_CHECK_LAUNCH("store_point_columns");
         });
@@ -472,10 +474,11 @@ private:
     }
 
     /// Morton sort, warp (or candidates) search and finalize of n device points, piece by
-    /// piece; `store(results, count)` takes each piece's results to their input positions.
+    /// piece; `store(results, count)` takes each piece's results to their input positions, and
+    /// `certificate` the float search's certificate counters.
     template <typename T, typename Store>
-    CertificateCounters search_points(const PreparedMesh& mesh, const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n,
-                                      double coordinate, EventTimer& compute, Store store) {
+    void search_points(const PreparedMesh& mesh, const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n,
+                       double coordinate, EventTimer& compute, CertificateCounters& certificate, Store store) {
         reset_certificate(dev);
         // Every device buffer is allocated before the timed work (allocation is not search).
         DeviceBuffer<Vec3d> sorted_points{size_t(n)};
@@ -502,9 +505,7 @@ private:
             store(r, piece.count);
             compute.end();
         }
-        CertificateCounters certificate;
         read_certificate(dev, certificate);
-        return certificate;
     }
 
     void record_query_timings(const PreparedMesh& mesh, int64_t n, const EventTimer& upload, const EventTimer& compute,

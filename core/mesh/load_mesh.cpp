@@ -117,6 +117,16 @@ size_t text_end(const std::string& bytes, MeshFormat format) {
 
 }  // namespace
 
+const char* mesh_format_name(MeshFormat format) {
+    switch (format) {
+        case MeshFormat::Obj: return "OBJ";
+        case MeshFormat::Ply: return "PLY";
+        case MeshFormat::Stl: return "STL";
+        case MeshFormat::Off: return "OFF";
+    }
+    return "?";
+}
+
 MeshFormat detect_mesh_format(const std::string& path, const std::string& bytes) {
     if (first_token_is(bytes, is_ply_magic)) return MeshFormat::Ply;
     if (first_token_is(bytes, is_off_magic)) return MeshFormat::Off;

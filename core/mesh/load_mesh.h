@@ -19,6 +19,9 @@ namespace sdf {
 
 enum class MeshFormat { Obj, Ply, Stl, Off };
 
+/// "OBJ", "PLY", "STL", "OFF": for messages.
+const char* mesh_format_name(MeshFormat format);
+
 /// The format of a file: by content where it is definite (the "ply" and "OFF" magic lines,
 /// binary STL's exact size, ASCII STL's "solid ... facet"), else by extension (".gz"
 /// stripped first). Throws std::runtime_error naming the file and the extension when

@@ -28,7 +28,7 @@ namespace {
 int64_t integer_argument(const py::handle& value, const std::string& what) {
     if (PyBool_Check(value.ptr()) || !PyIndex_Check(value.ptr()))
         throw py::type_error("sample(): " + what + " must be an integer (Python or NumPy), got " +
-                             std::string(py::str(value.get_type().attr("__name__"))) + " " + std::string(py::repr(value)));
+                             std::string(Py_TYPE(value.ptr())->tp_name) + " " + std::string(py::repr(value)));
     const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
     if (!index) throw py::error_already_set();
     int overflow = 0;

@@ -13,6 +13,7 @@
 
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
+#include "core/mesh/prepared_mesh.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
 
 namespace sdf {
