@@ -298,6 +298,13 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         if (writing.valid()) writing.get();  // rethrows the writer's error; frees its slab
         result.write_wait_seconds += seconds_since(wait_start);
     };
+    // A slab whose allocation fails: named with its planes, points and bytes.
+    auto slab_out_of_memory = [&](const LatticeSlab& slab) {
+        return out_of_memory_message("sampling z-planes " + std::to_string(slab.z_begin) + "-" + std::to_string(slab.z_end - 1) +
+                                         " of " + lattice_notation(lattice) + " (" +
+                                         std::to_string(slab_point_count(lattice, slab)) + " points) for " + options.header_path,
+                                     uint64_t(slab_point_count(lattice, slab)) * plan.bytes_per_point);
+    };
     for (size_t s = 0; s < slabs.size(); ++s) {
         const LatticeSlab slab = slabs[s];
         const auto slab_start = Clock::now();
@@ -305,11 +312,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         try {
             if (stored_layout) stored = sampler.sample_slab_stored(mesh, lattice, slab, *stored_layout);
         } catch (const std::bad_alloc&) {
-            throw std::runtime_error(out_of_memory_message(
-                "sampling z-planes " + std::to_string(slab.z_begin) + "-" + std::to_string(slab.z_end - 1) + " of " +
-                    lattice_notation(lattice) + " (" + std::to_string(slab_point_count(lattice, slab)) + " points) for " +
-                    options.header_path,
-                uint64_t(slab_point_count(lattice, slab)) * plan.bytes_per_point));
+            throw std::runtime_error(slab_out_of_memory(slab));
         }
         if (stored) {
             if (stored->points != slab_point_count(lattice, slab))
@@ -342,11 +345,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         try {
             field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
         } catch (const std::bad_alloc&) {
-            throw std::runtime_error(out_of_memory_message(
-                "sampling z-planes " + std::to_string(slab.z_begin) + "-" + std::to_string(slab.z_end - 1) + " of " +
-                    lattice_notation(lattice) + " (" + std::to_string(slab_point_count(lattice, slab)) + " points) for " +
-                    options.header_path,
-                uint64_t(slab_point_count(lattice, slab)) * plan.bytes_per_point));
+            throw std::runtime_error(slab_out_of_memory(slab));
         }
         if (field->size() != slab_point_count(lattice, slab))
             throw std::logic_error("sampler returned " + std::to_string(field->size()) + " points for a slab of " +
