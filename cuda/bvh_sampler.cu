@@ -337,6 +337,28 @@ private:
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
+        // Results made on the device in the field's own layout (the stored path with float64
+        // channels, stored_output.cuh) and copied once through pinned buffers straight into the
+        // field's arrays: no per-piece pageable copy, no host scatter. A slab whose channels do
+        // not fit a quarter of the free device memory takes the per-piece path below.
+        const int64_t points = int64_t(field.distance.size());
+        const StoredLayout layout{false, true, true};
+        size_t free_bytes = 0, total_bytes = 0;
+        CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total_bytes));
+        if (points > 0 && double(points) * double(layout.bytes_per_point()) <= 0.25 * double(free_bytes)) {
+            const StoredChannels<double> out = stored_buffers_.device_channels<double>(points, layout, dev.source_triangle.get());
+            const auto [computed, pieces] = store_blocks<T, double>(dev, lattice, slab, out, compute);
+            download.begin();
+            const size_t n = size_t(points);
+            staged_.to_host(out.distance, field.distance.data(), n * sizeof(double));
+            staged_.to_host(out.gradient, field.gradient.data(), 3 * n * sizeof(double));
+            staged_.to_host(out.triangle, field.closest_triangle.data(), n * sizeof(int32_t));
+            download.end();
+            record_provenance(field, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
+            record_search_certificate(dev, field);
+            if (options_.band_width > 0) field.sampler["band"] = band_provenance(mesh, count_narrow_band(field));
+            return field;
+        }
         auto sink = [&](const PieceResults& r, int64_t count) {
             download.begin();
             const PieceResults::Host h = r.download(count);
@@ -365,8 +387,11 @@ private:
         stored.info.lattice = lattice;
         stored.info.precision = options_.precision;
         const int64_t points = slab_point_count(lattice, slab);
-        const auto [computed, pieces] = layout.float32 ? store_blocks<T, float>(dev, lattice, slab, layout, points, compute)
-                                                       : store_blocks<T, double>(dev, lattice, slab, layout, points, compute);
+        const int32_t* source = dev.source_triangle.get();
+        const auto [computed, pieces] =
+            layout.float32 ? store_blocks<T, float>(dev, lattice, slab, stored_buffers_.device_channels<float>(points, layout, source), compute)
+                           : store_blocks<T, double>(dev, lattice, slab, stored_buffers_.device_channels<double>(points, layout, source),
+                                                     compute);
         download.begin();
         stored_buffers_.download(points, layout, stored);
         download.end();
@@ -379,8 +404,7 @@ private:
 
     template <typename T, typename F>
     std::pair<int64_t, int64_t> store_blocks(const DeviceBvh<T>& dev, const Lattice& lattice, const LatticeSlab& slab,
-                                             const StoredLayout& layout, int64_t points, EventTimer& compute) {
-        const StoredChannels<F> out = stored_buffers_.device_channels<F>(points, layout, dev.source_triangle.get());
+                                             const StoredChannels<F>& out, EventTimer& compute) {
         auto sink = [&](const PieceResults& r, int64_t count) {
             compute.begin();
             store_piece<F><<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, out);
