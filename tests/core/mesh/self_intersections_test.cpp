@@ -12,6 +12,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/mesh/exact_predicates.h"
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -87,6 +88,34 @@ struct CollinearEdges {
         return intersect(t1, {0, 1, 2}, t2, {3, 4, 5});
     }
 };
+
+// The certified "separated at the shared corner" shortcut (a plane through the corner with
+// each triangle strictly on its side) never hides an intersection: random sector pairs around
+// one vertex, coplanar (a tilted plane z = x/2 + y/4, exact in binary) and off the plane,
+// overlapping or not, give the answer of the exact tests alone.
+TEST(TrianglesIntersect, SharedCornerShortcutAgreesWithTheExactTests) {
+    std::mt19937_64 rng(26);
+    std::uniform_real_distribution<double> angle(0.0, 6.283185307179586), radius(0.25, 2.0), lift(-1e-9, 1e-9);
+    const Vec3d v{0.5, -0.25, 0.125};
+    auto corner = [&](double t, double r, double off_plane) {
+        const double x = std::ldexp(std::round(std::ldexp(r * std::cos(t), 20)), -20);
+        const double y = std::ldexp(std::round(std::ldexp(r * std::sin(t), 20)), -20);
+        return v + Vec3d{x, y, x / 2 + y / 4 + off_plane};
+    };
+    int intersecting = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const double ta = angle(rng), tb = angle(rng), wa = 0.05 + 2.5 * angle(rng) / 6.3, wb = 0.05 + 2.5 * angle(rng) / 6.3;
+        const bool planar = k % 2 == 0;
+        const Vec3d a[3] = {v, corner(ta, radius(rng), 0), corner(ta + wa, radius(rng), planar ? 0 : lift(rng))};
+        const Vec3d b[3] = {corner(tb, radius(rng), planar ? 0 : lift(rng)), v, corner(tb + wb, radius(rng), 0)};
+        const bool exact = exact::segment_meets_triangle(b[2], b[0], a[0], a[1], a[2]) ||
+                           exact::segment_meets_triangle(a[1], a[2], b[0], b[1], b[2]);
+        ASSERT_EQ(triangles_intersect(a, {0, 1, 2}, b, {3, 0, 4}), exact) << "pair " << k;
+        intersecting += exact;
+    }
+    EXPECT_GT(intersecting, 1000);  // both answers are exercised
+    EXPECT_LT(intersecting, 19000);
+}
 
 TEST(TrianglesIntersect, EdgesOnOneLineAreJudgedExactly) {
     std::mt19937_64 random(22);
