@@ -78,7 +78,7 @@ struct Certifier {
     /// The double search's winner (BVH slot) at p from the float search's winner and its
     /// candidates; counts what it took.
     int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
-                    const NearCandidates<float, kNearCandidates>& near, LocalCertificate& counters) const {
+                    const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters) const {
         Rerank r = kernels.rerank(exact.packed, view.triangle_index, p, winner, slack.radius(best_q), near.slot, near.q,
                                   near.count, near.dropped);
         if (r.overflow) {
@@ -118,7 +118,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
             int32_t slot;
             if constexpr (Certifier<T>::kActive) {
-                CertifiedNear<float> near{certifier.slack, {}};
+                CpuCertifiedNear near{certifier.slack, {}};
                 const BvhHit<float> hit = certifier.kernels.closest_triangle(view, pt, seed, stats, near);
                 previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
                 certifier.prefetch(near.near);
@@ -141,7 +141,7 @@ template <typename T>
 void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
                    BvhPacket<T, kCpuPacketLanes>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
     if constexpr (Certifier<T>::kActive) {
-        PacketCertifiedNear<float, kCpuPacketLanes> near;
+        CpuPacketCertifiedNear near;
         near.slack = certifier.slack;
         certifier.kernels.closest_triangles_packet(view, pk, stats, near);
         for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);

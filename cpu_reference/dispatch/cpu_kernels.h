@@ -29,6 +29,13 @@ namespace sdf {
 /// float lanes: one AVX-512 register, or two AVX2 registers, per coordinate in the leaf loop).
 constexpr int kCpuPacketLanes = 16;
 
+/// Candidates a certified CPU search keeps per point: twice the GPU's kNearCandidates. At a
+/// vertex of more than 8 triangles every one ties; with 8 slots 2.4% of the dragon-legacy
+/// 64^3 lattice's points overflowed into a second, unbounded search (AllNear).
+constexpr int kCpuNearCandidates = 16;
+using CpuCertifiedNear = CertifiedNear<float, kCpuNearCandidates>;
+using CpuPacketCertifiedNear = PacketCertifiedNear<float, kCpuPacketLanes, kCpuNearCandidates>;
+
 /// Every candidate of a certified float search, without a limit: the fallback for a point
 /// with more candidates than NearCandidates keeps (search_certificate.h).
 struct AllNear {
@@ -74,10 +81,10 @@ struct CpuKernels {
 /// The certified float search of one ISA level (search_certificate.h): the searches that keep
 /// their candidates, the fallbacks that keep every one, and the re-ranking in double.
 struct CpuCertifiedKernels {
-    NearestTrianglesFn<float, CertifiedNear<float>> nearest_triangles;
+    NearestTrianglesFn<float, CpuCertifiedNear> nearest_triangles;
     NearestTrianglesFn<float, AllNear> nearest_triangles_all;  ///< one point: count 1
-    ClosestTrianglesPacketFn<float, PacketCertifiedNear<float, kCpuPacketLanes>> closest_triangles_packet;
-    ClosestTriangleFn<float, CertifiedNear<float>> closest_triangle;
+    ClosestTrianglesPacketFn<float, CpuPacketCertifiedNear> closest_triangles_packet;
+    ClosestTriangleFn<float, CpuCertifiedNear> closest_triangle;
     ClosestTriangleFn<float, AllNear> closest_triangle_all;
     RerankFn rerank;
 };

@@ -47,14 +47,14 @@ constexpr CpuKernels<T> kernels_of() {
 
 constexpr CpuCertifiedKernels certified_kernels() {
     using Table = CpuCertifiedKernels;
-    using Packet = PacketCertifiedNear<float, kCpuPacketLanes>;
+    using Packet = CpuPacketCertifiedNear;
     return {&Flattened<static_cast<decltype(Table::nearest_triangles)>(
-                &nearest_triangles_vectorized<float, CertifiedNear<float>>)>::call,
+                &nearest_triangles_vectorized<float, CpuCertifiedNear>)>::call,
             &Flattened<static_cast<decltype(Table::nearest_triangles_all)>(&nearest_triangles_vectorized<float, AllNear>)>::call,
             &Flattened<static_cast<decltype(Table::closest_triangles_packet)>(
                 &closest_triangles_packet<float, kCpuPacketLanes, BvhStats, Packet>)>::call,
             &Flattened<static_cast<decltype(Table::closest_triangle)>(
-                &closest_triangle_bvh<float, BvhStats, CertifiedNear<float>>)>::call,
+                &closest_triangle_bvh<float, BvhStats, CpuCertifiedNear>)>::call,
             &Flattened<static_cast<decltype(Table::closest_triangle_all)>(&closest_triangle_bvh<float, BvhStats, AllNear>)>::call,
             &Flattened<&rerank>::call};
 }

@@ -22,9 +22,9 @@ using CpuKernel = CpuBruteForceKernel;
 /// (search_certificate.h); with too many candidates, every triangle within the radius is
 /// collected by one more float pass and re-ranked. counts: points, re-ranked, full pass.
 int certify_brute_force(const CpuCertifiedKernels& kernels, const TriangleSoA<float>& soa, const PackedTriangle<double>* exact,
-                        const Vec3d& p, int winner, float best_q, const CertifiedNear<float>& near, int64_t* counts) {
+                        const Vec3d& p, int winner, float best_q, const CpuCertifiedNear& near, int64_t* counts) {
     const float radius = near.radius(best_q);
-    const NearCandidates<float, kNearCandidates>& c = near.near;
+    const NearCandidates<float, kCpuNearCandidates>& c = near.near;
     Rerank r = kernels.rerank(exact, nullptr, p, winner, radius, c.slot, c.q, c.count, c.dropped);
     if (r.overflow) {
         // The same float pass keeps every triangle within its (shrinking) radius, so all
@@ -73,7 +73,7 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
         }
         if (kernel == CpuKernel::Vectorized) {
             if constexpr (kCertify) {
-                CertifiedNear<float> near[kPointTile];
+                CpuCertifiedNear near[kPointTile];
                 for (int k = 0; k < count; ++k) near[k].slack = slack;
                 certified.nearest_triangles(soa, count, px, py, pz, best, best_q, near);
                 int64_t counts[3] = {0, 0, 0};

@@ -236,7 +236,7 @@ TEST(CpuIsa, CertifiedKernelsAgreeAtEveryLevelAndCertify) {
                 seed[i] = -1;
             }
             // The brute force: a tile of points.
-            CertifiedNear<float> near[kPointTile], here_near[kPointTile];
+            CpuCertifiedNear near[kPointTile], here_near[kPointTile];
             for (int i = 0; i < kPointTile; ++i) near[i].slack = here_near[i].slack = slack;
             int best[kPointTile], here_best[kPointTile];
             float q[kPointTile], here_q[kPointTile];
@@ -245,7 +245,7 @@ TEST(CpuIsa, CertifiedKernelsAgreeAtEveryLevelAndCertify) {
             // The packet.
             seed_packet(view, seed, pk);
             seed_packet(view, seed, here_pk);
-            PacketCertifiedNear<float, kCpuPacketLanes> pnear, here_pnear;
+            CpuPacketCertifiedNear pnear, here_pnear;
             pnear.slack = here_pnear.slack = slack;
             k.closest_triangles_packet(view, pk, stats, pnear);
             closest_triangles_packet(view, here_pk, here_stats, here_pnear);
@@ -261,7 +261,7 @@ TEST(CpuIsa, CertifiedKernelsAgreeAtEveryLevelAndCertify) {
                 ASSERT_TRUE(same_bits(pk.best_q[i], here_pk.best_q[i])) << where;
                 ASSERT_EQ(kept(pnear.near[i]), kept(here_pnear.near[i])) << where;
                 // The one-point query and its fallback.
-                CertifiedNear<float> one{slack, {}}, here_one{slack, {}};
+                CpuCertifiedNear one{slack, {}}, here_one{slack, {}};
                 const BvhHit<float> hit = k.closest_triangle(view, pf, BvhHit<float>{}, stats, one);
                 const BvhHit<float> here_hit = closest_triangle_bvh(view, pf, BvhHit<float>{}, here_stats, here_one);
                 ASSERT_EQ(hit.slot, here_hit.slot) << where;
@@ -279,7 +279,7 @@ TEST(CpuIsa, CertifiedKernelsAgreeAtEveryLevelAndCertify) {
                 ASSERT_EQ(kept(tile_all), kept(here_tile_all)) << where;
                 // Every search, re-ranked in double, returns the double brute force's triangle:
                 // from its kept candidates, or (overflow) from every candidate.
-                auto certified = [&](int32_t winner, float best_q, const NearCandidates<float, kNearCandidates>& c,
+                auto certified = [&](int32_t winner, float best_q, const NearCandidates<float, kCpuNearCandidates>& c,
                                      const int32_t* index, const PackedTriangle<double>* packed, const AllNear& every) {
                     const float radius = slack.radius(best_q);
                     Rerank r = k.rerank(packed, index, p, winner, radius, c.slot, c.q, c.count, c.dropped);
