@@ -6,6 +6,8 @@
 //   Arbitrary points (issue 14): Sampler::query on 1M uniform-box and Gaussian-near-surface
 //   points (core/sampling/point_sets.h), kernel brick (Morton-ordered packets of 16) against
 //   seeded (one point at a time), 1 thread and all threads.
+//   BM_CpuBvhPacketKernel: the dispatched packet search alone (plain float, certified float,
+//   certified and re-ranked in double, plain double), 1 thread, CPU time.
 //   SDF_DATA_PATH=... bench_bvh --benchmark_counters_tabular=true --benchmark_filter=Cpu
 #include <benchmark/benchmark.h>
 

@@ -3,8 +3,12 @@
 // nearest triangle, lowest index on ties, and its squared distance), for the brute force and
 // the BVH packet traversal, in float and double; the one-point BVH query returns the bits of
 // the same template compiled in this file (at the build's target), and the BVH kernels visit
-// the same nodes at every level. Levels this CPU lacks are skipped; a build for one target
-// (SDF_CPU_TARGET other than portable) has no levels and skips. SDF_CPU_ISA chooses the level.
+// the same nodes at every level. The certified float kernels (search_certificate.h) keep the
+// same winners, Q bits and candidates at every level as the templates compiled here, and their
+// re-ranking gives the double brute force's triangle; the certified samplers at the chosen
+// level equal the double brute force in distance, gradient and triangle (CTest runs this at
+// SDF_CPU_ISA=v2, v3 and the widest level). Levels this CPU lacks are skipped; a build for one
+// target (SDF_CPU_TARGET other than portable) has no levels and skips.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
