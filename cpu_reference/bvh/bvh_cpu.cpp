@@ -15,8 +15,6 @@
 #include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
-#include "kernels/bvh/closest_triangle_bvh.h"
-#include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/core/morton.h"
 #include "kernels/distance/signed_distance.h"
 
@@ -26,9 +24,9 @@ namespace {
 /// Points per parallel_for chunk: long enough that most seeds come from the x-neighbour.
 constexpr int64_t kBvhChunk = 256;
 
-/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (16 float lanes: one
-/// AVX-512 register, or two AVX2 registers, per coordinate in the leaf loop).
+/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
+static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
 /// Bricks per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
 /// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
@@ -52,29 +50,18 @@ struct LocalCertificate {
 };
 
 /// The certified float search's context (search_certificate.h): the slack of every point of
-/// the run and the double constants for re-ranking. `T` double: the search is the reference.
+/// the run, the double constants for re-ranking and the kernels of the widest ISA the CPU
+/// has (cpu_kernels.h). `T` double: the search is the reference.
 template <typename T>
 struct Certifier {
     static constexpr bool kActive = std::is_same_v<T, float>;
     SearchSlack<float> slack;
     BvhView<double> exact;
+    const CpuCertifiedKernels& kernels = certified_cpu_kernels();
 
     Certifier(const PreparedMesh& mesh, const TriangleBvh& bvh, double point_coordinate) : exact(bvh.view<double>()) {
         if constexpr (kActive) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
     }
-
-    /// Every candidate, without a limit: the fallback when a point has more than fit.
-    struct AllNear {
-        static constexpr bool kKeeps = true;
-        SearchSlack<float> slack;
-        std::vector<int32_t> slot;
-        std::vector<float> q;
-        float radius(float v) const { return slack.radius(v); }
-        void offer(int32_t s, float v) {
-            slot.push_back(s);
-            q.push_back(v);
-        }
-    };
 
     /// Starts loading the double constants of the candidates (three cache lines each, in an
     /// array apart from the float ones): a packet's lanes then wait for memory together.
@@ -90,18 +77,17 @@ struct Certifier {
 
     /// The double search's winner (BVH slot) at p from the float search's winner and its
     /// candidates; counts what it took.
-    template <int N>
     int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
-                    const NearCandidates<float, N>& near, LocalCertificate& counters) const {
-        auto index_of = [&](int32_t s) { return view.triangle_index[s]; };
-        Rerank r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, slack.radius(best_q), near);
+                    const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters) const {
+        Rerank r = kernels.rerank(exact.packed, view.triangle_index, p, winner, slack.radius(best_q), near.slot, near.q,
+                                  near.count, near.dropped);
         if (r.overflow) {
             AllNear all{slack, {}, {}};
             const Vec3f pt(p);
-            NoBvhStats none;
-            const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed_hit(view, winner, pt), none, all);
-            r = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, hit.slot, slack.radius(hit.distance_squared),
-                                 all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
+            BvhStats uncounted;
+            const BvhHit<float> hit = kernels.closest_triangle_all(view, pt, seed_hit(view, winner, pt), uncounted, all);
+            r = kernels.rerank(exact.packed, view.triangle_index, p, hit.slot, slack.radius(hit.distance_squared),
+                               all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
             r.reranked = true;
             ++counters.full_double;
         }
@@ -120,6 +106,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const Certifier<T> certifier(mesh, bvh, point_coordinate);
+    const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the widest ISA the CPU has
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
@@ -131,13 +118,13 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
             int32_t slot;
             if constexpr (Certifier<T>::kActive) {
-                CertifiedNear<float> near{certifier.slack, {}};
-                const BvhHit<float> hit = closest_triangle_bvh(view, pt, seed, stats, near);
+                CpuCertifiedNear near{certifier.slack, {}};
+                const BvhHit<float> hit = certifier.kernels.closest_triangle(view, pt, seed, stats, near);
                 previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
                 certifier.prefetch(near.near);
                 slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified);
             } else {
-                slot = previous = closest_triangle_bvh(view, pt, seed, stats).slot;
+                slot = previous = closest_triangle(view, pt, seed, stats).slot;
             }
             emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
         }
@@ -150,18 +137,18 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
 
 /// One packet search (closest_triangles_packet.h): `slot` receives the winner of each of the
 /// first `count` lanes, certified for float (`position`: the lanes' exact points).
-template <typename T, int K>
+template <typename T>
 void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
-                   BvhPacket<T, K>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
+                   BvhPacket<T, kCpuPacketLanes>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
     if constexpr (Certifier<T>::kActive) {
-        PacketCertifiedNear<float, K> near;
+        CpuPacketCertifiedNear near;
         near.slack = certifier.slack;
-        closest_triangles_packet(view, pk, stats, near);
+        certifier.kernels.closest_triangles_packet(view, pk, stats, near);
         for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
         for (int k = 0; k < count; ++k)
             slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
     } else {
-        closest_triangles_packet(view, pk, stats);
+        cpu_kernels<T>().closest_triangles_packet(view, pk, stats);
         for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];
     }
 }
@@ -239,6 +226,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const BvhView<T> view = bvh.view<T>();
     const MeshView<double> exact = mesh.buffers<double>().view();
     const Certifier<T> certifier(mesh, bvh, largest_lattice_coordinate(lattice));
+    const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the probes': plain, the widest ISA
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
@@ -266,7 +254,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     for (int k = 0; k < br.count; ++k) c = c + br.position[k];
                     c = c * (1.0 / br.count);
                     const Vec3<T> pt(c);
-                    const BvhHit<T> hit = closest_triangle_bvh(view, pt, seed_hit(view, probe_seed, pt), stats);
+                    const BvhHit<T> hit = closest_triangle(view, pt, seed_hit(view, probe_seed, pt), stats);
                     probe_seed = hit.slot;
                     // The probe needs only a distance bound, which its margin covers: not certified.
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);

@@ -25,17 +25,41 @@ struct Flattened<F> {
     [[gnu::flatten]] static R call(Args... args) { return F(static_cast<Args&&>(args)...); }
 };
 
-template <typename T>
-constexpr decltype(CpuKernels<T>::closest_triangle) kClosestTriangle = &closest_triangle_bvh<T, BvhStats>;
+/// rerank_in_double() for BVH slots (`triangle_index` maps them to triangles) or, with
+/// `triangle_index` null, for triangle indices (the brute force's).
+Rerank rerank(const PackedTriangle<double>* exact, const int32_t* triangle_index, const Vec3d& p, int32_t winner,
+              float radius, const int32_t* slot, const float* q, int count, float dropped) {
+    if (triangle_index == nullptr)
+        return rerank_in_double(exact, [](int32_t s) { return s; }, p.x, p.y, p.z, winner, radius, slot, q, count, dropped);
+    return rerank_in_double(exact, [triangle_index](int32_t s) { return triangle_index[s]; }, p.x, p.y, p.z, winner, radius,
+                            slot, q, count, dropped);
+}
 
 template <typename T>
 constexpr CpuKernels<T> kernels_of() {
-    return {&Flattened<&nearest_triangles_vectorized<T>>::call,
-            &Flattened<&closest_triangles_packet<T, kCpuPacketLanes, BvhStats>>::call,
-            &Flattened<kClosestTriangle<T>>::call};
+    using Table = CpuKernels<T>;
+    return {&Flattened<static_cast<decltype(Table::nearest_triangles)>(&nearest_triangles_vectorized<T>)>::call,
+            &Flattened<static_cast<decltype(Table::closest_triangles_packet)>(
+                &closest_triangles_packet<T, kCpuPacketLanes, BvhStats>)>::call,
+            &Flattened<static_cast<decltype(Table::closest_triangle)>(&closest_triangle_bvh<T, BvhStats>)>::call,
+            &Flattened<&nearest_triangle_eberly<T>>::call};
 }
 
-constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>()};
+constexpr CpuCertifiedKernels certified_kernels() {
+    using Table = CpuCertifiedKernels;
+    using Packet = CpuPacketCertifiedNear;
+    return {&Flattened<static_cast<decltype(Table::nearest_triangles)>(
+                &nearest_triangles_vectorized<float, CpuCertifiedNear>)>::call,
+            &Flattened<static_cast<decltype(Table::nearest_triangles_all)>(&nearest_triangles_vectorized<float, AllNear>)>::call,
+            &Flattened<static_cast<decltype(Table::closest_triangles_packet)>(
+                &closest_triangles_packet<float, kCpuPacketLanes, BvhStats, Packet>)>::call,
+            &Flattened<static_cast<decltype(Table::closest_triangle)>(
+                &closest_triangle_bvh<float, BvhStats, CpuCertifiedNear>)>::call,
+            &Flattened<static_cast<decltype(Table::closest_triangle_all)>(&closest_triangle_bvh<float, BvhStats, AllNear>)>::call,
+            &Flattened<&rerank>::call};
+}
+
+constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels()};
 
 }  // namespace
 

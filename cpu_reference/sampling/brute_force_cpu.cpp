@@ -21,24 +21,20 @@ using CpuKernel = CpuBruteForceKernel;
 /// The double search's winner at p from the certified float search's winner and candidates
 /// (search_certificate.h); with too many candidates, every triangle within the radius is
 /// collected by one more float pass and re-ranked. counts: points, re-ranked, full pass.
-int certify_brute_force(const TriangleSoA<float>& soa, const PackedTriangle<double>* exact, const Vec3d& p, int winner,
-                        float best_q, const CertifiedNear<float>& near, int64_t* counts) {
-    auto index_of = [](int32_t s) { return s; };
+int certify_brute_force(const CpuCertifiedKernels& kernels, const TriangleSoA<float>& soa, const PackedTriangle<double>* exact,
+                        const Vec3d& p, int winner, float best_q, const CpuCertifiedNear& near, int64_t* counts) {
     const float radius = near.radius(best_q);
-    Rerank r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, near.near);
+    const NearCandidates<float, kCpuNearCandidates>& c = near.near;
+    Rerank r = kernels.rerank(exact, nullptr, p, winner, radius, c.slot, c.q, c.count, c.dropped);
     if (r.overflow) {
-        std::vector<int32_t> slot;
-        std::vector<float> q;
+        // The same float pass keeps every triangle within its (shrinking) radius, so all
+        // within the final one, which is this radius: best_q is the same float minimum.
+        AllNear all{near.slack, {}, {}};
         const Vec3f pf(p);
-        for (int i = 0; i < soa.size(); ++i) {
-            const PackedTriangle<float> t = soa[i];
-            const float d = squared_distance(t, pf) - sliver_excess(t);
-            if (d <= radius) {
-                slot.push_back(i);
-                q.push_back(d);
-            }
-        }
-        r = rerank_in_double(exact, index_of, p.x, p.y, p.z, winner, radius, slot.data(), q.data(), int(slot.size()), NAN);
+        int again = -1;
+        float again_q = 0;
+        kernels.nearest_triangles_all(soa, 1, &pf.x, &pf.y, &pf.z, &again, &again_q, &all);
+        r = kernels.rerank(exact, nullptr, p, winner, radius, all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
         r.reranked = true;
         ++counts[2];
     }
@@ -64,6 +60,8 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
     constexpr bool kCertify = std::is_same_v<T, float>;
     SearchSlack<float> slack;
     if constexpr (kCertify) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
+    const CpuKernels<T>& plain = cpu_kernels<T>();  // the widest ISA the CPU has
+    const CpuCertifiedKernels& certified = certified_cpu_kernels();
     ProgressReporter reporter("sampling " + mesh.name(), n, progress);
     parallel_for(n, kPointTile, threads, [&](int64_t begin, int64_t end) {
         const int count = int(end - begin);
@@ -75,20 +73,20 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
         }
         if (kernel == CpuKernel::Vectorized) {
             if constexpr (kCertify) {
-                CertifiedNear<float> near[kPointTile];
+                CpuCertifiedNear near[kPointTile];
                 for (int k = 0; k < count; ++k) near[k].slack = slack;
-                nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q, near);
+                certified.nearest_triangles(soa, count, px, py, pz, best, best_q, near);
                 int64_t counts[3] = {0, 0, 0};
                 for (int k = 0; k < count; ++k)
-                    best[k] = certify_brute_force(soa, exact.packed, pos(begin + k), best[k], best_q[k], near[k], counts);
+                    best[k] = certify_brute_force(certified, soa, exact.packed, pos(begin + k), best[k], best_q[k], near[k], counts);
                 counters.points += counts[0];
                 counters.reranked += counts[1];
                 counters.full_double += counts[2];
             } else {
-                nearest_triangles_vectorized(soa, count, px, py, pz, best, best_q);
+                plain.nearest_triangles(soa, count, px, py, pz, best, best_q);
             }
         } else {
-            for (int k = 0; k < count; ++k) best[k] = nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
+            for (int k = 0; k < count; ++k) best[k] = plain.nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
         for (int k = 0; k < count; ++k) {
             const Vec3d p = pos(begin + k);

@@ -6,9 +6,12 @@
 //   Arbitrary points (issue 14): Sampler::query on 1M uniform-box and Gaussian-near-surface
 //   points (core/sampling/point_sets.h), kernel brick (Morton-ordered packets of 16) against
 //   seeded (one point at a time), 1 thread and all threads.
+//   BM_CpuBvhPacketKernel: the dispatched packet search alone (plain float, certified float,
+//   certified and re-ranked in double, plain double), 1 thread, CPU time.
 //   SDF_DATA_PATH=... bench_bvh --benchmark_counters_tabular=true --benchmark_filter=Cpu
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -16,8 +19,11 @@
 #include <random>
 #include <memory>
 #include <sstream>
+#include <type_traits>
 
 #include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
+#include "core/sampling/certified_search.h"
 #include "core/bvh/triangle_bvh.h"
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_obj.h"
@@ -104,6 +110,77 @@ void BM_CpuBvhPointQuery(benchmark::State& state, const std::string& file) {
     state.counters["queries/s"] = benchmark::Counter(double(points.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["points"] = double(points.size());
     state.counters["threads"] = double(resolve_thread_count(o.threads));
+}
+
+/// The dispatched packet search alone (cpu_reference/dispatch/cpu_kernels.h) on the lattice's
+/// 4 x 2 x 2 bricks, 1 thread, each lane seeded by the brick before it along x, as the sampler
+/// runs it; no exact evaluation or sign. Arg: 0 plain float, 1 certified float (candidates
+/// kept, not re-ranked), 2 certified float and the re-ranking in double, 3 plain double.
+/// CPU time; `reranked`: the share of lanes with more than one candidate.
+void BM_CpuBvhPacketKernel(benchmark::State& state, const std::string& file) {
+    const auto mesh = load(file);
+    if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    const TriangleBvh bvh = build_triangle_bvh(*mesh);
+    const int mode = int(state.range(1));
+    const Int3 r = lattice.resolution;
+    constexpr int K = kCpuPacketLanes;
+    std::vector<Vec3d> lanes;  // K points per brick, brick by brick in x-major order
+    for (int k = 0; k + 1 < r.z; k += 2)
+        for (int j = 0; j + 1 < r.y; j += 2)
+            for (int i = 0; i + 3 < r.x; i += 4)
+                for (int l = 0; l < K; ++l)
+                    lanes.push_back(lattice.position_of_coords({2 * (i + l % 4), 2 * (j + (l / 4) % 2), 2 * (k + l / 8)}));
+    const int64_t bricks = int64_t(lanes.size()) / K;
+    const SearchSlack<float> slack = make_search_slack(float_search_bound(*mesh), largest_lattice_coordinate(lattice));
+    const CpuCertifiedKernels& certified = certified_cpu_kernels();
+    int64_t reranked = 0, lanes_done = 0;
+    auto run = [&](auto zero) {
+        using T = decltype(zero);
+        const BvhView<T> view = bvh.view<T>();
+        const BvhView<double> exact = bvh.view<double>();
+        int32_t seed[K];
+        BvhStats stats;
+        for (int64_t b = 0; b < bricks; ++b) {
+            if (b % (r.x / 4) == 0) std::fill(seed, seed + K, -1);
+            BvhPacket<T, K> pk;
+            for (int l = 0; l < K; ++l) {
+                const Vec3d& p = lanes[size_t(b * K + l)];
+                pk.x[l] = T(p.x); pk.y[l] = T(p.y); pk.z[l] = T(p.z);
+            }
+            seed_packet(view, seed, pk);
+            if constexpr (std::is_same_v<T, float>) {
+                if (mode == 0) {
+                    cpu_kernels<float>().closest_triangles_packet(view, pk, stats);
+                } else {
+                    CpuPacketCertifiedNear near;
+                    near.slack = slack;
+                    certified.closest_triangles_packet(view, pk, stats, near);
+                    if (mode == 2)
+                        for (int l = 0; l < K; ++l) {
+                            const NearCandidates<float, kCpuNearCandidates>& c = near.near[l];
+                            const Rerank rr = certified.rerank(exact.packed, view.triangle_index, lanes[size_t(b * K + l)],
+                                                               pk.best_slot[l], slack.radius(pk.best_q[l]), c.slot, c.q,
+                                                               c.count, c.dropped);
+                            benchmark::DoNotOptimize(rr.slot);
+                            reranked += rr.reranked;
+                        }
+                }
+            } else {
+                cpu_kernels<double>().closest_triangles_packet(view, pk, stats);
+            }
+            for (int l = 0; l < K; ++l) seed[l] = pk.best_slot[l];
+            benchmark::DoNotOptimize(pk.best_slot);
+        }
+        lanes_done += bricks * K;
+        state.counters["tris/pt"] = double(stats.triangles) / double(bricks * K);
+    };
+    for (auto _ : state) {
+        if (mode == 3) run(0.0); else run(0.0f);
+    }
+    state.SetLabel(active_cpu_kernels().isa);
+    state.counters["points"] = double(bricks * K);
+    if (mode == 2) state.counters["reranked"] = double(reranked) / double(lanes_done);
 }
 
 void point_query_args(benchmark::internal::Benchmark* b) {
@@ -257,6 +334,9 @@ BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark:
 BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
+BENCHMARK_CAPTURE(BM_CpuBvhPacketKernel, dragon, std::string("dragon.obj"))
+    ->ArgsProduct({{64, 128}, {0, 1, 2, 3}})->ArgNames({"res", "mode"})->Unit(benchmark::kMillisecond)->Iterations(1)
+    ->Repetitions(3)->ReportAggregatesOnly(true);
 BENCHMARK_CAPTURE(BM_CpuBvhPointQuery, bunny, std::string("bunny.obj"))->Apply(point_query_args);
 BENCHMARK_CAPTURE(BM_CpuBvhPointQuery, dragon, std::string("dragon.obj"))->Apply(point_query_args);
 BENCHMARK_CAPTURE(BM_CudaBvh, bunny, std::string("bunny.obj"))->Apply(cuda_args);

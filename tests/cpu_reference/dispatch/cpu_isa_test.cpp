@@ -3,8 +3,12 @@
 // nearest triangle, lowest index on ties, and its squared distance), for the brute force and
 // the BVH packet traversal, in float and double; the one-point BVH query returns the bits of
 // the same template compiled in this file (at the build's target), and the BVH kernels visit
-// the same nodes at every level. Levels this CPU lacks are skipped; a build for one target
-// (SDF_CPU_TARGET other than portable) has no levels and skips. SDF_CPU_ISA chooses the level.
+// the same nodes at every level. The certified float kernels (search_certificate.h) keep the
+// same winners, Q bits and candidates at every level as the templates compiled here, and their
+// re-ranking gives the double brute force's triangle; the certified samplers at the chosen
+// level equal the double brute force in distance, gradient and triangle (CTest runs this at
+// SDF_CPU_ISA=v2, v3 and the widest level). Levels this CPU lacks are skipped; a build for one
+// target (SDF_CPU_TARGET other than portable) has no levels and skips.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -14,7 +18,10 @@
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/mesh/prepared_mesh.h"
+#include "core/sampling/certified_search.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
 
 namespace sdf {
 namespace {
@@ -30,6 +37,13 @@ std::vector<const CpuKernelSet*> runnable_sets() {
     for (CpuIsa isa : kCpuIsaLevels)
         if (const CpuKernelSet* s = cpu_kernel_set(isa)) sets.push_back(s);
     return sets;
+}
+
+/// Whether SDF_CPU_ISA names a level that this CPU lacks: the tests of the chosen level skip
+/// (CTest forces x86-64-v3, which an old CPU may not run).
+bool requested_level_missing() {
+    const char* requested = std::getenv("SDF_CPU_ISA");
+    return requested != nullptr && *requested != '\0' && !cpu_supports(parse_cpu_isa(requested, "SDF_CPU_ISA"));
 }
 
 /// Random points around the mesh, the mesh's vertices (exact ties between the triangles that
@@ -56,6 +70,7 @@ void check_brute_force_at_every_level() {
     const PreparedMesh& mesh = test_mesh();
     const std::vector<PackedTriangle<T>>& packed = mesh.buffers<T>().packed;
     const TriangleSoA<T> soa(packed);
+    const MeshView<T> view = mesh.buffers<T>().view();
     const std::vector<Vec3d> pts = query_points(mesh, 512);
     const auto sets = runnable_sets();
     if (sets.empty()) GTEST_SKIP() << "a single-target build: one set of kernels, nothing to compare";
@@ -80,6 +95,8 @@ void check_brute_force_at_every_level() {
                 }
                 ASSERT_EQ(best[k], want) << set->isa << ", point " << first + k;
                 ASSERT_TRUE(same_bits(q[k], want_q)) << set->isa << ", point " << first + k << ": " << q[k] << " vs " << want_q;
+                const Vec3<T> p(px[k], py[k], pz[k]);  // the thesis's kernel: the template compiled here
+                ASSERT_EQ(set->get<T>().nearest_triangle_eberly(view, p), nearest_triangle_eberly(view, p)) << set->isa;
                 ++compared;
             }
         }
@@ -149,6 +166,208 @@ void check_bvh_at_every_level() {
 TEST(CpuIsa, BvhKernelsEqualTheScalarLoopAtEveryLevelFloat) { check_bvh_at_every_level<float>(); }
 TEST(CpuIsa, BvhKernelsEqualTheScalarLoopAtEveryLevelDouble) { check_bvh_at_every_level<double>(); }
 
+/// The candidates a certified search kept, in the order kept, with the bits of their Q and
+/// the smallest dropped Q: equal lists mean the same search, step for step.
+template <int N>
+std::vector<int64_t> kept(const NearCandidates<float, N>& c) {
+    std::vector<int64_t> out;
+    for (int i = 0; i < c.count; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, &c.q[i], sizeof bits);
+        out.push_back(int64_t(c.slot[i]) << 32 | bits);
+    }
+    uint32_t dropped;
+    std::memcpy(&dropped, &c.dropped, sizeof dropped);
+    out.push_back(dropped);
+    return out;
+}
+
+std::vector<int64_t> kept(const AllNear& c) {
+    std::vector<int64_t> out;
+    for (size_t i = 0; i < c.slot.size(); ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, &c.q[i], sizeof bits);
+        out.push_back(int64_t(c.slot[i]) << 32 | bits);
+    }
+    return out;
+}
+
+/// The double search's triangle at p: the scalar loop over squared_distance() in double,
+/// lowest triangle index on ties (prepared-mesh order).
+int32_t double_brute_force(const PreparedMesh& mesh, const Vec3d& p) {
+    const auto& packed = mesh.buffers<double>().packed;
+    int32_t best = -1;
+    double best_q = std::numeric_limits<double>::infinity();
+    for (size_t t = 0; t < packed.size(); ++t) {
+        const double d = squared_distance(packed[t], p.x, p.y, p.z);
+        if (d < best_q) { best_q = d; best = int32_t(t); }
+    }
+    return best;
+}
+
+/// The certified float kernels (search_certificate.h) at every level: the brute force, the
+/// one-point BVH query and the packet keep the same winner, Q bits and candidates as the same
+/// templates compiled in this file; the fallbacks that keep every candidate too; and the
+/// re-ranking in double turns them into the double brute force's triangle.
+TEST(CpuIsa, CertifiedKernelsAgreeAtEveryLevelAndCertify) {
+    const PreparedMesh& mesh = test_mesh();
+    const TriangleBvh bvh = build_triangle_bvh(mesh);
+    const BvhView<float> view = bvh.view<float>();
+    const BvhView<double> exact = bvh.view<double>();
+    const TriangleSoA<float> soa(mesh.buffers<float>().packed);
+    const PackedTriangle<double>* exact_ordered = mesh.buffers<double>().packed.data();
+    const std::vector<Vec3d> pts = query_points(mesh, 512);
+    const auto sets = runnable_sets();
+    if (sets.empty()) GTEST_SKIP() << "a single-target build: one set of kernels, nothing to compare";
+    double coordinate = 0;
+    for (const Vec3d& p : pts) coordinate = std::max(coordinate, largest_coordinate(p));
+    const SearchSlack<float> slack = make_search_slack(float_search_bound(mesh), coordinate);
+    ASSERT_TRUE(slack.certify);
+    std::vector<int32_t> truth;
+    for (const Vec3d& p : pts) truth.push_back(double_brute_force(mesh, p));
+    int64_t reranked = 0, overflowed = 0;
+    for (const CpuKernelSet* set : sets) {
+        const CpuCertifiedKernels& k = set->certified;
+        BvhStats stats, here_stats;
+        for (size_t first = 0; first < pts.size(); first += kCpuPacketLanes) {
+            float px[kPointTile], py[kPointTile], pz[kPointTile];
+            BvhPacket<float, kCpuPacketLanes> pk, here_pk;
+            int32_t seed[kCpuPacketLanes];
+            for (int i = 0; i < kPointTile; ++i) {
+                px[i] = pk.x[i] = here_pk.x[i] = float(pts[first + i].x);
+                py[i] = pk.y[i] = here_pk.y[i] = float(pts[first + i].y);
+                pz[i] = pk.z[i] = here_pk.z[i] = float(pts[first + i].z);
+                seed[i] = -1;
+            }
+            // The brute force: a tile of points.
+            CpuCertifiedNear near[kPointTile], here_near[kPointTile];
+            for (int i = 0; i < kPointTile; ++i) near[i].slack = here_near[i].slack = slack;
+            int best[kPointTile], here_best[kPointTile];
+            float q[kPointTile], here_q[kPointTile];
+            k.nearest_triangles(soa, kPointTile, px, py, pz, best, q, near);
+            nearest_triangles_vectorized(soa, kPointTile, px, py, pz, here_best, here_q, here_near);
+            // The packet.
+            seed_packet(view, seed, pk);
+            seed_packet(view, seed, here_pk);
+            CpuPacketCertifiedNear pnear, here_pnear;
+            pnear.slack = here_pnear.slack = slack;
+            k.closest_triangles_packet(view, pk, stats, pnear);
+            closest_triangles_packet(view, here_pk, here_stats, here_pnear);
+            for (int i = 0; i < kPointTile; ++i) {
+                const size_t n = first + size_t(i);
+                const Vec3d& p = pts[n];
+                const Vec3f pf(px[i], py[i], pz[i]);
+                const std::string where = std::string(set->isa) + ", point " + std::to_string(n);
+                ASSERT_EQ(best[i], here_best[i]) << where;
+                ASSERT_TRUE(same_bits(q[i], here_q[i])) << where;
+                ASSERT_EQ(kept(near[i].near), kept(here_near[i].near)) << where;
+                ASSERT_EQ(pk.best_slot[i], here_pk.best_slot[i]) << where;
+                ASSERT_TRUE(same_bits(pk.best_q[i], here_pk.best_q[i])) << where;
+                ASSERT_EQ(kept(pnear.near[i]), kept(here_pnear.near[i])) << where;
+                // The one-point query and its fallback.
+                CpuCertifiedNear one{slack, {}}, here_one{slack, {}};
+                const BvhHit<float> hit = k.closest_triangle(view, pf, BvhHit<float>{}, stats, one);
+                const BvhHit<float> here_hit = closest_triangle_bvh(view, pf, BvhHit<float>{}, here_stats, here_one);
+                ASSERT_EQ(hit.slot, here_hit.slot) << where;
+                ASSERT_TRUE(same_bits(hit.distance_squared, here_hit.distance_squared)) << where;
+                ASSERT_EQ(kept(one.near), kept(here_one.near)) << where;
+                AllNear all{slack, {}, {}}, here_all{slack, {}, {}};
+                const BvhHit<float> wide = k.closest_triangle_all(view, pf, BvhHit<float>{}, stats, all);
+                closest_triangle_bvh(view, pf, BvhHit<float>{}, here_stats, here_all);
+                ASSERT_EQ(kept(all), kept(here_all)) << where;
+                AllNear tile_all{slack, {}, {}}, here_tile_all{slack, {}, {}};
+                int one_best, here_one_best;
+                float one_q, here_one_q;
+                k.nearest_triangles_all(soa, 1, &pf.x, &pf.y, &pf.z, &one_best, &one_q, &tile_all);
+                nearest_triangles_vectorized(soa, 1, &pf.x, &pf.y, &pf.z, &here_one_best, &here_one_q, &here_tile_all);
+                ASSERT_EQ(kept(tile_all), kept(here_tile_all)) << where;
+                // Every search, re-ranked in double, returns the double brute force's triangle:
+                // from its kept candidates, or (overflow) from every candidate.
+                auto certified = [&](int32_t winner, float best_q, const NearCandidates<float, kCpuNearCandidates>& c,
+                                     const int32_t* index, const PackedTriangle<double>* packed, const AllNear& every) {
+                    const float radius = slack.radius(best_q);
+                    Rerank r = k.rerank(packed, index, p, winner, radius, c.slot, c.q, c.count, c.dropped);
+                    auto index_of = [&](int32_t s) { return index ? index[s] : s; };
+                    const Rerank here = rerank_in_double(packed, index_of, p.x, p.y, p.z, winner, radius, c);
+                    EXPECT_EQ(r.slot, here.slot) << where;
+                    EXPECT_EQ(r.overflow, here.overflow) << where;
+                    reranked += r.reranked;
+                    if (r.overflow) {
+                        ++overflowed;
+                        r = k.rerank(packed, index, p, winner, radius, every.slot.data(), every.q.data(),
+                                     int(every.slot.size()), NAN);
+                    }
+                    return index_of(r.slot);
+                };
+                EXPECT_EQ(certified(best[i], q[i], near[i].near, nullptr, exact_ordered, tile_all), truth[n]) << where << " brute force";
+                EXPECT_EQ(certified(pk.best_slot[i], pk.best_q[i], pnear.near[i], view.triangle_index, exact.packed, all),
+                          truth[n]) << where << " packet";
+                EXPECT_EQ(certified(hit.slot, hit.distance_squared, one.near, view.triangle_index, exact.packed, all), truth[n])
+                    << where << " one point";
+                EXPECT_EQ(view.triangle_index[wide.slot], view.triangle_index[hit.slot]) << where;
+            }
+        }
+        EXPECT_EQ(stats.nodes, here_stats.nodes) << set->isa << " traversed differently from this file's kernels";
+        EXPECT_EQ(stats.triangles, here_stats.triangles) << set->isa;
+    }
+    EXPECT_GT(reranked, 0);  // the vertices: exact ties between the triangles around them
+    std::printf("certified float kernels: %zu points at %zu levels; %lld searches re-ranked in double, %lld overflowed\n",
+                pts.size(), sets.size(), (long long)reranked, (long long)overflowed);
+}
+
+SamplerOptions float_options(const std::string& kernel) {
+    SamplerOptions o;
+    o.precision = Precision::Float;
+    o.kernel = kernel;
+    o.progress = false;
+    return o;
+}
+
+/// The certified float samplers at the level this process runs (CTest runs this test at
+/// x86-64-v2, -v3 and the widest level): distance, gradient and triangle bit for bit those of
+/// the double brute force, on point lists (brute force, BVH packets, seeded, unseeded) and on
+/// a lattice; most points are nearest to a vertex or an edge, where the triangles around it
+/// tie exactly and are re-ranked in double.
+TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    const PreparedMesh& mesh = test_mesh();
+    const std::vector<Vec3d> pts = query_points(mesh, 256);
+    SamplerOptions reference = float_options("vectorized");
+    reference.precision = Precision::Double;
+    const std::vector<PointSample> want = make_cpu_brute_force_sampler(reference)->query(mesh, pts);
+    auto same_sample = [](const PointSample& a, const PointSample& b) {
+        return a.triangle == b.triangle && same_bits(a.distance, b.distance) && same_bits(a.gradient.x, b.gradient.x) &&
+               same_bits(a.gradient.y, b.gradient.y) && same_bits(a.gradient.z, b.gradient.z);
+    };
+    struct Run { const char* method; const char* kernel; };
+    for (const Run r : {Run{"brute_force", "vectorized"}, Run{"bvh", "brick"}, Run{"bvh", "seeded"}, Run{"bvh", "unseeded"}}) {
+        const SamplerOptions o = float_options(r.kernel);
+        auto sampler = std::string(r.method) == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
+        const std::vector<PointSample> got = sampler->query(mesh, pts);
+        int64_t bad = 0;
+        for (size_t i = 0; i < pts.size(); ++i) bad += !same_sample(got[i], want[i]);
+        EXPECT_EQ(bad, 0) << active_cpu_kernels().isa << " " << r.method << "/" << r.kernel;
+        EXPECT_GT(sampler->last_query_timings().reranked_points, 0);
+    }
+    const Lattice lattice{LatticeType::CC, {-1.25, -1.25, -1.25}, 0.125, {21, 21, 21}};
+    const SampledField lattice_want = make_cpu_brute_force_sampler(reference)->sample(mesh, lattice);
+    for (const Run r : {Run{"brute_force", "vectorized"}, Run{"bvh", "brick"}, Run{"bvh", "seeded"}, Run{"bvh", "unseeded"}}) {
+        const SamplerOptions o = float_options(r.kernel);
+        auto sampler = std::string(r.method) == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
+        const SampledField got = sampler->sample(mesh, lattice);
+        ASSERT_EQ(got.distance.size(), lattice_want.distance.size());
+        int64_t bad = 0;
+        for (size_t i = 0; i < got.distance.size(); ++i)
+            bad += !(got.closest_triangle[i] == lattice_want.closest_triangle[i] && same_bits(got.distance[i], lattice_want.distance[i]) &&
+                     same_bits(got.gradient[i].x, lattice_want.gradient[i].x) && same_bits(got.gradient[i].y, lattice_want.gradient[i].y) &&
+                     same_bits(got.gradient[i].z, lattice_want.gradient[i].z));
+        EXPECT_EQ(bad, 0) << active_cpu_kernels().isa << " lattice " << r.method << "/" << r.kernel;
+        EXPECT_EQ(got.sampler["search_certificate"]["certified"], true);
+    }
+    std::printf("certified samplers at %s: %zu points and a %lld-point lattice equal the double brute force\n",
+                active_cpu_kernels().isa, pts.size(), (long long)lattice.num_points());
+}
+
 TEST(CpuIsa, ParsesLevelNames) {
     EXPECT_EQ(parse_cpu_isa("v2", "test"), CpuIsa::X86_64_V2);
     EXPECT_EQ(parse_cpu_isa("x86-64-v3", "test"), CpuIsa::X86_64_V3);
@@ -165,6 +384,7 @@ TEST(CpuIsa, ParsesLevelNames) {
 }
 
 TEST(CpuIsa, ChoosesTheWidestLevelOrTheRequestedOne) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
     const CpuKernelChoice choice = cpu_kernel_choice();
     std::printf("kernels: %s (chosen by %s)\n", choice.isa.c_str(), choice.chosen_by.c_str());
     EXPECT_EQ(choice.isa, active_cpu_kernels().isa);
