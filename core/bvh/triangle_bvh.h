@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "kernels/bvh/bvh_view.h"
 #include "kernels/core/vec3.h"
 #include "kernels/distance/packed_triangle.h"
+#include "kernels/distance/search_certificate.h"
 
 namespace sdf {
 
@@ -39,6 +41,9 @@ public:
     std::vector<PackedTriangle<float>> packed_float;    ///< search constants in BVH order
     std::vector<PackedTriangle<double>> packed_double;
     BvhBuildStats stats;
+    /// The certified float search's bound of these triangles (search_bound.h), computed by
+    /// the build so that a query does not pass over the mesh; empty for a tree made otherwise.
+    std::optional<FloatSearchBound> float_bound;
 
     template <typename T>
     BvhView<T> view() const;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/bvh/search_bound.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampled_field.h"
 #include "kernels/distance/search_certificate.h"

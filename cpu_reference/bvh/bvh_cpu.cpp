@@ -60,7 +60,8 @@ struct Certifier {
     const CpuCertifiedKernels& kernels = certified_cpu_kernels();
 
     Certifier(const PreparedMesh& mesh, const TriangleBvh& bvh, double point_coordinate) : exact(bvh.view<double>()) {
-        if constexpr (kActive) slack = make_search_slack(float_search_bound(mesh), point_coordinate);
+        if constexpr (kActive)
+            slack = make_search_slack(bvh.float_bound ? *bvh.float_bound : float_search_bound(mesh), point_coordinate);
     }
 
     /// Starts loading the double constants of the candidates (three cache lines each, in an
