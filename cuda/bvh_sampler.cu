@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -77,10 +78,32 @@ struct DeviceBvh {
     }
 };
 
+// EXPERIMENT (removed before merge): SDF_FUSE_EXPERIMENT=pass (the separate certify pass),
+// none (no certificate: timing only), cap4 (fused, 128-register cap).
+inline std::string fuse_experiment() {
+    const char* e = std::getenv("SDF_FUSE_EXPERIMENT");
+    return e ? std::string(e) : std::string();
+}
+
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
 template <typename T, typename Piece>
 void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {
+    if (fuse_experiment() == "none") return;
     if constexpr (std::is_same_v<T, float>) dev.certifier->certify(piece, point_coordinate, nearest);
+}
+
+/// The certificate fused into the warp and candidates kernels (float, and a bound that
+/// certifies at these points); none (exact == nullptr) otherwise.
+template <typename T>
+StreamedCertify streamed_certify(const DeviceBvh<T>& dev, BvhGpuKernel kernel, double point_coordinate) {
+    if (fuse_experiment() == "pass" || fuse_experiment() == "none") return {};
+    if constexpr (std::is_same_v<T, float>)
+        if (kernel == BvhGpuKernel::Warp || kernel == BvhGpuKernel::Candidates) {
+            StreamedCertify c = dev.certifier->streamed(point_coordinate);
+            if (fuse_experiment() == "cap4") c.min_blocks = 4;
+            return c;
+        }
+    return {};
 }
 
 /// Zeroes the certifier's counters.
@@ -214,7 +237,8 @@ private:
     }
 
     template <typename T>
-    void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) {
+    void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, const StreamedCertify& cert,
+                     int* nearest) {
         const int blocks = blocks_for(slab.threads(), kBvhThreads);
         const BvhView<T>& view = dev.view;
         switch (kernel_) {
@@ -228,11 +252,10 @@ private:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
                 break;
             case BvhGpuKernel::Warp:
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev), nearest);
+                launch_bvh_warp(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest);
                 break;
             case BvhGpuKernel::Candidates:
-                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),
-                                                                            nearest, candidate_stats_.get());
+                launch_bvh_candidates(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest, candidate_stats_.get());
                 break;
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
@@ -248,8 +271,10 @@ private:
         const SlabGeometry slab{block.resolution, z0, nz};
         PieceResults r(piece.count);
         compute.begin();
-        launch_slab<T>(dev, piece, slab, r.nearest.get());
-        certify(dev, piece, largest_lattice_coordinate(lattice), r.nearest.get());
+        const double coordinate = largest_lattice_coordinate(lattice);
+        const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
+        launch_slab<T>(dev, piece, slab, fused, r.nearest.get());
+        if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
@@ -493,12 +518,13 @@ private:
             const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
             const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
             const int blocks = blocks_for(layout.threads(), kBvhThreads);
+            const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
             if (kernel_ == BvhGpuKernel::Candidates)
-                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
+                launch_bvh_candidates(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get(), nullptr);
             else
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
+                launch_bvh_warp(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
-            certify(dev, piece, coordinate, r.nearest.get());
+            if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
