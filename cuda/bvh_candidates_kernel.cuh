@@ -50,13 +50,9 @@ __device__ SDF_INLINE T brick_gap_d2(const BvhNode& n, int c, const Vec3<T>& lo,
 
 }  // namespace detail
 
-/// kCertified (float only): the certified search fused in (streamed_certificate.h); the list
-/// then holds every leaf within radius(u), the widened radius of a winner no farther than u
-/// (radius() is monotone), and the scan streams the double re-rank.
-template <typename T, typename Layout, bool kCertified>
+template <typename T, typename Layout>
 __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(BvhView<T> bvh, Layout layout, BandSearch band,
-                                                                                StreamedCertify cert, int* nearest,
-                                                                                CandidateStats stats) {
+                                                                                int* nearest, CandidateStats stats) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
     __shared__ int32_t range_first[kWarps][kCandidateRanges];
@@ -89,16 +85,11 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
     T u = T(-1);
     for (int k = 0; k < count; ++k) u = max(u, squared_distance(seed_triangle, pk.x[k], pk.y[k], pk.z[k]));
     u = warp_max(u);
-    if constexpr (kCertified) u = cert.slack.radius(u);
-    auto policy = [&] {
-        if constexpr (kCertified) return StreamedRun<Layout>(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
-        else return PacketPlainNear{};
-    }();
 
     int ranges = 0, triangles = 0, rounds_ranges = 0;  // warp-uniform
     const auto scan_ranges = [&]() {
         __syncwarp();
-        for (int r = 0; r < ranges; ++r) sdf::detail::scan_leaf_packet(bvh, range_first[w][r], range_count[w][r], pk, policy);
+        for (int r = 0; r < ranges; ++r) sdf::detail::scan_leaf_packet(bvh, range_first[w][r], range_count[w][r], pk);
         rounds_ranges += ranges;
         ranges = 0;
         __syncwarp();
@@ -135,20 +126,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
         atomicAdd(stats + 1, (unsigned long long)triangles);
         atomicAdd(stats + 3, (unsigned long long)rounds_ranges);
     }
-    write_nearest<kCertified>(bvh, pk, policy, first, count, cert, nearest);
-}
-
-/// Launches the candidates search, with the certificate fused when `cert` holds one (float).
-template <typename T, typename Layout>
-void launch_bvh_candidates(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
-                           const StreamedCertify& cert, int* nearest, CandidateStats stats) {
-    if constexpr (std::is_same_v<T, float>) {
-        if (cert.exact) {
-            nearest_triangle_bvh_candidates<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, stats);
-            return;
-        }
-    }
-    nearest_triangle_bvh_candidates<T, Layout, false><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, stats);
+    for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
 }
 
 }  // namespace sdf::cuda

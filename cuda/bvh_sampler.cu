@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -78,31 +77,18 @@ struct DeviceBvh {
     }
 };
 
-// EXPERIMENT (removed before merge): SDF_FUSE_EXPERIMENT=pass (the separate certify pass),
-// none (no certificate: timing only), cap4 (fused, 128-register cap).
-inline std::string fuse_experiment() {
-    const char* e = std::getenv("SDF_FUSE_EXPERIMENT");
-    return e ? std::string(e) : std::string();
-}
-
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
 template <typename T, typename Piece>
 void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {
-    if (fuse_experiment() == "none") return;
     if constexpr (std::is_same_v<T, float>) dev.certifier->certify(piece, point_coordinate, nearest);
 }
 
-/// The certificate fused into the warp and candidates kernels (float, and a bound that
-/// certifies at these points); none (exact == nullptr) otherwise.
+/// The certificate fused into the warp kernel (float, and a bound that certifies at these
+/// points); none (exact == nullptr: the separate pass certifies) otherwise.
 template <typename T>
 StreamedCertify streamed_certify(const DeviceBvh<T>& dev, BvhGpuKernel kernel, double point_coordinate) {
-    if (fuse_experiment() == "pass" || fuse_experiment() == "none") return {};
     if constexpr (std::is_same_v<T, float>)
-        if (kernel == BvhGpuKernel::Warp || kernel == BvhGpuKernel::Candidates) {
-            StreamedCertify c = dev.certifier->streamed(point_coordinate);
-            if (fuse_experiment() == "cap4") c.min_blocks = 4;
-            return c;
-        }
+        if (kernel == BvhGpuKernel::Warp) return dev.certifier->streamed(point_coordinate);
     return {};
 }
 
@@ -255,7 +241,8 @@ private:
                 launch_bvh_warp(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest);
                 break;
             case BvhGpuKernel::Candidates:
-                launch_bvh_candidates(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest, candidate_stats_.get());
+                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),
+                                                                            nearest, candidate_stats_.get());
                 break;
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh_slab");
@@ -520,7 +507,7 @@ private:
             const int blocks = blocks_for(layout.threads(), kBvhThreads);
             const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
             if (kernel_ == BvhGpuKernel::Candidates)
-                launch_bvh_candidates(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get(), nullptr);
+                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
             else
                 launch_bvh_warp(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");

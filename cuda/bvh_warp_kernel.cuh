@@ -188,6 +188,10 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
     return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
 }
 
+/// Blocks per SM the fused warp kernel is compiled for: 4 caps it at 128 registers (154
+/// uncapped), which measured 9-11% faster on an H100 (docs/gpu-notes.md).
+constexpr int kFusedMinBlocks = 4;
+
 /// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
 /// load_packet), for the streamed certificate's double evaluations.
 template <typename Layout>
@@ -226,8 +230,8 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
 /// The warp search of a lattice slab or a sorted point list; kCertified (float only) fuses
 /// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
 /// the double search's triangles without the separate certify pass.
-template <typename T, typename Layout, bool kCertified, int kMinBlocks = 1>
-__global__ void __launch_bounds__(kBvhThreads, kMinBlocks) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band,
+template <typename T, typename Layout, bool kCertified>
+__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band,
                                                                           StreamedCertify cert, int* nearest) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
@@ -266,10 +270,6 @@ template <typename T, typename Layout>
 void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
                      const StreamedCertify& cert, int* nearest) {
     if constexpr (std::is_same_v<T, float>) {
-        if (cert.exact && cert.min_blocks == 4) {  // EXPERIMENT
-            nearest_triangle_bvh_warp<T, Layout, true, 4><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
-            return;
-        }
         if (cert.exact) {
             nearest_triangle_bvh_warp<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
             return;

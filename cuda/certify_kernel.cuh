@@ -1,6 +1,9 @@
 /// @file certify_kernel.cuh
-/// @brief The certified float search on the GPU (kernels/distance/search_certificate.h),
-/// between any float search and finalize_samples(): every point's float winner seeds a
+/// @brief The certified float search on the GPU (kernels/distance/search_certificate.h).
+/// The warp kernel fuses it into its traversal (StreamedCertify below,
+/// kernels/bvh/streamed_certificate.h). The other float searches (candidates and per-thread
+/// BVH kernels, tuned brute force) run the separate pass here, between the float search and
+/// finalize_samples(): every point's float winner seeds a
 /// certified BVH search (pruning radius widened by the float error bound, candidates kept),
 /// and the candidates are re-ranked in double, so `nearest` ends up holding the double
 /// search's triangle. One seeded traversal per point: the radius is already the winner's, so
@@ -42,7 +45,6 @@ struct StreamedCertify {
     const PackedTriangle<double>* exact = nullptr;
     SearchSlack<float> slack;
     unsigned long long* counters = nullptr;
-    int min_blocks = 1;  // EXPERIMENT
 };
 
 /// Adds `value` over the whole warp (every lane must take part) with one atomic.

@@ -226,9 +226,9 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
                         (long long)sampler->last_query_timings().full_double_points);
             EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
             EXPECT_EQ(sampler->last_query_timings().certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
-            // warp and candidates fuse the certificate (kernels/bvh/streamed_certificate.h):
-            // no point ever needs the full double search.
-            if (id == cuda::BvhGpuKernel::Warp || id == cuda::BvhGpuKernel::Candidates) {
+            // warp fuses the certificate (kernels/bvh/streamed_certificate.h): no point ever
+            // needs the full double search.
+            if (id == cuda::BvhGpuKernel::Warp) {
                 EXPECT_EQ(sampler->last_query_timings().full_double_points, 0) << c.mesh.name << " " << kernel;
             }
         }
@@ -240,7 +240,7 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             lattice.spacing = 1.0 / 37.0;
             lattice.resolution = {40, 40, 3};
         } else {  // the plate's box: points over its fan centres, whose dozens of exact ties
-                  // overflow the fused kernels' two deferred candidates
+                  // overflow the warp kernel's two deferred candidates
             lattice.origin = {-1.1, -1.1, -0.2};
             lattice.spacing = 2.2 / 22.0;
             lattice.resolution = {23, 23, 5};
