@@ -188,8 +188,8 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
     return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
 }
 
-/// Blocks per SM the fused warp kernel is compiled for: 4 caps it at 128 registers (154
-/// uncapped), which measured 9-11% faster on an H100 (docs/gpu-notes.md).
+/// Blocks per SM the fused warp kernel is compiled for: 4 caps it at 128 registers (146-154
+/// uncapped), which measured 7-11% faster on an H100 (docs/gpu-notes.md).
 constexpr int kFusedMinBlocks = 4;
 
 /// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
@@ -231,8 +231,8 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
 /// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
 /// the double search's triangles without the separate certify pass.
 template <typename T, typename Layout, bool kCertified>
-__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band,
-                                                                          StreamedCertify cert, int* nearest) {
+__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
+    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
     __shared__ T stack_d2[kWarps][kBvhMaxDepth];

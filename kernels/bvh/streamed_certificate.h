@@ -1,6 +1,6 @@
 /// @file streamed_certificate.h
 /// @brief The certified float search fused into a packet traversal (closest_triangles_packet.h
-/// and the GPU warp kernels): the double re-rank happens during the one float search, with
+/// and the GPU warp kernel): the double re-rank happens during the one float search, with
 /// two deferred candidates per lane in registers and no candidate list to overflow.
 ///
 /// Why it is exact. Let t* be the double search's winner (search_certificate.h). Its ranked
@@ -106,7 +106,7 @@ struct StreamedCertifiedNear {
             const int32_t triangle = bvh.triangle_index[j];
             const T excess = sliver_excess(tri);
             unsigned stream = 0;
-SDF_UNROLL_LANES
+            SDF_UNROLL_LANES
             for (int k = 0; k < K; ++k) {
                 const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
                 if (q < pk.best_q[k] || (q == pk.best_q[k] && wins_tie(triangle, pk.best_triangle[k]))) {

@@ -103,7 +103,7 @@ TEST(CertifiedSearch, ErrorBoundHoldsForEveryPair) {
 
 
 /// The certificate fused into a packet search (kernels/bvh/streamed_certificate.h, the GPU
-/// warp and candidates kernels' form) on the CPU: packets of 4 consecutive case points, and
+/// warp kernel's form) on the CPU: packets of 4 consecutive case points, and
 /// the same points 4 copies to a packet (every lane ties with the others). Every lane's
 /// triangle is the double brute force's; the fan plate's centre vertex (dozens of triangles
 /// tied exactly) overflows the two deferred candidates, so the streamed double re-rank runs.
