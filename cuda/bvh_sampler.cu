@@ -84,6 +84,15 @@ void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinat
     if constexpr (std::is_same_v<T, float>) dev.certifier->certify(piece, point_coordinate, nearest);
 }
 
+/// The certificate fused into the warp kernel (float, and a bound that certifies at these
+/// points); none (exact == nullptr: the separate pass certifies) otherwise.
+template <typename T>
+StreamedCertify streamed_certify(const DeviceBvh<T>& dev, BvhGpuKernel kernel, double point_coordinate) {
+    if constexpr (std::is_same_v<T, float>)
+        if (kernel == BvhGpuKernel::Warp) return dev.certifier->streamed(point_coordinate);
+    return {};
+}
+
 /// Zeroes the certifier's counters.
 template <typename T>
 void reset_certificate(const DeviceBvh<T>& dev) {
@@ -263,7 +272,8 @@ private:
     }
 
     template <typename T>
-    void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, int* nearest) {
+    void launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& piece, const SlabGeometry& slab, const StreamedCertify& cert,
+                     int* nearest) {
         const int blocks = blocks_for(slab.threads(), kBvhThreads);
         const BvhView<T>& view = dev.view;
         switch (kernel_) {
@@ -277,7 +287,7 @@ private:
                 nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
                 break;
             case BvhGpuKernel::Warp:
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev), nearest);
+                launch_bvh_warp(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest);
                 break;
             case BvhGpuKernel::Candidates:
                 nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),
@@ -297,8 +307,10 @@ private:
         const SlabGeometry slab{block.resolution, z0, nz};
         PieceResults r(piece.count);
         compute.begin();
-        launch_slab<T>(dev, piece, slab, r.nearest.get());
-        certify(dev, piece, largest_lattice_coordinate(lattice), r.nearest.get());
+        const double coordinate = largest_lattice_coordinate(lattice);
+        const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
+        launch_slab<T>(dev, piece, slab, fused, r.nearest.get());
+        if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
@@ -566,12 +578,13 @@ private:
             const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
             const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
             const int blocks = blocks_for(layout.threads(), kBvhThreads);
+            const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
             if (kernel_ == BvhGpuKernel::Candidates)
                 nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
             else
-                nearest_triangle_bvh_warp<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get());
+                launch_bvh_warp(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
-            certify(dev, piece, coordinate, r.nearest.get());
+            if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
             launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");

@@ -10,8 +10,12 @@
 /// its own exact minimum (up to ties). Leaves are scanned by every thread for its 4 points.
 #pragma once
 
+#include <type_traits>
+
 #include "kernels/bvh/closest_triangles_packet.h"
+#include "kernels/bvh/streamed_certificate.h"
 #include "cuda/bvh_kernel.cuh"
+#include "cuda/certify_kernel.cuh"
 #include "cuda/finalize_kernel.cuh"
 #include "kernels/distance/signed_distance.h"
 
@@ -78,11 +82,12 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
     return count;
 }
 
-/// The warp's shared traversal: completes the nearest triangle of every lane's points.
-/// `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
-template <typename T>
+/// The warp's shared traversal: completes the nearest triangle of every lane's points,
+/// pruning with each lane's radius (`policy`: plain, or the streamed certificate's widened
+/// one). `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
+template <typename T, typename Near>
 __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunPoints>& pk, bool valid, int32_t* stack_node,
-                                       T* stack_d2) {
+                                       T* stack_d2, Near& policy) {
     T worst = warp_max(valid ? T(INFINITY) : T(-1));
     int top = 0;  // warp-uniform
     int32_t node = 0;
@@ -96,9 +101,10 @@ __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunP
         const bool want_near = near ? want1 : want0, want_far = near ? want0 : want1;
         int32_t next = -1;
         bool scanned = false;
+        T mine = T(-1);  // the thread's largest radius after a scan
         if (want_near) {
             if (bvh_child_is_leaf(n, near)) {
-                detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk);
+                mine = detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk, policy);
                 scanned = true;
             } else {
                 next = n.ref[near];
@@ -107,7 +113,7 @@ __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunP
         if (want_far) {
             const int far = 1 - near;
             if (bvh_child_is_leaf(n, far)) {
-                detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk);
+                mine = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk, policy);
                 scanned = true;
             } else if (next < 0) {
                 next = n.ref[far];
@@ -119,11 +125,7 @@ __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunP
                 ++top;
             }
         }
-        if (scanned) {
-            T mine = pk.best_q[0];
-            for (int k = 1; k < kRunPoints; ++k) mine = max(mine, pk.best_q[k]);
-            worst = warp_max(mine);
-        }
+        if (scanned) worst = warp_max(mine);
         __syncwarp();
         while (next < 0 && top > 0) {
             --top;
@@ -186,9 +188,51 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
     return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
 }
 
-template <typename T, typename Layout>
-__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band,
-                                                                          int* nearest) {
+/// Blocks per SM the fused warp kernel is compiled for: 4 caps it at 128 registers (146-154
+/// uncapped), which measured 7-11% faster on an H100 (docs/gpu-notes.md).
+constexpr int kFusedMinBlocks = 4;
+
+/// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
+/// load_packet), for the streamed certificate's double evaluations.
+template <typename Layout>
+struct RunPoint {
+    Layout layout;
+    int64_t first = 0;
+    int count = 0;
+    SDF_CPU_GPU SDF_INLINE Vec3d operator()(int k) const { return layout.position(first + (k < count ? k : 0)); }
+};
+
+template <typename Layout>
+using StreamedRun = StreamedCertifiedNear<float, kRunPoints, RunPoint<Layout>>;
+
+/// Writes the nearest triangle of the thread's `count` points: the plain search's, or with
+/// the certificate fused (kCertified, float only) the double search's, counting the points
+/// and those that needed double evaluations (every lane of the warp must call this).
+template <bool kCertified, typename T, typename Near>
+__device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, kRunPoints>& pk, Near& policy, int64_t first,
+                                         int count, const StreamedCertify& cert, int* nearest) {
+    if constexpr (kCertified) {
+        unsigned reranked = 0;
+#pragma unroll
+        for (int k = 0; k < kRunPoints; ++k) {
+            if (k >= count) continue;
+            bool r = false;
+            nearest[first + k] = policy.finish(bvh, k, pk, r);
+            reranked += unsigned(r);
+        }
+        warp_add(cert.counters + 0, unsigned(count));
+        warp_add(cert.counters + 1, reranked);
+    } else {
+        for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
+    }
+}
+
+/// The warp search of a lattice slab or a sorted point list; kCertified (float only) fuses
+/// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
+/// the double search's triangles without the separate certify pass.
+template <typename T, typename Layout, bool kCertified>
+__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
+    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
     __shared__ T stack_d2[kWarps][kBvhMaxDepth];
@@ -210,8 +254,28 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_warp(BvhView
             return;
         }
     }
-    warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w]);
-    for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
+    if constexpr (kCertified) {
+        StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
+        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
+    } else {
+        PacketPlainNear policy;
+        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
+    }
+}
+
+/// Launches the warp search, with the certificate fused when `cert` holds one (float).
+template <typename T, typename Layout>
+void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
+                     const StreamedCertify& cert, int* nearest) {
+    if constexpr (std::is_same_v<T, float>) {
+        if (cert.exact) {
+            nearest_triangle_bvh_warp<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
+            return;
+        }
+    }
+    nearest_triangle_bvh_warp<T, Layout, false><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
 }
 
 }  // namespace sdf::cuda

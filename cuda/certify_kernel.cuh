@@ -1,6 +1,9 @@
 /// @file certify_kernel.cuh
-/// @brief The certified float search on the GPU (kernels/distance/search_certificate.h),
-/// between any float search and finalize_samples(): every point's float winner seeds a
+/// @brief The certified float search on the GPU (kernels/distance/search_certificate.h).
+/// The warp kernel fuses it into its traversal (StreamedCertify below,
+/// kernels/bvh/streamed_certificate.h). The other float searches (candidates and per-thread
+/// BVH kernels, tuned brute force) run the separate pass here, between the float search and
+/// finalize_samples(): every point's float winner seeds a
 /// certified BVH search (pruning radius widened by the float error bound, candidates kept),
 /// and the candidates are re-ranked in double, so `nearest` ends up holding the double
 /// search's triangle. One seeded traversal per point: the radius is already the winner's, so
@@ -33,6 +36,22 @@ struct CertifyView {
     SearchSlack<float> slack;
     unsigned long long* counters = nullptr;
 };
+
+/// The certificate fused into a warp search (kernels/bvh/streamed_certificate.h): the double
+/// triangles in BVH order, the slack at the launch's points and the counters (points,
+/// re-ranked, full double) of the DeviceCertifier. exact == nullptr: not fused (a double
+/// search, or a bound too loose to certify: the separate pass below runs instead).
+struct StreamedCertify {
+    const PackedTriangle<double>* exact = nullptr;
+    SearchSlack<float> slack;
+    unsigned long long* counters = nullptr;
+};
+
+/// Adds `value` over the whole warp (every lane must take part) with one atomic.
+__device__ inline void warp_add(unsigned long long* counter, unsigned value) {
+    for (int o = 16; o > 0; o >>= 1) value += __shfl_xor_sync(0xffffffffu, value, o);
+    if ((threadIdx.x % 32) == 0 && value != 0) atomicAdd(counter, (unsigned long long)value);
+}
 
 /// Adds `flag` over the active threads of the warp with one atomic.
 __device__ inline void warp_count(unsigned long long* counter, bool flag) {
@@ -103,6 +122,17 @@ public:
         if (n == 0) return;
         certify_nearest<<<unsigned((n + 127) / 128), 128>>>(v, piece, nearest);
         CUDA_CHECK_LAUNCH("certify_nearest");
+    }
+
+    /// The fused certificate for points of largest |coordinate| `point_coordinate`; not
+    /// fused (exact == nullptr) when the bound cannot certify there.
+    StreamedCertify streamed(double point_coordinate) const {
+        StreamedCertify c;
+        c.slack = make_search_slack(bound_, point_coordinate);
+        if (!c.slack.certify) return c;
+        c.exact = exact_.get();
+        c.counters = counters_.get();
+        return c;
     }
 
     void reset() { CUDA_CHECK(cudaMemset(counters_.get(), 0, 3 * sizeof(unsigned long long))); }

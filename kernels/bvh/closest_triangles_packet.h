@@ -40,6 +40,7 @@ struct BvhPacket {
 /// The plain packet search: each lane's radius is its best; nothing is kept.
 struct PacketPlainNear {
     static constexpr bool kKeeps = false;
+    static constexpr bool kStreams = false;
     template <typename T>
     SDF_CPU_GPU SDF_INLINE T radius(T q) const { return q; }
     template <typename T>
@@ -51,6 +52,7 @@ struct PacketPlainNear {
 template <typename T, int K, int N = kNearCandidates>
 struct PacketCertifiedNear {
     static constexpr bool kKeeps = true;
+    static constexpr bool kStreams = false;
     SearchSlack<T> slack;
     NearCandidates<T, N> near[K];
     SDF_CPU_GPU SDF_INLINE T radius(T q) const { return slack.radius(q); }
@@ -95,8 +97,8 @@ SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
 /// Tests every point of the packet against leaf triangles [first, first + count), offering
 /// those within a lane's radius to `near`; returns the new largest radius of the packet.
 template <typename T, int K, typename Near>
-SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
-                                          Near& near) {
+SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
+                                            Near& near) {
     for (int32_t j = first; j < first + count; ++j) {
         const PackedTriangle<T> tri = bvh.packed[j];
         const int32_t triangle = bvh.triangle_index[j];
@@ -126,6 +128,15 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, 
         }
     }
     return refresh_radii(pk, near);
+}
+
+/// The leaf scan of `near`: offering (above), or a streaming policy's own
+/// (streamed_certificate.h), which refreshes the radii itself.
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE T scan_leaf_packet(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
+                                          Near& near) {
+    if constexpr (Near::kStreams) return near.scan_leaf(bvh, first, count, pk);
+    else return scan_leaf_offering(bvh, first, count, pk, near);
 }
 
 template <typename T, int K>

@@ -7,12 +7,16 @@
 // change (the double BVH equals the double brute force on these points).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <limits>
 
+#include "core/bvh/triangle_bvh.h"
 #include "core/sampling/adversarial_cases.h"
 #include "core/sampling/certified_search.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "kernels/bvh/streamed_certificate.h"
 
 namespace sdf {
 namespace {
@@ -97,6 +101,58 @@ TEST(CertifiedSearch, ErrorBoundHoldsForEveryPair) {
     }
 }
 
+
+/// The certificate fused into a packet search (kernels/bvh/streamed_certificate.h, the GPU
+/// warp kernel's form) on the CPU: packets of 4 consecutive case points, and
+/// the same points 4 copies to a packet (every lane ties with the others). Every lane's
+/// triangle is the double brute force's; the fan plate's centre vertex (dozens of triangles
+/// tied exactly) overflows the two deferred candidates, so the streamed double re-rank runs.
+TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
+    constexpr int K = 4;
+    int64_t streamed_lanes = 0, single_lanes = 0;
+    for (const AdversarialCase& c : adversarial_cases(2026, 1500)) {
+        const PreparedMesh mesh = prepare_mesh(c.mesh);
+        const TriangleBvh bvh = build_triangle_bvh(mesh);
+        const BvhView<float> view = bvh.view<float>();
+        const std::vector<PointSample> want = query("brute_force", Precision::Double, "vectorized", mesh, c.points);
+        double coordinate = 0;
+        for (const Vec3d& p : c.points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const SearchSlack<float> slack = make_search_slack(float_search_bound(mesh), coordinate);
+        ASSERT_TRUE(slack.certify) << c.mesh.name;
+        int64_t bad = 0;
+        for (const int stride : {1, 0}) {  // 1: 4 consecutive points; 0: one point in every lane
+            for (size_t first = 0; first < c.points.size(); first += K) {
+                size_t index[K];
+                for (int k = 0; k < K; ++k) index[k] = std::min(first + size_t(k * stride), c.points.size() - 1);
+                const auto point_of = [&](int k) { return c.points[index[k]]; };
+                BvhPacket<float, K> pk;
+                for (int k = 0; k < K; ++k) {
+                    const Vec3f p(point_of(k));
+                    pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
+                    pk.best_q[k] = pk.radius[k] = std::numeric_limits<float>::infinity();
+                    pk.best_slot[k] = pk.best_triangle[k] = -1;
+                }
+                StreamedCertifiedNear<float, K, decltype(point_of)> near(slack, bvh.packed_double.data(), point_of);
+                NoBvhStats none;
+                closest_triangles_packet(view, pk, none, near);
+                for (int k = 0; k < K; ++k) {
+                    streamed_lanes += near.exact_triangle[k] >= 0;
+                    bool reranked = false;
+                    const int got = mesh.source_triangle()[size_t(near.finish(view, k, pk, reranked))];
+                    single_lanes += !reranked;
+                    if (got != want[index[k]].triangle && bad++ < 3)
+                        std::printf("  %s point %zu: streamed %d, double brute force %d\n", c.mesh.name.c_str(), index[k], got,
+                                    want[index[k]].triangle);
+                }
+            }
+        }
+        EXPECT_EQ(bad, 0) << c.mesh.name;
+    }
+    std::printf("streamed packets: %lld lanes streamed, %lld certified without double work\n", (long long)streamed_lanes,
+                (long long)single_lanes);
+    EXPECT_GT(streamed_lanes, 0);
+    EXPECT_GT(single_lanes, 0);
+}
 
 /// Lattices take the same path with bricks (packets) and per-point seeds: a lattice hugging
 /// the cube's top face 1e-4 above it, and the fan plate's whole box.
