@@ -243,7 +243,7 @@ private:
         }
         bvh_stats_ = lbvh->stats.to_json();
         bvh_stats_["built_on"] = "device";
-        bvh_stats_["builder"] = "lbvh";
+        bvh_stats_["builder"] = gpu_bvh_builder_name(GpuBvhBuildOptions{}.builder);
         bvh_stats_["device_seconds"] = lbvh->device_seconds;
         sign_.set_external_moments(lbvh->device_seconds, "device");
         slot = std::make_unique<DeviceBvh<T>>(std::move(lbvh), std::move(dmesh), mesh, sign_);

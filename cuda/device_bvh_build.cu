@@ -31,9 +31,67 @@ __global__ void lbvh_internal(LbvhArrays a) {
     if (i < a.n - 1) lbvh_internal_node(a, i);
 }
 
-__global__ void lbvh_kept_flags(LbvhArrays a, int32_t* flags) {
+__global__ void lbvh_leaves_in_place(LbvhArrays a) {
+    const int pos = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (pos < a.n) lbvh_leaf_in_place(a, pos);
+}
+
+__global__ void ploc_init(LbvhArrays a, PlocArrays p) {
     const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i < a.n - 1) flags[i] = lbvh_kept(a, i) ? 1 : 0;
+    if (i < a.n) ploc_leaf_cluster(a, p, i);
+}
+
+__global__ void ploc_nearest_kernel(PlocArrays p) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m) ploc_nearest(p, i);
+}
+
+__global__ void ploc_flags_kernel(PlocArrays p) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m) ploc_flags(p, i);
+}
+
+__global__ void ploc_merge_kernel(LbvhArrays a, PlocArrays p, const int32_t* merge_scan, int next_id) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m && p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
+}
+
+/// Copies the survivors; the last thread also writes the iteration's totals (merges, survivors).
+__global__ void ploc_compact_kernel(PlocArrays p, PlocArrays q, const int32_t* merge_scan, const int32_t* keep_scan,
+                                    int32_t* totals) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= p.m) return;
+    if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+    if (i == p.m - 1) {
+        totals[0] = merge_scan[i] + p.merges[i];
+        totals[1] = keep_scan[i] + p.keeps[i];
+    }
+}
+
+__global__ void ploc_root(LbvhArrays a) { a.parent[0] = -1; }
+
+__global__ void ploc_leaf_slots(LbvhArrays a) {
+    const int pos = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (pos < a.n) ploc_leaf_slot(a, pos);
+}
+
+__global__ void ploc_first_slots(LbvhArrays a) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n - 1) ploc_first_slot(a, i);
+}
+
+__global__ void lbvh_kept_flags(LbvhArrays a, int32_t* flags, uint64_t* preorder, int32_t* identity) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= a.n - 1) return;
+    flags[i] = lbvh_kept(a, i) ? 1 : 0;
+    preorder[i] = lbvh_preorder_key(a, i);
+    identity[i] = i;
+}
+
+/// kept_index[node] = its rank in pre-order (the first `kept` of the sorted nodes).
+__global__ void lbvh_number_kept(LbvhArrays a, const int32_t* by_key, int kept) {
+    const int r = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (r < kept) a.kept_index[by_key[r]] = r;
 }
 
 __global__ void lbvh_link(LbvhArrays a) {
@@ -98,6 +156,49 @@ void check_launch(const char* what) {
 
 }  // namespace
 
+/// PLOC's iterations (lbvh_steps.h): one launch per step, CUB scans between them, the
+/// iteration's totals read back to know when one cluster is left.
+static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigned char>& temp) {
+    const size_t n = size_t(a.n);
+    DeviceBuffer<int32_t> code[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
+    DeviceBuffer<int32_t> count[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
+    DeviceBuffer<float> box[2] = {DeviceBuffer<float>(6 * n), DeviceBuffer<float>(6 * n)};
+    DeviceBuffer<int32_t> nearest(n), merges(n), keeps(n), merge_scan(n), keep_scan(n), totals(2);
+    size_t scan_bytes = 0;
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, merges.get(), merge_scan.get(), a.n));
+    if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
+    int cur = 0, m = a.n, next_id = 0;
+    auto arrays = [&](int k, int clusters) {
+        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), merges.get(), keeps.get()};
+    };
+    ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
+    check_launch("ploc init");
+    while (m > 1) {
+        const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
+        ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
+        ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p);
+        check_launch("ploc nearest");
+        size_t bytes = temp.size();
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, merges.get(), merge_scan.get(), m));
+        bytes = temp.size();
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, keeps.get(), keep_scan.get(), m));
+        ploc_merge_kernel<<<blocks_for(m), kThreads>>>(a, p, merge_scan.get(), next_id);
+        ploc_compact_kernel<<<blocks_for(m), kThreads>>>(p, q, merge_scan.get(), keep_scan.get(), totals.get());
+        check_launch("ploc merge");
+        int32_t t[2] = {0, 0};
+        CUDA_CHECK(cudaMemcpy(t, totals.get(), sizeof(t), cudaMemcpyDeviceToHost));
+        if (t[0] < 1) throw std::logic_error("CUDA BVH build: a PLOC iteration merged nothing");
+        next_id += t[0];
+        m = t[1];
+        cur = 1 - cur;
+    }
+    ploc_root<<<1, 1>>>(a);
+    ploc_leaf_slots<<<blocks_for(a.n), kThreads>>>(a);
+    check_launch("ploc slots");
+    ploc_first_slots<<<blocks_for(a.n - 1), kThreads>>>(a);
+    check_launch("ploc first slots");
+}
+
 template <>
 BvhView<float> DeviceLbvh::view<float>() const {
     return {nodes.get(), packed_float.get(), triangle_index.get(), num_nodes, num_triangles};
@@ -127,10 +228,11 @@ LbvhBuild DeviceLbvh::download() const {
 }
 
 std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const Vec3d* vertices, const Int3* triangles,
-                                                 int max_leaf) {
+                                                 const GpuBvhBuildOptions& options) {
     const int n = int(mesh.triangles().size());
-    if (max_leaf < 1) throw std::invalid_argument("CUDA BVH build: max_leaf must be >= 1");
-    if (n <= max_leaf) return nullptr;
+    if (options.max_leaf < 1 || options.ploc_radius < 1)
+        throw std::invalid_argument("CUDA BVH build: max_leaf and ploc_radius must be >= 1");
+    if (n <= options.max_leaf) return nullptr;
     const auto start = std::chrono::steady_clock::now();
     EventTimer timer;
     timer.begin();
@@ -147,37 +249,52 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     const LbvhKeyFrame frame = lbvh_key_frame(mesh.bounds());
     const size_t count = mesh.triangles().size();
     DeviceBuffer<uint64_t> keys_in(count), keys(count);
-    DeviceBuffer<int32_t> identity(count);
+    DeviceBuffer<int32_t> identity(count), identity_sorted(count);
     d.triangle_index.allocate(count);
     lbvh_keys<<<blocks_for(n), kThreads>>>(vertices, triangles, n, frame.lo, frame.inv_extent, keys_in.get(), identity.get());
     check_launch("keys");
     size_t temp_bytes = 0;
     CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys_in.get(), keys.get(), identity.get(),
-                                               d.triangle_index.get(), n, 0, 63));
+                                               identity_sorted.get(), n, 0, 63));
     DeviceBuffer<unsigned char> temp(temp_bytes);
     CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys_in.get(), keys.get(), identity.get(),
-                                               d.triangle_index.get(), n, 0, 63));
+                                               identity_sorted.get(), n, 0, 63));
 
     const size_t internal = size_t(n - 1);
-    DeviceBuffer<int32_t> first(internal), last(internal), split(internal), parent(internal), kept_index(internal), flags(internal);
+    DeviceBuffer<int32_t> left(internal), right(internal), parent(internal), leaf_parent(count), node_count(internal),
+        first(internal), leaf_slot(count), kept_index(internal), flags(internal), by_key(internal);
     DeviceBuffer<uint32_t> arrivals(internal);
     CUDA_CHECK(cudaMemsetAsync(arrivals.get(), 0, internal * sizeof(uint32_t)));
     LbvhArrays a;
     a.n = n;
-    a.max_leaf = max_leaf;
+    a.max_leaf = options.max_leaf;
     a.vertices = vertices;
     a.triangles = triangles;
     a.keys = keys.get();
-    a.order = d.triangle_index.get();
-    a.first = first.get();
-    a.last = last.get();
-    a.split = split.get();
+    a.sorted = identity_sorted.get();
+    a.left = left.get();
+    a.right = right.get();
     a.parent = parent.get();
+    a.leaf_parent = leaf_parent.get();
+    a.count = node_count.get();
+    a.first = first.get();
+    a.leaf_slot = leaf_slot.get();
+    a.order = d.triangle_index.get();
     a.kept_index = kept_index.get();
     a.arrivals = arrivals.get();
-    lbvh_internal<<<blocks_for(n - 1), kThreads>>>(a);
-    check_launch("radix tree");
-    lbvh_kept_flags<<<blocks_for(n - 1), kThreads>>>(a, flags.get());
+    if (options.builder == GpuBvhBuilder::Lbvh) {
+        lbvh_internal<<<blocks_for(n - 1), kThreads>>>(a);
+        check_launch("radix tree");
+        lbvh_leaves_in_place<<<blocks_for(n), kThreads>>>(a);
+        check_launch("leaves");
+    } else {
+        ploc_on_device(a, options.ploc_radius, temp);
+    }
+
+    // Kept nodes, numbered in pre-order (lbvh_preorder_key).
+    DeviceBuffer<uint64_t> preorder(internal), preorder_sorted(internal);
+    DeviceBuffer<int32_t> node_ids(internal);
+    lbvh_kept_flags<<<blocks_for(n - 1), kThreads>>>(a, flags.get(), preorder.get(), node_ids.get());
     check_launch("kept flags");
     size_t scan_bytes = 0;
     CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags.get(), kept_index.get(), int(internal)));
@@ -187,6 +304,14 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     CUDA_CHECK(cudaMemcpy(&tail[0], kept_index.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
     CUDA_CHECK(cudaMemcpy(&tail[1], flags.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
     d.num_nodes = tail[0] + tail[1];
+    size_t sort_bytes = 0;
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, preorder.get(), preorder_sorted.get(), node_ids.get(),
+                                               by_key.get(), int(internal)));
+    if (sort_bytes > temp.size()) temp.allocate(sort_bytes);
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), sort_bytes, preorder.get(), preorder_sorted.get(), node_ids.get(),
+                                               by_key.get(), int(internal)));
+    lbvh_number_kept<<<blocks_for(d.num_nodes), kThreads>>>(a, by_key.get(), d.num_nodes);
+    check_launch("pre-order");
 
     d.nodes.allocate(size_t(d.num_nodes));
     d.moments.allocate(size_t(d.num_nodes));

@@ -1,10 +1,10 @@
 /// @file device_bvh_build.h
-/// @brief The BVH built on the GPU: the linear BVH of kernels/bvh/lbvh_steps.h (Karras
-/// 2012; Morton keys, CUB radix sort, the parallel radix tree, leaves of <= 4 triangles,
-/// one bottom-up pass for the float boxes and the winding moments, one for the exact
-/// radii), the packed search constants gathered into BVH order, and the slot of every
-/// triangle for the certified search. Bit for bit the tree of core/bvh/lbvh.h (its host
-/// emulation), which the CPU tests check.
+/// @brief The BVH built on the GPU by the steps of kernels/bvh/lbvh_steps.h: Morton keys,
+/// CUB radix sort, the tree (PLOC by default, or the LBVH radix tree), leaves of <= 4
+/// triangles, nodes in pre-order, one bottom-up pass for the float boxes and the winding
+/// moments, one for the exact radii; the packed search constants gathered into BVH order,
+/// and the slot of every triangle for the certified search. Bit for bit the tree of
+/// core/bvh/lbvh.h (its host emulation), which the CPU tests check.
 #pragma once
 
 #include <memory>
@@ -39,6 +39,6 @@ struct DeviceLbvh {
 /// triangles (`vertices`, `triangles`: a DeviceMesh<double>'s). Null when the mesh fits one
 /// leaf (no tree to build; the host build handles it). Throws on CUDA errors.
 std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const Vec3d* vertices, const Int3* triangles,
-                                                 int max_leaf = 4);
+                                                 const GpuBvhBuildOptions& options = {});
 
 }  // namespace sdf::cuda

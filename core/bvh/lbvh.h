@@ -1,5 +1,5 @@
 /// @file lbvh.h
-/// @brief The linear BVH (Karras 2012) of the GPU build, emulated on the host: the same
+/// @brief The BVH of the GPU build (LBVH or PLOC), emulated on the host: the same
 /// per-element steps (kernels/bvh/lbvh_steps.h) run one after another, so this produces
 /// the tree, boxes and winding moments of cuda/device_bvh_build.h bit for bit. The tests
 /// check the tree and its queries here on the CPU; the GPU test compares the two builds.
@@ -28,15 +28,29 @@ struct LbvhBuild {
     bool within_depth = true;
 };
 
-/// Builds the LBVH of the triangles (more than `max_leaf` of them; leaves hold at most
-/// `max_leaf`). `mesh_box` must contain every vertex (a PreparedMesh's bounds()).
-LbvhBuild build_lbvh(const BvhBuildInput& input, const Bounds3& mesh_box, int max_leaf = 4);
+/// Which tree the GPU build makes over the Morton-sorted triangles (kernels/bvh/lbvh_steps.h).
+enum class GpuBvhBuilder { Lbvh, Ploc };
+
+struct GpuBvhBuildOptions {
+    GpuBvhBuilder builder = GpuBvhBuilder::Ploc;
+    int max_leaf = 4;         ///< leaves hold at most this many triangles
+    int ploc_radius = 16;     ///< PLOC's search radius (positions on each side)
+    /// Host emulation only: 0 runs every step's elements in order; otherwise in an order
+    /// shuffled by this seed, as a GPU may schedule them (the result must not change).
+    uint64_t emulation_shuffle_seed = 0;
+};
+
+const char* gpu_bvh_builder_name(GpuBvhBuilder b);
+
+/// Builds the tree of the triangles (more than `max_leaf` of them). `mesh_box` must contain
+/// every vertex (a PreparedMesh's bounds()).
+LbvhBuild build_lbvh(const BvhBuildInput& input, const Bounds3& mesh_box, const GpuBvhBuildOptions& options = {});
 
 template <class Mesh>
-LbvhBuild build_lbvh(const Mesh& mesh, int max_leaf = 4) {
+LbvhBuild build_lbvh(const Mesh& mesh, const GpuBvhBuildOptions& options = {}) {
     return build_lbvh(BvhBuildInput{mesh.vertices(), mesh.triangles(), mesh.template buffers<float>().packed,
                                     mesh.template buffers<double>().packed, mesh.name()},
-                      mesh.bounds(), max_leaf);
+                      mesh.bounds(), options);
 }
 
 }  // namespace sdf

@@ -1,22 +1,29 @@
 /// @file lbvh_steps.h
-/// @brief The per-element steps of the linear BVH build (LBVH), written once for the host
+/// @brief The per-element steps of the BVH built on the GPU, written once for the host
 /// emulation (core/bvh/lbvh.cpp) and the CUDA build (cuda/device_bvh_build.cu), so both
 /// produce the same tree, boxes and winding moments bit for bit.
 ///
-/// Karras, "Maximizing Parallelism in the Construction of BVHs, Octrees, and k-d Trees"
-/// (HPG 2012): triangles sorted by the Morton key of their centroid form a binary radix
-/// tree of n - 1 internal nodes; internal node i finds its key range and split from its
-/// neighbours' keys alone (section 4), so every node is built in parallel. Equal keys are
-/// told apart by their sorted position (Karras' "augmented" keys).
+/// Two builders make the same binary tree over the triangles (n leaves, n - 1 internal
+/// nodes, the root internal node 0), from the triangles sorted by the Morton key of their
+/// centroids:
+/// - LBVH: Karras, "Maximizing Parallelism in the Construction of BVHs, Octrees, and k-d
+///   Trees" (HPG 2012): internal node i finds its key range and split from its neighbours'
+///   keys alone (section 4); equal keys are told apart by their positions.
+/// - PLOC: Meister & Bittner, "Parallel Locally-Ordered Clustering for Bounding Volume
+///   Hierarchy Construction" (IEEE TVCG 2018): clusters in Morton order each find their
+///   nearest neighbour (the smallest merged box surface) within `radius` positions; mutual
+///   nearest neighbours merge; the rest are compacted; repeat until one cluster. SAH-like
+///   quality at LBVH-like speed.
 ///
-/// Our flat layout (bvh_node.h) then needs: leaves of at most `max_leaf` triangles (an
-/// internal node whose range holds <= max_leaf triangles becomes one leaf of its parent:
-/// "kept" nodes are those with more, a connected top of the tree, numbered by a prefix sum
-/// so the root stays 0), float boxes rounded outward from the double triangle bounds, and
-/// the fast winding number's moments per child (winding_moments.h). Both come from one
-/// bottom-up pass (Karras section 4, with atomics: the second child to arrive at a node
-/// merges both and moves up), and an exact radius pass (each leaf raises its ancestors'
-/// radii with an atomic max).
+/// The flat layout (bvh_node.h) then needs: leaves of at most `max_leaf` triangles (a node
+/// whose subtree holds <= max_leaf triangles becomes one leaf of its parent: "kept" nodes
+/// are those with more, a connected top of the tree, numbered by a prefix sum so the root
+/// stays 0), leaves as contiguous slot ranges (slots = the tree's left-to-right leaf order),
+/// float boxes rounded outward from the double triangle bounds, and the fast winding
+/// number's moments per child (winding_moments.h). Both come from one bottom-up pass
+/// (Karras section 4, with atomics: the second child to arrive at a node merges both and
+/// moves up), and an exact radius pass (each leaf raises its ancestors' radii with an
+/// atomic max).
 #pragma once
 
 #include <cmath>
@@ -30,6 +37,9 @@
 
 namespace sdf {
 
+/// A child in the binary tree: >= 0 an internal node, < 0 the leaf of sorted position ~code.
+SDF_CPU_GPU SDF_INLINE bool lbvh_is_leaf(int32_t code) { return code < 0; }
+
 /// Plain pointers to the build's arrays (host or device). n triangles, n - 1 internal nodes.
 struct LbvhArrays {
     int n = 0;
@@ -37,11 +47,17 @@ struct LbvhArrays {
     const Vec3d* vertices = nullptr;
     const Int3* triangles = nullptr;
     const uint64_t* keys = nullptr;    ///< Morton keys, sorted (ties in triangle order)
-    const int32_t* order = nullptr;    ///< slot (sorted position) -> triangle
-    int32_t* first = nullptr;          ///< per internal node: first slot of its range
-    int32_t* last = nullptr;           ///< per internal node: last slot of its range
-    int32_t* split = nullptr;          ///< per internal node: Karras' gamma (left range ends there)
-    int32_t* parent = nullptr;         ///< per internal node: its parent (-1 for the root)
+    const int32_t* sorted = nullptr;   ///< sorted position -> triangle
+    // The binary tree (per internal node, except leaf_parent and leaf_slot: per leaf).
+    int32_t* left = nullptr;           ///< child codes (lbvh_is_leaf)
+    int32_t* right = nullptr;
+    int32_t* parent = nullptr;         ///< -1 for the root (node 0)
+    int32_t* leaf_parent = nullptr;
+    int32_t* count = nullptr;          ///< triangles under the node
+    int32_t* first = nullptr;          ///< its first slot
+    int32_t* leaf_slot = nullptr;      ///< the leaf's slot
+    int32_t* order = nullptr;          ///< slot -> triangle (the output's triangle_index)
+    // The flat layout.
     int32_t* kept_index = nullptr;     ///< per internal node: its node index when kept (prefix sum)
     uint32_t* arrivals = nullptr;      ///< per internal node: children arrived (bottom-up pass)
     BvhNode* nodes = nullptr;          ///< per kept node
@@ -156,7 +172,8 @@ SDF_CPU_GPU SDF_INLINE int lbvh_delta(const LbvhArrays& a, int i, int64_t j) {
     return 64 + lbvh_clz32(uint32_t(i) ^ uint32_t(j));
 }
 
-/// Internal node i: its range [first, last], its split and its children's parent links.
+/// Internal node i of the radix tree: its children, their parent links, its count and first
+/// slot (the LBVH keeps the sorted order: slot = sorted position).
 SDF_CPU_GPU SDF_INLINE void lbvh_internal_node(const LbvhArrays& a, int i) {
     const int d = lbvh_delta(a, i, int64_t(i) + 1) - lbvh_delta(a, i, int64_t(i) - 1) >= 0 ? 1 : -1;
     const int delta_min = lbvh_delta(a, i, int64_t(i) - d);
@@ -175,25 +192,175 @@ SDF_CPU_GPU SDF_INLINE void lbvh_internal_node(const LbvhArrays& a, int i) {
     }
     const int gamma = int(int64_t(i) + s * d + (d < 0 ? -1 : 0));
     const int lo = int(i < j ? i : j), hi = int(i < j ? j : i);
+    a.count[i] = hi - lo + 1;
     a.first[i] = lo;
-    a.last[i] = hi;
-    a.split[i] = gamma;
-    if (gamma != lo) a.parent[gamma] = i;          // left child is internal node gamma
-    if (gamma + 1 != hi) a.parent[gamma + 1] = i;  // right child is internal node gamma + 1
+    if (gamma == lo) {  // left child: the leaf gamma, or internal node gamma
+        a.left[i] = ~gamma;
+        a.leaf_parent[gamma] = i;
+    } else {
+        a.left[i] = gamma;
+        a.parent[gamma] = i;
+    }
+    if (gamma + 1 == hi) {
+        a.right[i] = ~(gamma + 1);
+        a.leaf_parent[gamma + 1] = i;
+    } else {
+        a.right[i] = gamma + 1;
+        a.parent[gamma + 1] = i;
+    }
     if (i == 0) a.parent[0] = -1;
 }
 
-/// Triangles under child c of internal node i, and its first slot.
-SDF_CPU_GPU SDF_INLINE int lbvh_child_count(const LbvhArrays& a, int i, int c) {
-    return c == 0 ? a.split[i] - a.first[i] + 1 : a.last[i] - a.split[i];
+/// The LBVH's slots are the sorted positions.
+SDF_CPU_GPU SDF_INLINE void lbvh_leaf_in_place(const LbvhArrays& a, int pos) {
+    a.leaf_slot[pos] = pos;
+    a.order[pos] = a.sorted[pos];
 }
-SDF_CPU_GPU SDF_INLINE int lbvh_child_first(const LbvhArrays& a, int i, int c) { return c == 0 ? a.first[i] : a.split[i] + 1; }
+
+// --- Step 2': PLOC (Meister & Bittner 2018) ----------------------------------------------
+
+/// The clusters of one PLOC iteration, in Morton order (host or device).
+struct PlocArrays {
+    int m = 0;                 ///< clusters this iteration
+    int radius = 16;           ///< positions searched on each side
+    int32_t* code = nullptr;   ///< child code of each cluster (lbvh_is_leaf)
+    float* box = nullptr;      ///< 6 per cluster: min x y z, max x y z
+    int32_t* count = nullptr;  ///< triangles in each cluster
+    int32_t* nearest = nullptr;
+    int32_t* merges = nullptr;  ///< 1 where the cluster merges with its (later) nearest neighbour
+    int32_t* keeps = nullptr;   ///< 1 where the cluster survives the iteration (merged or not)
+};
+
+/// Cluster i of the first iteration: the leaf of sorted position i, its box rounded outward.
+SDF_CPU_GPU SDF_INLINE void ploc_leaf_cluster(const LbvhArrays& a, const PlocArrays& p, int i) {
+    const Int3 t = a.triangles[a.sorted[i]];
+    const Vec3d v[3] = {a.vertices[t.x], a.vertices[t.y], a.vertices[t.z]};
+    for (int x = 0; x < 3; ++x) {
+        double lo = v[0][x], hi = v[0][x];
+        for (int k = 1; k < 3; ++k) {
+            lo = v[k][x] < lo ? v[k][x] : lo;
+            hi = v[k][x] > hi ? v[k][x] : hi;
+        }
+        p.box[6 * i + x] = float_below(lo);
+        p.box[6 * i + 3 + x] = float_above(hi);
+    }
+    p.code[i] = ~i;
+    p.count[i] = 1;
+}
+
+/// Surface area (half of it: only the order matters) of the union of clusters i and j.
+SDF_CPU_GPU SDF_INLINE float ploc_merged_area(const PlocArrays& p, int i, int j) {
+    float e[3];
+    for (int x = 0; x < 3; ++x) {
+        const float lo = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
+        const float hi = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
+        e[x] = hi - lo;
+    }
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+/// Cluster i's nearest neighbour within `radius` positions: the smallest merged area, ties
+/// to the smaller pair (min, max) of positions. A total order on pairs, so the best pair of
+/// the iteration is mutual and every iteration merges at least once.
+SDF_CPU_GPU SDF_INLINE void ploc_nearest(const PlocArrays& p, int i) {
+    const int lo = i - p.radius > 0 ? i - p.radius : 0;
+    const int hi = i + p.radius < p.m - 1 ? i + p.radius : p.m - 1;
+    int best = -1;
+    float best_area = 0;
+    for (int j = lo; j <= hi; ++j) {
+        if (j == i) continue;
+        const float area = ploc_merged_area(p, i, j);
+        // For a fixed i, the pair (min(i,j), max(i,j)) orders as j does.
+        if (best < 0 || area < best_area || (area == best_area && j < best)) {
+            best = j;
+            best_area = area;
+        }
+    }
+    p.nearest[i] = best;
+}
+
+/// Whether cluster i starts a merge (mutual nearest neighbours, i the first), and whether it
+/// survives the iteration (it is not the second of a merge).
+SDF_CPU_GPU SDF_INLINE void ploc_flags(const PlocArrays& p, int i) {
+    const int j = p.nearest[i];
+    const bool mutual = j >= 0 && p.nearest[j] == i;
+    p.merges[i] = mutual && i < j ? 1 : 0;
+    p.keeps[i] = mutual && i > j ? 0 : 1;
+}
+
+/// Merges cluster i with its nearest neighbour into internal node `id` (ids count down from
+/// n - 2, so the last merge, the root, is node 0).
+SDF_CPU_GPU SDF_INLINE void ploc_merge(const LbvhArrays& a, const PlocArrays& p, int i, int id) {
+    const int j = p.nearest[i];
+    const int32_t l = p.code[i], r = p.code[j];
+    a.left[id] = l;
+    a.right[id] = r;
+    if (lbvh_is_leaf(l)) a.leaf_parent[~l] = id;
+    else a.parent[l] = id;
+    if (lbvh_is_leaf(r)) a.leaf_parent[~r] = id;
+    else a.parent[r] = id;
+    a.count[id] = p.count[i] + p.count[j];
+    for (int x = 0; x < 3; ++x) {
+        p.box[6 * i + x] = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
+        p.box[6 * i + 3 + x] = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
+    }
+    p.code[i] = id;
+    p.count[i] = a.count[id];
+}
+
+/// Copies surviving cluster i to position `to` of the next iteration's arrays.
+SDF_CPU_GPU SDF_INLINE void ploc_compact(const PlocArrays& from, const PlocArrays& to_arrays, int i, int to) {
+    to_arrays.code[to] = from.code[i];
+    to_arrays.count[to] = from.count[i];
+    for (int k = 0; k < 6; ++k) to_arrays.box[6 * to + k] = from.box[6 * i + k];
+}
+
+SDF_CPU_GPU SDF_INLINE int lbvh_code_count(const LbvhArrays& a, int32_t code) { return lbvh_is_leaf(code) ? 1 : a.count[code]; }
+
+/// The slot of the leaf at sorted position `pos`: the triangles left of it in the tree
+/// (the counts of the left siblings on its path to the root).
+SDF_CPU_GPU SDF_INLINE void ploc_leaf_slot(const LbvhArrays& a, int pos) {
+    int slot = 0;
+    int32_t code = ~pos;
+    for (int node = a.leaf_parent[pos]; node >= 0; code = node, node = a.parent[node])
+        if (a.right[node] == code) slot += lbvh_code_count(a, a.left[node]);
+    a.leaf_slot[pos] = slot;
+    a.order[slot] = a.sorted[pos];
+}
+
+/// Internal node i's first slot: its leftmost leaf's (after ploc_leaf_slot).
+SDF_CPU_GPU SDF_INLINE void ploc_first_slot(const LbvhArrays& a, int i) {
+    int32_t code = a.left[i];
+    while (!lbvh_is_leaf(code)) code = a.left[code];
+    a.first[i] = a.leaf_slot[~code];
+}
+
+// --- Both: the flat layout ------------------------------------------------------------------
+
+SDF_CPU_GPU SDF_INLINE int32_t lbvh_child(const LbvhArrays& a, int i, int c) { return c == 0 ? a.left[i] : a.right[i]; }
+
+/// Triangles under child c of internal node i, and its first slot.
+SDF_CPU_GPU SDF_INLINE int lbvh_child_count(const LbvhArrays& a, int i, int c) { return lbvh_code_count(a, lbvh_child(a, i, c)); }
+SDF_CPU_GPU SDF_INLINE int lbvh_child_first(const LbvhArrays& a, int i, int c) {
+    const int32_t code = lbvh_child(a, i, c);
+    return lbvh_is_leaf(code) ? a.leaf_slot[~code] : a.first[code];
+}
 
 /// Kept internal nodes become nodes of the flat layout; the others are inside leaves.
-SDF_CPU_GPU SDF_INLINE bool lbvh_kept(const LbvhArrays& a, int i) { return a.last[i] - a.first[i] + 1 > a.max_leaf; }
+SDF_CPU_GPU SDF_INLINE bool lbvh_kept(const LbvhArrays& a, int i) { return a.count[i] > a.max_leaf; }
 
-/// Which child of its parent the kept internal node i is.
-SDF_CPU_GPU SDF_INLINE int lbvh_side(const LbvhArrays& a, int i) { return i == a.split[a.parent[i]] + 1 ? 1 : 0; }
+/// The sort key that puts kept nodes in depth-first pre-order (as the SAH builder numbers
+/// them: a parent before its children, the left subtree before the right, so a traversal
+/// walks nearby memory): by first slot, then larger count first (a node and its left
+/// descendants share the first slot; each has fewer triangles than its parent). Unique
+/// among kept nodes; the others sort last.
+SDF_CPU_GPU SDF_INLINE uint64_t lbvh_preorder_key(const LbvhArrays& a, int i) {
+    if (!lbvh_kept(a, i)) return ~uint64_t(0);
+    return uint64_t(uint32_t(a.first[i])) << 32 | uint32_t(a.n - a.count[i]);
+}
+
+/// Which child of its parent the internal node i is.
+SDF_CPU_GPU SDF_INLINE int lbvh_side(const LbvhArrays& a, int i) { return a.left[a.parent[i]] == i ? 0 : 1; }
 
 /// Writes the child references of kept internal node i into its flat node (boxes follow).
 SDF_CPU_GPU SDF_INLINE void lbvh_link_node(const LbvhArrays& a, int i) {
@@ -201,7 +368,7 @@ SDF_CPU_GPU SDF_INLINE void lbvh_link_node(const LbvhArrays& a, int i) {
     for (int c = 0; c < 2; ++c) {
         const int count = lbvh_child_count(a, i, c);
         const bool leaf = count <= a.max_leaf;
-        node.ref[c] = leaf ? lbvh_child_first(a, i, c) : a.kept_index[a.split[i] + c];
+        node.ref[c] = leaf ? lbvh_child_first(a, i, c) : a.kept_index[lbvh_child(a, i, c)];
         node.count[c] = leaf ? count : 0;
     }
 }

@@ -51,23 +51,28 @@ TEST(CudaBvhBuild, DeviceBuildEqualsTheHostEmulationBitForBit) {
         const PreparedMesh& mesh = *c.mesh;
         if (mesh.triangles().size() <= 4) continue;
         const cuda::DeviceMesh<double> dmesh(mesh.buffers<double>());
-        const auto device = cuda::build_lbvh_on_device(mesh, dmesh.view().vertices, dmesh.view().triangles);
-        ASSERT_TRUE(device) << c.name;
+        for (GpuBvhBuilder builder : {GpuBvhBuilder::Ploc, GpuBvhBuilder::Lbvh}) {
+        GpuBvhBuildOptions o;
+        o.builder = builder;
+        const std::string what = c.name + " " + gpu_bvh_builder_name(builder);
+        const auto device = cuda::build_lbvh_on_device(mesh, dmesh.view().vertices, dmesh.view().triangles, o);
+        ASSERT_TRUE(device) << what;
         const LbvhBuild d = device->download();
-        const LbvhBuild h = build_lbvh(mesh);
-        EXPECT_EQ(d.within_depth, h.within_depth) << c.name;
-        expect_bytes_equal(d.bvh.nodes, h.bvh.nodes, c.name + " nodes");
-        expect_bytes_equal(d.moments, h.moments, c.name + " moments");
-        expect_bytes_equal(d.bvh.triangle_index, h.bvh.triangle_index, c.name + " slots");
-        expect_bytes_equal(d.bvh.packed_float, h.bvh.packed_float, c.name + " packed float");
-        expect_bytes_equal(d.bvh.packed_double, h.bvh.packed_double, c.name + " packed double");
-        EXPECT_EQ(d.bvh.stats.nodes, h.bvh.stats.nodes) << c.name;
-        EXPECT_EQ(d.bvh.stats.depth, h.bvh.stats.depth) << c.name;
-        EXPECT_EQ(d.bvh.stats.leaves, h.bvh.stats.leaves) << c.name;
-        EXPECT_EQ(d.bvh.stats.largest_leaf, h.bvh.stats.largest_leaf) << c.name;
-        EXPECT_NEAR(d.bvh.stats.sah_cost, h.bvh.stats.sah_cost, 1e-9 * h.bvh.stats.sah_cost) << c.name;
-        std::printf("%-28s %7zu triangles: device %s, %.3f ms on the device\n", c.name.c_str(), mesh.triangles().size(),
+        const LbvhBuild h = build_lbvh(mesh, o);
+        EXPECT_EQ(d.within_depth, h.within_depth) << what;
+        expect_bytes_equal(d.bvh.nodes, h.bvh.nodes, what + " nodes");
+        expect_bytes_equal(d.moments, h.moments, what + " moments");
+        expect_bytes_equal(d.bvh.triangle_index, h.bvh.triangle_index, what + " slots");
+        expect_bytes_equal(d.bvh.packed_float, h.bvh.packed_float, what + " packed float");
+        expect_bytes_equal(d.bvh.packed_double, h.bvh.packed_double, what + " packed double");
+        EXPECT_EQ(d.bvh.stats.nodes, h.bvh.stats.nodes) << what;
+        EXPECT_EQ(d.bvh.stats.depth, h.bvh.stats.depth) << what;
+        EXPECT_EQ(d.bvh.stats.leaves, h.bvh.stats.leaves) << what;
+        EXPECT_EQ(d.bvh.stats.largest_leaf, h.bvh.stats.largest_leaf) << what;
+        EXPECT_NEAR(d.bvh.stats.sah_cost, h.bvh.stats.sah_cost, 1e-9 * h.bvh.stats.sah_cost) << what;
+        std::printf("%-32s %7zu triangles: device %s, %.3f ms on the device\n", what.c_str(), mesh.triangles().size(),
                     d.bvh.stats.to_json().dump().c_str(), 1e3 * device->device_seconds);
+        }
     }
 }
 

@@ -5,6 +5,7 @@
 // and the fast winding number within its error bound of the SAH tree's.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <memory>
 #include <random>
 
@@ -57,6 +58,9 @@ void check_tree(const PreparedMesh& mesh, const TriangleBvh& bvh, int max_leaf, 
                 continue;
             }
             ASSERT_GT(node.ref[c], 0) << what;
+            if (c == 0) {  // pre-order: a left child right after its parent
+                ASSERT_EQ(node.ref[c], it.node + 1) << what;
+            }
             ASSERT_LT(node.ref[c], int(bvh.nodes.size())) << what;
             const BvhNode& child = bvh.nodes[size_t(node.ref[c])];
             for (int cc = 0; cc < 2; ++cc) ASSERT_TRUE(box_inside(child, cc, node, c)) << what;
@@ -131,16 +135,28 @@ std::vector<Vec3d> points_around(const PreparedMesh& mesh, int count, unsigned s
     return pts;
 }
 
+GpuBvhBuildOptions gpu_options(GpuBvhBuilder builder, int max_leaf = 4) {
+    GpuBvhBuildOptions o;
+    o.builder = builder;
+    o.max_leaf = max_leaf;
+    return o;
+}
+
+constexpr GpuBvhBuilder kBuilders[] = {GpuBvhBuilder::Lbvh, GpuBvhBuilder::Ploc};
+
 TEST(Lbvh, ValidTreeExactQueriesAndMomentsOnEveryTestMesh) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
-        const LbvhBuild b = build_lbvh(m.mesh);
-        ASSERT_TRUE(b.within_depth) << m.name;
-        check_tree(m.mesh, b.bvh, 4, m.name);
-        expect_queries_match_loop(m.mesh, b.bvh, points_around(m.mesh, m.mesh.triangles().size() > 50000 ? 200 : 1000, 3));
-        expect_moments_match(m.mesh, b, m.name);
         const TriangleBvh sah = build_triangle_bvh(m.mesh);
-        std::printf("%-14s lbvh %s\n%-14s sah  %s\n", m.name.c_str(), b.bvh.stats.to_json().dump().c_str(), "",
-                    sah.stats.to_json().dump().c_str());
+        std::printf("%-14s sah  %s\n", m.name.c_str(), sah.stats.to_json().dump().c_str());
+        for (GpuBvhBuilder builder : kBuilders) {
+            const std::string what = m.name + " " + gpu_bvh_builder_name(builder);
+            const LbvhBuild b = build_lbvh(m.mesh, gpu_options(builder));
+            ASSERT_TRUE(b.within_depth) << what;
+            check_tree(m.mesh, b.bvh, 4, what);
+            expect_queries_match_loop(m.mesh, b.bvh, points_around(m.mesh, m.mesh.triangles().size() > 50000 ? 200 : 1000, 3));
+            expect_moments_match(m.mesh, b, what);
+            std::printf("%-14s %s %s\n", m.name.c_str(), gpu_bvh_builder_name(builder), b.bvh.stats.to_json().dump().c_str());
+        }
     }
 }
 
@@ -150,12 +166,41 @@ TEST(Lbvh, ValidTreeAndExactQueriesOnAdversarialCases) {
         po.orient_outward = false;
         const PreparedMesh mesh = prepare_mesh(c.mesh, po);
         if (int(mesh.triangles().size()) <= 4) continue;
-        for (int leaf : {1, 4}) {
-            const LbvhBuild b = build_lbvh(mesh, leaf);
+        for (int leaf : {1, 4})
+        for (GpuBvhBuilder builder : kBuilders) {
+            const LbvhBuild b = build_lbvh(mesh, gpu_options(builder, leaf));
             ASSERT_TRUE(b.within_depth) << mesh.name();
             check_tree(mesh, b.bvh, leaf, mesh.name());
             expect_queries_match_loop(mesh, b.bvh, c.points);
             expect_moments_match(mesh, b, mesh.name());
+        }
+    }
+}
+
+template <typename V>
+void expect_bytes_equal(const std::vector<V>& a, const std::vector<V>& b, const std::string& what) {
+    ASSERT_EQ(a.size(), b.size()) << what;
+    EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(V))) << what << " differ";
+}
+
+/// The GPU runs each step's elements in any order (and the bottom-up pass's second arrival
+/// is whichever thread comes second): the emulation in shuffled orders gives the same
+/// bytes, so the device build, which the GPU test compares with the emulation, does too.
+TEST(Lbvh, AnyOrderOfTheElementsGivesTheSameTree) {
+    for (const test::NamedMesh& m : test::bvh_test_meshes()) {
+        if (m.mesh.triangles().size() > 50000) continue;
+        for (GpuBvhBuilder builder : kBuilders) {
+            const std::string what = m.name + " " + gpu_bvh_builder_name(builder);
+            const LbvhBuild in_order = build_lbvh(m.mesh, gpu_options(builder));
+            for (uint64_t seed : {1u, 2u}) {
+                GpuBvhBuildOptions o = gpu_options(builder);
+                o.emulation_shuffle_seed = seed;
+                const LbvhBuild shuffled = build_lbvh(m.mesh, o);
+                expect_bytes_equal(shuffled.bvh.nodes, in_order.bvh.nodes, what + " nodes");
+                expect_bytes_equal(shuffled.moments, in_order.moments, what + " moments");
+                expect_bytes_equal(shuffled.bvh.triangle_index, in_order.bvh.triangle_index, what + " slots");
+                EXPECT_EQ(shuffled.bvh.stats.depth, in_order.bvh.stats.depth) << what;
+            }
         }
     }
 }
@@ -174,10 +219,12 @@ TEST(Lbvh, EqualKeysStillGiveAValidTree) {
     MeshPreparationOptions po;
     po.orient_outward = false;
     const PreparedMesh mesh = prepare_mesh(m, po);
-    const LbvhBuild b = build_lbvh(mesh);
-    ASSERT_TRUE(b.within_depth);
-    check_tree(mesh, b.bvh, 4, mesh.name());
-    expect_queries_match_loop(mesh, b.bvh, points_around(mesh, 500, 9));
+    for (GpuBvhBuilder builder : kBuilders) {
+        const LbvhBuild b = build_lbvh(mesh, gpu_options(builder));
+        ASSERT_TRUE(b.within_depth);
+        check_tree(mesh, b.bvh, 4, mesh.name());
+        expect_queries_match_loop(mesh, b.bvh, points_around(mesh, 500, 9));
+    }
 }
 
 /// The fast winding number (beta 2, order 2) through the LBVH and through the SAH tree:
@@ -186,7 +233,7 @@ TEST(Lbvh, EqualKeysStillGiveAValidTree) {
 /// within its bound of 1/2 the side may depend on the tree: counted and printed.
 TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
-        const LbvhBuild b = build_lbvh(m.mesh);
+        const LbvhBuild b = build_lbvh(m.mesh);  // the default builder
         const auto lbvh_tree = std::make_shared<const TriangleBvh>(b.bvh);
         WindingBvh lw;
         lw.bvh = lbvh_tree;
@@ -212,8 +259,10 @@ TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
 
 TEST(Lbvh, RejectsMeshesThatFitOneLeaf) {
     const PreparedMesh mesh = prepare_mesh(make_box());  // 12 triangles
-    EXPECT_THROW(build_lbvh(mesh, 12), std::invalid_argument);
-    EXPECT_NO_THROW(build_lbvh(mesh, 11));
+    for (GpuBvhBuilder builder : kBuilders) {
+        EXPECT_THROW(build_lbvh(mesh, gpu_options(builder, 12)), std::invalid_argument);
+        EXPECT_NO_THROW(build_lbvh(mesh, gpu_options(builder, 11)));
+    }
 }
 
 }  // namespace
