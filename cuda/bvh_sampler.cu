@@ -227,6 +227,10 @@ private:
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
         built = uploaded = false;
         if (slot && slot->lbvh && device_mesh_ == key) return slot.get();
+        if (device_failed_ == key) {  // this mesh's device tree was too deep: do not build it again
+            device_build_skipped_ = device_failed_reason_;
+            return nullptr;
+        }
         sign_.prepare_mode(mesh);
         device_float_.reset();
         device_double_.reset();
@@ -239,6 +243,8 @@ private:
                                                " (depth " + std::to_string(lbvh->stats.depth) + ")"
                                          : "the mesh fits one leaf";
             device_mesh_ = {};
+            device_failed_ = key;
+            device_failed_reason_ = device_build_skipped_;
             return nullptr;
         }
         bvh_stats_ = lbvh->stats.to_json();
@@ -630,6 +636,8 @@ private:
         bool operator==(const MeshKey& o) const { return mesh == o.mesh && sha == o.sha && triangles == o.triangles; }
     };
     MeshKey device_mesh_;
+    MeshKey device_failed_;             ///< the mesh whose device build fell back to the host
+    std::string device_failed_reason_;
     nlohmann::json bvh_stats_;          ///< the build statistics of the BVH in use, with where it was built
     std::string device_build_skipped_;  ///< why the last device_bvh() call built on the host
     std::unique_ptr<DeviceBvh<float>> device_float_;
