@@ -232,7 +232,8 @@ nlohmann::json options_to_json(const SamplerOptions& o) {
             {"max_points_per_piece", o.max_points_per_piece},
             {"max_triangles_per_chunk", o.max_triangles_per_chunk},
             {"points_per_thread", o.points_per_thread},
-            {"band_width", o.band_width}};
+            {"band_width", o.band_width},
+            {"bvh_build", int(o.bvh_build)}};
 }
 
 SamplerOptions options_from_json(const nlohmann::json& j) {
@@ -249,6 +250,7 @@ SamplerOptions options_from_json(const nlohmann::json& j) {
     o.max_triangles_per_chunk = j.at("max_triangles_per_chunk").get<int>();
     o.points_per_thread = j.at("points_per_thread").get<int>();
     o.band_width = j.at("band_width").get<double>();
+    o.bvh_build = BvhBuildSite(j.at("bvh_build").get<int>());
     return o;
 }
 
