@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/sampling/sampled_field.h"
+#include "core/sampling/sampler_options.h"
 
 namespace sdf {
 namespace py = pybind11;
@@ -47,6 +48,24 @@ py::array_t<double> vec3_array(const Vec3d* v, size_t n, std::vector<py::ssize_t
 
 /// JSON (provenance, reports) as Python dicts and lists, through the json module.
 py::object json_to_python(const nlohmann::json& j);
+
+/// The sampler options of a call's keywords (sampler_keywords.cpp): every keyword the call
+/// does not name itself is a key of the one options codec (harness/config/sampler_spec.h),
+/// read as a config's "sampler" object ("auto" resolved, every check and message the
+/// config's; an unknown keyword names the nearest key and lists `arguments`, the call's own
+/// names, and the codec's). sign="none" asks for unsigned distance.
+struct SamplerKeywords {
+    SamplerOptions options;
+    bool unsigned_distance = false;
+};
+SamplerKeywords read_sampler_keywords(const std::string& call, const py::kwargs& keywords,
+                                      const std::vector<std::string>& arguments);
+
+/// The docstrings' paragraph on the sampler keywords, generated from the codec's table.
+const std::string& sampler_keywords_doc();
+
+/// The sign names the module takes: the sign modes' table, then "none" (unsigned distance).
+std::vector<std::string> sign_names_with_none();
 
 // The binding files, one per job; module.cpp calls them in this order.
 void bind_mesh(py::module_& m);
