@@ -22,6 +22,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
+#include "experiments/common/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
@@ -206,8 +207,10 @@ int main(int argc, char** argv) {
                                                 {"components", mesh.report().components},
                                                 {"sign_reliable", mesh.report().sign_reliable()}};
         if (!quiet) std::cerr << plan.describe();
-        auto sampler = sdf::make_sampler(options);
-        const sdf::StreamResult r = sdf::sample_streamed(*sampler, options, mesh, lattice, stream, mesh_provenance);
+        // The front ends' one field source (experiments/common/field_source.h), without a cache:
+        // its sampler samples the slabs this tool streams to disk.
+        sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
+        const sdf::StreamResult r = sdf::sample_streamed(source.sampler(), options, mesh, lattice, stream, mesh_provenance);
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
                   << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds

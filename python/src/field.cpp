@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/common/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/sampler_spec.h"
@@ -315,6 +316,13 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
     return Field(std::move(f));
 }
 
+/// sign="none": |d| and gradients pointing away from the surface (the field was sampled with
+/// the pseudonormal sign, whose magnitudes are every mode's), the sign recorded as asked.
+void make_field_unsigned(SampledField& field) {
+    make_unsigned(field);
+    field.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
+}
+
 /// sample()'s own arguments; every other keyword is the sampler's (read_sampler_keywords).
 const std::vector<std::string> kSampleArguments = {"mesh",    "lattice", "resolution", "samples",  "margin", "bounds",
                                                    "spacing", "origin",  "progress",   "distributed"};
@@ -353,21 +361,20 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         task.total = request.lattice.num_points();
         task.label = "sampling '" + mesh->name() + "'";
         task.progress = progress;
-        SampledField field = sample_reporting_memory(mesh->name(), request.lattice, [&] {
-            return run_task([&] { return MeshSdf(mesh, request.options, unsigned_distance).sample(request.lattice); }, task);
-        });
+        // The front ends' one field path (experiments/common/field_source.h): no cache, this
+        // process's sampler; an allocation that fails names the mesh, the lattice and the bytes.
+        FieldSource source(nullptr, request.options, "sample()", SamplerReach::ThisProcess);
+        std::ostream no_log(nullptr);
+        SampledField field = run_task([&] {
+            return source.get(*mesh, request.lattice, "sample() of '" + mesh->name() + "'", no_log).field;
+        }, task);
+        if (unsigned_distance) make_field_unsigned(field);
         return field_for_mesh(std::move(field), *mesh);
     }
     TaskOptions task;
     task.background = false;  // MPI stays on the thread that started it
-    SampledField field = run_task([&] {
-        SampledField f = sample_collectively(*mesh, setup);
-        if (unsigned_distance) {
-            make_unsigned(f);
-            f.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
-        }
-        return f;
-    }, task);
+    SampledField field = run_task([&] { return sample_collectively(*mesh, setup); }, task);
+    if (unsigned_distance) make_field_unsigned(field);
     return field_for_mesh(std::move(field), *mesh);
 }
 
