@@ -426,8 +426,13 @@ def test_render_returns_a_shaded_image(box):
     assert 0 <= image.min() and image.max() <= 1
     centre, corner = image[16, 24], image[0, 0]
     assert not np.allclose(centre, corner)  # the box is hit in the middle, not in the corner
-    with pytest.raises(ValueError, match="view: unknown value"):
+    with pytest.raises(ValueError, match=r"render\(\): key 'render.views\[0\]': unknown view \"nowhere\""):
         sl.render(f, view="nowhere")
+    # The arguments are read by the configs' render codec: its checks and messages.
+    with pytest.raises(ValueError, match=r"render\(\): key 'render.size': expected \[width, height\] with entries in 1..16384"):
+        sl.render(f, size=(0, 32))
+    with pytest.raises(ValueError, match=r"render\(\): key 'render.fov': expected a vertical field of view in degrees in \(0, 180\)"):
+        sl.render(f, eye=(3, 2, 1), target=(0, 0, 0), fov=180)
 
 
 def test_version_matches_the_tools():
