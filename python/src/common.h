@@ -20,13 +20,9 @@ namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-/// "'a', 'b', 'c'"
-std::string quoted_list(const std::vector<std::string>& names);
-
-/// `value` when it is one of `choices`, else ValueError naming the argument and the choices.
+/// `value` when it is one of `choices`, else ValueError naming the argument and the choices
+/// (as the config reader words it: core/quoted_alternatives.h).
 const std::string& choose(const std::string& argument, const std::string& value, const std::vector<std::string>& choices);
-
-Precision precision_from_name(const std::string& name);
 
 /// `value` as a float64 array (NumPy arrays of any numeric dtype, nested sequences);
 /// TypeError naming the argument "points" and the type otherwise.

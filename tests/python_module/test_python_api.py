@@ -277,7 +277,7 @@ def test_reconstruct_outside_the_domain_is_nan_clamp_or_error(box):
     assert clamped[0] == nan_v[0] and np.isfinite(clamped[1])
     with pytest.raises(ValueError, match=r"points: row 1 \(10, 10, 10\) lies outside the field's domain"):
         f.reconstruct(p, outside="error")
-    with pytest.raises(ValueError, match="outside: unknown value 'zero'"):
+    with pytest.raises(ValueError, match='outside: unknown value "zero"; expected one of "nan", "clamp" or "error"'):
         f.reconstruct(p, outside="zero")
 
 

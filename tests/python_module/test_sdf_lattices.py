@@ -385,7 +385,7 @@ def test_sample_arguments_are_checked_by_the_config_parser(box):
         sl.sample(box, lattice="cc")
     with pytest.raises(ValueError, match=r"sample\(\): key 'kernel': unknown cpu bvh kernel \"brik\".*did you mean \"brick\""):
         sl.sample(box, lattice="cc", resolution=4, backend="cpu", kernel="brik")
-    with pytest.raises(ValueError, match="lattice: unknown value 'fcc'"):
+    with pytest.raises(ValueError, match='lattice: unknown value "fcc"; expected one of "cc" or "bcc"'):
         sl.sample(box, lattice="fcc", resolution=4)
     f = sl.sample(box, lattice="cc", samples=1000, backend="cpu")
     assert 700 < f.num_points < 1400
