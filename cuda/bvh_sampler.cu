@@ -30,6 +30,7 @@
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
 #include "cuda/launch_util.cuh"
+#include "cuda/staged_copy.h"
 #include "cuda/stored_output.cuh"
 
 namespace sdf::cuda {
@@ -140,8 +141,56 @@ public:
         return true;
     }
 
+    /// Host arrays in and out (a NumPy array's buffer): the caller's bytes go to the device as
+    /// they are (float32 stays float32 on the bus) through pinned buffers, the search is
+    /// query_device()'s, and the result columns come back through pinned buffers straight into
+    /// the caller's arrays: no conversion, no host scatter, the copies overlapped.
+    void query_host(const PreparedMesh& mesh, const HostPoints& points, const HostQueryResults& results) override {
+        if (points.count <= 0) return;
+        const auto start = std::chrono::steady_clock::now();
+        require_finite_points(points, "points", options_.threads);
+        CUDA_CHECK(cudaSetDevice(options_.device));
+        std::vector<Vec3d> gathered;  // only for rows that are not one block of bytes
+        const void* source = points.xyz;
+        size_t bytes = points.bytes();
+        DevicePoints on_device{nullptr, points.float32, points.count, 3, 1, options_.device, nullptr};
+        if (!points.contiguous()) {
+            gathered = gather_points(points, "points", options_.threads);
+            source = gathered.data();
+            bytes = gathered.size() * sizeof(Vec3d);
+            on_device.float32 = false;
+        }
+        grow(host_query_points_, bytes);
+        staged_.to_device(source, host_query_points_.get(), bytes);
+        on_device.xyz = host_query_points_.get();
+        const auto uploaded = std::chrono::steady_clock::now();
+        const size_t n = size_t(points.count);
+        DeviceQueryResults columns;
+        if (results.distance) columns.distance = grow(host_query_distance_, n);
+        if (results.gradient) columns.gradient = grow(host_query_gradient_, 3 * n);
+        if (results.triangle) columns.triangle = grow(host_query_triangle_, n);
+        query_device(mesh, on_device, columns);
+        const auto searched = std::chrono::steady_clock::now();
+        if (results.distance) staged_.to_host(columns.distance, results.distance, n * sizeof(double));
+        if (results.gradient) staged_.to_host(columns.gradient, results.gradient, 3 * n * sizeof(double));
+        if (results.triangle) staged_.to_host(columns.triangle, results.triangle, n * sizeof(int32_t));
+        const auto end = std::chrono::steady_clock::now();
+        using seconds = std::chrono::duration<double>;
+        query_timings_.upload += seconds(uploaded - start).count();
+        query_timings_.download = seconds(end - searched).count();
+        query_timings_.total = seconds(end - start).count();
+    }
+
 private:
     const char* kernel_name() const { return sdf::kernel_name(kCudaBvhKernels, kernel_); }
+
+    /// `buffer` with room for `count` elements (kept between queries: a bound SDF queried many
+    /// times allocates once).
+    template <typename E>
+    static E* grow(DeviceBuffer<E>& buffer, size_t count) {
+        if (buffer.size() < count) buffer.allocate(count);
+        return buffer.get();
+    }
 
     /// The device copy of this mesh's BVH, uploaded when the mesh (or precision) changes.
     template <typename T>
@@ -533,7 +582,11 @@ private:
     std::unique_ptr<DeviceBvh<float>> device_float_;
     std::unique_ptr<DeviceBvh<double>> device_double_;
     DeviceBuffer<unsigned long long> candidate_stats_;
-    StoredSlabBuffers stored_buffers_;  ///< sample_slab_stored(): the slab's device bytes and pinned host copies  ///< kernel "candidates": bvh_candidates_kernel.cuh's counters
+    StagedCopy staged_;  ///< query_host()'s pinned buffers
+    DeviceBuffer<char> host_query_points_;
+    DeviceBuffer<double> host_query_distance_, host_query_gradient_;
+    DeviceBuffer<int32_t> host_query_triangle_;
+    StoredSlabBuffers stored_buffers_;  ///< sample_slab_stored(): the slab's device bytes and pinned host copies
 };
 
 }  // namespace

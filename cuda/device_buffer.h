@@ -47,6 +47,26 @@ private:
     size_t count_ = 0;
 };
 
+/// Page-locked host memory (cudaMallocHost): the device copies into it at full bus speed and
+/// asynchronously, which pageable memory does not allow.
+class PinnedBytes {
+public:
+    explicit PinnedBytes(size_t bytes) : bytes_(bytes) {
+        if (bytes > 0) CUDA_CHECK(cudaMallocHost(&ptr_, bytes));
+    }
+    ~PinnedBytes() {
+        if (ptr_) cudaFreeHost(ptr_);
+    }
+    PinnedBytes(const PinnedBytes&) = delete;
+    PinnedBytes& operator=(const PinnedBytes&) = delete;
+    char* get() const { return static_cast<char*>(ptr_); }
+    size_t size() const { return bytes_; }
+
+private:
+    void* ptr_ = nullptr;
+    size_t bytes_ = 0;
+};
+
 /// Accumulates the time between begin() and end() pairs on one stream, in seconds.
 class EventTimer {
 public:

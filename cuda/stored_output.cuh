@@ -62,26 +62,6 @@ __global__ void store_point_samples(PieceOutputs piece, int64_t n, const int32_t
     out[o] = Sample{piece.distance[i], piece.gradient[i], t < 0 ? t : source_triangle[t]};
 }
 
-/// Page-locked host memory (cudaMallocHost): the device copies into it at full bus speed and
-/// asynchronously, which pageable memory does not allow.
-class PinnedBytes {
-public:
-    explicit PinnedBytes(size_t bytes) : bytes_(bytes) {
-        if (bytes > 0) CUDA_CHECK(cudaMallocHost(&ptr_, bytes));
-    }
-    ~PinnedBytes() {
-        if (ptr_) cudaFreeHost(ptr_);
-    }
-    PinnedBytes(const PinnedBytes&) = delete;
-    PinnedBytes& operator=(const PinnedBytes&) = delete;
-    char* get() const { return static_cast<char*>(ptr_); }
-    size_t size() const { return bytes_; }
-
-private:
-    void* ptr_ = nullptr;
-    size_t bytes_ = 0;
-};
-
 /// The device and pinned host buffers of stored slabs. Host buffers are handed out as shared
 /// pointers and taken again only when nobody else holds them (the writer of an earlier slab
 /// may still be copying from one), so two of them alternate while slabs stream to disk.

@@ -11,6 +11,7 @@
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/device_query.h"
+#include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler_options.h"
 #include "core/sampling/stored_slab.h"
@@ -58,6 +59,14 @@ public:
     virtual bool query_device(const PreparedMesh& mesh, const DevicePoints& points, const DeviceQueryResults& results) {
         (void)mesh, (void)points, (void)results;
         return false;
+    }
+    /// Samples points in the caller's host arrays, writing the results into its columns in
+    /// input order (core/sampling/host_query.h): query()'s numbers, with no conversion by the
+    /// caller. This default gathers the points and calls query(); GPU samplers stream the
+    /// caller's bytes through pinned buffers instead. Throws std::invalid_argument for a
+    /// point that is not finite (naming its row) or out of the search's range.
+    virtual void query_host(const PreparedMesh& mesh, const HostPoints& points, const HostQueryResults& results) {
+        scatter_samples(query(mesh, gather_points(points, "points", 0)), results, 0);
     }
     /// The timings of the last query() where the sampler measures them (GPU: `kernel` = the
     /// device's sort, search and finalize, `upload`/`download` the transfers); else zeros.

@@ -1,5 +1,6 @@
 #include "harness/sampling/mesh_sdf.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -50,6 +51,40 @@ void MeshSdf::query_device(const DevicePoints& points, const DeviceQueryResults&
     if (!sampler_->query_device(*mesh_, points, results))
         throw std::invalid_argument("points on a GPU need an SDF whose backend is cuda; this one's sampler is '" +
                                     sampler_name_ + "'");
+}
+
+void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& results) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!unsigned_distance_) return sampler_->query_host(*mesh_, points, results);
+    // |d| needs d's sign for the gradient's flip, also where the caller asked for no distance.
+    std::vector<double> own_distance;
+    HostQueryResults r = results;
+    if (!r.distance && r.gradient) {
+        own_distance.resize(size_t(std::max<int64_t>(points.count, 0)));
+        r.distance = own_distance.data();
+    }
+    sampler_->query_host(*mesh_, points, r);
+    if (!r.distance) return;
+    parallel_for(points.count, int64_t(1) << 16, options_.threads, [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i)
+            if (std::signbit(r.distance[i])) {
+                r.distance[i] = -r.distance[i];
+                if (r.gradient)
+                    for (int k = 0; k < 3; ++k) r.gradient[3 * i + k] = -r.gradient[3 * i + k];
+            }
+    });
+}
+
+void MeshSdf::closest_points(const HostPoints& points, const int32_t* triangle, double* point, double* barycentric,
+                             int threads) const {
+    parallel_for(points.count, int64_t(1) << 14, threads, [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+            const ClosestPointOnMesh c = closest_point(points[i], triangle[i]);
+            if (point) point[3 * i] = c.point.x, point[3 * i + 1] = c.point.y, point[3 * i + 2] = c.point.z;
+            if (barycentric)
+                barycentric[3 * i] = c.barycentric.x, barycentric[3 * i + 1] = c.barycentric.y, barycentric[3 * i + 2] = c.barycentric.z;
+        }
+    });
 }
 
 SampledField MeshSdf::sample(const Lattice& lattice) const {

@@ -58,11 +58,20 @@ public:
     /// Throws std::invalid_argument unless the bound sampler runs on a GPU. The distance is
     /// the signed one even with unsigned_distance (the caller takes |d| on its device).
     void query_device(const DevicePoints& points, const DeviceQueryResults& results) const;
+    /// Samples points in the caller's host arrays (a NumPy array's buffer), writing the
+    /// results into the caller's columns in input order (core/sampling/host_query.h): bit for
+    /// bit query()'s, with no conversion in between (the GPU sampler streams both through
+    /// pinned buffers). With unsigned_distance, |d| and the matching gradient.
+    void query_host(const HostPoints& points, const HostQueryResults& results) const;
     /// Samples every point of the lattice; with unsigned_distance, |d| everywhere.
     SampledField sample(const Lattice& lattice) const;
 
     /// The closest point of p on input face `triangle` (a query's PointSample::triangle).
     ClosestPointOnMesh closest_point(const Vec3d& p, int32_t triangle) const;
+    /// closest_point() of every point i and triangle[i], into point[3i..] and barycentric[3i..]
+    /// (either may be null), on `threads` threads (0: all).
+    void closest_points(const HostPoints& points, const int32_t* triangle, double* point, double* barycentric,
+                        int threads) const;
 
     /// The generalized winding number of every point (Jacobson et al. 2013): about 1 inside a
     /// closed outward mesh, 0 outside, fractional near holes. The fast evaluation with the

@@ -44,6 +44,34 @@ std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& ar
     return points;
 }
 
+namespace {
+void require_rows_of_three(const py::array& a, const std::string& argument) {
+    if (a.ndim() == 2 && a.shape(1) == 3) return;
+    std::string shape = "(";
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+    throw std::invalid_argument(argument + ": expected an array of shape (N, 3), got shape " + shape + (a.ndim() == 1 ? ",)" : ")"));
+}
+}  // namespace
+
+PointsView points_view(const py::object& value, const std::string& argument) {
+    PointsView v;
+    const bool float32 = py::isinstance<py::array_t<float>>(value);
+    if (float32 || py::isinstance<py::array_t<double>>(value)) {
+        v.keep = py::reinterpret_borrow<py::array>(value);
+        const py::ssize_t item = float32 ? py::ssize_t(sizeof(float)) : py::ssize_t(sizeof(double));
+        // Strides that are not whole elements (a view into a structured array) are copied.
+        if (v.keep.ndim() != 2 || v.keep.strides(0) % item != 0 || v.keep.strides(1) % item != 0) v.keep = points_argument(value);
+    } else {
+        v.keep = points_argument(value);
+    }
+    require_rows_of_three(v.keep, argument);
+    const bool f32 = py::isinstance<py::array_t<float>>(v.keep);
+    const py::ssize_t item = f32 ? py::ssize_t(sizeof(float)) : py::ssize_t(sizeof(double));
+    v.points = HostPoints{v.keep.data(), f32, int64_t(v.keep.shape(0)), int64_t(v.keep.strides(0) / item),
+                          int64_t(v.keep.strides(1) / item)};
+    return v;
+}
+
 py::array_t<double> vec3_array(const Vec3d* v, size_t n, std::vector<py::ssize_t> shape) {
     shape.push_back(3);
     return new_array<double>(shape, [&](double* out) {

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler_options.h"
 
@@ -30,6 +31,16 @@ DoubleArray points_argument(const py::object& value);
 
 /// An (N, 3) array of finite doubles as points; ValueError naming `argument` otherwise.
 std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument);
+
+/// Points as a host query reads them (core/sampling/host_query.h): an (N, 3) float32 or
+/// float64 array where it is, with its strides (no copy); any other numeric array or
+/// sequence as a float64 copy, which `keep` holds, as it holds the caller's array. TypeError
+/// or ValueError naming `argument` for anything else (shape, dtype).
+struct PointsView {
+    py::array keep;
+    HostPoints points;
+};
+PointsView points_view(const py::object& value, const std::string& argument);
 
 /// A new C-order array of `shape` filled from `fill(pointer)`.
 template <typename T, typename Fill>

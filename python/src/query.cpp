@@ -23,11 +23,32 @@ namespace {
 
 using SdfHolder = std::shared_ptr<const MeshSdf>;
 
+/// A query's results. The closest points and barycentric coordinates are computed from the
+/// points and triangles on first access (most callers never read them), so the result keeps
+/// the SDF and the caller's points.
 struct QueryResult {
-    py::array_t<double> distance, gradient, closest_point, barycentric;
+    py::array_t<double> distance, gradient;
     py::array_t<int32_t> triangle;
     py::object winding = py::none();
     std::string sampler, sign;
+    std::shared_ptr<const MeshSdf> sdf;
+    PointsView points;
+    py::object closest_point = py::none(), barycentric = py::none();
+
+    void compute_closest_points() {
+        if (!closest_point.is_none()) return;
+        const py::ssize_t rows = triangle.size();
+        py::array_t<double> point({rows, py::ssize_t(3)}), weights({rows, py::ssize_t(3)});
+        {
+            double* p = point.mutable_data();
+            double* w = weights.mutable_data();
+            const int32_t* t = triangle.data();
+            py::gil_scoped_release release;
+            sdf->closest_points(points.points, t, p, w, sdf->options().threads);
+        }
+        closest_point = point;
+        barycentric = weights;
+    }
 };
 
 /// Binds `mesh` for the sampler keywords of query()/SDF()/sdf(); the build runs as a task (Ctrl-C).
@@ -39,47 +60,30 @@ SdfHolder bind_mesh_sdf(const py::handle& mesh_in, const SamplerKeywords& k) {
     return run_task([&] { return std::make_shared<const MeshSdf>(mesh, k.options, k.unsigned_distance); }, task);
 }
 
-struct QueryOutput {
-    std::vector<PointSample> samples;
-    std::vector<ClosestPointOnMesh> closest;
-    std::vector<double> winding;
-};
-
-QueryResult query_bound(const MeshSdf& sdf, const py::object& points_in, bool winding, const py::object& progress) {
-    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
-    TaskOptions task;
-    task.total = int64_t(points.size());
-    task.label = "querying '" + sdf.mesh().name() + "'";
-    task.progress = progress;
-    QueryOutput r = run_task([&] {
-        QueryOutput out;
-        out.samples = sdf.query(points);
-        out.closest.resize(points.size());
-        parallel_for(int64_t(points.size()), 1024, sdf.options().threads, [&](int64_t b, int64_t e) {
-            for (int64_t i = b; i < e; ++i) out.closest[size_t(i)] = sdf.closest_point(points[size_t(i)], out.samples[size_t(i)].triangle);
-        });
-        if (winding) out.winding = sdf.winding_numbers(points, sdf.options().threads);
-        return out;
-    }, task);
-    const size_t n = r.samples.size();
-    const py::ssize_t rows = py::ssize_t(n);
+QueryResult query_bound(const std::shared_ptr<const MeshSdf>& sdf, const py::object& points_in, bool winding,
+                        const py::object& progress) {
     QueryResult q;
-    q.sampler = sdf.sampler_name();
-    q.sign = sdf.sign_mode();
-    q.distance = new_array<double>({rows}, [&](double* d) {
-        for (size_t i = 0; i < n; ++i) d[i] = r.samples[i].distance;
-    });
-    std::vector<Vec3d> v(n);
-    for (size_t i = 0; i < n; ++i) v[i] = r.samples[i].gradient;
-    q.gradient = vec3_array(v.data(), n, {rows});
-    for (size_t i = 0; i < n; ++i) v[i] = r.closest[i].point;
-    q.closest_point = vec3_array(v.data(), n, {rows});
-    for (size_t i = 0; i < n; ++i) v[i] = r.closest[i].barycentric;
-    q.barycentric = vec3_array(v.data(), n, {rows});
-    q.triangle = new_array<int32_t>({rows}, [&](int32_t* t) {
-        for (size_t i = 0; i < n; ++i) t[i] = r.samples[i].triangle;
-    });
-    if (winding) q.winding = new_array<double>({rows}, [&](double* w) { std::copy(r.winding.begin(), r.winding.end(), w); });
+    q.sdf = sdf;
+    q.points = points_view(points_in, "points");
+    const HostPoints& points = q.points.points;
+    const py::ssize_t rows = py::ssize_t(points.count);
+    q.distance = py::array_t<double>({rows});
+    q.gradient = py::array_t<double>({rows, py::ssize_t(3)});
+    q.triangle = py::array_t<int32_t>({rows});
+    const HostQueryResults columns{q.distance.mutable_data(), q.gradient.mutable_data(), q.triangle.mutable_data()};
+    TaskOptions task;
+    task.total = points.count;
+    task.label = "querying '" + sdf->mesh().name() + "'";
+    task.progress = progress;
+    std::vector<double> winding_numbers = run_task([&] {
+        sdf->query_host(points, columns);
+        if (!winding) return std::vector<double>{};
+        return sdf->winding_numbers(gather_points(points, "points", sdf->options().threads), sdf->options().threads);
+    }, task);
+    q.sampler = sdf->sampler_name();
+    q.sign = sdf->sign_mode();
+    if (winding)
+        q.winding = new_array<double>({rows}, [&](double* w) { std::copy(winding_numbers.begin(), winding_numbers.end(), w); });
     return q;
 }
 
@@ -114,8 +118,9 @@ void bind_query(py::module_& m) {
                       "(N, 3) float64: the exact unit gradient (sign='none': pointing away from the surface).")
         .def_readonly("triangle", &QueryResult::triangle,
                       "(N,) int32: the closest triangle, 0-based, in the caller's face order (the faces given to Mesh, or the file's).")
-        .def_readonly("closest_point", &QueryResult::closest_point, "(N, 3) float64: the closest point on the mesh.")
-        .def_readonly("barycentric", &QueryResult::barycentric,
+        .def_property_readonly("closest_point", [](QueryResult& r) { return (r.compute_closest_points(), r.closest_point); },
+                               "(N, 3) float64: the closest point on the mesh (computed on first access).")
+        .def_property_readonly("barycentric", [](QueryResult& r) { return (r.compute_closest_points(), r.barycentric); },
                       "(N, 3) float64: the closest point's weights of the closest face's three vertices, in the "
                       "caller's order: closest_point = sum_k barycentric[:, k] * vertices[faces[triangle, k]].")
         .def_readonly("winding", &QueryResult::winding,
@@ -144,7 +149,7 @@ same options, bit for bit. Thread-safe (calls on one object run one at a time).
                  return std::const_pointer_cast<MeshSdf>(bind_mesh_sdf(mesh, read_sampler_keywords("SDF()", sampler, {"mesh"})));
              }),
              py::arg("mesh"))
-        .def("query", [](const MeshSdf& s, const py::object& points, bool winding, const py::object& progress) {
+        .def("query", [](const std::shared_ptr<MeshSdf>& s, const py::object& points, bool winding, const py::object& progress) {
                  return query_bound(s, points, winding, progress);
              },
              py::arg("points"), py::arg("winding") = false, py::arg("progress") = py::none(),
@@ -206,7 +211,7 @@ double.
                       const py::kwargs& sampler) {
               const SdfHolder s =
                   bind_mesh_sdf(mesh, read_sampler_keywords("query()", sampler, {"mesh", "points", "progress", "winding"}));
-              return query_bound(*s, points, winding, progress);
+              return query_bound(s, points, winding, progress);
           },
           py::arg("mesh"), py::arg("points"), py::arg("progress") = py::none(), py::arg("winding") = false,
           query_doc.c_str());
@@ -220,7 +225,7 @@ sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D).
 )" + sampler_keywords_doc();
     m.def("sdf", [](const py::object& mesh, const py::object& points, const py::kwargs& sampler) {
               const SdfHolder s = bind_mesh_sdf(mesh, read_sampler_keywords("sdf()", sampler, {"mesh", "points"}));
-              return query_bound(*s, points, false, py::none()).distance;
+              return query_bound(s, points, false, py::none()).distance;
           },
           py::arg("mesh"), py::arg("points"), sdf_function_doc.c_str());
 }

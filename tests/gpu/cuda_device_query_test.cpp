@@ -1,7 +1,8 @@
 // Point queries whose points and results stay on the device (core/sampling/device_query.h):
 // float64 and float32 points, contiguous and strided (an N x 4 array's first three columns,
 // a column-major N x 3 view), equal Sampler::query() on the same points bit for bit; a
-// point that is not finite is refused by its index; a null output is skipped.
+// point that is not finite is refused by its index; a null output is skipped. Host arrays
+// in and out (query_host) equal query() too.
 #include <gtest/gtest.h>
 #include <cuda_runtime.h>
 
@@ -108,6 +109,54 @@ TEST(CudaDeviceQuery, EqualsTheHostQueryBitForBit) {
         cudaFree(d_rows);
         cudaFree(d_columns);
         cudaFree(d_padded);
+    }
+}
+
+// Host arrays in and out (core/sampling/host_query.h), as a NumPy caller passes them:
+// float32 rows go to the device as they are, strided float64 rows are gathered first, and
+// the columns come back through the pinned buffers. More points than one staging chunk
+// (cuda/staged_copy.h: 32 MiB), so both buffers alternate.
+TEST(CudaDeviceQuery, HostArraysEqualTheHostQueryBitForBit) {
+    const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
+    const size_t n = (size_t(3) << 20) + 17;  // 3M points: 72 MiB of gradients, three chunks
+    std::mt19937_64 rng(23);
+    const Bounds3& box = mesh.bounds();
+    std::uniform_real_distribution<double> u(-0.2, 1.2);
+    std::vector<float> rows32(3 * n);
+    std::vector<double> padded64(4 * n, -7.0);
+    std::vector<Vec3d> points(n), as_float(n);
+    for (size_t i = 0; i < n; ++i) {
+        points[i] = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
+        for (int k = 0; k < 3; ++k) {
+            rows32[3 * i + k] = float(points[i][k]);
+            padded64[4 * i + k] = points[i][k];
+            as_float[i][k] = double(rows32[3 * i + k]);
+        }
+    }
+    auto sampler = make_sampler(cuda_options(Precision::Float));
+    const std::vector<PointSample> truth = sampler->query(mesh, points), truth_float = sampler->query(mesh, as_float);
+    struct Case { const char* what; HostPoints points; const std::vector<PointSample>* truth; };
+    const Case cases[] = {{"float32 rows", HostPoints{rows32.data(), true, int64_t(n), 3, 1}, &truth_float},
+                          {"float64 N x 4", HostPoints{padded64.data(), false, int64_t(n), 4, 1}, &truth}};
+    for (const Case& c : cases) {
+        std::vector<double> d(n), g(3 * n);
+        std::vector<int32_t> t(n);
+        sampler->query_host(mesh, c.points, HostQueryResults{d.data(), g.data(), t.data()});
+        for (size_t i = 0; i < n; ++i) {
+            const PointSample& e = (*c.truth)[i];
+            ASSERT_EQ(std::memcmp(&d[i], &e.distance, sizeof(double)), 0) << c.what << " point " << i;
+            ASSERT_EQ(std::memcmp(&g[3 * i], &e.gradient, sizeof(Vec3d)), 0) << c.what << " point " << i;
+            ASSERT_EQ(t[i], e.triangle) << c.what << " point " << i;
+        }
+    }
+    // A point that is not finite is refused by its row, before anything reaches the device.
+    rows32[3 * 1234 + 2] = std::nanf("");
+    std::vector<double> d(n);
+    try {
+        sampler->query_host(mesh, HostPoints{rows32.data(), true, int64_t(n), 3, 1}, HostQueryResults{d.data(), nullptr, nullptr});
+        ADD_FAILURE() << "a NaN point was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("row 1234 is not three finite numbers"), std::string::npos) << e.what();
     }
 }
 

@@ -1,7 +1,7 @@
 // MeshSdf (harness/sampling/mesh_sdf.h), the bound object of issue 23: its queries and
 // fields are the sampler's own, bit for bit, however many calls follow one build; closest
 // points and barycentrics satisfy their definitions; unsigned distance is |d|; the winding
-// number is occupancy. And the task monitor (core/parallel/task_monitor.h): a stop request
+// number is occupancy; host arrays in and out equal the query. And the task monitor (core/parallel/task_monitor.h): a stop request
 // ends parallel_for between chunks, and warnings go to the monitor instead of stderr.
 #include <gtest/gtest.h>
 
@@ -108,6 +108,58 @@ TEST(MeshSdf, UnsignedDistanceAndWindingNumbers) {
         } else if (s[i].distance > 1e-3) {
             EXPECT_NEAR(w[i], 0.0, 0.05);
         }
+    }
+}
+
+// Host arrays in and out (core/sampling/host_query.h: the Python module's path): float32
+// rows and strided float64 rows give query()'s numbers bit for bit, signed and unsigned,
+// with or without the distance column; closest_points() is closest_point() per row.
+TEST(MeshSdf, HostArraysEqualTheQueryBitForBit) {
+    const auto points = random_points(2500, -1.6, 1.6, 9);
+    const size_t n = points.size();
+    std::vector<float> rows32(3 * n);
+    std::vector<double> padded64(5 * n, 99.0);
+    std::vector<Vec3d> as_float(n);
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            rows32[3 * i + k] = float(points[i][k]);
+            as_float[i][k] = double(rows32[3 * i + k]);
+            padded64[5 * i + 2 * k] = points[i][k];  // every other column of an N x 5 array
+        }
+    for (bool unsigned_distance : {false, true}) {
+        const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto), unsigned_distance);
+        const std::vector<PointSample> ref = bound.query(points), ref_float = bound.query(as_float);
+        struct Case { HostPoints points; const std::vector<PointSample>* truth; };
+        for (const Case& c : {Case{{rows32.data(), true, int64_t(n), 3, 1}, &ref_float}, Case{{padded64.data(), false, int64_t(n), 5, 2}, &ref}}) {
+            std::vector<double> d(n), g(3 * n), g_only(3 * n);
+            std::vector<int32_t> t(n);
+            bound.query_host(c.points, {d.data(), g.data(), t.data()});
+            bound.query_host(c.points, {nullptr, g_only.data(), nullptr});
+            for (size_t i = 0; i < n; ++i) {
+                const PointSample& e = (*c.truth)[i];
+                ASSERT_TRUE(same_bits(d[i], e.distance)) << "point " << i << (unsigned_distance ? " unsigned" : "");
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(same_bits(g[3 * i + k], e.gradient[k])) << "point " << i;
+                    ASSERT_TRUE(same_bits(g_only[3 * i + k], e.gradient[k])) << "point " << i;
+                }
+                ASSERT_EQ(t[i], e.triangle);
+            }
+            std::vector<double> cp(3 * n), bary(3 * n);
+            bound.closest_points(c.points, t.data(), cp.data(), bary.data(), 0);
+            for (size_t i = 0; i < n; i += 97) {
+                const ClosestPointOnMesh e = bound.closest_point(c.points[int64_t(i)], t[i]);
+                ASSERT_TRUE(same_bits(cp[3 * i + 1], e.point.y) && same_bits(bary[3 * i + 2], e.barycentric.z)) << i;
+            }
+        }
+    }
+    std::vector<double> bad(9, 0.5), d(3);
+    bad[7] = std::nan("");
+    const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto));
+    try {
+        bound.query_host({bad.data(), false, 3, 3, 1}, {d.data(), nullptr, nullptr});
+        ADD_FAILURE() << "a NaN point was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("row 2 is not three finite numbers"), std::string::npos) << e.what();
     }
 }
 
