@@ -92,45 +92,55 @@ Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const st
                        margin);
 }
 
-std::vector<ViewRequest> view_requests(const Options& o) {
-    std::vector<ViewRequest> views;
+/// The explicit camera's flags, checked with messages that name them (the codec then reads
+/// the camera as a config's).
+void check_camera_flags(const Options& o) {
     if (o.up_given && o.eye.empty())
         throw std::invalid_argument("--up applies to an explicit camera only; give --eye and --target too");
-    if (!o.eye.empty() || !o.target.empty()) {
-        if (o.eye.size() != 3 || o.target.size() != 3)
-            throw std::invalid_argument("--eye and --target are both needed for an explicit camera");
-        // A zero up vector, or one along the line of sight, leaves the camera's roll undefined.
-        const Vec3d forward = vec3(o.target) - vec3(o.eye);
-        if (length_squared(forward) == 0.0) throw std::invalid_argument("--eye and --target are the same point");
-        if (length_squared(cross(forward, vec3(o.up))) == 0.0)
-            throw std::invalid_argument("--up " + std::to_string(o.up[0]) + "," + std::to_string(o.up[1]) + "," +
-                                        std::to_string(o.up[2]) +
-                                        " is zero or parallel to the line of sight; expected a direction that fixes "
-                                        "the camera's roll");
-        ViewRequest v;
-        v.name = "camera";
-        v.explicit_camera = true;
-        v.eye = vec3(o.eye);
-        v.target = vec3(o.target);
-        v.up = vec3(o.up);
-        v.fov_y_degrees = o.fov;
-        views.push_back(v);
-    }
-    for (const std::string& name : o.views) {
-        ViewRequest v = named_view(name);
-        v.fov_y_degrees = o.fov;
-        views.push_back(v);
-    }
-    if (views.empty()) views.push_back(named_view("three_quarter"));
-    return views;
+    if (o.eye.empty() && o.target.empty()) return;
+    if (o.eye.size() != 3 || o.target.size() != 3)
+        throw std::invalid_argument("--eye and --target are both needed for an explicit camera");
+    // A zero up vector, or one along the line of sight, leaves the camera's roll undefined.
+    const Vec3d forward = vec3(o.target) - vec3(o.eye);
+    if (length_squared(forward) == 0.0) throw std::invalid_argument("--eye and --target are the same point");
+    if (length_squared(cross(forward, vec3(o.up))) == 0.0)
+        throw std::invalid_argument("--up " + std::to_string(o.up[0]) + "," + std::to_string(o.up[1]) + "," +
+                                    std::to_string(o.up[2]) +
+                                    " is zero or parallel to the line of sight; expected a direction that fixes "
+                                    "the camera's roll");
 }
 
-RenderOptions render_options(const Options& o) {
-    RenderOptions r;
-    r.backend = o.backend;
+/// The render flags as a config's "render" object, read by its one codec (render_spec.h): the
+/// views (the explicit camera first, then the named ones; three_quarter when none), size, fov,
+/// backend, precision and, for grids, the rows, heat-map scale, downsampling and panels.
+RenderSpec render_spec(const Options& o) {
+    check_camera_flags(o);
+    nlohmann::json j = {{"size", o.size.size() > 1 ? nlohmann::json{o.size[0], o.size[1]} : nlohmann::json(o.size[0])},
+                        {"fov", o.fov},
+                        {"backend", o.backend},
+                        {"precision", o.precision}};
+    nlohmann::json views = nlohmann::json::array();
+    if (!o.eye.empty())
+        views.push_back({{"name", "camera"}, {"eye", o.eye}, {"target", o.target}, {"up", o.up}, {"fov", o.fov}});
+    for (const std::string& name : o.views) views.push_back(name);
+    if (!views.empty()) j["views"] = views;
+    if (o.grid) {
+        j["reference"] = !o.no_reference;
+        j["error_maps"] = !o.no_error_maps;
+        j["heat_max_degrees"] = o.heat_max;
+        j["grid_downsample"] = o.downsample;
+        if (!o.panels.empty()) j["panels"] = o.panels;
+    } else {
+        j["reference"] = o.reference;
+    }
+    return render_spec_from_json(j, "the command line");
+}
+
+/// The spec's backend and precision, and the flags beyond a config's block.
+RenderOptions render_options(const Options& o, const RenderSpec& spec) {
+    RenderOptions r = render_options(spec);
     r.threads = o.threads;
     r.progress = !o.quiet;
-    r.precision = o.precision == "double" ? Precision::Double : Precision::Float;
     r.repetitions = o.repeat;
     r.device = o.device;
     return r;
@@ -168,7 +178,7 @@ nlohmann::json provenance(const Options& o, const nlohmann::json& resolved, cons
             {"input", o.input}};
 }
 
-int run_single(const Options& o, const nlohmann::json& resolved) {
+int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     std::optional<PreparedMesh> mesh;
     SampledField field;
     if (is_field_file(o.input)) {
@@ -180,20 +190,20 @@ int run_single(const Options& o, const nlohmann::json& resolved) {
         const std::vector<int> res = !o.resolution.empty() ? o.resolution : (o.lattice == "cc" ? o.cc_resolution : o.bcc_resolution);
         field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
     }
-    if (o.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
+    if (spec.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
     const Bounds3 bounds = mesh ? mesh->bounds() : field_solid_bounds(field);
     const Reconstruction recon(field, o.interpolator.empty() ? (field.lattice.type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm")
                                                              : o.interpolator,
                                o.derivatives);
-    const std::vector<ViewRequest> views = view_requests(o);
+    const std::vector<ViewRequest>& views = spec.views;
     const nlohmann::json prov = provenance(o, resolved, mesh ? mesh->content_sha256() : std::string());
     const Overwrite overwrite = o.overwrite ? Overwrite::Allow : Overwrite::Forbid;
     std::optional<MeshReferenceRenderer> reference_renderer;
-    if (o.reference) reference_renderer.emplace(*mesh);
+    if (spec.reference) reference_renderer.emplace(*mesh);
     for (const ViewRequest& v : views) {
-        const int w = o.size[0], h = o.size.size() > 1 ? o.size[1] : o.size[0];
+        const int w = spec.width, h = spec.height;
         const CameraSpec camera = mesh ? resolve_view(v, mesh->vertices(), w, h) : resolve_view(v, bounds, w, h);
-        const RenderedImage image = render_reconstruction(recon, camera, render_options(o));
+        const RenderedImage image = render_reconstruction(recon, camera, render_options(o, spec));
         print_timing(recon.description() + " " + lattice_notation(field.lattice) + ", view " + v.name, image);
         const std::string out = views.size() > 1 ? with_suffix(o.out, "_" + v.name) : o.out;
         nlohmann::json attributes = prov;
@@ -223,27 +233,20 @@ int run_single(const Options& o, const nlohmann::json& resolved) {
     return 0;
 }
 
-int run_grid(const Options& o, const nlohmann::json& resolved) {
+int run_grid(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     if (is_field_file(o.input)) throw std::invalid_argument("--grid needs a mesh INPUT (it samples CC and BCC fields)");
     const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
     const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, "cc", o.cc_resolution, o.margin), o);
     const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, "bcc", o.bcc_resolution, o.margin), o);
-    FigureOptions fo;
-    fo.render = render_options(o);
+    FigureOptions fo = figure_options(spec);  // panels, rows, heat-map scale, downsampling
+    fo.render = render_options(o, spec);
     fo.mesh.threads = o.threads;
     fo.mesh.progress = !o.quiet;
-    fo.reference_row = !o.no_reference;
-    fo.error_rows = !o.no_error_maps && !o.no_reference;
-    fo.heat_max_degrees = o.heat_max;
-    fo.downsample = o.downsample;
-    std::vector<RenderPanelRequest> panels;
-    for (const std::string& p : o.panels) panels.push_back(parse_panel_request(p));
-    fo.panels = figure_panels(panels);
     const nlohmann::json prov = provenance(o, resolved, mesh.content_sha256());
     const std::string name = o.name.empty() ? mesh.name() : o.name;
     fs::create_directories(o.out_dir);
-    for (const ViewRequest& v : view_requests(o)) {
-        const CameraSpec camera = resolve_view(v, mesh.vertices(), o.size[0], o.size.size() > 1 ? o.size[1] : o.size[0]);
+    for (const ViewRequest& v : spec.views) {
+        const CameraSpec camera = resolve_view(v, mesh.vertices(), spec.width, spec.height);
         fo.title = o.title.empty() ? name + ", view " + v.name + ": CC " + lattice_notation(cc.lattice) + " / BCC " +
                                          lattice_notation(bcc.lattice)
                                    : o.title;
@@ -364,7 +367,8 @@ int main(int argc, char** argv) {
         // Every option's value (defaults included) as CLI11 writes a config file: the
         // "config" whose SHA-256 is the images' config_hash
         const nlohmann::json resolved = app.config_to_str(true, false);
-        return o.grid ? run_grid(o, resolved) : run_single(o, resolved);
+        const RenderSpec spec = render_spec(o);
+        return o.grid ? run_grid(o, spec, resolved) : run_single(o, spec, resolved);
     } catch (const std::bad_alloc&) {
         std::cerr << "sdf-render: error: " << sdf::out_of_memory_message("rendering " + o.input, 0) << "\n";
         return 1;

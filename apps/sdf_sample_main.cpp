@@ -14,6 +14,7 @@
 
 #include "apps/cli_exit.h"
 #include "apps/cli_validators.h"
+#include "apps/sampler_cli.h"
 
 #include <filesystem>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
+#include "experiments/common/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
@@ -60,12 +62,13 @@ int main(int argc, char** argv) {
     CLI::App app{"Samples the exact signed distance of a mesh on a CC or BCC lattice slab by slab, streaming the "
                  "field file to disk under a memory budget."};
     sdf::add_version_flag(app, "sdf-sample");
-    std::string mesh_arg, out_path, lattice_type = "cc", method = "bvh", backend = "auto", kernel, precision = "float";
-    std::string sign = sdf::kSignModes[0].name, budget_text, channels_text = "distance,gradient,closest_triangle";
+    std::string mesh_arg, out_path, lattice_type = "cc";
+    std::string budget_text, channels_text = "distance,gradient,closest_triangle";
     std::string dtype = "float32";
     std::vector<int> resolution;
-    double margin = 0.1, band = 0;
-    int threads = 0, max_planes = 0;
+    double margin = 0.1;
+    int max_planes = 0;
+    sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
     bool overwrite = false, dry_run = false, quiet = false;
     app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME")->required();
     app.add_option("--lattice", lattice_type, "cc or bcc")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
@@ -77,20 +80,15 @@ int main(int argc, char** argv) {
     app.add_option("--margin", margin, "fraction of the mesh's largest extent added on every side")
         ->check(sdf::kNonNegativeNumber)
         ->capture_default_str();
-    app.add_option("--method", method, "search: bvh or brute_force")->check(CLI::IsMember(sdf::sampler_methods()))->capture_default_str();
-    app.add_option("--backend", backend, "cpu, cuda, or auto (cuda when a GPU is present)")
-        ->check(CLI::IsMember(sdf::sampler_backend_choices()))
-        ->capture_default_str();
-    app.add_option("--kernel", kernel, "backend kernel (" + sdf::sampler_kernels_help() + ")");
-    app.add_option("--threads", threads, "CPU threads (0 = all)")->check(sdf::kNonNegativeNumber)->capture_default_str();
-    app.add_option("--precision", precision, "float or double")->check(CLI::IsMember({"float", "double"}))->capture_default_str();
-    app.add_option("--sign", sign, "sign mode: auto, pseudonormal or winding")
-        ->check(CLI::IsMember(sdf::sign_mode_names()))
-        ->capture_default_str();
-    app.add_option("--band", band,
-                   "narrow band width in mesh units: exact values where |d| <= W, elsewhere +-W, gradient 0 and "
-                   "closest_triangle -2 (0: no band)")
-        ->check(sdf::kNonNegativeNumber);
+    sampler.add(app, "--method", "method", "search: bvh or brute_force");
+    sampler.add(app, "--backend", "backend", "cpu, cuda, or auto (cuda when a GPU is present)");
+    sampler.add(app, "--kernel", "kernel", "backend kernel (" + sdf::sampler_kernels_help() + ")");
+    sampler.add(app, "--threads", "threads", "CPU threads (0 = all)");
+    sampler.add(app, "--precision", "precision", "float or double");
+    sampler.add(app, "--sign", "sign", "sign mode: auto, pseudonormal or winding");
+    sampler.add(app, "--band", "band_width",
+                "narrow band width in mesh units: exact values where |d| <= W, elsewhere +-W, gradient 0 and "
+                "closest_triangle -2 (0: no band)");
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
     app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
@@ -114,9 +112,9 @@ int main(int argc, char** argv) {
     sdf::StreamOptions stream;
     sdf::LatticeSpec spec;
     sdf::SamplerOptions options;
+    double band = 0;
     try {
         if (resolution.size() == 2) throw std::invalid_argument("--resolution: expected N or NX NY NZ, got 2 numbers");
-        if (!(band >= 0) || !std::isfinite(band)) throw std::invalid_argument("--band: expected a finite width >= 0");
         stream.memory_budget = budget_text.empty() ? default_memory_budget() : sdf::parse_byte_size(budget_text, "--memory-budget");
         if (out_path.size() < 6 || out_path.compare(out_path.size() - 5, 5, ".json") != 0)
             throw std::invalid_argument("--out " + out_path + ": expected a field file header NAME.json");
@@ -133,8 +131,6 @@ int main(int argc, char** argv) {
         if (!has_distance) throw std::invalid_argument("--channels: the distance channel is always written; name it");
         if (!vdb_path.empty() && (vdb_path.size() < 5 || vdb_path.compare(vdb_path.size() - 4, 4, ".vdb") != 0))
             throw std::invalid_argument("--vdb " + vdb_path + ": expected a file name ending in .vdb");
-        if (backend == "auto" && !kernel.empty())
-            throw std::invalid_argument("--kernel " + kernel + ": a kernel needs --backend cpu or cuda");
         // The lattice and the sampler as the config parser reads them: its checks and messages.
         nlohmann::json lattice_json = {{"type", lattice_type}};
         if (resolution.size() == 1) {
@@ -145,12 +141,8 @@ int main(int argc, char** argv) {
         }
         sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
         spec = sdf::parse_lattice_spec(lattice_reader);
-        nlohmann::json sampler_json = {{"backend", backend}, {"method", method}, {"sign", sign},
-                                       {"precision", precision}, {"threads", threads}, {"progress", false},
-                                       {"band_width", band}};
-        if (!kernel.empty()) sampler_json["kernel"] = kernel;
-        sdf::JsonReader sampler_reader(sampler_json, "command line", "sampler");
-        options = sdf::parse_sampler_options(sampler_reader);
+        options = sampler.options({{"progress", false}});
+        band = options.band_width;
         // Values the output cannot hold: a band whose +-W the stored type would round to 0 or inf.
         sdf::require_representable_band(band, dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64,
                                         "--band");
@@ -206,8 +198,10 @@ int main(int argc, char** argv) {
                                                 {"components", mesh.report().components},
                                                 {"sign_reliable", mesh.report().sign_reliable()}};
         if (!quiet) std::cerr << plan.describe();
-        auto sampler = sdf::make_sampler(options);
-        const sdf::StreamResult r = sdf::sample_streamed(*sampler, options, mesh, lattice, stream, mesh_provenance);
+        // The front ends' one field source (experiments/common/field_source.h), without a cache:
+        // its sampler samples the slabs this tool streams to disk.
+        sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
+        const sdf::StreamResult r = sdf::sample_streamed(source.sampler(), options, mesh, lattice, stream, mesh_provenance);
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
                   << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds

@@ -30,13 +30,12 @@
 #include "cuda/device_points.cuh"
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
+#include "cuda/launch_util.cuh"
 #include "cuda/staged_copy.h"
 #include "cuda/stored_output.cuh"
 
 namespace sdf::cuda {
 namespace {
-
-int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
 
 __global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, uint64_t* keys, int64_t* identity) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -121,36 +120,15 @@ void read_certificate(const DeviceBvh<T>& dev, CertificateCounters& counters) {
     if constexpr (std::is_same_v<T, float>) dev.certifier->read(counters);
 }
 
-/// Per-piece results on the device, and their download.
+/// Per-piece results on the device: the search's nearest triangle, then the finalized samples.
 struct PieceResults {
     DeviceBuffer<int> nearest;
-    DeviceBuffer<double> distance;
-    DeviceBuffer<Vec3d> gradient;
-    DeviceBuffer<int> triangle;
-    DeviceBuffer<int64_t> output_index;
-    static size_t bytes_per_point() { return 2 * sizeof(int) + 4 * sizeof(double) + sizeof(int64_t); }
+    DevicePieceResults samples;
+    static size_t bytes_per_point() { return sizeof(int) + DevicePieceResults::bytes_per_point(); }
 
-    explicit PieceResults(int64_t n)
-        : nearest{size_t(n)}, distance{size_t(n)}, gradient{size_t(n)}, triangle{size_t(n)}, output_index{size_t(n)} {}
-    PieceOutputs outputs() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
-    PieceOutputs outputs_const() const { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
-
-    struct Host {
-        std::vector<double> distance;
-        std::vector<Vec3d> gradient;
-        std::vector<int> triangle;
-        std::vector<int64_t> output_index;
-    };
-    Host download(int64_t n) const {
-        Host h{std::vector<double>(size_t(n)), std::vector<Vec3d>(size_t(n)), std::vector<int>(size_t(n)),
-               std::vector<int64_t>(size_t(n))};
-        distance.download(h.distance.data(), size_t(n));
-        gradient.download(h.gradient.data(), size_t(n));
-        triangle.download(h.triangle.data(), size_t(n));
-        output_index.download(h.output_index.data(), size_t(n));
-        CUDA_CHECK(cudaStreamSynchronize(0));
-        return h;
-    }
+    explicit PieceResults(int64_t n) : nearest{size_t(n)}, samples(n) {}
+    PieceOutputs outputs() const { return samples.outputs(); }
+    HostPieceResults download(int64_t n) const { return samples.download(n); }
 };
 
 class CudaBvhSampler final : public Sampler {
@@ -449,7 +427,7 @@ private:
         }
         auto sink = [&](const PieceResults& r, int64_t count) {
             download.begin();
-            const PieceResults::Host h = r.download(count);
+            const HostPieceResults h = r.download(count);
             download.end();
             scatter_batch(h, mesh, field);
         };
@@ -495,7 +473,7 @@ private:
                                              const StoredChannels<F>& out, EventTimer& compute) {
         auto sink = [&](const PieceResults& r, int64_t count) {
             compute.begin();
-            store_piece<F><<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, out);
+            store_piece<F><<<blocks_for(count, 256), 256>>>(r.outputs(), count, out);
             CUDA_CHECK_LAUNCH("store_piece");
             compute.end();
         };
@@ -568,7 +546,7 @@ private:
         for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
         CertificateCounters certificate;
         search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
-            store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(),
+            store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(),
                                                                   device_out.get());
             CUDA_CHECK_LAUNCH("store_point_samples");
         });
@@ -597,7 +575,7 @@ private:
         const double coordinate = read_points(points, device_points.get());
         CertificateCounters certificate;
         search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
-            store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs_const(), count, dev.source_triangle.get(), results);
+            store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(), results);
             CUDA_CHECK_LAUNCH("store_point_columns");
         });
         CUDA_CHECK(cudaStreamSynchronize(0));

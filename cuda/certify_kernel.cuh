@@ -21,6 +21,7 @@
 #include "core/sampling/certified_search.h"
 #include "cuda/cuda_check.h"
 #include "cuda/device_buffer.h"
+#include "cuda/launch_util.cuh"
 #include "kernels/bvh/closest_triangle_bvh.h"
 
 namespace sdf::cuda {
@@ -133,7 +134,7 @@ public:
         v.counters = counters_.get();
         const int64_t n = piece.size();
         if (n == 0) return;
-        certify_nearest<<<unsigned((n + 127) / 128), 128>>>(v, piece, nearest);
+        certify_nearest<<<blocks_for(n, 128), 128>>>(v, piece, nearest);
         CUDA_CHECK_LAUNCH("certify_nearest");
     }
 

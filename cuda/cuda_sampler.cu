@@ -18,6 +18,7 @@
 #include "cuda/device_mesh.h"
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
+#include "cuda/launch_util.cuh"
 #include "cuda/point_pieces.h"
 #include "cuda/thesis_kernel.cuh"
 #include "cuda/tuned_kernel.cuh"
@@ -29,45 +30,11 @@ using CudaKernel = CudaBruteForceKernel;
 
 constexpr int kFinalizeThreads = 256;
 
-int blocks_for(int64_t n, int threads) { return int((n + threads - 1) / threads); }
-
-/// Results of one piece, on the host, before they are scattered.
-struct HostPiece {
-    std::vector<double> distance;
-    std::vector<Vec3d> gradient;
-    std::vector<int> triangle;
-    std::vector<int64_t> output_index;
-};
-
-/// Per-piece output buffers on the device.
-struct DevicePieceOutputs {
-    DeviceBuffer<double> distance;
-    DeviceBuffer<Vec3d> gradient;
-    DeviceBuffer<int> triangle;
-    DeviceBuffer<int64_t> output_index;
-    explicit DevicePieceOutputs(int64_t n) : distance{size_t(n)}, gradient{size_t(n)}, triangle{size_t(n)}, output_index{size_t(n)} {}
-    PieceOutputs view() { return {distance.get(), gradient.get(), triangle.get(), output_index.get()}; }
-    HostPiece download(int64_t n) const {
-        HostPiece h;
-        h.distance.resize(size_t(n));
-        h.gradient.resize(size_t(n));
-        h.triangle.resize(size_t(n));
-        h.output_index.resize(size_t(n));
-        distance.download(h.distance.data(), size_t(n));
-        gradient.download(h.gradient.data(), size_t(n));
-        triangle.download(h.triangle.data(), size_t(n));
-        output_index.download(h.output_index.data(), size_t(n));
-        CUDA_CHECK(cudaStreamSynchronize(0));
-        return h;
-    }
-    static size_t bytes_per_point() { return 4 * sizeof(double) + sizeof(int) + sizeof(int64_t); }
-};
-
 /// Everything one sampling call needs on the device, and its timers.
 template <typename T>
 class Engine {
 public:
-    using Sink = std::function<void(const HostPiece&)>;
+    using Sink = std::function<void(const HostPieceResults&)>;
 
     /// `sign` is prepared for `mesh`: in winding mode its moments are uploaded too.
     Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel, const SamplerSign& sign)
@@ -117,7 +84,7 @@ public:
         const int64_t resident = int64_t(sms_) * max_threads_per_sm_;
         int64_t regions = std::max<int64_t>(1, resident / GridRegionPiece::kRegionPoints);
         const size_t per_region = size_t(GridRegionPiece::kRegionPoints) * (3 * sizeof(T) + 2 * sizeof(int) +
-                                                                           DevicePieceOutputs::bytes_per_point());
+                                                                           DevicePieceResults::bytes_per_point());
         regions = std::min<int64_t>(regions, std::max<size_t>(1, budget_ / per_region));
         if (options_.max_points_per_piece > 0)
             regions = std::max<int64_t>(1, std::min<int64_t>(regions, options_.max_points_per_piece / GridRegionPiece::kRegionPoints));
@@ -181,7 +148,7 @@ private:
     int64_t tuned_piece_points(int64_t total) {
         points_per_thread_ = choose_points_per_thread(total);
         splits_ = choose_splits(total, points_per_thread_);
-        const size_t per_point = (sizeof(T) + sizeof(int)) * size_t(1 + splits_) + DevicePieceOutputs::bytes_per_point();
+        const size_t per_point = (sizeof(T) + sizeof(int)) * size_t(1 + splits_) + DevicePieceResults::bytes_per_point();
         const size_t chunk_bytes = size_t(chunk_size_) * sizeof(PackedTriangle<T>);
         const size_t left = budget_ > chunk_bytes ? budget_ - chunk_bytes : 0;
         int64_t step = std::min<int64_t>(total, int64_t(left / per_point));
@@ -204,11 +171,11 @@ private:
     }
 
     template <typename Piece>
-    HostPiece tuned_piece(const Piece& piece) {
+    HostPieceResults tuned_piece(const Piece& piece) {
         const int64_t n = piece.size();
         DeviceBuffer<T> best_q{size_t(n)}, partial_q{size_t(n) * size_t(splits_)};
         DeviceBuffer<int> best_i{size_t(n)}, partial_i{size_t(n) * size_t(splits_)};
-        DevicePieceOutputs out(n);
+        DevicePieceResults out(n);
         for (int chunk = 0; chunk < chunk_count(); ++chunk) {
             if (chunk != resident_chunk_) upload_chunk(chunk);
             compute_.begin();
@@ -232,11 +199,11 @@ private:
         compute_.begin();
         if (certifier_) certifier_->certify(piece, point_coordinate_, best_i.get());
         launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
-                                winding_.view(), options_.band_width, out.view());
+                                winding_.view(), options_.band_width, out.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
         download_.begin();
-        HostPiece h = out.download(n);
+        HostPieceResults h = out.download(n);
         download_.end();
         return h;
     }
@@ -257,12 +224,12 @@ private:
     }
 
     template <typename Piece>
-    HostPiece thesis_piece(const Piece& piece) {
+    HostPieceResults thesis_piece(const Piece& piece) {
         const int64_t n = piece.size();
         DeviceBuffer<T> d2{size_t(n)}, s{size_t(n)}, t{size_t(n)};
         DeviceBuffer<int> tri{size_t(n)}, feature{size_t(n)};
         const ThesisMinima<T> minima{d2.get(), tri.get(), s.get(), t.get(), feature.get()};
-        DevicePieceOutputs out(n);
+        DevicePieceResults out(n);
         compute_.begin();
         fill_thesis_minima<<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(n, minima);
         CUDA_CHECK_LAUNCH("fill_thesis_minima");
@@ -276,14 +243,14 @@ private:
         }
         if (winding_.view().enabled())
             finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
-                                                                                                  winding_.view(), options_.band_width, out.view());
+                                                                                                  winding_.view(), options_.band_width, out.outputs());
         else
             finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
-                                                                                                   winding_.view(), options_.band_width, out.view());
+                                                                                                   winding_.view(), options_.band_width, out.outputs());
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
         download_.begin();
-        HostPiece h = out.download(n);
+        HostPieceResults h = out.download(n);
         download_.end();
         return h;
     }
@@ -334,7 +301,7 @@ private:
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
         const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, largest_lattice_coordinate(lattice), engine);
-        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, field); };
+        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh, field); };
         GridBlock blocks[2];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
@@ -389,7 +356,7 @@ private:
         const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, coordinate, engine);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
-        auto sink = [&](const HostPiece& h) { scatter_batch(h, mesh, out); };
+        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh, out); };
         const int64_t n = int64_t(points.size());
         if (kernel_ == CudaKernel::Tuned) {
             engine.run_tuned(n, [&](int64_t begin, int64_t count) { return PointListPiece{device_points.get(), begin, count}; },

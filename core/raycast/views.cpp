@@ -86,7 +86,7 @@ CameraSpec fit_named_view(const ViewRequest& request, const std::vector<Vec3d>& 
     if (!(request.margin >= 0 && request.margin < 0.5))
         throw std::invalid_argument("view '" + request.name + "': margin " + std::to_string(request.margin) +
                                     " is outside [0, 0.5)");
-    const NamedView& v = find_named_view(request.name);
+    const NamedView& v = find_named_view(request.view.empty() ? request.name : request.view);
     CameraSpec c;
     c.name = request.name;
     c.fov_y_degrees = request.fov_y_degrees;
@@ -118,6 +118,7 @@ ViewRequest named_view(const std::string& name) {
     find_named_view(name);  // throws for unknown names
     ViewRequest r;
     r.name = name;
+    r.view = name;
     return r;
 }
 

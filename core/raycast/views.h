@@ -42,6 +42,9 @@ struct CameraSpec {
 /// explicit camera (explicit_camera = true: eye, target, up, fov used as given).
 struct ViewRequest {
     std::string name;
+    /// Named views: the view of the table it fits ("front"); `name` may rename it (a
+    /// config's {"view": "front", "name": "closeup"}). Empty: `name` is the table's name.
+    std::string view;
     bool explicit_camera = false;
     Vec3d eye{}, target{}, up{0, 1, 0};
     double fov_y_degrees = 30;

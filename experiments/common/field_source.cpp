@@ -27,14 +27,18 @@ nlohmann::json ObtainedField::describe() const {
 }
 
 FieldSource::FieldSource(const RunContext& context, SamplerOptions options)
-    : cache_(context.fields), options_(std::move(options)), where_(context.config_path + ": key 'sampler'") {}
+    : FieldSource(context.fields, std::move(options), context.config_path + ": key 'sampler'") {}
+
+FieldSource::FieldSource(const FieldCache* cache, SamplerOptions options, std::string where, SamplerReach reach)
+    : cache_(cache), options_(std::move(options)), where_(std::move(where)), reach_(reach) {}
 
 FieldSource::~FieldSource() = default;
 
 Sampler& FieldSource::sampler() {
     if (!sampler_) {
         try {
-            sampler_ = make_field_sampler(options_);  // split over the ranks of a distributed run
+            // Split over the ranks of a distributed run, or this process's alone.
+            sampler_ = reach_ == SamplerReach::Ranks ? make_field_sampler(options_) : make_sampler(options_);
         } catch (const std::exception& e) {
             throw std::runtime_error(where_ + ": " + e.what());
         }

@@ -1,7 +1,10 @@
 /// @file field_source.h
-/// @brief Sampled fields for an experiment: from the field cache when it holds them, else
-/// sampled (the sampler is made on first use) and stored in the cache at once, so an
-/// interrupted run resumes without sampling again.
+/// @brief The one "field from cache or sampler" path of every front end: run-experiment's
+/// studies and sdf-render (with the field cache), sdf-sample (its sampler, for the streamed
+/// slabs) and the Python module's sample() (no cache). A field comes from the field cache
+/// when it holds it, else it is sampled (the sampler is made on first use) and stored in the
+/// cache at once, so an interrupted run resumes without sampling again; an allocation that
+/// fails while sampling names the mesh, the lattice and the bytes.
 #pragma once
 
 #include <iosfwd>
@@ -21,9 +24,20 @@ struct ObtainedField {
     nlohmann::json describe() const;  ///< lattice, points, cache key, cached or sampled, timings
 };
 
+/// Where a field's sampler runs.
+enum class SamplerReach {
+    Ranks,        ///< over the ranks of a distributed run (make_field_sampler); this process alone without one
+    ThisProcess,  ///< on this process alone (make_sampler): sdf-sample, the module's sample(distributed=False)
+};
+
 class FieldSource {
 public:
+    /// A run's source: its field cache (none with --no-cache) and its config named in errors.
     FieldSource(const RunContext& context, SamplerOptions options);
+    /// `cache` null: every field is sampled. `where` prefixes the errors of the sampler's
+    /// making ("<config>: key 'sampler'", "the command line").
+    FieldSource(const FieldCache* cache, SamplerOptions options, std::string where,
+                SamplerReach reach = SamplerReach::Ranks);
     ~FieldSource();
 
     /// "cached" or "to sample" (with "--no-cache" when the cache is off), for plans.
@@ -39,6 +53,7 @@ private:
     SamplerOptions options_;
     std::unique_ptr<Sampler> sampler_;
     std::string where_;  ///< "<config>: key 'sampler'", for errors of the sampler's making
+    SamplerReach reach_;
 };
 
 }  // namespace sdf

@@ -55,7 +55,7 @@ ViewRequest parse_view(JsonReader& parent, const nlohmann::json& entry, size_t i
     if (r.has("view")) {
         const std::string name = r.required<std::string>("view", "a named view");
         v = named(r, "view", name, read_fov(r, fov), read_margin(r, margin));
-        v.name = r.optional<std::string>("name", name, "a name for the view");
+        v.name = r.optional<std::string>("name", name, "a name for the view");  // v.view stays the table's name
     } else {
         v.explicit_camera = true;
         v.name = r.required<std::string>("name", "a name for the explicit camera");
@@ -155,6 +155,53 @@ RenderSpec parse_render_spec(JsonReader& r) {
     }
     r.finish();
     return s;
+}
+
+RenderSpec render_spec_from_json(const nlohmann::json& j, const std::string& source) {
+    JsonReader r(j, source, "render");
+    return parse_render_spec(r);
+}
+
+namespace {
+
+nlohmann::json vec3_json(const Vec3d& v) { return {v.x, v.y, v.z}; }
+
+nlohmann::json view_to_json(const ViewRequest& v) {
+    if (v.explicit_camera)
+        return {{"name", v.name}, {"eye", vec3_json(v.eye)}, {"target", vec3_json(v.target)}, {"up", vec3_json(v.up)},
+                {"fov", v.fov_y_degrees}};
+    const std::string view = v.view.empty() ? v.name : v.view;
+    nlohmann::json j = {{"view", view}, {"fov", v.fov_y_degrees}, {"margin", v.margin}};
+    if (v.name != view) j["name"] = v.name;
+    return j;
+}
+
+}  // namespace
+
+nlohmann::json render_spec_to_json(const RenderSpec& s) {
+    nlohmann::json views = nlohmann::json::array();
+    for (const ViewRequest& v : s.views) views.push_back(view_to_json(v));
+    nlohmann::json j = {{"size", {s.width, s.height}},
+                        {"views", views},
+                        {"reference", s.reference},
+                        {"error_maps", s.error_maps},
+                        {"heat_max_degrees", s.heat_max_degrees},
+                        {"backend", s.backend},
+                        {"precision", s.precision},
+                        {"grid_downsample", s.grid_downsample}};
+    if (!s.panels.empty()) {
+        nlohmann::json panels = nlohmann::json::array();
+        for (const RenderPanelRequest& p : s.panels) panels.push_back(p.interpolator + "/" + p.derivatives);
+        j["panels"] = panels;
+    }
+    return j;
+}
+
+RenderOptions render_options(const RenderSpec& s) {
+    RenderOptions o;
+    o.backend = s.backend;
+    o.precision = s.precision == "double" ? Precision::Double : Precision::Float;
+    return o;
 }
 
 }  // namespace sdf

@@ -1,7 +1,9 @@
 /// @file render_spec.h
-/// @brief The "render" block of a config: image size, views, reference and error rows,
-/// backend (docs/raycast.md, "Config"). Plain structs plus one parse function, so the
-/// reconstruction experiment and sdf-render read the same thing.
+/// @brief The render options (RenderSpec) and their one JSON codec, the "render" block of a
+/// config: image size, views, reference and error rows, backend (docs/raycast.md, "Config").
+/// The reconstruction experiment reads a config's block with it, and sdf-render turns its
+/// flags into such a block (render_spec_from_json), so both get the same checks, defaults
+/// and messages; render_spec_to_json writes every field back.
 ///
 ///   "render": {
 ///     "size": [512, 512],              // or one integer for a square image; default 512
@@ -33,6 +35,7 @@
 
 #include "core/raycast/views.h"
 #include "harness/config/json_reader.h"
+#include "harness/render/render_backend.h"
 
 namespace sdf {
 
@@ -62,5 +65,18 @@ RenderPanelRequest parse_panel_request(const std::string& text);
 /// Reads a "render" object (r reads that object, e.g. config.optional_object("render")) and
 /// calls r.finish(). Errors name the file, the key path, the value and what was expected.
 RenderSpec parse_render_spec(JsonReader& r);
+
+/// The same for a "render" object from elsewhere (sdf-render's command line); errors name
+/// `source` and the key.
+RenderSpec render_spec_from_json(const nlohmann::json& j, const std::string& source);
+
+/// Every field, as the "render" object render_spec_from_json reads back to the same spec
+/// (views as {"view", "fov", "margin"[, "name"]} or explicit cameras, panels as
+/// "interpolator/derivatives").
+nlohmann::json render_spec_to_json(const RenderSpec& s);
+
+/// The ray caster's options the spec decides (backend, precision); threads, progress,
+/// repetitions and device keep RenderOptions' defaults for the caller to set.
+RenderOptions render_options(const RenderSpec& s);
 
 }  // namespace sdf

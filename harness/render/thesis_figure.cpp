@@ -139,8 +139,7 @@ std::vector<FigurePanelSpec> figure_panels(const std::vector<RenderPanelRequest>
 FigureOptions figure_options(const RenderSpec& spec) {
     FigureOptions o;
     o.panels = figure_panels(spec.panels);
-    o.render.backend = spec.backend;
-    o.render.precision = spec.precision == "double" ? Precision::Double : Precision::Float;
+    o.render = render_options(spec);
     o.reference_row = spec.reference;
     o.error_rows = spec.reference && spec.error_maps;
     o.heat_max_degrees = spec.heat_max_degrees;

@@ -3,7 +3,7 @@
 # every public name and member is here.
 import os
 import types
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union, Unpack
 
 import numpy as np
 import numpy.typing as npt
@@ -19,6 +19,22 @@ MeshLike = Union["Mesh", str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike], 
 """An sdf_lattices.Mesh, a mesh file path, (vertices, faces), an Open3D TriangleMesh or any
 object with vertices and faces arrays (trimesh)."""
 Grids = Union[ArrayF, Tuple[ArrayF, ArrayF]]
+
+class SamplerKeywords(TypedDict, total=False):
+    """The sampler keywords of SDF, query, sdf and sample: the keys of a config's "sampler"
+    object (core/sampling/sampler_options.h), with its defaults; sign also takes "none"."""
+    backend: str                  # "auto", "cpu", "cuda"
+    method: str                   # "bvh", "brute_force"
+    kernel: str                   # "" = the backend's default
+    precision: str                # "float", "double"
+    sign: str                     # "auto", "pseudonormal", "winding", "none"
+    threads: int                  # 0 = all cores
+    bcc_strategy: str             # "two_grids", "double_resolution"
+    device: int                   # CUDA device ordinal
+    max_points_per_piece: int     # 0 = automatic
+    max_triangles_per_chunk: int  # 0 = automatic
+    points_per_thread: int        # 0, 1, 2, 4, 8
+    band_width: float             # 0 = no band (lattices only)
 
 class SdfWarning(UserWarning): ...
 class MeshWarning(SdfWarning): ...
@@ -85,8 +101,7 @@ class Field:
                     sigma_units: str = "lattice", threads: int = 0, outside: str = "nan") -> Tuple[ArrayF, ArrayF]: ...
 
 class SDF:
-    def __init__(self, mesh: MeshLike, backend: str = "auto", method: str = "bvh", sign: str = "auto",
-                 precision: str = "float", kernel: str = "", threads: int = 0, bcc_strategy: str = "two_grids") -> None: ...
+    def __init__(self, mesh: MeshLike, **sampler: Unpack[SamplerKeywords]) -> None: ...
     mesh: Mesh
     sampler: str
     sign: str
@@ -105,16 +120,14 @@ class SDF:
 def as_mesh(mesh: MeshLike) -> Mesh: ...
 def cuda_available() -> bool: ...
 def load_mesh(path: str, weld_tolerance: float = 0.0, check_intersections: bool = True) -> Mesh: ...
-def query(mesh: MeshLike, points: Any, backend: str = "auto", method: str = "bvh", sign: str = "auto",
-          precision: str = "float", kernel: str = "", threads: int = 0, progress: Progress = None,
-          winding: bool = False) -> Union[QueryResult, DeviceQueryResult]: ...
-def sdf(mesh: MeshLike, points: Any, sign: str = "auto", backend: str = "auto") -> Any: ...
+def query(mesh: MeshLike, points: Any, progress: Progress = None, winding: bool = False,
+          **sampler: Unpack[SamplerKeywords]) -> Union[QueryResult, DeviceQueryResult]: ...
+def sdf(mesh: MeshLike, points: Any, **sampler: Unpack[SamplerKeywords]) -> Any: ...
 def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
            samples: Optional[int] = None, margin: Optional[float] = None,
            bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,
-           origin: Optional[Sequence[float]] = None, backend: str = "auto", method: str = "bvh", kernel: str = "",
-           sign: str = "auto", precision: str = "float", threads: int = 0, bcc_strategy: str = "two_grids",
-           progress: Progress = None, distributed: bool = True) -> Field: ...
+           origin: Optional[Sequence[float]] = None, progress: Progress = None, distributed: bool = True,
+           **sampler: Unpack[SamplerKeywords]) -> Field: ...
 def read_field(path: Union[str, os.PathLike]) -> Field: ...
 def read_field_file(path: str) -> Field: ...
 def render(field: Field, view: str = "three_quarter", size: Union[int, Tuple[int, int]] = 512, interpolator: str = "",

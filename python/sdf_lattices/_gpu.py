@@ -208,21 +208,17 @@ def install(core):
         "DeviceQueryResult of arrays of the same library on the same device (sdf_lattices._gpu); "
         "differentiable=True (PyTorch) gives a distance that autograd differentiates with the exact gradient.")
 
-    def module_query(mesh, points, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0,
-                     progress=None, winding=False):
+    def module_query(mesh, points, progress=None, winding=False, **sampler):
         if is_device_array(points):
-            bound = core.SDF(mesh, backend=backend, method=method, sign=sign, precision=precision, kernel=kernel,
-                             threads=threads)
-            return sdf_query(bound, points, winding=winding, progress=progress)
-        return host_module_query(mesh, points, backend=backend, method=method, sign=sign, precision=precision,
-                                 kernel=kernel, threads=threads, progress=progress, winding=winding)
+            return sdf_query(core.SDF(mesh, **sampler), points, winding=winding, progress=progress)
+        return host_module_query(mesh, points, progress=progress, winding=winding, **sampler)
 
     module_query.__doc__ = host_module_query.__doc__ + "\n\nGPU points stay on the GPU (see SDF.query)."
 
-    def module_sdf(mesh, points, sign="auto", backend="auto"):
+    def module_sdf(mesh, points, **sampler):
         if is_device_array(points):
-            return sdf_query(core.SDF(mesh, backend=backend, sign=sign), points).distance
-        return host_sdf(mesh, points, sign=sign, backend=backend)
+            return sdf_query(core.SDF(mesh, **sampler), points).distance
+        return host_sdf(mesh, points, **sampler)
 
     module_sdf.__doc__ = host_sdf.__doc__ + "\n\nGPU points stay on the GPU: the distances are an array of their library."
 

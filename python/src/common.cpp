@@ -4,22 +4,14 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace sdf {
+#include "core/quoted_alternatives.h"
 
-std::string quoted_list(const std::vector<std::string>& names) {
-    std::string s;
-    for (const std::string& n : names) s += (s.empty() ? "'" : ", '") + n + "'";
-    return s;
-}
+namespace sdf {
 
 const std::string& choose(const std::string& argument, const std::string& value, const std::vector<std::string>& choices) {
     if (std::find(choices.begin(), choices.end(), value) == choices.end())
-        throw std::invalid_argument(argument + ": unknown value '" + value + "'; expected one of " + quoted_list(choices));
+        throw std::invalid_argument(argument + ": unknown value \"" + value + "\"; expected one of " + quoted_alternatives(choices));
     return value;
-}
-
-Precision precision_from_name(const std::string& name) {
-    return choose("precision", name, {"float", "double"}) == "float" ? Precision::Float : Precision::Double;
 }
 
 DoubleArray points_argument(const py::object& value) {

@@ -14,19 +14,16 @@
 
 #include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
+#include "core/sampling/sampler_options.h"
 
 namespace sdf {
 namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-/// "'a', 'b', 'c'"
-std::string quoted_list(const std::vector<std::string>& names);
-
-/// `value` when it is one of `choices`, else ValueError naming the argument and the choices.
+/// `value` when it is one of `choices`, else ValueError naming the argument and the choices
+/// (as the config reader words it: core/quoted_alternatives.h).
 const std::string& choose(const std::string& argument, const std::string& value, const std::vector<std::string>& choices);
-
-Precision precision_from_name(const std::string& name);
 
 /// `value` as a float64 array (NumPy arrays of any numeric dtype, nested sequences);
 /// TypeError naming the argument "points" and the type otherwise.
@@ -58,6 +55,24 @@ py::array_t<double> vec3_array(const Vec3d* v, size_t n, std::vector<py::ssize_t
 
 /// JSON (provenance, reports) as Python dicts and lists, through the json module.
 py::object json_to_python(const nlohmann::json& j);
+
+/// The sampler options of a call's keywords (sampler_keywords.cpp): every keyword the call
+/// does not name itself is a key of the one options codec (harness/config/sampler_spec.h),
+/// read as a config's "sampler" object ("auto" resolved, every check and message the
+/// config's; an unknown keyword names the nearest key and lists `arguments`, the call's own
+/// names, and the codec's). sign="none" asks for unsigned distance.
+struct SamplerKeywords {
+    SamplerOptions options;
+    bool unsigned_distance = false;
+};
+SamplerKeywords read_sampler_keywords(const std::string& call, const py::kwargs& keywords,
+                                      const std::vector<std::string>& arguments);
+
+/// The docstrings' paragraph on the sampler keywords, generated from the codec's table.
+const std::string& sampler_keywords_doc();
+
+/// The sign names the module takes: the sign modes' table, then "none" (unsigned distance).
+std::vector<std::string> sign_names_with_none();
 
 // The binding files, one per job; module.cpp calls them in this order.
 void bind_mesh(py::module_& m);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/common/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/sampler_spec.h"
@@ -315,25 +316,31 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
     return Field(std::move(f));
 }
 
+/// sign="none": |d| and gradients pointing away from the surface (the field was sampled with
+/// the pseudonormal sign, whose magnitudes are every mode's), the sign recorded as asked.
+void make_field_unsigned(SampledField& field) {
+    make_unsigned(field);
+    field.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
+}
+
+/// sample()'s own arguments; every other keyword is the sampler's (read_sampler_keywords).
+const std::vector<std::string> kSampleArguments = {"mesh",    "lattice", "resolution", "samples",  "margin", "bounds",
+                                                   "spacing", "origin",  "progress",   "distributed"};
+
 Field sample(const py::object& mesh_in, const std::string& lattice, const py::object& resolution, const py::object& samples,
              const py::object& margin, const py::object& bounds, const py::object& spacing, const py::object& origin,
-             const std::string& backend, const std::string& method, const std::string& kernel, const std::string& sign,
-             const std::string& precision, int threads, const std::string& bcc_strategy, const py::object& progress,
-             bool distributed) {
+             const py::object& progress, bool distributed, const py::kwargs& sampler) {
     const MeshHolder mesh = mesh_argument(mesh_in);
     const bool collective = distributed && distributed_active();
-    const bool unsigned_distance = sign == "none";
+    bool unsigned_distance = false;
     // Under MPI a bad argument is this rank's failure in the collective exchange, raised on
     // every rank there (no rank waits for one that gave up); alone, it is raised here.
     std::function<SamplingRequest()> setup;
     try {
         const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, mesh->bounds());
-        nlohmann::json s = {{"backend", backend}, {"method", method},   {"sign", unsigned_distance ? "pseudonormal" : sign},
-                            {"precision", precision}, {"threads", threads}, {"bcc_strategy", bcc_strategy},
-                            {"progress", false}};
-        if (!kernel.empty()) s["kernel"] = kernel;
-        JsonReader reader(s, "sample()", "sampler");
-        const SamplerOptions options = parse_sampler_options(reader);
+        const SamplerKeywords k = read_sampler_keywords("sample()", sampler, kSampleArguments);
+        const SamplerOptions options = k.options;
+        unsigned_distance = k.unsigned_distance;
         setup = [l, options, name = mesh->name()] {
             // The memory plan of run-experiment: refused with the figures, before anything is allocated.
             require_host_memory(whole_lattice_sampling_need(l, name), "sample()");
@@ -354,21 +361,20 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         task.total = request.lattice.num_points();
         task.label = "sampling '" + mesh->name() + "'";
         task.progress = progress;
-        SampledField field = sample_reporting_memory(mesh->name(), request.lattice, [&] {
-            return run_task([&] { return MeshSdf(mesh, request.options, unsigned_distance).sample(request.lattice); }, task);
-        });
+        // The front ends' one field path (experiments/common/field_source.h): no cache, this
+        // process's sampler; an allocation that fails names the mesh, the lattice and the bytes.
+        FieldSource source(nullptr, request.options, "sample()", SamplerReach::ThisProcess);
+        std::ostream no_log(nullptr);
+        SampledField field = run_task([&] {
+            return source.get(*mesh, request.lattice, "sample() of '" + mesh->name() + "'", no_log).field;
+        }, task);
+        if (unsigned_distance) make_field_unsigned(field);
         return field_for_mesh(std::move(field), *mesh);
     }
     TaskOptions task;
     task.background = false;  // MPI stays on the thread that started it
-    SampledField field = run_task([&] {
-        SampledField f = sample_collectively(*mesh, setup);
-        if (unsigned_distance) {
-            make_unsigned(f);
-            f.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
-        }
-        return f;
-    }, task);
+    SampledField field = run_task([&] { return sample_collectively(*mesh, setup); }, task);
+    if (unsigned_distance) make_field_unsigned(field);
     return field_for_mesh(std::move(field), *mesh);
 }
 
@@ -449,13 +455,7 @@ reconstruction at the nearest point of the domain, as sdf-eval gives) or "error"
                    lattice_notation(f.lattice()) + ", " + std::to_string(f.lattice().num_points()) + " points>";
         });
 
-    m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
-          py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
-          py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("backend") = "auto",
-          py::arg("method") = "bvh", py::arg("kernel") = "", py::arg("sign") = "auto", py::arg("precision") = "float",
-          py::arg("threads") = 0, py::arg("bcc_strategy") = "two_grids", py::arg("progress") = py::none(),
-          py::arg("distributed") = true,
-          R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=None, bounds=None, spacing=None, origin=None, backend="auto", method="bvh", kernel="", sign="auto", precision="float", threads=0, bcc_strategy="two_grids", progress=None, distributed=True) -> Field
+    static const std::string sample_doc = R"(sample(mesh, lattice="cc", resolution=None, samples=None, margin=None, bounds=None, spacing=None, origin=None, progress=None, distributed=True, **sampler) -> Field
 
 Samples the exact signed distance on a CC or BCC lattice. Fitted around the mesh, as
 run-experiment does (its config parser checks these arguments, as the keys "lattice" and
@@ -467,7 +467,7 @@ Framed by you: bounds=((xmin, ymin, zmin), (xmax, ymax, zmax)) with spacing=h (t
 point at bounds[0], enough points per axis to reach bounds[1]) or with resolution (the
 widest axis decides h, the first point at bounds[0]); spacing alone frames the mesh's box
 grown by margin; origin, spacing and resolution give the lattice exactly. BCC's spacing is
-its primary grid's. mesh: anything SDF takes. sign: as query()'s ("none": unsigned).
+its primary grid's. mesh: anything SDF takes.
 progress: True (tqdm when installed, else lines on sys.stderr) or a callable progress(done,
 total). The GIL is released while sampling; Ctrl-C stops it within a fraction of a second.
 
@@ -477,8 +477,11 @@ z-planes per rank, balanced as run-experiment's are, every rank samples its slab
 rank returns the whole field, bit for bit the one a single process samples; its
 sampler["distributed"] records the slabs, hosts and per-rank seconds. A failure on any rank
 (or arguments that differ from rank 0's) raises on every rank. distributed=False samples on
-this rank alone (no other rank takes part).)");
-
+this rank alone (no other rank takes part).)" "\n\n" + sampler_keywords_doc();
+    m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
+          py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
+          py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
+          py::arg("distributed") = true, sample_doc.c_str());
 
     m.def("read_field_file", &read_field_file, py::arg("path"),
           R"(read_field_file(path) -> Field

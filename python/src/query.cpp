@@ -1,7 +1,7 @@
 // Queries: sdf_lattices.SDF, the bound object (harness/sampling/mesh_sdf.h: a mesh with its
 // BVH, winding data and device upload, built once and queried many times), query() and
 // its QueryResult, and sdf(), the one-liner. query() takes the path of sdf-query
-// (point_query.h): the same sampler, bit for bit.
+// (point_query.h: a MeshSdf of the options codec's options): the same sampler, bit for bit.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,8 +13,6 @@
 
 #include "core/parallel/parallel_for.h"
 #include "harness/sampling/mesh_sdf.h"
-#include "harness/sampling/point_query.h"
-#include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
 #include "python/src/mesh.h"
@@ -53,38 +51,13 @@ struct QueryResult {
     }
 };
 
-/// The sign names a query takes: the sign modes' table, and "none" (unsigned distance).
-std::vector<std::string> query_sign_names() {
-    std::vector<std::string> names = sign_mode_names();
-    names.push_back("none");
-    return names;
-}
-
-/// Binds `mesh` for the options of query()/SDF(); the build runs as a task (Ctrl-C).
-SdfHolder bind_mesh_sdf(const py::handle& mesh_in, const std::string& backend, const std::string& method,
-                        const std::string& sign, const std::string& precision, const std::string& kernel, int threads,
-                        const std::string& bcc_strategy) {
+/// Binds `mesh` for the sampler keywords of query()/SDF()/sdf(); the build runs as a task (Ctrl-C).
+SdfHolder bind_mesh_sdf(const py::handle& mesh_in, const SamplerKeywords& k) {
     const MeshHolder mesh = mesh_argument(mesh_in);
-    PointQueryOptions o;
-    o.backend = choose("backend", backend, point_query_backends());
-    o.method = choose("method", method, sampler_methods());
-    o.kernel = kernel;
-    const bool unsigned_distance = choose("sign", sign, query_sign_names()) == "none";
-    o.sign = unsigned_distance ? SignMode::Pseudonormal : sign_mode_from_name(sign, "sign");
-    o.precision = precision_from_name(precision);
-    if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
-    o.threads = threads;
-    o.progress = false;  // progress goes to the Python callback (task.h)
-    if (backend == "auto" && !kernel.empty())
-        throw std::invalid_argument("kernel: needs backend 'cpu' or 'cuda' (auto takes each backend's default kernel)");
-    SamplerOptions s = point_query_sampler_options(o);
-    s.bcc_strategy = choose("bcc_strategy", bcc_strategy, {"two_grids", "double_resolution"}) == "two_grids"
-                         ? BccStrategy::TwoGrids
-                         : BccStrategy::DoubleResolution;
     TaskOptions task;
     task.total = int64_t(mesh->triangles().size());
     task.label = "building '" + mesh->name() + "'";
-    return run_task([&] { return std::make_shared<const MeshSdf>(mesh, s, unsigned_distance); }, task);
+    return run_task([&] { return std::make_shared<const MeshSdf>(mesh, k.options, k.unsigned_distance); }, task);
 }
 
 QueryResult query_bound(const std::shared_ptr<const MeshSdf>& sdf, const py::object& points_in, bool winding,
@@ -159,25 +132,23 @@ void bind_query(py::module_& m) {
         .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
         .def("__repr__", &query_repr);
 
-    py::class_<MeshSdf, std::shared_ptr<MeshSdf>>(m, "SDF", R"(A mesh bound to a sampler: built once, queried many times.
+    static const std::string sdf_doc = R"(A mesh bound to a sampler: built once, queried many times.
 
-SDF(mesh, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0, bcc_strategy="two_grids")
+SDF(mesh, **sampler)
 
 Building it prepares everything a query of the mesh needs (its BVH, the winding data when
 the sign is the winding number's, the GPU upload), so that query() and sample() only
 search: a query of one point costs microseconds. mesh: an sdf_lattices.Mesh, a mesh file
 path, (vertices, faces) arrays, an object with vertices and faces arrays (trimesh), or an
-Open3D TriangleMesh (legacy or tensor). sign: "auto", "pseudonormal", "winding" or "none"
-(unsigned distance). Results equal query()'s and sample()'s with the same options, bit for
-bit. Thread-safe (calls on one object run one at a time).)")
-        .def(py::init([](const py::object& mesh, const std::string& backend, const std::string& method, const std::string& sign,
-                         const std::string& precision, const std::string& kernel, int threads, const std::string& bcc_strategy) {
-                 return std::const_pointer_cast<MeshSdf>(
-                     bind_mesh_sdf(mesh, backend, method, sign, precision, kernel, threads, bcc_strategy));
+Open3D TriangleMesh (legacy or tensor). Results equal query()'s and sample()'s with the
+same options, bit for bit. Thread-safe (calls on one object run one at a time).
+
+)" + sampler_keywords_doc();
+    py::class_<MeshSdf, std::shared_ptr<MeshSdf>>(m, "SDF", sdf_doc.c_str())
+        .def(py::init([](const py::object& mesh, const py::kwargs& sampler) {
+                 return std::const_pointer_cast<MeshSdf>(bind_mesh_sdf(mesh, read_sampler_keywords("SDF()", sampler, {"mesh"})));
              }),
-             py::arg("mesh"), py::arg("backend") = "auto", py::arg("method") = "bvh", py::arg("sign") = "auto",
-             py::arg("precision") = "float", py::arg("kernel") = "", py::arg("threads") = 0,
-             py::arg("bcc_strategy") = "two_grids")
+             py::arg("mesh"))
         .def("query", [](const std::shared_ptr<MeshSdf>& s, const py::object& points, bool winding, const py::object& progress) {
                  return query_bound(s, points, winding, progress);
              },
@@ -223,38 +194,40 @@ process, with the bound sampler.)")
                                "Wall time of the build (BVH, winding data, upload), seconds.")
         .def("__repr__", &sdf_repr);
 
-    m.def("query", [](const py::object& mesh, const py::object& points, const std::string& backend, const std::string& method,
-                      const std::string& sign, const std::string& precision, const std::string& kernel, int threads,
-                      const py::object& progress, bool winding) {
-              const SdfHolder s = bind_mesh_sdf(mesh, backend, method, sign, precision, kernel, threads, "two_grids");
-              return query_bound(s, points, winding, progress);
-          },
-          py::arg("mesh"), py::arg("points"), py::arg("backend") = "auto", py::arg("method") = "bvh",
-          py::arg("sign") = "auto", py::arg("precision") = "float", py::arg("kernel") = "", py::arg("threads") = 0,
-          py::arg("progress") = py::none(), py::arg("winding") = false,
-          R"(query(mesh, points, backend="auto", method="bvh", sign="auto", precision="float", kernel="", threads=0, progress=None, winding=False) -> QueryResult
+    static const std::string query_doc = R"(query(mesh, points, progress=None, winding=False, **sampler) -> QueryResult
 
 Exact signed distance, gradient, closest triangle, closest point and barycentric
 coordinates of points ((N, 3) array), computed as `sdf-query` computes them (the same
-sampler; equal to the last bit for the same options). It builds an SDF(mesh, ...) for the
-call: to query one mesh many times, build the SDF once. mesh: an sdf_lattices.Mesh, a mesh
-file path, (vertices, faces) arrays, an object with vertices and faces arrays (trimesh), or
-an Open3D TriangleMesh. backend: "auto" (cuda when a GPU is present, else cpu), "cpu" or
-"cuda"; method: "bvh" or "brute_force"; sign: "auto", "pseudonormal", "winding"
-(docs/winding.md) or "none" (unsigned); precision: the search's, "float" or "double" (the
-winner is always evaluated in double). progress: True or a callable progress(done, total);
-winding=True adds the winding number. The GIL is released while computing; Ctrl-C stops it.)");
+sampler; equal to the last bit for the same options). It builds an SDF(mesh, **sampler) for
+the call: to query one mesh many times, build the SDF once. mesh: an sdf_lattices.Mesh, a
+mesh file path, (vertices, faces) arrays, an object with vertices and faces arrays
+(trimesh), or an Open3D TriangleMesh. progress: True or a callable progress(done, total);
+winding=True adds the winding number. The GIL is released while computing; Ctrl-C stops it.
+The search runs in the precision keyword's precision; the winner is always evaluated in
+double.
 
-    m.def("sdf", [](const py::object& mesh, const py::object& points, const std::string& sign, const std::string& backend) {
-              const SdfHolder s = bind_mesh_sdf(mesh, backend, "bvh", sign, "float", "", 0, "two_grids");
-              return query_bound(s, points, false, py::none()).distance;
+)" + sampler_keywords_doc();
+    m.def("query", [](const py::object& mesh, const py::object& points, const py::object& progress, bool winding,
+                      const py::kwargs& sampler) {
+              const SdfHolder s =
+                  bind_mesh_sdf(mesh, read_sampler_keywords("query()", sampler, {"mesh", "points", "progress", "winding"}));
+              return query_bound(s, points, winding, progress);
           },
-          py::arg("mesh"), py::arg("points"), py::arg("sign") = "auto", py::arg("backend") = "auto",
-          R"(sdf(mesh, points, sign="auto", backend="auto") -> numpy.ndarray
+          py::arg("mesh"), py::arg("points"), py::arg("progress") = py::none(), py::arg("winding") = false,
+          query_doc.c_str());
+
+    static const std::string sdf_function_doc = R"(sdf(mesh, points, **sampler) -> numpy.ndarray
 
 The signed distance of points ((N, 3) array) to mesh, (N,) float64: the one-liner
-SDF(mesh, sign=sign, backend=backend).query(points).distance. mesh: anything SDF takes
-(an sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D).)");
+SDF(mesh, **sampler).query(points).distance. mesh: anything SDF takes (an
+sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D).
+
+)" + sampler_keywords_doc();
+    m.def("sdf", [](const py::object& mesh, const py::object& points, const py::kwargs& sampler) {
+              const SdfHolder s = bind_mesh_sdf(mesh, read_sampler_keywords("sdf()", sampler, {"mesh", "points"}));
+              return query_bound(s, points, false, py::none()).distance;
+          },
+          py::arg("mesh"), py::arg("points"), sdf_function_doc.c_str());
 }
 
 }  // namespace sdf

@@ -5,6 +5,7 @@
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/raycast/views.h"
+#include "harness/config/render_spec.h"
 #include "harness/render/image_buffer.h"
 #include "harness/render/render_backend.h"
 #include "python/src/common.h"
@@ -15,45 +16,37 @@
 namespace sdf {
 namespace {
 
+/// render()'s view, size and caster arguments as a config's "render" object, read by its one
+/// codec (harness/config/render_spec.h): the checks, defaults and messages of configs and
+/// sdf-render.
+RenderSpec render_spec_of(const std::string& view, const py::object& size, const std::string& backend,
+                          const std::string& precision, const py::object& eye, const py::object& target,
+                          const std::vector<double>& up, double fov) {
+    nlohmann::json j = {{"fov", fov}, {"backend", backend}, {"precision", precision}, {"reference", false}};
+    if (py::isinstance<py::int_>(size)) j["size"] = size.cast<int64_t>();
+    else j["size"] = size.cast<std::vector<int64_t>>();
+    if (!eye.is_none() || !target.is_none()) {
+        if (eye.is_none() || target.is_none()) throw std::invalid_argument("eye and target: both needed, 3 numbers each");
+        j["views"] = {{{"name", "camera"}, {"eye", eye.cast<std::vector<double>>()},
+                       {"target", target.cast<std::vector<double>>()}, {"up", up}, {"fov", fov}}};
+    } else {
+        j["views"] = {view};
+    }
+    return render_spec_from_json(j, "render()");
+}
+
 py::array_t<float> render(Field& field, const std::string& view, const py::object& size, const std::string& interpolator,
                           const std::string& derivatives, const std::string& backend, const std::string& precision,
                           const py::object& eye, const py::object& target, const std::vector<double>& up, double fov,
                           const py::object& mesh_in, int threads, const py::object& progress) {
     const MeshHolder mesh = mesh_in.is_none() ? nullptr : mesh_argument(mesh_in);
-    int width = 512, height = 512;
-    if (py::isinstance<py::int_>(size)) {
-        width = height = size.cast<int>();
-    } else {
-        const auto wh = size.cast<std::vector<int>>();
-        if (wh.size() != 2) throw std::invalid_argument("size: expected an int or (width, height)");
-        width = wh[0];
-        height = wh[1];
-    }
-    if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        throw std::invalid_argument("size: expected 1 to 16384 pixels per side");
-    if (!(fov > 0 && fov < 180)) throw std::invalid_argument("fov: expected a field of view between 0 and 180 degrees (exclusive)");
-    if (up.size() != 3) throw std::invalid_argument("up: expected 3 numbers");
-    ViewRequest v;
-    if (!eye.is_none() || !target.is_none()) {
-        const auto e = eye.is_none() ? std::vector<double>{} : eye.cast<std::vector<double>>();
-        const auto t = target.is_none() ? std::vector<double>{} : target.cast<std::vector<double>>();
-        if (e.size() != 3 || t.size() != 3) throw std::invalid_argument("eye and target: both needed, 3 numbers each");
-        v.name = "camera";
-        v.explicit_camera = true;
-        v.eye = {e[0], e[1], e[2]};
-        v.target = {t[0], t[1], t[2]};
-        v.up = {up[0], up[1], up[2]};
-    } else {
-        choose("view", view, named_view_names());
-        v = named_view(view);
-    }
-    v.fov_y_degrees = fov;
+    const RenderSpec spec = render_spec_of(view, size, backend, precision, eye, target, up, fov);
+    const ViewRequest& v = spec.views.front();
+    const int width = spec.width, height = spec.height;
     const std::shared_ptr<const Reconstruction> recon = field.reconstruction(interpolator, derivatives, 0.5, "lattice", threads);
-    RenderOptions o;
-    o.backend = choose("backend", backend, {"auto", "cpu", "cuda"});
+    RenderOptions o = render_options(spec);
     o.threads = threads;
     o.progress = false;  // to the Python callback (task.h)
-    o.precision = precision_from_name(precision);
     TaskOptions task;
     task.total = int64_t(width) * height;
     task.label = "rendering";

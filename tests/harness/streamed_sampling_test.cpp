@@ -275,6 +275,12 @@ TEST(StreamedSampling, ToolRefusesBadOptionsWithExitTwoAndWritesWhatItPlans) {
         const test::ShellResult r = test::run_in(dir.path(), exe + " shape:sphere " + args);
         EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     }
+    // The sampler flags are the options codec's keys: its checks and messages, as a config's.
+    const test::ShellResult band = test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --out f.json --band -1");
+    EXPECT_TRUE(test::Contains(band.err, "key 'sampler.band_width': expected a band width in mesh units")) << band.err;
+    const test::ShellResult kernel = test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --out f.json --kernel seeded");
+    EXPECT_EQ(kernel.code, 2) << kernel.err;
+    EXPECT_TRUE(test::Contains(kernel.err, "a kernel needs the backend cpu or cuda")) << kernel.err;
     const test::ShellResult plan = test::run_in(dir.path(), exe + " shape:sphere --lattice bcc --resolution 10 --out f.json --dry-run");
     EXPECT_EQ(plan.code, 0) << plan.err;
     EXPECT_TRUE(test::Contains(plan.out, "10x10x20"));

@@ -542,6 +542,18 @@ TEST_F(Trust, RenderRefusesACameraWithoutADefinedRoll) {
     EXPECT_FALSE(fs::exists(at("x.png")));
 }
 
+TEST_F(Trust, RenderFlagsAreReadByTheConfigsRenderCodec) {
+    // sdf-render's flags become a config's "render" object (harness/config/render_spec.h): a
+    // panel given twice is refused as in a config, before anything is sampled.
+    const ShellResult twice = render("shape:box --grid --no-cache --quiet --size 8 --backend cpu --sampler-backend cpu "
+                                     "--panels catmull_rom,bcc_linear,catmull_rom/fd --out-dir grid");
+    EXPECT_EQ(twice.code, 1);
+    EXPECT_TRUE(Contains(twice.err, "the command line: key 'render.panels[2]': \"catmull_rom/fd\" is already panel A"))
+        << twice.err;
+    EXPECT_FALSE(Contains(twice.err, "sampling"));
+    EXPECT_FALSE(fs::exists(at("grid")));
+}
+
 // ---- 6. results that claim success with nothing measured ---------------------------------------
 
 TEST_F(Trust, ReconstructionStudyThatPlacesNoProbeFails) {

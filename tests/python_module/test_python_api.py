@@ -172,8 +172,35 @@ def test_unsigned_mode_and_the_sign_mode_used(box):
         assert sl.SDF(open_box, backend="cpu").sign == "winding"
     f = sl.sample(box, lattice="cc", resolution=5, sign="none", backend="cpu")
     assert f.values.min() >= 0 and f.sampler["sign"]["mode"] == "none"
-    with pytest.raises(ValueError, match="sign: unknown value 'unsigned'; expected one of 'auto', 'pseudonormal', 'winding', 'none'"):
+    with pytest.raises(ValueError, match=r'SDF\(\): key \'sign\': unknown value "unsigned"; expected one of "auto", "pseudonormal", "winding" or "none"'):
         sl.SDF(box, sign="unsigned")
+
+
+def test_sampler_keywords_are_the_config_codecs(box):
+    """Every call's sampler keywords go through the one options codec: an unknown keyword is
+    refused as an unknown config key is (the key, the nearest name, every accepted one), and
+    the codec's keys beyond the old keyword lists work (band_width)."""
+    with pytest.raises(ValueError, match=r"sample\(\): unknown key 'bandwidth'; did you mean 'band_width'\? "
+                                         r"\(valid here: mesh, lattice, .*distributed, backend, method, kernel, .*band_width\)"):
+        sl.sample(box, resolution=5, bandwidth=0.1)
+    with pytest.raises(ValueError, match=r"query\(\): unknown key 'treads'; did you mean 'threads'\?"):
+        sl.query(box, np.zeros((1, 3)), treads=1)
+    with pytest.raises(ValueError, match=r"SDF\(\): key 'threads': expected a thread count \(0 = all cores\): 0 or a positive number, got -1"):
+        sl.SDF(box, threads=-1)
+    with pytest.raises(ValueError, match=r"sdf\(\): key 'kernel': \"backend\": \"auto\" takes no kernel"):
+        sl.sdf(box, np.zeros((1, 3)), kernel="brick")
+    with pytest.raises(ValueError, match=r"SDF\(\): key 'progress': progress goes to Python"):
+        sl.SDF(box, progress=True)
+    with pytest.raises(TypeError, match=r"sample\(\): key 'backend': expected a str, a number or a bool, got list"):
+        sl.sample(box, resolution=5, backend=["cpu"])
+    # The codec's keys all work from Python: a narrow band equals the full field clamped to +-W.
+    full = sl.sample(box, resolution=6, backend="cpu")
+    band = sl.sample(box, resolution=6, backend="cpu", band_width=np.float32(0.25))
+    v = full.values
+    inside = np.abs(v) <= 0.25
+    assert np.array_equal(band.values[inside], v[inside])
+    assert np.array_equal(band.values[~inside], np.where(v[~inside] < 0, -0.25, 0.25))
+    assert band.sampler["band"]["width"] == 0.25
 
 
 def test_winding_number_is_occupancy(box):
@@ -250,7 +277,7 @@ def test_reconstruct_outside_the_domain_is_nan_clamp_or_error(box):
     assert clamped[0] == nan_v[0] and np.isfinite(clamped[1])
     with pytest.raises(ValueError, match=r"points: row 1 \(10, 10, 10\) lies outside the field's domain"):
         f.reconstruct(p, outside="error")
-    with pytest.raises(ValueError, match="outside: unknown value 'zero'"):
+    with pytest.raises(ValueError, match='outside: unknown value "zero"; expected one of "nan", "clamp" or "error"'):
         f.reconstruct(p, outside="zero")
 
 

@@ -116,5 +116,68 @@ TEST(RenderSpec, PanelErrorsNameTheEntry) {
     EXPECT_NE(twice.find("\"catmull_rom/fd\" is already panel A"), std::string::npos) << twice;
 }
 
+/// Two specs ask for the same render: every field, each view's camera as it resolves.
+void expect_same(const RenderSpec& a, const RenderSpec& b) {
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.reference, b.reference);
+    EXPECT_EQ(a.error_maps, b.error_maps);
+    EXPECT_EQ(a.heat_max_degrees, b.heat_max_degrees);
+    EXPECT_EQ(a.backend, b.backend);
+    EXPECT_EQ(a.precision, b.precision);
+    EXPECT_EQ(a.grid_downsample, b.grid_downsample);
+    ASSERT_EQ(a.panels.size(), b.panels.size());
+    for (size_t i = 0; i < a.panels.size(); ++i) {
+        EXPECT_EQ(a.panels[i].interpolator, b.panels[i].interpolator);
+        EXPECT_EQ(a.panels[i].derivatives, b.panels[i].derivatives);
+    }
+    ASSERT_EQ(a.views.size(), b.views.size());
+    const Bounds3 box{{-1, -0.5, -2}, {1, 0.5, 2}};
+    for (size_t i = 0; i < a.views.size(); ++i) {
+        EXPECT_EQ(a.views[i].name, b.views[i].name);
+        const CameraSpec ca = resolve_view(a.views[i], box, a.width, a.height);
+        const CameraSpec cb = resolve_view(b.views[i], box, b.width, b.height);
+        EXPECT_EQ(ca.name, cb.name);
+        EXPECT_EQ(ca.eye, cb.eye);
+        EXPECT_EQ(ca.target, cb.target);
+        EXPECT_EQ(ca.up, cb.up);
+        EXPECT_EQ(ca.fov_y_degrees, cb.fov_y_degrees);
+    }
+}
+
+TEST(RenderSpec, ToJsonReadsBackToTheSameSpec) {
+    for (const char* text :
+         {"{}", R"({"size": [640, 480], "fov": 25, "margin": 0.2, "views": ["dragon_side",
+              {"name": "close", "eye": [0, 0.2, 0.4], "target": [0, 0.12, 0], "up": [0, 0, 1], "fov": 20},
+              {"view": "top", "margin": 0.1, "name": "top_wide"}], "reference": false, "error_maps": false,
+              "heat_max_degrees": 7, "backend": "cpu", "precision": "double", "grid_downsample": 2,
+              "panels": ["bcc_cubic", "catmull_rom/fd"]})"}) {
+        const RenderSpec s = parse(text);
+        const nlohmann::json j = render_spec_to_json(s);
+        expect_same(s, render_spec_from_json(j, "round trip"));
+        EXPECT_EQ(render_spec_to_json(render_spec_from_json(j, "round trip")), j) << text;
+    }
+    EXPECT_NE(render_spec_to_json(parse("{}")).dump().find(R"("views":[{"fov":30.0,"margin":0.04,"view":"three_quarter"}])"),
+              std::string::npos);
+}
+
+TEST(RenderSpec, RenamedNamedViewFitsItsTableView) {
+    // {"view": "top", "name": "top_wide"} fits the table's "top" and keeps the new name.
+    const RenderSpec s = parse(R"({"views": [{"view": "top", "name": "top_wide"}, "top"]})");
+    const Bounds3 box{{-1, -0.5, -2}, {1, 0.5, 2}};
+    const CameraSpec renamed = resolve_view(s.views[0], box, 64, 64), plain = resolve_view(s.views[1], box, 64, 64);
+    EXPECT_EQ(renamed.name, "top_wide");
+    EXPECT_EQ(renamed.eye, plain.eye);
+    EXPECT_EQ(renamed.up, plain.up);
+}
+
+TEST(RenderSpec, OptionsOfTheRayCaster) {
+    const RenderOptions o = render_options(parse(R"({"backend": "cpu", "precision": "double"})"));
+    EXPECT_EQ(o.backend, "cpu");
+    EXPECT_EQ(o.precision, Precision::Double);
+    EXPECT_EQ(render_options(parse("{}")).backend, "auto");
+    EXPECT_EQ(render_options(parse("{}")).precision, Precision::Float);
+}
+
 }  // namespace
 }  // namespace sdf
