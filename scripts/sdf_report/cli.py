@@ -5,7 +5,7 @@ import datetime
 import os
 import sys
 
-from . import analytic, filters, overview, peers, plots, reconstruction, sampling, scaling, speedup
+from . import analytic, filters, overview, peers, plots, reconstruction, sampling, scaling, speedup, user_wait
 from . import runs as run_loader
 from . import schema as run_schema
 from .document import Document
@@ -80,6 +80,7 @@ def build(doc, runs, args, skipped):
     for section in SECTIONS:
         section(doc, runs)
     scaling.section(doc, args.results)  # scripts/scaling-run's JSON lines, not run-experiment runs
+    user_wait.section(doc, args.results)  # scripts/user-wait's records, likewise
 
 
 def main(argv=None):
@@ -96,7 +97,11 @@ def main(argv=None):
         return 1
     prepare_output(args.output)
     doc = Document(args.output)
-    build(doc, runs, args, skipped)
+    try:
+        build(doc, runs, args, skipped)
+    except user_wait.UserWaitFileError as e:
+        print("make-report: error: %s" % e, file=sys.stderr)
+        return 1
     doc.write("sdf_lattices results")
     print("report: %s and index.html (%d runs)" % (os.path.join(args.output, "report.md"), len(runs)))
     return 0
