@@ -98,16 +98,16 @@ def rows_table(run):
 
 
 def one_liner_table(record):
-    table = Table(["method", "build (s)", "query (s)", "total (s)", "points/s", "max |error|", "median |error|",
-                   "wrong sign", "note"])
+    table = Table(["method", "build (s)", "query (s)", "total (s)", "points/s", "max |error|", "max error of |d|",
+                   "median |error|", "wrong sign", "note"])
     points = record["points"]
     for r in record["rows"]:
         table.add([r["method"], number(r["build_seconds"]), number(r["query_seconds"]), number(r["total_seconds"]),
                    "%.3g" % (points / r["total_seconds"]) if r["total_seconds"] > 0 else "n/a",
-                   number(r.get("max_abs_error")), number(r.get("median_abs_error")),
+                   number(r.get("max_abs_error")), number(r.get("max_abs_error_unsigned")), number(r.get("median_abs_error")),
                    "%.3f%%" % (100 * r["wrong_sign_fraction"]) if "wrong_sign_fraction" in r else "-", r["note"]])
     for r in record.get("not_run", []):
-        table.add([r["method"], "-", "-", "-", "-", "-", "-", "-", "not run: " + r["reason"]])
+        table.add([r["method"], "-", "-", "-", "-", "-", "-", "-", "-", "not run: " + r["reason"]])
     return table
 
 
@@ -139,7 +139,9 @@ def section(doc, results_dir):
                   "process or Python call beside the kernel (or compute) time the tool reports for the same call, and "
                   "the peer of the same run where the row compares with one. The issue's horse and 13k-triangle CAD "
                   "model are not among the project's meshes: the experiment row samples dragon.obj (99,902 triangles), "
-                  "the render row a generated 13,000-triangle CAD-like box. Rows the machine cannot run (no GPU, a peer "
+                  "the render row a generated 13,000-triangle CAD-like box (each planar face a fan from its centre "
+                  "over its split edges, as the project's CAD test models: a hard case for the BVH, since every "
+                  "triangle of a face reaches its centre). Rows the machine cannot run (no GPU, a peer "
                   "not built) say so. The latest run per machine.")
     for run in runs:
         doc.heading(3, "Run %s: %s" % (run["run_id"], machine_text(run)))
@@ -147,12 +149,17 @@ def section(doc, results_dir):
         if "load_start" in run and "load_end" in run:
             load_text = "; load average %s at the start, %s at the end" % (number(run["load_start"][0]), number(run["load_end"][0]))
         doc.paragraph("Commit %s, build %s%s." % (run["commit"][:16], os.path.basename(run.get("build", "?")), load_text))
+        threads = run["machine"].get("cpu_threads") or 0
+        if threads and max(run.get("load_start", [0])[0], run.get("load_end", [0])[0]) > threads:
+            doc.note("Made on a loaded machine (load above its %d hardware threads): the times are inflated by other "
+                     "work, and only the same run's numbers compare." % threads)
         doc.table(rows_table(run))
         record = run.get("one_liner")
         if record and record.get("status") == "measured":
             doc.paragraph("The Python one-liner against its peers on the same %s points (half uniform in the box grown "
                           "by 10%%, half Gaussian around the surface, sigma 1%%), dragon.obj normalised to the unit cube "
-                          "(%s triangles), ours on %s, sign %s; errors against our exact values:"
+                          "(%s triangles), ours on %s, sign %s; errors against our exact values (max |error| counts a wrong sign; "
+                          "max error of |d| does not):"
                           % (count(record["points"]), count(record["triangles"]), record["sampler"], record["sign"]))
             doc.table(one_liner_table(record))
         elif record:
