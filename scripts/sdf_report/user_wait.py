@@ -138,7 +138,7 @@ def section(doc, results_dir):
     doc.paragraph("Each row of issue 23's table measured as a user runs it (scripts/user-wait): the wall time of the "
                   "process or Python call beside the kernel (or compute) time the tool reports for the same call, and "
                   "the peer of the same run where the row compares with one. The issue's horse and 13k-triangle CAD "
-                  "model are not among the project's meshes: the experiment row samples dragon.obj (99,902 triangles), "
+                  "model are not among the project's meshes: the experiment row samples dragon-legacy.obj (100,000 triangles), "
                   "the render row a generated 13,000-triangle CAD-like box (each planar face a fan from its centre "
                   "over its split edges, as the project's CAD test models: a hard case for the BVH, since every "
                   "triangle of a face reaches its centre). Rows the machine cannot run (no GPU, a peer "
