@@ -82,18 +82,42 @@ def _peer_text(row):
                                                   number(our_total / (build + query)) if build + query > 0 else "n/a")
 
 
+# Details a row may record, each shown in the notes with its label and unit (one table).
+NOTES = [("seconds", "the tool's own end to end", "s"), ("disk_baseline_seconds", "dd writing the same bytes", "s"),
+         ("peak_resident_bytes", "peak RSS", "MiB"), ("load_mesh_seconds", "mesh load (Python, alone)", "s"),
+         ("build_seconds", "SDF build", "s"), ("query_without_built_sdf_seconds", "sl.query, building for the call", "s"),
+         ("sampling_seconds", "sampling end to end", "s"), ("render_seconds", "ray cast", "s"),
+         ("backend", "backend", ""), ("sign", "sign", "")]
+
+
+def _notes(row):
+    details = row.get("details", {})
+    parts = []
+    for key, label, unit in NOTES:
+        value = details.get(key)
+        if value is None:
+            continue
+        if unit == "MiB":
+            parts.append("%s %s MiB" % (label, number(value / 2**20)))
+        elif unit:
+            parts.append("%s %s %s" % (label, number(value), unit))
+        else:
+            parts.append("%s %s" % (label, value))
+    return "; ".join(parts) or "-"
+
+
 def rows_table(run):
     table = Table(["row", "what the user runs", "kernel or compute (s)", "what the user waits (s)", "wall / kernel",
-                   "the kernel time is", "peer, same run (s)", "ours / peer (time; below 1: ours faster)"])
+                   "the kernel time is", "peer, same run (s)", "ours / peer (time; below 1: ours faster)", "notes"])
     for row in run["rows"]:
         if row["status"] != "measured":
-            table.add([row["id"], "%s: %s" % (row["status"], row["reason"]), "-", "-", "-", "-", "-", "-"])
+            table.add([row["id"], "%s: %s" % (row["status"], row["reason"]), "-", "-", "-", "-", "-", "-", "-"])
             continue
         kernel = row.get("kernel_seconds")
         ratio = number(row["wall_seconds"] / kernel) if kernel else "n/a"
         peer, versus = _peer_text(row)
         table.add([row["id"], row["title"], number(kernel), number(row["wall_seconds"]), ratio, row["kernel_what"],
-                   peer, versus])
+                   peer, versus, _notes(row)])
     return table
 
 

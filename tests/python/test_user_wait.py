@@ -30,7 +30,8 @@ def record(run_id, gpu, started):
         {"id": "points_16m", "status": "measured", "title": "one point-query call, 16.8M uniform points",
          "wall_seconds": 1.4, "kernel_seconds": 0.0176, "kernel_what": "device time", "details": {}},
         {"id": "query_1_point", "status": "measured", "title": "Python .query of 1 point", "wall_seconds": 2.2e-5,
-         "kernel_seconds": None, "kernel_what": "none reported", "details": {}},
+         "kernel_seconds": None, "kernel_what": "none reported",
+         "details": {"build_seconds": 0.3, "peak_resident_bytes": 2 * 2**20, "backend": "cpu"}},
         {"id": "cpu_bvh_fcpw", "status": "measured", "title": "CPU BVH against FCPW", "wall_seconds": 0.5,
          "kernel_seconds": 0.4, "kernel_what": "the query",
          "peer": {"name": "FCPW", "build_seconds": 0.03, "query_seconds": 0.4},
@@ -74,8 +75,9 @@ def test_table_one_liner_and_plot_per_machine(tmp_path):
     assert "Run r2: Test CPU x2, GPU none" in md and "Run r1" not in md
     assert "Run g1: Test CPU x2, GPU NVIDIA H100 80GB HBM3" in md
     assert "Made on a loaded machine (load above its 2 hardware threads)" in md
-    assert "| points_16m | one point-query call, 16.8M uniform points | 0.0176 | 1.4 | 79.55 | device time | - | - |" in md
+    assert "| points_16m | one point-query call, 16.8M uniform points | 0.0176 | 1.4 | 79.55 | device time | - | - | - |" in md
     assert "| query_1_point | Python .query of 1 point | n/a | 2.200e-05 | n/a |" in md
+    assert "| peak RSS 2 MiB; SDF build 0.3 s; backend cpu |" in md
     assert "FCPW: build 0.03 + query 0.4 | query 1, build + query 1.163 |" in md
     assert "| sample_1024 | not run: no GPU on this machine |" in md
     assert "| Open3D 0.16.1 RaycastingScene | 0.001 | 4 | 4.001 | 2.5e+04 | 3.000e-08 | 1.000e-08 | 2.000e-09 | 8.000% | float32 |" in md
