@@ -19,6 +19,9 @@ RUN_KEYS = {"run_id": str, "started": str, "machine": dict, "commit": str, "rows
 MEASURED_KEYS = {"id": str, "title": str, "wall_seconds": (int, float), "kernel_what": str}
 
 
+HEADING = "Where the user waits (wall time beside kernel time)"
+
+
 class UserWaitFileError(ValueError):
     pass
 
@@ -51,9 +54,23 @@ def read_run(path):
     return run
 
 
-def load(results_dir):
-    """The latest run per machine (CPU model, threads, GPU), in order of start."""
-    paths = glob.glob(os.path.join(results_dir, "user_wait", "*", "user_wait.json")) + \
+def is_user_wait_file(path):
+    """Whether path is a scripts/user-wait record (a .json file whose "format" says so)."""
+    if not (os.path.isfile(path) and path.endswith(".json")):
+        return False
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("format") == FORMAT
+
+
+def load(results_dir, files=None):
+    """The latest run per machine (CPU model, threads, GPU), in order of start: of `files`
+    when given (user_wait.json paths), else of every run under results_dir/user_wait and
+    results_dir/gpu/user_wait."""
+    paths = files or glob.glob(os.path.join(results_dir, "user_wait", "*", "user_wait.json")) + \
         glob.glob(os.path.join(results_dir, "gpu", "user_wait", "*", "user_wait.json"))
     latest = {}
     for path in paths:
@@ -153,9 +170,9 @@ def _plot(doc, runs):
                     "conversion, writing).")
 
 
-def section(doc, results_dir):
-    runs = load(results_dir)
-    doc.heading(2, "Where the user waits (wall time beside kernel time)")
+def section(doc, results_dir, files=None):
+    runs = load(results_dir, files)
+    doc.heading(2, HEADING)
     if not runs:
         doc.note("No user-wait run in the results: run `scripts/user-wait` (issue 23's table, measured as a user runs it).")
         return

@@ -137,3 +137,51 @@ def test_peers_rows_that_did_not_run_are_not_run(tmp_path):
     assert driver.peer_row(metrics, "bvh_cpu", "64x64x64")["query_seconds"] == 0.4
     with pytest.raises(RuntimeError, match="no cubql row"):
         driver.peer_row(metrics, "cubql", "64x64x64")
+
+
+def test_make_report_takes_user_wait_records_and_rewrites_the_section_alone(tmp_path):
+    from sdf_report import cli
+    empty = tmp_path / "empty-results"
+    empty.mkdir()
+    gpu = tmp_path / "g1.json"
+    gpu.write_text(json.dumps(record("g1", "NVIDIA H100 80GB HBM3", "2026-11-25T09:00:00+00:00")))
+    out = tmp_path / "report"
+    assert cli.main(["--results", str(empty), "--output", str(out), str(gpu)]) == 0
+    md = (out / "report.md").read_text()
+    assert "Run g1: Test CPU x2, GPU NVIDIA H100 80GB HBM3" in md and "from 0 run(s)" in md
+    # a report whose other sections cannot be regenerated: only the section is rewritten
+    text = md.replace("## Where the user waits", "## Kept section\n\nkept text\n\n## Where the user waits")
+    (out / "report.md").write_text(text)
+    later = tmp_path / "g2.json"
+    later.write_text(json.dumps(record("g2", "NVIDIA H100 80GB HBM3", "2026-11-25T12:00:00+00:00")))
+    for _ in range(2):  # twice: the same text
+        assert cli.main(["--results", str(empty), "--output", str(out), "--only-section", "user-wait", str(later)]) == 0
+        md = (out / "report.md").read_text()
+        html = (out / "index.html").read_text()
+        assert "kept text" in md and "Run g2" in md and "Run g1" not in md and md.count("## Where the user waits") == 1
+        assert "Run g2" in html and html.count("<h2>Where the user waits") == 1 and html.rstrip().endswith("</body></html>")
+
+
+def test_only_section_needs_an_existing_report(tmp_path):
+    from sdf_report import cli
+    with pytest.raises(SystemExit, match="needs an existing report"):
+        cli.main(["--results", str(tmp_path), "--output", str(tmp_path / "nothing"), "--only-section", "user-wait"])
+
+
+def test_publish_gpu_results_copies_a_gpu_record_once(tmp_path):
+    import subprocess
+    import sys
+    script = os.path.join(REPO, "scripts", "publish-gpu-results")
+    gpu = tmp_path / "g.json"
+    gpu.write_text(json.dumps(record("2026-11-25T192119Z", "NVIDIA H100 80GB HBM3", "2026-11-25T19:21:19+00:00")))
+    out = tmp_path / "gpu"
+    r = subprocess.run([sys.executable, script, str(gpu), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    target = out / "user_wait" / "2026-11-25T192119Z" / "user_wait.json"
+    assert json.loads(target.read_text()) == json.loads(gpu.read_text())
+    r = subprocess.run([sys.executable, script, str(gpu), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode != 0 and "refusing to overwrite" in r.stderr
+    cpu = tmp_path / "c.json"
+    cpu.write_text(json.dumps(record("c1", None, "2026-11-25T19:21:19+00:00")))
+    r = subprocess.run([sys.executable, script, str(cpu), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode != 0 and "names no GPU" in r.stderr
