@@ -52,7 +52,9 @@ class _View:
         x = points
         if _library(x) == "torch" and x.requires_grad:
             x = x.detach()
-        if _cuda_interface(x) is None:  # DLPack only (JAX): a zero-copy view through torch or cupy
+        if (_cuda_interface(x) is None or _library(x) not in ("torch", "cupy")) and hasattr(points, "__dlpack__"):
+            # DLPack (JAX, whose GPU arrays may also have the array interface, or any object
+            # with __dlpack__): a zero-copy view through torch or cupy, which make the results
             x, self.back = _dlpack_view(points)
         self.array = x
         self.library = _library(x)
@@ -98,12 +100,17 @@ def _dlpack_view(points):
         except ImportError:
             continue
         view = library.from_dlpack(points)
-        back = None
-        if _library(points) in ("jax", "jaxlib"):
-            import jax.dlpack
-            back = jax.dlpack.from_dlpack
-        return view, back
+        return view, (_to_jax if _library(points) in ("jax", "jaxlib") else None)
     raise TypeError("GPU points given through DLPack need CuPy or PyTorch to be installed")
+
+
+def _to_jax(array):
+    """A torch or cupy result as a JAX array on the same device, without a copy."""
+    import jax.dlpack
+    try:
+        return jax.dlpack.from_dlpack(array)
+    except TypeError:  # JAX before the __dlpack__ protocol takes the capsule
+        return jax.dlpack.from_dlpack(array.__dlpack__())
 
 
 def _stream_of(x, cai):

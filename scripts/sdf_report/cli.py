@@ -5,10 +5,10 @@ import datetime
 import os
 import sys
 
-from . import analytic, filters, overview, peers, plots, reconstruction, sampling, scaling, speedup
+from . import analytic, filters, overview, peers, plots, reconstruction, sampling, scaling, speedup, user_wait
 from . import runs as run_loader
 from . import schema as run_schema
-from .document import Document
+from .document import Document, write_text_atomically
 
 REPO = run_schema.REPO
 PUBLISHED = os.path.join(REPO, "results", "report")
@@ -20,6 +20,10 @@ image grids embedded), with the plots as PNG beside them.
 Reads the runs under --results (every <experiment>/<run-id>/ holding manifest.json and
 metrics.json, and the published GPU runs gpu/*.json) and reports the latest run of each
 experiment, or the RUN paths given (run directories or published files), all of them.
+A RUN that is a scripts/user-wait record (user_wait.json) goes to the section "Where the user
+waits" instead of the records under --results (the latest per machine of those given).
+--only-section user-wait rewrites that section alone in an existing report (--output or
+--publish), keeping the rest as it is (for a published report whose runs are not all on disk).
 Every run is validated against harness/schema/run_schema.json: a missing or mistyped key
 is an error naming the file and the key (--skip-invalid leaves such runs out instead).
 
@@ -40,7 +44,13 @@ def parse_args(argv):
     ap.add_argument("--publish", action="store_true", help="write the committed report, %s" % os.path.relpath(PUBLISHED, REPO))
     ap.add_argument("--skip-invalid", action="store_true", help="leave out runs that do not match the schema (with a "
                                                                  "warning) instead of failing")
+    ap.add_argument("--only-section", choices=["user-wait"], help="rewrite only this section of the existing report "
+                                                                       "in the output directory")
     args = ap.parse_args(argv)
+    args.user_wait_files = [os.path.abspath(p) for p in args.runs if user_wait.is_user_wait_file(p)]
+    args.runs = [p for p in args.runs if not user_wait.is_user_wait_file(p)]
+    if args.only_section and args.runs:
+        ap.error("--only-section %s reads no experiment runs; give only user_wait.json records, or none" % args.only_section)
     if args.publish and args.output and os.path.abspath(args.output) != PUBLISHED:
         ap.error("--publish writes %s; do not combine it with --output %s" % (PUBLISHED, args.output))
     args.output = os.path.abspath(PUBLISHED if args.publish else args.output or LOCAL)
@@ -80,10 +90,52 @@ def build(doc, runs, args, skipped):
     for section in SECTIONS:
         section(doc, runs)
     scaling.section(doc, args.results)  # scripts/scaling-run's JSON lines, not run-experiment runs
+    user_wait.section(doc, args.results, args.user_wait_files)  # scripts/user-wait's records, likewise
+
+
+def rewrite_section(args):
+    """--only-section user-wait: the section rendered anew and put in place of the old one
+    (or after the last section) in the existing report.md and index.html; the rest is kept."""
+    paths = [os.path.join(args.output, name) for name in ("report.md", "index.html")]
+    if not all(os.path.isfile(p) for p in paths):
+        raise SystemExit("make-report: error: --only-section needs an existing report in %s (report.md, index.html)"
+                         % args.output)
+    doc = Document(args.output)
+    user_wait.section(doc, args.results, args.user_wait_files)
+    with open(paths[0], encoding="utf-8") as f:
+        markdown = f.read()
+    with open(paths[1], encoding="utf-8") as f:
+        page = f.read()
+    new_html = doc.html("").split("<body>", 1)[1].rsplit("</body>", 1)[0].strip("\n")
+    write_text_atomically(paths[0], _replace(markdown, "\n## " + user_wait.HEADING, "\n## ", doc.markdown().rstrip("\n")))
+    write_text_atomically(paths[1], _replace(page, "\n<h2>" + user_wait.HEADING, "\n<h2>", new_html, end="\n</body>",
+                                             sep="\n"))
+
+
+def _replace(text, start, next_start, new, end=None, sep="\n\n"):
+    """text with the part from `start` to the next `next_start` (or `end`, or the end of the
+    text) replaced by new; without `start`, new goes before `end` (or at the end). Blocks are
+    joined by sep, so that rewriting a section twice gives the same text."""
+    stop = len(text) if end is None else text.rindex(end)
+    begin = text.find(start)
+    if begin < 0:
+        begin = stop
+    following = text.find(next_start, begin + len(start))
+    finish = following if 0 <= following < stop and begin < stop else stop
+    tail = text[finish:].lstrip("\n")
+    return text[:begin].rstrip("\n") + sep + new + (sep + tail if tail else "\n")
 
 
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
+    if args.only_section:
+        try:
+            rewrite_section(args)
+        except user_wait.UserWaitFileError as e:
+            print("make-report: error: %s" % e, file=sys.stderr)
+            return 1
+        print("report: the section '%s' rewritten in %s" % (user_wait.HEADING, args.output))
+        return 0
     try:
         schema = run_schema.load_schema()
         runs, skipped = run_loader.collect(args.results, [os.path.abspath(p) for p in args.runs], schema,
@@ -96,7 +148,11 @@ def main(argv=None):
         return 1
     prepare_output(args.output)
     doc = Document(args.output)
-    build(doc, runs, args, skipped)
+    try:
+        build(doc, runs, args, skipped)
+    except user_wait.UserWaitFileError as e:
+        print("make-report: error: %s" % e, file=sys.stderr)
+        return 1
     doc.write("sdf_lattices results")
     print("report: %s and index.html (%d runs)" % (os.path.join(args.output, "report.md"), len(runs)))
     return 0

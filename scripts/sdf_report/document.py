@@ -76,10 +76,14 @@ class Document:
     def write(self, title):
         """Writes report.md and index.html into out_dir, each atomically."""
         for name, text in (("report.md", self.markdown()), ("index.html", self.html(title))):
-            tmp = os.path.join(self.out_dir, "." + name + ".tmp")
-            with open(tmp, "w", encoding="utf-8") as f:
-                f.write(text)
-            os.replace(tmp, os.path.join(self.out_dir, name))
+            write_text_atomically(os.path.join(self.out_dir, name), text)
+
+
+def write_text_atomically(path, text):
+    tmp = os.path.join(os.path.dirname(path), "." + os.path.basename(path) + ".tmp")
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(text)
+    os.replace(tmp, path)
 
 
 _STYLE = ("body{font-family:sans-serif;max-width:80em;margin:2em auto;padding:0 1em;color:#222;line-height:1.4}"

@@ -83,3 +83,32 @@ def remove_old_plots(out_dir):
     for name in os.listdir(out_dir):
         if name.endswith(".png"):
             os.remove(os.path.join(out_dir, name))
+
+
+def wall_against_kernel(path, title, series):
+    """Wall time against kernel time, log-log: `series` is [(label, [(name, kernel, wall)])],
+    one marker per series (a machine), each point named; the line wall = kernel is where the
+    user waits for nothing but the computation, wall = 10 x kernel and 100 x beside it."""
+    fig, ax = plt.subplots(figsize=(9.5, 5.6))
+    kernels = [k for _, points in series for _, k, _ in points]
+    walls = [w for _, points in series for _, _, w in points]
+    x_lo, x_hi = min(kernels) / 3, max(kernels) * 3
+    y_lo, y_hi = min(x_lo, min(walls) / 3), max(walls) * 3
+    for factor, style in ((1, "-"), (10, "--"), (100, ":")):
+        ax.plot([x_lo, x_hi], [x_lo * factor, x_hi * factor], linestyle=style, color="0.6", linewidth=1,
+                label="wall = kernel" if factor == 1 else "wall = %d x kernel" % factor)
+    for i, (label, points) in enumerate(series):
+        ax.scatter([k for _, k, _ in points], [w for _, _, w in points], marker=MARKERS[i % len(MARKERS)], s=36,
+                   zorder=5, label=label)
+        for name, k, w in points:
+            ax.annotate(name, (k, w), textcoords="offset points", xytext=(5, 3), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(x_lo, x_hi)
+    ax.set_ylim(y_lo, y_hi)
+    ax.set_xlabel("kernel (or compute) time, s")
+    ax.set_ylabel("what the user waits (wall time), s")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    _save(fig, path)

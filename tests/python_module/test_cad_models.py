@@ -104,8 +104,8 @@ def test_sdf_query_on_the_cad_box_writes_no_warning(name, tmp_path):
     vertices, faces = placed(name)
     obj = tmp_path / "cad_box.obj"
     with open(obj, "w") as f:
-        f.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices)
-        f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces)
+        f.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in vertices)
+        f.writelines(f"f {a + 1:d} {b + 1:d} {c + 1:d}\n" for a, b, c in faces)
     points, inside = points_clear_of_the_surface(name, n=100)
     np.save(tmp_path / "points.npy", points)
     r = subprocess.run([SDF_QUERY, str(obj), str(tmp_path / "points.npy"), "--backend", "cpu", "--sign", "auto",

@@ -103,7 +103,8 @@ def test_trimesh_like_objects_paths_and_meshes_are_accepted(tmp_path, box):
     p = random_points(200, seed=8)
     d, _ = box_sdf(p)
     obj = tmp_path / "b.obj"
-    obj.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v) + "".join(f"f {a+1} {b+1} {c+1}\n" for a, b, c in f))
+    obj.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in v) +  # explicit formats: NumPy 2's
+                   "".join(f"f {a + 1:d} {b + 1:d} {c + 1:d}\n" for a, b, c in f))     # repr is np.float64(...)
     for mesh in (box, (v, f), [v, f], TrimeshLike(v, f), str(obj), obj):
         assert np.max(np.abs(sl.sdf(mesh, p) - d)) < 1e-12
     assert sl.as_mesh(TrimeshLike(v, f)).name == "TrimeshLike"

@@ -110,7 +110,8 @@ def test_bad_arrays_raise_value_errors_naming_the_argument():
 def test_load_mesh_reads_files_and_shapes(tmp_path):
     v, f = box_arrays()
     obj = tmp_path / "b.obj"
-    obj.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v) + "".join(f"f {a+1} {b+1} {c+1}\n" for a, b, c in f))
+    obj.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in v) +  # explicit formats: NumPy 2's
+                   "".join(f"f {a + 1:d} {b + 1:d} {c + 1:d}\n" for a, b, c in f))     # repr is np.float64(...)
     m = sl.load_mesh(str(obj))
     assert m.name == "b" and m.source == str(obj) and m.closed
     assert sl.load_mesh("shape:torus").components == 1
@@ -204,7 +205,7 @@ def test_sdf_query_text_and_npy_agree_and_float32_points_are_read(tmp_path):
     p = random_points(200, seed=5)
     rows = npy_query(tmp_path, "shape:box", p, "--precision", "double")
     text = tmp_path / "p.txt"
-    text.write_text("".join(f"{x!r} {y!r} {z!r}\n" for x, y, z in p))
+    text.write_text("".join(f"{x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in p))
     out = run([SDF_QUERY, "shape:box", str(text), "--precision", "double"]).stdout
     assert np.array_equal(np.loadtxt(out.splitlines()), rows)
     rows32 = npy_query(tmp_path, "shape:box", p.astype(np.float32), "--precision", "double")
