@@ -133,7 +133,7 @@ SampledField collective_root(const PreparedMesh& mesh, const std::function<Sampl
         const auto end = std::chrono::steady_clock::now();
         finish_provenance(field, mine.options, plan, gathered, std::chrono::duration<double>(end - start).count(),
                           std::chrono::duration<double>(end - sampling_start).count());
-        field.sampler["distributed"]["collective"] = true;  // every rank called sample and holds the field
+        field.sampler.details["distributed"]["collective"] = true;  // every rank called sample and holds the field
         outcome["sampler"] = field.sampler;
         outcome["timings"] = timings_to_json(field.timings);
     }
@@ -197,7 +197,7 @@ SampledField collective_worker(const PreparedMesh& mesh, const std::function<Sam
     const nlohmann::json outcome = nlohmann::json::parse(receive_string(0, kTagOutcome));
     if (!outcome.at("ok").get<bool>()) raise_outcome(outcome, setup_error);
     broadcast_field(field);
-    field.sampler = outcome.at("sampler");
+    field.sampler = outcome.at("sampler").get<SamplerReport>();
     field.timings = timings_from_json(outcome.at("timings"));
     return field;
 }

@@ -144,8 +144,8 @@ bool held_by_the_ranks(const SampledField& field) {
     const Session::HeldField& h = s.held;
     return distributed_active() && s.rank == 0 && s.distribution == Distribution::LatticeSlabs && h.valid &&
            field.distance.data() == h.distance && field.size() == h.lattice.num_points() &&
-           lattice_to_json(field.lattice) == lattice_to_json(h.lattice) && field.sampler.is_object() &&
-           field.sampler.contains("distributed") && field.sampler["distributed"] == h.record;
+           lattice_to_json(field.lattice) == lattice_to_json(h.lattice) && field.sampler.details.contains("distributed") &&
+           field.sampler.details.at("distributed") == h.record;
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ public:
         const auto end = std::chrono::steady_clock::now();
         s.fields.push_back(finish_provenance(field, options_, plan, gathered, std::chrono::duration<double>(end - start).count(),
                                              std::chrono::duration<double>(end - sampling_start).count()));
-        s.held = {true, lattice, plan.slabs, field.sampler["distributed"], field.distance.data(), s.fields.size() - 1};
+        s.held = {true, lattice, plan.slabs, field.sampler.details["distributed"], field.distance.data(), s.fields.size() - 1};
         return field;
     }
 

@@ -59,13 +59,9 @@ nlohmann::json describe_part(const SampledField& part, int rank, const std::stri
                         {"upload_seconds", part.timings.upload},
                         {"download_seconds", part.timings.download},
                         {"pairs", part.timings.point_triangle_pairs}};
-    if (part.sampler.is_object()) {
-        j["points_computed"] = part.sampler.value("points_computed", int64_t(0));
-        if (part.sampler.contains("device")) j["device"] = part.sampler["device"];
-        if (part.sampler.contains("threads")) j["threads"] = part.sampler["threads"];
-    } else {
-        j["points_computed"] = 0;
-    }
+    j["points_computed"] = part.sampler.points_computed;
+    for (const char* key : {"device", "threads"})
+        if (part.sampler.details.contains(key)) j[key] = part.sampler.details.at(key);
     return j;
 }
 
@@ -91,7 +87,7 @@ void receive_answers(Gathered& g, SampledField* field, const Lattice& lattice, c
         if (!status.contains("part") || field == nullptr) continue;  // nothing sampled: the root had failed first
         receive_part(*field, lattice, slabs[size_t(r)], r);
         g.parts.push_back(status["part"]);
-        if (!g.sampler.is_object() && status["sampler"].is_object()) g.sampler = status["sampler"];
+        g.sampler.merge(status["sampler"].get<SamplerReport>());  // in rank order
     }
 }
 
@@ -106,7 +102,7 @@ Gathered sample_and_gather(const std::function<SampledField(const LatticeSlab&)>
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         place_part(field, lattice, plan.slabs[0], part);
         g.parts.push_back(describe_part(part, 0, host, plan.slabs[0], seconds));
-        g.sampler = part.sampler;
+        g.sampler.merge(part.sampler);
     } catch (const std::exception& e) {
         g.failures.push_back({0, host, e.what()});
     }
@@ -125,24 +121,25 @@ std::string failure_message(const std::string& lattice, const std::vector<RankFa
 nlohmann::json finish_provenance(SampledField& field, const SamplerOptions& options, const SlabPlan& plan,
                                  const Gathered& gathered, double total_seconds, double sampling_seconds) {
     const Session& s = session();
-    nlohmann::json parts = gathered.parts, sampler_json = gathered.sampler;
+    nlohmann::json parts = gathered.parts;
+    SamplerReport sampler = gathered.sampler;  // every rank's counters, merged
     std::sort(parts.begin(), parts.end(), [](const nlohmann::json& a, const nlohmann::json& b) { return a["rank"] < b["rank"]; });
-    int64_t computed = 0;
     double pairs = 0, max_seconds = 0, sum_seconds = 0, upload = 0, download = 0;
     for (size_t r = 0; r < parts.size(); ++r) {
         nlohmann::json& p = parts[r];
         p["estimated_cost"] = plan.slab_cost(int(r));
-        computed += p["points_computed"].get<int64_t>();
         pairs += p["pairs"].get<double>();
         max_seconds = std::max(max_seconds, p["seconds"].get<double>());
         sum_seconds += p["seconds"].get<double>();
         upload = std::max(upload, p["upload_seconds"].get<double>());
         download = std::max(download, p["download_seconds"].get<double>());
     }
-    if (!sampler_json.is_object() || sampler_json.empty())
-        sampler_json = {{"backend", options.backend}, {"method", options.method},
-                        {"kernel", options.kernel}, {"precision", precision_name(options.precision)}};
-    sampler_json["points_computed"] = computed;
+    if (sampler.backend.empty()) {  // no rank sampled a point
+        sampler.backend = options.backend;
+        sampler.method = options.method;
+        sampler.kernel = options.kernel;
+        sampler.precision = precision_name(options.precision);
+    }
     const double mean = sum_seconds / double(std::max<size_t>(1, parts.size()));
     nlohmann::json d = {{"ranks", s.size},
                         {"lattice", lattice_notation(field.lattice)},
@@ -154,8 +151,8 @@ nlohmann::json finish_provenance(SampledField& field, const SamplerOptions& opti
                         {"seconds", total_seconds}};
     if (field.lattice.type == LatticeType::BCC && options.bcc_strategy == BccStrategy::DoubleResolution)
         d["slab_bcc_strategy"] = "two_grids";  // lattice_slab.h: the same positions, the same samples
-    sampler_json["distributed"] = d;
-    field.sampler = sampler_json;
+    sampler.details["distributed"] = d;
+    field.sampler = sampler;
     field.timings.total = total_seconds;
     field.timings.kernel = sampling_seconds;
     field.timings.upload = upload;

@@ -31,12 +31,13 @@ struct RankFailure {
     bool setup = false;  ///< before sampling: the caller's arguments (collective sampling)
 };
 
-/// What the root gathers of one field: every rank's slab, described; the sampler's
-/// provenance (the root's slab's, or the first worker's when the root's slab is empty); and
-/// the ranks that failed.
+/// What the root gathers of one field: every rank's slab, described; the sampler's report,
+/// every rank's merged in rank order (SamplerReport::merge: the counters summed, the details
+/// the root's, or the first worker's when the root's slab is empty); and the ranks that
+/// failed.
 struct Gathered {
     nlohmann::json parts = nlohmann::json::array();
-    nlohmann::json sampler;
+    SamplerReport sampler;
     std::vector<RankFailure> failures;
 };
 
@@ -53,8 +54,8 @@ Gathered sample_and_gather(const std::function<SampledField(const LatticeSlab&)>
 /// "distributed sampling of 11x9x13 failed on 1 of 2 ranks: rank 1 (host vm): ..."
 std::string failure_message(const std::string& lattice, const std::vector<RankFailure>& failures);
 
-/// The field's provenance: the gathered sampler with the whole run's counts, and
-/// "distributed" (the slabs, per-rank seconds, the load balance), which it returns.
+/// The field's provenance: the gathered report (the whole lattice's counters), and as a
+/// detail "distributed" (the slabs, per-rank seconds, the load balance), which it returns.
 nlohmann::json finish_provenance(SampledField& field, const SamplerOptions& options, const SlabPlan& plan,
                                  const Gathered& gathered, double total_seconds, double sampling_seconds);
 
