@@ -11,7 +11,7 @@ namespace {
 nlohmann::json xyz(const Vec3d& v) { return {v.x, v.y, v.z}; }
 
 [[noreturn]] void wrong(const std::string& key, const char* expected, const nlohmann::json& got) {
-    throw std::runtime_error("mesh." + key + ": expected " + expected + ", got " + got.dump());
+    throw std::runtime_error((key.empty() ? "mesh" : "mesh." + key) + ": expected " + expected + ", got " + got.dump());
 }
 
 std::string text(const nlohmann::json& j, const char* key) {

@@ -213,7 +213,9 @@ void run_one(std::vector<PlannedRun>& runs, size_t i, const std::string& staging
     ctx.output_dir = sweep ? (fs::path(staging) / runs[i].point.name).string() : staging;
     ctx.run_id = run_id + (sweep ? "/" + runs[i].point.name : "");
     ctx.log = &log;
-    if (sweep) log << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
+    if (sweep)
+        log << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump()
+            << std::endl;
     runs[i].experiment->run(ctx);
 }
 
