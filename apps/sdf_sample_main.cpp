@@ -190,13 +190,7 @@ int main(int argc, char** argv) {
         require_output_space(plan, out_path);
         // Temporaries of an interrupted earlier run in the output folder (their process is gone).
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
-        const nlohmann::json mesh_provenance = {{"name", mesh.name()},
-                                                {"source", mesh.source()},
-                                                {"sha256", mesh.content_sha256()},
-                                                {"vertices", mesh.vertices().size()},
-                                                {"triangles", mesh.triangles().size()},
-                                                {"components", mesh.report().components},
-                                                {"sign_reliable", mesh.report().sign_reliable()}};
+        const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
         if (!quiet) std::cerr << plan.describe();
         // The front ends' one field source (experiments/common/field_source.h), without a cache:
         // its sampler samples the slabs this tool streams to disk.

@@ -434,7 +434,7 @@ private:
         const auto [computed, pieces] = run_blocks<T>(dev, lattice, slab, compute, sink);
         record_provenance(field, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
         record_search_certificate(dev, field);
-        if (options_.band_width > 0) field.sampler["band"] = band_provenance(mesh, count_narrow_band(field));
+        if (options_.band_width > 0) field.sampler.band = band_provenance(mesh, count_narrow_band(field));
         return field;
     }
 
@@ -463,8 +463,8 @@ private:
         download.end();
         record_provenance(stored.info, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
         record_search_certificate(dev, stored.info);
-        if (options_.band_width > 0) stored.info.sampler["band"] = band_provenance(mesh, stored.band);
-        stored.info.sampler["stored_on_device"] = true;
+        if (options_.band_width > 0) stored.info.sampler.band = band_provenance(mesh, stored.band);
+        stored.info.sampler.details["stored_on_device"] = true;
         return stored;
     }
 
@@ -493,15 +493,15 @@ private:
         bvh_info["built_by_this_call"] = built;
         bvh_info["uploaded_by_this_call"] = uploaded;
         field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
-        field.sampler["bvh"] = bvh_info;
-        field.sampler["device"] = describe_device(options_.device);
+        field.sampler.details["plan"] = {{"pieces", pieces}, {"threads_per_block", kBvhThreads}, {"points_per_thread", kRunPoints}};
+        field.sampler.details["bvh"] = bvh_info;
+        field.sampler.details["device"] = describe_device(options_.device);
         if (kernel_ == BvhGpuKernel::Candidates) {
             unsigned long long counts[4] = {0, 0, 0, 0};
             candidate_stats_.download(counts, 4);
             CUDA_CHECK(cudaStreamSynchronize(0));
             const double bricks = double(counts[0]);
-            field.sampler["candidates"] = {{"bricks_searched", counts[0]},
+            field.sampler.details["candidates"] = {{"bricks_searched", counts[0]},
                                            {"bricks_outside_band", counts[2]},
                                            {"mean_candidate_triangles", bricks > 0 ? double(counts[1]) / bricks : 0.0},
                                            {"mean_leaf_ranges", bricks > 0 ? double(counts[3]) / bricks : 0.0},
@@ -516,10 +516,10 @@ private:
         CertificateCounters certificate;
         read_certificate(dev, certificate);
         record_certificate(field.timings, certificate);
-        field.sampler["search_certificate"] = certificate_provenance(std::is_same_v<T, float>, true, certificate);
+        field.sampler.search_certificate = certificate_provenance(std::is_same_v<T, float>, true, certificate);
     }
 
-    nlohmann::json band_provenance(const PreparedMesh& mesh, const NarrowBandCounts& counts) const {
+    BandReport band_provenance(const PreparedMesh& mesh, const NarrowBandCounts& counts) const {
         const bool skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) &&
                            (sign_.winding() || choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal);
         return narrow_band_provenance(options_.band_width, counts, skips ? "bricks skipped by the distance bound" : "post-processed");

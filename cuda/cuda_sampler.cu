@@ -334,14 +334,14 @@ private:
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler["plan"] = engine.plan();
-        field.sampler["device"] = describe_device(options_.device);
+        field.sampler.details["plan"] = engine.plan();
+        field.sampler.details["device"] = describe_device(options_.device);
         CertificateCounters certificate;
         if (certifier) certifier->read(certificate);
         record_certificate(field.timings, certificate);
-        field.sampler["search_certificate"] = certificate_provenance(std::is_same_v<T, float>, certifier != nullptr, certificate);
+        field.sampler.search_certificate = certificate_provenance(std::is_same_v<T, float>, certifier != nullptr, certificate);
         if (options_.band_width > 0)
-            field.sampler["band"] = narrow_band_provenance(options_.band_width, count_narrow_band(field), "post-processed");
+            field.sampler.band = narrow_band_provenance(options_.band_width, count_narrow_band(field), "post-processed");
         return field;
     }
 

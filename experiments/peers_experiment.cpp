@@ -200,7 +200,7 @@ public:
                                 {"our_sign_point_sets", sign_mode_name(point_set_sign_)}};
         for (const MeshCase& c : cases_) {
             const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
-            ctx.metrics["meshes"][c.label] = describe_mesh(mesh);
+            ctx.metrics["meshes"][c.label] = describe_prepared_mesh(mesh);
             sign_ = lattice_sign_;
             for (int64_t samples : c.samples) run_lattice_case(ctx, c, mesh, samples);
             sign_ = point_set_sign_;
@@ -321,7 +321,7 @@ private:
             const double cpu = (process_cpu_seconds() - cpu0) / repetitions_;
             if (reference.empty()) reference = f.distance;
             nlohmann::json row = base_row(label, set, mesh, "bvh_cpu", "ours");
-            const double build = f.sampler["bvh"]["build_seconds"].get<double>();
+            const double build = f.sampler.details.at("bvh")["build_seconds"].get<double>();
             set_times(row, build, median_of(query), lattice.num_points());
             row["cpu_seconds"] = cpu;
             row["threads"] = resolve_thread_count(t);
@@ -329,7 +329,7 @@ private:
             set_errors(row, e, true);
             set_check(row, e, true, true, tolerance(mesh));
             row["notes"] = "reference field (exact: equals brute force, tests/cpu_reference/bvh); kernel " +
-                           f.sampler["kernel"].get<std::string>() + ", " + f.sampler["bvh"].dump();
+                           f.sampler.kernel + ", " + f.sampler.details.at("bvh").dump();
             emit(ctx, row);
         }
     }
@@ -446,7 +446,7 @@ private:
         const Errors e = compare(f.distance, reference, {}, true, nullptr, true, tolerance(mesh));
         set_errors(row, e, true);
         set_check(row, e, true, true, tolerance(mesh));
-        row["notes"] = "CUDA-event time of the search and the double finalize; " + f.sampler["device"].value("name", std::string());
+        row["notes"] = "CUDA-event time of the search and the double finalize; " + f.sampler.details.at("device").value("name", std::string());
         emit(ctx, row);
     }
 

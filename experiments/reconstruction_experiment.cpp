@@ -144,7 +144,7 @@ public:
     void run(RunContext& ctx) override {
         std::ostream& log = *ctx.log;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
-        ctx.metrics["mesh"] = describe_mesh(mesh);
+        ctx.metrics["mesh"] = describe_prepared_mesh(mesh);
         ctx.inputs["mesh"] = {{"source", mesh.source()}, {"sha256", mesh.content_sha256()}};
         FieldSource source(ctx, inputs_.sampler);
 
@@ -160,7 +160,7 @@ public:
             nlohmann::json input = {{"label", inputs_.lattice_labels[i]}, {"cache_key", got.cache_key}};
             if (write_fields_) {
                 const std::string file = "fields/" + mesh.name() + "-" + inputs_.lattice_labels[i] + ".json";
-                got.field.mesh = ctx.metrics["mesh"];
+                got.field.mesh = describe_prepared_mesh(mesh);
                 write_field((std::filesystem::path(ctx.output_dir) / file).string(), got.field);
                 input["file"] = file;
             }

@@ -60,16 +60,16 @@ public:
     void run(RunContext& ctx) override {
         std::ostream& log = *ctx.log;
         const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
-        const nlohmann::json mesh_json = describe_mesh(mesh);
-        ctx.metrics["mesh"] = mesh_json;
-        ctx.inputs["mesh"] = mesh_json;
+        const MeshProvenance described = describe_prepared_mesh(mesh);
+        ctx.metrics["mesh"] = described;
+        ctx.inputs["mesh"] = described;
         FieldSource source(ctx, inputs_.sampler);
         const std::string fields_dir = (std::filesystem::path(ctx.output_dir) / "fields").string();
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
             const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
             ObtainedField got = source.get(mesh, lattice, inputs_.lattice_labels[i], log);
             SampledField& field = got.field;
-            field.mesh = mesh_json;
+            field.mesh = described;
             const std::string stem = mesh.name() + "-" + inputs_.lattice_labels[i];
             FieldWriteOptions wo;
             wo.dtype = dtype_;
@@ -130,8 +130,8 @@ private:
                       lattice_type_name(f.lattice.type), lattice_notation(f.lattice).c_str(),
                       with_commas(f.size()).c_str(), with_commas(int64_t(mesh.triangles().size())).c_str(),
                       t.point_triangle_pairs, t.kernel,
-                      (f.sampler.value("backend", std::string("?")) + "/" + f.sampler.value("kernel", std::string("?"))).c_str(),
-                      f.sampler.value("threads", nlohmann::json(0)).dump().c_str(), precision_name(f.precision),
+                      (f.sampler.backend.empty() ? std::string("?/?") : f.sampler.backend + "/" + f.sampler.kernel).c_str(),
+                      f.sampler.details.value("threads", nlohmann::json(0)).dump().c_str(), precision_name(f.precision),
                       got.from_cache ? ", from the cache" : "", t.pairs_per_second(), *lo, *hi, with_commas(inside).c_str());
         log << line;
         nlohmann::json entry = got.describe();

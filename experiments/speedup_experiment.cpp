@@ -112,7 +112,7 @@ public:
     void run(RunContext& ctx) override {
         for (const MeshCase& c : cases_) {
             const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
-            nlohmann::json described = describe_mesh(mesh);
+            nlohmann::json described = describe_prepared_mesh(mesh);
             for (const ThesisMeshCounts& t : kThesisTable31)
                 if (c.label == t.mesh) described["thesis_table_3_1"] = {{"triangles", t.triangles}, {"vertices", t.vertices}};
             ctx.metrics["meshes"][c.label] = described;

@@ -9,24 +9,22 @@ FloatSearchBound float_search_bound(const PreparedMesh& mesh) {
     return float_search_bound(d.vertices, d.triangles, d.packed, mesh.buffers<float>().packed);
 }
 
-nlohmann::json certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters) {
-    nlohmann::json j;
+CertificateReport certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters) {
+    CertificateReport c;
     if (!float_search) {
-        j["certified"] = true;
-        j["note"] = "double search: the reference";
-        return j;
+        c.note = "double search: the reference";
+        return c;
     }
-    j["certified"] = certified;
+    c.certified = certified;
     if (!certified) {
-        j["note"] = "uncertified: the float search's own winner (near-ties may differ from the double search)";
-        return j;
+        c.note = "uncertified: the float search's own winner (near-ties may differ from the double search)";
+        return c;
     }
-    const int64_t n = counters.points.load();
-    j["points"] = n;
-    j["reranked_in_double"] = counters.reranked.load();
-    j["full_double_search"] = counters.full_double.load();
-    j["reranked_fraction"] = n > 0 ? double(counters.reranked.load()) / double(n) : 0.0;
-    return j;
+    c.counted = true;
+    c.points = counters.points.load();
+    c.reranked_in_double = counters.reranked.load();
+    c.full_double_search = counters.full_double.load();
+    return c;
 }
 
 }  // namespace sdf

@@ -47,6 +47,6 @@ inline void record_certificate(SamplingTimings& t, const CertificateCounters& c)
 /// search's (certified) and how many points needed double work; for double runs the search
 /// is the reference itself. `certified` false: a search that keeps its own float winner
 /// (the thesis's kernel, the Eberly kernel).
-nlohmann::json certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters);
+CertificateReport certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters);
 
 }  // namespace sdf

@@ -32,8 +32,13 @@ NarrowBandCounts count_narrow_band(const SampledField& field) {
     return counts;
 }
 
-nlohmann::json narrow_band_provenance(double w, const NarrowBandCounts& counts, const std::string& how) {
-    return {{"width", w}, {"points_in_band", counts.in_band}, {"points_outside", counts.outside}, {"how", how}};
+BandReport narrow_band_provenance(double w, const NarrowBandCounts& counts, const std::string& how) {
+    BandReport b;
+    b.width = w;
+    b.points_in_band = counts.in_band;
+    b.points_outside = counts.outside;
+    b.how = how;
+    return b;
 }
 
 }  // namespace sdf

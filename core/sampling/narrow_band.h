@@ -43,8 +43,8 @@ NarrowBandCounts apply_narrow_band(SampledField& field, double w);
 /// The counts of a banded field, without changing it.
 NarrowBandCounts count_narrow_band(const SampledField& field);
 
-/// The "band" object of a field's sampler provenance: {"width", "points_in_band",
-/// "points_outside", "how"} (how: "bricks skipped by the distance bound" or "post-processed").
-nlohmann::json narrow_band_provenance(double w, const NarrowBandCounts& counts, const std::string& how);
+/// The band of a field's sampler report (SamplerReport::band) of width w with these counts
+/// (how: "bricks skipped by the distance bound" or "post-processed").
+BandReport narrow_band_provenance(double w, const NarrowBandCounts& counts, const std::string& how);
 
 }  // namespace sdf

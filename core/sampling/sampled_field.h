@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/mesh/mesh_provenance.h"
+#include "core/sampling/sampler_report.h"
 #include "kernels/lattice/lattice.h"
 
 namespace sdf {
@@ -41,8 +43,8 @@ struct SampledField {
     std::vector<int32_t> closest_triangle;  ///< 0-based, in the mesh file's face order
     Precision precision = Precision::Float;
     SamplingTimings timings;
-    nlohmann::json sampler;             ///< backend, method, kernel, threads, strategy, device
-    nlohmann::json mesh;                ///< name, source, sha256, counts, report
+    SamplerReport sampler;              ///< how it was sampled (sampler_report.h)
+    MeshProvenance mesh;                ///< the mesh it was sampled from (mesh_provenance.h)
 
     int64_t size() const { return int64_t(distance.size()); }
     void resize(int64_t n) {

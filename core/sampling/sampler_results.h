@@ -64,11 +64,12 @@ void scatter_batch(const Batch& batch, const PreparedMesh& mesh, std::vector<Poi
             points[size_t(batch.output_index[i])] = point_sample(mesh, batch.distance[i], batch.gradient[i], batch.triangle[i]);
 }
 
-/// The provenance every sampler records in SampledField::sampler: "backend", "method",
-/// "kernel", "precision", "points_computed", "sign" (the requested and resolved sign mode
-/// and why: SamplerSign::provenance()), and "bcc_strategy" on a BCC lattice. Each sampler
-/// adds its own keys (threads, plan, bvh, device).
-nlohmann::json sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
+/// The report every sampler records in SampledField::sampler: backend, method, kernel,
+/// precision, points computed, and as details "sign" (the requested and resolved sign mode
+/// and why: SamplerSign::provenance()), "bcc_strategy" on a BCC lattice and "band_width" in a
+/// band. Each sampler adds its band and certificate counts and its own details (threads,
+/// plan, bvh, device).
+SamplerReport sampler_provenance(const std::string& backend, const std::string& method, const std::string& kernel,
                                   const SamplerOptions& options, const Lattice& lattice, int64_t points_computed,
                                   const SamplerSign& sign);
 

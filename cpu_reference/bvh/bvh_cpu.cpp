@@ -485,18 +485,19 @@ private:
         bvh_info["node_visits_per_point"] = computed > 0 ? double(counters.nodes) / double(computed) : 0.0;
         bvh_info["point_triangle_tests_per_point"] = computed > 0 ? double(counters.triangles) / double(computed) : 0.0;
         field.sampler = sampler_provenance("cpu", "bvh", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler["threads"] = resolve_thread_count(options_.threads);
-        field.sampler["bvh"] = bvh_info;
+        field.sampler.details["threads"] = resolve_thread_count(options_.threads);
+        field.sampler.details["bvh"] = bvh_info;
         record_certificate(field.timings, counters.certificate);
-        field.sampler["search_certificate"] =
+        field.sampler.search_certificate =
             certificate_provenance(options_.precision == Precision::Float, true, counters.certificate);
         if (w > 0) {
-            nlohmann::json info = narrow_band_provenance(
+            BandReport info = narrow_band_provenance(
                 w, count_narrow_band(field), band.enabled() ? "bricks skipped by the distance bound" : "post-processed");
-            info["probes"] = band_counters.probes.load();
-            info["bricks_skipped"] = band_counters.bricks_skipped.load();
-            info["points_skipped"] = band_counters.points_skipped.load();
-            field.sampler["band"] = info;
+            info.counts_skips = true;
+            info.probes = band_counters.probes.load();
+            info.bricks_skipped = band_counters.bricks_skipped.load();
+            info.points_skipped = band_counters.points_skipped.load();
+            field.sampler.band = info;
         }
         return field;
     }

@@ -160,12 +160,12 @@ private:
         field.timings.kernel = seconds;
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler["threads"] = resolve_thread_count(options_.threads);
+        field.sampler.details["threads"] = resolve_thread_count(options_.threads);
         record_certificate(field.timings, counters);
-        field.sampler["search_certificate"] =
+        field.sampler.search_certificate =
             certificate_provenance(options_.precision == Precision::Float, kernel_ == CpuKernel::Vectorized, counters);
         if (options_.band_width > 0)  // brute force tests every pair anyway: the band by post-processing
-            field.sampler["band"] =
+            field.sampler.band =
                 narrow_band_provenance(options_.band_width, apply_narrow_band(field, options_.band_width), "post-processed");
         return field;
     }

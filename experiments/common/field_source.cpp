@@ -61,7 +61,7 @@ ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice,
     if (cache_) {
         if (std::optional<SampledField> f = cache_->load(key)) {
             log << "  " << what << ": from the cache (" << out.cache_key.substr(0, 12) << ")\n";
-            const std::string sign_warning = auto_sign_warning(f->sampler, mesh);
+            const std::string sign_warning = auto_sign_warning(f->sampler.details, mesh);
             if (!sign_warning.empty()) std::cerr << "warning: " << sign_warning << "\n";
             out.field = std::move(*f);
             out.from_cache = true;
@@ -80,7 +80,7 @@ ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice,
                   out.field.timings.pairs_per_second());
     log << line;
     if (cache_) {
-        out.field.mesh = describe_mesh(mesh);
+        out.field.mesh = describe_prepared_mesh(mesh);
         const bool stored = cache_->store(key, out.field);
         log << (stored ? "; cached as " : "; already cached as ") << out.cache_key.substr(0, 12);
     }

@@ -52,32 +52,6 @@ StudyInputs read_study_inputs(JsonReader& config, const RunContext& context, boo
     return in;
 }
 
-nlohmann::json describe_mesh(const PreparedMesh& m) {
-    const MeshReport& r = m.report();
-    return {{"name", m.name()},
-            {"source", m.source()},
-            {"sha256", m.content_sha256()},
-            {"vertices", m.vertices().size()},
-            {"triangles", m.triangles().size()},
-            {"bounds", {{"min", {m.bounds().min.x, m.bounds().min.y, m.bounds().min.z}},
-                        {"max", {m.bounds().max.x, m.bounds().max.y, m.bounds().max.z}}}},
-            {"report", {{"input_vertices", r.input_vertices},
-                        {"input_triangles", r.input_triangles},
-                        {"welded_vertices", r.welded_vertices},
-                        {"degenerate_triangles", r.degenerate_triangles},
-                        {"polygons", r.polygons.polygons},
-                        {"non_planar_polygons", r.polygons.non_planar},
-                        {"max_polygon_non_planarity", r.polygons.max_non_planarity},
-                        {"non_simple_polygons", r.polygons.not_simple},
-                        {"boundary_edges", r.boundary_edges},
-                        {"nonmanifold_edges", r.nonmanifold_edges},
-                        {"inconsistent_edges", r.inconsistent_edges},
-                        {"components", r.components},
-                        {"signed_volume", r.signed_volume},
-                        {"flipped", r.flipped},
-                        {"sign_reliable", r.sign_reliable()}}}};
-}
-
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log) {
     const PreparedMesh mesh = [&] {
         try {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/mesh/mesh_provenance.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/sampler.h"
 #include "harness/experiment/experiment.h"
@@ -48,8 +49,7 @@ void require_backend(const SamplerOptions& options, const JsonReader& config, co
 /// Loads (or generates) and prepares the mesh; prints its summary and warnings to `log`.
 PreparedMesh load_prepared_mesh(const StudyInputs& inputs, std::ostream& log);
 
-/// Name, source, hash, counts and preparation report, for headers and manifests.
-nlohmann::json describe_mesh(const PreparedMesh& mesh);
+// The mesh's record in headers and manifests: describe_prepared_mesh (core/mesh/mesh_provenance.h).
 
 /// "512,000"
 std::string with_commas(int64_t v);

@@ -235,10 +235,8 @@ void require_representable_band(double w, FieldDtype dtype, const std::string& w
 }
 
 void require_storable(const SampledField& field, const FieldWriteOptions& options, const std::string& header_path) {
-    const nlohmann::json& s = field.sampler;
-    if (s.is_object() && s.contains("band") && s["band"].is_object() && s["band"].contains("width") &&
-        s["band"]["width"].is_number())
-        require_representable_band(s["band"]["width"].get<double>(), options.dtype, header_path + ": the narrow band width");
+    if (field.sampler.band)
+        require_representable_band(field.sampler.band->width, options.dtype, header_path + ": the narrow band width");
 }
 
 SampledField read_field(const std::string& header_path) {
@@ -267,9 +265,13 @@ SampledField read_field(const std::string& header_path) {
         field.closest_triangle = convert_all<int32_t>(tri.data(), tri.size());
     }
     if (r.has("precision")) field.precision = r.raw("precision") == "double" ? Precision::Double : Precision::Float;
-    if (r.has("mesh")) field.mesh = r.raw("mesh");
-    if (r.has("sampler")) field.sampler = r.raw("sampler");
-    // Provenance keys are free-form; other channels are allowed and ignored.
+    try {  // the typed records (mesh_provenance.h, sampler_report.h)
+        if (r.has("mesh")) field.mesh = r.raw("mesh").get<MeshProvenance>();
+        if (r.has("sampler")) field.sampler = r.raw("sampler").get<SamplerReport>();
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(header_path + ": " + e.what());
+    }
+    // Other provenance keys are free-form; other channels are allowed and ignored.
     return field;
 }
 

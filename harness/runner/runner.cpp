@@ -203,6 +203,22 @@ nlohmann::json make_manifest(const LoadedConfig& config, const std::vector<Plann
     return manifest;
 }
 
+/// Runs run i of the plan (one sweep point) into `staging`, as part of the run named `run_id`
+/// ("<name>/<run-id>"): a sweep's runs each in their own subdirectory, announced on `log`.
+/// The one per-run step of both ways to run a plan: all runs here, or this rank's share.
+void run_one(std::vector<PlannedRun>& runs, size_t i, const std::string& staging, const std::string& run_id,
+             std::ostream& log) {
+    const bool sweep = runs.size() > 1;
+    RunContext& ctx = runs[i].context;
+    ctx.output_dir = sweep ? (fs::path(staging) / runs[i].point.name).string() : staging;
+    ctx.run_id = run_id + (sweep ? "/" + runs[i].point.name : "");
+    ctx.log = &log;
+    if (sweep)
+        log << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump()
+            << std::endl;
+    runs[i].experiment->run(ctx);
+}
+
 /// Sends the root's staging directory to the workers of a run distributed by runs, or ""
 /// when the root failed before it had one (the workers then stop).
 class StagingAnnouncement {
@@ -237,15 +253,10 @@ nlohmann::json run_my_share(std::vector<PlannedRun>& runs, const std::string& st
                                      " is not visible here: --distribute runs needs a file system shared by every rank");
         for (size_t i = 0; i < runs.size(); ++i) {
             if (int(i % size_t(distributed_size())) != distributed_rank()) continue;
-            RunContext& ctx = runs[i].context;
-            ctx.output_dir = runs.size() == 1 ? staging : (fs::path(staging) / runs[i].point.name).string();
-            ctx.run_id = run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
-            ctx.log = &log;
-            log << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump()
-                << std::endl;
             const auto start = std::chrono::steady_clock::now();
             fail_here_if_asked();
-            runs[i].experiment->run(ctx);
+            run_one(runs, i, staging, run_id, log);
+            const RunContext& ctx = runs[i].context;
             mine["runs"].push_back({{"index", i},
                                     {"metrics", ctx.metrics},
                                     {"inputs", ctx.inputs},
@@ -345,14 +356,7 @@ int run_experiment(const RunnerOptions& options) {
         announcement.send(out.path() + "\n" + name + "/" + run_id);
         ran_by = collect_shares(runs, gather_to_root(run_my_share(runs, out.path(), name + "/" + run_id, std::cout)));
     } else {
-        for (size_t i = 0; i < runs.size(); ++i) {
-            RunContext& ctx = runs[i].context;
-            ctx.output_dir = runs.size() == 1 ? out.path() : (fs::path(out.path()) / runs[i].point.name).string();
-            ctx.run_id = name + "/" + run_id + (runs.size() == 1 ? "" : "/" + runs[i].point.name);
-            if (runs.size() > 1)
-                std::cout << "[" << i + 1 << "/" << runs.size() << "] " << runs[i].point.name << " " << runs[i].point.parameters.dump() << std::endl;
-            runs[i].experiment->run(ctx);
-        }
+        for (size_t i = 0; i < runs.size(); ++i) run_one(runs, i, out.path(), name + "/" + run_id, std::cout);
     }
 
     const nlohmann::json metrics = combined_metrics(runs);

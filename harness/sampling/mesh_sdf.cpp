@@ -92,7 +92,7 @@ SampledField MeshSdf::sample(const Lattice& lattice) const {
     SampledField field = sampler_->sample(*mesh_, lattice);
     if (unsigned_distance_) {
         make_unsigned(field);
-        field.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", sign_reason_}};
+        field.sampler.details["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", sign_reason_}};
     }
     return field;
 }

@@ -146,20 +146,6 @@ struct TemporaryFile {
     std::string path;
 };
 
-/// The merged sampler provenance of the slabs: the first slab's, with the counts summed.
-void merge_slab_provenance(nlohmann::json& merged, const nlohmann::json& slab) {
-    if (merged.is_null()) {
-        merged = slab;
-        return;
-    }
-    if (merged.contains("points_computed") && slab.contains("points_computed"))
-        merged["points_computed"] = merged["points_computed"].get<int64_t>() + slab["points_computed"].get<int64_t>();
-    if (merged.contains("band") && slab.contains("band"))
-        for (const char* key : {"probes", "bricks_skipped", "points_skipped"})
-            if (merged["band"].contains(key) && slab["band"].contains(key))
-                merged["band"][key] = merged["band"][key].get<int64_t>() + slab["band"][key].get<int64_t>();
-}
-
 /// The stored bytes the plan's channel files hold, for samplers that produce them
 /// (Sampler::sample_slab_stored).
 StoredLayout stored_layout_of(const StreamPlan& plan, const StreamOptions& options) {
@@ -254,7 +240,7 @@ StreamPlan plan_streamed_sampling(const Lattice& lattice, const StreamOptions& o
 }
 
 StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
-                             const Lattice& lattice, const StreamOptions& options, const nlohmann::json& mesh_provenance) {
+                             const Lattice& lattice, const StreamOptions& options, const MeshProvenance& mesh_provenance) {
     const auto start = Clock::now();
     const double w = sampler_options.band_width;
     require_band_width(w, "band width");
@@ -287,7 +273,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     const std::optional<StoredLayout> stored_layout =
         vdb ? std::nullopt : std::optional<StoredLayout>(stored_layout_of(plan, options));
     auto account = [&](const SampledField& info) {
-        merge_slab_provenance(header.sampler, info.sampler);
+        header.sampler.merge(info.sampler);  // the counters of every slab
         header.timings.kernel += info.timings.kernel;
         header.timings.upload += info.timings.upload;
         header.timings.download += info.timings.download;
@@ -354,7 +340,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
             const NarrowBandCounts c = apply_narrow_band(*field, w);
             result.band.in_band += c.in_band;
             result.band.outside += c.outside;
-            if (!field->sampler.contains("band")) field->sampler["band"] = narrow_band_provenance(w, c, "post-processed by sdf-sample");
+            if (!field->sampler.band) field->sampler.band = narrow_band_provenance(w, c, "post-processed by sdf-sample");
         }
         fault_point("sampled slab " + std::to_string(s + 1) + " of " + std::to_string(slabs.size()));
         account(*field);
@@ -387,10 +373,6 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
     result.seconds = seconds_since(start);
     result.peak_resident_bytes = peak_resident_bytes();
     header.timings.total = result.seconds;
-    if (w > 0) {
-        header.sampler["band"]["points_in_band"] = result.band.in_band;
-        header.sampler["band"]["points_outside"] = result.band.outside;
-    }
     nlohmann::json streaming = plan.to_json();
     streaming["seconds"] = result.seconds;
     streaming["write_wait_seconds"] = result.write_wait_seconds;
@@ -399,7 +381,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         streaming["vdb"] = {{"file", fs::path(options.vdb_path).filename().string()},
                             {"band", options.vdb_band},
                             {"active_points", result.vdb_active_points}};
-    header.sampler["streaming"] = streaming;
+    header.sampler.details["streaming"] = streaming;
     replacement.commit(header);  // the commit point: the header names the new channels
     if (vdb) {
         fault_point("rename " + vdb_file.path + " to " + options.vdb_path);

@@ -104,6 +104,6 @@ struct StreamResult {
 /// a sampler's own band alone). Refuses existing targets first unless overwriting, and a band
 /// the output's dtype cannot hold (require_representable_band).
 StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
-                             const Lattice& lattice, const StreamOptions& options, const nlohmann::json& mesh_provenance);
+                             const Lattice& lattice, const StreamOptions& options, const MeshProvenance& mesh_provenance);
 
 }  // namespace sdf

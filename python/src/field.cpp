@@ -168,14 +168,7 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
 }
 
 Field field_for_mesh(SampledField field, const PreparedMesh& mesh) {
-    const MeshReport& r = mesh.report();
-    field.mesh = {{"name", mesh.name()},
-                  {"source", mesh.source()},
-                  {"sha256", mesh.content_sha256()},
-                  {"vertices", mesh.vertices().size()},
-                  {"triangles", mesh.triangles().size()},
-                  {"components", r.components},
-                  {"sign_reliable", r.sign_reliable()}};
+    field.mesh = describe_prepared_mesh(mesh);
     return Field(std::move(field));
 }
 
@@ -311,8 +304,7 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
         }
     }
     f.precision = Precision::Double;
-    f.sampler = {{"source", "arrays"}};
-    f.mesh = nlohmann::json::object();
+    f.sampler.details = {{"source", "arrays"}};
     return Field(std::move(f));
 }
 
@@ -320,7 +312,7 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
 /// the pseudonormal sign, whose magnitudes are every mode's), the sign recorded as asked.
 void make_field_unsigned(SampledField& field) {
     make_unsigned(field);
-    field.sampler["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
+    field.sampler.details["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", "unsigned distance requested"}};
 }
 
 /// sample()'s own arguments; every other keyword is the sampler's (read_sampler_keywords).
@@ -427,9 +419,9 @@ sampled one.)")
         .def_property_readonly("triangle", &Field::triangle, "Closest triangle per point, int32; None when absent.")
         .def_property_readonly("precision", [](const Field& f) { return precision_name(f.field().precision); },
                                "The search precision it was sampled with.")
-        .def_property_readonly("sampler", [](const Field& f) { return json_to_python(f.field().sampler); },
+        .def_property_readonly("sampler", [](const Field& f) { return json_to_python(nlohmann::json(f.field().sampler)); },
                                "How it was sampled (backend, method, kernel, threads, sign, ...), as recorded in field files.")
-        .def_property_readonly("mesh", [](const Field& f) { return json_to_python(f.field().mesh); }, "The mesh it was sampled from (dict).")
+        .def_property_readonly("mesh", [](const Field& f) { return json_to_python(nlohmann::json(f.field().mesh)); }, "The mesh it was sampled from (dict).")
         .def_property_readonly("seconds", [](const Field& f) { return f.field().timings.total; }, "Sampling wall time, seconds.")
         .def("write", &Field::write, py::arg("path"), py::arg("dtype") = "float32", py::arg("overwrite") = false,
              py::arg("closest_triangle") = true,

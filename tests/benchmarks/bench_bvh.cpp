@@ -67,9 +67,9 @@ void set_counters(benchmark::State& state, const PreparedMesh& mesh, const Latti
         state.counters["reranked"] = double(f.timings.reranked_points) / double(f.timings.certified_points);
         state.counters["full_dbl"] = double(f.timings.full_double_points) / double(f.timings.certified_points);
     }
-    if (f.sampler.contains("bvh") && f.sampler["bvh"].contains("node_visits_per_point")) {
-        state.counters["nodes/pt"] = f.sampler["bvh"]["node_visits_per_point"].get<double>();
-        state.counters["tris/pt"] = f.sampler["bvh"]["point_triangle_tests_per_point"].get<double>();
+    if (f.sampler.details.contains("bvh") && f.sampler.details.at("bvh").contains("node_visits_per_point")) {
+        state.counters["nodes/pt"] = f.sampler.details.at("bvh")["node_visits_per_point"].get<double>();
+        state.counters["tris/pt"] = f.sampler.details.at("bvh")["point_triangle_tests_per_point"].get<double>();
     }
 }
 
@@ -238,8 +238,8 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
-    if (f.sampler.contains("candidates"))
-        state.counters["candidate_triangles"] = f.sampler["candidates"]["mean_candidate_triangles"].get<double>();
+    if (f.sampler.details.contains("candidates"))
+        state.counters["candidate_triangles"] = f.sampler.details.at("candidates")["mean_candidate_triangles"].get<double>();
 }
 
 /// Arbitrary points (issue 14): uniform in the mesh's box (kind 0) or Gaussian around

@@ -61,10 +61,10 @@ void BM_CpuBvhBand(benchmark::State& state) {
     }
     const double points = double(lattice.num_points());
     state.counters["points/s"] = benchmark::Counter(points * double(state.iterations()), benchmark::Counter::kIsRate);
-    state.counters["computed"] = f.sampler["points_computed"].get<double>() / points;
-    if (f.sampler.contains("band")) {
-        state.counters["in_band"] = f.sampler["band"]["points_in_band"].get<double>() / points;
-        state.counters["probes"] = f.sampler["band"]["probes"].get<double>() / points;
+    state.counters["computed"] = double(f.sampler.points_computed) / points;
+    if (f.sampler.band.has_value()) {
+        state.counters["in_band"] = double(f.sampler.band->points_in_band) / points;
+        state.counters["probes"] = double(f.sampler.band->probes) / points;
     }
     state.counters["threads"] = double(resolve_thread_count(0));
 }

@@ -5,6 +5,11 @@
 #       one process and by 1, 2 and 3 ranks: every field file's bytes must be equal, and the
 #       manifest must record the ranks and that every rank wrote its own slab's bytes of every
 #       channel file (MPI-IO), and nothing more.
+#   mpi_runs.sh narrow_band RUN_EXPERIMENT MPIEXEC
+#       a narrow band (sampler band_width) sampled by one process and by 3 ranks: the same
+#       field files byte for byte and the same counters in the field's sampler report (the
+#       band's points in and outside it, the points computed and searched), every rank's
+#       merged (SamplerReport::merge), not rank 0's.
 #   mpi_runs.sh ci_smoke RUN_EXPERIMENT MPIEXEC
 #       the CI smoke reconstruction study (configs/ci_smoke.json) on 2 ranks passes its
 #       baseline check: the root's reconstructions and metrics work on distributed fields.
@@ -115,6 +120,53 @@ PY
     same_fields "--distribute runs" "$dist"
     grep -q '"mode": "runs"' "$dist/manifest.json" || fail "--distribute runs: the manifest does not say so"
     echo "--distribute runs: the same results tree and channel files"
+    exit 0
+fi
+
+if [ "$case_name" = narrow_band ]; then
+    # Brute force bands by post-processing; the BVH skips bricks outside the band (its skip
+    # counters depend on the bricks, which a slab cuts, so they are checked for consistency).
+    sed 's/"progress": false}/"progress": false, "band_width": 0.12}/' "$work/mpi_fields.json" > "$work/band.json"
+    grep -q '"band_width": 0.12' "$work/band.json" || fail "no band in the config"
+    "$tool" "$work/band.json" --no-cache --quiet --output-root "$work/serial" > "$work/serial.log"
+    mpi 3 "$tool" "$work/band.json" --no-cache --quiet --output-root "$work/np3" > "$work/np3.log" 2>&1 ||
+        { cat "$work/np3.log"; fail "mpirun -np 3 with a narrow band failed"; }
+    serial=$(run_dir "$work/serial") dist=$(run_dir "$work/np3")
+    (cd "$serial" && find . -name '*.raw' | sort) > "$work/serial.files"
+    [ "$(wc -l < "$work/serial.files")" -eq 12 ] || fail "expected 12 channel files"
+    while read -r f; do
+        cmp "$serial/$f" "$dist/$f" || fail "narrow band, np 3: $f differs from the single process's"
+    done < "$work/serial.files"
+    python3 - "$serial" "$dist" <<'PY' || fail "narrow band, np 3: the sampler reports differ from the single process's"
+import json, os, sys
+def fields(run):  # field name -> (its sampler report, its lattice's points)
+    metrics = json.load(open(os.path.join(run, "metrics.json")))
+    return {p["name"] + "/" + f["name"]: (f["sampler"], f["lattice"]["points"])
+            for p in metrics["points"] for f in p["metrics"]["fields"]}
+one, three = fields(sys.argv[1]), fields(sys.argv[2])
+assert sorted(one) == sorted(three) and len(one) == 4, (sorted(one), sorted(three))
+for name, (s1, points) in sorted(one.items()):
+    s3 = three[name][0]
+    b1, b3 = s1["band"], s3["band"]
+    assert b1["points_in_band"] + b1["points_outside"] == points, (name, b1)
+    assert b1["points_outside"] > 0 and b1["points_in_band"] > 0, (name, b1)
+    for key in ("width", "points_in_band", "points_outside", "how"):
+        assert b1[key] == b3[key], (name, key, b1, b3)
+    slabs = s3["distributed"]["slabs"]
+    assert len(slabs) == 3 and sum(s["points_computed"] for s in slabs) == s3["points_computed"], (name, slabs)
+    c1, c3 = s1["search_certificate"], s3["search_certificate"]
+    if "probes" in b1:  # the BVH's brick skip: every point computed or skipped, on every rank
+        assert s1["points_computed"] + b1["points_skipped"] == points, (name, s1)
+        assert s3["points_computed"] + b3["points_skipped"] == points, (name, s3)
+        assert c3["points"] == s3["points_computed"] and c1["points"] == s1["points_computed"], (name, c1, c3)
+    else:  # brute force computes every point: the counters are the single process's
+        assert s1["points_computed"] == s3["points_computed"] == points, (name, s1, s3)
+        for key in ("points", "reranked_in_double", "full_double_search"):
+            assert c1[key] == c3[key], (name, key, c1, c3)
+    print(f"{name}: {b1['points_in_band']} of {points} points in the band on 1 and 3 ranks; "
+          f"computed {s1['points_computed']} and {s3['points_computed']}")
+PY
+    echo "narrow band, np 3: 12 channel files identical to the single process's, the same band counters"
     exit 0
 fi
 

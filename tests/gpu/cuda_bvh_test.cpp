@@ -58,7 +58,7 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
                         cmp.fields(cpu, gpu, what);
                         if (HasFatalFailure()) return;
                         print(what, cmp.agreement(), gpu);
-                        EXPECT_EQ(gpu.sampler["method"], "bvh");
+                        EXPECT_EQ(gpu.sampler.method, "bvh");
                     }
             }
         }
@@ -72,7 +72,7 @@ TEST(CudaBvh, SlabsDoNotChangeTheResult) {
     const SampledField whole = make_sampler(o)->sample(mesh, lattice);
     o.max_points_per_piece = 1000;  // a few z-layers per slab
     const SampledField split = make_sampler(o)->sample(mesh, lattice);
-    EXPECT_GT(split.sampler["plan"]["pieces"].get<int>(), 2);
+    EXPECT_GT(split.sampler.details.at("plan")["pieces"].get<int>(), 2);
     EXPECT_EQ(whole.distance, split.distance);
     EXPECT_EQ(whole.closest_triangle, split.closest_triangle);
 }
@@ -148,13 +148,13 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
                             ASSERT_EQ(band.closest_triangle, expected.closest_triangle) << what;
                             for (int64_t i = 0; i < band.size(); ++i)
                                 ASSERT_TRUE(band.gradient[size_t(i)] == expected.gradient[size_t(i)]) << what << " point " << i;
-                            EXPECT_EQ(band.sampler["band_width"].get<double>(), w);
+                            EXPECT_EQ(band.sampler.details.at("band_width").get<double>(), w);
                             int64_t in_band = 0;
                             for (int32_t t : band.closest_triangle) in_band += t != kOutsideBandTriangle;
                             EXPECT_GT(in_band, 0) << what;
                             EXPECT_LT(in_band, band.size()) << what;
                             if (std::string(kernel) == "candidates") {
-                                const auto& c = band.sampler["candidates"];
+                                const auto& c = band.sampler.details.at("candidates");
                                 std::printf("%-60s bricks searched %lld, outside the band %lld\n", what.c_str(),
                                             (long long)c["bricks_searched"].get<int64_t>(),
                                             (long long)c["bricks_outside_band"].get<int64_t>());
@@ -178,8 +178,8 @@ TEST(CudaBvh, RepeatedCallsReuseTheUploadedBvh) {
     auto sampler = make_sampler(options("cuda", "bvh", Precision::Float));
     const SampledField first = sampler->sample(mesh, lattice);
     const SampledField second = sampler->sample(mesh, lattice);
-    EXPECT_TRUE(first.sampler["bvh"]["uploaded_by_this_call"].get<bool>());
-    EXPECT_FALSE(second.sampler["bvh"]["uploaded_by_this_call"].get<bool>());
+    EXPECT_TRUE(first.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
+    EXPECT_FALSE(second.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
     EXPECT_EQ(first.distance, second.distance);
 }
 
@@ -258,7 +258,7 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             for (size_t i = 0; i < got.distance.size(); ++i)
                 bad += !(got.closest_triangle[i] == want_field.closest_triangle[i] && same(got.distance[i], want_field.distance[i]));
             EXPECT_EQ(bad, 0) << c.mesh.name << " lattice " << kernel;
-            EXPECT_EQ(got.sampler["search_certificate"]["certified"], true) << kernel;
+            EXPECT_EQ(got.sampler.search_certificate->certified, true) << kernel;
         }
     }
 }

@@ -154,8 +154,8 @@ TEST(CudaSampler, SplittingLatticesAndMeshesDoesNotChangeTheResult) {
         o.max_points_per_piece = 1000;       // many pieces (thesis: one 32^3 region per piece)
         o.max_triangles_per_chunk = 700;     // several triangle chunks per piece
         const SampledField split = make_sampler(o)->sample(mesh, lattice);
-        EXPECT_GT(split.sampler["plan"]["pieces"].get<int>(), 1) << kernel;
-        EXPECT_GT(split.sampler["plan"]["triangle_chunks"].get<int>(), 1) << kernel;
+        EXPECT_GT(split.sampler.details.at("plan")["pieces"].get<int>(), 1) << kernel;
+        EXPECT_GT(split.sampler.details.at("plan")["triangle_chunks"].get<int>(), 1) << kernel;
         EXPECT_EQ(whole.distance, split.distance) << kernel;
         EXPECT_EQ(whole.closest_triangle, split.closest_triangle) << kernel;
     }
@@ -249,7 +249,7 @@ TEST(CudaSampler, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             for (size_t i = 0; i < got.distance.size(); ++i)
                 bad += !(got.closest_triangle[i] == want_field.closest_triangle[i] && same(got.distance[i], want_field.distance[i]));
             EXPECT_EQ(bad, 0) << "cube lattice " << kernel;
-            EXPECT_EQ(got.sampler["search_certificate"]["certified"], true) << kernel;
+            EXPECT_EQ(got.sampler.search_certificate->certified, true) << kernel;
         }
     }
 }

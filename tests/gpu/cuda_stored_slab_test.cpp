@@ -64,14 +64,14 @@ TEST(CudaStoredSlab, EqualsTheWrittenBytesOfSampleSlab) {
                             const std::optional<StoredSlab> stored = sampler->sample_slab_stored(mesh, lattice, slab, layout);
                             ASSERT_TRUE(stored.has_value()) << what;
                             ASSERT_EQ(stored->points, field.size()) << what;
-                            EXPECT_EQ(stored->info.sampler["stored_on_device"], true) << what;
-                            EXPECT_EQ(stored->info.sampler["points_computed"], field.sampler["points_computed"]) << what;
+                            EXPECT_EQ(stored->info.sampler.details.at("stored_on_device"), true) << what;
+                            EXPECT_EQ(stored->info.sampler.points_computed, field.sampler.points_computed) << what;
                             if (band > 0) {
                                 const NarrowBandCounts counts = count_narrow_band(field);
                                 EXPECT_EQ(stored->band.outside, counts.outside) << what;
                                 EXPECT_EQ(stored->band.in_band, counts.in_band) << what;
                                 EXPECT_GT(counts.outside, 0) << what;
-                                EXPECT_EQ(stored->info.sampler["band"], field.sampler["band"]) << what;
+                                EXPECT_EQ(nlohmann::json(stored->info.sampler).at("band"), nlohmann::json(field.sampler).at("band")) << what;
                             }
                             for (const FieldChannelFile& c : channels_of(layout)) {
                                 const std::vector<char> truth = field_channel_bytes(field, c, 0, size_t(field.size()));

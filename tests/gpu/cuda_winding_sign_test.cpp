@@ -67,7 +67,7 @@ TEST(CudaWindingSign, EqualsTheCpuSignWhereTheBoundDecides) {
     for (const NamedMesh& m : meshes()) {
         const Lattice lattice = fit_lattice(LatticeType::BCC, m.resolution, m.mesh.bounds(), 0.1);
         const SampledField cpu = make_sampler(options("cpu", "bvh", "", SignMode::Auto))->sample(m.mesh, lattice);
-        ASSERT_EQ(cpu.sampler.at("sign").at("mode"), "winding") << m.name;
+        ASSERT_EQ(cpu.sampler.details.at("sign").at("mode"), "winding") << m.name;
         const SampledField pseudonormal =
             make_sampler(options("cpu", "bvh", "", SignMode::Pseudonormal))->sample(m.mesh, lattice);
         // The bound at each point, from the CPU's fast evaluation at the samplers' accuracy.
@@ -92,7 +92,7 @@ TEST(CudaWindingSign, EqualsTheCpuSignWhereTheBoundDecides) {
         for (const auto& [method, kernel] : gpu_samplers) {
             const SampledField gpu = make_sampler(options("cuda", method, kernel, SignMode::Auto))->sample(m.mesh, lattice);
             const std::string what = m.name + " cuda/" + method + "/" + kernel;
-            EXPECT_EQ(gpu.sampler.at("sign").at("mode"), "winding") << what;
+            EXPECT_EQ(gpu.sampler.details.at("sign").at("mode"), "winding") << what;
             int64_t checked = 0, undecided_differ = 0;
             for (int64_t i = 0; i < lattice.num_points(); ++i) {
                 const size_t k = size_t(i);

@@ -37,7 +37,7 @@ namespace fs = std::filesystem;
 std::string fingerprint(const std::string& header) {
     try {
         const SampledField f = read_field(header);
-        std::string bytes = f.mesh.dump() + lattice_to_json(f.lattice).dump();
+        std::string bytes = nlohmann::json(f.mesh).dump() + lattice_to_json(f.lattice).dump();
         bytes.append(reinterpret_cast<const char*>(f.distance.data()), f.distance.size() * sizeof(double));
         bytes.append(reinterpret_cast<const char*>(f.gradient.data()), f.gradient.size() * sizeof(Vec3d));
         bytes.append(reinterpret_cast<const char*>(f.closest_triangle.data()), f.closest_triangle.size() * sizeof(int32_t));

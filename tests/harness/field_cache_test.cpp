@@ -50,7 +50,11 @@ SampledField field(const Lattice& l) {
     f.timings.total = 1.5;
     f.timings.kernel = 1.25;
     f.timings.point_triangle_pairs = 1e6;
-    f.sampler = {{"backend", "cpu"}, {"kernel", "vectorized"}, {"threads", 2}};
+    f.sampler.backend = "cpu";
+    f.sampler.method = "brute_force";
+    f.sampler.kernel = "vectorized";
+    f.sampler.precision = "float";
+    f.sampler.details["threads"] = 2;
     return f;
 }
 

@@ -305,6 +305,18 @@ TEST_F(FuzzReaders, FieldHeaders) {
         f.distance.push_back(double(i) * 0.25 - 3);
         f.gradient.push_back({1, 0, 0});
     }
+    // The typed records (sampler_report.h, mesh_provenance.h), so mutations reach their readers.
+    f.sampler.backend = "cpu";
+    f.sampler.method = "bvh";
+    f.sampler.kernel = "brick";
+    f.sampler.precision = "float";
+    f.sampler.points_computed = 20;
+    f.sampler.band = BandReport{0.5, 20, 7, "bricks skipped by the distance bound", true, 3, 1, 7};
+    f.sampler.search_certificate = CertificateReport{true, "", true, 20, 2, 0};
+    f.mesh.name = "fuzz";
+    f.mesh.sha256 = "00ff";
+    f.mesh.has_bounds = true;
+    f.mesh.report = {{"components", 1}};
     FieldWriteOptions o;
     write_field(at("f.json"), f, o);
     const std::string seed = test::read_text(at("f.json"));

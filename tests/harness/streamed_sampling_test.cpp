@@ -127,7 +127,7 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
                         const SamplerOptions options = sampler_options(band);
                         std::unique_ptr<Sampler> sampler = make_cpu_bvh_sampler(options);
                         if (stored_slabs) sampler = std::make_unique<StoringSampler>(std::move(sampler), band);
-                        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {{"name", "torus"}});
+                        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, describe_prepared_mesh(mesh));
                         EXPECT_GE(r.plan.slabs, 4) << what;
                         if (stored_slabs) {
                             EXPECT_EQ(static_cast<StoringSampler&>(*sampler).stored_slabs, r.plan.slabs) << what;

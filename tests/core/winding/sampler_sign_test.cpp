@@ -102,7 +102,7 @@ TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
         EXPECT_NE(warning.find("warning: sign auto"), std::string::npos) << b.name << ": " << warning;
         EXPECT_NE(warning.find("3 shells"), std::string::npos) << b.name << ": " << warning;
         EXPECT_NE(warning.find("winding number"), std::string::npos) << b.name << ": " << warning;
-        const nlohmann::json& sign = winding.sampler.at("sign");
+        const nlohmann::json& sign = winding.sampler.details.at("sign");
         EXPECT_EQ(sign.at("requested"), "auto") << b.name;
         EXPECT_EQ(sign.at("mode"), "winding") << b.name;
         EXPECT_NE(sign.at("reason").get<std::string>().find("3 shells"), std::string::npos) << b.name;
@@ -113,7 +113,7 @@ TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
         const std::string quiet =
             captured_cerr([&] { pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice); });
         EXPECT_EQ(quiet.find("warning"), std::string::npos) << b.name << ": " << quiet;
-        EXPECT_EQ(pseudonormal.sampler.at("sign").at("mode"), "pseudonormal");
+        EXPECT_EQ(pseudonormal.sampler.details.at("sign").at("mode"), "pseudonormal");
         EXPECT_EQ(auto_sign_warning(pseudonormal.sampler, mesh), "");
         EXPECT_EQ(auto_sign_warning(nlohmann::json::object(), mesh), "");  // a field sampled before sign modes
 
@@ -167,11 +167,11 @@ TEST(SamplerSign, ClosedSingleShellMeshKeepsThePseudonormalSign) {
         SampledField automatic, pseudonormal, winding;
         const std::string log = captured_cerr([&] { automatic = b.make(options(SignMode::Auto))->sample(mesh, lattice); });
         EXPECT_EQ(log.find("warning"), std::string::npos) << b.name << ": " << log;
-        EXPECT_EQ(automatic.sampler.at("sign").at("mode"), "pseudonormal") << b.name;
-        EXPECT_FALSE(automatic.sampler.at("sign").contains("winding")) << b.name;
+        EXPECT_EQ(automatic.sampler.details.at("sign").at("mode"), "pseudonormal") << b.name;
+        EXPECT_FALSE(automatic.sampler.details.at("sign").contains("winding")) << b.name;
         pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice);
         winding = b.make(options(SignMode::Winding))->sample(mesh, lattice);
-        EXPECT_EQ(winding.sampler.at("sign").at("reason"), "winding requested") << b.name;
+        EXPECT_EQ(winding.sampler.details.at("sign").at("reason"), "winding requested") << b.name;
         int judged = 0;
         for (int64_t i = 0; i < lattice.num_points(); ++i) {
             const size_t k = size_t(i);

@@ -57,7 +57,7 @@ TEST(CpuBvh, EqualsBruteForceOnLatticesOfEveryMesh) {
                 cmp.fields(brute, bvh, what);
                 if (HasFatalFailure()) return;
                 print(what, cmp.agreement(), m.mesh);
-                EXPECT_EQ(bvh.sampler["method"], "bvh");
+                EXPECT_EQ(bvh.sampler.method, "bvh");
             }
         }
     }
@@ -154,7 +154,7 @@ TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
     cmp.fields(two, doubled, "soccer ball BCC strategies");
 }
 
-double work_seeded_or_zero(const SampledField& f) { return f.sampler["bvh"]["node_visits_per_point"].get<double>(); }
+double work_seeded_or_zero(const SampledField& f) { return f.sampler.details.at("bvh")["node_visits_per_point"].get<double>(); }
 
 TEST(CpuBvh, BrickSeededAndUnseededKernelsAgreeAndCoherenceSavesWork) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
@@ -166,9 +166,9 @@ TEST(CpuBvh, BrickSeededAndUnseededKernelsAgreeAndCoherenceSavesWork) {
     const SampledField brick = make_cpu_bvh_sampler(options(Precision::Float, "brick"))->sample(mesh, lattice);
     test::FieldComparer cmp_brick(mesh, test::epsilon_of(Precision::Float));
     cmp_brick.fields(unseeded, brick, "pawn brick vs unseeded");
-    EXPECT_LT(brick.sampler["bvh"]["node_visits_per_point"].get<double>(), work_seeded_or_zero(seeded));
-    const double work_seeded = seeded.sampler["bvh"]["node_visits_per_point"].get<double>();
-    const double work_unseeded = unseeded.sampler["bvh"]["node_visits_per_point"].get<double>();
+    EXPECT_LT(brick.sampler.details.at("bvh")["node_visits_per_point"].get<double>(), work_seeded_or_zero(seeded));
+    const double work_seeded = seeded.sampler.details.at("bvh")["node_visits_per_point"].get<double>();
+    const double work_unseeded = unseeded.sampler.details.at("bvh")["node_visits_per_point"].get<double>();
     std::printf("pawn 32^3: node visits per point %.2f seeded, %.2f unseeded\n", work_seeded, work_unseeded);
     EXPECT_LT(work_seeded, work_unseeded);
 }

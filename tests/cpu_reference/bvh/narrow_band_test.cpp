@@ -43,9 +43,9 @@ void expect_banded(const SampledField& full, const SampledField& banded, double 
     EXPECT_TRUE(same_bits(expected.distance, banded.distance)) << what;
     EXPECT_TRUE(same_bits(expected.gradient, banded.gradient)) << what;
     EXPECT_TRUE(same_bits(expected.closest_triangle, banded.closest_triangle)) << what;
-    ASSERT_TRUE(banded.sampler.contains("band")) << what;
-    EXPECT_EQ(banded.sampler["band"]["points_in_band"].get<int64_t>(), counts.in_band) << what;
-    EXPECT_EQ(banded.sampler["band"]["points_outside"].get<int64_t>(), counts.outside) << what;
+    ASSERT_TRUE(banded.sampler.band.has_value()) << what;
+    EXPECT_EQ(banded.sampler.band->points_in_band, counts.in_band) << what;
+    EXPECT_EQ(banded.sampler.band->points_outside, counts.outside) << what;
     EXPECT_GT(counts.in_band, 0) << what;
     EXPECT_GT(counts.outside, 0) << what;
 }
@@ -71,11 +71,11 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
                                              " w = " + std::to_string(spacings) + " h";
                     const SampledField bvh = make_cpu_bvh_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
                     expect_banded(full_bvh, bvh, w, what + " bvh");
-                    EXPECT_EQ(bvh.sampler["band"]["how"], "bricks skipped by the distance bound") << what;
-                    EXPECT_GT(bvh.sampler["band"]["bricks_skipped"].get<int64_t>(), 0) << what;
+                    EXPECT_EQ(bvh.sampler.band->how, "bricks skipped by the distance bound") << what;
+                    EXPECT_GT(bvh.sampler.band->bricks_skipped, 0) << what;
                     const SampledField brute = make_cpu_brute_force_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
                     expect_banded(full_brute, brute, w, what + " brute force");
-                    EXPECT_EQ(brute.sampler["band"]["how"], "post-processed") << what;
+                    EXPECT_EQ(brute.sampler.band->how, "post-processed") << what;
                     if (HasFailure()) return;
                 }
             }
@@ -91,8 +91,8 @@ TEST(NarrowBand, PseudonormalSignOnAnOpenMeshAndPointKernelsPostProcess) {
     const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Pseudonormal))->sample(mesh, lattice);
     const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Pseudonormal))->sample(mesh, lattice);
     expect_banded(full, banded, w, "bowl forced pseudonormal");
-    EXPECT_EQ(banded.sampler["band"]["how"], "post-processed");
-    EXPECT_EQ(banded.sampler["band"]["bricks_skipped"].get<int64_t>(), 0);
+    EXPECT_EQ(banded.sampler.band->how, "post-processed");
+    EXPECT_EQ(banded.sampler.band->bricks_skipped, 0);
     for (const char* kernel : {"seeded", "unseeded"}) {
         const SampledField k_full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding, kernel))->sample(mesh, lattice);
         const SampledField k_band = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding, kernel))->sample(mesh, lattice);
@@ -107,17 +107,18 @@ TEST(NarrowBand, FewPointsAreComputedWhenMostOfTheLatticeIsOutsideTheBand) {
     const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0))->sample(mesh, lattice);
     const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w))->sample(mesh, lattice);
     expect_banded(full, banded, w, "sphere 64^3 w = h");
-    const nlohmann::json& band = banded.sampler["band"];
-    const int64_t computed = banded.sampler["points_computed"].get<int64_t>();
-    const int64_t in_band = band["points_in_band"].get<int64_t>(), probes = band["probes"].get<int64_t>();
+    ASSERT_TRUE(banded.sampler.band.has_value());
+    const BandReport& band = *banded.sampler.band;
+    const int64_t computed = banded.sampler.points_computed;
+    const int64_t in_band = band.points_in_band, probes = band.probes;
     std::printf("sphere 64^3, w = h: %lld of %lld points in the band, %lld computed exactly, %lld probes, %lld bricks skipped\n",
                 (long long)in_band, (long long)lattice.num_points(), (long long)computed, (long long)probes,
-                (long long)band["bricks_skipped"].get<int64_t>());
+                (long long)band.bricks_skipped);
     // The shell |d| <= h of a sphere of radius 1 on this lattice holds about 4 pi r^2 * 2h / h^3 points;
     // the bricks that touch it hold a few times more; the rest is skipped.
     EXPECT_LT(computed, 8 * in_band);
     EXPECT_LT(computed + probes, lattice.num_points() / 5);
-    EXPECT_EQ(computed + band["points_skipped"].get<int64_t>(), lattice.num_points());
+    EXPECT_EQ(computed + band.points_skipped, lattice.num_points());
 }
 
 TEST(NarrowBand, RefusesBadWidthsByName) {

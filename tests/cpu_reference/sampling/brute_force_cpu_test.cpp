@@ -186,8 +186,8 @@ TEST(CpuBruteForce, BccStrategiesGiveIdenticalFields) {
     EXPECT_EQ(a.gradient, b.gradient);
     EXPECT_EQ(a.closest_triangle, b.closest_triangle);
     // Strategy A computes the 2x-resolution CC grid: 8 R^3 points, most discarded.
-    EXPECT_EQ(a.sampler["points_computed"].get<int64_t>(), 8 * 11 * 12 * 10);
-    EXPECT_EQ(b.sampler["points_computed"].get<int64_t>(), lattice.num_points());
+    EXPECT_EQ(a.sampler.points_computed, 8 * 11 * 12 * 10);
+    EXPECT_EQ(b.sampler.points_computed, lattice.num_points());
 }
 
 TEST(CpuBruteForce, OneThreadAndManyThreadsAreBitIdentical) {

@@ -1,0 +1,129 @@
+// The typed provenance of a field (core/sampling/sampler_report.h, core/mesh/mesh_provenance.h):
+// merge sums the counters of the parts of one lattice, whatever the order and however it is
+// cut; the JSON is the keys field headers and manifests have always had, read back to the
+// same record; a wrong type names its key.
+#include <gtest/gtest.h>
+
+#include "core/mesh/mesh_provenance.h"
+#include "core/mesh/prepared_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/sampling/sampler_report.h"
+
+namespace sdf {
+namespace {
+
+/// The report a sampler gives one part: `points` computed, `in` of them in the band.
+SamplerReport part(int64_t points, int64_t in, int64_t reranked, bool skips) {
+    SamplerReport r;
+    r.backend = "cpu";
+    r.method = "bvh";
+    r.kernel = "brick";
+    r.precision = "float";
+    r.points_computed = points;
+    r.details["threads"] = 2;
+    r.details["sign"] = {{"requested", "auto"}, {"mode", "pseudonormal"}, {"reason", "closed"}};
+    BandReport b;
+    b.width = 0.125;
+    b.points_in_band = in;
+    b.points_outside = points - in;
+    b.how = skips ? "bricks skipped by the distance bound" : "post-processed";
+    b.counts_skips = skips;
+    b.probes = skips ? points / 8 : 0;
+    b.bricks_skipped = skips ? 3 : 0;
+    b.points_skipped = skips ? 5 : 0;
+    r.band = b;
+    CertificateReport c;
+    c.counted = true;
+    c.points = points;
+    c.reranked_in_double = reranked;
+    c.full_double_search = reranked / 2;
+    r.search_certificate = c;
+    return r;
+}
+
+TEST(SamplerReport, MergeSumsEveryCounterAndKeepsTheFirstPartsDetails) {
+    SamplerReport whole;
+    whole.merge(part(100, 40, 10, true));
+    whole.merge(SamplerReport());  // an empty slab (a rank with no planes) adds nothing
+    whole.merge(part(50, 20, 4, true));
+    whole.merge(part(30, 1, 0, true));
+    EXPECT_EQ(whole.points_computed, 180);
+    ASSERT_TRUE(whole.band && whole.search_certificate);
+    EXPECT_EQ(whole.band->points_in_band, 61);
+    EXPECT_EQ(whole.band->points_outside, 119);
+    EXPECT_EQ(whole.band->probes, 100 / 8 + 50 / 8 + 30 / 8);
+    EXPECT_EQ(whole.band->bricks_skipped, 9);
+    EXPECT_EQ(whole.band->points_skipped, 15);
+    EXPECT_EQ(whole.band->width, 0.125);
+    EXPECT_EQ(whole.search_certificate->points, 180);
+    EXPECT_EQ(whole.search_certificate->reranked_in_double, 14);
+    EXPECT_EQ(whole.search_certificate->full_double_search, 5 + 2 + 0);
+    EXPECT_EQ(whole.details.at("threads"), 2);
+    EXPECT_EQ(whole.kernel, "brick");
+
+    SamplerReport reversed;  // the order of the parts does not matter to the counters
+    reversed.merge(part(30, 1, 0, true));
+    reversed.merge(part(50, 20, 4, true));
+    reversed.merge(part(100, 40, 10, true));
+    EXPECT_EQ(nlohmann::json(reversed), nlohmann::json(whole));
+}
+
+TEST(SamplerReport, JsonHasTheRecordedKeysAndReadsBackToTheSameRecord) {
+    const SamplerReport r = part(100, 40, 10, true);
+    const nlohmann::json j = r;
+    EXPECT_EQ(j.at("backend"), "cpu");
+    EXPECT_EQ(j.at("points_computed"), 100);
+    EXPECT_EQ(j.at("threads"), 2);
+    EXPECT_EQ(j.at("sign").at("mode"), "pseudonormal");
+    EXPECT_EQ(j.at("band"), (nlohmann::json{{"width", 0.125}, {"points_in_band", 40}, {"points_outside", 60},
+                                             {"how", "bricks skipped by the distance bound"}, {"probes", 12},
+                                             {"bricks_skipped", 3}, {"points_skipped", 5}}));
+    EXPECT_EQ(j.at("search_certificate"),
+              (nlohmann::json{{"certified", true}, {"points", 100}, {"reranked_in_double", 10}, {"full_double_search", 5},
+                              {"reranked_fraction", 0.1}}));
+    EXPECT_EQ(nlohmann::json(j.get<SamplerReport>()), j);
+
+    const SamplerReport post = part(10, 4, 0, false);  // no skip counters: none written
+    EXPECT_FALSE(nlohmann::json(post).at("band").contains("probes"));
+    EXPECT_EQ(nlohmann::json(nlohmann::json(post).get<SamplerReport>()), nlohmann::json(post));
+
+    SamplerReport arrays;  // a field made from arrays: its details only
+    arrays.details["source"] = "arrays";
+    EXPECT_EQ(nlohmann::json(arrays), (nlohmann::json{{"source", "arrays"}}));
+    EXPECT_TRUE(nlohmann::json(SamplerReport()).is_null());
+    EXPECT_TRUE(nlohmann::json(nullptr).get<SamplerReport>().empty());
+}
+
+TEST(SamplerReport, AWrongTypeNamesItsKey) {
+    nlohmann::json j = part(100, 40, 10, true);
+    j["band"]["points_in_band"] = "forty";
+    try {
+        (void)j.get<SamplerReport>();
+        FAIL() << "accepted a string count";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("sampler.band.points_in_band: expected an integer"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)nlohmann::json::array().get<SamplerReport>(), std::runtime_error);
+}
+
+TEST(MeshProvenance, OneRecordReadBackWholeAndTheEarlierShortOneIntoItsReport) {
+    const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.35, 12, 8));
+    const MeshProvenance m = describe_prepared_mesh(mesh);
+    const nlohmann::json j = m;
+    for (const char* key : {"name", "source", "sha256", "vertices", "triangles", "bounds", "report"}) EXPECT_TRUE(j.contains(key)) << key;
+    EXPECT_EQ(j.at("triangles"), int64_t(mesh.triangles().size()));
+    EXPECT_EQ(j.at("report").at("components"), 1);
+    EXPECT_TRUE(j.at("report").contains("sign_reliable"));
+    EXPECT_EQ(nlohmann::json(j.get<MeshProvenance>()), j);
+
+    const nlohmann::json short_record = {{"name", "torus"}, {"source", "shape:torus"}, {"sha256", "ab"}, {"vertices", 96},
+                                         {"triangles", 192}, {"components", 1}, {"sign_reliable", true}};
+    const nlohmann::json read = nlohmann::json(short_record.get<MeshProvenance>());
+    EXPECT_FALSE(read.contains("bounds"));
+    EXPECT_EQ(read.at("report"), (nlohmann::json{{"components", 1}, {"sign_reliable", true}}));
+    EXPECT_EQ(nlohmann::json(MeshProvenance()), nlohmann::json::object());
+    EXPECT_THROW((void)nlohmann::json({{"name", "x"}, {"vertices", "many"}}).get<MeshProvenance>(), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace sdf
