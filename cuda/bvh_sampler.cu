@@ -422,7 +422,7 @@ private:
             download.end();
             record_provenance(field, mesh, lattice, upload, compute, download, computed, pieces, built, uploaded, start);
             record_search_certificate(dev, field);
-            if (options_.band_width > 0) field.sampler["band"] = band_provenance(mesh, count_narrow_band(field));
+            if (options_.band_width > 0) field.sampler.band = band_provenance(mesh, count_narrow_band(field));
             return field;
         }
         auto sink = [&](const PieceResults& r, int64_t count) {
