@@ -364,7 +364,7 @@ void BM_CudaBvhOnTree(benchmark::State& state, const std::string& file) {
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
-    state.counters["sah_cost"] = f.sampler["bvh"]["sah_cost"].get<double>();
+    state.counters["sah_cost"] = f.sampler.details["bvh"]["sah_cost"].get<double>();
 }
 
 /// Point queries on each tree (args: points, 0 uniform / 1 Gaussian near the surface as

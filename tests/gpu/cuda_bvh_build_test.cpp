@@ -152,8 +152,8 @@ TEST(CudaBvhBuild, FieldsAndQueriesOnTheDeviceTreeEqualTheHostTree) {
             SideCount n;
             for (const Lattice& lattice : {cc, bcc}) {
                 const SampledField fh = host->sample(mesh, lattice), fd = device->sample(mesh, lattice);
-                EXPECT_EQ(fh.sampler["bvh"]["built_on"], "host") << c.name;
-                EXPECT_EQ(fd.sampler["bvh"]["built_on"], "device") << c.name;
+                EXPECT_EQ(fh.sampler.details["bvh"]["built_on"], "host") << c.name;
+                EXPECT_EQ(fd.sampler.details["bvh"]["built_on"], "device") << c.name;
                 const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision);
                 ASSERT_EQ(fh.size(), fd.size()) << what;
                 for (int64_t i = 0; i < fh.size(); ++i) {
@@ -197,8 +197,8 @@ TEST(CudaBvhBuild, WindingSidesOnTheLegacyDragon) {
     std::printf("dragon-legacy 128^3 float, sign %s: %lld points, %lld on the other side; build host %.4f s, device %.4f s "
                 "(device %s)\n",
                 winding ? "winding" : "pseudonormal", (long long)n.points, (long long)n.other_side,
-                fh.sampler["bvh"]["build_seconds"].get<double>(), fd.sampler["bvh"]["build_seconds"].get<double>(),
-                fd.sampler["bvh"].dump().c_str());
+                fh.sampler.details["bvh"]["build_seconds"].get<double>(), fd.sampler.details["bvh"]["build_seconds"].get<double>(),
+                fd.sampler.details["bvh"].dump().c_str());
 }
 
 TEST(CudaBvhBuild, AutoBuildsOnTheDeviceWhereTheFieldCannotChange) {
@@ -207,20 +207,20 @@ TEST(CudaBvhBuild, AutoBuildsOnTheDeviceWhereTheFieldCannotChange) {
     const Lattice l1 = fit_lattice(LatticeType::CC, {12, 12, 12}, solid.bounds(), 0.1);
     const Lattice l2 = fit_lattice(LatticeType::CC, {12, 12, 12}, bowl.bounds(), 0.1);
     const SampledField a = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->sample(solid, l1);
-    EXPECT_EQ(a.sampler["bvh"]["built_on"], "device");
+    EXPECT_EQ(a.sampler.details["bvh"]["built_on"], "device");
     const SampledField a2 = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Double))->sample(solid, l1);
-    EXPECT_EQ(a2.sampler["bvh"]["built_on"], "host");
+    EXPECT_EQ(a2.sampler.details["bvh"]["built_on"], "host");
     const SampledField b = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->sample(bowl, l2);
-    EXPECT_EQ(b.sampler["bvh"]["built_on"], "host");
-    EXPECT_TRUE(b.sampler["bvh"].contains("device_build_skipped"));
+    EXPECT_EQ(b.sampler.details["bvh"]["built_on"], "host");
+    EXPECT_TRUE(b.sampler.details["bvh"].contains("device_build_skipped"));
     const SampledField c = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->sample(bowl, l2);
-    EXPECT_EQ(c.sampler["bvh"]["built_on"], "device");
-    EXPECT_EQ(c.sampler["sign"]["winding"]["moments_built_on"], "device");
+    EXPECT_EQ(c.sampler.details["bvh"]["built_on"], "device");
+    EXPECT_EQ(c.sampler.details["sign"]["winding"]["moments_built_on"], "device");
     // A repeated call reuses the device tree.
     auto sampler = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float));
     const SampledField first = sampler->sample(solid, l1), second = sampler->sample(solid, l1);
-    EXPECT_TRUE(first.sampler["bvh"]["built_by_this_call"].get<bool>());
-    EXPECT_FALSE(second.sampler["bvh"]["built_by_this_call"].get<bool>());
+    EXPECT_TRUE(first.sampler.details["bvh"]["built_by_this_call"].get<bool>());
+    EXPECT_FALSE(second.sampler.details["bvh"]["built_by_this_call"].get<bool>());
     EXPECT_EQ(first.distance, second.distance);
 }
 

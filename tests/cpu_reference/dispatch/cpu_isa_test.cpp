@@ -362,7 +362,7 @@ TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
                      same_bits(got.gradient[i].x, lattice_want.gradient[i].x) && same_bits(got.gradient[i].y, lattice_want.gradient[i].y) &&
                      same_bits(got.gradient[i].z, lattice_want.gradient[i].z));
         EXPECT_EQ(bad, 0) << active_cpu_kernels().isa << " lattice " << r.method << "/" << r.kernel;
-        EXPECT_EQ(got.sampler["search_certificate"]["certified"], true);
+        EXPECT_EQ(got.sampler.search_certificate->certified, true);
     }
     std::printf("certified samplers at %s: %zu points and a %lld-point lattice equal the double brute force\n",
                 active_cpu_kernels().isa, pts.size(), (long long)lattice.num_points());
