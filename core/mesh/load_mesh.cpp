@@ -67,25 +67,32 @@ int64_t line_of(std::string_view bytes, size_t at) {
 
 /// What load_mesh_file() can tell from the content while it is still being read: a file
 /// that holds binary data where every reader expects text is refused at once (a gzip of
-/// zeros after its first megabyte), and a binary STL may not outgrow its declared size.
+/// zeros after its first megabyte), and a binary STL or binary PLY may not outgrow the size
+/// its header declares.
 ContentCheck content_check(const std::string& path) {
-    return [path, ext = inner_extension(path)](std::string_view so_far, size_t new_from) -> uint64_t {
+    return [path, ext = inner_extension(path), ply_header_read = false](std::string_view so_far,
+                                                                        size_t new_from) mutable -> ContentLimit {
         const size_t bom = so_far.size() - without_utf8_bom(so_far).size();
         if (first_token_is(so_far.substr(bom), is_ply_magic)) {
             // Text up to "end_header", binary data after it in binary PLY.
-            if (new_from > 0) return kMaxMeshFileBytes;
+            if (ply_header_read) return {};
             const std::string_view header = so_far.substr(0, so_far.find("end_header"));
-            if (const size_t nul = header.find('\0'); nul != std::string_view::npos)
+            if (const size_t nul = header.find('\0', new_from); nul != std::string_view::npos)
                 throw_mesh_error(path, "PLY header line " + std::to_string(line_of(so_far, nul)),
                                  "byte " + std::to_string(nul) + " is a NUL byte; expected a text header");
-            return kMaxMeshFileBytes;
+            std::optional<ContentLimit> limit = ply_size_limit(so_far.substr(bom), path);
+            if (!limit) return {};  // the header is not complete yet
+            ply_header_read = true;
+            limit->bytes += limit->bytes < kMaxMeshFileBytes ? bom : 0;
+            return *limit;
         }
         const bool off = first_token_is(so_far.substr(bom), is_off_magic);
         if (!off && so_far.size() >= 84 && ext != "obj" && ext != "off" && ext != "ply" &&
             (holds_binary_bytes(so_far) || (ext == "stl" && !is_ascii_stl_start(so_far)))) {
             uint32_t n = 0;
             std::memcpy(&n, so_far.data() + 80, 4);
-            return 84 + 50 * uint64_t(n);  // binary STL, or nothing readable
+            return {84 + 50 * uint64_t(n), "what its binary STL header declares: " + std::to_string(n) +
+                                               " triangles, 84 + 50 x " + std::to_string(n) + " bytes"};
         }
         if (new_from == 0) reject_wide_encodings(so_far, path, "mesh file");
         if (const size_t nul = so_far.find('\0', new_from); nul != std::string_view::npos)
@@ -93,7 +100,7 @@ ContentCheck content_check(const std::string& path) {
                              "byte " + std::to_string(nul) +
                                  " is a NUL byte; expected text (OBJ, OFF and ASCII STL are text): is the file binary, "
                                  "or UTF-16?");
-        return kMaxMeshFileBytes;
+        return {};
     };
 }
 

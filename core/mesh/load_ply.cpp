@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "core/mesh/mesh_file_bytes.h"
@@ -175,14 +176,36 @@ public:
 
     bool trailing_data() { return encoding_ == PlyEncoding::Ascii ? !text_.at_end() : pos_ != bytes_.size(); }
 
+    /// Where what follows begins: "line 13 ('3')" (its first word) or "byte 345".
+    std::string next_place() const {
+        std::string_view w;
+        int line = 0;
+        if (encoding_ == PlyEncoding::Ascii && text_.peek(w, line)) return "line " + std::to_string(line) + " (" + quoted(w) + ")";
+        return "byte " + std::to_string(pos_);
+    }
+
     /// Ascii PLY writes one element per line; reading each on its own line turns a wrong
     /// count in the header into a message at the line where it shows (a vertex line with
     /// a face's values), not at a later, unrelated element.
-    void begin_element(uint64_t index) {
+    void begin_element(uint64_t index, uint64_t count) {
         index_ = index;
+        count_ = count;
         element_line_ = -1;
         values_ = 0;
+        std::string_view w;
+        int line = 0;
+        element_start_ = encoding_ == PlyEncoding::Ascii && text_.peek(w, line) ? size_t(w.data() - bytes_.data()) : bytes_.size();
     }
+
+    /// The ascii line the current element begins on (for messages).
+    std::string_view element_text() const {
+        std::string_view rest = std::string_view(bytes_).substr(element_start_);
+        rest = rest.substr(0, rest.find('\n'));
+        if (!rest.empty() && rest.back() == '\r') rest.remove_suffix(1);
+        return rest;
+    }
+
+    bool ascii() const { return encoding_ == PlyEncoding::Ascii; }
     void end_element(const PlyElement& e) {
         std::string_view w;
         int line = 0;
@@ -200,14 +223,20 @@ public:
     }
 
     std::string element_, where_;  ///< set by the reader for errors raised here
-    uint64_t index_ = 0;
+    uint64_t index_ = 0, count_ = 0;
 
 private:
     [[noreturn]] void fail(const std::string& what) const { throw_mesh_error(path_, element_place(element_, index_), what); }
 
     double ascii_value(PlyType type) {
         std::string_view token;
-        if (!text_.next(token)) fail("file ends early (truncated?); expected a value");
+        if (!text_.next(token)) {
+            if (values_ == 0)
+                fail("file ends after " + std::to_string(index_) + " of " + std::to_string(count_) + " '" + element_ +
+                     "' elements (expected " + std::to_string(count_) + " lines of them, found " + std::to_string(index_) +
+                     "; is the header's count too large, or the file truncated?)");
+            fail("file ends early (truncated?); expected a value");
+        }
         if (element_line_ < 0) element_line_ = text_.line();
         if (text_.line() != element_line_)
             throw_mesh_error(path_, "PLY element '" + element_ + "' " + std::to_string(index_) + " (line " +
@@ -258,6 +287,7 @@ private:
     TextCursor text_;
     const std::string& path_;
     int element_line_ = -1;  ///< line of the element being read (ascii)
+    size_t element_start_ = 0;  ///< its first byte (ascii)
     uint64_t values_ = 0;    ///< values of it read so far
 };
 
@@ -294,6 +324,7 @@ struct Reader {
     const std::string& path;
     TriangleMesh& mesh;
     uint64_t vertex_count = 0;
+    const PlyElement* vertex_element = nullptr;
     std::vector<double> scratch;
     PolygonList polygons;  ///< triangulated once every vertex is read (elements may come in any order)
 
@@ -310,7 +341,7 @@ struct Reader {
         mesh.vertices.reserve(size_t(e.count));
         scratch.resize(e.properties.size());
         for (uint64_t i = 0; i < e.count; ++i) {
-            values.begin_element(i);
+            values.begin_element(i, e.count);
             read_element(e);
             values.end_element(e);
             mesh.vertices.push_back({scratch[size_t(at.x)], scratch[size_t(at.y)], scratch[size_t(at.z)]});
@@ -342,16 +373,44 @@ struct Reader {
             throw_mesh_error(path, "PLY header", "face indices must have an integer type");
         std::vector<int> polygon;
         for (uint64_t i = 0; i < e.count; ++i) {
-            values.begin_element(i);
-            for (size_t k = 0; k < e.properties.size(); ++k) {
-                const PlyProperty& p = e.properties[k];
-                if (int(k) == list) read_polygon(e, p, polygon);
-                else if (!p.is_list) values.value(p.type);
-                else skip_list(e, p);
+            values.begin_element(i, e.count);
+            try {
+                for (size_t k = 0; k < e.properties.size(); ++k) {
+                    const PlyProperty& p = e.properties[k];
+                    if (int(k) == list) read_polygon(e, p, polygon);
+                    else if (!p.is_list) values.value(p.type);
+                    else skip_list(e, p);
+                }
+                values.end_element(e);
+            } catch (const std::runtime_error&) {
+                refuse_vertex_line_among_faces(e);
+                throw;
             }
-            values.end_element(e);
             polygons.add(polygon);
         }
+    }
+
+    /// A face that does not read, on an ascii line that reads as a vertex (as many numbers
+    /// as the vertex element has properties): the header's vertex count is too small.
+    void refuse_vertex_line_among_faces(const PlyElement& e) const {
+        if (!values.ascii() || !vertex_element) return;
+        for (const PlyProperty& p : vertex_element->properties) if (p.is_list) return;
+        const std::string_view line = values.element_text();
+        TextCursor words(line);
+        std::string_view w;
+        double v = 0;
+        int64_t first = -1;
+        size_t numbers = 0;
+        while (words.next(w)) {
+            if (!parse_double(w, v)) return;
+            if (numbers++ == 0 && !parse_int(w, first)) first = -1;
+        }
+        if (first >= 0 && numbers == size_t(first) + 1) return;  // a face's shape, however bad ("2 0 1")
+        if (numbers != vertex_element->properties.size()) return;
+        fail(e, "expected face " + std::to_string(values.index_) + " of " + std::to_string(e.count) +
+                    ", found a vertex line (" + quoted(line) + "): the header declares " + std::to_string(vertex_count) +
+                    " vertices, but vertex lines continue after them (is the header's count of 'vertex' elements too "
+                    "small?)");
     }
 
     void read_polygon(const PlyElement& e, const PlyProperty& p, std::vector<int>& polygon) {
@@ -373,7 +432,7 @@ struct Reader {
     void skip(const PlyElement& e) {
         scratch.resize(e.properties.size());
         for (uint64_t i = 0; i < e.count; ++i) {
-            values.begin_element(i);
+            values.begin_element(i, e.count);
             read_element(e);
             values.end_element(e);
         }
@@ -384,7 +443,71 @@ struct Reader {
     }
 };
 
+/// Largest item count a list's count type can hold.
+uint64_t max_list_count(PlyType t) {
+    switch (t) {
+        case PlyType::Int8: return 127;
+        case PlyType::UInt8: return 255;
+        case PlyType::Int16: return 32767;
+        case PlyType::UInt16: return 65535;
+        case PlyType::Int32: return 2147483647;
+        default: return 4294967295;
+    }
+}
+
+/// Most bytes one binary element can take, and its description for messages.
+uint64_t max_element_bytes(const PlyElement& e, bool& fixed) {
+    uint64_t n = 0;
+    fixed = true;
+    for (const PlyProperty& p : e.properties) {
+        n += size_of(p.is_list ? p.count_type : p.type);
+        if (p.is_list) { n += max_list_count(p.count_type) * size_of(p.type); fixed = false; }
+    }
+    return n;
+}
+
+/// The first byte after the header's "end_header" line (its line end included: LF, CRLF or
+/// a lone CR), or npos when `bytes` do not hold it. Only a line whose only word is
+/// end_header ends the header (not a comment that mentions it).
+size_t ply_header_end(std::string_view bytes) {
+    for (size_t at = 0; at < bytes.size();) {
+        const size_t eol = bytes.find_first_of("\r\n", at);
+        if (eol == std::string_view::npos) return eol;  // the line may not be complete yet
+        TextCursor words(bytes.substr(at, eol - at));
+        std::string_view w;
+        const bool end = words.next(w) && w == "end_header" && !words.next(w);
+        at = eol + 1 + (bytes[eol] == '\r' && eol + 1 < bytes.size() && bytes[eol + 1] == '\n');
+        if (end) return bytes[eol] == '\r' && eol + 1 == bytes.size() ? std::string_view::npos : at;  // CR: LF may follow
+    }
+    return std::string_view::npos;
+}
+
 }  // namespace
+
+std::optional<ContentLimit> ply_size_limit(std::string_view bytes, const std::string& path) {
+    // A header no longer than this is looked for: the check runs after every decompressed
+    // megabyte, and a file without "end_header" is the reader's to refuse.
+    constexpr size_t kLongestHeader = size_t(16) << 20;
+    const size_t end = ply_header_end(bytes.substr(0, kLongestHeader));
+    if (end == std::string_view::npos) return bytes.size() < kLongestHeader ? std::nullopt : std::optional(ContentLimit{});
+    // The header as read_ply() sees it: lone CRs (classic Mac line ends) become LFs.
+    std::string text(bytes.substr(0, end));
+    for (size_t i = 0; i < text.size(); ++i)
+        if (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n')) text[i] = '\n';
+    const PlyHeader header = HeaderParser(text, path).parse();
+    if (header.encoding == PlyEncoding::Ascii) return ContentLimit{};
+    uint64_t total = header.data_offset;
+    std::string parts = std::to_string(header.data_offset) + " header bytes";
+    for (const PlyElement& e : header.elements) {
+        bool fixed = true;
+        const uint64_t per = max_element_bytes(e, fixed);
+        if (per > 0 && e.count > (kMaxMeshFileBytes - total) / per) return ContentLimit{};  // beyond any file read: the reader says why
+        total += e.count * per;
+        parts += ", element '" + e.name + "' " + std::to_string(e.count) + " x " + (fixed ? "" : "at most ") +
+                 std::to_string(per) + " bytes";
+    }
+    return ContentLimit{total, "what its binary PLY header declares: " + parts};
+}
 
 TriangleMesh read_ply(const std::string& bytes, const std::string& path) {
     const PlyHeader header = HeaderParser(bytes, path).parse();
@@ -397,7 +520,7 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& path) {
 
     TriangleMesh mesh;
     PlyValues values(bytes, header, path);
-    Reader reader{header, values, path, mesh, vertex->count, {}};
+    Reader reader{header, values, path, mesh, vertex->count, vertex, {}};
     bool have_faces = false;
     for (const PlyElement& e : header.elements) {
         values.element_ = e.name;
@@ -407,7 +530,8 @@ TriangleMesh read_ply(const std::string& bytes, const std::string& path) {
     }
     if (!have_faces) throw_mesh_error(path, "PLY header", "no element 'face' (a point cloud has no surface)");
     if (values.trailing_data())
-        throw_mesh_error(path, "PLY data (" + values.place() + ")", "data continues after the last declared element (wrong counts?)");
+        throw_mesh_error(path, "PLY data (" + values.next_place() + ")",
+                         "data continues after the last declared element (is a count in the header too small?)");
     check_finite_vertices(mesh, path);
     reader.polygons.triangulate_into(mesh);
     check_loaded_mesh(mesh, path, "PLY file");

@@ -170,7 +170,10 @@ TriangleMesh read_stl(const std::string& bytes, const std::string& path) {
         throw_mesh_error(path, "binary STL header",
                          "declares " + std::to_string(n) + " triangles, which take " +
                              std::to_string(kBinaryHeader + kBinaryTriangle * n) + " bytes, but the file has " +
-                             std::to_string(bytes.size()) + " (truncated, or not STL)" +
+                             std::to_string(bytes.size()) +
+                             (bytes.size() < kBinaryHeader + kBinaryTriangle * n
+                                  ? " (truncated, or not STL)"
+                                  : " (data after the declared triangles: is the count too small? or not STL)") +
                              (starts_with_solid(bytes) ? "; the header begins with 'solid', but the file holds binary "
                                                          "bytes, so it is not ASCII STL"
                                                        : ""));

@@ -41,21 +41,32 @@ std::string gunzip(const std::string& compressed, const std::string& path, const
     struct End { z_stream* z; ~End() { inflateEnd(z); } } end{&z};
     constexpr size_t kStep = size_t(1) << 20;     // the check's granularity
     constexpr size_t kMaxFeed = size_t(1) << 30;  // zlib counts in 32-bit unsigned
-    uint64_t limit = kMaxMeshFileBytes;
-    std::string limit_reason = "the largest mesh file read";
+    ContentLimit limit{kMaxMeshFileBytes, "the largest mesh file read"};
     const uint64_t hint = gzip_size_hint(compressed);
     std::string out;
     size_t in_at = 0, have = 0, checked = 0;
     const auto over = [&] {
-        throw_mesh_error(path, "", "decompresses to more than " + std::to_string(limit) + " bytes (" + limit_reason + ")");
+        throw_mesh_error(path, "", "decompresses to more than " + std::to_string(limit.bytes) + " bytes (" + limit.reason + ")");
     };
     for (;;) {
         if (have == out.size()) {
-            // A megabyte more at a time (resize touches what it adds); the capacity is
-            // reserved once the content check has had its say, so the hint is not trusted
-            // before the check has seen the first megabyte.
-            if (checked > 0 && out.capacity() < hint && hint <= limit) out.reserve(size_t(hint));
-            out.resize(size_t(std::min<uint64_t>(limit + 1, uint64_t(have) + kStep)));
+            // A megabyte more at a time (resize touches what it adds). Once the content check
+            // has had its say (so the hint is not trusted before it has seen the first
+            // megabyte), the capacity is reserved at the trailer's size plus one byte, and the
+            // buffer stays within it: one byte of room lets zlib report the stream's end, and
+            // growing past the reservation would reallocate at twice the size.
+            const bool use_hint = checked > 0 && hint > 0 && hint <= limit.bytes;
+            uint64_t next = std::min<uint64_t>(limit.bytes + 1, uint64_t(have) + kStep);
+            if (use_hint && have <= hint) next = std::min<uint64_t>(next, hint + 1);
+            const bool reserve = use_hint && out.capacity() < hint + 1;
+            try {
+                if (reserve) out.reserve(size_t(hint + 1));
+                out.resize(size_t(next));
+            } catch (const std::bad_alloc&) {
+                throw_mesh_error(path, "", "not enough memory to decompress the mesh file: " + std::to_string(compressed.size()) +
+                                               " bytes gzip-compressed, " + std::to_string(reserve ? hint : next) +
+                                               " bytes decompressed (a buffer of that size could not be allocated)");
+            }
         }
         const size_t feed = std::min(compressed.size() - in_at, kMaxFeed);
         z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data() + in_at));
@@ -71,11 +82,11 @@ std::string gunzip(const std::string& compressed, const std::string& path, const
         if (code == Z_MEM_ERROR) throw std::bad_alloc();
         const bool stream_end = code == Z_STREAM_END;
         if (check && (have - checked >= kStep || stream_end)) {
-            const uint64_t allowed = check(std::string_view(out.data(), have), checked);
+            ContentLimit allowed = check(std::string_view(out.data(), have), checked);
             checked = have;
-            if (allowed < limit) { limit = allowed; limit_reason = "what its content declares"; }
+            if (allowed.bytes < limit.bytes) limit = std::move(allowed);
         }
-        if (have > limit) over();
+        if (have > limit.bytes) over();
         if (stream_end) {
             if (in_at == compressed.size()) break;
             // Another member (concatenated .gz files), or data that does not belong to the stream.

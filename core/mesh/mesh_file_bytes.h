@@ -26,12 +26,18 @@ struct MeshFileBytes {
     std::string file_sha256;  ///< of the file's bytes as stored (compressed or not)
 };
 
+/// The most bytes a file's content may have, by what it declares, and why (for the message).
+struct ContentLimit {
+    uint64_t bytes = kMaxMeshFileBytes;
+    std::string reason;  ///< e.g. "its binary STL header declares 2 triangles (84 + 50 x 2 bytes)"
+};
+
 /// What the content read so far allows, asked while a gzip file is decompressed (after
 /// each megabyte, with the bytes so far and where the new ones begin): the most bytes the
-/// whole content may have (e.g. a binary STL's declared size), or it throws (e.g. a NUL
-/// byte in a text format). So a gzip bomb is refused after its first megabyte, not after
-/// it has filled the memory.
-using ContentCheck = std::function<uint64_t(std::string_view so_far, size_t new_from)>;
+/// whole content may have (e.g. a binary STL's or a binary PLY's declared size), or it
+/// throws (e.g. a NUL byte in a text format). So a gzip bomb is refused after its first
+/// megabyte, not after it has filled the memory.
+using ContentCheck = std::function<ContentLimit(std::string_view so_far, size_t new_from)>;
 
 /// Reads `path` whole, gunzipping it when it starts with the gzip magic (1f 8b), at most
 /// kMaxMeshFileBytes and what `check` allows. Throws std::runtime_error naming the file

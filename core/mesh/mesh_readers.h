@@ -5,9 +5,11 @@
 /// file and the header line, element or byte offset of what it could not read.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
+#include "core/mesh/mesh_file_bytes.h"
 #include "core/mesh/triangle_mesh.h"
 
 namespace sdf {
@@ -16,6 +18,14 @@ namespace sdf {
 /// with scalar properties x, y, z of any type; element "face" with a list property
 /// "vertex_indices" (or "vertex_index"); other elements and properties are skipped.
 TriangleMesh read_ply(const std::string& bytes, const std::string& path);
+
+/// The most bytes a binary PLY whose header `bytes` begin with may have: the header, then
+/// every declared element at its properties' sizes, lists at their count type's largest
+/// count (nothing may follow the last element); ascii PLY declares no byte size (the limit
+/// is kMaxMeshFileBytes). std::nullopt while `bytes` hold only part of the header. Lets a
+/// .ply.gz be decompressed no further than its own header allows. Throws, as read_ply()
+/// would, for a complete header that does not parse.
+std::optional<ContentLimit> ply_size_limit(std::string_view bytes, const std::string& path);
 
 /// STL, binary (80-byte header, uint32 count, 50 bytes per triangle; recognised by its exact
 /// size even when the header starts with "solid") or ASCII. STL repeats each corner per

@@ -95,8 +95,9 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     if (origin.size() != 3) r.fail("origin", "expected an array of 3 numbers, got " + r.raw("origin").dump());
     if (res.size() != 3 || *std::min_element(res.begin(), res.end()) < 1)
         r.fail("resolution", "expected an array of 3 positive integers, got " + r.raw("resolution").dump());
-    if (!(l.spacing > 0) || !std::isfinite(l.spacing))
-        r.fail("spacing", "expected a positive number, got " + r.raw("spacing").dump());
+    // Not subnormal: positions divide by the spacing, and 1/h must stay finite.
+    if (!(l.spacing >= std::numeric_limits<double>::min()) || !std::isfinite(l.spacing))
+        r.fail("spacing", "expected a positive number (finite, not subnormal), got " + r.raw("spacing").dump());
     l.origin = {origin[0], origin[1], origin[2]};
     l.resolution = {res[0], res[1], res[2]};
     if (l.type == LatticeType::BCC) {
@@ -111,6 +112,10 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     } catch (const std::invalid_argument& e) {
         r.fail("resolution", e.what());
     }
+    for (const Vec3d& corner : {l.domain_min(), l.domain_max()})
+        if (!std::isfinite(corner.x) || !std::isfinite(corner.y) || !std::isfinite(corner.z))
+            r.fail("origin", "the lattice's far corner (origin + spacing x (resolution - 1)) is not finite: origin " +
+                                 r.raw("origin").dump() + ", spacing " + r.raw("spacing").dump());
     r.finish({"notation", "points"});
     return l;
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/io/text_file.h"
+#include "core/mesh/text_cursor.h"
 #include "harness/io/npy_file.h"
 
 namespace sdf {
@@ -23,8 +24,8 @@ Vec3d parse_point(const std::string& line, const std::string& name, int number) 
     Vec3d p;
     std::string extra;
     if (!(ss >> p.x >> p.y >> p.z) || (ss >> extra) || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        throw std::runtime_error(name + ":" + std::to_string(number) + ": expected three finite numbers \"x y z\", got \"" +
-                                 line + "\"");
+        throw std::runtime_error(name + ":" + std::to_string(number) + ": expected three finite numbers \"x y z\", got " +
+                                 quoted(line));
     return p;
 }
 

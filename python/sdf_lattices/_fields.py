@@ -2,6 +2,7 @@
 the lattice, and a ValueError that says why (and what to do) where it does not."""
 import errno
 import os
+import zipfile
 
 import numpy as np
 
@@ -12,9 +13,22 @@ def _missing(path):
     return FileNotFoundError(errno.ENOENT, "no such field file", path)
 
 
+def _named(path, read):
+    """read(), with any error of a bad file (not a zip, a missing or misshapen entry, a
+    lattice the Field refuses) raised as a ValueError that names the file."""
+    try:
+        return read()
+    except (ValueError, TypeError, KeyError, IndexError, EOFError, OSError, zipfile.BadZipFile) as e:
+        if isinstance(e, FileNotFoundError) or str(e).startswith(path):
+            raise
+        raise ValueError(f"{path}: {str(e).strip(chr(39)) or type(e).__name__}") from e
+
+
 def _read_npz(path):
     from . import _core
 
+    if os.path.getsize(path) == 0 or not zipfile.is_zipfile(path):
+        raise ValueError(f"{path}: not a .npz file (no zip archive; truncated or not written by Field.write?)")
     with np.load(path, allow_pickle=False) as z:
         lattice = str(z["lattice"]) if "lattice" in z else None
         if lattice == "cc":
@@ -36,8 +50,13 @@ def _read_vti_grid(path):
         raise ValueError(f"{path}: reading .vti needs VTK's Python module (Debian python3-vtk9), which is not "
                          "installed; the field file (.json) or .npz hold the same field") from None
     reader = vtk.vtkXMLImageDataReader()
+    errors = []
+    reader.AddObserver("ErrorEvent", lambda obj, event: errors.append(event))
     reader.SetFileName(path)
     reader.Update()
+    if errors or reader.GetErrorCode() != 0:
+        raise ValueError(f"{path}: not a readable VTK ImageData XML file (truncated or corrupt?); VTK: "
+                         f"{reader.GetErrorCode() and vtk.vtkErrorCode.GetStringFromErrorCode(reader.GetErrorCode()) or 'parse error'}")
     image = reader.GetOutput()
     data = image.GetPointData()
     if image.GetNumberOfPoints() == 0 or data.GetArray("distance") is None:
@@ -89,9 +108,9 @@ def read_field(path):
     if ext == ".npz":
         if not os.path.exists(path):
             raise _missing(path)
-        return _read_npz(path)
+        return _named(path, lambda: _read_npz(path))
     if ext == ".vti":
-        return _read_vti(path)
+        return _named(path, lambda: _read_vti(path))
     if ext == ".npy":
         raise ValueError(f"{path}: a .npy file holds the values without their lattice (origin, spacing), so it cannot "
                          "be read back as a Field: use numpy.load and sdf_lattices.Field(values, origin, spacing), or "

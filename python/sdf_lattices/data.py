@@ -112,10 +112,31 @@ def surface_gaussian(vertices, triangles, count, sigma, seed):
     return points, tri
 
 
+# The most points drawn per mesh: the largest lattice sampled (2^36), checked before any array is made.
+_MAX_COUNT = 1 << 36
+
+
 def _check_count(count):
     if isinstance(count, (bool, np.bool_)) or not isinstance(count, (int, np.integer)) or count < 0:
         raise ValueError(f"count: expected a non-negative integer, got {count!r}")
+    if count > _MAX_COUNT:
+        raise ValueError(f"count: expected at most 2^36 points per mesh, got {count}")
     return int(count)
+
+
+def _check_sigmas(sigmas):
+    """sigmas as a tuple of floats; a single number or text is named, not iterated."""
+    if isinstance(sigmas, (str, bytes)) or not hasattr(sigmas, "__iter__"):
+        raise ValueError(f"sigmas: expected a sequence of standard deviations, e.g. (0.025, 0.008), got {sigmas!r}")
+    out = []
+    for s in sigmas:
+        if isinstance(s, (str, bytes, bool, np.bool_)):
+            raise ValueError(f"sigmas: expected numbers, got {s!r}")
+        try:
+            out.append(float(s))
+        except (TypeError, ValueError):
+            raise ValueError(f"sigmas: expected numbers, got {s!r}") from None
+    return tuple(out)
 
 
 # ---- meshes ---------------------------------------------------------------------------------
@@ -239,7 +260,7 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
     if dtype not in ("float32", "float64", np.float32, np.float64):
         raise ValueError(f"dtype: expected \"float32\" or \"float64\", got {dtype!r}")
     dtype = np.dtype(dtype)
-    sigmas = tuple(float(s) for s in sigmas)
+    sigmas = _check_sigmas(sigmas)
     for s in sigmas:
         if not (np.isfinite(s) and s > 0):
             raise ValueError(f"sigmas: expected finite values > 0, got {s!r}")

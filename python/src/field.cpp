@@ -1,5 +1,6 @@
 // Fields: sdf_lattices.Field, sample (as run-experiment samples a lattice) and read_field.
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -38,6 +39,25 @@ int64_t integer_argument(const py::handle& value, const std::string& what) {
     return n;
 }
 
+/// A number argument (float, int or NumPy scalar), else a TypeError naming it: not
+/// pybind11's "Unable to cast Python instance to C++ type".
+double number_argument(const py::object& value, const std::string& what) {
+    if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()) || PyComplex_Check(value.ptr()))
+        throw py::type_error(what + ": expected a number, got " + std::string(Py_TYPE(value.ptr())->tp_name) + " " +
+                             std::string(py::repr(value)));
+    const double v = PyFloat_AsDouble(value.ptr());
+    if (v == -1.0 && PyErr_Occurred()) throw py::error_already_set();
+    return v;
+}
+
+/// The shortest text that reads back as `v`, for messages (std::to_string writes 1e-300 as
+/// 0.000000).
+std::string number_text(double v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    return std::string(text, end);
+}
+
 /// The "lattice" object of a config, from sample()'s arguments, parsed by the config's own
 /// parser: the same checks and messages as run-experiment's, key path "sample(): lattice".
 LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::object& resolution, const py::object& samples,
@@ -54,7 +74,7 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
         j["resolution"] = r;
     }
     if (!samples.is_none()) j["samples"] = integer_argument(samples, "samples");
-    if (!margin.is_none()) j["margin"] = margin.cast<double>();
+    if (!margin.is_none()) j["margin"] = number_argument(margin, "margin");
     JsonReader reader(j, "sample()", "lattice");
     LatticeSpec spec = parse_lattice_spec(reader);
     reader.finish();
@@ -105,7 +125,7 @@ Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing
         // 1e-9: an extent that is a whole number of spacings up to rounding gets no extra point.
         const double points = std::ceil(cells[k] * (1 - 1e-9)) + 1;
         if (!(points <= double(1 << 30)))
-            throw std::invalid_argument("spacing: " + std::to_string(spacing) + " gives more than 2^30 points along an axis");
+            throw std::invalid_argument("spacing: " + number_text(spacing) + " gives more than 2^30 points along an axis");
         n[k] = std::max(2, int(points));
     }
     l.resolution = {n[0], n[1], n[2]};
@@ -118,16 +138,19 @@ Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing
 Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
     const LatticeType type = choose("lattice", a.type, {"cc", "bcc"}) == "bcc" ? LatticeType::BCC : LatticeType::CC;
     const bool framed = !a.bounds.is_none() || !a.spacing.is_none() || !a.origin.is_none();
-    const double margin = a.margin.is_none() ? 0.1 : a.margin.cast<double>();
-    if (!(margin >= 0)) throw std::invalid_argument("margin: expected a non-negative fraction of the mesh's largest extent");
+    const double margin = a.margin.is_none() ? 0.1 : number_argument(a.margin, "margin");
+    if (!(margin >= 0 && std::isfinite(margin)))
+        throw std::invalid_argument("margin: expected a finite, non-negative fraction of the mesh's largest extent, got " +
+                                    number_text(margin));
+    const double spacing = a.spacing.is_none() ? 0.0 : number_argument(a.spacing, "spacing");
     if (!framed) return build_lattice(lattice_spec_from_arguments(a.type, a.resolution, a.samples, py::none()), mesh_bounds, margin);
     // A lattice framed by the caller: bounds and spacing or resolution, or origin, spacing
     // and resolution; spacing alone covers the mesh's box grown by the margin.
     if (!a.samples.is_none()) throw std::invalid_argument("samples: not with bounds, spacing or origin (give resolution or spacing)");
     if (!a.bounds.is_none() && !a.margin.is_none())
         throw std::invalid_argument("margin: not with bounds (bounds frame the lattice as given)");
-    if (!a.spacing.is_none() && !(a.spacing.cast<double>() > 0 && std::isfinite(a.spacing.cast<double>())))
-        throw std::invalid_argument("spacing: expected a finite distance > 0");
+    if (!a.spacing.is_none() && !(spacing >= std::numeric_limits<double>::min() && std::isfinite(spacing)))
+        throw std::invalid_argument("spacing: expected a finite distance > 0 (and not subnormal), got " + number_text(spacing));
     Int3 resolution{};
     if (!a.resolution.is_none()) resolution = lattice_spec_from_arguments(a.type, a.resolution, py::none(), py::none()).resolution;
     if (!a.origin.is_none()) {
@@ -137,7 +160,7 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
         Lattice l;
         l.type = type;
         l.origin = vec3_argument(a.origin, "origin");
-        l.spacing = a.spacing.cast<double>();
+        l.spacing = spacing;
         l.resolution = resolution;
         checked_lattice_points(type, resolution);
         return l;
@@ -153,7 +176,7 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
     }
     if (a.spacing.is_none() == a.resolution.is_none())
         throw std::invalid_argument("bounds: give exactly one of spacing and resolution");
-    if (!a.spacing.is_none()) return lattice_covering(type, box, a.spacing.cast<double>());
+    if (!a.spacing.is_none()) return lattice_covering(type, box, spacing);
     if (resolution.x < 2 || resolution.y < 2 || resolution.z < 2)
         throw std::invalid_argument("resolution: expected at least 2 points per axis with bounds");
     // The widest axis decides the (isotropic) spacing; the lattice starts at bounds[0].
@@ -201,6 +224,8 @@ Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::obj
 py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
                              double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
     choose("outside", outside, {"nan", "clamp", "error"});
+    if (!(sigma2 > 0 && std::isfinite(sigma2)))
+        throw std::invalid_argument("sigma2: expected a finite variance > 0, got " + number_text(sigma2));
     const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
     const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
     TaskOptions task;
@@ -245,12 +270,29 @@ py::object Field::points() const {
 
 namespace {
 
+/// "float64 array" or the Python type, for messages.
+std::string dtype_text(const py::object& o) {
+    if (py::isinstance<py::array>(o)) return "an array of dtype " + std::string(py::str(py::array(o).dtype()));
+    return std::string(Py_TYPE(o.ptr())->tp_name);
+}
+
+/// Refuses arrays of strings, objects, complex numbers or booleans, which NumPy would
+/// otherwise convert (or truncate) to numbers without a word.
+void require_real_dtype(const py::object& o, const std::string& name) {
+    const py::array a = py::array::ensure(o);
+    if (!a) throw py::type_error(name + ": expected a numeric array, got " + dtype_text(o));
+    if (std::string("iuf").find(a.dtype().kind()) == std::string::npos)
+        throw py::type_error(name + ": expected an array of real numbers (integer or float dtype), got " +
+                             (py::isinstance<py::array>(o) ? dtype_text(o) : "values of dtype " + std::string(py::str(a.dtype()))));
+}
+
 /// A Field from arrays: values (and optionally gradient and triangle) per grid, as Field's
 /// arrays are shaped, on the lattice of origin and spacing.
 Field field_from_arrays(const py::object& values, const py::object& origin, double spacing, const std::string& lattice,
                         const py::object& gradient, const py::object& triangle) {
     const bool bcc = choose("lattice", lattice, {"cc", "bcc"}) == "bcc";
-    if (!(spacing > 0 && std::isfinite(spacing))) throw std::invalid_argument("spacing: expected a finite distance > 0");
+    if (!(spacing >= std::numeric_limits<double>::min() && std::isfinite(spacing)))
+        throw std::invalid_argument("spacing: expected a finite distance > 0 (and not subnormal), got " + number_text(spacing));
     // Every channel as a list of C-order arrays, one per grid.
     const auto grids_of = [&](const py::object& channel, const std::string& name) {
         std::vector<py::object> out;
@@ -265,6 +307,7 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
         return out;
     };
     const std::vector<py::object> v = grids_of(values, "values");
+    for (const py::object& o : v) require_real_dtype(o, "values");
     std::vector<DoubleArray> va;
     for (const py::object& o : v) va.push_back(DoubleArray::ensure(o));
     for (size_t k = 0; k < va.size(); ++k)
@@ -280,13 +323,16 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
         if (va[1].shape(0) != s.z || va[1].shape(1) != s.y || va[1].shape(2) != s.x)
             throw std::invalid_argument("values: the secondary grid must have shape (nz-1, ny-1, nx-1) of the primary's (nz, ny, nx)");
     }
-    const py::tuple o = py::tuple(py::module_::import("builtins").attr("tuple")(origin));
-    if (o.size() != 3) throw std::invalid_argument("origin: expected 3 numbers");
-    f.lattice.origin = {o[0].cast<double>(), o[1].cast<double>(), o[2].cast<double>()};
+    f.lattice.origin = vec3_argument(origin, "origin");
+    for (const Vec3d& corner : {f.lattice.domain_min(), f.lattice.domain_max()})
+        if (!std::isfinite(corner.x) || !std::isfinite(corner.y) || !std::isfinite(corner.z))
+            throw std::invalid_argument("origin, spacing: the lattice's far corner (origin + spacing x (resolution - 1)) "
+                                        "is not finite");
     for (const DoubleArray& a : va) f.distance.insert(f.distance.end(), a.data(), a.data() + a.size());
     if (!gradient.is_none()) {
         const std::vector<py::object> g = grids_of(gradient, "gradient");
         for (size_t k = 0; k < g.size(); ++k) {
+            require_real_dtype(g[k], "gradient");
             const DoubleArray a = DoubleArray::ensure(g[k]);
             if (!a || a.ndim() != 4 || a.shape(3) != 3 || a.shape(0) != va[k].shape(0) || a.shape(1) != va[k].shape(1) ||
                 a.shape(2) != va[k].shape(2))
@@ -297,9 +343,16 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
     if (!triangle.is_none()) {
         const std::vector<py::object> t = grids_of(triangle, "triangle");
         for (size_t k = 0; k < t.size(); ++k) {
+            if (!py::isinstance<py::array>(t[k]) || std::string("iu").find(py::array(t[k]).dtype().kind()) == std::string::npos)
+                throw py::type_error("triangle: expected integer arrays (0-based triangle indices, -2 outside a narrow band), got " +
+                                     dtype_text(t[k]));
             const auto a = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(t[k]);
             if (!a || a.ndim() != 3 || a.shape(0) != va[k].shape(0) || a.shape(1) != va[k].shape(1) || a.shape(2) != va[k].shape(2))
                 throw std::invalid_argument("triangle: expected integer arrays of the values' shape");
+            for (py::ssize_t i = 0; i < a.size(); ++i)
+                if (a.data()[i] < -2)
+                    throw std::invalid_argument("triangle: entry " + std::to_string(i) + " is " + std::to_string(a.data()[i]) +
+                                                "; expected a triangle index >= 0, or -2 (outside a narrow band)");
             f.closest_triangle.insert(f.closest_triangle.end(), a.data(), a.data() + a.size());
         }
     }

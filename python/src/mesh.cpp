@@ -46,6 +46,9 @@ MeshHolder mesh_from_arrays(const py::array& vertices_in, const py::array& faces
     if (kind != 'i' && kind != 'u')
         throw py::type_error("faces: expected an integer array of shape (M, 3), got dtype " +
                              std::string(py::str(faces_in.dtype())));
+    if (std::string("iuf").find(vertices_in.dtype().kind()) == std::string::npos)
+        throw py::type_error("vertices: expected an array of real numbers of shape (N, 3), got dtype " +
+                             std::string(py::str(vertices_in.dtype())));
     const DoubleArray vertices = DoubleArray::ensure(vertices_in);
     const auto faces = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(faces_in);
     if (!vertices || !faces) throw py::type_error("vertices and faces must be numeric arrays");

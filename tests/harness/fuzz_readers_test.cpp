@@ -234,7 +234,8 @@ std::string polygon_prism(const std::string& format) {
 }
 
 // The reader rules of issue 26: polygons, ASCII STL in capitals or on one line, classic Mac
-// line ends, a binary STL whose header begins with "solid", gzip members.
+// line ends, a binary STL whose header begins with "solid", gzip members, a .ply.gz bounded
+// by its header.
 TEST_F(FuzzReaders, MeshFilesUnderTheReaderRules) {
     const TriangleMesh box = make_box({1.0, 0.5, 0.25});
     std::string upper = test::stl_ascii_text(box);
@@ -255,6 +256,15 @@ TEST_F(FuzzReaders, MeshFilesUnderTheReaderRules) {
     test::write_gzip(at("b.gz"), polygon_prism("ply").substr(100));
     const std::string members = test::read_text(at("a.gz")) + test::read_text(at("b.gz"));
     fuzz(at("m.ply.gz"), members, kPerSeed / 3, 7100, load_and_prepare);
+    // A binary PLY gzip-compressed after each mutation: its header's declared sizes bound the
+    // decompression (mutated counts and types included).
+    fuzz(at("g.ply.gz"), test::ply_text(box, test::PlyEncoding::BinaryLittleEndian), kPerSeed / 3, 7200,
+         [](const std::string& path, const std::string& bytes) {
+             test::write_gzip(path, bytes);
+             MeshPreparationOptions o;
+             o.detect_intersections = false;
+             prepare_mesh(load_mesh_file(path), o);
+         });
 }
 
 TEST_F(FuzzReaders, PointsFiles) {

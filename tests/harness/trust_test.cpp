@@ -4,7 +4,9 @@
 // against closed-form truth: the unit-corner tetrahedron's distances and a linear field that
 // trilinear reconstruction reproduces exactly.
 #include <gtest/gtest.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -385,6 +387,66 @@ TEST_F(Trust, RunThatDoesNotFitInMemoryIsRefusedBeforeSampling) {
                                                      quote(RUN_EXPERIMENT_EXE) + " " + config("s.json", "shape:box") +
                                                      " --quiet");
     EXPECT_EQ(small.code, 0) << small.err;
+}
+
+// Issue 26: a mesh whose declared sizes are legal but larger than the memory this process
+// may use (ulimit -v) ends with exit code 1 and a message naming the file and the size, not
+// a bare std::bad_alloc: while decompressing it, and while building the mesh from it.
+TEST_F(Trust, MeshLargerThanTheMemoryLimitIsNamedWithItsSize) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: ulimit -v cannot be used";
+#endif
+    // 60 million float vertices at the origin (720 MB, 0.7 MB gzip-compressed) and one triangle.
+    const uint64_t vertices = 60000000;
+    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
+                               "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                               "property list uchar int vertex_indices\nend_header\n";
+    const uint64_t bytes = header.size() + vertices * 12 + 13;
+    {
+        gzFile f = gzopen(at("big.ply.gz").c_str(), "wb1");
+        ASSERT_TRUE(f != nullptr);
+        gzwrite(f, header.data(), unsigned(header.size()));
+        const std::string zeros(size_t(1) << 20, '\0');
+        for (uint64_t done = 0; done < vertices * 12; done += zeros.size())
+            gzwrite(f, zeros.data(), unsigned(std::min<uint64_t>(zeros.size(), vertices * 12 - done)));
+        const char face[13] = {3, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0};
+        gzwrite(f, face, sizeof face);
+        ASSERT_EQ(gzclose(f), Z_OK);
+    }
+    write("p.txt", "0 0 0\n");
+    const auto limited = [&](int kib) {
+        return test::run_in(dir_, "ulimit -v " + std::to_string(kib) + " && " + quote(SDF_QUERY_EXE) + " big.ply.gz p.txt");
+    };
+    // 500 MB: the decompressed content does not fit.
+    const ShellResult decompress = limited(500000);
+    EXPECT_EQ(decompress.code, 1) << decompress.err;
+    EXPECT_TRUE(Contains(decompress.err, "big.ply.gz: not enough memory to decompress the mesh file: ")) << decompress.err;
+    EXPECT_TRUE(Contains(decompress.err, std::to_string(bytes) + " bytes decompressed (a buffer of that size could not be allocated)"))
+        << decompress.err;
+    // 1.5 GB: the content fits, its 60 million vertices in double (1.44 GB) do not.
+    const ShellResult build = limited(1500000);
+    EXPECT_EQ(build.code, 1) << build.err;
+    EXPECT_TRUE(Contains(build.err, "big.ply.gz: not enough memory to read the PLY mesh (" + std::to_string(bytes) +
+                                    " bytes decompressed)"))
+        << build.err;
+    for (const ShellResult* r : {&decompress, &build}) {
+        EXPECT_FALSE(Contains(r->err, "std::bad_alloc")) << r->err;
+        EXPECT_TRUE(r->out.empty()) << r->out;
+    }
+}
+
+// Issue 26: a points file's bad line is quoted with its control and non-ASCII bytes escaped
+// (a NUL no longer cuts the message short, raw bytes no longer reach the terminal).
+TEST_F(Trust, PointsFileErrorsQuoteTheLineWithItsBytesEscaped) {
+    const std::string nul = write("nul.txt", std::string("0 0 0\n1 2 3\0\n", 13));
+    EXPECT_EQ(error_of([&] { read_points_file(nul); }),
+              nul + ":2: expected three finite numbers \"x y z\", got '1 2 3\\x00'");
+    const std::string binary = write("binary.txt", "0 0 0\n\x80\x81 1 1\n");
+    EXPECT_EQ(error_of([&] { read_points_file(binary); }),
+              binary + ":2: expected three finite numbers \"x y z\", got '\\x80\\x81 1 1'");
+    const ShellResult r = query(quote(write("t.obj", tetra_obj())) + " " + quote(nul));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "got '1 2 3\\x00'")) << r.err;
 }
 
 TEST_F(Trust, RenderLargerThanMemoryIsRefusedWithTheFigure) {

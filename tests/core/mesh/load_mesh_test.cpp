@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -233,6 +234,54 @@ TEST_F(LoadMeshErrors, OffAndPlyCountsThatDoNotMatchTheData) {
     expect_error("short.ply", short_line, "PLY element 'vertex' 1 (line 11): the line ends after 2 values");
 }
 
+// Counts one too large and one too small, for vertices and faces, in every format that
+// declares counts: each named with the line (or byte), the count and what was found (issue 26).
+TEST_F(LoadMeshErrors, CountsOneTooLargeOrTooSmallAreNamedPrecisely) {
+    const std::string off_body = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n";
+    expect_error("v+1.off", "OFF\n5 2 0\n" + off_body,
+                 "OFF line 7: expected 5 vertex lines, found 4 before the faces: this line ('3 0 1 2') is a face line, read "
+                 "as vertex 4, and the file then ends after 1 of 2 faces (is the vertex count too large by 1?)");
+    expect_error("v-1.off", "OFF\n3 2 0\n" + off_body,
+                 "OFF line 6: expected face 0 of 2, found a vertex line ('0 0 1'): the header declares 3 vertices, but "
+                 "vertex lines continue after them (is the vertex count too small?)");
+    expect_error("f+1.off", "OFF\n4 3 0\n" + off_body,
+                 "OFF line 8: file ends after 2 of 3 faces (expected 3 face lines, found 2; is the face count too large, "
+                 "or the file truncated?)");
+    expect_error("f-1.off", "OFF\n4 1 0\n" + off_body,
+                 "OFF line 8: data continues after the 1 faces the header declares (found '3'; is the face count too small?)");
+    // A bad face that is no vertex line keeps its own message.
+    expect_error("bad-face.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n2 0 1\n3 0 1 3\n",
+                 "OFF line 7: face 0 has vertex count '2'; expected 3 or more");
+
+    const auto ply = [](const std::string& from, const std::string& to) {
+        std::string text = kTrianglePly;
+        text.replace(text.find(from), from.size(), to);
+        return text;
+    };
+    expect_error("v+1.ply", ply("vertex 3", "vertex 4"),
+                 "PLY element 'vertex' 3 (line 13): the line has more values than the element's properties (x y z)");
+    expect_error("v-1.ply", ply("vertex 3", "vertex 2"),
+                 "PLY element 'face' 0 (line 12): expected face 0 of 1, found a vertex line ('0 1 0'): the header declares 2 "
+                 "vertices, but vertex lines continue after them (is the header's count of 'vertex' elements too small?)");
+    expect_error("f+1.ply", ply("face 1", "face 2"),
+                 "file ends after 1 of 2 'face' elements (expected 2 lines of them, found 1; is the header's count too "
+                 "large, or the file truncated?)");
+    expect_error("f-1.ply", ply("face 1", "face 0"), "PLY data (line 13 ('3')): data continues after the last declared element (is a count in the header too small?)");
+
+    // Binary STL: the size tells both ways.
+    std::string stl = test::stl_binary_text(test_shape(true));
+    stl.replace(0, 5, "xxxxx");
+    const uint32_t n = 576;
+    for (const uint32_t wrong : {n + 1, n - 1}) {
+        std::string text = stl;
+        std::memcpy(text.data() + 80, &wrong, 4);
+        expect_error("count" + std::to_string(wrong) + ".stl", text,
+                     "binary STL header: declares " + std::to_string(wrong) + " triangles, which take " +
+                         std::to_string(84 + 50 * wrong) + " bytes, but the file has " + std::to_string(stl.size()) +
+                         (wrong > n ? " (truncated, or not STL)" : " (data after the declared triangles: is the count too small?"));
+    }
+}
+
 TEST_F(LoadMeshErrors, Utf16WithoutByteOrderMarkIsNamed) {
     std::string utf16;
     for (const char c : std::string("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")) { utf16 += c; utf16 += '\0'; }
@@ -314,9 +363,44 @@ TEST_F(LoadMeshErrors, GzipIsDecompressedOnlyAsFarAsTheContentAllows) {
     write_gzip_zeros(at("tail.stl.gz"), zeros, test::stl_binary_text(test_shape(true)));
     const long before = peak_rss_kib();
     expect_error("zeros.obj.gz", test::read_text(at("zeros.obj.gz")), "line 1: byte 0 is a NUL byte");
-    expect_error("zeros.stl.gz", test::read_text(at("zeros.stl.gz")), "decompresses to more than 84 bytes (what its content declares)");
+    expect_error("zeros.stl.gz", test::read_text(at("zeros.stl.gz")), "decompresses to more than 84 bytes (what its binary STL header declares: 0 triangles, 84 + 50 x 0 bytes)");
     expect_error("tail.stl.gz", test::read_text(at("tail.stl.gz")), "decompresses to more than 28884 bytes");
     EXPECT_LT(peak_rss_kib() - before, 64 * 1024) << "KiB";
+}
+
+// A binary PLY's header declares its size (elements x their properties' sizes, lists at
+// their count type's largest count, nothing after the last element): a .ply.gz is
+// decompressed no further, whatever follows in the stream (issue 26). Here a triangle
+// followed by 256 MiB of zeros (1 MB compressed).
+TEST_F(LoadMeshErrors, BinaryPlyGzipIsDecompressedNoFurtherThanItsHeaderDeclares) {
+    const std::string header =
+        "ply\nformat binary_little_endian 1.0\ncomment bounded\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string data = header;
+    for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) data.append(reinterpret_cast<const char*>(&v), 4);
+    data += char(3);
+    for (const int32_t i : {0, 1, 2}) data.append(reinterpret_cast<const char*>(&i), 4);
+    test::write_gzip(at("triangle.ply.gz"), data);
+    EXPECT_EQ(load_mesh_file(at("triangle.ply.gz")).triangles.size(), 1u);
+
+    write_gzip_zeros(at("bomb.ply.gz"), size_t(256) << 20, data);
+    const long before = peak_rss_kib();
+    const uint64_t most = header.size() + 3 * 12 + 1 * (1 + 255 * 4);
+    expect_error("bomb.ply.gz", test::read_text(at("bomb.ply.gz")),
+                 "decompresses to more than " + std::to_string(most) + " bytes (what its binary PLY header declares: " +
+                     std::to_string(header.size()) + " header bytes, element 'vertex' 3 x 12 bytes, element 'face' 1 x at "
+                     "most 1021 bytes)");
+    EXPECT_LT(peak_rss_kib() - before, 64 * 1024) << "KiB";
+    // Within the bound, what follows the last element is the reader's to refuse.
+    write_gzip_zeros(at("tail.ply.gz"), 16, data);
+    expect_error("tail.ply.gz", test::read_text(at("tail.ply.gz")), "data continues after the last declared element");
+    // A byte-order mark and CRLF line ends before big-endian doubles.
+    const std::string big = "\xEF\xBB\xBFply\r\nformat binary_big_endian 1.0\r\nelement vertex 1\r\nproperty double x\r\n"
+                            "property double y\r\nproperty double z\r\nend_header\r\n";
+    write_gzip_zeros(at("big.ply.gz"), size_t(16) << 20, big);
+    expect_error("big.ply.gz", test::read_text(at("big.ply.gz")),
+                 "decompresses to more than " + std::to_string(big.size() + 24) + " bytes (what its binary PLY header declares: " +
+                     std::to_string(big.size() - 3) + " header bytes, element 'vertex' 1 x 24 bytes)");
 }
 
 TEST_F(LoadMeshErrors, GzipMembersConcatenatedAndDataAfterTheStream) {
