@@ -168,7 +168,8 @@ void BM_CpuBvhPacketKernel(benchmark::State& state, const std::string& file) {
                             const Rerank rr = certified.rerank(exact.packed, view.triangle_index, lanes[size_t(b * K + l)],
                                                                pk.best_slot[l], slack.radius(pk.best_q[l]), c.slot, c.q,
                                                                c.count, c.dropped);
-                            benchmark::DoNotOptimize(rr.slot);
+                            int winner = rr.slot;
+                            benchmark::DoNotOptimize(winner);
                             reranked += rr.reranked;
                         }
                 }
