@@ -64,8 +64,14 @@ def mpirun(mpiexec, ranks, script, env=None):
 def main():
     case, mpiexec = sys.argv[1], sys.argv[2]
     if case == "abort":
-        r, seconds = mpirun(mpiexec, 2, ABORT_SCRIPT)
-        out = r.stdout + r.stderr
+        # Open MPI 4.1's help-message relay sometimes loses the MPI_ABORT banner (an
+        # "ORTE_ERROR_LOG: ... show_help.c" line instead, about 2 runs in 5 on a 2-core machine):
+        # only that signature of the launcher's own race is run again.
+        for _ in range(5):
+            r, seconds = mpirun(mpiexec, 2, ABORT_SCRIPT)
+            out = r.stdout + r.stderr
+            if "MPI_ABORT was invoked" in out or "show_help.c" not in out:
+                break
         assert r.returncode != 0, out
         assert "a user's error on rank 1" in out and "MPI_ABORT was invoked on rank 1" in out, out
         assert "sampled without rank 1" not in out, out
