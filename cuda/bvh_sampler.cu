@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/bvh/bvh_cache.h"
+#include "core/bvh/triangle_bvh.h"
 #include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
@@ -205,17 +205,17 @@ private:
     template <typename T>
     const DeviceBvh<T>& device_bvh(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
         CUDA_CHECK(cudaSetDevice(options_.device));
-        const auto bvh = cache_.get(mesh, built);
-        sign_.prepare(mesh, bvh);  // the winding sign shares the BVH
+        const auto bvh = mesh.bvh(&built);  // the mesh's own, built once
+        sign_.prepare(mesh);  // the winding sign shares the BVH
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
-        uploaded = !slot || uploaded_for_ != bvh.get();
+        // host_bvh_ holds the tree uploaded last, so no other mesh's tree can have its address.
+        uploaded = !slot || host_bvh_ != bvh;
         if (uploaded) {
             device_float_.reset();
             device_double_.reset();
             upload.begin();
             slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh, sign_);
             upload.end();
-            uploaded_for_ = bvh.get();
             host_bvh_ = bvh;
         }
         return *slot;
@@ -612,10 +612,8 @@ private:
 
     SamplerOptions options_;
     BvhGpuKernel kernel_ = BvhGpuKernel::Warp;
-    BvhCache cache_;
     SamplerSign sign_;
-    std::shared_ptr<const TriangleBvh> host_bvh_;
-    const TriangleBvh* uploaded_for_ = nullptr;
+    std::shared_ptr<const TriangleBvh> host_bvh_;  ///< the mesh BVH the device copies were made of
     std::unique_ptr<DeviceBvh<float>> device_float_;
     std::unique_ptr<DeviceBvh<double>> device_double_;
     DeviceBuffer<unsigned long long> candidate_stats_;

@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "core/bvh/bvh_cache.h"
+#include "core/bvh/triangle_bvh.h"
 #include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
@@ -380,8 +380,7 @@ private:
     template <typename T>
     std::unique_ptr<DeviceCertifier> certifier_for(const PreparedMesh& mesh, double point_coordinate, Engine<T>& engine) {
         if (!std::is_same_v<T, float> || kernel_ != CudaKernel::Tuned) return nullptr;
-        bool built = false;
-        auto certifier = std::make_unique<DeviceCertifier>(*bvh_cache_.get(mesh, built), mesh);
+        auto certifier = std::make_unique<DeviceCertifier>(*mesh.bvh(), mesh);
         engine.certify_with(certifier.get(), point_coordinate);
         return certifier;
     }
@@ -389,7 +388,6 @@ private:
     SamplerOptions options_;
     CudaKernel kernel_ = CudaKernel::Tuned;
     SamplerSign sign_;
-    BvhCache bvh_cache_;  ///< the certified tuned search's BVH
 };
 
 }  // namespace

@@ -229,7 +229,9 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.double_buffers_ = make_buffers<double>(out);
 
     if (options.detect_intersections && !out.triangles_.empty()) {
-        const SelfIntersections found = find_self_intersections(out, build_triangle_bvh(out), out.shell_of_);
+        // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.
+        out.bvh_slot_->tree = std::make_shared<const TriangleBvh>(build_triangle_bvh(out));
+        const SelfIntersections found = find_self_intersections(out, *out.bvh_slot_->tree, out.shell_of_);
         out.intersecting_triangles_ = found.pairs;
         rep.intersections_checked = true;
         rep.self_intersecting_pairs = found.within_shell;
@@ -314,6 +316,14 @@ MeshView<T> MeshBuffers<T>::view() const {
     return v;
 }
 
+
+std::shared_ptr<const TriangleBvh> PreparedMesh::bvh(bool* built_by_this_call) const {
+    std::lock_guard<std::mutex> lock(bvh_slot_->mutex);
+    const bool build = !bvh_slot_->tree;
+    if (build) bvh_slot_->tree = std::make_shared<const TriangleBvh>(build_triangle_bvh(*this));
+    if (built_by_this_call) *built_by_this_call = build;
+    return bvh_slot_->tree;
+}
 
 template <>
 const MeshBuffers<float>& PreparedMesh::buffers<float>() const {

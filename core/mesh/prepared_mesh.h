@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,8 @@
 #include "kernels/distance/mesh_view.h"
 
 namespace sdf {
+
+class TriangleBvh;  // core/bvh/triangle_bvh.h: include it to use bvh()'s tree
 
 struct MeshPreparationOptions {
     /// Vertices closer than this (absolute, mesh units) are merged; 0 merges only
@@ -65,7 +68,10 @@ struct MeshBuffers {
 };
 
 /// A prepared mesh is immutable: only prepare_mesh() builds one, with its float and double
-/// buffers made at once, so that any number of threads and samplers can share it.
+/// buffers made at once, so that any number of threads and samplers can share it. Its BVH
+/// belongs to it too (bvh()), built once however many samplers and calls use it, as fcpw's
+/// Scene::build() and NanoVDB's grids keep their acceleration data with what they describe.
+/// Copies share the buffers and the BVH (the same content).
 class PreparedMesh {
 public:
     const std::string& name() const { return name_; }
@@ -93,6 +99,15 @@ public:
     template <typename T>
     const MeshBuffers<T>& buffers() const;
 
+    /// The BVH of the triangles (binned SAH with the default BvhBuildOptions, the one set
+    /// every sampler uses; a tree with other options is build_triangle_bvh(mesh, options),
+    /// its caller's). Built at most once per mesh and its copies: by prepare_mesh() when it
+    /// looks for self-intersections (the same tree), else by the first call. Thread-safe:
+    /// concurrent first calls wait for one build. `built_by_this_call` (may be null) tells
+    /// whether this call built it, for the samplers' provenance; the tree's stats.seconds
+    /// is its build time either way. Throws what build_triangle_bvh throws.
+    std::shared_ptr<const TriangleBvh> bvh(bool* built_by_this_call = nullptr) const;
+
 private:
     friend PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options);
     PreparedMesh() = default;
@@ -109,6 +124,13 @@ private:
     // Shared, so that copies of a prepared mesh share one set of buffers.
     std::shared_ptr<const MeshBuffers<float>> float_buffers_;
     std::shared_ptr<const MeshBuffers<double>> double_buffers_;
+    /// The BVH, built on first use under the lock; shared by copies like the buffers (a
+    /// mutex cannot be copied or moved, a pointer to one can).
+    struct BvhSlot {
+        std::mutex mutex;
+        std::shared_ptr<const TriangleBvh> tree;
+    };
+    std::shared_ptr<BvhSlot> bvh_slot_ = std::make_shared<BvhSlot>();
 };
 
 PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options = {});

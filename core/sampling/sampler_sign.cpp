@@ -11,21 +11,18 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
 
 }  // namespace
 
-const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
-    const bool same_mesh =
-        mesh_ == &mesh && mesh_sha_ == mesh.content_sha256() && mesh_triangles_ == mesh.triangles().size();
-    if (same_mesh) return choice_;
-    choice_ = choose_sign_mode(mesh.report(), requested_);
-    winding_.reset();
-    if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
-        report_warning(auto_sign_text(mesh, choice_.reason));
-    if (choice_.mode == SignMode::Winding) {
-        winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
-                       : std::make_shared<const WindingSign>(mesh, winding_options());
+const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
+    choice_ = choose_sign_mode(mesh.report(), requested_);  // cheap, and never another mesh's
+    if (choice_.mode != SignMode::Winding) {
+        winding_.reset();
+        return choice_;
     }
-    mesh_ = &mesh;
-    mesh_sha_ = mesh.content_sha256();
-    mesh_triangles_ = mesh.triangles().size();
+    std::shared_ptr<const TriangleBvh> bvh = mesh.bvh();
+    // winding_ holds the tree it was built over, so that tree cannot have been freed and its
+    // address reused: the same tree means this mesh or a copy (sharing its buffers).
+    if (winding_ && winding_->winding_bvh().bvh == bvh) return choice_;
+    if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
+    winding_ = std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options());
     return choice_;
 }
 

@@ -21,10 +21,11 @@ class SamplerSign {
 public:
     explicit SamplerSign(SignMode requested = SignMode::Auto) : requested_(requested) {}
 
-    /// Resolves the mode for `mesh` and, for winding, builds its WindingSign over `bvh`
-    /// (built here when null). Both are kept while the mesh stays the same (the warning is
-    /// written once per mesh). Not thread-safe: call it before the parallel loop.
-    const SignModeChoice& prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh = nullptr);
+    /// Resolves the mode for `mesh` (from its own report, on every call) and, for winding,
+    /// builds its WindingSign over the mesh's BVH, kept while the mesh stays the same (the
+    /// warning is written once per WindingSign built). Not thread-safe: call it before the
+    /// parallel loop.
+    const SignModeChoice& prepare(const PreparedMesh& mesh);
 
     SignMode requested() const { return requested_; }
     const SignModeChoice& choice() const { return choice_; }
@@ -49,9 +50,6 @@ private:
     SignMode requested_;
     SignModeChoice choice_;
     std::shared_ptr<const WindingSign> winding_;
-    const PreparedMesh* mesh_ = nullptr;
-    std::string mesh_sha_;
-    size_t mesh_triangles_ = 0;
 };
 
 /// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler

@@ -95,7 +95,7 @@ WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const Tri
 }
 
 WindingBvh build_winding_bvh(const PreparedMesh& mesh) {
-    return build_winding_bvh(mesh, std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh)));
+    return build_winding_bvh(mesh, mesh.bvh());
 }
 
 template <>

@@ -29,7 +29,7 @@ public:
 /// area-weighted normal sum and the second-order matrix. O(triangles x depth).
 WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh);
 
-/// Builds the BVH too.
+/// Over the mesh's own BVH (PreparedMesh::bvh()).
 WindingBvh build_winding_bvh(const PreparedMesh& mesh);
 
 }  // namespace sdf

@@ -39,7 +39,7 @@ SignModeChoice choose_sign_mode(const MeshReport& r, SignMode requested) {
 }
 
 WindingSign::WindingSign(const PreparedMesh& mesh, const WindingSignOptions& options)
-    : WindingSign(mesh, std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh)), options) {}
+    : WindingSign(mesh, mesh.bvh(), options) {}
 
 WindingSign::WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options)
     : options_(options), winding_(build_winding_bvh(mesh, std::move(bvh))) {

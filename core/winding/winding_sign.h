@@ -38,8 +38,9 @@ struct WindingSignOptions {
 /// The CPU winding-number sign of one mesh: build once, call inside() from any thread.
 class WindingSign {
 public:
+    /// Over the mesh's own BVH (PreparedMesh::bvh()).
     WindingSign(const PreparedMesh& mesh, const WindingSignOptions& options = {});
-    /// Shares an existing BVH of `mesh` (e.g. the BVH sampler's).
+    /// Over `bvh`, a BVH of `mesh` (mesh.bvh(), or a tree built with other options).
     WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options = {});
 
     /// True when w(p) > 1/2: the fast value's side of 1/2, or with `certify` the side

@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/bvh/bvh_cache.h"
+#include "core/bvh/triangle_bvh.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/progress.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
@@ -410,9 +410,8 @@ public:
     std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
         require_search_range(mesh, points, options_.precision);
         std::vector<PointSample> out(points.size());
-        bool built = false;
-        const auto bvh = cache_.get(mesh, built);
-        sign_.prepare(mesh, bvh);
+        const auto bvh = mesh.bvh();
+        sign_.prepare(mesh);
         QueryCounters counters;
         auto run = [&](auto zero) {
             using T = decltype(zero);
@@ -442,8 +441,8 @@ private:
     SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
         const auto start = std::chrono::steady_clock::now();
         bool built = false;
-        const auto bvh = cache_.get(mesh, built);
-        sign_.prepare(mesh, bvh);  // shares the BVH: only the winding moments are added
+        const auto bvh = mesh.bvh(&built);  // the mesh's own, built once
+        sign_.prepare(mesh);  // over the same BVH: only the winding moments are added
         const auto query_start = std::chrono::steady_clock::now();
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         GridBlock blocks[2];
@@ -523,7 +522,6 @@ private:
 
     SamplerOptions options_;
     BvhKernel kernel_ = BvhKernel::Brick;
-    BvhCache cache_;
     SamplerSign sign_;
 };
 

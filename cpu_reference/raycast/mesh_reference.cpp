@@ -11,9 +11,9 @@
 
 namespace sdf {
 
-MeshReferenceRenderer::MeshReferenceRenderer(const PreparedMesh& mesh) : mesh_(mesh), bvh_(build_triangle_bvh(mesh)) {
-    corners_.reserve(bvh_.triangle_index.size() * 3);
-    for (int32_t t : bvh_.triangle_index) {
+MeshReferenceRenderer::MeshReferenceRenderer(const PreparedMesh& mesh) : mesh_(mesh), bvh_(mesh.bvh()) {
+    corners_.reserve(bvh_->triangle_index.size() * 3);
+    for (int32_t t : bvh_->triangle_index) {
         const Int3 tri = mesh.triangles()[size_t(t)];
         for (int k = 0; k < 3; ++k) corners_.push_back(mesh.vertices()[size_t(tri[k])]);
     }
@@ -24,7 +24,7 @@ PixelRecord MeshReferenceRenderer::cast(const Ray<double>& ray, const Vec3d& key
     const WatertightRay<double> w = make_watertight_ray(ray);
     TriangleHit<double> best;
     int32_t best_slot = -1;
-    closest_hit_bvh(bvh_.nodes.data(), ray, std::numeric_limits<double>::infinity(),
+    closest_hit_bvh(bvh_->nodes.data(), ray, std::numeric_limits<double>::infinity(),
                     [&](int32_t first, int32_t count, double& t_max) {
                         for (int32_t s = first; s < first + count; ++s) {
                             TriangleHit<double> h;
@@ -36,9 +36,9 @@ PixelRecord MeshReferenceRenderer::cast(const Ray<double>& ray, const Vec3d& key
                             }
                         }
                     });
-    if (triangle) *triangle = best_slot < 0 ? -1 : bvh_.triangle_index[size_t(best_slot)];
+    if (triangle) *triangle = best_slot < 0 ? -1 : bvh_->triangle_index[size_t(best_slot)];
     if (best_slot < 0) return background_pixel();
-    const int32_t t = bvh_.triangle_index[size_t(best_slot)];
+    const int32_t t = bvh_->triangle_index[size_t(best_slot)];
     Vec3d n = mesh_.face_normals()[size_t(t)];
     if (interpolate_normals) {
         const Int3 tri = mesh_.triangles()[size_t(t)];

@@ -38,11 +38,11 @@ public:
 
 private:
     const PreparedMesh& mesh_;
-    TriangleBvh bvh_;
+    std::shared_ptr<const TriangleBvh> bvh_;  ///< the mesh's own (PreparedMesh::bvh())
     std::vector<Vec3d> corners_;  ///< 3 vertices per BVH slot, in BVH order
 };
 
-/// One view, building the BVH for it.
+/// One view, over the mesh's BVH.
 RenderedImage render_mesh_reference(const PreparedMesh& mesh, const CameraSpec& camera,
                                     const MeshRenderOptions& options = {});
 

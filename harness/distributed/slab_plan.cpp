@@ -29,8 +29,8 @@ double probe_plane(const BvhView<T>& view, const Lattice& lattice, const Int3& r
 
 template <typename T>
 std::vector<double> bvh_plane_costs(const PreparedMesh& mesh, const Lattice& lattice) {
-    const TriangleBvh bvh = build_triangle_bvh(mesh);
-    const BvhView<T> view = bvh.view<T>();
+    const std::shared_ptr<const TriangleBvh> bvh = mesh.bvh();  // the samplers' tree, built once
+    const BvhView<T> view = bvh->view<T>();
     const Int3 r = lattice.resolution, s = lattice.secondary_resolution();
     const bool secondary = lattice.secondary_count() > 0;
     std::vector<double> cost(size_t(r.z), 0.0);

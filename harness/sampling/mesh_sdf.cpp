@@ -27,8 +27,9 @@ MeshSdf::MeshSdf(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions&
         sign_mode_ = sign_mode_name(choice.mode);
         sign_reason_ = choice.reason;
     }
-    // One query builds everything the sampler keeps for this mesh (BVH, winding data,
-    // device upload); an empty one would not reach the GPU's upload.
+    // One query builds everything a query of this mesh needs: the mesh's BVH (unless its
+    // preparation or another sampler built it), the sampler's winding data and device
+    // upload; an empty one would not reach the GPU's upload.
     const Bounds3& b = mesh_->bounds();
     sampler_->query(*mesh_, {(b.min + b.max) * 0.5});
     prepared_of_input_.assign(size_t(mesh_->report().input_triangles), -1);

@@ -46,11 +46,9 @@ std::shared_ptr<PreparedMesh> load(const std::string& file) {
 /// The winding BVH of the mesh, built once.
 const WindingSign& winding_of(const PreparedMesh& mesh, const WindingSignOptions& o) {
     static std::map<std::pair<const PreparedMesh*, std::string>, std::unique_ptr<WindingSign>> cache;
-    static std::shared_ptr<const TriangleBvh> bvh;
-    if (!bvh) bvh = std::make_shared<const TriangleBvh>(build_triangle_bvh(mesh));
     const std::string key = std::to_string(o.accuracy.beta) + "/" + std::to_string(o.accuracy.order) + "/" + std::to_string(o.certify);
     auto& slot = cache[{&mesh, key}];
-    if (!slot) slot = std::make_unique<WindingSign>(mesh, bvh, o);
+    if (!slot) slot = std::make_unique<WindingSign>(mesh, mesh.bvh(), o);
     return *slot;
 }
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <new>
 
 #include "core/sampling/adversarial_cases.h"
 
@@ -181,6 +182,46 @@ TEST(CudaBvh, RepeatedCallsReuseTheUploadedBvh) {
     EXPECT_TRUE(first.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
     EXPECT_FALSE(second.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
     EXPECT_EQ(first.distance, second.distance);
+}
+
+/// The device copies follow the mesh's own tree (PreparedMesh::bvh()): a second sampler of
+/// one mesh builds no tree, and a mesh made at a freed mesh's address from the same input
+/// (same name, hash, triangle count and bounds), but flipped outward, gets its own tree,
+/// upload, winding sign and certifier: its fields equal a fresh sampler's bit for bit.
+TEST(CudaBvh, AMeshAtAFreedMeshsAddressGetsItsOwnUpload) {
+    TriangleMesh inward = make_icosphere(2);
+    for (Int3& t : inward.triangles) std::swap(t.y, t.z);
+    MeshPreparationOptions keep_inward, flip;
+    keep_inward.detect_intersections = flip.detect_intersections = false;
+    keep_inward.orient_outward = false;
+    const PreparedMesh fresh = prepare_mesh(inward, flip);
+    const Lattice lattice = fit_lattice(LatticeType::CC, {12, 12, 12}, fresh.bounds(), 0.2);
+    for (const char* method : {"bvh", "brute_force"})
+        for (SignMode sign : {SignMode::Winding, SignMode::Pseudonormal}) {
+            SCOPED_TRACE(std::string(method) + " " + sign_mode_name(sign));
+            SamplerOptions o = options("cuda", method, Precision::Float);
+            o.sign = sign;
+            const SampledField expected = make_sampler(o)->sample(fresh, lattice);
+            auto sampler = make_sampler(o);
+            alignas(PreparedMesh) unsigned char storage[sizeof(PreparedMesh)];
+            PreparedMesh* first = new (storage) PreparedMesh(prepare_mesh(inward, keep_inward));
+            sampler->sample(*first, lattice);
+            first->~PreparedMesh();
+            PreparedMesh* second = new (storage) PreparedMesh(prepare_mesh(inward, flip));
+            ASSERT_EQ(static_cast<void*>(second), static_cast<void*>(first));
+            const SampledField got = sampler->sample(*second, lattice);
+            EXPECT_EQ(got.distance, expected.distance);
+            EXPECT_EQ(got.closest_triangle, expected.closest_triangle);
+            if (std::string(method) == "bvh") {
+                EXPECT_TRUE(got.sampler.details.at("bvh")["built_by_this_call"].get<bool>());
+                EXPECT_TRUE(got.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
+                // Another sampler of the same mesh uploads its own copy of the same tree.
+                const SampledField other = make_sampler(o)->sample(*second, lattice);
+                EXPECT_FALSE(other.sampler.details.at("bvh")["built_by_this_call"].get<bool>());
+                EXPECT_EQ(other.distance, expected.distance);
+            }
+            second->~PreparedMesh();
+        }
 }
 
 TEST(CudaBvh, ErrorsNameTheKernel) {

@@ -64,6 +64,21 @@ TEST(MeshSdf, QueriesEqualTheSamplersBitForBitCallAfterCall) {
         }
 }
 
+TEST(MeshSdf, BoundObjectsOfOneMeshShareItsTree) {
+    MeshPreparationOptions unchecked;
+    unchecked.detect_intersections = false;  // so that the first bound object builds the tree
+    const auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(make_torus(1.0, 0.35, 32, 16), unchecked));
+    const MeshSdf first(mesh, cpu("bvh", SignMode::Pseudonormal));
+    bool built = true;
+    const auto tree = mesh->bvh(&built);
+    EXPECT_FALSE(built);  // the first bound object built it
+    const MeshSdf second(mesh, cpu("bvh", SignMode::Winding));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {8, 8, 8}, mesh->bounds(), 0.1);
+    const SampledField field = second.sample(lattice);
+    EXPECT_FALSE(field.sampler.details.at("bvh").at("built_by_this_call").get<bool>());
+    EXPECT_EQ(mesh->bvh(), tree);
+}
+
 TEST(MeshSdf, FieldsEqualTheSamplersBitForBit) {
     const Lattice lattice = fit_lattice(LatticeType::BCC, {9, 8, 7}, torus()->bounds(), 0.1);
     const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto));
