@@ -11,14 +11,33 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
 
 }  // namespace
 
-const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
+const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
     const bool same_mesh =
         mesh_ == &mesh && mesh_sha_ == mesh.content_sha256() && mesh_triangles_ == mesh.triangles().size();
     if (same_mesh) return choice_;
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
+    external_moments_on_.clear();
     if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
         report_warning(auto_sign_text(mesh, choice_.reason));
+    mesh_ = &mesh;
+    mesh_sha_ = mesh.content_sha256();
+    mesh_triangles_ = mesh.triangles().size();
+    return choice_;
+}
+
+const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
+    const bool same_mesh =
+        mesh_ == &mesh && mesh_sha_ == mesh.content_sha256() && mesh_triangles_ == mesh.triangles().size();
+    // After prepare_mode() the mode is known but a winding sign may still be missing.
+    if (same_mesh && (choice_.mode != SignMode::Winding || winding_)) return choice_;
+    if (!same_mesh) {
+        choice_ = choose_sign_mode(mesh.report(), requested_);
+        if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
+            report_warning(auto_sign_text(mesh, choice_.reason));
+    }
+    winding_.reset();
+    external_moments_on_.clear();
     if (choice_.mode == SignMode::Winding) {
         winding_ = bvh ? std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options())
                        : std::make_shared<const WindingSign>(mesh, winding_options());
@@ -39,6 +58,13 @@ nlohmann::json SamplerSign::provenance() const {
                         {"order", o.accuracy.order},
                         {"certified", o.certify},
                         {"moments_seconds", winding_->winding_bvh().seconds}};
+    } else if (winding() && !external_moments_on_.empty()) {
+        const WindingSignOptions o = winding_options();
+        p["winding"] = {{"beta", o.accuracy.beta},
+                        {"order", o.accuracy.order},
+                        {"certified", o.certify},
+                        {"moments_seconds", external_moments_seconds_},
+                        {"moments_built_on", external_moments_on_}};
     }
     return p;
 }
