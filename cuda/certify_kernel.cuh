@@ -129,6 +129,7 @@ public:
         CertifyView v;
         v.bvh = {arrays_.nodes, arrays_.packed, arrays_.triangle_index, num_nodes_, num_triangles_};
         v.exact = {arrays_.nodes, arrays_.exact, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact.margin = double_prune_margin(bound_);  // the full double search equals the brute force
         v.slot_of = arrays_.slot_of;
         v.slack = make_search_slack(bound_, point_coordinate);
         v.counters = counters_.get();
@@ -144,7 +145,7 @@ public:
         StreamedCertify c;
         c.slack = make_search_slack(bound_, point_coordinate);
         if (!c.slack.certify) return c;
-        c.exact = exact_.get();
+        c.exact = arrays_.exact;  // this certifier's upload, or the GPU build's arrays
         c.counters = counters_.get();
         return c;
     }
