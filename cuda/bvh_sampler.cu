@@ -73,7 +73,10 @@ struct DeviceBvh {
         source_triangle.upload(prepared.source_triangle());
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         winding.upload(sign, mesh->view());
-        view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        if constexpr (std::is_same_v<T, float>)
+            view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        else
+            view = bvh.view<double>().with_arrays(nodes.get(), packed.get(), triangle_index.get());  // and its margin
         if constexpr (std::is_same_v<T, float>) certifier = std::make_unique<DeviceCertifier>(bvh, prepared);
     }
 
@@ -89,6 +92,8 @@ struct DeviceBvh {
         view = lbvh->view<T>();
         if constexpr (std::is_same_v<T, float>)
             certifier = std::make_unique<DeviceCertifier>(view, lbvh->packed_double.get(), lbvh->slot_of.get(), prepared);
+        else
+            view.margin = double_prune_margin(float_search_bound(prepared));
     }
     std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };
@@ -254,9 +259,6 @@ private:
             if (choose_sign_mode(mesh.report(), options_.sign).mode != SignMode::Pseudonormal)
                 device_build_skipped_ = "bvh_build auto with the winding sign: its fast winding number may take the "
                                         "other side of 1/2 on another tree, so the host tree keeps the field unchanged";
-            else if (options_.precision != Precision::Float)
-                device_build_skipped_ = "bvh_build auto with precision double: the uncertified double search may pick "
-                                        "another triangle of a near-tie on another tree, so the host tree keeps the field unchanged";
             if (!device_build_skipped_.empty()) return nullptr;
         }
         const MeshKey key{&mesh, mesh.content_sha256(), mesh.triangles().size()};

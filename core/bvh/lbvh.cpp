@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/bvh/search_bound.h"
 #include "kernels/bvh/lbvh_steps.h"
 
 namespace sdf {
@@ -181,6 +182,8 @@ LbvhBuild build_lbvh(const BvhBuildInput& mesh, const Bounds3& box, const GpuBvh
     st.sah_cost = bvh_sah_cost(bvh.nodes);
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     out.within_depth = depth <= kBvhMaxDepth;
+    // The search bound, as build_triangle_bvh() keeps it (the double view's pruning margin).
+    bvh.float_bound = float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
     return out;
 }
 

@@ -225,7 +225,11 @@ BvhView<float> TriangleBvh::view<float>() const {
 
 template <>
 BvhView<double> TriangleBvh::view<double>() const {
-    return {nodes.data(), packed_double.data(), triangle_index.data(), int(nodes.size()), int(triangle_index.size())};
+    BvhView<double> v{nodes.data(), packed_double.data(), triangle_index.data(), int(nodes.size()),
+                      int(triangle_index.size())};
+    // Without the bound (a tree made by hand) the margin is infinite: the brute force.
+    v.margin = float_bound ? double_prune_margin(*float_bound) : PruneMargin<double>{INFINITY, 0.0};
+    return v;
 }
 
 TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions& options) {

@@ -73,36 +73,34 @@ void check_tree(const PreparedMesh& mesh, const TriangleBvh& bvh, int max_leaf, 
     EXPECT_LE(deepest, kBvhMaxDepth) << what;
 }
 
-/// The double query through `bvh` and the loop over all triangles: the same minimum, or
-/// (at a tie of true distances that the double rounding splits by more than the query's
-/// 8-ulp slack, closest_triangle_bvh.h) another triangle of the tie, within the search
-/// rounding of docs/bvh.md ("Exactness"). Returns the points where the minimum differs.
-int queries_off_the_loop(const PreparedMesh& mesh, const TriangleBvh& bvh, const std::vector<Vec3d>& pts) {
-    const BvhView<double> view = bvh.view<double>();
-    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
-    const double edge = test::longest_edge(mesh);
-    int off = 0;
-    for (const Vec3d& p : pts) {
-        double best = std::numeric_limits<double>::infinity();
-        for (const PackedTriangle<double>& t : packed) best = std::min(best, squared_distance(t, p));
-        const BvhHit<double> hit = closest_triangle_bvh(view, p);
-        EXPECT_GE(hit.slot, 0) << mesh.name();
-        if (hit.distance_squared == best) continue;
-        ++off;
-        const double d = std::sqrt(best);
-        const double slack = 64 * std::numeric_limits<double>::epsilon() * (d + edge) * (d + edge + length(p));
-        EXPECT_LE(hit.distance_squared - best, slack) << mesh.name() << ": not a tie";
-    }
-    return off;
-}
-
-/// The LBVH's queries, and the SAH tree's on the same points for comparison.
+/// The double query through `bvh` equals the loop over all triangles, triangle and distance
+/// bit for bit with the one tie rule (wins_tie), whatever the tree: the double view's pruning
+/// margin (search_certificate.h, PruneMargin) covers the rounding of squared_distance().
 void expect_queries_match_loop(const PreparedMesh& mesh, const TriangleBvh& bvh, const std::vector<Vec3d>& pts) {
-    const int lbvh_off = queries_off_the_loop(mesh, bvh, pts);
-    if (lbvh_off == 0) return;
-    const int sah_off = queries_off_the_loop(mesh, build_triangle_bvh(mesh), pts);
-    std::printf("%-20s double query off the loop's minimum at a tie: LBVH %d, SAH tree %d of %zu points\n",
-                mesh.name().c_str(), lbvh_off, sah_off, pts.size());
+    const BvhView<double> view = bvh.view<double>();
+    ASSERT_TRUE(bvh.float_bound.has_value()) << mesh.name();
+    ASSERT_TRUE(std::isfinite(view.margin.rho) && view.margin.rho > 0) << mesh.name() << ": no margin, or the brute force";
+    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
+    BvhView<double> unwidened = view;  // the old 8-ulp slack alone, for the printed count
+    unwidened.margin = {};
+    int off_without_margin = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const Vec3d& p = pts[i];
+        double best = std::numeric_limits<double>::infinity();
+        int32_t winner = -1;
+        for (size_t t = 0; t < packed.size(); ++t) {
+            const double q = squared_distance(packed[t], p);
+            if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
+        }
+        const BvhHit<double> hit = closest_triangle_bvh(view, p);
+        ASSERT_GE(hit.slot, 0) << mesh.name();
+        ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i;
+        ASSERT_EQ(hit.distance_squared, best) << mesh.name() << " point " << i;
+        off_without_margin += closest_triangle_bvh(unwidened, p).distance_squared != best;
+    }
+    if (off_without_margin > 0)
+        std::printf("%-20s without the margin the double query is off the loop's minimum at %d of %zu points\n",
+                    mesh.name().c_str(), off_without_margin, pts.size());
 }
 
 /// The moments of the bottom-up pass against the direct sums over each child's triangles
@@ -148,12 +146,14 @@ TEST(Lbvh, ValidTreeExactQueriesAndMomentsOnEveryTestMesh) {
     for (const test::NamedMesh& m : test::bvh_test_meshes()) {
         const TriangleBvh sah = build_triangle_bvh(m.mesh);
         std::printf("%-14s sah  %s\n", m.name.c_str(), sah.stats.to_json().dump().c_str());
+        const std::vector<Vec3d> points = points_around(m.mesh, m.mesh.triangles().size() > 50000 ? 200 : 1000, 3);
+        expect_queries_match_loop(m.mesh, sah, points);  // the SAH tree too: the same minimum
         for (GpuBvhBuilder builder : kBuilders) {
             const std::string what = m.name + " " + gpu_bvh_builder_name(builder);
             const LbvhBuild b = build_lbvh(m.mesh, gpu_options(builder));
             ASSERT_TRUE(b.within_depth) << what;
             check_tree(m.mesh, b.bvh, 4, what);
-            expect_queries_match_loop(m.mesh, b.bvh, points_around(m.mesh, m.mesh.triangles().size() > 50000 ? 200 : 1000, 3));
+            expect_queries_match_loop(m.mesh, b.bvh, points);
             expect_moments_match(m.mesh, b, what);
             std::printf("%-14s %s %s\n", m.name.c_str(), gpu_bvh_builder_name(builder), b.bvh.stats.to_json().dump().c_str());
         }
@@ -166,6 +166,7 @@ TEST(Lbvh, ValidTreeAndExactQueriesOnAdversarialCases) {
         po.orient_outward = false;
         const PreparedMesh mesh = prepare_mesh(c.mesh, po);
         if (int(mesh.triangles().size()) <= 4) continue;
+        expect_queries_match_loop(mesh, build_triangle_bvh(mesh), c.points);
         for (int leaf : {1, 4})
         for (GpuBvhBuilder builder : kBuilders) {
             const LbvhBuild b = build_lbvh(mesh, gpu_options(builder, leaf));
