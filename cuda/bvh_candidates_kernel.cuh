@@ -8,9 +8,10 @@
 /// squared distance from a point p of the brick to t_c. Each point's own winner t* has
 /// q(p, t*) <= q(p, t_c) <= u. A leaf box B holding t* has box_d2(B, brick) <= box_d2(B, p)
 /// (the brick box holds p, and float subtraction is monotone, so this holds as computed) and
-/// box_d2(B, p) is within may_hold_nearer's 8 ulps of q(p, t*), the premise every BVH search
-/// of the project rests on (closest_triangle_bvh.h). So every leaf with
-/// may_hold_nearer(box_d2(B, brick), u) is a candidate, t* is among them, and the minimum
+/// box_d2(B, p) is within may_hold_nearer's 8 ulps of q(p, t*) plus the view's margin (in
+/// double; search_certificate.h's PruneMargin), the premise every BVH search of the project
+/// rests on (closest_triangle_bvh.h). So every leaf with
+/// may_hold_nearer(box_d2(B, brick), margin.widen(u)) is a candidate, t* is among them, and the minimum
 /// over the candidates with the one tie rule is the brute-force winner, bit for bit.
 ///
 /// Narrow band (SamplerOptions::band_width w). By 1-Lipschitz continuity every point of the
@@ -84,7 +85,7 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
     const PackedTriangle<T> seed_triangle = bvh.packed[seed.slot];
     T u = T(-1);
     for (int k = 0; k < count; ++k) u = max(u, squared_distance(seed_triangle, pk.x[k], pk.y[k], pk.z[k]));
-    u = warp_max(u);
+    u = bvh.margin.widen(warp_max(u));  // the double search's margin (zero in float)
 
     int ranges = 0, triangles = 0, rounds_ranges = 0;  // warp-uniform
     const auto scan_ranges = [&]() {

@@ -25,6 +25,7 @@
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
+#include "cuda/device_bvh_build.h"
 #include "cuda/device_mesh.h"
 #include "cuda/device_points.cuh"
 #include "cuda/device_winding.h"
@@ -72,9 +73,29 @@ struct DeviceBvh {
         source_triangle.upload(prepared.source_triangle());
         mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         winding.upload(sign, mesh->view());
-        view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        if constexpr (std::is_same_v<T, float>)
+            view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
+        else
+            view = bvh.view<double>().with_arrays(nodes.get(), packed.get(), triangle_index.get());  // and its margin
         if constexpr (std::is_same_v<T, float>) certifier = std::make_unique<DeviceCertifier>(bvh, prepared);
     }
+
+    /// The BVH built on the device (cuda/device_bvh_build.h), with its winding moments;
+    /// `device_mesh` is the double mesh it was built from. Nothing is copied.
+    DeviceBvh(std::unique_ptr<DeviceLbvh> built, std::unique_ptr<DeviceMesh<double>> device_mesh,
+              const PreparedMesh& prepared, const SamplerSign& sign)
+        : mesh(std::move(device_mesh)),
+          solid(choose_sign_mode(prepared.report(), SignMode::Auto).mode == SignMode::Pseudonormal),
+          lbvh(std::move(built)) {
+        source_triangle.upload(prepared.source_triangle());
+        winding.adopt(sign, lbvh->nodes.get(), lbvh->moments.get(), lbvh->triangle_index.get(), lbvh->num_nodes, mesh->view());
+        view = lbvh->view<T>();
+        if constexpr (std::is_same_v<T, float>)
+            certifier = std::make_unique<DeviceCertifier>(view, lbvh->packed_double.get(), lbvh->slot_of.get(), prepared);
+        else
+            view.margin = double_prune_margin(float_search_bound(prepared));
+    }
+    std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };
 
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
@@ -205,6 +226,7 @@ private:
     template <typename T>
     const DeviceBvh<T>& device_bvh(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
         CUDA_CHECK(cudaSetDevice(options_.device));
+        if (const DeviceBvh<T>* dev = built_on_device<T>(mesh, built, uploaded, upload)) return *dev;
         const auto bvh = mesh.bvh(&built);  // the mesh's own, built once
         sign_.prepare(mesh);  // the winding sign shares the BVH
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
@@ -217,8 +239,64 @@ private:
             slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh, sign_);
             upload.end();
             host_bvh_ = bvh;
+            device_mesh_ = 0;
+            bvh_stats_ = bvh->stats.to_json();
+            bvh_stats_["built_on"] = "host";
+            if (!device_build_skipped_.empty()) bvh_stats_["device_build_skipped"] = device_build_skipped_;
         }
         return *slot;
+    }
+
+    /// The BVH built on the device (bvh_build "device", or "auto" with the pseudonormal
+    /// sign, whose field does not depend on the tree: docs/bvh.md, "Build on the GPU");
+    /// null where the host builds it (also when the device tree is too deep: said in the
+    /// provenance's bvh.device_build_skipped).
+    template <typename T>
+    const DeviceBvh<T>* built_on_device(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
+        device_build_skipped_.clear();
+        if (options_.bvh_build == BvhBuildSite::Host) return nullptr;
+        if (options_.bvh_build == BvhBuildSite::Auto) {
+            if (choose_sign_mode(mesh.report(), options_.sign).mode != SignMode::Pseudonormal)
+                device_build_skipped_ = "bvh_build auto with the winding sign: its fast winding number may take the "
+                                        "other side of 1/2 on another tree, so the host tree keeps the field unchanged";
+            if (!device_build_skipped_.empty()) return nullptr;
+        }
+        // A mesh's id() is never another mesh's, even one made where a freed mesh was.
+        const uint64_t key = mesh.id();
+        std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
+        built = uploaded = false;
+        if (slot && slot->lbvh && device_mesh_ == key) return slot.get();
+        if (device_failed_ == key) {  // this mesh's device tree was too deep: do not build it again
+            device_build_skipped_ = device_failed_reason_;
+            return nullptr;
+        }
+        sign_.prepare_mode(mesh);
+        device_float_.reset();
+        device_double_.reset();
+        upload.begin();
+        auto dmesh = std::make_unique<DeviceMesh<double>>(mesh.buffers<double>());
+        std::unique_ptr<DeviceLbvh> lbvh = build_lbvh_on_device(mesh, dmesh->view().vertices, dmesh->view().triangles);
+        if (!lbvh || !lbvh->within_depth) {
+            upload.end();
+            device_build_skipped_ = lbvh ? "the device tree is deeper than kBvhMaxDepth = " + std::to_string(kBvhMaxDepth) +
+                                               " (depth " + std::to_string(lbvh->stats.depth) + ")"
+                                         : "the mesh fits one leaf";
+            device_mesh_ = 0;
+            device_failed_ = key;
+            device_failed_reason_ = device_build_skipped_;
+            return nullptr;
+        }
+        bvh_stats_ = lbvh->stats.to_json();
+        bvh_stats_["built_on"] = "device";
+        bvh_stats_["builder"] = gpu_bvh_builder_name(GpuBvhBuildOptions{}.builder);
+        bvh_stats_["device_seconds"] = lbvh->device_seconds;
+        sign_.set_external_moments(lbvh->device_seconds, "device");
+        slot = std::make_unique<DeviceBvh<T>>(std::move(lbvh), std::move(dmesh), mesh, sign_);
+        upload.end();
+        built = uploaded = true;
+        device_mesh_ = key;
+        host_bvh_.reset();
+        return slot.get();
     }
 
     template <typename T>
@@ -413,7 +491,7 @@ private:
         field.timings.download = download.seconds();
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());  // brute-force equivalent
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        nlohmann::json bvh_info = host_bvh_->stats.to_json();
+        nlohmann::json bvh_info = bvh_stats_;
         bvh_info["built_by_this_call"] = built;
         bvh_info["uploaded_by_this_call"] = uploaded;
         field.sampler = sampler_provenance("cuda", "bvh", kernel_name(), options_, lattice, computed, sign_);
@@ -614,6 +692,11 @@ private:
     BvhGpuKernel kernel_ = BvhGpuKernel::Warp;
     SamplerSign sign_;
     std::shared_ptr<const TriangleBvh> host_bvh_;  ///< the mesh BVH the device copies were made of
+    uint64_t device_mesh_ = 0;          ///< the id() of the mesh the device-built BVH belongs to (0: none)
+    uint64_t device_failed_ = 0;        ///< the id() of the mesh whose device build fell back to the host
+    std::string device_failed_reason_;
+    nlohmann::json bvh_stats_;          ///< the build statistics of the BVH in use, with where it was built
+    std::string device_build_skipped_;  ///< why the last device_bvh() call built on the host
     std::unique_ptr<DeviceBvh<float>> device_float_;
     std::unique_ptr<DeviceBvh<double>> device_double_;
     DeviceBuffer<unsigned long long> candidate_stats_;

@@ -105,8 +105,21 @@ public:
         slot_of_.upload(slots);
         counters_.allocate(3);
         reset();
+        arrays_ = {nodes_.get(), packed_.get(), exact_.get(), triangle_index_.get(), slot_of_.get()};
         num_nodes_ = int(bvh.nodes.size());
         num_triangles_ = int(bvh.triangle_index.size());
+    }
+
+    /// Over a BVH already on the device (the GPU build's): nothing is copied; the arrays
+    /// must outlive the certifier.
+    DeviceCertifier(const BvhView<float>& bvh, const PackedTriangle<double>* exact, const int32_t* slot_of,
+                    const PreparedMesh& mesh)
+        : bound_(float_search_bound(mesh)) {
+        counters_.allocate(3);
+        reset();
+        arrays_ = {bvh.nodes, bvh.packed, exact, bvh.triangle_index, slot_of};
+        num_nodes_ = bvh.num_nodes;
+        num_triangles_ = bvh.num_triangles;
     }
 
     /// Replaces `nearest` (prepared-mesh triangles of the float search, or band codes) with
@@ -114,9 +127,10 @@ public:
     template <typename Piece>
     void certify(const Piece& piece, double point_coordinate, int* nearest) const {
         CertifyView v;
-        v.bvh = {nodes_.get(), packed_.get(), triangle_index_.get(), num_nodes_, num_triangles_};
-        v.exact = {nodes_.get(), exact_.get(), triangle_index_.get(), num_nodes_, num_triangles_};
-        v.slot_of = slot_of_.get();
+        v.bvh = {arrays_.nodes, arrays_.packed, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact = {arrays_.nodes, arrays_.exact, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact.margin = double_prune_margin(bound_);  // the full double search equals the brute force
+        v.slot_of = arrays_.slot_of;
         v.slack = make_search_slack(bound_, point_coordinate);
         v.counters = counters_.get();
         const int64_t n = piece.size();
@@ -131,7 +145,7 @@ public:
         StreamedCertify c;
         c.slack = make_search_slack(bound_, point_coordinate);
         if (!c.slack.certify) return c;
-        c.exact = exact_.get();
+        c.exact = arrays_.exact;  // this certifier's upload, or the GPU build's arrays
         c.counters = counters_.get();
         return c;
     }
@@ -149,7 +163,17 @@ public:
     }
 
 private:
+    /// The arrays the kernel reads: the buffers below, or another owner's.
+    struct Arrays {
+        const BvhNode* nodes = nullptr;
+        const PackedTriangle<float>* packed = nullptr;
+        const PackedTriangle<double>* exact = nullptr;
+        const int32_t* triangle_index = nullptr;
+        const int32_t* slot_of = nullptr;
+    };
+
     FloatSearchBound bound_;
+    Arrays arrays_;
     DeviceBuffer<BvhNode> nodes_;
     DeviceBuffer<PackedTriangle<float>> packed_;
     DeviceBuffer<PackedTriangle<double>> exact_;

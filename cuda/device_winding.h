@@ -27,6 +27,16 @@ public:
         view_.accuracy = SamplerSign::winding_options().accuracy;
     }
 
+    /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
+    /// `sign`'s mode is winding: nothing is copied; the arrays must outlive this view.
+    void adopt(const SamplerSign& sign, const BvhNode* nodes, const WindingNode<double>* moments,
+               const int32_t* triangle_index, int num_nodes, const MeshView<double>& mesh) {
+        view_ = {};
+        if (!sign.winding()) return;
+        view_.view = {nodes, moments, triangle_index, mesh.vertices, mesh.triangles, num_nodes};
+        view_.accuracy = SamplerSign::winding_options().accuracy;
+    }
+
     const WindingSignView& view() const { return view_; }
 
 private:

@@ -42,6 +42,7 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
     FloatSearchBound b;
     b.rho = rho_of(0x1p-24, sin2_float * (1.0 - 1e-6)) + rho_of(0x1p-53, sin2_double * (1.0 - 1e-6)) +
             3.0 * (0x1p-24 + 0x1p-53);
+    b.rho_double = rho_of(0x1p-53, sin2_double * (1.0 - 1e-6)) + 3.0 * 0x1p-53;
     b.two_l = 2.0 * longest;
     b.coordinate = coordinate;
     b.usable = std::isfinite(b.two_l) && std::isfinite(b.coordinate) && std::sqrt(2.0 * b.rho) < 0.25;

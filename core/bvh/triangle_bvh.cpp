@@ -176,9 +176,11 @@ std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
     return refs;
 }
 
+}  // namespace
+
 /// Expected triangle tests of a point query that visits every node and leaf in proportion
 /// to its surface area (the SAH's model), for the build statistics.
-double sah_cost(const std::vector<BvhNode>& nodes, double node_cost) {
+double bvh_sah_cost(const std::vector<BvhNode>& nodes, double node_cost) {
     auto area = [](const BvhNode& n, int c) {
         const double ex = double(n.max_x[c]) - n.min_x[c], ey = double(n.max_y[c]) - n.min_y[c],
                      ez = double(n.max_z[c]) - n.min_z[c];
@@ -198,8 +200,6 @@ double sah_cost(const std::vector<BvhNode>& nodes, double node_cost) {
             cost += area(n, c) / root_area * (n.count[c] > 0 ? double(n.count[c]) : (n.ref[c] > 0 ? node_cost : 0.0));
     return cost;
 }
-
-}  // namespace
 
 float round_down_to_float(double x) {
     float f = float(x);
@@ -225,7 +225,11 @@ BvhView<float> TriangleBvh::view<float>() const {
 
 template <>
 BvhView<double> TriangleBvh::view<double>() const {
-    return {nodes.data(), packed_double.data(), triangle_index.data(), int(nodes.size()), int(triangle_index.size())};
+    BvhView<double> v{nodes.data(), packed_double.data(), triangle_index.data(), int(nodes.size()),
+                      int(triangle_index.size())};
+    // Without the bound (a tree made by hand) the margin is infinite: the brute force.
+    v.margin = float_bound ? double_prune_margin(*float_bound) : PruneMargin<double>{INFINITY, 0.0};
+    return v;
 }
 
 TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions& options) {
@@ -262,7 +266,7 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
         bvh.packed_double[size_t(i)] = pd[size_t(bvh.triangle_index[size_t(i)])];
     }
     bvh.stats.nodes = int(bvh.nodes.size());
-    bvh.stats.sah_cost = sah_cost(bvh.nodes, options.node_cost);
+    bvh.stats.sah_cost = bvh_sah_cost(bvh.nodes, options.node_cost);
     bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -72,6 +72,10 @@ TriangleBvh build_triangle_bvh(const Mesh& mesh, const BvhBuildOptions& options 
                               options);
 }
 
+/// Expected triangle tests of a point query through the root of `nodes` under the SAH's
+/// model (BvhBuildStats::sah_cost), for any builder's flat tree.
+double bvh_sah_cost(const std::vector<BvhNode>& nodes, double node_cost = 1.0);
+
 /// The same box, rounded outward from double to float so that it still contains the input.
 float round_down_to_float(double x);
 float round_up_to_float(double x);

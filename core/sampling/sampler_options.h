@@ -23,6 +23,9 @@
 
 namespace sdf {
 
+/// Where a GPU sampler's BVH is built (SamplerOptions::bvh_build).
+enum class BvhBuildSite { Auto, Host, Device };
+
 struct SamplerOptions {
     std::string backend = "auto";  ///< "auto", or a backend of the sampler table ("cpu", "cuda")
     std::string method = "bvh";    ///< a method of the sampler table ("bvh", "brute_force")
@@ -44,6 +47,10 @@ struct SamplerOptions {
     /// and closest_triangle kOutsideBandTriangle (core/sampling/sampled_field.h). The result
     /// is a function of the exact field alone, so it is the same for every sampler and split.
     double band_width = 0;
+    /// Where the CUDA BVH sampler builds its BVH (docs/bvh.md, "Build on the GPU"): auto =
+    /// on the device where that gives the same field as the host build (pseudonormal sign),
+    /// else on the host; host and device force one. The CPU samplers always build on the host.
+    BvhBuildSite bvh_build = BvhBuildSite::Auto;
 };
 
 /// Whether a field decides the sampled values.
@@ -72,7 +79,7 @@ struct OptionField {
 };
 
 /// The number of rows below; the codec checks it against the struct's field count.
-inline constexpr std::size_t kSamplerOptionFields = 13;
+inline constexpr std::size_t kSamplerOptionFields = 14;
 
 /// Calls f(OptionField, member) for every field of `o`, in the order above. `O` is
 /// SamplerOptions or const SamplerOptions.
@@ -96,6 +103,7 @@ void for_each_sampler_option(O& o, F&& f) {
     f(OptionField{"points_per_thread", R::Execution, D::PointsPerThread, "1, 2, 4 or 8 (0 = automatic)"},
       o.points_per_thread);
     f(OptionField{"band_width", R::Result, D::Width, "a band width in mesh units (0 = no band)"}, o.band_width);
+    f(OptionField{"bvh_build", R::Execution, D::Named, "where the GPU BVH is built"}, o.bvh_build);
 }
 
 /// Names of the enums a sampler option takes (the first is the default of a new struct).
@@ -111,6 +119,20 @@ struct NamedBccStrategy {
 };
 inline constexpr NamedBccStrategy kBccStrategies[] = {{"two_grids", BccStrategy::TwoGrids},
                                                       {"double_resolution", BccStrategy::DoubleResolution}};
+
+struct NamedBvhBuildSite {
+    const char* name;
+    BvhBuildSite value;
+};
+inline constexpr NamedBvhBuildSite kBvhBuildSites[] = {
+    {"auto", BvhBuildSite::Auto}, {"host", BvhBuildSite::Host}, {"device", BvhBuildSite::Device}};
+
+/// Names a BVH build site as in configs ("auto" / "host" / "device").
+inline const char* bvh_build_site_name(BvhBuildSite s) {
+    for (const NamedBvhBuildSite& b : kBvhBuildSites)
+        if (b.value == s) return b.name;
+    return "auto";
+}
 
 /// Names a BCC strategy as in configs ("two_grids" / "double_resolution").
 const char* bcc_strategy_name(BccStrategy s);

@@ -11,8 +11,18 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
 
 }  // namespace
 
+const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
+    choice_ = choose_sign_mode(mesh.report(), requested_);
+    winding_.reset();
+    external_moments_on_.clear();
+    if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
+        report_warning(auto_sign_text(mesh, choice_.reason));
+    return choice_;
+}
+
 const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);  // cheap, and never another mesh's
+    external_moments_on_.clear();
     if (choice_.mode != SignMode::Winding) {
         winding_.reset();
         return choice_;
@@ -36,6 +46,13 @@ nlohmann::json SamplerSign::provenance() const {
                         {"order", o.accuracy.order},
                         {"certified", o.certify},
                         {"moments_seconds", winding_->winding_bvh().seconds}};
+    } else if (winding() && !external_moments_on_.empty()) {
+        const WindingSignOptions o = winding_options();
+        p["winding"] = {{"beta", o.accuracy.beta},
+                        {"order", o.accuracy.order},
+                        {"certified", o.certify},
+                        {"moments_seconds", external_moments_seconds_},
+                        {"moments_built_on", external_moments_on_}};
     }
     return p;
 }

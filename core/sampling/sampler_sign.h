@@ -27,6 +27,17 @@ public:
     /// parallel loop.
     const SignModeChoice& prepare(const PreparedMesh& mesh);
 
+    /// Resolves the mode as prepare() does but builds no host winding sign: for a sampler
+    /// that computes the winding moments itself (the CUDA BVH sampler's device build), which
+    /// calls it when it builds them (the warning is written then) and reports their time with
+    /// set_external_moments(). winding_sign() stays null.
+    const SignModeChoice& prepare_mode(const PreparedMesh& mesh);
+    /// Seconds the external moments took and where they were built, for provenance().
+    void set_external_moments(double seconds, const std::string& built_on) {
+        external_moments_seconds_ = seconds;
+        external_moments_on_ = built_on;
+    }
+
     SignMode requested() const { return requested_; }
     const SignModeChoice& choice() const { return choice_; }
     bool winding() const { return choice_.mode == SignMode::Winding; }
@@ -50,6 +61,8 @@ private:
     SignMode requested_;
     SignModeChoice choice_;
     std::shared_ptr<const WindingSign> winding_;
+    double external_moments_seconds_ = 0;
+    std::string external_moments_on_;  ///< empty: the moments are winding_'s
 };
 
 /// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler

@@ -55,10 +55,16 @@ std::vector<std::string> names_of(BccStrategy) {
     return n;
 }
 std::vector<std::string> names_of(SignMode) { return sign_mode_names(); }
+std::vector<std::string> names_of(BvhBuildSite) {
+    std::vector<std::string> n;
+    for (const auto& b : kBvhBuildSites) n.emplace_back(b.name);
+    return n;
+}
 
 const char* name_of(Precision v) { return precision_name(v); }
 const char* name_of(BccStrategy v) { return bcc_strategy_name(v); }
 const char* name_of(SignMode v) { return sign_mode_name(v); }
+const char* name_of(BvhBuildSite v) { return bvh_build_site_name(v); }
 
 /// `name` is one of names_of(out) (checked by the reader before).
 void set_from_name(const std::string& name, Precision& out) {
@@ -70,6 +76,10 @@ void set_from_name(const std::string& name, BccStrategy& out) {
         if (name == b.name) out = b.value;
 }
 void set_from_name(const std::string& name, SignMode& out) { out = sign_mode_from_name(name, "sampler.sign"); }
+void set_from_name(const std::string& name, BvhBuildSite& out) {
+    for (const auto& b : kBvhBuildSites)
+        if (name == b.name) out = b.value;
+}
 
 template <class T>
 nlohmann::json encode(const T& v) {

@@ -5,7 +5,7 @@
 ///    "precision": "float" | "double", "sign": "auto" | "pseudonormal" | "winding",
 ///    "threads": 0, "bcc_strategy": "two_grids" | "double_resolution", "progress": true,
 ///    "device": 0, "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
-///    "points_per_thread": 0, "band_width": 0}
+///    "points_per_thread": 0, "band_width": 0, "bvh_build": "auto" | "host" | "device"}
 /// and every other place options travel as JSON: the tools' command lines, the Python
 /// module's keywords, the MPI wire, the run's manifest, the field cache's key. Every absent
 /// key takes the struct's default (docs/harness.md, "Defaults").

@@ -11,11 +11,11 @@
 /// brute-force samplers.
 ///
 /// Exactness. A subtree is skipped only when its box, which contains every one of its
-/// triangles, is farther than the best triangle so far (by more than the rounding of the two
-/// distances: may_hold_nearer), so no triangle that could be strictly nearer is skipped:
-/// the result is the brute-force minimum of squared_distance()
-/// (up to ties, and up to the rounding of the box and triangle distances, which brute force
-/// shares). A query may be seeded with any triangle (e.g. the winner of a
+/// triangles, is farther than the best triangle so far by more than the rounding of the two
+/// distances (may_hold_nearer's ulps, and in double the view's margin, which bounds how far
+/// a computed squared_distance() may fall below the true one: search_certificate.h), so no
+/// triangle whose computed distance could beat the best is skipped: the result is the
+/// brute-force minimum of squared_distance() with the one tie rule, whatever the tree. A query may be seeded with any triangle (e.g. the winner of a
 /// neighbouring lattice point): its distance is a true upper bound, so the seed only
 /// shrinks the initial radius and never changes which distance is found.
 ///
@@ -119,7 +119,7 @@ SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int3
              wins_tie(bvh.triangle_index[j], best.slot < 0 ? -1 : bvh.triangle_index[best.slot]))) {
             best.distance_squared = q;
             best.slot = j;
-            radius = near.radius(q);
+            radius = bvh.margin.widen(near.radius(q));
         }
     }
 }
@@ -137,7 +137,7 @@ SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int3
 template <typename T, typename Stats, typename Near>
 SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats,
                                            Near& near) {
-    T radius = near.radius(best.distance_squared);
+    T radius = bvh.margin.widen(near.radius(best.distance_squared));
     int32_t stack_node[kBvhMaxDepth];
     T stack_d2[kBvhMaxDepth];
     int top = 0;

@@ -84,11 +84,11 @@ SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacke
 
 /// Sets every lane's radius from its best; returns the largest.
 template <typename T, int K, typename Near>
-SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
+SDF_CPU_GPU SDF_INLINE T refresh_radii(const BvhView<T>& bvh, BvhPacket<T, K>& pk, const Near& near) {
 #if !SDF_IS_GPU_CODE
 #pragma omp simd
 #endif
-    for (int k = 0; k < K; ++k) pk.radius[k] = near.radius(pk.best_q[k]);
+    for (int k = 0; k < K; ++k) pk.radius[k] = bvh.margin.widen(near.radius(pk.best_q[k]));
     T worst = pk.radius[0];
     for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
     return worst;
@@ -127,7 +127,7 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first
                     if (qs[k] <= pk.radius[k]) near.offer(k, j, qs[k]);
         }
     }
-    return refresh_radii(pk, near);
+    return refresh_radii(bvh, pk, near);
 }
 
 /// The leaf scan of `near`: offering (above), or a streaming policy's own
@@ -163,7 +163,7 @@ SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* se
 /// offering every triangle within a lane's final radius to `near`.
 template <typename T, int K, typename Stats, typename Near>
 SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats, Near& near) {
-    T worst = detail::refresh_radii(pk, near);
+    T worst = detail::refresh_radii(bvh, pk, near);
     int32_t stack_node[kBvhMaxDepth];
     T stack_d2[kBvhMaxDepth];
     int top = 0;

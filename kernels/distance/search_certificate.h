@@ -69,7 +69,41 @@ struct FloatSearchBound {
     double two_l = 0;       ///< 2 L
     double coordinate = 0;  ///< C_mesh: the largest |coordinate| of the mesh
     bool usable = false;    ///< false: the bound is too loose (rho too large) to certify anything
+    /// rho of double alone (|Q_d - Q| <= rho_double M^2: double's points and vertices are
+    /// exact, d0 = 0), for the double search's pruning margin (PruneMargin below).
+    double rho_double = 0;
 };
+
+/// How far beyond a search's radius a box must still be entered for the search to return
+/// the brute-force argmin of the computed Q (closest_triangle_bvh.h): a triangle with
+/// computed Q <= r has a true squared distance up to r + rho M^2, M <= sqrt(r) + l (the bound
+/// above with M's estimate), and its box's computed distance is within a few ulps of the true
+/// one. Zero (no margin) for float views: a certified float radius already holds the float
+/// bound, which covers the pruning. Without it, where Q's rounding is large against Q (a point
+/// much nearer a triangle than the triangle is long, or far from the origin) a box could be
+/// skipped whose triangle rounds below the radius, and the winner would depend on the tree.
+template <typename T>
+struct PruneMargin {
+    T rho = T(0), l = T(0);
+
+    SDF_CPU_GPU SDF_INLINE T widen(T radius) const {
+        if (!(rho > T(0)) || radius < T(0)) return radius;  // no margin; an unused lane (-1)
+        const T m = std::sqrt(radius) + l;
+        return radius + rho * m * m;
+    }
+};
+
+/// The double search's margin of a mesh: rho_double / (1 - sqrt(rho_double))^2 (M's own
+/// estimate, as in the file comment), l = 2 L, both rounded up generously; an unusable bound
+/// gives an infinite margin (every box entered: the brute force).
+inline PruneMargin<double> double_prune_margin(const FloatSearchBound& b) {
+    PruneMargin<double> m;
+    const double root = std::sqrt(b.rho_double);
+    m.rho = root < 0.5 ? b.rho_double / ((1.0 - root) * (1.0 - root)) * 1.01 : INFINITY;
+    m.l = b.two_l * 1.01;
+    if (!std::isfinite(m.l)) m.rho = INFINITY;
+    return m;
+}
 
 /// The search radius of a certified float search at one point (or a packet of points whose
 /// largest |coordinate| is `point_coordinate`): every triangle with Q_f <= radius(q_best)

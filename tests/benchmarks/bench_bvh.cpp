@@ -12,6 +12,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -25,12 +26,17 @@
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "core/sampling/certified_search.h"
 #include "core/bvh/triangle_bvh.h"
+#include "core/winding/winding_bvh.h"
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_obj.h"
 #include "core/parallel/parallel_for.h"
 #include "core/sampling/point_sets.h"
 #include "harness/build_config.h"
 #include "harness/sampling/sampler_table.h"
+#if SDF_HAVE_CUDA
+#include "cuda/device_bvh_build.h"
+#include "cuda/device_mesh.h"
+#endif
 
 namespace sdf {
 namespace {
@@ -296,6 +302,106 @@ void BM_CudaBvhBand(benchmark::State& state, const std::string& file) {
     state.counters["points_in_band"] = double(in_band);
 }
 
+/// The GPU sampler's BVH build (issue 23): arg 0 = on the host (binned SAH, the winding
+/// moments, and the upload of nodes, packed constants in BVH order, slots and moments, as
+/// the sampler does), 1 = on the device (cuda/device_bvh_build.h: the LBVH with its moments,
+/// the packed constants uploaded in triangle order and gathered there). Wall time; the
+/// double mesh, which both need on the device, is uploaded before the clock starts.
+void BM_CudaBvhBuild(benchmark::State& state, const std::string& file) {
+#if SDF_HAVE_CUDA
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
+    const cuda::DeviceMesh<double> dmesh(mesh->buffers<double>());
+    const bool device = state.range(0) == 1;
+    BvhBuildStats stats;
+    double device_ms = 0;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        if (device) {
+            const auto built = cuda::build_lbvh_on_device(*mesh, dmesh.view().vertices, dmesh.view().triangles);
+            stats = built->stats;
+            device_ms = 1e3 * built->device_seconds;
+        } else {
+            const auto bvh = std::make_shared<const TriangleBvh>(build_triangle_bvh(*mesh));
+            const WindingBvh moments = build_winding_bvh(*mesh, bvh);
+            cuda::DeviceBuffer<BvhNode> nodes;
+            cuda::DeviceBuffer<PackedTriangle<float>> pf;
+            cuda::DeviceBuffer<PackedTriangle<double>> pd;
+            cuda::DeviceBuffer<int32_t> slots;
+            cuda::DeviceBuffer<WindingNode<double>> m;
+            nodes.upload(bvh->nodes);
+            pf.upload(bvh->packed_float);
+            pd.upload(bvh->packed_double);
+            slots.upload(bvh->triangle_index);
+            m.upload(moments.moments);
+            CUDA_CHECK(cudaStreamSynchronize(0));
+            stats = bvh->stats;
+        }
+        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    state.counters["triangles"] = double(mesh->triangles().size());
+    state.counters["nodes"] = stats.nodes;
+    state.counters["depth"] = stats.depth;
+    state.counters["sah_cost"] = stats.sah_cost;
+    if (device) state.counters["device_ms"] = device_ms;
+#else
+    state.SkipWithError("built without CUDA");
+    (void)file;
+#endif
+}
+
+/// The query time on each tree (args: resolution, 0 = host-built SAH tree / 1 = device-built
+/// LBVH), warp kernel, float: the device tree must keep the query speed.
+void BM_CudaBvhOnTree(benchmark::State& state, const std::string& file) {
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
+    const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
+    SamplerOptions o = cuda_bvh_options("warp");
+    o.bvh_build = state.range(1) ? BvhBuildSite::Device : BvhBuildSite::Host;
+    auto sampler = make_sampler(o);
+    SampledField f = sampler->sample(*mesh, lattice);
+    for (auto _ : state) {
+        f = sampler->sample(*mesh, lattice);
+        state.SetIterationTime(f.timings.kernel);
+    }
+    set_counters(state, *mesh, lattice, f);
+    state.counters["sah_cost"] = f.sampler.details["bvh"]["sah_cost"].get<double>();
+}
+
+/// Point queries on each tree (args: points, 0 uniform / 1 Gaussian near the surface as
+/// BM_CudaBvhPoints draws them, 0 host / 1 device tree); manual time = the device time.
+void BM_CudaBvhPointsOnTree(benchmark::State& state, const std::string& file) {
+    const auto mesh = load_for_cuda(state, file);
+    if (!mesh) return;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> g(0.0, 0.01 * mesh->bounds().diagonal());
+    std::vector<Vec3d> points(size_t(state.range(0)));
+    const Bounds3& box = mesh->bounds();
+    for (Vec3d& p : points) {
+        if (state.range(1) == 0) {
+            p = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
+        } else {
+            const Int3 t = mesh->triangles()[size_t(rng() % mesh->triangles().size())];
+            double a = u(rng), b = u(rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            const Vec3d& v0 = mesh->vertices()[size_t(t.x)];
+            p = v0 + (mesh->vertices()[size_t(t.y)] - v0) * a + (mesh->vertices()[size_t(t.z)] - v0) * b +
+                Vec3d{g(rng), g(rng), g(rng)};
+        }
+    }
+    SamplerOptions o = cuda_bvh_options("warp");
+    o.bvh_build = state.range(2) ? BvhBuildSite::Device : BvhBuildSite::Host;
+    auto sampler = make_sampler(o);
+    sampler->query(*mesh, points);
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
+        state.SetIterationTime(sampler->last_query_timings().kernel);
+    }
+    state.counters["points"] = double(points.size());
+    state.counters["queries_per_second"] = double(points.size()) / sampler->last_query_timings().kernel;
+}
+
 /// The tuned CUDA brute force on the same lattices (float), for the BVH's speedup.
 void BM_CudaBrute(benchmark::State& state, const std::string& file) {
     if (!cuda_backend_available()) { state.SkipWithError("no CUDA device"); return; }
@@ -347,6 +453,15 @@ BENCHMARK_CAPTURE(BM_CudaBvhPoints, dragon, std::string("dragon.obj"))
     ->ArgNames({"points", "gaussian", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);  // each call also transfers and scatters on the host
 BENCHMARK_CAPTURE(BM_CudaBvhBand, dragon, std::string("dragon.obj"))
     ->ArgsProduct({{256}, {2, 8}, {3, 4}})->ArgNames({"res", "band_spacings", "kernel"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
+BENCHMARK_CAPTURE(BM_CudaBvhBuild, bunny, std::string("bunny.obj"))->Arg(0)->Arg(1)->ArgName("device")
+    ->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CudaBvhBuild, dragon, std::string("dragon.obj"))->Arg(0)->Arg(1)->ArgName("device")
+    ->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CudaBvhOnTree, dragon, std::string("dragon.obj"))
+    ->ArgsProduct({{128, 256}, {0, 1}})->ArgNames({"res", "device_tree"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
+BENCHMARK_CAPTURE(BM_CudaBvhPointsOnTree, dragon, std::string("dragon.obj"))
+    ->ArgsProduct({{1 << 20, 1 << 24}, {0, 1}, {0, 1}})->ArgNames({"points", "gaussian", "device_tree"})->UseManualTime()
+    ->Unit(benchmark::kMillisecond)->MinTime(0.5);
 BENCHMARK_CAPTURE(BM_CudaBrute, bunny, std::string("bunny.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()
     ->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_CudaBrute, dragon, std::string("dragon.obj"))->Arg(64)->Arg(128)->ArgName("res")->UseManualTime()

@@ -144,7 +144,7 @@ TEST(FieldCacheKey, EveryResultOptionChangesTheKeyAndNoOtherDoes) {
     });
     EXPECT_EQ(visited, kSamplerOptionFields);
     const std::vector<std::string> must_not_key = {"backend", "threads", "progress", "device", "max_points_per_piece",
-                                                   "max_triangles_per_chunk", "points_per_thread"};
+                                                   "max_triangles_per_chunk", "points_per_thread", "bvh_build"};
     EXPECT_EQ(execution, must_not_key);
 }
 
