@@ -23,7 +23,8 @@
 /// summary names the fastest peer that passes and says whether it signs. "sign" is our
 /// samplers' sign mode (core/winding/sign_mode.h): "auto" takes the winding number on open or
 /// self-intersecting meshes, whose cost near the surface is most of a near-surface query;
-/// "pseudonormal" is the cheap sign of a closed mesh. "point_set_sign" (default: "sign") is
+/// "pseudonormal" is the cheap sign of a closed mesh. "gpu_bvh_build" (default "auto") is
+/// where our GPU rows build their BVH (SamplerOptions::bvh_build: "host", "device", "auto"). "point_set_sign" (default: "sign") is
 /// our sign on point sets, "point_set_meshes" the cases that get point sets (default: all).
 /// Where the two differ, the point sets' reference is a query with "sign" (the exact sign; row
 /// "bvh_cpu_exact_sign", all threads), and our faster-signed rows are checked against it like
@@ -149,6 +150,13 @@ public:
         point_set_sign_ = sign_mode_from_name(config.choice("point_set_sign", sign_mode_names(), sign_mode_name(lattice_sign_)),
                                               "point_set_sign");
         sign_ = lattice_sign_;
+        {
+            std::vector<std::string> sites;
+            for (const NamedBvhBuildSite& b : kBvhBuildSites) sites.emplace_back(b.name);
+            const std::string site = config.choice("gpu_bvh_build", sites, bvh_build_site_name(gpu_bvh_build_));
+            for (const NamedBvhBuildSite& b : kBvhBuildSites)
+                if (site == b.name) gpu_bvh_build_ = b.value;
+        }
         repetitions_ = config.optional<int>("repetitions", 1, "a positive count");
         if (repetitions_ < 1) config.fail("repetitions", "expected at least 1, got " + std::to_string(repetitions_));
         const int64_t seed = config.optional<int64_t>("seed", 1, "a non-negative seed for the point sets");
@@ -212,7 +220,8 @@ public:
                                 {"rule", "max |distance error| <= tolerance x bounding-box diagonal, and (signed peers) no wrong sign "
                                          "farther than that from the surface; unsigned peers pass as exact-unsigned"},
                                 {"our_sign", sign_mode_name(lattice_sign_)},
-                                {"our_sign_point_sets", sign_mode_name(point_set_sign_)}};
+                                {"our_sign_point_sets", sign_mode_name(point_set_sign_)},
+                                {"our_gpu_bvh_build", bvh_build_site_name(gpu_bvh_build_)}};
         for (const MeshCase& c : cases_) {
             const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
             ctx.metrics["meshes"][c.label] = describe_prepared_mesh(mesh);
@@ -445,6 +454,7 @@ private:
         o.backend = "cuda";
         o.method = name == "bvh_gpu" ? "bvh" : "brute_force";
         o.sign = sign_;
+        o.bvh_build = gpu_bvh_build_;
         o.progress = false;
         auto sampler = make_sampler(o);
         sampler->sample(mesh, lattice);  // warm-up: module load, uploads (and the BVH build)
@@ -477,6 +487,7 @@ private:
         o.backend = "cuda";
         o.method = "bvh";
         o.sign = lattice_sign_;  // on the GPU the exact sign costs little: no faster-signed row there
+        o.bvh_build = gpu_bvh_build_;
         o.progress = false;
         auto sampler = make_sampler(o);
         // Warm-up: module load, upload, and the tree where the device builds it; the host
@@ -717,6 +728,7 @@ private:
     int64_t brute_max_points_ = 4096;
     peers::PeerOptions peer_options_;
     int repetitions_ = 1;
+    BvhBuildSite gpu_bvh_build_ = BvhBuildSite::Auto;
     SignMode sign_ = SignMode::Auto;  ///< our samplers' sign in the current case: lattice_sign_ or point_set_sign_
     SignMode lattice_sign_ = SignMode::Auto, point_set_sign_ = SignMode::Auto;
     std::vector<std::string> point_set_meshes_;
