@@ -98,6 +98,42 @@ struct Certifier {
     }
 };
 
+/// The sign of a packet's lanes. With the samplers' winding sign (uncertified: the fast
+/// value's side), the fast winding numbers of all kCpuPacketLanes lanes come from one
+/// traversal (fast_winding_packet.h), each lane's value the bits WindingSign::inside()
+/// computes; otherwise each point gets SamplerSign::apply().
+class PacketSign {
+public:
+    explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
+        const WindingSign* w = sign.winding() ? sign.winding_sign() : nullptr;
+        winding_ = w != nullptr && !w->options().certify ? w : nullptr;
+    }
+
+    /// Evaluates the sides of the packet's points `position` (all kCpuPacketLanes lanes).
+    void prepare(const Vec3d* position) {
+        if (winding_ == nullptr) return;
+        double px[kCpuPacketLanes], py[kCpuPacketLanes], pz[kCpuPacketLanes], w[kCpuPacketLanes];
+        for (int k = 0; k < kCpuPacketLanes; ++k) {
+            px[k] = position[k].x;
+            py[k] = position[k].y;
+            pz[k] = position[k].z;
+        }
+        kernel_(winding_->view(), px, py, pz, winding_->options().accuracy, w);
+        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::inside()
+    }
+
+    /// Lane k's sample `s` at p with its sign (after prepare() of its packet).
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, int k, const Vec3d& p) const {
+        return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p);
+    }
+
+private:
+    const SamplerSign& sign_;
+    const WindingSign* winding_ = nullptr;  ///< non-null: packets of winding numbers
+    WindingPacketFn kernel_ = active_cpu_kernels().winding_numbers_packet;
+    bool inside_[kCpuPacketLanes] = {};
+};
+
 /// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
 /// In a chunk, point i is seeded with point i-1's triangle when `seeded` (any triangle is
 /// a valid seed: its distance only bounds the search radius).
@@ -243,6 +279,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         int32_t probe_seed = -1;
         ProbeBall ball;
         std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
+        PacketSign packet_sign(sign);
         int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
@@ -287,9 +324,11 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             seed_packet(view, seed, pk);
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
+            packet_sign.prepare(br.position);
             for (int k = 0; k < br.count; ++k)
-                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]),
-                                             br.position[k]));
+                emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
+                                                                                view.triangle_index[slot[k]]),
+                                                    k, br.position[k]));
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
         }
         certified.add_to(counters.certificate);
@@ -363,6 +402,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
         LocalCertificate certified;
         int32_t seed[kPointPacket];
         for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
+        PacketSign packet_sign(sign);
         int64_t done = 0;
         for (int64_t b = begin; b < end; ++b) {
             const int64_t first = b * kPointPacket;
@@ -378,10 +418,11 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
             search_packet(view, certifier, position, count, pk, stats, certified, slot);
+            packet_sign.prepare(position);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
-                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), p));
+                emit(i, packet_sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), k, p));
             }
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;

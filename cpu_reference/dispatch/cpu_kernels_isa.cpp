@@ -59,7 +59,8 @@ constexpr CpuCertifiedKernels certified_kernels() {
             &Flattened<&rerank>::call};
 }
 
-constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels()};
+constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels(),
+                            &Flattened<&fast_winding_numbers_packet<kCpuPacketLanes>>::call};
 
 }  // namespace
 

@@ -22,6 +22,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "core/winding/winding_sign.h"
 
 namespace sdf {
 namespace {
@@ -366,6 +367,73 @@ TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
     }
     std::printf("certified samplers at %s: %zu points and a %lld-point lattice equal the double brute force\n",
                 active_cpu_kernels().isa, pts.size(), (long long)lattice.num_points());
+}
+
+/// A torus with every fifth triangle removed: open, so its winding numbers take every value
+/// between 0 and 1 near the holes, where a wrong term or order would show.
+const PreparedMesh& holed_mesh() {
+    static const PreparedMesh mesh = [] {
+        TriangleMesh m = make_torus(1.0, 0.35, 48, 24);
+        std::vector<Int3> kept;
+        for (size_t t = 0; t < m.triangles.size(); ++t)
+            if (t % 5 != 0) kept.push_back(m.triangles[t]);
+        m.triangles = kept;
+        return prepare_mesh(m);
+    }();
+    return mesh;
+}
+
+/// The packet of fast winding numbers (fast_winding_packet.h) gives every lane the bits of
+/// WindingSign's own evaluation of its point, at every level and the chosen one, at the
+/// samplers' accuracy and others: on lattice-like bricks (coherent lanes, as the samplers
+/// run it), on packets of scattered points (lanes that open different nodes), on vertices
+/// and far away.
+TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    constexpr int K = kCpuPacketLanes;
+    std::vector<const CpuKernelSet*> sets = runnable_sets();
+    sets.push_back(&active_cpu_kernels());
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.6, 1.6), spacing(1e-3, 0.2);
+    for (const PreparedMesh* mesh : {&holed_mesh(), &test_mesh()}) {
+        std::vector<Vec3d> pts;
+        for (int b = 0; b < 64; ++b) {  // 4 x 2 x 2 bricks
+            const Vec3d o{u(rng), u(rng), 0.3 * u(rng)};
+            const double h = spacing(rng);
+            for (int k = 0; k < K; ++k) pts.push_back(o + Vec3d{h * (k % 4), h * ((k / 4) % 2), h * (k / 8)});
+        }
+        for (int i = 0; i < 64 * K; ++i) pts.push_back({u(rng), u(rng), 0.5 * u(rng)});
+        for (size_t v = 0; v < mesh->vertices().size() && v < size_t(4 * K); v += 3) pts.push_back(mesh->vertices()[v]);
+        for (int i = 0; i < 2 * K; ++i) pts.push_back({1e3 * u(rng), 1e3 * u(rng), 1e3 * u(rng)});
+        while (pts.size() % K != 0) pts.push_back(pts.front());
+        for (const WindingAccuracy<double> acc : {WindingAccuracy<double>{}, WindingAccuracy<double>{1.5, 1},
+                                                  WindingAccuracy<double>{3.0, 2}}) {
+            WindingSignOptions options;
+            options.accuracy = acc;
+            const WindingSign sign(*mesh, options);
+            for (const CpuKernelSet* set : sets) {
+                int64_t bad = 0, between = 0;
+                for (size_t first = 0; first < pts.size(); first += K) {
+                    double px[K], py[K], pz[K], value[K];
+                    for (int k = 0; k < K; ++k) {
+                        px[k] = pts[first + size_t(k)].x;
+                        py[k] = pts[first + size_t(k)].y;
+                        pz[k] = pts[first + size_t(k)].z;
+                    }
+                    set->winding_numbers_packet(sign.view(), px, py, pz, acc, value);
+                    for (int k = 0; k < K; ++k) {
+                        const double want = sign.estimate(pts[first + size_t(k)]).value;
+                        bad += !same_bits(value[k], want);
+                        between += want > 0.05 && want < 0.95;
+                    }
+                }
+                EXPECT_EQ(bad, 0) << set->isa << " beta " << acc.beta << " order " << acc.order;
+                if (mesh == &holed_mesh()) {
+                    EXPECT_GT(between, 100) << "the holes should give fractional winding numbers";
+                }
+            }
+        }
+    }
 }
 
 TEST(CpuIsa, ParsesLevelNames) {
