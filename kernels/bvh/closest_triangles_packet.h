@@ -21,7 +21,19 @@
 /// more candidates.
 #pragma once
 
+#include <cstdint>
+#include <type_traits>
+
 #include "kernels/bvh/closest_triangle_bvh.h"
+
+// Vector compares for the leaf loop's lane mask: host compilers with SSE2 (every x86-64), not
+// the CUDA compiler's passes.
+#if !defined(__CUDACC__) && defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define SDF_PACKET_MASK_INTRINSICS 1
+#else
+#define SDF_PACKET_MASK_INTRINSICS 0
+#endif
 
 namespace sdf {
 
@@ -94,6 +106,46 @@ SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
     return worst;
 }
 
+/// The lanes k with qs[k] <= radius[k] as bit k of a mask (K <= 32). Float packets of 16 on
+/// the host compare as whole vectors (one instruction with AVX-512); otherwise lane by lane.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE uint32_t lanes_within(const T* qs, const T* radius) {
+    static_assert(K <= 32, "one bit per lane in a 32-bit mask");
+#if SDF_PACKET_MASK_INTRINSICS
+    if constexpr (std::is_same_v<T, float> && K == 16) {
+#if defined(__AVX512F__)
+        return uint32_t(_mm512_cmp_ps_mask(_mm512_loadu_ps(qs), _mm512_loadu_ps(radius), _CMP_LE_OQ));
+#elif defined(__AVX__)
+        const int lo = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(qs), _mm256_loadu_ps(radius), _CMP_LE_OQ));
+        const int hi = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(qs + 8), _mm256_loadu_ps(radius + 8), _CMP_LE_OQ));
+        return uint32_t(lo) | uint32_t(hi) << 8;
+#else
+        uint32_t m = 0;
+        for (int i = 0; i < 4; ++i)
+            m |= uint32_t(_mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(qs + 4 * i), _mm_loadu_ps(radius + 4 * i)))) << (4 * i);
+        return m;
+#endif
+    }
+#endif
+    uint32_t m = 0;
+    for (int k = 0; k < K; ++k) m |= uint32_t(qs[k] <= radius[k]) << k;
+    return m;
+}
+
+/// Offers slot j to the lanes whose Q (`qs`) is within their radius, in lane order: only the
+/// lanes of the mask are visited (a tie at a shared vertex makes most leaves offer to some).
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE void offer_within(const T* qs, const T* radius, int32_t j, Near& near) {
+    for (uint32_t within = lanes_within<T, K>(qs, radius); within != 0; within &= within - 1) {
+#if SDF_IS_GPU_CODE
+        const int k = __ffs(int(within)) - 1;
+#else
+        const int k = __builtin_ctz(within);
+#endif
+        near.offer(k, j, qs[k]);
+    }
+}
+
 /// Tests every point of the packet against leaf triangles [first, first + count), offering
 /// those within a lane's radius to `near`; returns the new largest radius of the packet.
 template <typename T, int K, typename Near>
@@ -104,9 +156,8 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first
         const int32_t triangle = bvh.triangle_index[j];
         const T excess = Near::kKeeps ? sliver_excess(tri) : T(0);
         T qs[K];
-        int within = 0;
 #if !SDF_IS_GPU_CODE
-#pragma omp simd reduction(| : within)
+#pragma omp simd
 #endif
         for (int k = 0; k < K; ++k) {
             const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
@@ -116,16 +167,9 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first
             pk.best_q[k] = better ? q : pk.best_q[k];
             pk.best_slot[k] = better ? j : pk.best_slot[k];
             pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
-            if constexpr (Near::kKeeps) {
-                qs[k] = q - excess;
-                within |= int(qs[k] <= pk.radius[k]);
-            }
+            if constexpr (Near::kKeeps) qs[k] = q - excess;
         }
-        if constexpr (Near::kKeeps) {
-            if (within)
-                for (int k = 0; k < K; ++k)
-                    if (qs[k] <= pk.radius[k]) near.offer(k, j, qs[k]);
-        }
+        if constexpr (Near::kKeeps) offer_within<T, K>(qs, pk.radius, j, near);
     }
     return refresh_radii(pk, near);
 }
