@@ -11,6 +11,7 @@
 // target (SDF_CPU_TARGET other than portable) has no levels and skips.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -434,6 +435,56 @@ TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
             }
         }
     }
+}
+
+/// The dispatched re-ranking (rerank_simd.h: the candidates' double Q in one vector loop, in
+/// chunks of kRerankChunk) returns what rerank_in_double() returns, at every level: on the
+/// mesh's vertices (every triangle around one ties in exact arithmetic, and double's
+/// rounding decides), near them, and with up to 40 candidates (several chunks), some beyond
+/// the radius, duplicates, and a dropped one within it (overflow).
+TEST(CpuIsa, RerankEqualsTheScalarReRanking) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    const PreparedMesh& mesh = test_mesh();
+    const TriangleBvh bvh = build_triangle_bvh(mesh);
+    const BvhView<double> exact = bvh.view<double>();
+    std::vector<const CpuKernelSet*> sets = runnable_sets();
+    sets.push_back(&active_cpu_kernels());
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> jitter(-1e-9, 1e-9), unit(0.0, 1.0);
+    const int n = exact.num_triangles;
+    int64_t cases = 0, reranked = 0, changed = 0;
+    for (size_t v = 0; v < mesh.vertices().size(); v += 2) {
+        const Vec3d p = mesh.vertices()[v] * (1.0 + 1e-3 * unit(rng)) + Vec3d{jitter(rng), jitter(rng), jitter(rng)};
+        // The slots of the triangles around vertex v first (the ties), then random ones.
+        std::vector<int32_t> slots;
+        for (int s = 0; s < n; ++s) {
+            const Int3 t = mesh.triangles()[size_t(exact.triangle_index[s])];
+            if (t[0] == int(v) || t[1] == int(v) || t[2] == int(v)) slots.push_back(s);
+        }
+        const int extra = int(rng() % 34);
+        for (int i = 0; i < extra; ++i) slots.push_back(int32_t(rng() % uint64_t(n)));
+        std::shuffle(slots.begin(), slots.end(), rng);
+        const float radius = 1.0f;
+        std::vector<float> q(slots.size());
+        for (float& x : q) x = float(unit(rng) < 0.8 ? 0.5 : 1.5);  // 1 in 5 beyond the radius
+        const int32_t winner = slots[0];
+        const float dropped = unit(rng) < 0.05 ? 0.75f : NAN;
+        const auto index_of = [&](int32_t s) { return exact.triangle_index[s]; };
+        const Rerank want = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, radius, slots.data(), q.data(),
+                                             int(slots.size()), dropped);
+        for (const CpuKernelSet* set : sets) {
+            const Rerank got = set->certified.rerank(exact.packed, exact.triangle_index, p, winner, radius, slots.data(),
+                                                     q.data(), int(slots.size()), dropped);
+            EXPECT_EQ(got.slot, want.slot) << set->isa << " vertex " << v;
+            EXPECT_EQ(got.reranked, want.reranked) << set->isa << " vertex " << v;
+            EXPECT_EQ(got.overflow, want.overflow) << set->isa << " vertex " << v;
+        }
+        ++cases;
+        reranked += want.reranked;
+        changed += want.slot != winner;
+    }
+    EXPECT_GT(reranked, cases / 2);
+    EXPECT_GT(changed, cases / 4) << "the double search should overrule the float winner often here";
 }
 
 TEST(CpuIsa, ParsesLevelNames) {
