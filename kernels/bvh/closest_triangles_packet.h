@@ -73,39 +73,6 @@ struct PacketCertifiedNear {
 
 namespace detail {
 
-/// Whether child c's box may hold a nearer triangle for any lane (its distance to that lane
-/// is below the lane's best); `min_d2` receives the smallest distance over the lanes.
-template <typename T, int K>
-SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacket<T, K>& pk, T& min_d2) {
-    const T lo_x = T(n.min_x[c]), hi_x = T(n.max_x[c]), lo_y = T(n.min_y[c]), hi_y = T(n.max_y[c]);
-    const T lo_z = T(n.min_z[c]), hi_z = T(n.max_z[c]);
-    int wanted = 0;
-    T m = std::numeric_limits<T>::infinity();
-#if !SDF_IS_GPU_CODE
-#pragma omp simd reduction(| : wanted) reduction(min : m)
-#endif
-    for (int k = 0; k < K; ++k) {
-        const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
-        const T d = gx * gx + gy * gy + gz * gz;
-        wanted |= int(may_hold_nearer(d, pk.radius[k]));
-        m = d < m ? d : m;
-    }
-    min_d2 = m;
-    return wanted != 0;
-}
-
-/// Sets every lane's radius from its best; returns the largest.
-template <typename T, int K, typename Near>
-SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
-#if !SDF_IS_GPU_CODE
-#pragma omp simd
-#endif
-    for (int k = 0; k < K; ++k) pk.radius[k] = near.radius(pk.best_q[k]);
-    T worst = pk.radius[0];
-    for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
-    return worst;
-}
-
 /// The lanes k with qs[k] <= radius[k] as bit k of a mask (K <= 32). Float packets of 16 on
 /// the host compare as whole vectors (one instruction with AVX-512); otherwise lane by lane.
 template <typename T, int K>
@@ -132,6 +99,53 @@ SDF_CPU_GPU SDF_INLINE uint32_t lanes_within(const T* qs, const T* radius) {
     return m;
 }
 
+/// Whether child c's box may hold a nearer triangle for any lane (its distance to that lane
+/// is below the lane's best); `min_d2` receives the smallest distance over the lanes.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacket<T, K>& pk, T& min_d2) {
+    const T lo_x = T(n.min_x[c]), hi_x = T(n.max_x[c]), lo_y = T(n.min_y[c]), hi_y = T(n.max_y[c]);
+    const T lo_z = T(n.min_z[c]), hi_z = T(n.max_z[c]);
+    T m = std::numeric_limits<T>::infinity();
+#if SDF_PACKET_MASK_INTRINSICS
+    if constexpr (std::is_same_v<T, float> && K == 16) {  // the lanes' test as one vector compare
+        T d[K], limit[K];
+#pragma omp simd reduction(min : m)
+        for (int k = 0; k < K; ++k) {
+            const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
+            d[k] = gx * gx + gy * gy + gz * gz;
+            limit[k] = pk.radius[k] * (T(1) + T(8) * std::numeric_limits<T>::epsilon());  // may_hold_nearer()'s
+            m = d[k] < m ? d[k] : m;
+        }
+        min_d2 = m;
+        return lanes_within<T, K>(d, limit) != 0;
+    }
+#endif
+    int wanted = 0;
+#if !SDF_IS_GPU_CODE
+#pragma omp simd reduction(| : wanted) reduction(min : m)
+#endif
+    for (int k = 0; k < K; ++k) {
+        const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
+        const T d = gx * gx + gy * gy + gz * gz;
+        wanted |= int(may_hold_nearer(d, pk.radius[k]));
+        m = d < m ? d : m;
+    }
+    min_d2 = m;
+    return wanted != 0;
+}
+
+/// Sets every lane's radius from its best; returns the largest.
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE T refresh_radii(BvhPacket<T, K>& pk, const Near& near) {
+#if !SDF_IS_GPU_CODE
+#pragma omp simd
+#endif
+    for (int k = 0; k < K; ++k) pk.radius[k] = near.radius(pk.best_q[k]);
+    T worst = pk.radius[0];
+    for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
+    return worst;
+}
+
 /// Offers slot j to the lanes whose Q (`qs`) is within their radius, in lane order: only the
 /// lanes of the mask are visited (a tie at a shared vertex makes most leaves offer to some).
 template <typename T, int K, typename Near>
@@ -151,19 +165,21 @@ SDF_CPU_GPU SDF_INLINE void offer_within(const T* qs, const T* radius, int32_t j
 template <typename T, int K, typename Near>
 SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
                                             Near& near) {
+    int improved = 0;
     for (int32_t j = first; j < first + count; ++j) {
         const PackedTriangle<T> tri = bvh.packed[j];
         const int32_t triangle = bvh.triangle_index[j];
         const T excess = Near::kKeeps ? sliver_excess(tri) : T(0);
         T qs[K];
 #if !SDF_IS_GPU_CODE
-#pragma omp simd
+#pragma omp simd reduction(| : improved)
 #endif
         for (int k = 0; k < K; ++k) {
             const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
             // The tie rule of closest_triangle_bvh.h (wins_tie), lane by lane.
             const bool better = q < pk.best_q[k] ||
                                 (q == pk.best_q[k] && (pk.best_triangle[k] < 0 || triangle < pk.best_triangle[k]));
+            improved |= int(better);
             pk.best_q[k] = better ? q : pk.best_q[k];
             pk.best_slot[k] = better ? j : pk.best_slot[k];
             pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
@@ -171,6 +187,16 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first
         }
         if constexpr (Near::kKeeps) offer_within<T, K>(qs, pk.radius, j, near);
     }
+#if !SDF_IS_GPU_CODE
+    // No best changed: the radii, set from the bests after the previous leaf, stand.
+    if (!improved) {
+        T worst = pk.radius[0];
+        for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
+        return worst;
+    }
+#else
+    (void)improved;
+#endif
     return refresh_radii(pk, near);
 }
 
