@@ -27,10 +27,11 @@ constexpr int64_t kBvhChunk = 256;
 /// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
 static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
-/// Bricks per parallel_for chunk.
+/// Packets of arbitrary points per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
-/// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
-constexpr int64_t kBandChunkRows = 8;
+/// Rows of lattice bricks (along x) per parallel_for chunk: a row's first brick is seeded by
+/// the first brick of the row before it, and a narrow band's probes are shared along x and y.
+constexpr int64_t kChunkRows = 8;
 
 using BvhKernel = CpuBvhKernel;
 
@@ -268,14 +269,16 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", block.count(), progress);
-    // With a band, chunks are whole rows of bricks (8 rows), so that a brick can reuse the
-    // probe of the brick beside it in x and of the one below it in y (column_ball).
-    const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
+    // Chunks are whole rows of bricks, so that a brick can take its seeds from the brick
+    // before it in x or, first in its row, from the first brick of the row before (2 spacings
+    // away in y, not the end of that row), and reuse the probe of the brick beside it in x
+    // and of the one below it in y (column_ball).
+    const int64_t chunk = int64_t(bricks.x) * kChunkRows;
     parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         LocalCertificate certified;
-        int32_t seed[kBrick];
-        for (int k = 0; k < kBrick; ++k) seed[k] = -1;
+        int32_t seed[kBrick], row_seed[kBrick];
+        for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k] = -1;
         int32_t probe_seed = -1;
         ProbeBall ball;
         std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
@@ -284,6 +287,9 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
             done += br.count;
+            const bool row_start = b % bricks.x == 0;
+            if (row_start)
+                for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k];
             if (band.enabled()) {
                 ProbeBall& below = column_ball[size_t(b % bricks.x)];
                 if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
@@ -329,7 +335,11 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
                                                                                 view.triangle_index[slot[k]]),
                                                     k, br.position[k]));
-            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
+            // The next brick's lanes start from this brick's last column in x, (1 to 4
+            // spacings away rather than 4): a tighter first radius.
+            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k - k % kBrickX + kBrickX - 1];
+            if (row_start)
+                for (int k = 0; k < kBrick; ++k) row_seed[k] = pk.best_slot[k];
         }
         certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
