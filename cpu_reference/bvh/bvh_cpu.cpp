@@ -217,6 +217,25 @@ Brick brick_points(const Lattice& lattice, const GridBlock& block, const Int3& b
     return out;
 }
 
+/// Seeds each lane of `pk` (seeded by seed_packet()) with the winner of the nearest lane of
+/// the brick before it in y, `below` (that brick's winners; -1: none), where that triangle is
+/// nearer: a tighter first radius. Any triangle is a valid seed (its distance only bounds the
+/// search), so the result does not change.
+template <typename T>
+void improve_seeds_from_below(const BvhView<T>& view, const int32_t* below, BvhPacket<T, kBrick>& pk) {
+    for (int k = 0; k < kBrick; ++k) {
+        const int i = k % kBrickX, l = k / (kBrickX * kBrickY);
+        const int32_t s = below[i + kBrickX * (kBrickY - 1) + kBrickX * kBrickY * l];
+        if (s < 0 || s == pk.best_slot[k]) continue;
+        const T q = squared_distance(view.packed[s], pk.x[k], pk.y[k], pk.z[k]);
+        if (q < pk.best_q[k]) {
+            pk.best_q[k] = pk.radius[k] = q;
+            pk.best_slot[k] = s;
+            pk.best_triangle[k] = view.triangle_index[s];
+        }
+    }
+}
+
 /// The narrow band's brick skip (SamplerOptions::band_width). The exact distance is
 /// 1-Lipschitz: a probe at c with exact distance D proves |d(p)| >= D - |p - c| for every p,
 /// so every point of a brick within D - w - margin of c lies outside the band and needs no
@@ -282,6 +301,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         int32_t probe_seed = -1;
         ProbeBall ball;
         std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
+        std::vector<int32_t> below(size_t(bricks.x) * kBrick, -1);  // each column's winners in the row before
         PacketSign packet_sign(sign);
         int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
@@ -328,8 +348,11 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 pk.z[k] = T(br.position[k].z);
             }
             seed_packet(view, seed, pk);
+            int32_t* column_below = &below[size_t(b % bricks.x) * kBrick];
+            improve_seeds_from_below(view, column_below, pk);
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
+            for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
             packet_sign.prepare(br.position);
             for (int k = 0; k < br.count; ++k)
                 emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
