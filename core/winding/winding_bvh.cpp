@@ -13,10 +13,32 @@ struct SlotRange {
     int32_t begin = 0, end = 0;
 };
 
+/// What the moments need of one triangle (BVH slot), computed once instead of once per level
+/// of the tree, by the same expressions, so the sums below add the same bits in the same order.
+struct SlotTerms {
+    Vec3d a, b, c;                ///< corners
+    Vec3d area_normal;            ///< a_i n_i = (b - a) x (c - a) / 2
+    double area = 0;              ///< a_i = |a_i n_i|
+    Vec3d weighted_centroid;      ///< (a + b + c) a_i / 3
+    Vec3d centroid;               ///< (a + b + c) / 3
+};
+
 class MomentBuilder {
 public:
     MomentBuilder(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<WindingNode<double>>& out)
-        : mesh_(mesh), bvh_(bvh), out_(out) {}
+        : bvh_(bvh), out_(out), slots_(bvh.triangle_index.size()) {
+        for (size_t s = 0; s < slots_.size(); ++s) {
+            const Int3& t = mesh.triangles()[size_t(bvh.triangle_index[s])];
+            SlotTerms& x = slots_[s];
+            x.a = mesh.vertices()[size_t(t[0])];
+            x.b = mesh.vertices()[size_t(t[1])];
+            x.c = mesh.vertices()[size_t(t[2])];
+            x.area_normal = cross(x.b - x.a, x.c - x.a) * 0.5;
+            x.area = length(x.area_normal);
+            x.weighted_centroid = (x.a + x.b + x.c) * (x.area / 3.0);
+            x.centroid = (x.a + x.b + x.c) / 3.0;
+        }
+    }
 
     /// Fills the moments of both children of `node`; returns the slots under it.
     SlotRange visit(int32_t node) {
@@ -33,39 +55,36 @@ public:
     }
 
 private:
-    Vec3d corner(int32_t slot, int k) const {
-        return mesh_.vertices()[size_t(mesh_.triangles()[size_t(bvh_.triangle_index[size_t(slot)])][k])];
-    }
-
     WindingMoments<double> moments_of(SlotRange r) const {
         WindingMoments<double> m;
         Vec3d weighted_centroids(0.0);
         for (int32_t s = r.begin; s < r.end; ++s) {
-            const Vec3d a = corner(s, 0), b = corner(s, 1), c = corner(s, 2);
-            const Vec3d area_normal = cross(b - a, c - a) * 0.5;  // a_i n_i
-            const double area = length(area_normal);
-            m.area += area;
-            m.normal_sum += area_normal;
-            weighted_centroids += (a + b + c) * (area / 3.0);
+            const SlotTerms& x = slots_[size_t(s)];
+            m.area += x.area;
+            m.normal_sum += x.area_normal;
+            weighted_centroids += x.weighted_centroid;
         }
         if (r.end <= r.begin) return m;
-        m.center = m.area > 0 ? weighted_centroids / m.area : corner(r.begin, 0);
+        m.center = m.area > 0 ? weighted_centroids / m.area : slots_[size_t(r.begin)].a;
+        // The largest |v - p~|: sqrt is correctly rounded, hence monotone, so the square root
+        // of the largest square is the largest of the square roots.
+        double radius2 = 0;
         for (int32_t s = r.begin; s < r.end; ++s) {
-            const Vec3d a = corner(s, 0), b = corner(s, 1), c = corner(s, 2);
-            for (const Vec3d& v : {a, b, c}) m.radius = std::max(m.radius, length(v - m.center));
-            const Vec3d area_normal = cross(b - a, c - a) * 0.5;
-            const Vec3d h = (a + b + c) / 3.0 - m.center;
+            const SlotTerms& x = slots_[size_t(s)];
+            for (const Vec3d& v : {x.a, x.b, x.c}) radius2 = std::max(radius2, length_squared(v - m.center));
+            const Vec3d h = x.centroid - m.center;
             for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) m.second[3 * i + j] += h[i] * area_normal[j];
+                for (int j = 0; j < 3; ++j) m.second[3 * i + j] += h[i] * x.area_normal[j];
         }
+        m.radius = std::sqrt(radius2);
         // Rounding of |v - p~| must not shrink the ball: widen it by a relative 1e-12.
         m.radius *= 1.0 + 1e-12;
         return m;
     }
 
-    const PreparedMesh& mesh_;
     const TriangleBvh& bvh_;
     std::vector<WindingNode<double>>& out_;
+    std::vector<SlotTerms> slots_;  ///< by BVH slot
 };
 
 WindingMoments<float> to_float(const WindingMoments<double>& m) {

@@ -56,6 +56,10 @@ public:
     int64_t exact_evaluations() const { return exact_.load(); }
 
     const WindingBvh& winding_bvh() const { return winding_; }
+    /// What inside() evaluates: for evaluations of several points at once that must give the
+    /// same sides (the CPU's packets, fast_winding_packet.h).
+    const WindingView<double>& view() const { return view_; }
+    const WindingSignOptions& options() const { return options_; }
 
 private:
     WindingSignOptions options_;

@@ -27,10 +27,11 @@ constexpr int64_t kBvhChunk = 256;
 /// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
 constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
 static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
-/// Bricks per parallel_for chunk.
+/// Packets of arbitrary points per parallel_for chunk.
 constexpr int64_t kBrickChunk = 16;
-/// Rows of bricks per parallel_for chunk with a narrow band (probes are shared along x and y).
-constexpr int64_t kBandChunkRows = 8;
+/// Rows of lattice bricks (along x) per parallel_for chunk: a row's first brick is seeded by
+/// the first brick of the row before it, and a narrow band's probes are shared along x and y.
+constexpr int64_t kChunkRows = 8;
 
 using BvhKernel = CpuBvhKernel;
 
@@ -96,6 +97,42 @@ struct Certifier {
         counters.reranked += r.reranked;
         return r.slot;
     }
+};
+
+/// The sign of a packet's lanes. With the samplers' winding sign (uncertified: the fast
+/// value's side), the fast winding numbers of all kCpuPacketLanes lanes come from one
+/// traversal (fast_winding_packet.h), each lane's value the bits WindingSign::inside()
+/// computes; otherwise each point gets SamplerSign::apply().
+class PacketSign {
+public:
+    explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
+        const WindingSign* w = sign.winding() ? sign.winding_sign() : nullptr;
+        winding_ = w != nullptr && !w->options().certify ? w : nullptr;
+    }
+
+    /// Evaluates the sides of the packet's points `position` (all kCpuPacketLanes lanes).
+    void prepare(const Vec3d* position) {
+        if (winding_ == nullptr) return;
+        double px[kCpuPacketLanes], py[kCpuPacketLanes], pz[kCpuPacketLanes], w[kCpuPacketLanes];
+        for (int k = 0; k < kCpuPacketLanes; ++k) {
+            px[k] = position[k].x;
+            py[k] = position[k].y;
+            pz[k] = position[k].z;
+        }
+        kernel_(winding_->view(), px, py, pz, winding_->options().accuracy, w);
+        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::inside()
+    }
+
+    /// Lane k's sample `s` at p with its sign (after prepare() of its packet).
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, int k, const Vec3d& p) const {
+        return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p);
+    }
+
+private:
+    const SamplerSign& sign_;
+    const WindingSign* winding_ = nullptr;  ///< non-null: packets of winding numbers
+    WindingPacketFn kernel_ = active_cpu_kernels().winding_numbers_packet;
+    bool inside_[kCpuPacketLanes] = {};
 };
 
 /// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
@@ -180,6 +217,25 @@ Brick brick_points(const Lattice& lattice, const GridBlock& block, const Int3& b
     return out;
 }
 
+/// Seeds each lane of `pk` (seeded by seed_packet()) with the winner of the nearest lane of
+/// the brick before it in y, `below` (that brick's winners; -1: none), where that triangle is
+/// nearer: a tighter first radius. Any triangle is a valid seed (its distance only bounds the
+/// search), so the result does not change.
+template <typename T>
+void improve_seeds_from_below(const BvhView<T>& view, const int32_t* below, BvhPacket<T, kBrick>& pk) {
+    for (int k = 0; k < kBrick; ++k) {
+        const int i = k % kBrickX, l = k / (kBrickX * kBrickY);
+        const int32_t s = below[i + kBrickX * (kBrickY - 1) + kBrickX * kBrickY * l];
+        if (s < 0 || s == pk.best_slot[k]) continue;
+        const T q = squared_distance(view.packed[s], pk.x[k], pk.y[k], pk.z[k]);
+        if (q < pk.best_q[k]) {
+            pk.best_q[k] = pk.radius[k] = q;
+            pk.best_slot[k] = s;
+            pk.best_triangle[k] = view.triangle_index[s];
+        }
+    }
+}
+
 /// The narrow band's brick skip (SamplerOptions::band_width). The exact distance is
 /// 1-Lipschitz: a probe at c with exact distance D proves |d(p)| >= D - |p - c| for every p,
 /// so every point of a brick within D - w - margin of c lies outside the band and needs no
@@ -232,21 +288,28 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
     ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", block.count(), progress);
-    // With a band, chunks are whole rows of bricks (8 rows), so that a brick can reuse the
-    // probe of the brick beside it in x and of the one below it in y (column_ball).
-    const int64_t chunk = band.enabled() ? int64_t(bricks.x) * kBandChunkRows : kBrickChunk;
+    // Chunks are whole rows of bricks, so that a brick can take its seeds from the brick
+    // before it in x or, first in its row, from the first brick of the row before (2 spacings
+    // away in y, not the end of that row), and reuse the probe of the brick beside it in x
+    // and of the one below it in y (column_ball).
+    const int64_t chunk = int64_t(bricks.x) * kChunkRows;
     parallel_for(n, chunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         LocalCertificate certified;
-        int32_t seed[kBrick];
-        for (int k = 0; k < kBrick; ++k) seed[k] = -1;
+        int32_t seed[kBrick], row_seed[kBrick];
+        for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k] = -1;
         int32_t probe_seed = -1;
         ProbeBall ball;
         std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
+        std::vector<int32_t> below(size_t(bricks.x) * kBrick, -1);  // each column's winners in the row before
+        PacketSign packet_sign(sign);
         int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
             done += br.count;
+            const bool row_start = b % bricks.x == 0;
+            if (row_start)
+                for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k];
             if (band.enabled()) {
                 ProbeBall& below = column_ball[size_t(b % bricks.x)];
                 if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
@@ -285,12 +348,21 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 pk.z[k] = T(br.position[k].z);
             }
             seed_packet(view, seed, pk);
+            int32_t* column_below = &below[size_t(b % bricks.x) * kBrick];
+            improve_seeds_from_below(view, column_below, pk);
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
+            for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
+            packet_sign.prepare(br.position);
             for (int k = 0; k < br.count; ++k)
-                emit(br.local[k], sign.apply(signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]),
-                                             br.position[k]));
-            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k];
+                emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
+                                                                                view.triangle_index[slot[k]]),
+                                                    k, br.position[k]));
+            // The next brick's lanes start from this brick's last column in x, (1 to 4
+            // spacings away rather than 4): a tighter first radius.
+            for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k - k % kBrickX + kBrickX - 1];
+            if (row_start)
+                for (int k = 0; k < kBrick; ++k) row_seed[k] = pk.best_slot[k];
         }
         certified.add_to(counters.certificate);
         counters.nodes += stats.nodes;
@@ -363,6 +435,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
         LocalCertificate certified;
         int32_t seed[kPointPacket];
         for (int k = 0; k < kPointPacket; ++k) seed[k] = -1;
+        PacketSign packet_sign(sign);
         int64_t done = 0;
         for (int64_t b = begin; b < end; ++b) {
             const int64_t first = b * kPointPacket;
@@ -378,10 +451,11 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
             search_packet(view, certifier, position, count, pk, stats, certified, slot);
+            packet_sign.prepare(position);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
-                emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), p));
+                emit(i, packet_sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), k, p));
             }
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;

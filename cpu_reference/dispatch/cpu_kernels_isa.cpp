@@ -9,6 +9,7 @@
 // linkage: this object defines one global symbol, the accessor, and CTest checks that
 // (scripts/check-isa-objects).
 #include "cpu_reference/dispatch/cpu_kernels.h"
+#include "cpu_reference/dispatch/rerank_simd.h"
 
 #if !defined(SDF_CPU_KERNEL_SET) || !defined(SDF_CPU_KERNEL_ISA)
 #error "cpu_kernels_isa.cpp is compiled by CMake once per ISA level, with SDF_CPU_KERNEL_SET and SDF_CPU_KERNEL_ISA"
@@ -26,13 +27,15 @@ struct Flattened<F> {
 };
 
 /// rerank_in_double() for BVH slots (`triangle_index` maps them to triangles) or, with
-/// `triangle_index` null, for triangle indices (the brute force's).
+/// `triangle_index` null, for triangle indices (the brute force's); its vector form
+/// (rerank_simd.h), the same winner.
 Rerank rerank(const PackedTriangle<double>* exact, const int32_t* triangle_index, const Vec3d& p, int32_t winner,
               float radius, const int32_t* slot, const float* q, int count, float dropped) {
     if (triangle_index == nullptr)
-        return rerank_in_double(exact, [](int32_t s) { return s; }, p.x, p.y, p.z, winner, radius, slot, q, count, dropped);
-    return rerank_in_double(exact, [triangle_index](int32_t s) { return triangle_index[s]; }, p.x, p.y, p.z, winner, radius,
-                            slot, q, count, dropped);
+        return rerank_in_double_simd(exact, [](int32_t s) { return s; }, p.x, p.y, p.z, winner, radius, slot, q, count,
+                                     dropped);
+    return rerank_in_double_simd(exact, [triangle_index](int32_t s) { return triangle_index[s]; }, p.x, p.y, p.z, winner,
+                                 radius, slot, q, count, dropped);
 }
 
 template <typename T>
@@ -59,7 +62,8 @@ constexpr CpuCertifiedKernels certified_kernels() {
             &Flattened<&rerank>::call};
 }
 
-constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels()};
+constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels(),
+                            &Flattened<&fast_winding_numbers_packet<kCpuPacketLanes>>::call};
 
 }  // namespace
 

@@ -21,7 +21,19 @@
 /// more candidates.
 #pragma once
 
+#include <cstdint>
+#include <type_traits>
+
 #include "kernels/bvh/closest_triangle_bvh.h"
+
+// Vector compares for the leaf loop's lane mask: host compilers with SSE2 (every x86-64), not
+// the CUDA compiler's passes.
+#if !defined(__CUDACC__) && defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define SDF_PACKET_MASK_INTRINSICS 1
+#else
+#define SDF_PACKET_MASK_INTRINSICS 0
+#endif
 
 namespace sdf {
 
@@ -61,14 +73,54 @@ struct PacketCertifiedNear {
 
 namespace detail {
 
+/// The lanes k with qs[k] <= radius[k] as bit k of a mask (K <= 32). Float packets of 16 on
+/// the host compare as whole vectors (one instruction with AVX-512); otherwise lane by lane.
+template <typename T, int K>
+SDF_CPU_GPU SDF_INLINE uint32_t lanes_within(const T* qs, const T* radius) {
+    static_assert(K <= 32, "one bit per lane in a 32-bit mask");
+#if SDF_PACKET_MASK_INTRINSICS
+    if constexpr (std::is_same_v<T, float> && K == 16) {
+#if defined(__AVX512F__)
+        return uint32_t(_mm512_cmp_ps_mask(_mm512_loadu_ps(qs), _mm512_loadu_ps(radius), _CMP_LE_OQ));
+#elif defined(__AVX__)
+        const int lo = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(qs), _mm256_loadu_ps(radius), _CMP_LE_OQ));
+        const int hi = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(qs + 8), _mm256_loadu_ps(radius + 8), _CMP_LE_OQ));
+        return uint32_t(lo) | uint32_t(hi) << 8;
+#else
+        uint32_t m = 0;
+        for (int i = 0; i < 4; ++i)
+            m |= uint32_t(_mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(qs + 4 * i), _mm_loadu_ps(radius + 4 * i)))) << (4 * i);
+        return m;
+#endif
+    }
+#endif
+    uint32_t m = 0;
+    for (int k = 0; k < K; ++k) m |= uint32_t(qs[k] <= radius[k]) << k;
+    return m;
+}
+
 /// Whether child c's box may hold a nearer triangle for any lane (its distance to that lane
 /// is below the lane's best); `min_d2` receives the smallest distance over the lanes.
 template <typename T, int K>
 SDF_CPU_GPU SDF_INLINE bool child_wanted(const BvhNode& n, int c, const BvhPacket<T, K>& pk, T& min_d2) {
     const T lo_x = T(n.min_x[c]), hi_x = T(n.max_x[c]), lo_y = T(n.min_y[c]), hi_y = T(n.max_y[c]);
     const T lo_z = T(n.min_z[c]), hi_z = T(n.max_z[c]);
-    int wanted = 0;
     T m = std::numeric_limits<T>::infinity();
+#if SDF_PACKET_MASK_INTRINSICS
+    if constexpr (std::is_same_v<T, float> && K == 16) {  // the lanes' test as one vector compare
+        T d[K], limit[K];
+#pragma omp simd reduction(min : m)
+        for (int k = 0; k < K; ++k) {
+            const T gx = axis_gap(lo_x, hi_x, pk.x[k]), gy = axis_gap(lo_y, hi_y, pk.y[k]), gz = axis_gap(lo_z, hi_z, pk.z[k]);
+            d[k] = gx * gx + gy * gy + gz * gz;
+            limit[k] = pk.radius[k] * (T(1) + T(8) * std::numeric_limits<T>::epsilon());  // may_hold_nearer()'s
+            m = d[k] < m ? d[k] : m;
+        }
+        min_d2 = m;
+        return lanes_within<T, K>(d, limit) != 0;
+    }
+#endif
+    int wanted = 0;
 #if !SDF_IS_GPU_CODE
 #pragma omp simd reduction(| : wanted) reduction(min : m)
 #endif
@@ -94,39 +146,57 @@ SDF_CPU_GPU SDF_INLINE T refresh_radii(const BvhView<T>& bvh, BvhPacket<T, K>& p
     return worst;
 }
 
+/// Offers slot j to the lanes whose Q (`qs`) is within their radius, in lane order: only the
+/// lanes of the mask are visited (a tie at a shared vertex makes most leaves offer to some).
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE void offer_within(const T* qs, const T* radius, int32_t j, Near& near) {
+    for (uint32_t within = lanes_within<T, K>(qs, radius); within != 0; within &= within - 1) {
+#if SDF_IS_GPU_CODE
+        const int k = __ffs(int(within)) - 1;
+#else
+        const int k = __builtin_ctz(within);
+#endif
+        near.offer(k, j, qs[k]);
+    }
+}
+
 /// Tests every point of the packet against leaf triangles [first, first + count), offering
 /// those within a lane's radius to `near`; returns the new largest radius of the packet.
 template <typename T, int K, typename Near>
 SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first, int32_t count, BvhPacket<T, K>& pk,
                                             Near& near) {
+    int improved = 0;
     for (int32_t j = first; j < first + count; ++j) {
         const PackedTriangle<T> tri = bvh.packed[j];
         const int32_t triangle = bvh.triangle_index[j];
         const T excess = Near::kKeeps ? sliver_excess(tri) : T(0);
         T qs[K];
-        int within = 0;
 #if !SDF_IS_GPU_CODE
-#pragma omp simd reduction(| : within)
+#pragma omp simd reduction(| : improved)
 #endif
         for (int k = 0; k < K; ++k) {
             const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
             // The tie rule of closest_triangle_bvh.h (wins_tie), lane by lane.
             const bool better = q < pk.best_q[k] ||
                                 (q == pk.best_q[k] && (pk.best_triangle[k] < 0 || triangle < pk.best_triangle[k]));
+            improved |= int(better);
             pk.best_q[k] = better ? q : pk.best_q[k];
             pk.best_slot[k] = better ? j : pk.best_slot[k];
             pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
-            if constexpr (Near::kKeeps) {
-                qs[k] = q - excess;
-                within |= int(qs[k] <= pk.radius[k]);
-            }
+            if constexpr (Near::kKeeps) qs[k] = q - excess;
         }
-        if constexpr (Near::kKeeps) {
-            if (within)
-                for (int k = 0; k < K; ++k)
-                    if (qs[k] <= pk.radius[k]) near.offer(k, j, qs[k]);
-        }
+        if constexpr (Near::kKeeps) offer_within<T, K>(qs, pk.radius, j, near);
     }
+#if !SDF_IS_GPU_CODE
+    // No best changed: the radii, set from the bests after the previous leaf, stand.
+    if (!improved) {
+        T worst = pk.radius[0];
+        for (int k = 1; k < K; ++k) worst = worst > pk.radius[k] ? worst : pk.radius[k];
+        return worst;
+    }
+#else
+    (void)improved;
+#endif
     return refresh_radii(bvh, pk, near);
 }
 

@@ -57,28 +57,40 @@ struct WindingEstimate {
     int opened = 0;   ///< nodes opened (a cost figure)
 };
 
+/// The squared distance (beta r)^2 beyond which a child's expansion is used: q is far from it
+/// when |p~ - q|^2 > far_limit.
+template <typename T>
+SDF_CPU_GPU SDF_INLINE T far_limit(const WindingMoments<T>& m, const WindingAccuracy<T>& acc) {
+    return acc.beta * acc.beta * m.radius * m.radius;
+}
+
+/// The far-field value of one child at y = p~ - q (inv_d = 1 / |y|, inv_d3 = inv_d^3): the
+/// one formula of far_field() and of the CPU's packet evaluation (fast_winding_packet.h).
+template <typename T>
+SDF_CPU_GPU SDF_INLINE T far_field_value(const WindingMoments<T>& m, const Vec3<T>& y, T inv_d, T inv_d3, int order) {
+    T value = dot(m.normal_sum, y) * inv_d3;
+    if (order >= 2) {
+        const T* M = m.second;
+        const T trace = M[0] + M[4] + M[8];
+        const Vec3<T> My{M[0] * y.x + M[1] * y.y + M[2] * y.z, M[3] * y.x + M[4] * y.y + M[5] * y.z,
+                         M[6] * y.x + M[7] * y.y + M[8] * y.z};
+        value += trace * inv_d3 - T(3) * dot(y, My) * inv_d3 * inv_d * inv_d;
+    }
+    return value * inverse_four_pi<T>();
+}
+
 /// Far-field value and error bound of one child seen from q; false when q is not far enough.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE bool far_field(const WindingMoments<T>& m, const Vec3<T>& q, const WindingAccuracy<T>& acc,
                                       T& value, T& bound) {
     const Vec3<T> y = m.center - q;
     const T d2 = length_squared(y);
-    if (!(d2 > acc.beta * acc.beta * m.radius * m.radius)) return false;
+    if (!(d2 > far_limit(m, acc))) return false;
     const T d = std::sqrt(d2), inv_d = T(1) / d, inv_d3 = inv_d * inv_d * inv_d;
-    value = dot(m.normal_sum, y) * inv_d3;
+    value = far_field_value(m, y, inv_d, inv_d3, acc.order);
     const T t = m.radius * inv_d, one_minus_t = T(1) - t;  // t < 1 / beta < 1
     const T scale = m.area * inv_d * inv_d / (one_minus_t * one_minus_t);
-    if (acc.order >= 2) {
-        const T* M = m.second;
-        const T trace = M[0] + M[4] + M[8];
-        const Vec3<T> My{M[0] * y.x + M[1] * y.y + M[2] * y.z, M[3] * y.x + M[4] * y.y + M[5] * y.z,
-                         M[6] * y.x + M[7] * y.y + M[8] * y.z};
-        value += trace * inv_d3 - T(3) * dot(y, My) * inv_d3 * inv_d * inv_d;
-        bound = scale * t * t * (T(3) - T(2) * t);
-    } else {
-        bound = scale * t * (T(2) - t);
-    }
-    value *= inverse_four_pi<T>();
+    bound = acc.order >= 2 ? scale * t * t * (T(3) - T(2) * t) : scale * t * (T(2) - t);
     bound *= inverse_four_pi<T>();
     return true;
 }

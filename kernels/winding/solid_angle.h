@@ -25,12 +25,21 @@ SDF_CPU_GPU constexpr T inverse_four_pi() { return T(0.0795774715459476678844418
 
 /// Signed solid angle of triangle (v0, v1, v2) seen from p, in (-2 pi, 2 pi]. 0 for p in the
 /// triangle's plane outside it (and for p on the triangle, where it is undefined).
+/// The numerator and denominator of Van Oosterom & Strackee's tan(Omega / 2) (above): the
+/// one formula of triangle_solid_angle() and of the CPU's packet evaluation.
 template <typename T>
-SDF_CPU_GPU SDF_INLINE T triangle_solid_angle(const Vec3<T>& p, const Vec3<T>& v0, const Vec3<T>& v1, const Vec3<T>& v2) {
+SDF_CPU_GPU SDF_INLINE void solid_angle_terms(const Vec3<T>& p, const Vec3<T>& v0, const Vec3<T>& v1, const Vec3<T>& v2,
+                                              T& numerator, T& denominator) {
     const Vec3<T> a = v0 - p, b = v1 - p, c = v2 - p;
     const T la = length(a), lb = length(b), lc = length(c);
-    const T numerator = dot(a, cross(b, c));
-    const T denominator = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    numerator = dot(a, cross(b, c));
+    denominator = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+}
+
+template <typename T>
+SDF_CPU_GPU SDF_INLINE T triangle_solid_angle(const Vec3<T>& p, const Vec3<T>& v0, const Vec3<T>& v1, const Vec3<T>& v2) {
+    T numerator, denominator;
+    solid_angle_terms(p, v0, v1, v2, numerator, denominator);
     return T(2) * std::atan2(numerator, denominator);
 }
 

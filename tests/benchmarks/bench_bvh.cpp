@@ -441,6 +441,7 @@ BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark:
 BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
+BENCHMARK_CAPTURE(BM_CpuBvh, dragon_legacy, std::string("dragon-legacy.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvhPacketKernel, dragon, std::string("dragon.obj"))
     ->ArgsProduct({{64, 128}, {0, 1, 2, 3}})->ArgNames({"res", "mode"})->Unit(benchmark::kMillisecond)->Iterations(1)
     ->Repetitions(3)->ReportAggregatesOnly(true);

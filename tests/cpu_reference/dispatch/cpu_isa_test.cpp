@@ -11,6 +11,7 @@
 // target (SDF_CPU_TARGET other than portable) has no levels and skips.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -22,6 +23,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "core/winding/winding_sign.h"
 
 namespace sdf {
 namespace {
@@ -366,6 +368,123 @@ TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
     }
     std::printf("certified samplers at %s: %zu points and a %lld-point lattice equal the double brute force\n",
                 active_cpu_kernels().isa, pts.size(), (long long)lattice.num_points());
+}
+
+/// A torus with every fifth triangle removed: open, so its winding numbers take every value
+/// between 0 and 1 near the holes, where a wrong term or order would show.
+const PreparedMesh& holed_mesh() {
+    static const PreparedMesh mesh = [] {
+        TriangleMesh m = make_torus(1.0, 0.35, 48, 24);
+        std::vector<Int3> kept;
+        for (size_t t = 0; t < m.triangles.size(); ++t)
+            if (t % 5 != 0) kept.push_back(m.triangles[t]);
+        m.triangles = kept;
+        return prepare_mesh(m);
+    }();
+    return mesh;
+}
+
+/// The packet of fast winding numbers (fast_winding_packet.h) gives every lane the bits of
+/// WindingSign's own evaluation of its point, at every level and the chosen one, at the
+/// samplers' accuracy and others: on lattice-like bricks (coherent lanes, as the samplers
+/// run it), on packets of scattered points (lanes that open different nodes), on vertices
+/// and far away.
+TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    constexpr int K = kCpuPacketLanes;
+    std::vector<const CpuKernelSet*> sets = runnable_sets();
+    sets.push_back(&active_cpu_kernels());
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.6, 1.6), spacing(1e-3, 0.2);
+    for (const PreparedMesh* mesh : {&holed_mesh(), &test_mesh()}) {
+        std::vector<Vec3d> pts;
+        for (int b = 0; b < 64; ++b) {  // 4 x 2 x 2 bricks
+            const Vec3d o{u(rng), u(rng), 0.3 * u(rng)};
+            const double h = spacing(rng);
+            for (int k = 0; k < K; ++k) pts.push_back(o + Vec3d{h * (k % 4), h * ((k / 4) % 2), h * (k / 8)});
+        }
+        for (int i = 0; i < 64 * K; ++i) pts.push_back({u(rng), u(rng), 0.5 * u(rng)});
+        for (size_t v = 0; v < mesh->vertices().size() && v < size_t(4 * K); v += 3) pts.push_back(mesh->vertices()[v]);
+        for (int i = 0; i < 2 * K; ++i) pts.push_back({1e3 * u(rng), 1e3 * u(rng), 1e3 * u(rng)});
+        while (pts.size() % K != 0) pts.push_back(pts.front());
+        for (const WindingAccuracy<double> acc : {WindingAccuracy<double>{}, WindingAccuracy<double>{1.5, 1},
+                                                  WindingAccuracy<double>{3.0, 2}}) {
+            WindingSignOptions options;
+            options.accuracy = acc;
+            const WindingSign sign(*mesh, options);
+            for (const CpuKernelSet* set : sets) {
+                int64_t bad = 0, between = 0;
+                for (size_t first = 0; first < pts.size(); first += K) {
+                    double px[K], py[K], pz[K], value[K];
+                    for (int k = 0; k < K; ++k) {
+                        px[k] = pts[first + size_t(k)].x;
+                        py[k] = pts[first + size_t(k)].y;
+                        pz[k] = pts[first + size_t(k)].z;
+                    }
+                    set->winding_numbers_packet(sign.view(), px, py, pz, acc, value);
+                    for (int k = 0; k < K; ++k) {
+                        const double want = sign.estimate(pts[first + size_t(k)]).value;
+                        bad += !same_bits(value[k], want);
+                        between += want > 0.05 && want < 0.95;
+                    }
+                }
+                EXPECT_EQ(bad, 0) << set->isa << " beta " << acc.beta << " order " << acc.order;
+                if (mesh == &holed_mesh()) {
+                    EXPECT_GT(between, 100) << "the holes should give fractional winding numbers";
+                }
+            }
+        }
+    }
+}
+
+/// The dispatched re-ranking (rerank_simd.h: the candidates' double Q in one vector loop, in
+/// chunks of kRerankChunk) returns what rerank_in_double() returns, at every level: on the
+/// mesh's vertices (every triangle around one ties in exact arithmetic, and double's
+/// rounding decides), near them, and with up to 40 candidates (several chunks), some beyond
+/// the radius, duplicates, and a dropped one within it (overflow).
+TEST(CpuIsa, RerankEqualsTheScalarReRanking) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    const PreparedMesh& mesh = test_mesh();
+    const TriangleBvh bvh = build_triangle_bvh(mesh);
+    const BvhView<double> exact = bvh.view<double>();
+    std::vector<const CpuKernelSet*> sets = runnable_sets();
+    sets.push_back(&active_cpu_kernels());
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> jitter(-1e-9, 1e-9), unit(0.0, 1.0);
+    const int n = exact.num_triangles;
+    int64_t cases = 0, reranked = 0, changed = 0;
+    for (size_t v = 0; v < mesh.vertices().size(); v += 2) {
+        const Vec3d p = mesh.vertices()[v] * (1.0 + 1e-3 * unit(rng)) + Vec3d{jitter(rng), jitter(rng), jitter(rng)};
+        // The slots of the triangles around vertex v first (the ties), then random ones.
+        std::vector<int32_t> slots;
+        for (int s = 0; s < n; ++s) {
+            const Int3 t = mesh.triangles()[size_t(exact.triangle_index[s])];
+            if (t[0] == int(v) || t[1] == int(v) || t[2] == int(v)) slots.push_back(s);
+        }
+        const int extra = int(rng() % 34);
+        for (int i = 0; i < extra; ++i) slots.push_back(int32_t(rng() % uint64_t(n)));
+        std::shuffle(slots.begin(), slots.end(), rng);
+        const float radius = 1.0f;
+        std::vector<float> q(slots.size());
+        for (float& x : q) x = float(unit(rng) < 0.8 ? 0.5 : 1.5);  // 1 in 5 beyond the radius
+        const int32_t winner = slots[0];
+        const float dropped = unit(rng) < 0.05 ? 0.75f : NAN;
+        const auto index_of = [&](int32_t s) { return exact.triangle_index[s]; };
+        const Rerank want = rerank_in_double(exact.packed, index_of, p.x, p.y, p.z, winner, radius, slots.data(), q.data(),
+                                             int(slots.size()), dropped);
+        for (const CpuKernelSet* set : sets) {
+            const Rerank got = set->certified.rerank(exact.packed, exact.triangle_index, p, winner, radius, slots.data(),
+                                                     q.data(), int(slots.size()), dropped);
+            EXPECT_EQ(got.slot, want.slot) << set->isa << " vertex " << v;
+            EXPECT_EQ(got.reranked, want.reranked) << set->isa << " vertex " << v;
+            EXPECT_EQ(got.overflow, want.overflow) << set->isa << " vertex " << v;
+        }
+        ++cases;
+        reranked += want.reranked;
+        changed += want.slot != winner;
+    }
+    EXPECT_GT(reranked, cases / 2);
+    EXPECT_GT(changed, cases / 4) << "the double search should overrule the float winner often here";
 }
 
 TEST(CpuIsa, ParsesLevelNames) {
