@@ -7,6 +7,8 @@
 /// "winding" the sample then takes the fast winding number's side (winding_sign_kernel.cuh).
 #pragma once
 
+#include <cstdlib>
+
 #include "core/sampling/sampled_field.h"
 #include "cuda/point_pieces.h"
 #include "cuda/winding_sign_kernel.cuh"
@@ -49,37 +51,54 @@ __device__ inline void store_sample(const PieceOutputs& out, int64_t i, const Si
 /// becomes the band's value with its sign, gradient 0 and kOutsideBandTriangle; `nearest`
 /// may then also hold the search's outside-band codes (bvh_candidates_kernel.cuh), whose
 /// points get the same values without a triangle.
-template <typename Piece, bool Winding>
+/// The winding numbers are found per warp (warp_fast_winding_value: every thread of the block,
+/// in the piece or not, reaches that call; blocks are whole warps), or with `PerThread` by
+/// each thread alone (the same bits: the measurement baseline, SDF_CUDA_WINDING_PER_THREAD).
+template <typename Piece, bool Winding, bool PerThread = false>
 __global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
                                  PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= piece.size()) return;
-    const int64_t o = piece.block_local(i) < 0 ? -1 : piece.output_index(i);
-    out.output_index[i] = o;
+    const bool in_piece = i < piece.size();
+    const int64_t o = !in_piece || piece.block_local(i) < 0 ? -1 : piece.output_index(i);
+    if (in_piece) out.output_index[i] = o;
+    const Vec3d p = o >= 0 ? piece.position(i) : Vec3d(0.0);
+    const int n = o >= 0 ? nearest[i] : -1;
+    double w = 0.0;
+    if constexpr (Winding) {
+        const bool wants = o >= 0 && (n >= 0 || n == kOutsideBandSignPerPoint);
+        if constexpr (PerThread) w = wants ? fast_winding_number(sign.view, p, sign.accuracy).value : 0.0;
+        else w = warp_fast_winding_value(sign.view, p, wants, sign.accuracy);
+    }
     if (o < 0) return;
-    const Vec3d p = piece.position(i);
-    const int n = nearest[i];
     if (n >= 0) {
         SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, n);
-        if constexpr (Winding) s = apply_winding_sign(sign, s, p);
+        if constexpr (Winding) s = with_sign(s, w > 0.5);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
         return;
     }
     bool inside = n == kOutsideBandInside;  // a brick wholly outside the band
     if constexpr (Winding) {
-        if (n == kOutsideBandSignPerPoint) inside = fast_winding_number(sign.view, p, sign.accuracy).value > 0.5;
+        if (n == kOutsideBandSignPerPoint) inside = w > 0.5;
     }
     out.distance[i] = inside ? -band_width : band_width;
     out.gradient[i] = Vec3d(0.0);
     out.triangle[i] = kOutsideBandTriangle;
 }
 
+/// Whether the environment asks for the per-thread winding traversal (SDF_CUDA_WINDING_PER_THREAD
+/// set: the baseline that docs/gpu-notes.md measures the warp traversal against).
+inline bool winding_per_thread() {
+    static const bool per_thread = std::getenv("SDF_CUDA_WINDING_PER_THREAD") != nullptr;
+    return per_thread;
+}
+
 /// Launches finalize_samples with or without the winding sign, as `sign` says.
 template <typename Piece>
 void launch_finalize_samples(int blocks, int threads, MeshView<double> mesh, const Piece& piece, const int* nearest,
                              const WindingSignView& sign, double band_width, PieceOutputs out) {
-    if (sign.enabled()) finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
-    else finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+    if (!sign.enabled()) finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+    else if (winding_per_thread()) finalize_samples<Piece, true, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+    else finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
 }
 
 }  // namespace sdf::cuda
