@@ -17,6 +17,7 @@ struct BuildRef {
     Bounds3 box;
     Vec3d centroid;
     int32_t triangle;
+    uint8_t bin[3];  ///< its SAH bin on each axis at the node being split (in the padding)
 };
 
 /// A built subtree as its parent stores it.
@@ -53,6 +54,12 @@ void write_child(BvhNode& n, int c, const BuiltChild& child) {
 /// Most SAH bins per axis (BvhBuildOptions::bins is checked against it).
 constexpr int kMaxBins = 64;
 
+/// A bin's box, left unconstructed until its first ref arrives (best_split).
+union BinSlot {
+    BinSlot() {}
+    Bounds3 box;
+};
+
 struct Split {
     int axis = -1;
     int bin = 0;  ///< refs in bins [0, bin) go left
@@ -73,7 +80,7 @@ public:
         int mid = -1;
         if (depth < o_.median_split_depth) {
             const Split s = best_split(begin, end, centroids, box);
-            if (s.axis >= 0) mid = partition(begin, end, s, centroids);
+            if (s.axis >= 0) mid = partition(begin, end, s);
         }
         if (mid <= begin || mid >= end) mid = median_partition(begin, end, centroids);
         return inner(box, begin, mid, end, depth);
@@ -99,53 +106,74 @@ private:
         return {box, index, 0};
     }
 
-    int bin_of(const Vec3d& c, int axis, const Bounds3& centroids) const {
-        const double lo = centroids.min[axis], extent = centroids.max[axis] - lo;
-        const int b = int(double(o_.bins) * (c[axis] - lo) / extent);
-        return std::clamp(b, 0, o_.bins - 1);
-    }
-
-    /// Binned SAH over the 3 axes: cost = node_cost + (A_L N_L + A_R N_R) / A.
-    Split best_split(int begin, int end, const Bounds3& centroids, const Bounds3& box) const {
-        Split best;
-        const double area = surface_area(box);
+    /// Binned SAH over the 3 axes: cost = node_cost + (A_L N_L + A_R N_R) / A. One pass
+    /// bins every ref on all three axes and keeps its bins for partition(); each bin's box
+    /// grows in the same order as with one pass per axis, and sweep() takes the same first
+    /// minimum (tests/cpu_reference/bvh/sah_build_test.cpp checks the trees byte for byte).
+    Split best_split(int begin, int end, const Bounds3& centroids, const Bounds3& box) {
+        const int bins = o_.bins;
+        bool active[3];
+        double lo[3], extent[3];
         for (int axis = 0; axis < 3; ++axis) {
-            if (!(centroids.max[axis] > centroids.min[axis])) continue;
-            Bounds3 bin_box[kMaxBins];
-            int bin_count[kMaxBins] = {};
-            for (int i = begin; i < end; ++i) {
-                const int b = bin_of(refs_[size_t(i)].centroid, axis, centroids);
-                bin_box[b] = merged(bin_box[b], refs_[size_t(i)].box);
-                ++bin_count[b];
-            }
-            // Right-to-left sweep for the right sides, then left-to-right for the costs.
-            double right_area[kMaxBins] = {};
-            int right_count[kMaxBins] = {};
-            Bounds3 acc;
-            int n = 0;
-            for (int b = o_.bins - 1; b > 0; --b) {
-                acc = merged(acc, bin_box[b]);
-                n += bin_count[b];
-                right_area[b] = surface_area(acc);
-                right_count[b] = n;
-            }
-            acc = Bounds3{};
-            n = 0;
-            for (int b = 1; b < o_.bins; ++b) {
-                acc = merged(acc, bin_box[b - 1]);
-                n += bin_count[b - 1];
-                if (n == 0 || right_count[b] == 0) continue;
-                const double cost = o_.node_cost +
-                                    (surface_area(acc) * n + right_area[b] * right_count[b]) / area;
-                if (cost < best.cost) best = {axis, b, cost};
+            active[axis] = centroids.max[axis] > centroids.min[axis];
+            lo[axis] = centroids.min[axis];
+            extent[axis] = centroids.max[axis] - lo[axis];
+        }
+        // A bin's box is made empty when its first ref arrives, so that a small node does not
+        // pay for clearing every bin (BinSlot leaves its box unconstructed).
+        BinSlot bin_box[3][kMaxBins];
+        int bin_count[3][kMaxBins] = {};
+        for (int i = begin; i < end; ++i) {
+            BuildRef& r = refs_[size_t(i)];
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!active[axis]) continue;
+                const int b = std::clamp(int(double(bins) * (r.centroid[axis] - lo[axis]) / extent[axis]), 0, bins - 1);
+                r.bin[axis] = uint8_t(b);
+                Bounds3& bin = bin_box[axis][b].box;
+                if (bin_count[axis][b]++ == 0) bin = Bounds3{};
+                bin = merged(bin, r.box);
             }
         }
+        Split best;
+        const double area = surface_area(box);
+        for (int axis = 0; axis < 3; ++axis)
+            if (active[axis]) sweep(axis, bin_box[axis], bin_count[axis], area, best);
         return best;
     }
 
-    int partition(int begin, int end, const Split& s, const Bounds3& centroids) {
+    /// The SAH costs of the splits between bins of one axis, into `best` (first minimum wins).
+    /// An empty bin changes neither side, so a split just after one repeats the cost of the
+    /// split before it, which never wins a strict `<`: only the splits just after a nonempty
+    /// bin are costed, each at the first bin that makes it (the one the full sweep keeps).
+    void sweep(int axis, const BinSlot* bin_box, const int* bin_count, double area, Split& best) const {
+        int used[kMaxBins], n_used = 0;
+        for (int b = 0; b < o_.bins; ++b)
+            if (bin_count[b] > 0) used[n_used++] = b;
+        // Right-to-left for the right sides (right of split k: used bins k..), then left to right.
+        double right_area[kMaxBins];
+        int right_count[kMaxBins];
+        Bounds3 acc;
+        int n = 0;
+        for (int k = n_used - 1; k > 0; --k) {
+            acc = merged(acc, bin_box[used[k]].box);
+            n += bin_count[used[k]];
+            right_area[k] = surface_area(acc);
+            right_count[k] = n;
+        }
+        acc = Bounds3{};
+        n = 0;
+        for (int k = 1; k < n_used; ++k) {
+            acc = merged(acc, bin_box[used[k - 1]].box);
+            n += bin_count[used[k - 1]];
+            const double cost = o_.node_cost + (surface_area(acc) * n + right_area[k] * right_count[k]) / area;
+            if (cost < best.cost) best = {axis, used[k - 1] + 1, cost};
+        }
+    }
+
+    /// The refs left of the split first, by the bins best_split() stored.
+    int partition(int begin, int end, const Split& s) {
         auto first = refs_.begin() + begin, last = refs_.begin() + end;
-        auto mid = std::partition(first, last, [&](const BuildRef& r) { return bin_of(r.centroid, s.axis, centroids) < s.bin; });
+        auto mid = std::partition(first, last, [&](const BuildRef& r) { return r.bin[s.axis] < s.bin; });
         return int(mid - refs_.begin());
     }
 
@@ -171,7 +199,7 @@ std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
         const Int3 t = mesh.triangles[i];
         Bounds3 b;
         for (int k = 0; k < 3; ++k) b.extend(mesh.vertices[size_t(t[k])]);
-        refs[i] = {b, b.center(), int32_t(i)};
+        refs[i] = {b, b.center(), int32_t(i), {}};
     }
     return refs;
 }
@@ -259,11 +287,11 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
     for (int i = 0; i < n; ++i) bvh.triangle_index[size_t(i)] = refs[size_t(i)].triangle;
     const auto& pf = mesh.packed_float;
     const auto& pd = mesh.packed_double;
-    bvh.packed_float.resize(size_t(n));
-    bvh.packed_double.resize(size_t(n));
+    bvh.packed_float.reserve(size_t(n));  // reserve, not resize: no pass that clears them first
+    bvh.packed_double.reserve(size_t(n));
     for (int i = 0; i < n; ++i) {
-        bvh.packed_float[size_t(i)] = pf[size_t(bvh.triangle_index[size_t(i)])];
-        bvh.packed_double[size_t(i)] = pd[size_t(bvh.triangle_index[size_t(i)])];
+        bvh.packed_float.push_back(pf[size_t(bvh.triangle_index[size_t(i)])]);
+        bvh.packed_double.push_back(pd[size_t(bvh.triangle_index[size_t(i)])]);
     }
     bvh.stats.nodes = int(bvh.nodes.size());
     bvh.stats.sah_cost = bvh_sah_cost(bvh.nodes, options.node_cost);
