@@ -94,7 +94,7 @@ void expect_queries_match_loop(const PreparedMesh& mesh, const TriangleBvh& bvh,
         }
         const BvhHit<double> hit = closest_triangle_bvh(view, p);
         ASSERT_GE(hit.slot, 0) << mesh.name();
-        ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i;
+        ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i << " q " << hit.distance_squared << " loop " << best << " p " << p.x << " " << p.y << " " << p.z;
         ASSERT_EQ(hit.distance_squared, best) << mesh.name() << " point " << i;
         off_without_margin += closest_triangle_bvh(unwidened, p).distance_squared != best;
     }
@@ -255,6 +255,93 @@ TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
         }
         std::printf("%-14s winding sides differing between the LBVH and the SAH tree: %d of %d points\n", m.name.c_str(),
                     differ, total);
+    }
+}
+
+/// Hostile cases for the double search's margin: fans of long needles (length 1e3, the
+/// smallest angles just above the sliver threshold) whose apex lies 1e7 from the origin, each
+/// ring slightly out of plane; points at the apex (an exact tie of every needle), on the
+/// spokes (shared edges), inside the needles near the apex (a point far nearer a triangle
+/// than the triangle is long) and a little above all of these. Every tree must give the loop.
+TEST(Lbvh, NeedleFansFarFromTheOriginGiveTheLoop) {
+    for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
+        TriangleMesh m;
+        m.name = "needle_fan";
+        const int spokes = 120, rings = 3;
+        m.vertices.push_back(center);
+        for (int r = 0; r < rings; ++r)
+            for (int i = 0; i < spokes; ++i) {
+                const double a = 2 * M_PI * i / spokes, len = 1e3 * (r + 1);
+                m.vertices.push_back(center + Vec3d{len * std::cos(a), len * std::sin(a), 1e-3 * len * ((i * 7 + r) % 5)});
+            }
+        for (int i = 0; i < spokes; ++i) {
+            const int j = (i + 1) % spokes;
+            m.triangles.push_back({0, 1 + i, 1 + j});
+            for (int r = 1; r < rings; ++r) {
+                const int a = 1 + (r - 1) * spokes, b = 1 + r * spokes;
+                m.triangles.push_back({a + i, b + i, b + j});
+                m.triangles.push_back({a + i, b + j, a + j});
+            }
+        }
+        MeshPreparationOptions po;
+        po.orient_outward = false;
+        const PreparedMesh mesh = prepare_mesh(m, po);
+        std::mt19937_64 rng(5);
+        std::uniform_real_distribution<double> u(0, 1);
+        std::vector<Vec3d> pts{center};
+        for (int k = 0; k < 600; ++k) {
+            const Int3 t = m.triangles[size_t(rng() % m.triangles.size())];
+            const Vec3d a = m.vertices[size_t(t.x)], b = m.vertices[size_t(t.y)], c = m.vertices[size_t(t.z)];
+            const double s = std::pow(10.0, -6.0 * u(rng)) * (k % 3 == 0 ? 0.0 : 1.0), w = u(rng) * (1 - s);
+            const Vec3d on = k % 4 == 0 ? a : a + (b - a) * s + (c - a) * (k % 2 ? w * 1e-3 : 0.0);
+            const double lift = k % 5 == 0 ? 0.0 : std::pow(10.0, -9.0 * u(rng)) * 1e3;
+            pts.push_back(on + Vec3d{0.0, 0.0, lift * (k % 2 ? 1.0 : -1.0)});
+        }
+        expect_queries_match_loop(mesh, build_triangle_bvh(mesh), pts);
+        for (int leaf : {1, 4})
+            for (GpuBvhBuilder builder : kBuilders) {
+                const LbvhBuild b = build_lbvh(mesh, gpu_options(builder, leaf));
+                check_tree(mesh, b.bvh, leaf, mesh.name());
+                expect_queries_match_loop(mesh, b.bvh, pts);
+            }
+    }
+}
+
+/// A tree without the mesh's bound (made by hand) searches like the brute force: its margin
+/// is infinite, also where the radius is 0 (a point on the surface; inf * 0 must not make
+/// the radius NaN and skip every box), so the tie at a vertex goes to the smallest index.
+TEST(Lbvh, TreeWithoutTheBoundIsTheBruteForceAtSurfacePoints) {
+    TriangleMesh m;
+    m.name = "fan_without_bound";
+    const int spokes = 64;
+    m.vertices.push_back({0, 0, 0});
+    for (int i = 0; i < spokes; ++i) {
+        const double a = 2 * M_PI * i / spokes;
+        m.vertices.push_back({std::cos(a), std::sin(a), 0.1 * (i % 3)});
+    }
+    // The apex last in the triangles with large indices, first in those with small ones:
+    // every triangle's Q at the apex is exactly 0.
+    for (int i = 0; i < spokes; ++i) m.triangles.push_back({1 + i, 1 + (i + 1) % spokes, 0});
+    MeshPreparationOptions po;
+    po.orient_outward = false;
+    const PreparedMesh mesh = prepare_mesh(m, po);
+    for (GpuBvhBuilder builder : kBuilders) {
+        LbvhBuild b = build_lbvh(mesh, gpu_options(builder, 1));
+        b.bvh.float_bound.reset();
+        const BvhView<double> view = b.bvh.view<double>();
+        const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
+        for (const Vec3d& p : {Vec3d{0, 0, 0}, mesh.vertices()[5], mesh.vertices()[40]}) {
+            double best = INFINITY;
+            int32_t winner = -1;
+            for (size_t t = 0; t < packed.size(); ++t) {
+                const double q = squared_distance(packed[t], p);
+                if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
+            }
+            const BvhHit<double> hit = closest_triangle_bvh(view, p);
+            ASSERT_GE(hit.slot, 0);
+            EXPECT_EQ(hit.distance_squared, best);
+            EXPECT_EQ(b.bvh.triangle_index[size_t(hit.slot)], winner) << "point " << p.x << " " << p.y;
+        }
     }
 }
 
