@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "core/bvh/lbvh.h"
 #include "core/sampling/adversarial_cases.h"
@@ -73,6 +74,18 @@ void check_tree(const PreparedMesh& mesh, const TriangleBvh& bvh, int max_leaf, 
     EXPECT_LE(deepest, kBvhMaxDepth) << what;
 }
 
+/// The double loop over all triangles with the one tie rule (wins_tie): the truth.
+std::pair<int32_t, double> loop_winner(const PreparedMesh& mesh, const Vec3d& p) {
+    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
+    double best = std::numeric_limits<double>::infinity();
+    int32_t winner = -1;
+    for (size_t t = 0; t < packed.size(); ++t) {
+        const double q = squared_distance(packed[t], p);
+        if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
+    }
+    return {winner, best};
+}
+
 /// The double query through `bvh` equals the loop over all triangles, triangle and distance
 /// bit for bit with the one tie rule (wins_tie), whatever the tree: the double view's pruning
 /// margin (search_certificate.h, PruneMargin) covers the rounding of squared_distance().
@@ -80,18 +93,12 @@ void expect_queries_match_loop(const PreparedMesh& mesh, const TriangleBvh& bvh,
     const BvhView<double> view = bvh.view<double>();
     ASSERT_TRUE(bvh.float_bound.has_value()) << mesh.name();
     ASSERT_TRUE(std::isfinite(view.margin.rho) && view.margin.rho > 0) << mesh.name() << ": no margin, or the brute force";
-    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
     BvhView<double> unwidened = view;  // the old 8-ulp slack alone, for the printed count
     unwidened.margin = {};
     int off_without_margin = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
         const Vec3d& p = pts[i];
-        double best = std::numeric_limits<double>::infinity();
-        int32_t winner = -1;
-        for (size_t t = 0; t < packed.size(); ++t) {
-            const double q = squared_distance(packed[t], p);
-            if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
-        }
+        const auto [winner, best] = loop_winner(mesh, p);
         const BvhHit<double> hit = closest_triangle_bvh(view, p);
         ASSERT_GE(hit.slot, 0) << mesh.name();
         ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i << " q " << hit.distance_squared << " loop " << best << " p " << p.x << " " << p.y << " " << p.z;
@@ -329,14 +336,8 @@ TEST(Lbvh, TreeWithoutTheBoundIsTheBruteForceAtSurfacePoints) {
         LbvhBuild b = build_lbvh(mesh, gpu_options(builder, 1));
         b.bvh.float_bound.reset();
         const BvhView<double> view = b.bvh.view<double>();
-        const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
         for (const Vec3d& p : {Vec3d{0, 0, 0}, mesh.vertices()[5], mesh.vertices()[40]}) {
-            double best = INFINITY;
-            int32_t winner = -1;
-            for (size_t t = 0; t < packed.size(); ++t) {
-                const double q = squared_distance(packed[t], p);
-                if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
-            }
+            const auto [winner, best] = loop_winner(mesh, p);
             const BvhHit<double> hit = closest_triangle_bvh(view, p);
             ASSERT_GE(hit.slot, 0);
             EXPECT_EQ(hit.distance_squared, best);
