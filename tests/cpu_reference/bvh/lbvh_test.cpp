@@ -265,45 +265,14 @@ TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
     }
 }
 
-/// Hostile cases for the double search's margin: fans of long needles (length 1e3, the
-/// smallest angles just above the sliver threshold) whose apex lies 1e7 from the origin, each
-/// ring slightly out of plane; points at the apex (an exact tie of every needle), on the
-/// spokes (shared edges), inside the needles near the apex (a point far nearer a triangle
-/// than the triangle is long) and a little above all of these. Every tree must give the loop.
+/// The needle fans (bvh_test_meshes.h) 1e7 from the origin and near it: every tree gives the loop.
 TEST(Lbvh, NeedleFansFarFromTheOriginGiveTheLoop) {
     for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
-        TriangleMesh m;
-        m.name = "needle_fan";
-        const int spokes = 120, rings = 3;
-        m.vertices.push_back(center);
-        for (int r = 0; r < rings; ++r)
-            for (int i = 0; i < spokes; ++i) {
-                const double a = 2 * M_PI * i / spokes, len = 1e3 * (r + 1);
-                m.vertices.push_back(center + Vec3d{len * std::cos(a), len * std::sin(a), 1e-3 * len * ((i * 7 + r) % 5)});
-            }
-        for (int i = 0; i < spokes; ++i) {
-            const int j = (i + 1) % spokes;
-            m.triangles.push_back({0, 1 + i, 1 + j});
-            for (int r = 1; r < rings; ++r) {
-                const int a = 1 + (r - 1) * spokes, b = 1 + r * spokes;
-                m.triangles.push_back({a + i, b + i, b + j});
-                m.triangles.push_back({a + i, b + j, a + j});
-            }
-        }
+        const test::NeedleFan fan = test::make_needle_fan(center);
         MeshPreparationOptions po;
         po.orient_outward = false;
-        const PreparedMesh mesh = prepare_mesh(m, po);
-        std::mt19937_64 rng(5);
-        std::uniform_real_distribution<double> u(0, 1);
-        std::vector<Vec3d> pts{center};
-        for (int k = 0; k < 600; ++k) {
-            const Int3 t = m.triangles[size_t(rng() % m.triangles.size())];
-            const Vec3d a = m.vertices[size_t(t.x)], b = m.vertices[size_t(t.y)], c = m.vertices[size_t(t.z)];
-            const double s = std::pow(10.0, -6.0 * u(rng)) * (k % 3 == 0 ? 0.0 : 1.0), w = u(rng) * (1 - s);
-            const Vec3d on = k % 4 == 0 ? a : a + (b - a) * s + (c - a) * (k % 2 ? w * 1e-3 : 0.0);
-            const double lift = k % 5 == 0 ? 0.0 : std::pow(10.0, -9.0 * u(rng)) * 1e3;
-            pts.push_back(on + Vec3d{0.0, 0.0, lift * (k % 2 ? 1.0 : -1.0)});
-        }
+        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const std::vector<Vec3d>& pts = fan.points;
         expect_queries_match_loop(mesh, build_triangle_bvh(mesh), pts);
         for (int leaf : {1, 4})
             for (GpuBvhBuilder builder : kBuilders) {
