@@ -86,9 +86,13 @@ template <typename T>
 struct PruneMargin {
     T rho = T(0), l = T(0);
 
+    /// A computed Q, and so a radius, may round below 0 (a point on a triangle): it is widened
+    /// like 0, as a true Q of 0 would be. An unused packet lane (radius -1) stays below every
+    /// box while rho l^2 < 1, and otherwise only enters boxes it did not need.
     SDF_CPU_GPU SDF_INLINE T widen(T radius) const {
-        if (!(rho > T(0)) || radius < T(0)) return radius;  // no margin; an unused lane (-1)
-        const T m = std::sqrt(radius) + l;
+        if (!(rho > T(0))) return radius;             // no margin (float views)
+        if (!(rho < T(INFINITY))) return T(INFINITY);  // the brute force (inf * 0 at radius 0 is NaN)
+        const T m = std::sqrt(radius > T(0) ? radius : T(0)) + l;
         return radius + rho * m * m;
     }
 };

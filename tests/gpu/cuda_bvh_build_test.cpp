@@ -10,6 +10,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/sampling/adversarial_cases.h"
+#include "cuda/bvh_sampler.h"
 #include "cuda/device_bvh_build.h"
 #include "cuda/device_mesh.h"
 #include "core/winding/winding_sign.h"
@@ -128,6 +129,43 @@ std::vector<Vec3d> query_points(const PreparedMesh& mesh, size_t count) {
         }
     }
     return pts;
+}
+
+/// The needle fans (bvh_test_meshes.h), 1e7 from the origin and near it, points on the
+/// surface among them (a computed Q below 0, exact ties at the apex): every CUDA BVH kernel,
+/// float and double, on the host and the device tree, gives the CPU double brute force's
+/// triangle, distance and gradient bit for bit (the pseudonormal sign on both sides).
+TEST(CudaBvhBuild, NeedleFansEqualTheDoubleBruteForceOnEitherTree) {
+    auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
+        const test::NeedleFan fan = test::make_needle_fan(center);
+        MeshPreparationOptions po;
+        po.orient_outward = false;
+        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        SamplerOptions ref;
+        ref.backend = "cpu";
+        ref.method = "brute_force";
+        ref.precision = Precision::Double;
+        ref.sign = SignMode::Pseudonormal;
+        ref.progress = false;
+        const std::vector<PointSample> want = make_sampler(ref)->query(mesh, fan.points);
+        for (BvhBuildSite site : {BvhBuildSite::Host, BvhBuildSite::Device})
+            for (Precision precision : {Precision::Float, Precision::Double})
+                for (const auto& [kernel, id] : cuda::kCudaBvhKernels) {
+                    SamplerOptions o = gpu_options(site, precision);
+                    o.sign = SignMode::Pseudonormal;
+                    o.kernel = kernel;
+                    const std::vector<PointSample> got = make_sampler(o)->query(mesh, fan.points);
+                    const std::string what = std::string(bvh_build_site_name(site)) + " " +
+                                             (precision == Precision::Float ? "float " : "double ") + kernel;
+                    int64_t bad = 0;
+                    for (size_t i = 0; i < got.size(); ++i)
+                        bad += !(got[i].triangle == want[i].triangle && same(got[i].distance, want[i].distance) &&
+                                 same(got[i].gradient.x, want[i].gradient.x) && same(got[i].gradient.y, want[i].gradient.y) &&
+                                 same(got[i].gradient.z, want[i].gradient.z));
+                    EXPECT_EQ(bad, 0) << "needle fan at " << center.x << ": " << what;
+                }
+    }
 }
 
 TEST(CudaBvhBuild, FieldsAndQueriesOnTheDeviceTreeEqualTheHostTree) {

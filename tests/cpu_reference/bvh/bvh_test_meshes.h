@@ -15,6 +15,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <random>
 #include <tuple>
 #include <vector>
 
@@ -236,6 +237,51 @@ private:
     double edge_, eps_, rel_, abs_floor_, gradient_floor_;
     Agreement a_;
 };
+
+/// A fan of long needles (length 1e3 per ring, the smallest angles just above the sliver
+/// threshold) around an apex at `center`, each ring slightly out of plane, with points where
+/// the double search's rounding is largest against Q: at the apex (an exact tie of every
+/// needle), on the spokes (shared edges), inside the needles near the apex (a point far
+/// nearer a triangle than the triangle is long) and a little above and below these. The
+/// computed Q of a point on the surface may round below 0 there.
+struct NeedleFan {
+    TriangleMesh mesh;
+    std::vector<Vec3d> points;
+};
+
+inline NeedleFan make_needle_fan(const Vec3d& center, int count = 600, unsigned seed = 5) {
+    NeedleFan f;
+    TriangleMesh& m = f.mesh;
+    m.name = "needle_fan";
+    const int spokes = 120, rings = 3;
+    m.vertices.push_back(center);
+    for (int r = 0; r < rings; ++r)
+        for (int i = 0; i < spokes; ++i) {
+            const double a = 2 * M_PI * i / spokes, len = 1e3 * (r + 1);
+            m.vertices.push_back(center + Vec3d{len * std::cos(a), len * std::sin(a), 1e-3 * len * ((i * 7 + r) % 5)});
+        }
+    for (int i = 0; i < spokes; ++i) {
+        const int j = (i + 1) % spokes;
+        m.triangles.push_back({0, 1 + i, 1 + j});
+        for (int r = 1; r < rings; ++r) {
+            const int a = 1 + (r - 1) * spokes, b = 1 + r * spokes;
+            m.triangles.push_back({a + i, b + i, b + j});
+            m.triangles.push_back({a + i, b + j, a + j});
+        }
+    }
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    f.points.push_back(center);
+    for (int k = 0; k < count; ++k) {
+        const Int3 t = m.triangles[size_t(rng() % m.triangles.size())];
+        const Vec3d a = m.vertices[size_t(t.x)], b = m.vertices[size_t(t.y)], c = m.vertices[size_t(t.z)];
+        const double s = std::pow(10.0, -6.0 * u(rng)) * (k % 3 == 0 ? 0.0 : 1.0), w = u(rng) * (1 - s);
+        const Vec3d on = k % 4 == 0 ? a : a + (b - a) * s + (c - a) * (k % 2 ? w * 1e-3 : 0.0);
+        const double lift = k % 5 == 0 ? 0.0 : std::pow(10.0, -9.0 * u(rng)) * 1e3;
+        f.points.push_back(on + Vec3d{0.0, 0.0, lift * (k % 2 ? 1.0 : -1.0)});
+    }
+    return f;
+}
 
 inline double epsilon_of(Precision p) {
     return p == Precision::Float ? double(std::numeric_limits<float>::epsilon()) : std::numeric_limits<double>::epsilon();

@@ -17,6 +17,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "kernels/bvh/streamed_certificate.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
 namespace {
@@ -72,6 +73,24 @@ TEST(CertifiedSearch, FloatEqualsDoubleBruteForceOnAdversarialPoints) {
         }
         const std::vector<PointSample> bvh_double = query("bvh", Precision::Double, "brick", mesh, c.points);
         EXPECT_EQ(differences(c.mesh.name + " double bvh", c.points, bvh_double, want), 0);
+    }
+}
+
+/// The samplers on the needle fans (bvh_test_meshes.h), 1e7 from the origin and near it:
+/// double BVH (every kernel) and certified float equal the double brute force.
+TEST(CertifiedSearch, NeedleFansEqualDoubleBruteForce) {
+    for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
+        const test::NeedleFan fan = test::make_needle_fan(center);
+        MeshPreparationOptions po;
+        po.orient_outward = false;
+        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const std::vector<PointSample> want = query("brute_force", Precision::Double, "vectorized", mesh, fan.points);
+        for (const char* kernel : {"brick", "seeded", "unseeded"}) {
+            for (Precision p : {Precision::Double, Precision::Float}) {
+                const std::string what = std::string("needle_fan ") + (p == Precision::Double ? "double" : "float") + " bvh/" + kernel;
+                EXPECT_EQ(differences(what, fan.points, query("bvh", p, kernel, mesh, fan.points), want), 0) << what;
+            }
+        }
     }
 }
 

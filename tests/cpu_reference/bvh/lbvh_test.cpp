@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "core/bvh/lbvh.h"
 #include "core/sampling/adversarial_cases.h"
@@ -73,6 +74,18 @@ void check_tree(const PreparedMesh& mesh, const TriangleBvh& bvh, int max_leaf, 
     EXPECT_LE(deepest, kBvhMaxDepth) << what;
 }
 
+/// The double loop over all triangles with the one tie rule (wins_tie): the truth.
+std::pair<int32_t, double> loop_winner(const PreparedMesh& mesh, const Vec3d& p) {
+    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
+    double best = std::numeric_limits<double>::infinity();
+    int32_t winner = -1;
+    for (size_t t = 0; t < packed.size(); ++t) {
+        const double q = squared_distance(packed[t], p);
+        if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
+    }
+    return {winner, best};
+}
+
 /// The double query through `bvh` equals the loop over all triangles, triangle and distance
 /// bit for bit with the one tie rule (wins_tie), whatever the tree: the double view's pruning
 /// margin (search_certificate.h, PruneMargin) covers the rounding of squared_distance().
@@ -80,21 +93,15 @@ void expect_queries_match_loop(const PreparedMesh& mesh, const TriangleBvh& bvh,
     const BvhView<double> view = bvh.view<double>();
     ASSERT_TRUE(bvh.float_bound.has_value()) << mesh.name();
     ASSERT_TRUE(std::isfinite(view.margin.rho) && view.margin.rho > 0) << mesh.name() << ": no margin, or the brute force";
-    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
     BvhView<double> unwidened = view;  // the old 8-ulp slack alone, for the printed count
     unwidened.margin = {};
     int off_without_margin = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
         const Vec3d& p = pts[i];
-        double best = std::numeric_limits<double>::infinity();
-        int32_t winner = -1;
-        for (size_t t = 0; t < packed.size(); ++t) {
-            const double q = squared_distance(packed[t], p);
-            if (q < best || (q == best && wins_tie(int32_t(t), winner))) best = q, winner = int32_t(t);
-        }
+        const auto [winner, best] = loop_winner(mesh, p);
         const BvhHit<double> hit = closest_triangle_bvh(view, p);
         ASSERT_GE(hit.slot, 0) << mesh.name();
-        ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i;
+        ASSERT_EQ(bvh.triangle_index[size_t(hit.slot)], winner) << mesh.name() << " point " << i << " q " << hit.distance_squared << " loop " << best << " p " << p.x << " " << p.y << " " << p.z;
         ASSERT_EQ(hit.distance_squared, best) << mesh.name() << " point " << i;
         off_without_margin += closest_triangle_bvh(unwidened, p).distance_squared != best;
     }
@@ -255,6 +262,56 @@ TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
         }
         std::printf("%-14s winding sides differing between the LBVH and the SAH tree: %d of %d points\n", m.name.c_str(),
                     differ, total);
+    }
+}
+
+/// The needle fans (bvh_test_meshes.h) 1e7 from the origin and near it: every tree gives the loop.
+TEST(Lbvh, NeedleFansFarFromTheOriginGiveTheLoop) {
+    for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
+        const test::NeedleFan fan = test::make_needle_fan(center);
+        MeshPreparationOptions po;
+        po.orient_outward = false;
+        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const std::vector<Vec3d>& pts = fan.points;
+        expect_queries_match_loop(mesh, build_triangle_bvh(mesh), pts);
+        for (int leaf : {1, 4})
+            for (GpuBvhBuilder builder : kBuilders) {
+                const LbvhBuild b = build_lbvh(mesh, gpu_options(builder, leaf));
+                check_tree(mesh, b.bvh, leaf, mesh.name());
+                expect_queries_match_loop(mesh, b.bvh, pts);
+            }
+    }
+}
+
+/// A tree without the mesh's bound (made by hand) searches like the brute force: its margin
+/// is infinite, also where the radius is 0 (a point on the surface; inf * 0 must not make
+/// the radius NaN and skip every box), so the tie at a vertex goes to the smallest index.
+TEST(Lbvh, TreeWithoutTheBoundIsTheBruteForceAtSurfacePoints) {
+    TriangleMesh m;
+    m.name = "fan_without_bound";
+    const int spokes = 64;
+    m.vertices.push_back({0, 0, 0});
+    for (int i = 0; i < spokes; ++i) {
+        const double a = 2 * M_PI * i / spokes;
+        m.vertices.push_back({std::cos(a), std::sin(a), 0.1 * (i % 3)});
+    }
+    // The apex last in the triangles with large indices, first in those with small ones:
+    // every triangle's Q at the apex is exactly 0.
+    for (int i = 0; i < spokes; ++i) m.triangles.push_back({1 + i, 1 + (i + 1) % spokes, 0});
+    MeshPreparationOptions po;
+    po.orient_outward = false;
+    const PreparedMesh mesh = prepare_mesh(m, po);
+    for (GpuBvhBuilder builder : kBuilders) {
+        LbvhBuild b = build_lbvh(mesh, gpu_options(builder, 1));
+        b.bvh.float_bound.reset();
+        const BvhView<double> view = b.bvh.view<double>();
+        for (const Vec3d& p : {Vec3d{0, 0, 0}, mesh.vertices()[5], mesh.vertices()[40]}) {
+            const auto [winner, best] = loop_winner(mesh, p);
+            const BvhHit<double> hit = closest_triangle_bvh(view, p);
+            ASSERT_GE(hit.slot, 0);
+            EXPECT_EQ(hit.distance_squared, best);
+            EXPECT_EQ(b.bvh.triangle_index[size_t(hit.slot)], winner) << "point " << p.x << " " << p.y;
+        }
     }
 }
 
