@@ -91,9 +91,7 @@ struct DeviceBvh {
         winding.adopt(sign, lbvh->nodes.get(), lbvh->moments.get(), lbvh->triangle_index.get(), lbvh->num_nodes, mesh->view());
         view = lbvh->view<T>();
         if constexpr (std::is_same_v<T, float>)
-            certifier = std::make_unique<DeviceCertifier>(view, lbvh->packed_double.get(), lbvh->slot_of.get(), prepared);
-        else
-            view.margin = double_prune_margin(float_search_bound(prepared));
+            certifier = std::make_unique<DeviceCertifier>(view, lbvh->packed_double.get(), lbvh->slot_of.get(), lbvh->bound);
     }
     std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };

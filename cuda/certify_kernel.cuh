@@ -110,11 +110,11 @@ public:
         num_triangles_ = int(bvh.triangle_index.size());
     }
 
-    /// Over a BVH already on the device (the GPU build's): nothing is copied; the arrays
-    /// must outlive the certifier.
+    /// Over a BVH already on the device (the GPU build's, with its bound): nothing is
+    /// copied; the arrays must outlive the certifier.
     DeviceCertifier(const BvhView<float>& bvh, const PackedTriangle<double>* exact, const int32_t* slot_of,
-                    const PreparedMesh& mesh)
-        : bound_(float_search_bound(mesh)) {
+                    const FloatSearchBound& bound)
+        : bound_(bound) {
         counters_.allocate(3);
         reset();
         arrays_ = {bvh.nodes, bvh.packed, exact, bvh.triangle_index, slot_of};

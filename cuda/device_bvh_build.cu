@@ -8,6 +8,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
+#include "core/sampling/certified_search.h"
 #include "cuda/cuda_check.h"
 #include "kernels/bvh/lbvh_steps.h"
 
@@ -206,7 +207,9 @@ BvhView<float> DeviceLbvh::view<float>() const {
 
 template <>
 BvhView<double> DeviceLbvh::view<double>() const {
-    return {nodes.get(), packed_double.get(), triangle_index.get(), num_nodes, num_triangles};
+    BvhView<double> v{nodes.get(), packed_double.get(), triangle_index.get(), num_nodes, num_triangles};
+    v.margin = double_prune_margin(bound);  // as TriangleBvh::view<double>(): the double search is the brute force's
+    return v;
 }
 
 LbvhBuild DeviceLbvh::download() const {
@@ -223,6 +226,7 @@ LbvhBuild DeviceLbvh::download() const {
     packed_double.download(b.bvh.packed_double.data(), size_t(num_triangles));
     CUDA_CHECK(cudaStreamSynchronize(0));
     b.bvh.stats = stats;
+    b.bvh.float_bound = bound;
     b.within_depth = within_depth;
     return b;
 }
@@ -350,6 +354,7 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     d.stats.largest_leaf = h[2];
     d.stats.sah_cost = sah_cost;
     d.within_depth = h[0] <= kBvhMaxDepth;
+    d.bound = float_search_bound(mesh);  // a host pass over the mesh, counted in the build's wall time
     d.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }

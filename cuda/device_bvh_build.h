@@ -26,6 +26,8 @@ struct DeviceLbvh {
     BvhBuildStats stats;       ///< seconds: wall time of the whole build (uploads of the packed constants included)
     double device_seconds = 0;  ///< CUDA events around the same work
     bool within_depth = true;   ///< false: deeper than kBvhMaxDepth, not to be queried
+    FloatSearchBound bound;     ///< the search bound of these triangles (search_certificate.h): the
+                                ///< certified float search's, and the double view's pruning margin
     int num_nodes = 0, num_triangles = 0;
 
     template <typename T>
