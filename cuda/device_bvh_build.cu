@@ -308,6 +308,9 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     CUDA_CHECK(cudaMemcpy(&tail[0], kept_index.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
     CUDA_CHECK(cudaMemcpy(&tail[1], flags.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
     d.num_nodes = tail[0] + tail[1];
+    if (d.num_nodes < 1 || int64_t(d.num_nodes) > int64_t(internal))  // read back from the device: checked before it sizes anything
+        throw std::runtime_error("GPU BVH build of mesh '" + mesh.name() + "': " + std::to_string(d.num_nodes) +
+                                 " nodes kept, expected 1.." + std::to_string(internal));
     size_t sort_bytes = 0;
     CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, preorder.get(), preorder_sorted.get(), node_ids.get(),
                                                by_key.get(), int(internal)));
