@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/bvh/search_bound.h"
+#include "kernels/core/directed_rounding.h"
 
 namespace sdf {
 namespace {
@@ -229,17 +230,9 @@ double bvh_sah_cost(const std::vector<BvhNode>& nodes, double node_cost) {
     return cost;
 }
 
-float round_down_to_float(double x) {
-    float f = float(x);
-    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-}
+float round_down_to_float(double x) { return float_below(x); }
 
-float round_up_to_float(double x) {
-    float f = float(x);
-    if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
-}
+float round_up_to_float(double x) { return float_above(x); }
 
 nlohmann::json BvhBuildStats::to_json() const {
     return {{"nodes", nodes}, {"leaves", leaves}, {"depth", depth}, {"largest_leaf", largest_leaf},

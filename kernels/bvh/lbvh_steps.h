@@ -31,6 +31,7 @@
 #include <limits>
 
 #include "kernels/bvh/bvh_node.h"
+#include "kernels/core/directed_rounding.h"
 #include "kernels/core/morton.h"
 #include "kernels/core/vec3.h"
 #include "kernels/winding/winding_moments.h"
@@ -80,27 +81,6 @@ SDF_CPU_GPU SDF_INLINE int lbvh_clz32(uint32_t x) {
     return __clz(int(x));
 #else
     return x == 0 ? 32 : __builtin_clz(x);
-#endif
-}
-
-/// x rounded toward -infinity / +infinity to float (exact directed rounding on both sides).
-SDF_CPU_GPU SDF_INLINE float float_below(double x) {
-#if SDF_IS_GPU_CODE
-    return __double2float_rd(x);
-#else
-    float f = float(x);
-    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-#endif
-}
-
-SDF_CPU_GPU SDF_INLINE float float_above(double x) {
-#if SDF_IS_GPU_CODE
-    return __double2float_ru(x);
-#else
-    float f = float(x);
-    if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
 #endif
 }
 

@@ -243,6 +243,31 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
         state.counters["candidate_triangles"] = f.sampler.details.at("candidates")["mean_candidate_triangles"].get<double>();
 }
 
+/// `count` points for the point-query benchmarks (seed 7): uniform in the mesh's box, or
+/// `near_surface`: on a random triangle plus a Gaussian of sigma 1% of the diagonal (an
+/// area-weighted triangle would be the textbook draw; a uniform one is close on these evenly
+/// tessellated scans and keeps set-up cheap).
+std::vector<Vec3d> benchmark_points(const PreparedMesh& mesh, int64_t count, bool near_surface) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> g(0.0, 0.01 * mesh.bounds().diagonal());
+    std::vector<Vec3d> points(static_cast<size_t>(count));
+    const Bounds3& box = mesh.bounds();
+    for (Vec3d& p : points) {
+        if (!near_surface) {
+            p = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
+        } else {
+            const Int3 t = mesh.triangles()[size_t(rng() % mesh.triangles().size())];
+            double a = u(rng), b = u(rng);
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            const Vec3d& v0 = mesh.vertices()[size_t(t.x)];
+            p = v0 + (mesh.vertices()[size_t(t.y)] - v0) * a + (mesh.vertices()[size_t(t.z)] - v0) * b +
+                Vec3d{g(rng), g(rng), g(rng)};
+        }
+    }
+    return points;
+}
+
 /// Arbitrary points (issue 14): uniform in the mesh's box (kind 0) or Gaussian around
 /// surface points, sigma = 1% of the diagonal (kind 1); the device time of the Morton sort,
 /// search and finalize (Sampler::last_query_timings), float search.
@@ -250,26 +275,7 @@ void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
     const auto mesh = load_for_cuda(state, file);
     if (!mesh) return;
     const int64_t n = state.range(0);
-    std::mt19937_64 rng(7);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::normal_distribution<double> g(0.0, 0.01 * mesh->bounds().diagonal());
-    const size_t count = size_t(n);
-    std::vector<Vec3d> points(count);
-    const Bounds3& box = mesh->bounds();
-    for (Vec3d& p : points) {
-        if (state.range(1) == 0) {
-            p = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
-        } else {
-            // An area-weighted triangle would be the textbook draw; a uniform triangle is
-            // close on these evenly tessellated scans and keeps set-up cheap.
-            const Int3 t = mesh->triangles()[size_t(rng() % mesh->triangles().size())];
-            double a = u(rng), b = u(rng);
-            if (a + b > 1) { a = 1 - a; b = 1 - b; }
-            const Vec3d& v0 = mesh->vertices()[size_t(t.x)];
-            p = v0 + (mesh->vertices()[size_t(t.y)] - v0) * a + (mesh->vertices()[size_t(t.z)] - v0) * b +
-                Vec3d{g(rng), g(rng), g(rng)};
-        }
-    }
+    const std::vector<Vec3d> points = benchmark_points(*mesh, n, state.range(1) != 0);
     auto sampler = make_sampler(cuda_bvh_options(kKernels[state.range(2)]));
     sampler->query(*mesh, points);  // warm-up: BVH upload
     for (auto _ : state) {
@@ -373,23 +379,7 @@ void BM_CudaBvhOnTree(benchmark::State& state, const std::string& file) {
 void BM_CudaBvhPointsOnTree(benchmark::State& state, const std::string& file) {
     const auto mesh = load_for_cuda(state, file);
     if (!mesh) return;
-    std::mt19937_64 rng(7);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::normal_distribution<double> g(0.0, 0.01 * mesh->bounds().diagonal());
-    std::vector<Vec3d> points(size_t(state.range(0)));
-    const Bounds3& box = mesh->bounds();
-    for (Vec3d& p : points) {
-        if (state.range(1) == 0) {
-            p = box.min + component_mul(box.extent(), Vec3d{u(rng), u(rng), u(rng)});
-        } else {
-            const Int3 t = mesh->triangles()[size_t(rng() % mesh->triangles().size())];
-            double a = u(rng), b = u(rng);
-            if (a + b > 1) { a = 1 - a; b = 1 - b; }
-            const Vec3d& v0 = mesh->vertices()[size_t(t.x)];
-            p = v0 + (mesh->vertices()[size_t(t.y)] - v0) * a + (mesh->vertices()[size_t(t.z)] - v0) * b +
-                Vec3d{g(rng), g(rng), g(rng)};
-        }
-    }
+    const std::vector<Vec3d> points = benchmark_points(*mesh, state.range(0), state.range(1) != 0);
     SamplerOptions o = cuda_bvh_options("warp");
     o.bvh_build = state.range(2) ? BvhBuildSite::Device : BvhBuildSite::Host;
     auto sampler = make_sampler(o);
