@@ -11,6 +11,15 @@
 
 namespace sdf::cuda {
 
+/// Device memory for DeviceBuffer: stream-ordered (cudaMallocAsync/cudaFreeAsync on stream 0)
+/// from the device's default pool, which keeps freed memory for the next allocation instead
+/// of returning it to the driver: a BVH build or a point query allocates and frees a dozen
+/// buffers, and cudaMalloc + cudaFree (which waits for the whole device) cost more than the
+/// kernels at a million points. The pool keeps up to 1/16 of the device's memory (the rest
+/// goes back at the next synchronisation); devices without pools use cudaMalloc/cudaFree.
+void* allocate_device_bytes(size_t bytes, int& device);
+void free_device_bytes(void* ptr, int device) noexcept;
+
 template <typename T>
 class DeviceBuffer {
 public:
@@ -19,15 +28,18 @@ public:
     ~DeviceBuffer() { release(); }
     DeviceBuffer(const DeviceBuffer&) = delete;
     DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-    DeviceBuffer(DeviceBuffer&& o) noexcept : ptr_(o.ptr_), count_(o.count_) { o.ptr_ = nullptr; o.count_ = 0; }
+    DeviceBuffer(DeviceBuffer&& o) noexcept : ptr_(o.ptr_), count_(o.count_), device_(o.device_) {
+        o.ptr_ = nullptr;
+        o.count_ = 0;
+    }
 
     void allocate(size_t count) {
         release();
-        if (count > 0) CUDA_CHECK(cudaMalloc(&ptr_, count * sizeof(T)));
+        if (count > 0) ptr_ = static_cast<T*>(allocate_device_bytes(count * sizeof(T), device_));
         count_ = count;
     }
     void release() {
-        if (ptr_) cudaFree(ptr_);
+        if (ptr_) free_device_bytes(ptr_, device_);
         ptr_ = nullptr;
         count_ = 0;
     }
@@ -45,6 +57,7 @@ public:
 private:
     T* ptr_ = nullptr;
     size_t count_ = 0;
+    int device_ = 0;  ///< the device the memory is on (freed there)
 };
 
 /// Page-locked host memory (cudaMallocHost): the device copies into it at full bus speed and

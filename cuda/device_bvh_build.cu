@@ -3,14 +3,17 @@
 #include "cuda/device_bvh_build.h"
 
 #include <chrono>
+#include <future>
 #include <stdexcept>
 
+#include <cub/block/block_scan.cuh>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
 #include "core/sampling/certified_search.h"
 #include "cuda/cuda_check.h"
 #include "kernels/bvh/lbvh_steps.h"
+#include "kernels/distance/packed_triangle.h"
 
 namespace sdf::cuda {
 namespace {
@@ -66,6 +69,59 @@ __global__ void ploc_compact_kernel(PlocArrays p, PlocArrays q, const int32_t* m
     if (i == p.m - 1) {
         totals[0] = merge_scan[i] + p.merges[i];
         totals[1] = keep_scan[i] + p.keeps[i];
+    }
+}
+
+/// PLOC's last iterations, once at most kPlocTailClusters clusters are left: one block runs
+/// them all, the steps of the launches above in the same order (so the same tree), where the
+/// launches and a read-back per iteration would cost some 40 us each for little work.
+constexpr int kPlocTailThreads = 1024;
+constexpr int kPlocTailClusters = 8192;
+
+/// p: this iteration's clusters (p.m of them), q: the other cluster arrays; `status` becomes 1
+/// where an iteration merged nothing (lbvh_steps.h rules it out; checked, not assumed).
+__global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays a, PlocArrays p, PlocArrays q,
+                                                                       int32_t* merge_scan, int32_t* keep_scan, int next_id,
+                                                                       int32_t* status) {
+    using Scan = cub::BlockScan<int, kPlocTailThreads>;
+    __shared__ typename Scan::TempStorage scan_storage;
+    for (int m = p.m; m > 1;) {
+        p.m = m;
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_nearest(p, i);
+        __syncthreads();
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_flags(p, i);
+        __syncthreads();
+        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m < 2^16) low.
+        int merges = 0, keeps = 0;
+        for (int base = 0; base < m; base += kPlocTailThreads) {
+            const int i = base + int(threadIdx.x);
+            const int both = i < m ? (p.merges[i] << 16) | p.keeps[i] : 0;
+            int before = 0, chunk = 0;
+            Scan(scan_storage).ExclusiveSum(both, before, chunk);
+            if (i < m) {
+                merge_scan[i] = merges + (before >> 16);
+                keep_scan[i] = keeps + (before & 0xffff);
+            }
+            merges += chunk >> 16;
+            keeps += chunk & 0xffff;
+            __syncthreads();  // scan_storage is reused
+        }
+        if (merges < 1) {  // the same in every thread: the block leaves together
+            if (threadIdx.x == 0) *status = 1;
+            return;
+        }
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
+            if (p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
+        __syncthreads();
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
+            if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+        __syncthreads();
+        next_id += merges;
+        m = keeps;
+        // The survivors are in q's cluster arrays now (nearest, merges and keeps are shared).
+        const PlocArrays was = p;
+        p.code = q.code, p.box = q.box, p.count = q.count;
+        q.code = was.code, q.box = was.box, q.count = was.count;
     }
 }
 
@@ -140,13 +196,17 @@ __global__ void lbvh_sah(const BvhNode* nodes, int num_nodes, double node_cost, 
     atomicAdd(sum, cost);
 }
 
-__global__ void lbvh_gather(const int32_t* order, int n, const PackedTriangle<float>* pf, const PackedTriangle<double>* pd,
-                            PackedTriangle<float>* out_f, PackedTriangle<double>* out_d, int32_t* slot_of) {
+/// The packed constants of the triangle in slot s, made here (pack_triangle() computes them
+/// bit for bit as the host's mesh buffers hold them): cheaper than uploading the host's.
+__global__ void lbvh_pack(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
+                          PackedTriangle<float>* out_f, PackedTriangle<double>* out_d, int32_t* slot_of) {
     const int s = int(blockIdx.x) * blockDim.x + threadIdx.x;
     if (s >= n) return;
     const int32_t t = order[s];
-    out_f[s] = pf[t];
-    out_d[s] = pd[t];
+    const Int3 tri = triangles[t];
+    const Vec3d v0 = vertices[tri.x], v1 = vertices[tri.y], v2 = vertices[tri.z];
+    out_f[s] = pack_triangle<float>(v0, v1, v2);
+    out_d[s] = pack_triangle<double>(v0, v1, v2);
     slot_of[t] = s;
 }
 
@@ -158,7 +218,8 @@ void check_launch(const char* what) {
 }  // namespace
 
 /// PLOC's iterations (lbvh_steps.h): one launch per step, CUB scans between them, the
-/// iteration's totals read back to know when one cluster is left.
+/// iteration's totals read back to know how many clusters are left; the last iterations in
+/// one block (ploc_tail_kernel).
 static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigned char>& temp) {
     const size_t n = size_t(a.n);
     DeviceBuffer<int32_t> code[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
@@ -174,7 +235,7 @@ static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigne
     };
     ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
     check_launch("ploc init");
-    while (m > 1) {
+    while (m > kPlocTailClusters) {
         const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
         ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
         ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p);
@@ -192,6 +253,15 @@ static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigne
         next_id += t[0];
         m = t[1];
         cur = 1 - cur;
+    }
+    if (m > 1) {
+        CUDA_CHECK(cudaMemsetAsync(totals.get(), 0, sizeof(int32_t)));
+        ploc_tail_kernel<<<1, kPlocTailThreads>>>(a, arrays(cur, m), arrays(1 - cur, 0), merge_scan.get(), keep_scan.get(),
+                                                  next_id, totals.get());
+        check_launch("ploc tail");
+        int32_t status = 0;
+        CUDA_CHECK(cudaMemcpy(&status, totals.get(), sizeof(status), cudaMemcpyDeviceToHost));
+        if (status != 0) throw std::logic_error("CUDA BVH build: a PLOC iteration merged nothing");
     }
     ploc_root<<<1, 1>>>(a);
     ploc_leaf_slots<<<blocks_for(a.n), kThreads>>>(a);
@@ -238,17 +308,14 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
         throw std::invalid_argument("CUDA BVH build: max_leaf and ploc_radius must be >= 1");
     if (n <= options.max_leaf) return nullptr;
     const auto start = std::chrono::steady_clock::now();
+    // The search bound is a host pass over the mesh (about a millisecond at 100k triangles):
+    // made on another thread while the device builds.
+    std::future<FloatSearchBound> bound = std::async(std::launch::async, [&mesh] { return float_search_bound(mesh); });
     EventTimer timer;
     timer.begin();
     auto out = std::make_unique<DeviceLbvh>();
     DeviceLbvh& d = *out;
     d.num_triangles = n;
-
-    // The packed constants in triangle order go up while the tree is built.
-    DeviceBuffer<PackedTriangle<float>> pf;
-    DeviceBuffer<PackedTriangle<double>> pd;
-    pf.upload(mesh.buffers<float>().packed);
-    pd.upload(mesh.buffers<double>().packed);
 
     const LbvhKeyFrame frame = lbvh_key_frame(mesh.bounds());
     const size_t count = mesh.triangles().size();
@@ -342,9 +409,9 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     d.packed_float.allocate(count);
     d.packed_double.allocate(count);
     d.slot_of.allocate(count);
-    lbvh_gather<<<blocks_for(n), kThreads>>>(d.triangle_index.get(), n, pf.get(), pd.get(), d.packed_float.get(),
-                                             d.packed_double.get(), d.slot_of.get());
-    check_launch("gather");
+    lbvh_pack<<<blocks_for(n), kThreads>>>(vertices, triangles, d.triangle_index.get(), n, d.packed_float.get(),
+                                           d.packed_double.get(), d.slot_of.get());
+    check_launch("pack");
     int h[3] = {0, 0, 0};
     double sah_cost = 0;
     counters.download(h, 3);
@@ -357,7 +424,7 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     d.stats.largest_leaf = h[2];
     d.stats.sah_cost = sah_cost;
     d.within_depth = h[0] <= kBvhMaxDepth;
-    d.bound = float_search_bound(mesh);  // a host pass over the mesh, counted in the build's wall time
+    d.bound = bound.get();
     d.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }

@@ -23,7 +23,7 @@ struct DeviceLbvh {
     DeviceBuffer<int32_t> slot_of;               ///< prepared-mesh triangle -> BVH slot
     DeviceBuffer<PackedTriangle<float>> packed_float;    ///< search constants in BVH order
     DeviceBuffer<PackedTriangle<double>> packed_double;
-    BvhBuildStats stats;       ///< seconds: wall time of the whole build (uploads of the packed constants included)
+    BvhBuildStats stats;       ///< seconds: wall time of the whole build (the host's search bound included)
     double device_seconds = 0;  ///< CUDA events around the same work
     bool within_depth = true;   ///< false: deeper than kBvhMaxDepth, not to be queried
     FloatSearchBound bound;     ///< the search bound of these triangles (search_certificate.h): the

@@ -53,8 +53,22 @@ struct alignas(16) PackedTriangle {
     T g, w12;            ///< g and 2 (b - c)
 };
 
+/// The next T above x (host and device).
 template <typename T>
-PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v2) {
+SDF_CPU_GPU SDF_INLINE T next_above(T x) {
+#if SDF_IS_GPU_CODE
+    if constexpr (std::is_same_v<T, float>) return nextafterf(x, INFINITY);
+    else return nextafter(x, double(INFINITY));
+#else
+    return std::nextafter(x, T(INFINITY));
+#endif
+}
+
+/// The constants of triangle (v0, v1, v2). Host and device compute them bit for bit alike
+/// (IEEE operations only, no contraction: the build flags), so the GPU BVH build packs its
+/// triangles where it sorts them instead of uploading the host's.
+template <typename T>
+SDF_CPU_GPU PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v2) {
     // Constants are formed in double and rounded once, so float and double runs agree.
     const Vec3d e0 = v1 - v0, e1 = v2 - v0;
     const double a = dot(e0, e0), b = dot(e0, e1), c = dot(e1, e1);
@@ -62,8 +76,11 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     const double det = a * c - b * b;
     const Vec3d n = normalize_or_zero(cross(e0, e1));
     // sin^2 of the angle at V0 is det / (a c); the smallest angle matters, and with the
-    // edge lengths it is at most that one's, so test all three corners.
-    const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
+    // edge lengths it is at most that one's, so test all three corners. (The first smallest,
+    // as std::min({...}): a NaN first stays.)
+    double sin2 = det / (a * c);
+    if (det / (a * g) < sin2) sin2 = det / (a * g);
+    if (det / (c * g) < sin2) sin2 = det / (c * g);
     const double sliver = sizeof(T) < sizeof(double) ? kFloatSliverSin2 : kSliverSin2;
     const bool interior = det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= sliver;
     const T nan = std::numeric_limits<T>::quiet_NaN();  // NaN >= 0 is false: never inside
@@ -72,7 +89,7 @@ PackedTriangle<T> pack_triangle(const Vec3d& v0, const Vec3d& v1, const Vec3d& v
     const bool float_only_sliver =
         sizeof(T) < sizeof(double) && det > 0.0 && a > 0.0 && c > 0.0 && g > 0.0 && sin2 >= kSliverSin2 && !interior;
     const double inradius = float_only_sliver ? std::sqrt(det) / (std::sqrt(a) + std::sqrt(c) + std::sqrt(g)) : 0.0;
-    const T excess = std::nextafter(T(inradius * inradius * 1.001), T(INFINITY));
+    const T excess = next_above(T(inradius * inradius * 1.001));
     PackedTriangle<T> t{};
     t.bx = T(v0.x); t.by = T(v0.y); t.bz = T(v0.z);
     t.e0x = T(2 * e0.x); t.e0y = T(2 * e0.y); t.e0z = T(2 * e0.z);
