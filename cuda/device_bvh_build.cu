@@ -72,11 +72,11 @@ __global__ void ploc_compact_kernel(PlocArrays p, PlocArrays q, const int32_t* m
     }
 }
 
-/// PLOC's last iterations, once at most kPlocTailClusters clusters are left: one block runs
-/// them all, the steps of the launches above in the same order (so the same tree), where the
-/// launches and a read-back per iteration would cost some 40 us each for little work.
+/// PLOC's last iterations, once at most GpuBvhBuildOptions::ploc_tail_clusters are left: one
+/// block runs them all, the steps of the launches above in the same order (so the same tree),
+/// where the launches and a read-back per iteration would cost some 40 us each for little work.
 constexpr int kPlocTailThreads = 1024;
-constexpr int kPlocTailClusters = 8192;
+constexpr int kPlocTailMaxClusters = 1 << 15;  ///< the scan packs two counts of at most this in an int
 
 /// p: this iteration's clusters (p.m of them), q: the other cluster arrays; `status` becomes 1
 /// where an iteration merged nothing (lbvh_steps.h rules it out; checked, not assumed).
@@ -91,7 +91,7 @@ __global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays 
         __syncthreads();
         for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_flags(p, i);
         __syncthreads();
-        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m < 2^16) low.
+        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m <= 2^15) low.
         int merges = 0, keeps = 0;
         for (int base = 0; base < m; base += kPlocTailThreads) {
             const int i = base + int(threadIdx.x);
@@ -220,7 +220,7 @@ void check_launch(const char* what) {
 /// PLOC's iterations (lbvh_steps.h): one launch per step, CUB scans between them, the
 /// iteration's totals read back to know how many clusters are left; the last iterations in
 /// one block (ploc_tail_kernel).
-static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigned char>& temp) {
+static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, DeviceBuffer<unsigned char>& temp) {
     const size_t n = size_t(a.n);
     DeviceBuffer<int32_t> code[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
     DeviceBuffer<int32_t> count[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
@@ -235,7 +235,7 @@ static void ploc_on_device(const LbvhArrays& a, int radius, DeviceBuffer<unsigne
     };
     ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
     check_launch("ploc init");
-    while (m > kPlocTailClusters) {
+    while (m > 1 && m > tail_clusters) {
         const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
         ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
         ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p);
@@ -306,6 +306,9 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     const int n = int(mesh.triangles().size());
     if (options.max_leaf < 1 || options.ploc_radius < 1)
         throw std::invalid_argument("CUDA BVH build: max_leaf and ploc_radius must be >= 1");
+    if (options.ploc_tail_clusters < 0 || options.ploc_tail_clusters > kPlocTailMaxClusters)
+        throw std::invalid_argument("CUDA BVH build: ploc_tail_clusters must be in 0.." + std::to_string(kPlocTailMaxClusters) +
+                                    ", got " + std::to_string(options.ploc_tail_clusters));
     if (n <= options.max_leaf) return nullptr;
     const auto start = std::chrono::steady_clock::now();
     // The search bound is a host pass over the mesh (about a millisecond at 100k triangles):
@@ -359,7 +362,7 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
         lbvh_leaves_in_place<<<blocks_for(n), kThreads>>>(a);
         check_launch("leaves");
     } else {
-        ploc_on_device(a, options.ploc_radius, temp);
+        ploc_on_device(a, options.ploc_radius, options.ploc_tail_clusters, temp);
     }
 
     // Kept nodes, numbered in pre-order (lbvh_preorder_key).

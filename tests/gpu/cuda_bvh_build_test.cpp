@@ -1,8 +1,9 @@
 // The BVH built on the GPU (cuda/device_bvh_build.h) against its host emulation
-// (core/bvh/lbvh.h): nodes, moments, slots and packed constants bit for bit; and the CUDA
-// BVH sampler's fields and point queries on the device-built tree against the host-built
-// (SAH) tree: triangle, distance and gradient bit for bit, the sign too wherever the sign
-// is the pseudonormal's (the winding number's side is counted: it may depend on the tree).
+// (core/bvh/lbvh.h): nodes, moments, slots and packed constants bit for bit (PLOC's last
+// iterations in one block or not); and the CUDA BVH sampler's fields and point queries on
+// the device-built tree against the host-built (SAH) tree: triangle, distance and gradient
+// bit for bit, the sign too wherever the sign is the pseudonormal's (the winding number's
+// side is counted: it may depend on the tree).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -52,10 +53,15 @@ TEST(CudaBvhBuild, DeviceBuildEqualsTheHostEmulationBitForBit) {
         const PreparedMesh& mesh = *c.mesh;
         if (mesh.triangles().size() <= 4) continue;
         const cuda::DeviceMesh<double> dmesh(mesh.buffers<double>());
-        for (GpuBvhBuilder builder : {GpuBvhBuilder::Ploc, GpuBvhBuilder::Lbvh}) {
+        // PLOC three times: its last iterations in one block from the default cluster count,
+        // from 100 clusters, and never (a launch sequence per iteration): the same bytes.
+        for (const auto& [builder, tail] : {std::pair{GpuBvhBuilder::Ploc, GpuBvhBuildOptions{}.ploc_tail_clusters},
+                                            std::pair{GpuBvhBuilder::Ploc, 100}, std::pair{GpuBvhBuilder::Ploc, 0},
+                                            std::pair{GpuBvhBuilder::Lbvh, 0}}) {
         GpuBvhBuildOptions o;
         o.builder = builder;
-        const std::string what = c.name + " " + gpu_bvh_builder_name(builder);
+        o.ploc_tail_clusters = tail;
+        const std::string what = c.name + " " + gpu_bvh_builder_name(builder) + " tail " + std::to_string(tail);
         const auto device = cuda::build_lbvh_on_device(mesh, dmesh.view().vertices, dmesh.view().triangles, o);
         ASSERT_TRUE(device) << what;
         const LbvhBuild d = device->download();
