@@ -272,8 +272,10 @@ private:
         device_float_.reset();
         device_double_.reset();
         upload.begin();
-        auto dmesh = std::make_unique<DeviceMesh<double>>(mesh.buffers<double>());
-        std::unique_ptr<DeviceLbvh> lbvh = build_lbvh_on_device(mesh, dmesh->view().vertices, dmesh->view().triangles);
+        std::unique_ptr<DeviceLbvh> lbvh;
+        auto dmesh = DeviceMesh<double>::upload_during(mesh.buffers<double>(), [&](const DeviceMesh<double>& on_device) {
+            lbvh = build_lbvh_on_device(mesh, on_device.view().vertices, on_device.view().triangles);
+        });
         if (!lbvh || !lbvh->within_depth) {
             upload.end();
             device_build_skipped_ = lbvh ? "the device tree is deeper than kBvhMaxDepth = " + std::to_string(kBvhMaxDepth) +
