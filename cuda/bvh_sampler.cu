@@ -367,7 +367,7 @@ private:
         const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
         launch_slab<T>(dev, piece, slab, fused, r.nearest.get());
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
-        launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
+        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(),
                                 options_.band_width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (bvh slab)");
         compute.end();
@@ -641,7 +641,7 @@ private:
                 launch_bvh_warp(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get());
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
             if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
-            launch_finalize_samples(blocks_for(piece.count, 256), 256, dev.mesh->view(), piece, r.nearest.get(),
+            launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(),
                                     dev.winding.view(), options_.band_width, r.outputs());
             CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
             store(r, piece.count);

@@ -198,7 +198,7 @@ private:
         }
         compute_.begin();
         if (certifier_) certifier_->certify(piece, point_coordinate_, best_i.get());
-        launch_finalize_samples(blocks_for(n, kFinalizeThreads), kFinalizeThreads, mesh_->view(), piece, best_i.get(),
+        launch_finalize_samples(n, mesh_->view(), piece, best_i.get(),
                                 winding_.view(), options_.band_width, out.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();

@@ -45,6 +45,16 @@ __device__ inline void store_sample(const PieceOutputs& out, int64_t i, const Si
     out.triangle[i] = s.triangle;
 }
 
+/// The block size of every finalize launch (launch_finalize_samples), which __launch_bounds__ needs.
+constexpr int kFinalizeBlock = 256;
+
+/// Blocks per SM that the warp winding walk's registers must allow. The walk is latency-bound
+/// (dependent double operations); at its natural 95 registers only 2 blocks fit an SM (25%
+/// occupancy). Capped at 64 registers (4 blocks) the dragon's 16.8M points near the surface
+/// took 52.7 ms instead of 65.5 ms on an H200 (80 registers: 55.7; the walk's stack in shared
+/// memory, 40-95 registers: 54.7-68.3 ms). docs/gpu-notes.md.
+constexpr int kWarpWindingMinBlocks = 4;
+
 /// With `Winding` the sample then takes the winding number's side; without it the kernel has
 /// no winding code at all (pseudonormal mode: the kernel as it was before sign modes).
 /// With a narrow band (band_width > 0, SamplerOptions::band_width) a sample with |d| > w
@@ -55,8 +65,9 @@ __device__ inline void store_sample(const PieceOutputs& out, int64_t i, const Si
 /// in the piece or not, reaches that call; blocks are whole warps), or with `PerThread` by
 /// each thread alone (the same bits: the measurement baseline, SDF_CUDA_WINDING_PER_THREAD).
 template <typename Piece, bool Winding, bool PerThread = false>
-__global__ void finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
-                                 PieceOutputs out) {
+__global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpWindingMinBlocks : 1)
+    finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
+                     PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     const bool in_piece = i < piece.size();
     const int64_t o = !in_piece || piece.block_local(i) < 0 ? -1 : piece.output_index(i);
@@ -92,10 +103,12 @@ inline bool winding_per_thread() {
     return per_thread;
 }
 
-/// Launches finalize_samples with or without the winding sign, as `sign` says.
+/// Launches finalize_samples with or without the winding sign, as `sign` says, over the
+/// piece's `count` points in blocks of kFinalizeBlock.
 template <typename Piece>
-void launch_finalize_samples(int blocks, int threads, MeshView<double> mesh, const Piece& piece, const int* nearest,
+void launch_finalize_samples(int64_t count, MeshView<double> mesh, const Piece& piece, const int* nearest,
                              const WindingSignView& sign, double band_width, PieceOutputs out) {
+    const int blocks = int((count + kFinalizeBlock - 1) / kFinalizeBlock), threads = kFinalizeBlock;
     if (!sign.enabled()) finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
     else if (winding_per_thread()) finalize_samples<Piece, true, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
     else finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);

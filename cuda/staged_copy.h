@@ -22,11 +22,10 @@ class StagedCopy {
 public:
     static constexpr size_t kChunkBytes = size_t(32) << 20;
 
-    StagedCopy() {
-        for (int b = 0; b < 2; ++b) CUDA_CHECK(cudaEventCreateWithFlags(&done_[b], cudaEventDisableTiming));
-    }
+    StagedCopy() = default;
     ~StagedCopy() {
-        for (cudaEvent_t e : done_) cudaEventDestroy(e);
+        for (cudaEvent_t e : done_)
+            if (e) cudaEventDestroy(e);
     }
     StagedCopy(const StagedCopy&) = delete;
     StagedCopy& operator=(const StagedCopy&) = delete;
@@ -34,6 +33,7 @@ public:
     /// `bytes` from host memory to the device, on stream 0 (after the work already on it);
     /// returns when the device holds them.
     void to_device(const void* host, void* device, size_t bytes) {
+        make_events();
         const char* from = static_cast<const char*>(host);
         char* to = static_cast<char*>(device);
         for (size_t k = 0, offset = 0; offset < bytes; ++k, offset += kChunkBytes) {
@@ -49,6 +49,7 @@ public:
 
     /// `bytes` from the device to host memory, after the work already on stream 0.
     void to_host(const void* device, void* host, size_t bytes) {
+        make_events();
         const char* from = static_cast<const char*>(device);
         char* to = static_cast<char*>(host);
         const size_t chunks = (bytes + kChunkBytes - 1) / kChunkBytes;
@@ -68,6 +69,13 @@ public:
     }
 
 private:
+    /// The events, made at the first copy: on the caller's device then (its sampler has set
+    /// it), not on whichever device was current when the sampler was made.
+    void make_events() {
+        for (cudaEvent_t& e : done_)
+            if (!e) CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
+    }
+
     char* buffer(int b) {
         if (!pinned_[b]) pinned_[b] = std::make_unique<PinnedBytes>(kChunkBytes);
         return pinned_[b]->get();
