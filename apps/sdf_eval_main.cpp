@@ -5,7 +5,7 @@
 // with or without a gradient channel, any scalar volume) and prints one line per input
 // point, in input order: "f gx gy gz" (value and world-space gradient, %.9g). POINTS has
 // "x y z" per line in world units ('-' = stdin; blank lines and '#' comments are skipped), or
-// is a .npy file of shape (N, 3).
+// is a .npy file of shape (N, 3); at least one point (none is an error naming the input).
 // Points outside the interpolator's domain are clamped into it (a warning counts them).
 // docs/reconstruction.md describes the interpolators and derivative sources.
 #include <CLI/CLI.hpp>
@@ -28,7 +28,10 @@ int main(int argc, char** argv) {
     sdf::ReconstructionSpec spec;
     int threads = 0;
     app.add_option("field", field_path, "field header (NAME.json, docs/field-format.md)")->required();
-    app.add_option("points", points_path, "file with \"x y z\" per line (world units), a .npy file of shape (N, 3), or - for stdin")->required();
+    app.add_option("points", points_path,
+                   "file with \"x y z\" per line (world units), a .npy file of shape (N, 3), or - for stdin; at least one "
+                   "point (none is an error)")
+        ->required();
     app.add_option("--interpolator", interpolator, sdf::interpolator_help())
         ->required()
         ->check(CLI::IsMember(sdf::interpolator_names()));

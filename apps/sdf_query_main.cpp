@@ -5,7 +5,8 @@
 // gradient, 0-based closest triangle in the file's face order). MESH is a mesh file (OBJ,
 // PLY, STL, OFF, optionally gzip-compressed; a relative name is looked up in the current
 // directory, then on the data search path: harness/config/mesh_spec.h) or shape:NAME;
-// POINTS has "x y z" per line ('-' = stdin) or is a .npy file of shape (N, 3). Results go to
+// POINTS has "x y z" per line ('-' = stdin) or is a .npy file of shape (N, 3), N >= 1 (no
+// points is an error naming the input: most often the wrong file). Results go to
 // stdout as text, or to --out: a .npy file of shape (N, 5) float64 (the same five columns,
 // every bit of the double results), any other name a text file. The query itself is
 // harness/sampling/point_query.h, shared with the Python module.
@@ -64,7 +65,9 @@ int main(int argc, char** argv) {
     app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME (sphere, box, torus, "
                                      "pawn, soccer_ball)")
         ->required();
-    app.add_option("points", points_path, "file with \"x y z\" per line, a .npy file of shape (N, 3), or - for stdin")
+    app.add_option("points", points_path,
+                   "file with \"x y z\" per line, a .npy file of shape (N, 3), or - for stdin; at least one point "
+                   "(none is an error)")
         ->required();
     sampler.add(app, "--method", "method", "search: bvh (about log n per point) or brute_force (every triangle)");
     sampler.add(app, "--backend", "backend", "sampler backend (auto: cuda when a GPU is present, else cpu)");

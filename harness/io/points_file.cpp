@@ -29,25 +29,38 @@ Vec3d parse_point(const std::string& line, const std::string& name, int number) 
     return p;
 }
 
-std::vector<Vec3d> read_points(const std::string& text, const std::string& name) {
+/// The points of `text`; `name` names it in messages, `file` says what it is ("the file",
+/// "standard input") where no point is found.
+std::vector<Vec3d> read_points(const std::string& text, const std::string& name, const std::string& file) {
     std::istringstream in(text);
     std::vector<Vec3d> points;
     std::string line;
-    for (int number = 1; std::getline(in, line); ++number)
+    int lines = 0;
+    for (int number = 1; std::getline(in, line); ++number, ++lines)
         if (!is_blank_or_comment(line)) points.push_back(parse_point(line, name, number));
+    if (points.empty())
+        throw std::runtime_error(name + ": no points: expected \"x y z\" per line (blank lines and '#' comment lines are "
+                                        "skipped), but " + file + " " +
+                                 (lines == 0 ? std::string("is empty")
+                                             : "has only blank or comment lines (" + std::to_string(lines) + ")"));
     return points;
 }
 
 }  // namespace
 
 std::vector<Vec3d> read_points_file(const std::string& path) {
-    if (is_npy_path(path)) return read_npy_points(path);
-    if (path != "-") return read_points(read_text_file(path, "points file"), path);
+    if (is_npy_path(path)) {
+        std::vector<Vec3d> points = read_npy_points(path);
+        if (points.empty())
+            throw std::runtime_error(path + ": no points: the array has shape (0, 3); expected (N, 3) with N >= 1");
+        return points;
+    }
+    if (path != "-") return read_points(read_text_file(path, "points file"), path, "the file");
     std::stringstream all;
     all << std::cin.rdbuf();
     const std::string bytes = all.str();
     reject_wide_encodings(bytes, path, "points file");
-    return read_points(std::string(without_utf8_bom(bytes)), path);
+    return read_points(std::string(without_utf8_bom(bytes)), path, "standard input");
 }
 
 }  // namespace sdf

@@ -261,10 +261,16 @@ py::tuple Field::reconstruct(const py::object& points_in, const std::string& int
 
 py::object Field::points() const {
     return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
-        const size_t n = size_t(g.resolution.x) * size_t(g.resolution.y) * size_t(g.resolution.z);
-        std::vector<Vec3d> p(n);
-        for (size_t i = 0; i < n; ++i) p[i] = lattice().position(g.first + int64_t(i));
-        return vec3_array(p.data(), n, shape);
+        const int64_t n = int64_t(g.resolution.x) * g.resolution.y * g.resolution.z;
+        std::vector<py::ssize_t> vec3_shape = shape;
+        vec3_shape.push_back(3);
+        // Written straight into the array: no second host buffer of n points to fill and copy.
+        return new_array<double>(vec3_shape, [&](double* out) {
+            for (int64_t i = 0; i < n; ++i) {
+                const Vec3d p = lattice().position(g.first + i);
+                out[3 * i] = p.x, out[3 * i + 1] = p.y, out[3 * i + 2] = p.z;
+            }
+        });
     });
 }
 
@@ -328,20 +334,26 @@ Field field_from_arrays(const py::object& values, const py::object& origin, doub
         if (!std::isfinite(corner.x) || !std::isfinite(corner.y) || !std::isfinite(corner.z))
             throw std::invalid_argument("origin, spacing: the lattice's far corner (origin + spacing x (resolution - 1)) "
                                         "is not finite");
+    const size_t points = size_t(f.lattice.num_points());
+    f.distance.reserve(points);
     for (const DoubleArray& a : va) f.distance.insert(f.distance.end(), a.data(), a.data() + a.size());
     if (!gradient.is_none()) {
         const std::vector<py::object> g = grids_of(gradient, "gradient");
+        f.gradient.reserve(points);
         for (size_t k = 0; k < g.size(); ++k) {
             require_real_dtype(g[k], "gradient");
             const DoubleArray a = DoubleArray::ensure(g[k]);
             if (!a || a.ndim() != 4 || a.shape(3) != 3 || a.shape(0) != va[k].shape(0) || a.shape(1) != va[k].shape(1) ||
                 a.shape(2) != va[k].shape(2))
                 throw std::invalid_argument("gradient: expected the values' shape + (3,)");
-            for (py::ssize_t i = 0; i < a.size() / 3; ++i) f.gradient.push_back({a.data()[3 * i], a.data()[3 * i + 1], a.data()[3 * i + 2]});
+            const size_t first = f.gradient.size(), n = size_t(a.size() / 3);
+            f.gradient.resize(first + n);
+            for (size_t i = 0; i < n; ++i) f.gradient[first + i] = {a.data()[3 * i], a.data()[3 * i + 1], a.data()[3 * i + 2]};
         }
     }
     if (!triangle.is_none()) {
         const std::vector<py::object> t = grids_of(triangle, "triangle");
+        f.closest_triangle.reserve(points);
         for (size_t k = 0; k < t.size(); ++k) {
             if (!py::isinstance<py::array>(t[k]) || std::string("iu").find(py::array(t[k]).dtype().kind()) == std::string::npos)
                 throw py::type_error("triangle: expected integer arrays (0-based triangle indices, -2 outside a narrow band), got " +
@@ -434,10 +446,12 @@ Field read_field_file(const std::string& path) {
 
 void bind_field(py::module_& m) {
     py::class_<Field>(m, "Field", R"(A sampled field on a CC or BCC lattice: signed distance, exact gradient and
-closest triangle at every lattice point, with the lattice and provenance. Arrays are copies
-in z, y, x order: CC values have shape (nz, ny, nx); a BCC field (thesis notation
-Rx x Ry x 2Rz) is its two CC sub-grids, a tuple (primary (Rz, Ry, Rx), secondary
-(Rz-1, Ry-1, Rx-1)), the secondary grid's origin h/2 further along every axis.
+closest triangle at every lattice point, with the lattice and provenance. values, gradient
+and triangle are read-only views of the field's memory (no copy; each keeps the field alive;
+.copy() gives a writable array), in z, y, x order: CC values have shape (nz, ny, nx); a BCC
+field (thesis notation Rx x Ry x 2Rz) is its two CC sub-grids, a tuple (primary
+(Rz, Ry, Rx), secondary (Rz-1, Ry-1, Rx-1)), the secondary grid's origin h/2 further along
+every axis.
 
 Field(values, origin, spacing, lattice="cc", gradient=None, triangle=None) makes a field of
 your own arrays, shaped as above (BCC: (primary, secondary) tuples), on the lattice of
@@ -467,9 +481,9 @@ sampled one.)")
                                "The origin of each CC sub-grid: one tuple (CC), or (primary, secondary) (BCC).")
         .def_property_readonly("lattice_info", [](const Field& f) { return json_to_python(lattice_to_json(f.lattice())); },
                                "The lattice as a field file's header stores it (dict).")
-        .def_property_readonly("values", &Field::values, "Signed distance (or the stored scalar), float64 arrays as described above.")
-        .def_property_readonly("gradient", &Field::gradient, "Gradient, float64, shape (..., 3) per sub-grid; None when absent.")
-        .def_property_readonly("triangle", &Field::triangle, "Closest triangle per point, int32; None when absent.")
+        .def_property_readonly("values", &Field::values, "Signed distance (or the stored scalar), float64, read-only views as described above.")
+        .def_property_readonly("gradient", &Field::gradient, "Gradient, float64, shape (..., 3) per sub-grid (read-only views); None when absent.")
+        .def_property_readonly("triangle", &Field::triangle, "Closest triangle per point, int32 (read-only views); None when absent.")
         .def_property_readonly("precision", [](const Field& f) { return precision_name(f.field().precision); },
                                "The search precision it was sampled with.")
         .def_property_readonly("sampler", [](const Field& f) { return json_to_python(nlohmann::json(f.field().sampler)); },

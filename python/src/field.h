@@ -45,26 +45,27 @@ public:
         return py::make_tuple(arrays[0], arrays[1]);
     }
 
+    // The arrays are read-only NumPy views of the field's own memory, each holding the field
+    // alive: no copy (16.8M points of distance, gradient and triangle are 604 MB, which a
+    // copy would also have to page-fault) and no way to change a field that its cached
+    // reconstruction and write() read.
     py::object values() const {
         return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
-            const double* src = field_->distance.data() + g.first;
-            const int64_t n = int64_t(g.resolution.x) * g.resolution.y * g.resolution.z;
-            return new_array<double>(shape, [&](double* out) { std::copy(src, src + n, out); });
+            return view(field_->distance.data() + g.first, shape);
         });
     }
     py::object gradient() const {
         if (field_->gradient.empty()) return py::none();
-        return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
-            const size_t n = size_t(g.resolution.x) * size_t(g.resolution.y) * size_t(g.resolution.z);
-            return vec3_array(field_->gradient.data() + g.first, n, shape);
+        static_assert(sizeof(Vec3d) == 3 * sizeof(double), "a gradient array views Vec3d as 3 packed doubles");
+        return per_grid([&](const Grid& g, std::vector<py::ssize_t> shape) -> py::object {
+            shape.push_back(3);
+            return view(&field_->gradient[size_t(g.first)].x, shape);
         });
     }
     py::object triangle() const {
         if (field_->closest_triangle.empty()) return py::none();
         return per_grid([&](const Grid& g, const std::vector<py::ssize_t>& shape) -> py::object {
-            const int32_t* src = field_->closest_triangle.data() + g.first;
-            const int64_t n = int64_t(g.resolution.x) * g.resolution.y * g.resolution.z;
-            return new_array<int32_t>(shape, [&](int32_t* out) { std::copy(src, src + n, out); });
+            return view(field_->closest_triangle.data() + g.first, shape);
         });
     }
     py::object grid_origins() const {
@@ -121,6 +122,17 @@ public:
     py::object points() const;
 
 private:
+    /// A read-only C-order array of `shape` over `data` (inside field_), whose base owns a
+    /// reference to field_.
+    template <typename T>
+    py::array view(const T* data, const std::vector<py::ssize_t>& shape) const {
+        auto* owner = new std::shared_ptr<const SampledField>(field_);
+        const py::capsule base(owner, [](void* p) { delete static_cast<std::shared_ptr<const SampledField>*>(p); });
+        py::array_t<T> a(shape, data, base);
+        a.attr("setflags")(py::arg("write") = false);
+        return std::move(a);
+    }
+
     std::shared_ptr<const SampledField> field_;
     std::shared_ptr<const Reconstruction> recon_;
     std::string recon_key_;

@@ -273,11 +273,34 @@ TEST_F(Cli, QueryReadsStdin) {
     EXPECT_NEAR(lines[2].d, std::sqrt(4.0 + 9.0), 1e-14);
 }
 
-TEST_F(Cli, QueryEmptyPointsFileGivesNoOutput) {
-    write("p.txt", "# nothing\n\n");
-    const ShellResult r = query("shape:box p.txt");
-    EXPECT_EQ(r.code, 0) << r.err;
-    EXPECT_EQ(r.out, "");
+// A query of no points is most often the wrong file or a failed step before it: refused,
+// naming the input and what it should hold, in every format, and no --out file is written.
+TEST_F(Cli, QueryRefusesInputWithoutPointsNamingIt) {
+    write("empty.txt", "");
+    write("comments.txt", "# nothing\r\n\n   \n");
+    write_npy(at("none.npy"), std::vector<double>{}, {0, 3});
+    const struct {
+        std::string args, message;
+    } cases[] = {
+        {"empty.txt", "empty.txt: no points: expected \"x y z\" per line (blank lines and '#' comment lines are "
+                      "skipped), but the file is empty"},
+        {"comments.txt", "comments.txt: no points: expected \"x y z\" per line (blank lines and '#' comment lines are "
+                         "skipped), but the file has only blank or comment lines (3)"},
+        {"- < empty.txt", "-: no points: expected \"x y z\" per line (blank lines and '#' comment lines are skipped), "
+                          "but standard input is empty"},
+        {"none.npy", "none.npy: no points: the array has shape (0, 3); expected (N, 3) with N >= 1"},
+    };
+    for (const auto& c : cases) {
+        const ShellResult r = query("shape:box " + c.args);
+        EXPECT_EQ(r.code, 1) << c.args;
+        EXPECT_TRUE(Contains(r.err, "sdf-query: error: ")) << r.err;
+        EXPECT_TRUE(Contains(r.err, c.message)) << r.err;
+        EXPECT_EQ(r.out, "") << c.args;
+        for (const char* out : {"r.npy", "r.txt"}) {
+            EXPECT_EQ(query("shape:box " + c.args + " --out " + out).code, 1) << c.args;
+            EXPECT_FALSE(fs::exists(at(out))) << c.args << " wrote " << out;
+        }
+    }
 }
 
 TEST_F(Cli, QueryMalformedLineNamesFileAndLine) {

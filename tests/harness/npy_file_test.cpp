@@ -71,7 +71,13 @@ TEST_F(NpyFile, EveryDtypeAndShapeRoundTrips) {
 
     write_npy(at("empty.npy"), NpyDtype::Float64, {0, 3}, nullptr);
     EXPECT_EQ(read_npy(at("empty.npy")).count(), 0);
-    EXPECT_TRUE(read_points_file(at("empty.npy")).empty());
+    try {  // an array without points is no points file (harness/io/points_file.h)
+        read_points_file(at("empty.npy"));
+        FAIL() << "read an empty points file";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  at("empty.npy") + ": no points: the array has shape (0, 3); expected (N, 3) with N >= 1");
+    }
 }
 
 TEST_F(NpyFile, HeadersAreAlignedAndNeverOverwritten) {

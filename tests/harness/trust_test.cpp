@@ -449,6 +449,17 @@ TEST_F(Trust, PointsFileErrorsQuoteTheLineWithItsBytesEscaped) {
     EXPECT_TRUE(Contains(r.err, "got '1 2 3\\x00'")) << r.err;
 }
 
+// Both tools that read points files refuse one without points (harness/io/points_file.h),
+// as sdf-query does in every format (cli_test.cpp): sdf-eval printed nothing and exited 0.
+TEST_F(Trust, SdfEvalRefusesAPointsFileWithoutPoints) {
+    const std::string field = linear_field("f.json");
+    write("none.txt", "# no points\n");
+    const ShellResult r = eval(field + " none.txt --interpolator trilinear");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(Contains(r.err, "sdf-eval: error: none.txt: no points: expected \"x y z\" per line")) << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
 TEST_F(Trust, RenderLargerThanMemoryIsRefusedWithTheFigure) {
     const ShellResult huge = render("shape:sphere --size 100000 --out x.pfm");
     EXPECT_EQ(huge.code, 2);  // beyond 16384, the configs' limit too

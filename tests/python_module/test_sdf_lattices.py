@@ -320,6 +320,27 @@ def test_bcc_field_is_two_cc_subgrids_half_a_spacing_apart(box):
     assert abs(secondary[k, j, i] - d[0]) < 1e-14
 
 
+def test_field_arrays_are_read_only_views_that_outlive_the_field(tmp_path, box):
+    f = sl.sample(box, lattice="bcc", resolution=6, backend="cpu", precision="double")
+    path = str(tmp_path / "box.json")
+    f.write(path, dtype="float64")
+    values, gradient, triangle = f.values, f.gradient, f.triangle
+    assert values[1].base is not None and not values[1].flags.owndata  # a view, no copy
+    del f  # the views keep the field's memory alive
+    raw = {c: np.fromfile(str(tmp_path / f"box.{c}.raw"), dtype=t)  # an independent reader
+           for c, t in (("distance", "<f8"), ("gradient", "<f8"), ("closest_triangle", "<i4"))}
+    assert same_bits(raw["distance"], np.concatenate([v.reshape(-1) for v in values]))
+    assert same_bits(raw["gradient"], np.concatenate([g.reshape(-1) for g in gradient]))
+    assert np.array_equal(raw["closest_triangle"], np.concatenate([t.reshape(-1) for t in triangle]))
+    for a in (*values, *gradient, *triangle):
+        assert not a.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        values[0][0, 0, 0] = 1.0
+    mine = values[0].copy()
+    mine[0, 0, 0] = 1.0  # a copy is the caller's to change
+    assert mine[0, 0, 0] == 1.0 and values[0][0, 0, 0] != 1.0
+
+
 def test_resolution_and_samples_take_numpy_integers(box):
     want = sl.sample(box, lattice="bcc", resolution=6, backend="cpu", precision="double")
     for resolution in (np.int64(6), np.uint8(6), np.array([6, 6, 12]), (np.int32(6), 6, np.int16(12))):
