@@ -17,11 +17,12 @@ constexpr uint64_t kPoolKeptDivisor = 16;
 
 /// Whether `device` allocates from its pool; the pool's release threshold is set on first use.
 bool pool_ready(int device) {
-    static std::mutex mutex;
-    static std::vector<int> state;  // per device: 0 unknown, 1 pool, 2 no pool
-    std::lock_guard<std::mutex> lock(mutex);
-    if (size_t(device) >= state.size()) state.resize(size_t(device) + 1, 0);
-    int& s = state[size_t(device)];
+    // Never destroyed: a buffer freed by another static's destructor at exit still finds them.
+    static std::mutex* const mutex = new std::mutex;
+    static std::vector<int>* const state = new std::vector<int>;  // per device: 0 unknown, 1 pool, 2 no pool
+    std::lock_guard<std::mutex> lock(*mutex);
+    if (size_t(device) >= state->size()) state->resize(size_t(device) + 1, 0);
+    int& s = (*state)[size_t(device)];
     if (s == 0) {
         int supported = 0;
         cudaMemPool_t pool{};
