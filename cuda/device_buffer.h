@@ -43,8 +43,14 @@ public:
         ptr_ = nullptr;
         count_ = 0;
     }
+    /// The memory is allocated and freed in stream 0's order: a copy on another stream into
+    /// a fresh allocation first waits for stream 0, and work on another stream must be done
+    /// before the buffer is released.
     void upload(const T* host, size_t count, cudaStream_t stream = 0) {
-        if (count > count_) allocate(count);
+        if (count > count_) {
+            allocate(count);
+            if (stream != 0) CUDA_CHECK(cudaStreamSynchronize(0));
+        }
         if (count > 0) CUDA_CHECK(cudaMemcpyAsync(ptr_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream));
     }
     void upload(const std::vector<T>& host, cudaStream_t stream = 0) { upload(host.data(), host.size(), stream); }

@@ -81,7 +81,11 @@ private:
         CUDA_CHECK(cudaSetDevice(device));  // the current device is per host thread
         struct OwnStream {
             cudaStream_t stream{};
-            ~OwnStream() { if (stream) cudaStreamDestroy(stream); }
+            ~OwnStream() {  // after its copies, also when one of them threw: the normals are freed on stream 0
+                if (!stream) return;
+                cudaStreamSynchronize(stream);
+                cudaStreamDestroy(stream);
+            }
         } own;
         CUDA_CHECK(cudaStreamCreateWithFlags(&own.stream, cudaStreamNonBlocking));
         face_normals_.upload(host.face_normals, own.stream);

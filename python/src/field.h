@@ -59,7 +59,7 @@ public:
         static_assert(sizeof(Vec3d) == 3 * sizeof(double), "a gradient array views Vec3d as 3 packed doubles");
         return per_grid([&](const Grid& g, std::vector<py::ssize_t> shape) -> py::object {
             shape.push_back(3);
-            return view(&field_->gradient[size_t(g.first)].x, shape);
+            return view(reinterpret_cast<const double*>(field_->gradient.data() + g.first), shape);  // no element taken: a grid may be empty
         });
     }
     py::object triangle() const {
