@@ -24,7 +24,8 @@ struct SelfIntersections {
 };
 
 /// `shell_of[t]` is triangle t's edge-connected component (any ids; empty = one shell).
+/// `threads` (0: all hardware threads) share the descent; the result does not depend on it.
 SelfIntersections find_self_intersections(const PreparedMesh& mesh, const TriangleBvh& bvh,
-                                          const std::vector<int>& shell_of = {});
+                                          const std::vector<int>& shell_of = {}, int threads = 0);
 
 }  // namespace sdf

@@ -15,6 +15,7 @@
 #include "core/mesh/exact_predicates.h"
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
+#include "core/mesh/self_intersections.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/mesh/triangle_intersection.h"
 
@@ -193,6 +194,24 @@ TEST(SelfIntersections, OneShellFoldedThroughItself) {
     bool warned = false;
     for (const std::string& w : m.warnings()) warned = warned || w.find("intersects itself") != std::string::npos;
     EXPECT_TRUE(warned);
+}
+
+TEST(SelfIntersections, TheSameListOnAnyNumberOfThreads) {
+    // The descent is split into tasks that threads take in any order; the sorted list of
+    // pairs must not depend on it (a torus through itself, two overlapping boxes).
+    for (const PreparedMesh& m : {prepare_mesh(make_torus(0.3, 0.5, 32, 16)),
+                                  prepare_mesh(concatenated(make_box({1, 1, 1}), make_box({1, 1, 1}, {1, 0.5, 0.25})))}) {
+        const SelfIntersections one = find_self_intersections(m, *m.bvh(), m.shell_of(), 1);
+        ASSERT_GT(one.pairs.size(), 0u);
+        for (int threads : {2, 3, 8}) {
+            const SelfIntersections many = find_self_intersections(m, *m.bvh(), m.shell_of(), threads);
+            EXPECT_EQ(many.pairs, one.pairs) << threads << " threads";
+            EXPECT_EQ(many.within_shell, one.within_shell);
+            EXPECT_EQ(many.between_shells, one.between_shells);
+            EXPECT_EQ(many.overlapping_shell_pairs, one.overlapping_shell_pairs);
+        }
+        EXPECT_EQ(one.pairs, m.intersecting_triangles());  // what preparation found, on all threads
+    }
 }
 
 std::string find_data_file(const std::string& file) {
