@@ -28,6 +28,11 @@ bool boxes_overlap(const Child& a, const Child& b) {
     return true;
 }
 
+double volume(const Child& c) { return double(c.hi[0] - c.lo[0]) * double(c.hi[1] - c.lo[1]) * double(c.hi[2] - c.lo[2]); }
+
+/// Which child a pair descent opens: the inner one, the larger when both are.
+bool opens_first(const Child& a, const Child& b) { return !a.leaf && (b.leaf || volume(a) >= volume(b)); }
+
 /// A triangle's box in double: its corners' min and max, exact.
 struct TriangleBox {
     double lo[3], hi[3];
@@ -83,8 +88,7 @@ public:
                 for (int32_t j = b.ref; j < b.ref + b.count; ++j) test(i, j);
             return;
         }
-        // Open the inner child (the larger one when both are inner).
-        const bool open_a = !a.leaf && (b.leaf || volume(a) >= volume(b));
+        const bool open_a = opens_first(a, b);
         const Child& open = open_a ? a : b;
         const Child& keep = open_a ? b : a;
         const BvhNode& n = bvh_.nodes[size_t(open.ref)];
@@ -93,10 +97,6 @@ public:
     }
 
 private:
-    static double volume(const Child& c) {
-        return double(c.hi[0] - c.lo[0]) * double(c.hi[1] - c.lo[1]) * double(c.hi[2] - c.lo[2]);
-    }
-
     /// The exact test, for triangles whose own boxes overlap (a leaf's box holds several, and
     /// triangles with disjoint boxes cannot meet: the box test is exact and closed).
     void test(int32_t slot_a, int32_t slot_b) {
@@ -143,11 +143,7 @@ std::vector<DescentTask> descent_tasks(const TriangleBvh& bvh, size_t target) {
             } else {
                 if (!boxes_overlap(t.a, t.b)) continue;
                 if (t.a.leaf && t.b.leaf) { tasks.push_back(t); continue; }
-                // As PairDescent::between opens it: the inner child, the larger when both are.
-                const auto volume = [](const Child& c) {
-                    return double(c.hi[0] - c.lo[0]) * double(c.hi[1] - c.lo[1]) * double(c.hi[2] - c.lo[2]);
-                };
-                const bool open_a = !t.a.leaf && (t.b.leaf || volume(t.a) >= volume(t.b));
+                const bool open_a = opens_first(t.a, t.b);  // as PairDescent::between opens it
                 const Child& opened = open_a ? t.a : t.b;
                 const Child& kept = open_a ? t.b : t.a;
                 const BvhNode& n = bvh.nodes[size_t(opened.ref)];
