@@ -145,9 +145,7 @@ TEST(CudaBvhBuild, NeedleFansEqualTheDoubleBruteForceOnEitherTree) {
     auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
     for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
         const test::NeedleFan fan = test::make_needle_fan(center);
-        MeshPreparationOptions po;
-        po.orient_outward = false;
-        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const PreparedMesh mesh = test::prepare_needle_fan(fan);
         SamplerOptions ref;
         ref.backend = "cpu";
         ref.method = "brute_force";

@@ -283,6 +283,13 @@ inline NeedleFan make_needle_fan(const Vec3d& center, int count = 600, unsigned 
     return f;
 }
 
+/// The fan prepared as every needle-fan test searches it: its triangles as built (orient_outward off).
+inline PreparedMesh prepare_needle_fan(const NeedleFan& fan) {
+    MeshPreparationOptions options;
+    options.orient_outward = false;
+    return prepare_mesh(fan.mesh, options);
+}
+
 inline double epsilon_of(Precision p) {
     return p == Precision::Float ? double(std::numeric_limits<float>::epsilon()) : std::numeric_limits<double>::epsilon();
 }

@@ -81,9 +81,7 @@ TEST(CertifiedSearch, FloatEqualsDoubleBruteForceOnAdversarialPoints) {
 TEST(CertifiedSearch, NeedleFansEqualDoubleBruteForce) {
     for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
         const test::NeedleFan fan = test::make_needle_fan(center);
-        MeshPreparationOptions po;
-        po.orient_outward = false;
-        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const PreparedMesh mesh = test::prepare_needle_fan(fan);
         const std::vector<PointSample> want = query("brute_force", Precision::Double, "vectorized", mesh, fan.points);
         for (const char* kernel : {"brick", "seeded", "unseeded"}) {
             for (Precision p : {Precision::Double, Precision::Float}) {

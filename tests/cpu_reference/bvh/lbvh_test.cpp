@@ -269,9 +269,7 @@ TEST(Lbvh, FastWindingNumberAgreesWithTheSahTreeWithinItsBound) {
 TEST(Lbvh, NeedleFansFarFromTheOriginGiveTheLoop) {
     for (const Vec3d center : {Vec3d{1e7, -3e6, 5e6}, Vec3d{0.5, 0.25, -0.125}}) {
         const test::NeedleFan fan = test::make_needle_fan(center);
-        MeshPreparationOptions po;
-        po.orient_outward = false;
-        const PreparedMesh mesh = prepare_mesh(fan.mesh, po);
+        const PreparedMesh mesh = test::prepare_needle_fan(fan);
         const std::vector<Vec3d>& pts = fan.points;
         expect_queries_match_loop(mesh, build_triangle_bvh(mesh), pts);
         for (int leaf : {1, 4})
