@@ -307,8 +307,7 @@ private:
 
     /// z-layers per slab: as many as 80% of free GPU memory holds (and max_points_per_piece).
     int layers_per_slab(const GridBlock& block) const {
-        size_t free_bytes = 0, total = 0;
-        CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
+        const size_t free_bytes = free_device_memory();
         const int64_t layer = int64_t(block.resolution.x) * block.resolution.y;
         int64_t points = int64_t(0.8 * double(free_bytes)) / int64_t(PieceResults::bytes_per_point());
         if (options_.max_points_per_piece > 0) points = std::min(points, options_.max_points_per_piece);
@@ -411,8 +410,7 @@ private:
         // not fit a quarter of the free device memory takes the per-piece path below.
         const int64_t points = int64_t(field.distance.size());
         const StoredLayout layout{false, true, true};
-        size_t free_bytes = 0, total_bytes = 0;
-        CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total_bytes));
+        const size_t free_bytes = free_device_memory();
         if (points > 0 && double(points) * double(layout.bytes_per_point()) <= 0.25 * double(free_bytes)) {
             const StoredChannels<double> out = stored_buffers_.device_channels<double>(points, layout, dev.source_triangle.get());
             const auto [computed, pieces] = store_blocks<T, double>(dev, lattice, slab, out, compute);

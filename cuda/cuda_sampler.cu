@@ -48,8 +48,7 @@ public:
         mesh_ = std::make_unique<DeviceMesh<double>>(exact_host_);
         winding_.upload(sign, mesh_->view());
         upload_.end();
-        size_t free_bytes = 0, total = 0;
-        CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
+        const size_t free_bytes = free_device_memory();
         budget_ = size_t(0.8 * double(free_bytes));
         num_triangles_ = int(host_.triangles.size());
         if (kernel_ == CudaKernel::Tuned) plan_triangle_chunks();

@@ -11,14 +11,20 @@
 
 namespace sdf::cuda {
 
-/// Device memory for DeviceBuffer: stream-ordered (cudaMallocAsync/cudaFreeAsync on stream 0)
-/// from the device's default pool, which keeps freed memory for the next allocation instead
-/// of returning it to the driver: a BVH build or a point query allocates and frees a dozen
-/// buffers, and cudaMalloc + cudaFree (which waits for the whole device) cost more than the
-/// kernels at a million points. The pool keeps up to 1/16 of the device's memory (the rest
-/// goes back at the next synchronisation); devices without pools use cudaMalloc/cudaFree.
+/// Device memory for DeviceBuffer: stream-ordered (cudaMallocFromPoolAsync/cudaFreeAsync on
+/// stream 0) from a pool of this module's own on each device, which keeps freed memory for
+/// the next allocation instead of returning it to the driver: a BVH build or a point query
+/// allocates and frees a dozen buffers, and cudaMalloc + cudaFree (which waits for the whole
+/// device) cost more than the kernels at a million points. The pool keeps up to 1/16 of the
+/// device's memory (the rest goes back at the next synchronisation); devices without pools
+/// use cudaMalloc/cudaFree.
 void* allocate_device_bytes(size_t bytes, int& device);
 void free_device_bytes(void* ptr, int device) noexcept;
+
+/// The current device's memory that an allocation of ours can take: the driver's free memory
+/// (cudaMemGetInfo) plus what our pool keeps unused, which cudaMemGetInfo counts as taken.
+/// What slabs and pieces are sized by.
+size_t free_device_memory();
 
 template <typename T>
 class DeviceBuffer {
