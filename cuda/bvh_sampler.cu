@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -95,6 +96,16 @@ struct DeviceBvh {
     }
     std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };
+
+/// Points per thread of the warp search over a point list (SDF_LIST_RUN: 1, 2 or 4; 4 by default).
+int list_points_per_thread() {
+    static const int run = [] {
+        const char* e = std::getenv("SDF_LIST_RUN");
+        const int v = e ? std::atoi(e) : kRunPoints;
+        return v == 1 || v == 2 ? v : kRunPoints;
+    }();
+    return run;
+}
 
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
 template <typename T, typename Piece>
@@ -630,13 +641,22 @@ private:
             compute.begin();
             if (begin == 0) sort.run(mesh, device_points, sorted_points.get(), order.get());
             const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
-            const ListLayout layout{PointListPiece{sorted_points.get(), begin, piece.count}};
-            const int blocks = blocks_for(layout.threads(), kBvhThreads);
+            const PointListPiece list{sorted_points.get(), begin, piece.count};
             const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
-            if (kernel_ == BvhGpuKernel::Candidates)
-                nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
-            else
-                launch_bvh_warp(blocks, dev.view, layout, BandSearch{}, fused, r.nearest.get());
+            const auto warp = [&](auto layout) {
+                launch_bvh_warp(blocks_for(layout.threads(), kBvhThreads), dev.view, layout, BandSearch{}, fused, r.nearest.get());
+            };
+            if (kernel_ == BvhGpuKernel::Candidates) {
+                const ListLayout layout{list};
+                nearest_triangle_bvh_candidates<T><<<blocks_for(layout.threads(), kBvhThreads), kBvhThreads>>>(
+                    dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
+            } else if (const int run = list_points_per_thread(); run == 1) {
+                warp(ListRuns<1>{list});
+            } else if (run == 2) {
+                warp(ListRuns<2>{list});
+            } else {
+                warp(ListLayout{list});
+            }
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
             if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
             launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(),

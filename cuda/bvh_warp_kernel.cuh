@@ -40,6 +40,7 @@ __device__ SDF_INLINE T warp_max(T v) {
 /// a point list sorted into Morton order gives it 128 consecutive points, which are then
 /// neighbours in space as well (kernels/core/morton.h).
 struct SlabLayout {
+    static constexpr int kPoints = kRunPoints;  ///< points per thread
     GridRangePiece piece;
     SlabGeometry slab;
     SDF_CPU_GPU int64_t threads() const { return slab.threads(); }
@@ -54,24 +55,28 @@ struct SlabLayout {
     SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
 };
 
-struct ListLayout {
+/// A sorted point list, K consecutive points per thread (32 K per warp).
+template <int K>
+struct ListRuns {
+    static constexpr int kPoints = K;
     PointListPiece piece;
-    SDF_CPU_GPU int64_t threads() const { return (piece.size() + kRunPoints - 1) / kRunPoints; }
+    SDF_CPU_GPU int64_t threads() const { return (piece.size() + K - 1) / K; }
     SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
-        first = t * kRunPoints;
+        first = t * K;
         const int64_t left = piece.size() - first;
         if (left <= 0) first = 0;
-        return left <= 0 ? 0 : int(left < kRunPoints ? left : kRunPoints);
+        return left <= 0 ? 0 : int(left < K ? left : K);
     }
     SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
 };
+using ListLayout = ListRuns<kRunPoints>;
 
 /// Loads thread t's points into a packet; lanes without points get best = -1, so they never
 /// want a box or a triangle and never hold the warp back.
 template <typename T, typename Layout>
-__device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& first, BvhPacket<T, kRunPoints>& pk) {
+__device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& first, BvhPacket<T, Layout::kPoints>& pk) {
     const int count = layout.points_of(t, first);
-    for (int k = 0; k < kRunPoints; ++k) {
+    for (int k = 0; k < Layout::kPoints; ++k) {
         const Vec3<T> p(layout.position(first + (k < count ? k : 0)));
         pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
         pk.best_q[k] = count > 0 ? T(INFINITY) : T(-1);
@@ -85,8 +90,8 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
 /// The warp's shared traversal: completes the nearest triangle of every lane's points,
 /// pruning with each lane's radius (`policy`: plain, or the streamed certificate's widened
 /// one). `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
-template <typename T, typename Near>
-__device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, kRunPoints>& pk, bool valid, int32_t* stack_node,
+template <typename T, int K, typename Near>
+__device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, K>& pk, bool valid, int32_t* stack_node,
                                        T* stack_d2, Near& policy) {
     T worst = warp_max(valid ? T(INFINITY) : T(-1));
     int top = 0;  // warp-uniform
@@ -150,8 +155,8 @@ struct BandSearch {
 };
 
 /// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
-template <typename T>
-__device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, kRunPoints>& pk, int count, Vec3<T>& lo, Vec3<T>& hi) {
+template <typename T, int K>
+__device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, K>& pk, int count, Vec3<T>& lo, Vec3<T>& hi) {
     const T inf = T(INFINITY);
     lo = Vec3<T>(inf, inf, inf);
     hi = Vec3<T>(-inf, -inf, -inf);
@@ -170,8 +175,8 @@ __device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, kRunPoints>& pk, in
 /// with the pseudonormal sign, as the brick does not cross the surface; "per point" with the
 /// winding sign, whose side may change away from the surface), or 0 when the brick must be
 /// searched. `seed` receives c's nearest triangle.
-template <typename T>
-__device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket<T, kRunPoints>& pk, int count, const Vec3<T>& c,
+template <typename T, int K>
+__device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, int count, const Vec3<T>& c,
                                           const BvhHit<T>& seed, const BandSearch& band) {
     T r2 = T(0);
     for (int k = 0; k < count; ++k) {
@@ -203,18 +208,18 @@ struct RunPoint {
 };
 
 template <typename Layout>
-using StreamedRun = StreamedCertifiedNear<float, kRunPoints, RunPoint<Layout>>;
+using StreamedRun = StreamedCertifiedNear<float, Layout::kPoints, RunPoint<Layout>>;
 
 /// Writes the nearest triangle of the thread's `count` points: the plain search's, or with
 /// the certificate fused (kCertified, float only) the double search's, counting the points
 /// and those that needed double evaluations (every lane of the warp must call this).
-template <bool kCertified, typename T, typename Near>
-__device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, kRunPoints>& pk, Near& policy, int64_t first,
+template <bool kCertified, typename T, int K, typename Near>
+__device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, Near& policy, int64_t first,
                                          int count, const StreamedCertify& cert, int* nearest) {
     if constexpr (kCertified) {
         unsigned reranked = 0;
 #pragma unroll
-        for (int k = 0; k < kRunPoints; ++k) {
+        for (int k = 0; k < K; ++k) {
             if (k >= count) continue;
             bool r = false;
             nearest[first + k] = policy.finish(bvh, k, pk, r);
@@ -241,7 +246,7 @@ __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
     // Every thread stays to the end: the votes and shuffles need the whole warp.
     const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     int64_t first = 0;
-    BvhPacket<T, kRunPoints> pk;
+    BvhPacket<T, Layout::kPoints> pk;
     const int count = load_packet<T>(layout, t, first, pk);
     if (band.width > 0 && band.skip_bricks) {
         Vec3<T> lo, hi;
