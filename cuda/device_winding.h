@@ -25,7 +25,6 @@ public:
         view_.view = {nodes_.get(), moments_.get(), triangle_index_.get(), mesh.vertices, mesh.triangles,
                       int(bvh.bvh->nodes.size())};
         view_.accuracy = SamplerSign::winding_options().accuracy;
-        round_moments(stream);
     }
 
     /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
@@ -36,23 +35,14 @@ public:
         if (!sign.winding()) return;
         view_.view = {nodes, moments, triangle_index, mesh.vertices, mesh.triangles, num_nodes};
         view_.accuracy = SamplerSign::winding_options().accuracy;
-        round_moments(0);
     }
 
     const WindingSignView& view() const { return view_; }
 
-    /// Whether the sides are decided float first (warp_winding_side); off when the
-    /// environment sets SDF_CUDA_WINDING_DOUBLE, the measurement baseline (the same sides).
-    static bool float_first();
-
 private:
-    /// The moments rounded to float beside the double ones (the float-first side).
-    void round_moments(cudaStream_t stream);
-
     DeviceBuffer<BvhNode> nodes_;
     DeviceBuffer<WindingNode<double>> moments_;
     DeviceBuffer<int32_t> triangle_index_;
-    DeviceBuffer<WindingNode<float>> float_moments_;
     WindingSignView view_;
 };
 

@@ -15,8 +15,6 @@ namespace sdf::cuda {
 struct WindingSignView {
     WindingView<double> view{};
     WindingAccuracy<double> accuracy{};
-    /// The moments rounded to float, one per node (null: every side is decided in double).
-    const WindingNode<float>* float_moments = nullptr;
     SDF_CPU_GPU bool enabled() const { return view.nodes != nullptr; }
 };
 
@@ -72,70 +70,6 @@ __device__ inline double warp_fast_winding_value(const WindingView<double>& v, c
         }
     }
     return value;
-}
-
-/// The side warp_fast_winding_value(w.view, p, wants, w.accuracy) > 0.5 of every lane's point,
-/// the same bit for every lane, found float first. The warp walks the same nodes as
-/// warp_fast_winding_value (far_field_float() decides far or open in double, as far_field()
-/// does), sums the leaves' solid angles with the same double code, and evaluates the far
-/// children's expansions in float (the FP64 units are the double walk's limit), adding up a
-/// bound on how far the sum can be from the double one: each float term's own bound, and
-/// 2^-50 of the running sum per addition for the two sums' roundings. Where the bound keeps
-/// the sum on one side of 1/2 that is the double value's side; the other lanes (near 1/2:
-/// holes, points on the surface, or distances float cannot hold) walk again in double. Every
-/// lane of the warp must call it; `redone` (optional) counts the lanes that walked again.
-__device__ inline bool warp_winding_side(const WindingSignView& w, const Vec3d& p, bool wants, unsigned* redone = nullptr) {
-    constexpr unsigned kWarp = 0xffffffffu;
-    if (w.float_moments == nullptr) return warp_fast_winding_value(w.view, p, wants, w.accuracy) > 0.5;
-    const WindingView<double>& v = w.view;
-    const unsigned lane_bit = 1u << (threadIdx.x & 31u);
-    double value = 0.0, error = 0.0;
-    int32_t stack_node[kBvhMaxDepth + 1];
-    unsigned stack_lanes[kBvhMaxDepth + 1];
-    stack_lanes[0] = __ballot_sync(kWarp, wants);
-    if (stack_lanes[0] == 0) return false;
-    stack_node[0] = 0;
-    int top = 1;
-    while (top > 0) {  // warp-uniform, as in warp_fast_winding_value
-        --top;
-        const int32_t node = stack_node[top];
-        const bool active = (stack_lanes[top] & lane_bit) != 0;
-        const BvhNode& n = v.nodes[node];
-        for (int c = 0; c < 2; ++c) {
-            bool open = false;
-            if (active) {
-                float term, bound;
-                if (far_field_float(v.moments[node].child[c], w.float_moments[node].child[c], p, w.accuracy, term, bound)) {
-                    value += double(term);
-                    error += double(bound) + 0x1p-50 * fabs(value);
-                } else {
-                    open = true;
-                }
-            }
-            const unsigned opened = __ballot_sync(kWarp, open);
-            if (opened == 0) continue;
-            if (bvh_child_is_leaf(n, c)) {
-                if (open) {
-                    value += leaf_winding_number(v, n.ref[c], n.count[c], p);
-                    error += 0x1p-50 * fabs(value);
-                }
-            } else {
-                SDF_DCHECK(top <= kBvhMaxDepth);
-                stack_node[top] = n.ref[c];
-                stack_lanes[top] = opened;
-                ++top;
-            }
-        }
-    }
-    bool inside = value - error > 0.5;  // rounding is monotone: only a sum above 1/2 by more than the bound passes
-    const bool again = wants && !inside && !(value + error < 0.5);
-    const unsigned lanes = __ballot_sync(kWarp, again);
-    if (lanes != 0) {
-        const double exact = warp_fast_winding_value(v, p, again, w.accuracy);
-        if (again) inside = exact > 0.5;
-        if (redone != nullptr && (threadIdx.x & 31u) == 0) atomicAdd(redone, unsigned(__popc(lanes)));
-    }
-    return inside;
 }
 
 }  // namespace sdf::cuda

@@ -95,37 +95,6 @@ SDF_CPU_GPU SDF_INLINE bool far_field(const WindingMoments<T>& m, const Vec3<T>&
     return true;
 }
 
-/// far_field_float()'s allowance for float rounding, in units of A / (4 pi d^2) (A: the
-/// child's area, d: its distance). The value's three terms are bounded by |N| <= A,
-/// |tr M| <= sqrt(3) |M|_F and |M|_F <= A r (N, M: winding_moments.h), so their absolute
-/// sum is at most (1 + (3 + sqrt 3) t) A / d^2 <= 5.8 A / d^2 (t = r / d < 1); each is
-/// evaluated in at most 32 roundings of u = 2^-24 (the float moments, y and 1/d included),
-/// so |float - double| <= 186 u A / (4 pi d^2); 512 u leaves a factor of 2.7 for the double
-/// value's own rounding and the allowance's.
-constexpr float kFarFieldFloatRounding = float(512.0 / 16777216.0);
-
-/// far_field() of the child with moments `m`, decided exactly as there (in double, the same
-/// operations: the same children are far), with the value evaluated in float from `mf`, the
-/// same moments rounded to float. `error` bounds |value - far_field(m, q, acc).value|; it is
-/// +infinity where float cannot be trusted to that bound (distances beyond 1e-10..1e10, or a
-/// value that overflowed), so that the caller decides that point in double.
-SDF_CPU_GPU SDF_INLINE bool far_field_float(const WindingMoments<double>& m, const WindingMoments<float>& mf, const Vec3d& q,
-                                            const WindingAccuracy<double>& acc, float& value, float& error) {
-    const Vec3d y = m.center - q;
-    const double d2 = length_squared(y);
-    if (!(d2 > far_limit(m, acc))) return false;
-    value = 0.0f;
-    error = INFINITY;
-    if (!(d2 > 1e-20 && d2 < 1e20)) return true;  // inv_d^5 stays a normal float within these
-    const Vec3<float> yf(float(y.x), float(y.y), float(y.z));
-    const float inv_d = 1.0f / std::sqrt(float(d2)), inv_d3 = inv_d * inv_d * inv_d;
-    value = far_field_value(mf, yf, inv_d, inv_d3, acc.order);
-    // 1e-30: an allowance for products that underflow (terms below 1e-30 in all).
-    const float bound = kFarFieldFloatRounding * inverse_four_pi<float>() * mf.area * inv_d * inv_d + 1e-30f;
-    if (std::isfinite(value) && std::isfinite(bound)) error = bound;
-    return true;
-}
-
 /// Sum of the exact solid angles of the leaf's triangles (BVH slots [first, first + count)), over 4 pi.
 template <typename T>
 SDF_CPU_GPU SDF_INLINE T leaf_winding_number(const WindingView<T>& v, int32_t first, int32_t count, const Vec3<T>& q) {

@@ -25,20 +25,4 @@ struct WindingNode {
     WindingMoments<T> child[2];
 };
 
-/// The moments rounded to float (to nearest), for the far field's float evaluation
-/// (far_field_float(), fast_winding_number.h); host and device round alike.
-SDF_CPU_GPU inline WindingNode<float> rounded_to_float(const WindingNode<double>& n) {
-    WindingNode<float> f;
-    for (int c = 0; c < 2; ++c) {
-        const WindingMoments<double>& m = n.child[c];
-        WindingMoments<float>& r = f.child[c];
-        r.center = Vec3<float>(float(m.center.x), float(m.center.y), float(m.center.z));
-        r.radius = float(m.radius);
-        r.area = float(m.area);
-        r.normal_sum = Vec3<float>(float(m.normal_sum.x), float(m.normal_sum.y), float(m.normal_sum.z));
-        for (int k = 0; k < 9; ++k) r.second[k] = float(m.second[k]);
-    }
-    return f;
-}
-
 }  // namespace sdf

@@ -15,7 +15,6 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
-#include "core/winding/winding_bvh.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/with_sign.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
@@ -184,57 +183,6 @@ TEST(FastWindingNumber, ErrorStaysWithinTheStatedBound) {
             const WindingEstimate<double> all = sign.estimate(points[i], {kInf, 2});
             EXPECT_EQ(all.error_bound, 0.0);
             EXPECT_NEAR(all.value, exact_winding(mesh, points[i]), 1e-12);
-        }
-    }
-}
-
-/// far_field_float() (the GPU's float-first side) decides far or open exactly as far_field()
-/// does, and its float value is within its stated rounding bound of the double value, for
-/// every node child of the winding BVH seen from points near and far, at both orders and
-/// several betas, on meshes scaled from 1e-5 to 1e5; distances float cannot hold get an
-/// infinite bound.
-TEST(FastWindingNumber, FloatFarFieldStaysWithinItsRoundingBound) {
-    for (const double scale : {1e-5, 1.0, 1e5, 1e12}) {
-        for (const PreparedMesh& unit : bound_meshes()) {
-            TriangleMesh scaled;
-            scaled.vertices = unit.vertices();
-            scaled.triangles = unit.triangles();
-            for (Vec3d& v : scaled.vertices) v = v * scale;
-            const PreparedMesh mesh = prepare_mesh(scaled);
-            const WindingBvh w = build_winding_bvh(mesh);
-            std::vector<WindingNode<float>> rounded;
-            for (const WindingNode<double>& n : w.moments) rounded.push_back(rounded_to_float(n));
-            std::vector<Vec3d> points = random_points(300, {-1.3, -1.3, -1.3}, {1.3, 1.3, 1.3}, 11);
-            for (const Vec3d& p : random_points(100, {-20, -20, -20}, {20, 20, 20}, 12)) points.push_back(p);
-            for (Vec3d& p : points) p = p * scale;
-            double worst = 0;
-            int64_t far = 0, unbounded = 0;
-            for (const int order : {1, 2})
-                for (const double beta : {1.2, 2.0, 3.0}) {
-                    const WindingAccuracy<double> acc{beta, order};
-                    for (const Vec3d& p : points)
-                        for (size_t node = 0; node < w.moments.size(); ++node)
-                            for (int c = 0; c < 2; ++c) {
-                                double vd = 0, bd = 0;
-                                float vf = 0, ef = 0;
-                                const bool is_far = far_field(w.moments[node].child[c], p, acc, vd, bd);
-                                ASSERT_EQ(far_field_float(w.moments[node].child[c], rounded[node].child[c], p, acc, vf, ef), is_far);
-                                if (!is_far) continue;
-                                ++far;
-                                if (std::isinf(ef)) {
-                                    ++unbounded;
-                                    continue;
-                                }
-                                const double diff = std::abs(double(vf) - vd);
-                                ASSERT_LE(diff, double(ef)) << "scale " << scale << " node " << node << " order " << order;
-                                worst = std::max(worst, diff / double(ef));
-                            }
-                }
-            std::printf("scale %g: %lld far children, %lld beyond float's range, worst |float - double| / bound %.3f\n", scale,
-                        (long long)far, (long long)unbounded, worst);
-            if (scale == 1e12) EXPECT_EQ(unbounded, far);  // distances beyond 1e10: always double
-            else EXPECT_EQ(unbounded, 0);
-            EXPECT_LT(worst, 0.5);  // the bound's margin (fast_winding_number.h: a factor of 2.7)
         }
     }
 }
