@@ -97,14 +97,31 @@ struct DeviceBvh {
     std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };
 
-/// Points per thread of the warp search over a point list (SDF_LIST_RUN: 1, 2 or 4; 4 by default).
-int list_points_per_thread() {
-    static const int run = [] {
+/// Points per thread of the warp search over `n` listed points on a GPU of `sms`
+/// multiprocessors: 4, the lattice's, where the list fills the GPU's resident warps many
+/// times over; fewer for sparser lists, whose 128-point warps leave the GPU to a few long,
+/// divergent traversals. Measured on an H200 (docs/gpu-notes.md): 1M points 6.1 -> 5.6 ms
+/// uniform, 6.9 -> 6.1 ms near the surface at 2; 16.8M points fastest at 4.
+/// SDF_LIST_RUN (1, 2 or 4) overrides the rule, for measurement.
+int list_points_per_thread(int64_t n, int sms) {
+    static const int forced = [] {
         const char* e = std::getenv("SDF_LIST_RUN");
-        const int v = e ? std::atoi(e) : kRunPoints;
-        return v == 1 || v == 2 ? v : kRunPoints;
+        const int v = e ? std::atoi(e) : 0;
+        return v == 1 || v == 2 || v == 4 ? v : 0;
     }();
-    return run;
+    if (forced) return forced;
+    const int64_t resident_warps = int64_t(sms) * kFusedMinBlocks * (kBvhThreads / 32);
+    if (n / (32 * 4) >= 16 * resident_warps) return 4;
+    if (n / (32 * 2) >= 2 * resident_warps) return 2;
+    return 1;
+}
+
+/// The current device's multiprocessors.
+int multiprocessors() {
+    int device = 0, sms = 1;
+    CUDA_CHECK(cudaGetDevice(&device));
+    CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+    return sms;
 }
 
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
@@ -637,6 +654,7 @@ private:
         int64_t step = n;
         if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
         PieceResults r(step);  // reused by every piece
+        const int run = list_points_per_thread(step, multiprocessors());
         for (int64_t begin = 0; begin < n; begin += step) {
             compute.begin();
             if (begin == 0) sort.run(mesh, device_points, sorted_points.get(), order.get());
@@ -650,7 +668,7 @@ private:
                 const ListLayout layout{list};
                 nearest_triangle_bvh_candidates<T><<<blocks_for(layout.threads(), kBvhThreads), kBvhThreads>>>(
                     dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
-            } else if (const int run = list_points_per_thread(); run == 1) {
+            } else if (run == 1) {
                 warp(ListRuns<1>{list});
             } else if (run == 2) {
                 warp(ListRuns<2>{list});

@@ -54,9 +54,20 @@ void MeshSdf::query_device(const DevicePoints& points, const DeviceQueryResults&
                                     sampler_name_ + "'");
 }
 
-void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& results) const {
+void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!unsigned_distance_) return sampler_->query_host(*mesh_, points, results);
+    const auto start = std::chrono::steady_clock::now();
+    // The sampler's timings of this call; a sampler that keeps none (the CPU's) gets the call's wall time as total.
+    auto record = [&] {
+        if (!timings) return;
+        *timings = sampler_->last_query_timings();
+        if (timings->total <= 0) timings->total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    if (!unsigned_distance_) {
+        sampler_->query_host(*mesh_, points, results);
+        record();
+        return;
+    }
     // |d| needs d's sign for the gradient's flip, also where the caller asked for no distance.
     std::vector<double> own_distance;
     HostQueryResults r = results;
@@ -65,6 +76,7 @@ void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& resul
         r.distance = own_distance.data();
     }
     sampler_->query_host(*mesh_, points, r);
+    record();
     if (!r.distance) return;
     parallel_for(points.count, int64_t(1) << 16, options_.threads, [&](int64_t b, int64_t e) {
         for (int64_t i = b; i < e; ++i)

@@ -61,8 +61,9 @@ public:
     /// Samples points in the caller's host arrays (a NumPy array's buffer), writing the
     /// results into the caller's columns in input order (core/sampling/host_query.h): bit for
     /// bit query()'s, with no conversion in between (the GPU sampler streams both through
-    /// pinned buffers). With unsigned_distance, |d| and the matching gradient.
-    void query_host(const HostPoints& points, const HostQueryResults& results) const;
+    /// pinned buffers). With unsigned_distance, |d| and the matching gradient. `timings`
+    /// (optional) receives the sampler's timings of this call (kernel, transfers, total).
+    void query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings = nullptr) const;
     /// Samples every point of the lattice; with unsigned_distance, |d| everywhere.
     SampledField sample(const Lattice& lattice) const;
 

@@ -66,6 +66,7 @@ class QueryResult:
     winding: Optional[ArrayF]
     sign: str
     sampler: str
+    timings_seconds: Dict[str, float]
     def __len__(self) -> int: ...
 
 class DeviceQueryResult:

@@ -34,6 +34,7 @@ struct QueryResult {
     std::shared_ptr<const MeshSdf> sdf;
     PointsView points;
     py::object closest_point = py::none(), barycentric = py::none();
+    SamplingTimings timings;
 
     void compute_closest_points() {
         if (!closest_point.is_none()) return;
@@ -76,7 +77,7 @@ QueryResult query_bound(const std::shared_ptr<const MeshSdf>& sdf, const py::obj
     task.label = "querying '" + sdf->mesh().name() + "'";
     task.progress = progress;
     std::vector<double> winding_numbers = run_task([&] {
-        sdf->query_host(points, columns);
+        sdf->query_host(points, columns, &q.timings);
         if (!winding) return std::vector<double>{};
         return sdf->winding_numbers(gather_points(points, "points", sdf->options().threads), sdf->options().threads);
     }, task);
@@ -129,6 +130,15 @@ void bind_query(py::module_& m) {
         .def_readonly("sign", &QueryResult::sign,
                       "The sign mode actually used: 'pseudonormal', 'winding' (sign='auto' resolved for the mesh) or 'none'.")
         .def_readonly("sampler", &QueryResult::sampler, "The sampler that computed them, e.g. 'cpu/bvh/brick'.")
+        .def_property_readonly("timings_seconds", [](const QueryResult& r) {
+            py::dict d;
+            d["total"] = r.timings.total;
+            d["kernel"] = r.timings.kernel;
+            d["upload"] = r.timings.upload;
+            d["download"] = r.timings.download;
+            return d;
+        }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
+           "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (CPU).")
         .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
         .def("__repr__", &query_repr);
 

@@ -36,22 +36,23 @@ def test_user_wait_measures_the_cpu_rows_and_names_the_rest(tmp_path):
     box = tmp_path / "box.obj"
     box.write_text("".join("v %d %d %d\n" % v for v in BOX) + "".join("f %d %d %d\n" % (a + 1, b + 1, c + 1)
                                                                         for a, b, c in BOX_FACES))
-    rows = "sample_1024,python_sample,query_1_point,experiment,render"
+    rows = "sample_1024,python_sample,python_query_16m,query_1_point,experiment,render"
     r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "user-wait"), "--build", os.environ["SDF_BUILD_DIR"],
                         "--rows", rows, "--backend", "cpu", "--resolution", "16", "--python-resolution", "8",
-                        "--render-mesh", str(box), "--query-calls", "50", "--results", str(tmp_path / "results" / "user_wait")],
+                        "--render-mesh", str(box), "--query-calls", "50", "--query-points", "1000", "--results", str(tmp_path / "results" / "user_wait")],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     (path,) = (tmp_path / "results" / "user_wait").glob("*/user_wait.json")
     run = user_wait.read_run(str(path))
     by_id = {row["id"]: row for row in run["rows"]}
     assert list(by_id) == rows.split(",")
-    for name in ("sample_1024", "python_sample", "query_1_point", "experiment", "render"):
+    for name in ("sample_1024", "python_sample", "python_query_16m", "query_1_point", "experiment", "render"):
         row = by_id[name]
         assert row["status"] == "measured", row
         assert row["wall_seconds"] > 0
     assert by_id["sample_1024"]["details"]["points"] == 16 ** 3 and by_id["sample_1024"]["details"]["backend"] == "cpu"
     assert by_id["python_sample"]["details"]["points"] == 8 ** 3
+    assert by_id["python_query_16m"]["details"]["points"] == 1000 and by_id["python_query_16m"]["kernel_seconds"] is None
     assert by_id["experiment"]["details"]["points"] == 48 ** 3 and by_id["experiment"]["details"]["method"] == "bvh"
     assert by_id["render"]["details"]["method"] == "bvh" and by_id["render"]["kernel_seconds"] > 0
     assert by_id["query_1_point"]["kernel_seconds"] is None and by_id["query_1_point"]["details"]["calls"] == 50
