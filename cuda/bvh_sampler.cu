@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <future>
 #include <stdexcept>
 #include <string>
 
@@ -225,7 +226,16 @@ public:
         if (results.distance) columns.distance = grow(host_query_distance_, n);
         if (results.gradient) columns.gradient = grow(host_query_gradient_, 3 * n);
         if (results.triangle) columns.triangle = grow(host_query_triangle_, n);
-        query_device(mesh, on_device, columns);
+        {
+            // The caller's result arrays are mapped on other threads while the device searches.
+            std::future<void> mapped = std::async(std::launch::async, [&] {
+                if (results.distance) StagedCopy::map_pages(results.distance, n * sizeof(double));
+                if (results.gradient) StagedCopy::map_pages(results.gradient, 3 * n * sizeof(double));
+                if (results.triangle) StagedCopy::map_pages(results.triangle, n * sizeof(int32_t));
+            });
+            query_device(mesh, on_device, columns);
+            mapped.get();
+        }
         const auto searched = std::chrono::steady_clock::now();
         if (results.distance) staged_.to_host(columns.distance, results.distance, n * sizeof(double));
         if (results.gradient) staged_.to_host(columns.gradient, results.gradient, 3 * n * sizeof(double));

@@ -68,6 +68,19 @@ public:
         }
     }
 
+    /// Maps the pages of host memory that to_host() will write, by writing a byte in each, on a
+    /// few threads: a new NumPy array's pages are mapped at their first write, which costs
+    /// more than the copy itself (about 50 against 25 ms for 600 MB). Meant to run on another
+    /// thread while the device computes what will be copied there.
+    static void map_pages(void* host, size_t bytes) {
+        constexpr int64_t kPage = 4096, kBlock = int64_t(16) << 20;
+        char* p = static_cast<char*>(host);
+        const int threads = std::min(8, resolve_thread_count(0));
+        parallel_for(int64_t(bytes), kBlock, threads, [&](int64_t b, int64_t e) {
+            for (int64_t i = b; i < e; i += kPage) p[i] = 0;
+        });
+    }
+
 private:
     /// The events, made at the first copy: on the caller's device then (its sampler has set
     /// it), not on whichever device was current when the sampler was made.
