@@ -138,7 +138,7 @@ void bind_query(py::module_& m) {
             d["download"] = r.timings.download;
             return d;
         }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
-           "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (CPU).")
+           "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (the CPU's, CUDA brute force).")
         .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
         .def("__repr__", &query_repr);
 

@@ -199,12 +199,14 @@ def test_cuda_query_equals_sdf_query_and_the_cpu(tmp_path, method):
     assert same_bits(r.gradient, np.ascontiguousarray(rows[:, 1:4]))
     cpu = sl.query(mesh, p, backend="cpu", method=method)
     assert np.max(np.abs(r.distance - cpu.distance)) < 1e-12
-    t = r.timings_seconds  # the GPU's own clocks: device time within the call's wall time
-    assert 0 < t["kernel"] <= t["total"] and t["upload"] > 0 and t["download"] > 0
+    t = r.timings_seconds  # the BVH sampler's own clocks: device time within the call's wall time
+    assert t["total"] > 0
+    if method == "bvh":
+        assert 0 < t["kernel"] <= t["total"] and t["upload"] > 0 and t["download"] > 0
 
 
 def test_query_timings_on_the_cpu():
-    t = sl.query(sl.load_mesh("shape:torus"), random_points(1000, -1.6, 1.6, seed=3)).timings_seconds
+    t = sl.query(sl.load_mesh("shape:torus"), random_points(1000, -1.6, 1.6, seed=3), backend="cpu").timings_seconds
     assert set(t) == {"total", "kernel", "upload", "download"}
     assert t["total"] > 0 and t["kernel"] == 0 and t["upload"] == 0 and t["download"] == 0
 
