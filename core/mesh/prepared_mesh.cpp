@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "core/bvh/search_bound.h"
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/exact_predicates.h"
 #include "core/mesh/self_intersections.h"
@@ -230,6 +231,8 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
     out.float_buffers_ = make_buffers<float>(out);
     out.double_buffers_ = make_buffers<double>(out);
+    out.search_bound_ = float_search_bound(out.double_buffers_->vertices, out.double_buffers_->triangles,
+                                           out.double_buffers_->packed, out.float_buffers_->packed);
 
     if (options.detect_intersections && !out.triangles_.empty()) {
         // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.

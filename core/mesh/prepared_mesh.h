@@ -12,6 +12,7 @@
 
 #include "core/mesh/triangle_mesh.h"
 #include "kernels/distance/mesh_view.h"
+#include "kernels/distance/search_certificate.h"
 
 namespace sdf {
 
@@ -105,6 +106,10 @@ public:
     template <typename T>
     const MeshBuffers<T>& buffers() const;
 
+    /// The float search's per-mesh bound constants (core/bvh/search_bound.h), computed with
+    /// the buffers: every certified float search and every tree's build reads them here.
+    const FloatSearchBound& search_bound() const { return search_bound_; }
+
     /// The BVH of the triangles (binned SAH with the default BvhBuildOptions, the one set
     /// every sampler uses; a tree with other options is build_triangle_bvh(mesh, options),
     /// its caller's). Built at most once per mesh and its copies: by prepare_mesh() when it
@@ -131,6 +136,7 @@ private:
     // Shared, so that copies of a prepared mesh share one set of buffers.
     std::shared_ptr<const MeshBuffers<float>> float_buffers_;
     std::shared_ptr<const MeshBuffers<double>> double_buffers_;
+    FloatSearchBound search_bound_;
     /// The BVH, built on first use under the lock; shared by copies like the buffers (a
     /// mutex cannot be copied or moved, a pointer to one can).
     struct BvhSlot {

@@ -4,10 +4,7 @@
 #include <cmath>
 
 namespace sdf {
-FloatSearchBound float_search_bound(const PreparedMesh& mesh) {
-    const MeshBuffers<double>& d = mesh.buffers<double>();
-    return float_search_bound(d.vertices, d.triangles, d.packed, mesh.buffers<float>().packed);
-}
+FloatSearchBound float_search_bound(const PreparedMesh& mesh) { return mesh.search_bound(); }
 
 CertificateReport certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters) {
     CertificateReport c;

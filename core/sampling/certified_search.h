@@ -18,7 +18,8 @@
 namespace sdf {
 
 /// The constants of the float error bound of `mesh`: the smallest sin^2 of an angle of its
-/// non-sliver triangles, its longest |E0| + |E1| and its largest |coordinate|.
+/// non-sliver triangles, its longest |E0| + |E1| and its largest |coordinate| (made with the
+/// mesh: PreparedMesh::search_bound()).
 FloatSearchBound float_search_bound(const PreparedMesh& mesh);
 
 /// Largest |coordinate| of p.
