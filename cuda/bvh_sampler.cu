@@ -310,10 +310,11 @@ private:
         device_float_.reset();
         device_double_.reset();
         upload.begin();
-        std::unique_ptr<DeviceLbvh> lbvh;
-        auto dmesh = DeviceMesh<double>::upload_during(mesh.buffers<double>(), [&](const DeviceMesh<double>& on_device) {
-            lbvh = build_lbvh_on_device(mesh, on_device.view().vertices, on_device.view().triangles);
-        });
+        // The whole mesh first: its normals' copy from pageable memory beside the build (another
+        // host thread, another stream) made the build 1.5-2 ms slower and the first call no
+        // faster (H100, docs/gpu-notes.md).
+        auto dmesh = std::make_unique<DeviceMesh<double>>(mesh.buffers<double>());
+        std::unique_ptr<DeviceLbvh> lbvh = build_lbvh_on_device(mesh, dmesh->view().vertices, dmesh->view().triangles);
         if (!lbvh || !lbvh->within_depth) {
             upload.end();
             device_build_skipped_ = lbvh ? "the device tree is deeper than kBvhMaxDepth = " + std::to_string(kBvhMaxDepth) +
