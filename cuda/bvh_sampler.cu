@@ -117,6 +117,19 @@ int list_points_per_thread(int64_t n, int sms) {
     return 1;
 }
 
+/// The largest |coordinate| of `points` (the certified search's bound needs it), on a few threads.
+double largest_coordinate_of(const std::vector<Vec3d>& points) {
+    constexpr int64_t kChunk = int64_t(1) << 18;
+    const int64_t n = int64_t(points.size());
+    std::vector<double> largest(size_t((n + kChunk - 1) / kChunk), 0.0);
+    parallel_for(n, kChunk, std::min(8, resolve_thread_count(0)), [&](int64_t b, int64_t e) {
+        double m = 0;
+        for (int64_t i = b; i < e; ++i) m = std::max(m, largest_coordinate(points[size_t(i)]));
+        largest[size_t(b / kChunk)] = m;
+    });
+    return largest.empty() ? 0.0 : *std::max_element(largest.begin(), largest.end());
+}
+
 /// The current device's multiprocessors.
 int multiprocessors() {
     int device = 0, sms = 1;
@@ -442,17 +455,22 @@ private:
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
-        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
+        require_search_range(mesh, lattice, options_.precision);
         // Results made on the device in the field's own layout (the stored path with float64
         // channels, stored_output.cuh) and copied once through pinned buffers straight into the
         // field's arrays: no per-piece pageable copy, no host scatter. A slab whose channels do
         // not fit a quarter of the free device memory takes the per-piece path below.
-        const int64_t points = int64_t(field.distance.size());
+        const int64_t points = slab_point_count(lattice, slab);
         const StoredLayout layout{false, true, true};
         const size_t free_bytes = free_device_memory();
         if (points > 0 && double(points) * double(layout.bytes_per_point()) <= 0.25 * double(free_bytes)) {
+            // The field's host arrays (each page mapped at its first write) are made on other
+            // threads while the device computes.
+            std::future<SampledField> made =
+                std::async(std::launch::async, [&] { return unfilled_field(mesh, lattice, slab, options_.precision); });
             const StoredChannels<double> out = stored_buffers_.device_channels<double>(points, layout, dev.source_triangle.get());
             const auto [computed, pieces] = store_blocks<T, double>(dev, lattice, slab, out, compute);
+            SampledField field = made.get();
             download.begin();
             const size_t n = size_t(points);
             staged_.to_host(out.distance, field.distance.data(), n * sizeof(double));
@@ -464,6 +482,7 @@ private:
             if (options_.band_width > 0) field.sampler.band = band_provenance(mesh, count_narrow_band(field));
             return field;
         }
+        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
         auto sink = [&](const PieceResults& r, int64_t count) {
             download.begin();
             const HostPieceResults h = r.download(count);
@@ -569,20 +588,21 @@ private:
     /// output_index sends every result back to its input position.
     template <typename T>
     std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
-        std::vector<PointSample> out(points.size());
-        if (points.empty()) return out;
+        if (points.empty()) return {};
         EventTimer upload, compute, download;
         bool built = false, uploaded = false;
         const DeviceBvh<T>& dev = device_bvh<T>(mesh, built, uploaded, upload);
         const auto start = std::chrono::steady_clock::now();
         const int64_t n = int64_t(points.size());
+        // The result vector (40 bytes a point, each page mapped at its first write) is made on
+        // another thread while the points go up and the device searches.
+        std::future<std::vector<PointSample>> made = std::async(std::launch::async, [n] { return std::vector<PointSample>(size_t(n)); });
         DeviceBuffer<Vec3d> device_points{size_t(n)};
         upload.begin();
-        device_points.upload(points);
+        staged_.to_device(points.data(), device_points.get(), size_t(n) * sizeof(Vec3d));
         upload.end();
         DeviceBuffer<PointSample> device_out{size_t(n)};
-        double coordinate = 0;
-        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const double coordinate = largest_coordinate_of(points);
         CertificateCounters certificate;
         search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
             store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(),
@@ -590,8 +610,9 @@ private:
             CUDA_CHECK_LAUNCH("store_point_samples");
         });
         // The results are in input order on the device already: one copy, no host scatter.
+        std::vector<PointSample> out = made.get();
         download.begin();
-        device_out.download(out.data(), out.size());
+        staged_.to_host(device_out.get(), out.data(), out.size() * sizeof(PointSample));
         download.end();
         record_query_timings(mesh, n, upload, compute, download, start);
         record_certificate(query_timings_, certificate);
