@@ -40,8 +40,9 @@ public:
             const int b = int(k % 2);
             const size_t n = std::min(kChunkBytes, bytes - offset);
             if (k >= 2) CUDA_CHECK(cudaEventSynchronize(done_[b]));  // the bus is done with this buffer
-            host_copy(buffer(b), from + offset, n);
-            CUDA_CHECK(cudaMemcpyAsync(to + offset, buffer(b), n, cudaMemcpyHostToDevice, 0));
+            char* staging = buffer(b, n);
+            host_copy(staging, from + offset, n);
+            CUDA_CHECK(cudaMemcpyAsync(to + offset, staging, n, cudaMemcpyHostToDevice, 0));
             CUDA_CHECK(cudaEventRecord(done_[b], 0));
         }
         CUDA_CHECK(cudaStreamSynchronize(0));
@@ -55,15 +56,14 @@ public:
         const size_t chunks = (bytes + kChunkBytes - 1) / kChunkBytes;
         for (size_t k = 0; k <= chunks; ++k) {
             if (k < chunks) {  // chunk k starts on the bus ...
-                const size_t offset = k * kChunkBytes;
-                CUDA_CHECK(cudaMemcpyAsync(buffer(int(k % 2)), from + offset, std::min(kChunkBytes, bytes - offset),
-                                           cudaMemcpyDeviceToHost, 0));
+                const size_t offset = k * kChunkBytes, n = std::min(kChunkBytes, bytes - offset);
+                CUDA_CHECK(cudaMemcpyAsync(buffer(int(k % 2), n), from + offset, n, cudaMemcpyDeviceToHost, 0));
                 CUDA_CHECK(cudaEventRecord(done_[k % 2], 0));
             }
             if (k >= 1) {  // ... while chunk k-1 goes to the caller
                 const size_t j = k - 1, offset = j * kChunkBytes;
                 CUDA_CHECK(cudaEventSynchronize(done_[j % 2]));
-                host_copy(to + offset, buffer(int(j % 2)), std::min(kChunkBytes, bytes - offset));
+                host_copy(to + offset, pinned_[j % 2]->get(), std::min(kChunkBytes, bytes - offset));
             }
         }
     }
@@ -89,8 +89,14 @@ private:
             if (!e) CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
     }
 
-    char* buffer(int b) {
-        if (!pinned_[b]) pinned_[b] = std::make_unique<PinnedBytes>(kChunkBytes);
+    /// Buffer b, at least `need` bytes (at most a chunk): as large as the largest chunk so far,
+    /// so that a small copy (a query of a few points) does not pin 64 MB, which takes 15 ms.
+    char* buffer(int b, size_t need) {
+        constexpr size_t kSmallest = size_t(64) << 10;
+        if (!pinned_[b] || pinned_[b]->size() < need) {
+            pinned_[b].reset();
+            pinned_[b] = std::make_unique<PinnedBytes>(std::min(kChunkBytes, std::max(need, kSmallest)));
+        }
         return pinned_[b]->get();
     }
 
