@@ -183,7 +183,8 @@ LbvhBuild build_lbvh(const BvhBuildInput& mesh, const Bounds3& box, const GpuBvh
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     out.within_depth = depth <= kBvhMaxDepth;
     // The search bound, as build_triangle_bvh() keeps it (the double view's pruning margin).
-    bvh.float_bound = float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
+    bvh.float_bound = mesh.search_bound ? *mesh.search_bound
+                                       : float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
     return out;
 }
 

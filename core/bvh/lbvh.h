@@ -52,7 +52,7 @@ LbvhBuild build_lbvh(const BvhBuildInput& input, const Bounds3& mesh_box, const 
 template <class Mesh>
 LbvhBuild build_lbvh(const Mesh& mesh, const GpuBvhBuildOptions& options = {}) {
     return build_lbvh(BvhBuildInput{mesh.vertices(), mesh.triangles(), mesh.template buffers<float>().packed,
-                                    mesh.template buffers<double>().packed, mesh.name()},
+                                    mesh.template buffers<double>().packed, mesh.name(), &mesh.search_bound()},
                       mesh.bounds(), options);
 }
 

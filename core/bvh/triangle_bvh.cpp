@@ -262,7 +262,8 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
                                     std::to_string(options.max_leaf_size) + " and " + std::to_string(options.bins));
     const auto start = std::chrono::steady_clock::now();
     TriangleBvh bvh;
-    bvh.float_bound = float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
+    bvh.float_bound = mesh.search_bound ? *mesh.search_bound
+                                       : float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
     std::vector<BuildRef> refs = build_refs(mesh);
     const int n = int(refs.size());
     bvh.nodes.reserve(size_t(2 * n / std::max(1, options.max_leaf_size) + 1));

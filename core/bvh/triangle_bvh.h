@@ -58,17 +58,20 @@ struct BvhBuildInput {
     const std::vector<PackedTriangle<float>>& packed_float;    ///< one per triangle, in triangle order
     const std::vector<PackedTriangle<double>>& packed_double;
     const std::string& name;  ///< for messages
+    /// The float search's bound of these arrays where the caller has it already (a prepared
+    /// mesh makes it once: PreparedMesh::search_bound()); null: the build computes it.
+    const FloatSearchBound* search_bound = nullptr;
 };
 
 /// Builds the BVH of the triangles (throws std::invalid_argument for an empty mesh).
 TriangleBvh build_triangle_bvh(const BvhBuildInput& input, const BvhBuildOptions& options = {});
 
-/// The BVH of a PreparedMesh (or anything with its vertices(), triangles(), buffers<T>() and
-/// name()); a template only so that this layer needs no include of core/mesh.
+/// The BVH of a PreparedMesh (or anything with its vertices(), triangles(), buffers<T>(), name()
+/// and search_bound()); a template only so that this layer needs no include of core/mesh.
 template <class Mesh>
 TriangleBvh build_triangle_bvh(const Mesh& mesh, const BvhBuildOptions& options = {}) {
     return build_triangle_bvh(BvhBuildInput{mesh.vertices(), mesh.triangles(), mesh.template buffers<float>().packed,
-                                            mesh.template buffers<double>().packed, mesh.name()},
+                                            mesh.template buffers<double>().packed, mesh.name(), &mesh.search_bound()},
                               options);
 }
 

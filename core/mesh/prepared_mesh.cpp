@@ -231,8 +231,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
     out.float_buffers_ = make_buffers<float>(out);
     out.double_buffers_ = make_buffers<double>(out);
-    out.search_bound_ = float_search_bound(out.double_buffers_->vertices, out.double_buffers_->triangles,
-                                           out.double_buffers_->packed, out.float_buffers_->packed);
+    out.search_bound_ = float_search_bound(out.vertices_, out.triangles_, out.double_buffers_->packed, out.float_buffers_->packed);
 
     if (options.detect_intersections && !out.triangles_.empty()) {
         // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.
