@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/bvh/search_bound.h"
+#include "core/parallel/parallel_for.h"
 #include "kernels/core/directed_rounding.h"
 
 namespace sdf {
@@ -34,8 +35,12 @@ double surface_area(const Bounds3& b) {
     return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+/// a grown by b. For a nonempty b (b.min <= b.max) this has the bits of a.extend(b.min) then
+/// a.extend(b.max): the comparisons keep the later of equal values (+0 after -0), and b's
+/// corners, where equal on an axis, are the same bits. Every merge order below is the order
+/// of the refs, so a box is the same bits however the work is split (parallel_bins()).
 Bounds3 merged(Bounds3 a, const Bounds3& b) {
-    if (!b.empty()) { a.extend(b.min); a.extend(b.max); }
+    if (!b.empty()) { a.min = component_min(a.min, b.min); a.max = component_max(a.max, b.max); }
     return a;
 }
 
@@ -67,16 +72,62 @@ struct Split {
     double cost = std::numeric_limits<double>::infinity();
 };
 
+/// The bins of the three axes over a range of refs: each bin's box and count, made when its
+/// first ref arrives (`used`), so that a small node pays neither for clearing every bin nor
+/// for looking at every bin in sweep().
+struct Bins {
+    BinSlot box[3][kMaxBins];
+    int count[3][kMaxBins];
+    uint64_t used[3] = {0, 0, 0};  ///< bit b: bin b holds a ref
+};
+
+/// Where the centroids of a node lie, per axis, for its bins.
+struct BinGrid {
+    bool active[3];
+    double lo[3], extent[3];
+};
+
+/// Refs of a node above which its box and bins are computed on several threads, in chunks of
+/// kBinChunk refs, and merged in chunk order (the order of the refs, so the same bits).
+constexpr int kParallelBinning = 8192;
+constexpr int kBinChunk = 8192;
+/// Fewest refs a subtree task gets (below it a task costs less than starting one).
+constexpr int kMinTaskRefs = 2048;
+/// Refs of a node from which its refs are binned into two sets of bins (bin_range()).
+constexpr int kTwoBinSets = 256;
+
+/// A subtree below the top of the tree, built on its own by one thread into its own nodes,
+/// numbered from 0 in pre-order like the whole tree's (its root, an inner node, is 0).
+struct SubtreeTask {
+    int begin = 0, end = 0, depth = 0;
+    std::vector<BvhNode> nodes;
+    BvhBuildStats stats;
+};
+
+/// Marks a child of a top node whose subtree is a task (BuiltChild::ref: the task's index);
+/// a built child's count is never negative.
+constexpr int32_t kTaskChild = -1;
+
+/// Top-down binned SAH. With `tasks` set (the top of the tree), nodes of more than
+/// kParallelBinning refs bin on several threads and nodes of at most `grain` refs become
+/// SubtreeTasks, built afterwards on all threads and spliced in (build_triangle_bvh). Every
+/// split is the one the one-threaded recursion makes, so the tree is the same bytes at any
+/// thread count (tests/cpu_reference/bvh/sah_build_test.cpp).
 class Builder {
 public:
-    Builder(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& nodes)
-        : refs_(refs), o_(o), stats_(stats), nodes_(nodes) {}
+    Builder(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& nodes,
+            std::vector<SubtreeTask>* tasks = nullptr, int grain = 0, int threads = 1)
+        : refs_(refs), o_(o), stats_(stats), nodes_(nodes), tasks_(tasks), grain_(grain), threads_(threads) {}
 
     BuiltChild build(int begin, int end, int depth) {
         Bounds3 box, centroids;
-        for (int i = begin; i < end; ++i) { box = merged(box, refs_[size_t(i)].box); centroids.extend(refs_[size_t(i)].centroid); }
+        bounds(begin, end, box, centroids);
         const int count = end - begin;
         if (count <= o_.max_leaf_size) return leaf(box, begin, count);
+        if (tasks_ && count <= grain_) {
+            tasks_->push_back({begin, end, depth, {}, {}});
+            return {box, int32_t(tasks_->size() - 1), kTaskChild};
+        }
         // Leaves are small (GPU-friendly); SAH only chooses where to split.
         int mid = -1;
         if (depth < o_.median_split_depth) {
@@ -88,6 +139,17 @@ public:
     }
 
 private:
+    bool parallel(int count) const { return tasks_ && threads_ > 1 && count > kParallelBinning; }
+
+    /// The node's box and the box of its refs' centroids (one thread: a pass this short
+    /// gains nothing from more).
+    void bounds(int begin, int end, Bounds3& box, Bounds3& centroids) const {
+        for (int i = begin; i < end; ++i) {
+            box = merged(box, refs_[size_t(i)].box);
+            centroids.extend(refs_[size_t(i)].centroid);
+        }
+    }
+
     BuiltChild leaf(const Bounds3& box, int begin, int count) {
         ++stats_.leaves;
         stats_.largest_leaf = std::max(stats_.largest_leaf, count);
@@ -107,38 +169,88 @@ private:
         return {box, index, 0};
     }
 
+    /// Bins refs [begin, end) on every active axis into `bins` (whose boxes start unmade: a
+    /// bin's box is made empty when its first ref arrives, so that a small node does not pay
+    /// for clearing every bin), and keeps each ref's bins for partition().
+    void bin_range(int begin, int end, const BinGrid& g, Bins& bins) const {
+        const int n_bins = o_.bins;
+        const auto add = [&](int i, Bins& to) {
+            BuildRef& r = refs_[size_t(i)];
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!g.active[axis]) continue;
+                const int b = std::clamp(int(double(n_bins) * (r.centroid[axis] - g.lo[axis]) / g.extent[axis]), 0, n_bins - 1);
+                r.bin[axis] = uint8_t(b);
+                Bounds3& bin = to.box[axis][b].box;
+                const uint64_t bit = uint64_t(1) << b;
+                if (!(to.used[axis] & bit)) {
+                    to.used[axis] |= bit;
+                    to.count[axis][b] = 1;
+                    bin = r.box;
+                } else {
+                    ++to.count[axis][b];
+                    bin = merged(bin, r.box);
+                }
+            }
+        };
+        if (end - begin < kTwoBinSets) {
+            for (int i = begin; i < end; ++i) add(i, bins);
+            return;
+        }
+        // Neighbouring refs mostly fall into the same bins, and each update of a bin's box
+        // waits for the one before it; two sets of bins, alternate refs, halve those chains.
+        // A bin's box enters the SAH through its surface area only, so the order in which
+        // it grows (which of +0 and -0 it keeps) does not matter, unlike a node's box.
+        Bins odd;
+        int i = begin;
+        for (; i + 1 < end; i += 2) { add(i, bins); add(i + 1, odd); }
+        if (i < end) add(i, bins);
+        merge_bins(bins, odd);
+    }
+
+    /// Adds the bins of `from` to `into`, whose refs came first.
+    void merge_bins(Bins& into, const Bins& from) const {
+        for (int axis = 0; axis < 3; ++axis)
+            for (uint64_t m = from.used[axis]; m != 0; m &= m - 1) {
+                const int b = __builtin_ctzll(m);
+                Bounds3& bin = into.box[axis][b].box;
+                if (into.used[axis] & (uint64_t(1) << b)) {
+                    bin = merged(bin, from.box[axis][b].box);
+                    into.count[axis][b] += from.count[axis][b];
+                } else {
+                    bin = from.box[axis][b].box;
+                    into.count[axis][b] = from.count[axis][b];
+                }
+            }
+        for (int axis = 0; axis < 3; ++axis) into.used[axis] |= from.used[axis];
+    }
+
     /// Binned SAH over the 3 axes: cost = node_cost + (A_L N_L + A_R N_R) / A. One pass
     /// bins every ref on all three axes and keeps its bins for partition(); each bin's box
     /// grows in the same order as with one pass per axis, and sweep() takes the same first
     /// minimum (tests/cpu_reference/bvh/sah_build_test.cpp checks the trees byte for byte).
     Split best_split(int begin, int end, const Bounds3& centroids, const Bounds3& box) {
-        const int bins = o_.bins;
-        bool active[3];
-        double lo[3], extent[3];
+        BinGrid g;
         for (int axis = 0; axis < 3; ++axis) {
-            active[axis] = centroids.max[axis] > centroids.min[axis];
-            lo[axis] = centroids.min[axis];
-            extent[axis] = centroids.max[axis] - lo[axis];
+            g.active[axis] = centroids.max[axis] > centroids.min[axis];
+            g.lo[axis] = centroids.min[axis];
+            g.extent[axis] = centroids.max[axis] - g.lo[axis];
         }
-        // A bin's box is made empty when its first ref arrives, so that a small node does not
-        // pay for clearing every bin (BinSlot leaves its box unconstructed).
-        BinSlot bin_box[3][kMaxBins];
-        int bin_count[3][kMaxBins] = {};
-        for (int i = begin; i < end; ++i) {
-            BuildRef& r = refs_[size_t(i)];
-            for (int axis = 0; axis < 3; ++axis) {
-                if (!active[axis]) continue;
-                const int b = std::clamp(int(double(bins) * (r.centroid[axis] - lo[axis]) / extent[axis]), 0, bins - 1);
-                r.bin[axis] = uint8_t(b);
-                Bounds3& bin = bin_box[axis][b].box;
-                if (bin_count[axis][b]++ == 0) bin = Bounds3{};
-                bin = merged(bin, r.box);
-            }
+        Bins bins;
+        if (!parallel(end - begin)) {
+            bin_range(begin, end, g, bins);
+        } else {
+            const int chunks = (end - begin + kBinChunk - 1) / kBinChunk;
+            std::vector<Bins> part(static_cast<size_t>(chunks));
+            parallel_for(chunks, 1, threads_, [&](int64_t k0, int64_t k1) {
+                for (int64_t k = k0; k < k1; ++k)
+                    bin_range(begin + int(k) * kBinChunk, std::min(end, begin + int(k + 1) * kBinChunk), g, part[size_t(k)]);
+            });
+            for (const Bins& p : part) merge_bins(bins, p);
         }
         Split best;
         const double area = surface_area(box);
         for (int axis = 0; axis < 3; ++axis)
-            if (active[axis]) sweep(axis, bin_box[axis], bin_count[axis], area, best);
+            if (g.active[axis]) sweep(axis, bins.box[axis], bins.count[axis], bins.used[axis], area, best);
         return best;
     }
 
@@ -146,10 +258,9 @@ private:
     /// An empty bin changes neither side, so a split just after one repeats the cost of the
     /// split before it, which never wins a strict `<`: only the splits just after a nonempty
     /// bin are costed, each at the first bin that makes it (the one the full sweep keeps).
-    void sweep(int axis, const BinSlot* bin_box, const int* bin_count, double area, Split& best) const {
+    void sweep(int axis, const BinSlot* bin_box, const int* bin_count, uint64_t used_bins, double area, Split& best) const {
         int used[kMaxBins], n_used = 0;
-        for (int b = 0; b < o_.bins; ++b)
-            if (bin_count[b] > 0) used[n_used++] = b;
+        for (uint64_t m = used_bins; m != 0; m &= m - 1) used[n_used++] = __builtin_ctzll(m);
         // Right-to-left for the right sides (right of split k: used bins k..), then left to right.
         double right_area[kMaxBins];
         int right_count[kMaxBins];
@@ -192,6 +303,8 @@ private:
     const BvhBuildOptions& o_;
     BvhBuildStats& stats_;
     std::vector<BvhNode>& nodes_;
+    std::vector<SubtreeTask>* tasks_;
+    int grain_, threads_;
 };
 
 std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
@@ -203,6 +316,64 @@ std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
         refs[i] = {b, b.center(), int32_t(i), {}};
     }
     return refs;
+}
+
+/// Appends top node `t` and, in pre-order, everything below it: its top children and the
+/// tasks' nodes, whose inner-child references move by where they land. Returns t's index.
+int32_t splice(const std::vector<BvhNode>& top, int32_t t, std::vector<SubtreeTask>& tasks, std::vector<BvhNode>& out) {
+    const int32_t at = int32_t(out.size());
+    out.push_back(top[size_t(t)]);
+    for (int c = 0; c < 2; ++c) {
+        const int32_t count = top[size_t(t)].count[c], ref = top[size_t(t)].ref[c];
+        int32_t moved = ref;
+        if (count == kTaskChild) {
+            std::vector<BvhNode>& nodes = tasks[size_t(ref)].nodes;
+            moved = int32_t(out.size());
+            for (BvhNode& node : nodes) {
+                for (int k = 0; k < 2; ++k)
+                    if (node.count[k] == 0 && node.ref[k] > 0) node.ref[k] += moved;
+                out.push_back(node);
+            }
+            std::vector<BvhNode>().swap(nodes);
+        } else if (count == 0 && ref > 0) {
+            moved = splice(top, ref, tasks, out);
+        }
+        out[size_t(at)].ref[c] = moved;
+        out[size_t(at)].count[c] = count == kTaskChild ? 0 : count;
+    }
+    return at;
+}
+
+/// The nodes of the whole tree in pre-order, and the root's child (a leaf if the mesh fits
+/// one). On one thread, one recursion; on several, the top of the tree first (its big nodes
+/// binned on all threads) down to subtrees of about n / (8 threads) refs, those subtrees on
+/// all threads, then spliced in pre-order.
+BuiltChild build_nodes(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats,
+                       std::vector<BvhNode>& nodes) {
+    const int n = int(refs.size());
+    const int threads = resolve_thread_count(o.threads);
+    const int grain = std::max(kMinTaskRefs, n / (8 * threads));
+    if (threads <= 1 || n <= grain) return Builder(refs, o, stats, nodes).build(0, n, 0);
+    std::vector<SubtreeTask> tasks;
+    std::vector<BvhNode> top;
+    const BuiltChild root = Builder(refs, o, stats, top, &tasks, grain, threads).build(0, n, 0);
+    if (root.count > 0) return root;  // one leaf (max_leaf_size >= n); n > grain: never a task
+    parallel_for(int64_t(tasks.size()), 1, threads, [&](int64_t k0, int64_t k1) {
+        for (int64_t k = k0; k < k1; ++k) {
+            SubtreeTask& t = tasks[size_t(k)];
+            Builder(refs, o, t.stats, t.nodes).build(t.begin, t.end, t.depth);
+        }
+    });
+    size_t total = top.size();
+    for (const SubtreeTask& t : tasks) {
+        total += t.nodes.size();
+        stats.leaves += t.stats.leaves;
+        stats.largest_leaf = std::max(stats.largest_leaf, t.stats.largest_leaf);
+        stats.depth = std::max(stats.depth, t.stats.depth);
+    }
+    nodes.reserve(total);
+    splice(top, 0, tasks, nodes);
+    return root;
 }
 
 }  // namespace
@@ -267,10 +438,9 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
     std::vector<BuildRef> refs = build_refs(mesh);
     const int n = int(refs.size());
     bvh.nodes.reserve(size_t(2 * n / std::max(1, options.max_leaf_size) + 1));
-    Builder builder(refs, options, bvh.stats, bvh.nodes);
     // Nodes are numbered in pre-order, so the root is node 0; a mesh that fits one leaf gets
     // a root with that leaf and an empty child.
-    const BuiltChild root = builder.build(0, n, 0);
+    const BuiltChild root = build_nodes(refs, options, bvh.stats, bvh.nodes);
     if (root.count > 0) {
         bvh.nodes.emplace_back();
         write_child(bvh.nodes[0], 0, root);

@@ -25,6 +25,8 @@ struct BvhBuildOptions {
     int bins = 32;                ///< SAH bins per axis
     double node_cost = 1.0;       ///< SAH cost of visiting a node, relative to one triangle test
     int median_split_depth = 32;  ///< below this depth, split at the object median (bounds the depth)
+    /// Threads of the build (0: all hardware threads). The tree does not depend on it.
+    int threads = 0;
 };
 
 struct BvhBuildStats {

@@ -6,7 +6,8 @@
 
 #include <cstdio>
 #include <cstring>
-#include <ctime>
+#include <chrono>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/load_obj.h"
 #include "core/mesh/prepared_mesh.h"
+#include "core/parallel/parallel_for.h"
 #include "core/sampling/adversarial_cases.h"
 #include "sah_build_reference.h"
 
@@ -86,18 +88,63 @@ TEST(SahBuild, SameTreeAsBeforeOnTheAdversarialCases) {
     }
 }
 
-double cpu_seconds_of_best_of_3(const std::function<void()>& f) {
+// A soup of 60,000 small triangles, a quarter of them in the plane x = 0 with +0 and -0 mixed
+// (a node's box keeps the later of two equal coordinates, so the order in which the threads'
+// parts are merged shows in the tree's bytes), built on 1, 2, 3 and 8 threads: large enough
+// for the top of the tree to bin on several threads and the rest to be split into tasks.
+TEST(SahBuild, SameTreeAtEveryThreadCountWithSignedZeros) {
+    TriangleMesh soup;
+    soup.name = "signed-zero soup";
+    soup.source = "test";
+    uint64_t state = 12345;
+    const auto uniform = [&state] {  // splitmix64, in [-1, 1)
+        state += 0x9e3779b97f4a7c15ull;
+        uint64_t z = state;
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return double((z ^ (z >> 31)) >> 11) * 0x1.0p-52 - 1.0;
+    };
+    for (int t = 0; t < 60000; ++t) {
+        const Vec3d c{uniform(), uniform(), uniform()};
+        const bool on_plane = uniform() < -0.5;
+        for (int k = 0; k < 3; ++k) {
+            Vec3d v{c.x + 0.01 * uniform(), c.y + 0.01 * uniform(), c.z + 0.01 * uniform()};
+            if (on_plane) v.x = uniform() < 0 ? -0.0 : 0.0;
+            soup.vertices.push_back(v);
+        }
+        soup.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+    }
+    MeshPreparationOptions p;
+    p.detect_intersections = false;
+    const PreparedMesh mesh = prepare_mesh(soup, p);
+    int negative_zeros = 0, positive_zeros = 0;
+    for (const Vec3d& v : mesh.vertices())
+        if (v.x == 0) ++(std::signbit(v.x) ? negative_zeros : positive_zeros);
+    ASSERT_GT(negative_zeros, 1000);
+    ASSERT_GT(positive_zeros, 1000);
+    for (int threads : {1, 2, 3, 8}) {
+        BvhBuildOptions o;
+        o.threads = threads;
+        expect_same_build(mesh, o, "threads " + std::to_string(threads));
+    }
+    BvhBuildOptions small_leaves;  // a deeper tree, more tasks
+    small_leaves.max_leaf_size = 1;
+    small_leaves.threads = 5;
+    expect_same_build(mesh, small_leaves, "leaf 1, threads 5");
+}
+
+double seconds_of_best_of_3(const std::function<void()>& f) {
     double best = 1e300;
     for (int k = 0; k < 3; ++k) {
-        const std::clock_t t0 = std::clock();
+        const auto t0 = std::chrono::steady_clock::now();
         f();
-        best = std::min(best, double(std::clock() - t0) / CLOCKS_PER_SEC);
+        best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     return best;
 }
 
-// dragon-legacy (the 100k-triangle dragon of the timings in docs/bvh.md): the same tree, and
-// both builds' CPU times printed (never asserted).
+// dragon-legacy (the 100k-triangle dragon of the timings in docs/bvh.md): the same tree on
+// 1, 2 and 3 threads, and both builds' wall times printed (never asserted).
 TEST(SahBuild, SameTreeAsBeforeOnDragonLegacyWithTimes) {
     const std::string path = test::find_data_file("dragon-legacy.obj");
     if (path.empty()) GTEST_SKIP() << "dragon-legacy.obj not in SDF_DATA_PATH";
@@ -107,10 +154,18 @@ TEST(SahBuild, SameTreeAsBeforeOnDragonLegacyWithTimes) {
     expect_same_build(mesh, BvhBuildOptions{}, "dragon-legacy");
     const BvhBuildInput in{mesh.vertices(), mesh.triangles(), mesh.buffers<float>().packed, mesh.buffers<double>().packed,
                            mesh.name()};
-    const double old_s = cpu_seconds_of_best_of_3([&] { test::reference::build_triangle_bvh_reference(in); });
-    const double new_s = cpu_seconds_of_best_of_3([&] { build_triangle_bvh(in); });
-    std::printf("dragon-legacy %zu triangles: SAH build CPU seconds (best of 3) before %.4f, now %.4f\n",
-                mesh.triangles().size(), old_s, new_s);
+    for (int threads : {1, 2, 3}) {
+        BvhBuildOptions o;
+        o.threads = threads;
+        expect_same_build(mesh, o, "dragon-legacy, threads " + std::to_string(threads));
+    }
+    const double old_s = seconds_of_best_of_3([&] { test::reference::build_triangle_bvh_reference(in); });
+    BvhBuildOptions one_thread;
+    one_thread.threads = 1;
+    const double one_s = seconds_of_best_of_3([&] { build_triangle_bvh(in, one_thread); });
+    const double all_s = seconds_of_best_of_3([&] { build_triangle_bvh(in); });
+    std::printf("dragon-legacy %zu triangles: SAH build seconds (best of 3) before %.4f, now %.4f on one thread, "
+                "%.4f on %d\n", mesh.triangles().size(), old_s, one_s, all_s, resolve_thread_count(0));
 }
 
 }  // namespace
