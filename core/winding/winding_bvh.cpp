@@ -1,8 +1,11 @@
 #include "core/winding/winding_bvh.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+
+#include "core/parallel/parallel_for.h"
 
 namespace sdf {
 namespace {
@@ -23,32 +26,49 @@ struct SlotTerms {
     Vec3d centroid;               ///< (a + b + c) / 3
 };
 
+/// Nodes of moments per task of build_winding_bvh's parallel loop.
+constexpr int64_t kNodesPerTask = 64;
+
 class MomentBuilder {
 public:
-    MomentBuilder(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<WindingNode<double>>& out)
-        : bvh_(bvh), out_(out), slots_(bvh.triangle_index.size()) {
-        for (size_t s = 0; s < slots_.size(); ++s) {
-            const Int3& t = mesh.triangles()[size_t(bvh.triangle_index[s])];
-            SlotTerms& x = slots_[s];
-            x.a = mesh.vertices()[size_t(t[0])];
-            x.b = mesh.vertices()[size_t(t[1])];
-            x.c = mesh.vertices()[size_t(t[2])];
-            x.area_normal = cross(x.b - x.a, x.c - x.a) * 0.5;
-            x.area = length(x.area_normal);
-            x.weighted_centroid = (x.a + x.b + x.c) * (x.area / 3.0);
-            x.centroid = (x.a + x.b + x.c) / 3.0;
-        }
+    MomentBuilder(const PreparedMesh& mesh, const TriangleBvh& bvh, std::vector<WindingNode<double>>& out, int threads)
+        : bvh_(bvh), out_(out), slots_(bvh.triangle_index.size()), ranges_(bvh.nodes.size()), threads_(threads) {
+        parallel_for(int64_t(slots_.size()), 4096, threads_, [&](int64_t begin, int64_t end) {
+            for (int64_t s = begin; s < end; ++s) {
+                const Int3& t = mesh.triangles()[size_t(bvh.triangle_index[size_t(s)])];
+                SlotTerms& x = slots_[size_t(s)];
+                x.a = mesh.vertices()[size_t(t[0])];
+                x.b = mesh.vertices()[size_t(t[1])];
+                x.c = mesh.vertices()[size_t(t[2])];
+                x.area_normal = cross(x.b - x.a, x.c - x.a) * 0.5;
+                x.area = length(x.area_normal);
+                x.weighted_centroid = (x.a + x.b + x.c) * (x.area / 3.0);
+                x.centroid = (x.a + x.b + x.c) / 3.0;
+            }
+        });
     }
 
-    /// Fills the moments of both children of `node`; returns the slots under it.
-    SlotRange visit(int32_t node) {
+    /// Fills the moments of both children of every node. Each child's moments are summed over
+    /// its own slots (not from its children's), so every node is independent of the others:
+    /// the slot ranges first (one walk), then all nodes on all threads, the same bits as one.
+    void run() {
+        ranges_of(0);
+        parallel_for(int64_t(bvh_.nodes.size()), kNodesPerTask, threads_, [&](int64_t begin, int64_t end) {
+            for (int64_t node = begin; node < end; ++node)
+                for (int c = 0; c < 2; ++c) out_[size_t(node)].child[c] = moments_of(ranges_[size_t(node)][c]);
+        });
+    }
+
+private:
+    /// Records the slots under both children of `node`; returns the slots under it.
+    SlotRange ranges_of(int32_t node) {
         const BvhNode& n = bvh_.nodes[size_t(node)];
         SlotRange under{INT32_MAX, INT32_MIN};
         for (int c = 0; c < 2; ++c) {
             SlotRange r{0, 0};
             if (bvh_child_is_leaf(n, c)) r = {std::max(n.ref[c], 0), std::max(n.ref[c], 0) + n.count[c]};
-            else r = visit(n.ref[c]);
-            out_[size_t(node)].child[c] = moments_of(r);
+            else r = ranges_of(n.ref[c]);
+            ranges_[size_t(node)][c] = r;
             if (r.end > r.begin) { under.begin = std::min(under.begin, r.begin); under.end = std::max(under.end, r.end); }
         }
         return under.end > under.begin ? under : SlotRange{0, 0};
@@ -84,7 +104,9 @@ private:
 
     const TriangleBvh& bvh_;
     std::vector<WindingNode<double>>& out_;
-    std::vector<SlotTerms> slots_;  ///< by BVH slot
+    std::vector<SlotTerms> slots_;                  ///< by BVH slot
+    std::vector<std::array<SlotRange, 2>> ranges_;  ///< by node: the slots under each child
+    int threads_;
 };
 
 WindingMoments<float> to_float(const WindingMoments<double>& m) {
@@ -100,15 +122,18 @@ WindingMoments<float> to_float(const WindingMoments<double>& m) {
 
 }  // namespace
 
-WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh) {
+WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, int threads) {
     const auto start = std::chrono::steady_clock::now();
     WindingBvh w;
     w.bvh = std::move(bvh);
     w.moments.resize(w.bvh->nodes.size());
-    MomentBuilder(mesh, *w.bvh, w.moments).visit(0);
+    threads = resolve_thread_count(threads);
+    MomentBuilder(mesh, *w.bvh, w.moments, threads).run();
     w.moments_float.resize(w.moments.size());
-    for (size_t i = 0; i < w.moments.size(); ++i)
-        for (int c = 0; c < 2; ++c) w.moments_float[i].child[c] = to_float(w.moments[i].child[c]);
+    parallel_for(int64_t(w.moments.size()), 1024, threads, [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i)
+            for (int c = 0; c < 2; ++c) w.moments_float[size_t(i)].child[c] = to_float(w.moments[size_t(i)].child[c]);
+    });
     w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return w;
 }

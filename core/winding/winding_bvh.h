@@ -26,8 +26,9 @@ public:
 };
 
 /// Moments of every node child of `bvh` (built from `mesh`): center, radius, area, the
-/// area-weighted normal sum and the second-order matrix. O(triangles x depth).
-WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh);
+/// area-weighted normal sum and the second-order matrix. O(triangles x depth), on `threads`
+/// threads (0: all hardware threads; the moments do not depend on it).
+WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, int threads = 0);
 
 /// Over the mesh's own BVH (PreparedMesh::bvh()).
 WindingBvh build_winding_bvh(const PreparedMesh& mesh);

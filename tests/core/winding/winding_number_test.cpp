@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "core/winding/winding_bvh.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/with_sign.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
@@ -184,6 +186,23 @@ TEST(FastWindingNumber, ErrorStaysWithinTheStatedBound) {
             EXPECT_EQ(all.error_bound, 0.0);
             EXPECT_NEAR(all.value, exact_winding(mesh, points[i]), 1e-12);
         }
+    }
+}
+
+// The moments are computed node by node on every thread; each node's sums are its own, so
+// the moments are the same bytes on 1 thread as on 3.
+TEST(FastWindingNumber, MomentsAreTheSameBytesAtEveryThreadCount) {
+    std::vector<PreparedMesh> meshes = bound_meshes();
+    meshes.push_back(prepare_mesh(make_icosphere(5, 1.0)));
+    for (const PreparedMesh& mesh : meshes) {
+        const WindingBvh one = build_winding_bvh(mesh, mesh.bvh(), 1), three = build_winding_bvh(mesh, mesh.bvh(), 3);
+        ASSERT_EQ(one.moments.size(), three.moments.size());
+        ASSERT_EQ(std::memcmp(one.moments.data(), three.moments.data(), one.moments.size() * sizeof(one.moments[0])), 0)
+            << mesh.name();
+        ASSERT_EQ(std::memcmp(one.moments_float.data(), three.moments_float.data(),
+                              one.moments_float.size() * sizeof(one.moments_float[0])),
+                  0)
+            << mesh.name();
     }
 }
 
