@@ -575,9 +575,10 @@ private:
     /// output_index sends every result back to its input position.
     template <typename T>
     std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
-        // The vector first, pageable copies: making it on another thread beside staged (pinned)
-        // copies measured slower (16.8M points, H200: 0.37 against 0.17 s), and a new sampler's
-        // pinned buffers cost a one-point query 15 ms (docs/gpu-notes.md).
+        // The vector first, pageable copies: making it on another thread while the device
+        // works measured 2.5-3x slower (16.8M points, H200: 0.30-0.39 against 0.11-0.13 s),
+        // with staged (pinned) copies too (0.37 against 0.17 s), and a new sampler's pinned
+        // buffers cost a one-point query 15 ms (docs/gpu-notes.md).
         std::vector<PointSample> out(points.size());
         if (points.empty()) return out;
         EventTimer upload, compute, download;
@@ -590,8 +591,7 @@ private:
         device_points.upload(points);
         upload.end();
         DeviceBuffer<PointSample> device_out{size_t(n)};
-        double coordinate = 0;
-        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const double coordinate = largest_coordinate(points);
         CertificateCounters certificate;
         search_points<T>(mesh, dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
             store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(),

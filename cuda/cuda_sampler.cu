@@ -350,8 +350,7 @@ private:
         if (points.empty()) return out;
         sign_.prepare(mesh);
         Engine<T> engine(mesh, options_, kernel_, sign_);
-        double coordinate = 0;
-        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const double coordinate = largest_coordinate(points);
         const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, coordinate, engine);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
