@@ -25,9 +25,9 @@ FloatSearchBound float_search_bound(const PreparedMesh& mesh);
 /// Largest |coordinate| of p.
 inline double largest_coordinate(const Vec3d& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}); }
 
-/// Largest |coordinate| of the points, on all threads for a long list (a maximum is the same
-/// whichever thread finds it).
-double largest_coordinate(const std::vector<Vec3d>& points);
+/// Largest |coordinate| of the points, on `threads` threads (0: all) for a long list (a maximum
+/// is the same whichever thread finds it).
+double largest_coordinate(const std::vector<Vec3d>& points, int threads = 0);
 
 /// Largest |coordinate| of a lattice's points.
 inline double largest_lattice_coordinate(const Lattice& lattice) {

@@ -492,8 +492,7 @@ public:
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                 out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
             };
-            double coordinate = 0;
-            for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+            const double coordinate = largest_coordinate(points, options_.threads);
             if (kernel_ == BvhKernel::Brick && points.size() < (size_t(1) << 32))  // 32-bit indices in the sort
                 evaluate_point_packets<T>(mesh, *bvh, sign_, points, options_.threads, options_.progress, coordinate, counters, emit);
             else

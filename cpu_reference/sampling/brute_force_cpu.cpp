@@ -115,8 +115,7 @@ public:
         std::vector<PointSample> out(points.size());
         sign_.prepare(mesh);
         CertificateCounters counters;
-        double coordinate = 0;
-        for (const Vec3d& p : points) coordinate = std::max(coordinate, largest_coordinate(p));
+        const double coordinate = largest_coordinate(points, options_.threads);
         auto run = [&](auto zero) {
             using T = decltype(zero);
             evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()), coordinate,
