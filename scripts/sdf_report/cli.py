@@ -23,7 +23,10 @@ experiment, or the RUN paths given (run directories or published files), all of 
 A RUN that is a scripts/user-wait record (user_wait.json) goes to the section "Where the user
 waits" instead of the records under --results (the latest per machine of those given).
 --only-section user-wait rewrites that section alone in an existing report (--output or
---publish), keeping the rest as it is (for a published report whose runs are not all on disk).
+--publish), keeping the rest as it is (for a published report whose runs are not all on disk);
+--only-section peers likewise rewrites the peers section from the peers runs given (run
+directories or published files), or else the latest ones under --results, and says so in it
+(the overview at the top keeps the runs of the last full report).
 Every run is validated against harness/schema/run_schema.json: a missing or mistyped key
 is an error naming the file and the key (--skip-invalid leaves such runs out instead).
 
@@ -33,6 +36,8 @@ directory; --publish writes the committed report, results/report/. docs/harness.
 """
 
 SECTIONS = (sampling.section, speedup.section, analytic.section, reconstruction.section, filters.section, peers.section)
+# The sections --only-section can rewrite alone, by their headings.
+SECTION_HEADINGS = {"user-wait": user_wait.HEADING, "peers": peers.HEADING}
 
 
 def parse_args(argv):
@@ -44,13 +49,15 @@ def parse_args(argv):
     ap.add_argument("--publish", action="store_true", help="write the committed report, %s" % os.path.relpath(PUBLISHED, REPO))
     ap.add_argument("--skip-invalid", action="store_true", help="leave out runs that do not match the schema (with a "
                                                                  "warning) instead of failing")
-    ap.add_argument("--only-section", choices=["user-wait"], help="rewrite only this section of the existing report "
-                                                                       "in the output directory")
+    ap.add_argument("--only-section", choices=sorted(SECTION_HEADINGS), help="rewrite only this section of the "
+                                                                              "existing report in the output directory")
     args = ap.parse_args(argv)
     args.user_wait_files = [os.path.abspath(p) for p in args.runs if user_wait.is_user_wait_file(p)]
     args.runs = [p for p in args.runs if not user_wait.is_user_wait_file(p)]
-    if args.only_section and args.runs:
-        ap.error("--only-section %s reads no experiment runs; give only user_wait.json records, or none" % args.only_section)
+    if args.only_section == "user-wait" and args.runs:
+        ap.error("--only-section user-wait reads no experiment runs; give only user_wait.json records, or none")
+    if args.only_section == "peers" and args.user_wait_files:
+        ap.error("--only-section peers reads no user_wait.json records; give peers runs, or none")
     if args.publish and args.output and os.path.abspath(args.output) != PUBLISHED:
         ap.error("--publish writes %s; do not combine it with --output %s" % (PUBLISHED, args.output))
     args.output = os.path.abspath(PUBLISHED if args.publish else args.output or LOCAL)
@@ -94,22 +101,34 @@ def build(doc, runs, args, skipped):
 
 
 def rewrite_section(args):
-    """--only-section user-wait: the section rendered anew and put in place of the old one
-    (or after the last section) in the existing report.md and index.html; the rest is kept."""
+    """--only-section: the section rendered anew and put in place of the old one (or after the
+    last section) in the existing report.md and index.html; the rest is kept."""
     paths = [os.path.join(args.output, name) for name in ("report.md", "index.html")]
     if not all(os.path.isfile(p) for p in paths):
         raise SystemExit("make-report: error: --only-section needs an existing report in %s (report.md, index.html)"
                          % args.output)
     doc = Document(args.output)
-    user_wait.section(doc, args.results, args.user_wait_files)
+    if args.only_section == "user-wait":
+        user_wait.section(doc, args.results, args.user_wait_files)
+    else:
+        runs, _ = run_loader.collect(args.results, [os.path.abspath(p) for p in args.runs], run_schema.load_schema())
+        runs = [r for r in runs if r.kind == "peers"]
+        if not runs:
+            raise SystemExit("make-report: error: --only-section peers: no peers run %s"
+                             % ("among the runs given" if args.runs else "under " + args.results))
+        peers.section(doc, runs)
+        doc.paragraph("This section was rewritten alone on %s (scripts/make-report --only-section peers) from the "
+                      "runs %s; the overview at the top lists the runs of the last full report." % (
+                          datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+                          ", ".join("%s %s" % (r.name, r.run_id) for r in runs)))
+    heading = SECTION_HEADINGS[args.only_section]
     with open(paths[0], encoding="utf-8") as f:
         markdown = f.read()
     with open(paths[1], encoding="utf-8") as f:
         page = f.read()
     new_html = doc.html("").split("<body>", 1)[1].rsplit("</body>", 1)[0].strip("\n")
-    write_text_atomically(paths[0], _replace(markdown, "\n## " + user_wait.HEADING, "\n## ", doc.markdown().rstrip("\n")))
-    write_text_atomically(paths[1], _replace(page, "\n<h2>" + user_wait.HEADING, "\n<h2>", new_html, end="\n</body>",
-                                             sep="\n"))
+    write_text_atomically(paths[0], _replace(markdown, "\n## " + heading, "\n## ", doc.markdown().rstrip("\n")))
+    write_text_atomically(paths[1], _replace(page, "\n<h2>" + heading, "\n<h2>", new_html, end="\n</body>", sep="\n"))
 
 
 def _replace(text, start, next_start, new, end=None, sep="\n\n"):
@@ -131,10 +150,10 @@ def main(argv=None):
     if args.only_section:
         try:
             rewrite_section(args)
-        except user_wait.UserWaitFileError as e:
+        except (user_wait.UserWaitFileError, run_schema.RunFileError, run_schema.SchemaFileError) as e:
             print("make-report: error: %s" % e, file=sys.stderr)
             return 1
-        print("report: the section '%s' rewritten in %s" % (user_wait.HEADING, args.output))
+        print("report: the section '%s' rewritten in %s" % (SECTION_HEADINGS[args.only_section], args.output))
         return 0
     try:
         schema = run_schema.load_schema()

@@ -73,9 +73,12 @@ def summary_table(metrics):
     return table
 
 
+HEADING = "Exact sampling against the peer libraries (BVH)"
+
+
 def section(doc, runs):
     peers_runs = [r for r in runs if r.kind == "peers"]
-    doc.heading(2, "Exact sampling against the peer libraries (BVH)")
+    doc.heading(2, HEADING)
     if not peers_runs:
         doc.note("No peers run in the results: run `run-experiment configs/peers.json` (docs/bvh.md).")
         return

@@ -1,5 +1,6 @@
 """scripts/make-report end to end: a full report from a fake results tree, where it is
 written, and its errors."""
+import json
 import os
 import re
 import subprocess
@@ -106,3 +107,31 @@ def test_no_runs_at_all(tmp_path):
     r = make_report("--results", tmp_path / "nothing", "--output", tmp_path / "report")
     assert r.returncode == 0, r.stderr
     assert "No runs found" in (tmp_path / "report" / "report.md").read_text()
+
+
+def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
+    fake_runs.full_tree(tmp_path / "results")
+    out = tmp_path / "report"
+    assert make_report("--results", tmp_path / "results", "--output", out).returncode == 0
+    # a report whose other sections cannot be regenerated: only the peers section is rewritten
+    md = (out / "report.md").read_text().replace("## Exact sampling against the peer libraries",
+                                                 "## Kept section\n\nkept text\n\n## Exact sampling against the peer libraries")
+    (out / "report.md").write_text(md)
+    later = tmp_path / "later"
+    metrics = fake_runs.peers_metrics()
+    metrics["summary"][0]["query_speedup"] = 7.25
+    run = fake_runs.write_run(later, "peers", "peers", metrics, run_id="r9")
+    for _ in range(2):  # twice: the same text
+        r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers", run)
+        assert r.returncode == 0, r.stderr
+        md = (out / "report.md").read_text()
+        html = (out / "index.html").read_text()
+        assert "kept text" in md and md.count("## Exact sampling against the peer libraries") == 1
+        with open(os.path.join(run, "manifest.json")) as f:
+            run_id = json.load(f)["run_id"]
+        assert "| 7.25 |" in md and "rewritten alone" in md and "runs peers %s;" % run_id in md
+        assert "7.25" in html and html.count("<h2>Exact sampling against the peer libraries") == 1
+        assert "## Where the user waits" in md and md.index("## Exact sampling") < md.index("## Where the user waits")
+    # no peers run: an error naming where it looked
+    r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers")
+    assert r.returncode != 0 and "no peers run under" in r.stderr
