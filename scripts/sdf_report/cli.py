@@ -25,7 +25,8 @@ waits" instead of the records under --results (the latest per machine of those g
 --only-section user-wait rewrites that section alone in an existing report (--output or
 --publish), keeping the rest as it is (for a published report whose runs are not all on disk);
 --only-section peers likewise rewrites the peers section from the peers runs given (run
-directories or published files), or else the latest ones under --results, and says so in it
+directories or published files), or else the latest run of each peers experiment under
+--results, and says so in it
 (the overview at the top keeps the runs of the last full report).
 Every run is validated against harness/schema/run_schema.json: a missing or mistyped key
 is an error naming the file and the key (--skip-invalid leaves such runs out instead).
@@ -111,7 +112,9 @@ def rewrite_section(args):
     if args.only_section == "user-wait":
         user_wait.section(doc, args.results, args.user_wait_files)
     else:
-        runs, _ = run_loader.collect(args.results, [os.path.abspath(p) for p in args.runs], run_schema.load_schema())
+        runs, _ = run_loader.collect(args.results, [os.path.abspath(p) for p in args.runs], run_schema.load_schema(),
+                                     skip_invalid=args.skip_invalid,
+                                     warn=lambda text: print("make-report: warning: " + text, file=sys.stderr))
         runs = [r for r in runs if r.kind == "peers"]
         if not runs:
             raise SystemExit("make-report: error: --only-section peers: no peers run %s"

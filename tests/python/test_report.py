@@ -121,7 +121,7 @@ def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
     metrics = fake_runs.peers_metrics()
     metrics["summary"][0]["query_speedup"] = 7.25
     run = fake_runs.write_run(later, "peers", "peers", metrics, run_id="r9")
-    for _ in range(2):  # twice: the same text
+    for _ in range(2):  # twice: still one section, in its place
         r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers", run)
         assert r.returncode == 0, r.stderr
         md = (out / "report.md").read_text()
@@ -129,7 +129,8 @@ def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
         assert "kept text" in md and md.count("## Exact sampling against the peer libraries") == 1
         with open(os.path.join(run, "manifest.json")) as f:
             run_id = json.load(f)["run_id"]
-        assert "| 7.25 |" in md and "rewritten alone" in md and "runs peers %s;" % run_id in md
+        assert "| 7.25 | 4.75 |" in md and "| 5 | 4.75 |" not in md  # the old run's summary row is gone
+        assert "rewritten alone" in md and "runs peers %s;" % run_id in md
         assert "7.25" in html and html.count("<h2>Exact sampling against the peer libraries") == 1
         assert "## Where the user waits" in md and md.index("## Exact sampling") < md.index("## Where the user waits")
     # no peers run: an error naming where it looked

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -55,6 +56,30 @@ std::vector<PointSample> query(const std::string& method, Precision precision, c
     std::vector<PointSample> out = sampler->query(mesh, points);
     if (timings) *timings = sampler->last_query_timings();
     return out;
+}
+
+// A long point list's largest |coordinate| (the bound of every certified query) is taken in
+// chunks on several threads: the same value as one pass, wherever the largest point is, with
+// infinities kept and NaN coordinates passed over as std::max passes over them.
+TEST(CertifiedSearch, LargestCoordinateOfAPointListAtEveryThreadCount) {
+    std::vector<Vec3d> points(700000);
+    for (size_t i = 0; i < points.size(); ++i)
+        points[i] = {std::sin(double(i)), -std::cos(0.5 * double(i)), 0.25 * std::sin(0.3 * double(i))};
+    const auto one_pass = [](const std::vector<Vec3d>& p) {
+        double m = 0;
+        for (const Vec3d& q : p) m = std::max(m, largest_coordinate(q));
+        return m;
+    };
+    for (const size_t at : {size_t(0), size_t(262143), size_t(262144), size_t(699999)}) {
+        std::vector<Vec3d> p = points;
+        p[at].y = -7.5;
+        p[(at + 1) % p.size()].x = std::numeric_limits<double>::quiet_NaN();
+        for (const int threads : {1, 2, 3, 0}) EXPECT_EQ(largest_coordinate(p, threads), 7.5) << at << " " << threads;
+        EXPECT_EQ(one_pass(p), 7.5);
+        p[at].z = std::numeric_limits<double>::infinity();
+        EXPECT_EQ(largest_coordinate(p, 2), std::numeric_limits<double>::infinity());
+    }
+    EXPECT_EQ(largest_coordinate(std::vector<Vec3d>{}, 2), 0.0);
 }
 
 TEST(CertifiedSearch, FloatEqualsDoubleBruteForceOnAdversarialPoints) {

@@ -89,9 +89,9 @@ TEST(SahBuild, SameTreeAsBeforeOnTheAdversarialCases) {
 }
 
 // A soup of 60,000 small triangles, a quarter of them in the plane x = 0 with +0 and -0 mixed
-// (a node's box keeps the later of two equal coordinates, so the order in which the threads'
-// parts are merged shows in the tree's bytes), built on 1, 2, 3 and 8 threads: large enough
-// for the top of the tree to bin on several threads and the rest to be split into tasks.
+// (a node's box keeps the later of two equal coordinates, so the order in which a box grows
+// shows in the tree's bytes), built on 1, 2, 3 and 8 threads: large enough for the top of the
+// tree to bin in chunks on several threads and the rest to be split into tasks.
 TEST(SahBuild, SameTreeAtEveryThreadCountWithSignedZeros) {
     TriangleMesh soup;
     soup.name = "signed-zero soup";
