@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <map>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -72,6 +71,43 @@ struct EdgeUse {
     int triangle;
     int local_edge;
     bool forward;  ///< traversed from the lower vertex id to the higher one
+};
+
+/// Every edge's uses, in the order a std::map from (smaller, larger) vertex id to the uses in
+/// triangle order would give them, without a node and a vector per edge: one array of
+/// (edge, use) sorted stably by edge. for_each(fn) calls fn(uses, count) once per edge.
+class EdgeUses {
+public:
+    explicit EdgeUses(const std::vector<Int3>& triangles) {
+        std::vector<Keyed> keyed;
+        keyed.reserve(3 * triangles.size());
+        for (size_t i = 0; i < triangles.size(); ++i)
+            for (int e = 0; e < 3; ++e) {
+                const int a = triangles[i][e], b = triangles[i][(e + 1) % 3];
+                const uint64_t key = uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b));
+                keyed.push_back({key, {int(i), e, a < b}});
+            }
+        std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& x, const Keyed& y) { return x.key < y.key; });
+        uses_.reserve(keyed.size());
+        for (size_t k = 0; k < keyed.size(); ++k) {
+            if (k == 0 || keyed[k].key != keyed[k - 1].key) first_.push_back(k);
+            uses_.push_back(keyed[k].use);
+        }
+        first_.push_back(keyed.size());
+    }
+
+    template <class Fn>
+    void for_each(Fn fn) const {
+        for (size_t g = 0; g + 1 < first_.size(); ++g) fn(&uses_[first_[g]], first_[g + 1] - first_[g]);
+    }
+
+private:
+    struct Keyed {
+        uint64_t key;
+        EdgeUse use;
+    };
+    std::vector<EdgeUse> uses_;
+    std::vector<size_t> first_;  ///< where each edge's uses begin, and the end
 };
 
 int find_root(std::vector<int>& parent, int i) {
@@ -161,21 +197,16 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.triangles_ = std::move(tris);
 
     // Edge adjacency: boundary, non-manifold and orientation checks; components.
-    std::map<std::pair<int, int>, std::vector<EdgeUse>> edges;
-    for (size_t i = 0; i < out.triangles_.size(); ++i)
-        for (int e = 0; e < 3; ++e) {
-            const int a = out.triangles_[i][e], b = out.triangles_[i][(e + 1) % 3];
-            edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
-        }
+    EdgeUses edges(out.triangles_);
     std::vector<int> parent(out.triangles_.size());
     std::iota(parent.begin(), parent.end(), 0);
-    for (const auto& [key, uses] : edges) {
-        if (uses.size() == 1) ++rep.boundary_edges;
-        if (uses.size() > 2) ++rep.nonmanifold_edges;
-        if (uses.size() == 2 && uses[0].forward == uses[1].forward) ++rep.inconsistent_edges;
-        for (size_t u = 1; u < uses.size(); ++u)
+    edges.for_each([&](const EdgeUse* uses, size_t count) {
+        if (count == 1) ++rep.boundary_edges;
+        if (count > 2) ++rep.nonmanifold_edges;
+        if (count == 2 && uses[0].forward == uses[1].forward) ++rep.inconsistent_edges;
+        for (size_t u = 1; u < count; ++u)
             parent[size_t(find_root(parent, uses[u].triangle))] = find_root(parent, uses[0].triangle);
-    }
+    });
     out.shell_of_.assign(parent.size(), -1);
     std::vector<int> shell_of_root(parent.size(), -1);
     for (size_t i = 0; i < parent.size(); ++i) {
@@ -193,12 +224,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         rep.signed_volume = -rep.signed_volume;
         rep.flipped = true;
         // Edge e of a flipped triangle is a different edge; rebuild the adjacency lookups below.
-        edges.clear();
-        for (size_t i = 0; i < out.triangles_.size(); ++i)
-            for (int e = 0; e < 3; ++e) {
-                const int a = out.triangles_[i][e], b = out.triangles_[i][(e + 1) % 3];
-                edges[{std::min(a, b), std::max(a, b)}].push_back({int(i), e, a < b});
-            }
+        edges = EdgeUses(out.triangles_);
     }
 
     // Angle-weighted pseudonormals.
@@ -218,16 +244,16 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         out.vertex_normals_[size_t(t.z)] += n * corner_angle(c, a, b);
     }
     for (Vec3d& n : out.vertex_normals_) n = normalize_or_zero(n);
-    for (const auto& [key, uses] : edges) {
+    edges.for_each([&](const EdgeUse* uses, size_t count) {
         // Each incident face contributes its normal with weight pi (the angle of a face
         // around an edge); for a manifold edge this is the normalised sum of both normals.
         Vec3d sum(0.0);
-        for (const EdgeUse& u : uses) sum += out.face_normals_[size_t(u.triangle)] * kPi;
+        for (size_t u = 0; u < count; ++u) sum += out.face_normals_[size_t(uses[u].triangle)] * kPi;
         const Vec3d n = normalize_or_zero(sum);
-        for (const EdgeUse& u : uses)
-            out.edge_normals_[3 * size_t(u.triangle) + size_t(u.local_edge)] =
-                length_squared(n) > 0 ? n : out.face_normals_[size_t(u.triangle)];
-    }
+        for (size_t u = 0; u < count; ++u)
+            out.edge_normals_[3 * size_t(uses[u].triangle) + size_t(uses[u].local_edge)] =
+                length_squared(n) > 0 ? n : out.face_normals_[size_t(uses[u].triangle)];
+    });
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
     out.float_buffers_ = make_buffers<float>(out);
     out.double_buffers_ = make_buffers<double>(out);
