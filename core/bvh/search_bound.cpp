@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#include "core/parallel/parallel_for.h"
 
 namespace sdf {
 namespace {
@@ -22,22 +25,44 @@ double rho_of(double u, double smallest_sin2) {
 
 FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles,
                                     const std::vector<PackedTriangle<double>>& packed_double,
-                                    const std::vector<PackedTriangle<float>>& packed_float) {
+                                    const std::vector<PackedTriangle<float>>& packed_float, int threads) {
     // Smallest sin^2 of the triangles each precision searches inside (pack_triangle; sb NaN:
-    // edges only). Float-only slivers carry their own bound (sliver_excess).
+    // edges only). Float-only slivers carry their own bound (sliver_excess). Minima and
+    // maxima of non-NaN values: the same whatever the chunks.
+    struct Extremes {
+        double sin2_float = 1.0, sin2_double = 1.0, longest = 0.0, coordinate = 0.0;
+    };
+    constexpr int64_t kChunk = 16384;
+    const int64_t n = int64_t(triangles.size()), nv = int64_t(vertices.size());
+    const int64_t chunks = std::max<int64_t>(1, (std::max(n, nv) + kChunk - 1) / kChunk);
+    std::vector<Extremes> part(static_cast<size_t>(chunks));
+    parallel_for(chunks, 1, threads, [&](int64_t k0, int64_t k1) {
+        for (int64_t k = k0; k < k1; ++k) {
+            Extremes& x = part[size_t(k)];
+            for (int64_t i = k * kChunk; i < std::min(n, (k + 1) * kChunk); ++i) {
+                const Int3 t = triangles[size_t(i)];
+                const Vec3d v0 = vertices[size_t(t.x)], e0 = vertices[size_t(t.y)] - v0, e1 = vertices[size_t(t.z)] - v0;
+                const double a = dot(e0, e0), b = dot(e0, e1), c = dot(e1, e1), g = a - 2.0 * b + c;
+                x.longest = std::max(x.longest, std::sqrt(a) + std::sqrt(c));
+                if (std::isnan(packed_double[size_t(i)].sb)) continue;  // a sliver: never "inside" in either precision
+                const double det = a * c - b * b;
+                const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
+                x.sin2_double = std::min(x.sin2_double, sin2);
+                if (!std::isnan(packed_float[size_t(i)].sb)) x.sin2_float = std::min(x.sin2_float, sin2);
+            }
+            for (int64_t i = k * kChunk; i < std::min(nv, (k + 1) * kChunk); ++i) {
+                const Vec3d& v = vertices[size_t(i)];
+                x.coordinate = std::max(x.coordinate, std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}));
+            }
+        }
+    });
     double sin2_float = 1.0, sin2_double = 1.0, longest = 0.0, coordinate = 0.0;
-    for (size_t i = 0; i < triangles.size(); ++i) {
-        const Int3 t = triangles[i];
-        const Vec3d v0 = vertices[size_t(t.x)], e0 = vertices[size_t(t.y)] - v0, e1 = vertices[size_t(t.z)] - v0;
-        const double a = dot(e0, e0), b = dot(e0, e1), c = dot(e1, e1), g = a - 2.0 * b + c;
-        longest = std::max(longest, std::sqrt(a) + std::sqrt(c));
-        if (std::isnan(packed_double[i].sb)) continue;  // a sliver: never "inside" in either precision
-        const double det = a * c - b * b;
-        const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
-        sin2_double = std::min(sin2_double, sin2);
-        if (!std::isnan(packed_float[i].sb)) sin2_float = std::min(sin2_float, sin2);
+    for (const Extremes& x : part) {
+        sin2_float = std::min(sin2_float, x.sin2_float);
+        sin2_double = std::min(sin2_double, x.sin2_double);
+        longest = std::max(longest, x.longest);
+        coordinate = std::max(coordinate, x.coordinate);
     }
-    for (const Vec3d& v : vertices) coordinate = std::max(coordinate, std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}));
     // pack_triangle() computes the same sin^2 in double; the margins cover its rounding.
     FloatSearchBound b;
     b.rho = rho_of(0x1p-24, sin2_float * (1.0 - 1e-6)) + rho_of(0x1p-53, sin2_double * (1.0 - 1e-6)) +

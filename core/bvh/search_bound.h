@@ -14,9 +14,10 @@
 namespace sdf {
 
 /// The smallest sin^2 of an angle of the non-sliver triangles (per precision), the longest
-/// |E0| + |E1| and the largest |coordinate|, folded into the bound's constants.
+/// |E0| + |E1| and the largest |coordinate|, folded into the bound's constants; the
+/// minima and maxima over chunks on `threads` threads (0 = all) are the one pass's.
 FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles,
                                     const std::vector<PackedTriangle<double>>& packed_double,
-                                    const std::vector<PackedTriangle<float>>& packed_float);
+                                    const std::vector<PackedTriangle<float>>& packed_float, int threads = 1);
 
 }  // namespace sdf

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <future>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/exact_predicates.h"
 #include "core/mesh/self_intersections.h"
+#include "core/parallel/parallel_for.h"
 
 namespace sdf {
 namespace {
@@ -74,26 +76,48 @@ struct EdgeUse {
 };
 
 /// Every edge's uses, in the order a std::map from (smaller, larger) vertex id to the uses in
-/// triangle order would give them, without a node and a vector per edge: one array of
-/// (edge, use) sorted stably by edge. for_each(fn) calls fn(uses, count) once per edge.
+/// triangle order would give them, without a node and a vector per edge: one array of uses
+/// ordered by edge. for_each(fn) calls fn(uses, count) once per edge.
+///
+/// The order is a stable sort by (smaller, larger) id, made as a counting sort by the smaller
+/// id (a pass in triangle order, so each vertex's uses stay in triangle order) and then an
+/// insertion sort of each vertex's few uses by the larger id (stable too): O(n) instead of
+/// a merge sort of 3n keys.
 class EdgeUses {
 public:
-    explicit EdgeUses(const std::vector<Int3>& triangles) {
-        std::vector<Keyed> keyed;
-        keyed.reserve(3 * triangles.size());
+    EdgeUses(const std::vector<Int3>& triangles, int num_vertices, int threads) {
+        const size_t n = 3 * triangles.size();
+        std::vector<uint32_t> start(size_t(num_vertices) + 1, 0);
+        for (const Int3& t : triangles)
+            for (int e = 0; e < 3; ++e) ++start[size_t(std::min(t[e], t[(e + 1) % 3])) + 1];
+        for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+        std::vector<Sorted> sorted(n);
+        std::vector<uint32_t> next(start.begin(), start.end() - 1);
         for (size_t i = 0; i < triangles.size(); ++i)
             for (int e = 0; e < 3; ++e) {
                 const int a = triangles[i][e], b = triangles[i][(e + 1) % 3];
-                const uint64_t key = uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b));
-                keyed.push_back({key, {int(i), e, a < b}});
+                sorted[next[size_t(std::min(a, b))]++] = {std::max(a, b), {int(i), e, a < b}};
             }
-        std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& x, const Keyed& y) { return x.key < y.key; });
-        uses_.reserve(keyed.size());
-        for (size_t k = 0; k < keyed.size(); ++k) {
-            if (k == 0 || keyed[k].key != keyed[k - 1].key) first_.push_back(k);
-            uses_.push_back(keyed[k].use);
-        }
-        first_.push_back(keyed.size());
+        // Each vertex's uses by the larger id (stable), then the edges' first uses.
+        parallel_for(num_vertices, 4096, threads, [&](int64_t v0, int64_t v1) {
+            for (int64_t v = v0; v < v1; ++v) {
+                const size_t lo = start[size_t(v)], hi = start[size_t(v) + 1];
+                for (size_t k = lo + 1; k < hi; ++k) {
+                    const Sorted x = sorted[k];
+                    size_t j = k;
+                    for (; j > lo && sorted[j - 1].other > x.other; --j) sorted[j] = sorted[j - 1];
+                    sorted[j] = x;
+                }
+            }
+        });
+        uses_.resize(n);
+        first_.reserve(n / 2 + 1);
+        for (int v = 0; v < num_vertices; ++v)
+            for (size_t k = start[size_t(v)]; k < start[size_t(v) + 1]; ++k) {
+                if (k == start[size_t(v)] || sorted[k].other != sorted[k - 1].other) first_.push_back(k);
+                uses_[k] = sorted[k].use;
+            }
+        first_.push_back(n);
     }
 
     template <class Fn>
@@ -101,9 +125,18 @@ public:
         for (size_t g = 0; g + 1 < first_.size(); ++g) fn(&uses_[first_[g]], first_[g + 1] - first_[g]);
     }
 
+    /// fn(uses, count) for every edge, on `threads` threads: for work that writes only the
+    /// edge's own uses.
+    template <class Fn>
+    void parallel_for_each(int threads, Fn fn) const {
+        parallel_for(int64_t(first_.size()) - 1, 4096, threads, [&](int64_t g0, int64_t g1) {
+            for (int64_t g = g0; g < g1; ++g) fn(&uses_[first_[size_t(g)]], first_[size_t(g) + 1] - first_[size_t(g)]);
+        });
+    }
+
 private:
-    struct Keyed {
-        uint64_t key;
+    struct Sorted {
+        int other;  ///< the edge's larger vertex id
         EdgeUse use;
     };
     std::vector<EdgeUse> uses_;
@@ -119,29 +152,34 @@ int find_root(std::vector<int>& parent, int i) {
 
 namespace {
 template <typename T>
-std::vector<Vec3<T>> convert(const std::vector<Vec3d>& in) {
+std::vector<Vec3<T>> convert(const std::vector<Vec3d>& in, int threads) {
     std::vector<Vec3<T>> out(in.size());
-    for (size_t i = 0; i < in.size(); ++i) out[i] = Vec3<T>(in[i]);
+    parallel_for(int64_t(in.size()), 16384, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) out[size_t(i)] = Vec3<T>(in[size_t(i)]);
+    });
     return out;
 }
 
 template <typename T>
-std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m) {
+std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m, int threads) {
     auto b = std::make_shared<MeshBuffers<T>>();
-    b->vertices = convert<T>(m.vertices());
-    b->face_normals = convert<T>(m.face_normals());
-    b->edge_normals = convert<T>(m.edge_normals());
-    b->vertex_normals = convert<T>(m.vertex_normals());
+    b->vertices = convert<T>(m.vertices(), threads);
+    b->face_normals = convert<T>(m.face_normals(), threads);
+    b->edge_normals = convert<T>(m.edge_normals(), threads);
+    b->vertex_normals = convert<T>(m.vertex_normals(), threads);
     b->triangles = m.triangles();
     if (!b->vertices.empty()) b->box_lo = b->box_hi = b->vertices.front();
     for (const Vec3<T>& v : b->vertices) {
         b->box_lo = {std::min(b->box_lo.x, v.x), std::min(b->box_lo.y, v.y), std::min(b->box_lo.z, v.z)};
         b->box_hi = {std::max(b->box_hi.x, v.x), std::max(b->box_hi.y, v.y), std::max(b->box_hi.z, v.z)};
     }
-    b->packed.reserve(m.triangles().size());
-    for (const Int3& t : m.triangles())
-        b->packed.push_back(pack_triangle<T>(m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)],
-                                             m.vertices()[size_t(t.z)]));
+    b->packed.resize(m.triangles().size());
+    parallel_for(int64_t(m.triangles().size()), 8192, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const Int3 t = m.triangles()[size_t(i)];
+            b->packed[size_t(i)] = pack_triangle<T>(m.vertices()[size_t(t.x)], m.vertices()[size_t(t.y)], m.vertices()[size_t(t.z)]);
+        }
+    });
     return b;
 }
 }  // namespace
@@ -162,18 +200,31 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     std::vector<Vec3d> welded;
     const std::vector<int> remap = weld_vertices(mesh.vertices, options.weld_tolerance, welded);
     rep.welded_vertices = int(mesh.vertices.size() - welded.size());
+    const int threads = resolve_thread_count(options.threads);
+    const int64_t input_triangles = int64_t(mesh.triangles.size());
+    std::vector<Int3> welded_triangles(static_cast<size_t>(input_triangles));
+    std::vector<uint8_t> degenerate(static_cast<size_t>(input_triangles));
+    parallel_for(input_triangles, 8192, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const Int3 t = mesh.triangles[size_t(i)];
+            const Int3 w{remap[size_t(t.x)], remap[size_t(t.y)], remap[size_t(t.z)]};
+            const bool repeated = w.x == w.y || w.y == w.z || w.z == w.x;
+            // Exactly collinear, decided in exact arithmetic (a rounded cross product of
+            // collinear points need not be 0): the intersection predicates need a plane per
+            // triangle.
+            degenerate[size_t(i)] = repeated || exact::collinear(welded[size_t(w.x)], welded[size_t(w.y)], welded[size_t(w.z)]);
+            welded_triangles[size_t(i)] = w;
+        }
+    });
     std::vector<Int3> tris;
-    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-        const Int3 t = mesh.triangles[i];
-        const Int3 w{remap[size_t(t.x)], remap[size_t(t.y)], remap[size_t(t.z)]};
-        const bool repeated = w.x == w.y || w.y == w.z || w.z == w.x;
-        // Exactly collinear, decided in exact arithmetic (a rounded cross product of collinear
-        // points need not be 0): the intersection predicates need a plane per triangle.
-        if (repeated || exact::collinear(welded[size_t(w.x)], welded[size_t(w.y)], welded[size_t(w.z)])) {
+    tris.reserve(size_t(input_triangles));
+    out.source_triangle_.reserve(size_t(input_triangles));
+    for (int64_t i = 0; i < input_triangles; ++i) {
+        if (degenerate[size_t(i)]) {
             ++rep.degenerate_triangles;
             continue;
         }
-        tris.push_back(w);
+        tris.push_back(welded_triangles[size_t(i)]);
         out.source_triangle_.push_back(int(i));
     }
 
@@ -197,7 +248,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.triangles_ = std::move(tris);
 
     // Edge adjacency: boundary, non-manifold and orientation checks; components.
-    EdgeUses edges(out.triangles_);
+    EdgeUses edges(out.triangles_, int(out.vertices_.size()), threads);
     std::vector<int> parent(out.triangles_.size());
     std::iota(parent.begin(), parent.end(), 0);
     edges.for_each([&](const EdgeUse* uses, size_t count) {
@@ -224,27 +275,39 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         rep.signed_volume = -rep.signed_volume;
         rep.flipped = true;
         // Edge e of a flipped triangle is a different edge; rebuild the adjacency lookups below.
-        edges = EdgeUses(out.triangles_);
+        edges = EdgeUses(out.triangles_, int(out.vertices_.size()), threads);
     }
 
     // Angle-weighted pseudonormals.
     const size_t nt = out.triangles_.size();
     out.face_normals_.resize(nt);
-    out.edge_normals_.assign(3 * nt, Vec3d(0.0));
+    out.edge_normals_.resize(3 * nt);
     out.vertex_normals_.assign(out.vertices_.size(), Vec3d(0.0));
+    // Each triangle's normal and corner weights on every thread; the vertex normals are then
+    // summed in triangle order, as one pass would (the same bits).
+    std::vector<Vec3d> corner_weights(nt);
+    parallel_for(int64_t(nt), 8192, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const Int3 t = out.triangles_[size_t(i)];
+            const Vec3d& a = out.vertices_[size_t(t.x)];
+            const Vec3d& b = out.vertices_[size_t(t.y)];
+            const Vec3d& c = out.vertices_[size_t(t.z)];
+            out.face_normals_[size_t(i)] = normalize_or_zero(cross(b - a, c - a));
+            corner_weights[size_t(i)] = {corner_angle(a, b, c), corner_angle(b, c, a), corner_angle(c, a, b)};
+        }
+    });
     for (size_t i = 0; i < nt; ++i) {
         const Int3 t = out.triangles_[i];
-        const Vec3d& a = out.vertices_[size_t(t.x)];
-        const Vec3d& b = out.vertices_[size_t(t.y)];
-        const Vec3d& c = out.vertices_[size_t(t.z)];
-        const Vec3d n = normalize_or_zero(cross(b - a, c - a));
-        out.face_normals_[i] = n;
-        out.vertex_normals_[size_t(t.x)] += n * corner_angle(a, b, c);
-        out.vertex_normals_[size_t(t.y)] += n * corner_angle(b, c, a);
-        out.vertex_normals_[size_t(t.z)] += n * corner_angle(c, a, b);
+        const Vec3d n = out.face_normals_[i];
+        out.vertex_normals_[size_t(t.x)] += n * corner_weights[i].x;
+        out.vertex_normals_[size_t(t.y)] += n * corner_weights[i].y;
+        out.vertex_normals_[size_t(t.z)] += n * corner_weights[i].z;
     }
-    for (Vec3d& n : out.vertex_normals_) n = normalize_or_zero(n);
-    edges.for_each([&](const EdgeUse* uses, size_t count) {
+    parallel_for(int64_t(out.vertex_normals_.size()), 16384, threads, [&](int64_t v0, int64_t v1) {
+        for (int64_t v = v0; v < v1; ++v) out.vertex_normals_[size_t(v)] = normalize_or_zero(out.vertex_normals_[size_t(v)]);
+    });
+    // Every use of a triangle's edge is one edge's: each edge writes only its own uses.
+    edges.parallel_for_each(threads, [&](const EdgeUse* uses, size_t count) {
         // Each incident face contributes its normal with weight pi (the angle of a face
         // around an edge); for a manifold edge this is the normalised sum of both normals.
         Vec3d sum(0.0);
@@ -255,9 +318,15 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
                 length_squared(n) > 0 ? n : out.face_normals_[size_t(uses[u].triangle)];
     });
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
-    out.float_buffers_ = make_buffers<float>(out);
-    out.double_buffers_ = make_buffers<double>(out);
-    out.search_bound_ = float_search_bound(out.vertices_, out.triangles_, out.double_buffers_->packed, out.float_buffers_->packed);
+    {
+        // The two precisions' buffers at once, each pass on every thread.
+        std::future<std::shared_ptr<MeshBuffers<float>>> floats =
+            std::async(std::launch::async, [&] { return make_buffers<float>(out, threads); });
+        out.double_buffers_ = make_buffers<double>(out, threads);
+        out.float_buffers_ = floats.get();
+    }
+    out.search_bound_ =
+        float_search_bound(out.vertices_, out.triangles_, out.double_buffers_->packed, out.float_buffers_->packed, threads);
 
     if (options.detect_intersections && !out.triangles_.empty()) {
         // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.

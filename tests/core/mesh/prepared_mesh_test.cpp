@@ -1,10 +1,12 @@
 // prepare_mesh(): angle-weighted pseudonormals against values known in closed form (box
 // corners and edges), welding, dropping degenerate triangles, and the reports and warnings
-// for open, inward and inconsistently oriented meshes.
+// for open, inward and inconsistently oriented meshes; the same bytes at every thread count.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <map>
+#include <random>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -247,6 +249,118 @@ TEST(PreparedMesh, WeldsVerticesCloserThanTheToleranceAcrossGridCells) {
     const PreparedMesh m = prepare_mesh(soup, options);
     EXPECT_EQ(m.vertices().size(), 8u);
     EXPECT_TRUE(m.report().closed());
+}
+
+/// An icosphere, an inward torus, a fan of triangles sharing one edge (non-manifold), a
+/// random soup over shared vertices (boundary, inconsistent and non-manifold edges, -0 and
+/// +0 coordinates) and some degenerate triangles: one mesh with every case of preparation.
+TriangleMesh every_case_mesh() {
+    TriangleMesh m = make_icosphere(4, 1.0, {3, 0, 0});
+    auto append = [&](const TriangleMesh& part) {
+        const int first = int(m.vertices.size());
+        m.vertices.insert(m.vertices.end(), part.vertices.begin(), part.vertices.end());
+        for (const Int3& t : part.triangles) m.triangles.push_back({t.x + first, t.y + first, t.z + first});
+    };
+    append(reversed(make_torus(1.0, 0.3, 48, 24), 0, 48 * 24 * 2));
+    const int fan = int(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), {{0, 0, -2}, {1, 0, -2}, {0, 1, -2}, {0, -1, -2}, {0, 0, -1}, {0, 0, -3}});
+    for (int k = 2; k < 6; ++k) m.triangles.push_back({fan, fan + 1, fan + k});
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const int soup = int(m.vertices.size());
+    // Clusters of 8 vertices, 0.1 apart, with 24 triangles each over their own cluster: small
+    // triangles whose edges are shared by 1, 2 or more of them, in either direction.
+    for (int i = 0; i < 4000; ++i)
+        m.vertices.push_back({6 + 0.1 * (i / 8) + 0.05 * u(rng), 0.05 * u(rng), i % 3 == 0 ? (i % 2 ? 0.0 : -0.0) : 0.05 * u(rng)});
+    std::uniform_int_distribution<int> pick(0, 7);
+    for (int i = 0; i < 12000; ++i) {
+        const int cluster = soup + 8 * (i / 24);
+        m.triangles.push_back({cluster + pick(rng), cluster + pick(rng), cluster + pick(rng)});  // some repeat a vertex
+    }
+    m.triangles.push_back({fan, fan + 1, fan + 1});
+    m.name = "every-case";
+    return m;
+}
+
+template <typename V>
+bool same_bytes(const V& a, const V& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+}
+
+template <typename T>
+void expect_same_buffers(const MeshBuffers<T>& a, const MeshBuffers<T>& b) {
+    EXPECT_TRUE(same_bytes(a.vertices, b.vertices));
+    EXPECT_TRUE(same_bytes(a.face_normals, b.face_normals));
+    EXPECT_TRUE(same_bytes(a.edge_normals, b.edge_normals));
+    EXPECT_TRUE(same_bytes(a.vertex_normals, b.vertex_normals));
+    EXPECT_TRUE(same_bytes(a.triangles, b.triangles));
+    EXPECT_TRUE(same_bytes(a.packed, b.packed));
+}
+
+TEST(PreparedMesh, IsTheSameBytesAtEveryThreadCount) {
+    const TriangleMesh mesh = every_case_mesh();
+    MeshPreparationOptions one;
+    one.threads = 1;
+    const PreparedMesh a = prepare_mesh(mesh, one);
+    ASSERT_GT(a.report().boundary_edges, 0);
+    ASSERT_GT(a.report().nonmanifold_edges, 0);
+    ASSERT_GT(a.report().inconsistent_edges, 0);
+    ASSERT_GT(a.report().degenerate_triangles, 0);
+    for (int threads : {2, 3, 7}) {
+        SCOPED_TRACE("threads " + std::to_string(threads));
+        MeshPreparationOptions o;
+        o.threads = threads;
+        const PreparedMesh b = prepare_mesh(mesh, o);
+        EXPECT_TRUE(same_bytes(a.vertices(), b.vertices()));
+        EXPECT_TRUE(same_bytes(a.triangles(), b.triangles()));
+        EXPECT_TRUE(same_bytes(a.face_normals(), b.face_normals()));
+        EXPECT_TRUE(same_bytes(a.edge_normals(), b.edge_normals()));
+        EXPECT_TRUE(same_bytes(a.vertex_normals(), b.vertex_normals()));
+        EXPECT_TRUE(same_bytes(a.source_triangle(), b.source_triangle()));
+        EXPECT_TRUE(same_bytes(a.shell_of(), b.shell_of()));
+        EXPECT_EQ(a.intersecting_triangles(), b.intersecting_triangles());
+        expect_same_buffers(a.buffers<float>(), b.buffers<float>());
+        expect_same_buffers(a.buffers<double>(), b.buffers<double>());
+        const FloatSearchBound x = a.search_bound(), y = b.search_bound();
+        EXPECT_EQ(std::memcmp(&x.rho, &y.rho, sizeof(double)), 0);
+        EXPECT_EQ(std::memcmp(&x.rho_double, &y.rho_double, sizeof(double)), 0);
+        EXPECT_EQ(x.two_l, y.two_l);
+        EXPECT_EQ(x.coordinate, y.coordinate);
+        EXPECT_EQ(a.report().components, b.report().components);
+        EXPECT_EQ(a.report().boundary_edges, b.report().boundary_edges);
+        EXPECT_EQ(a.report().nonmanifold_edges, b.report().nonmanifold_edges);
+        EXPECT_EQ(a.report().inconsistent_edges, b.report().inconsistent_edges);
+        EXPECT_EQ(std::memcmp(&a.report().signed_volume, &b.report().signed_volume, sizeof(double)), 0);
+    }
+}
+
+/// The edge pseudonormals against an independent adjacency: a std::map from (smaller, larger)
+/// vertex id to the edge's uses in triangle order, each use's face normal times pi summed in
+/// that order and normalised (a lone face keeps its own normal), bit for bit.
+TEST(PreparedMesh, EdgeNormalsSumTheirFacesInTriangleOrder) {
+    const PreparedMesh m = prepare_mesh(every_case_mesh());
+    std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> uses;  // edge -> (triangle, local edge)
+    for (size_t i = 0; i < m.triangles().size(); ++i)
+        for (int e = 0; e < 3; ++e) {
+            const int a = m.triangles()[i][e], b = m.triangles()[i][(e + 1) % 3];
+            uses[{std::min(a, b), std::max(a, b)}].push_back({int(i), e});
+        }
+    constexpr double kPi = 3.14159265358979323846;
+    size_t checked = 0, shared_by_three = 0;
+    for (const auto& [edge, list] : uses) {
+        Vec3d sum(0.0);
+        for (const auto& [t, e] : list) sum += m.face_normals()[size_t(t)] * kPi;
+        const Vec3d n = normalize_or_zero(sum);
+        shared_by_three += list.size() > 2;
+        for (const auto& [t, e] : list) {
+            const Vec3d want = length_squared(n) > 0 ? n : m.face_normals()[size_t(t)];
+            const Vec3d got = m.edge_normals()[3 * size_t(t) + size_t(e)];
+            ASSERT_EQ(std::memcmp(&got, &want, sizeof(Vec3d)), 0) << "triangle " << t << " edge " << e;
+            ++checked;
+        }
+    }
+    EXPECT_EQ(checked, 3 * m.triangles().size());
+    EXPECT_GT(shared_by_three, 0u);
 }
 
 }  // namespace
