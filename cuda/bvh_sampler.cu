@@ -60,26 +60,42 @@ struct DeviceBvh {
     DeviceBuffer<PackedTriangle<T>> packed;
     DeviceBuffer<int32_t> triangle_index;
     DeviceBuffer<int32_t> source_triangle;  ///< prepared -> mesh file face order (stored slabs)
+    DeviceBuffer<PackedTriangle<double>> exact;  ///< a host tree's double constants (float search's certificate)
+    DeviceBuffer<int32_t> slot_of;               ///< a host tree's slot of every triangle (the same)
     std::unique_ptr<DeviceMesh<double>> mesh;
     DeviceWinding winding;
     std::unique_ptr<DeviceCertifier> certifier;  ///< float only (certify_kernel.cuh)
     BvhView<T> view{};
     bool solid = false;  ///< auto would sign this mesh by pseudonormals (the narrow band's brick skip)
 
-    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared, const SamplerSign& sign)
+    /// A tree built on the host: its nodes and triangle order and the double mesh go up once
+    /// (the search, the certificate and the winding walk share them); the packed constants
+    /// in tree order are made on the device from the mesh (the host's bits, and 29 MB less
+    /// to copy at 100k triangles). The winding moments follow with add_winding().
+    DeviceBvh(const TriangleBvh& bvh, const PreparedMesh& prepared)
         : solid(choose_sign_mode(prepared.report(), SignMode::Auto).mode == SignMode::Pseudonormal) {
+        mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
         nodes.upload(bvh.nodes);
-        if constexpr (std::is_same_v<T, float>) packed.upload(bvh.packed_float);
-        else packed.upload(bvh.packed_double);
         triangle_index.upload(bvh.triangle_index);
         source_triangle.upload(prepared.source_triangle());
-        mesh = std::make_unique<DeviceMesh<double>>(prepared.buffers<double>());
-        winding.upload(sign, mesh->view());
-        if constexpr (std::is_same_v<T, float>)
-            view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), int(bvh.triangle_index.size())};
-        else
+        const int n = int(bvh.triangle_index.size());
+        const MeshView<double> m = mesh->view();
+        packed.allocate(size_t(n));
+        if constexpr (std::is_same_v<T, float>) {
+            exact.allocate(size_t(n));
+            slot_of.allocate(size_t(n));
+            pack_in_slot_order(m.vertices, m.triangles, triangle_index.get(), n, packed.get(), exact.get(), slot_of.get());
+            view = {nodes.get(), packed.get(), triangle_index.get(), int(bvh.nodes.size()), n};
+            certifier = std::make_unique<DeviceCertifier>(view, exact.get(), slot_of.get(), prepared.search_bound());
+        } else {
+            pack_in_slot_order(m.vertices, m.triangles, triangle_index.get(), n, nullptr, packed.get(), nullptr);
             view = bvh.view<double>().with_arrays(nodes.get(), packed.get(), triangle_index.get());  // and its margin
-        if constexpr (std::is_same_v<T, float>) certifier = std::make_unique<DeviceCertifier>(bvh, prepared);
+        }
+    }
+
+    /// The winding moments of `sign` (prepared for this mesh over `bvh`, this tree) beside it.
+    void add_winding(const SamplerSign& sign, const TriangleBvh& bvh) {
+        winding.upload_moments(sign, bvh, nodes.get(), triangle_index.get(), mesh->view());
     }
 
     /// The BVH built on the device (cuda/device_bvh_build.h), with its winding moments;
@@ -264,15 +280,27 @@ private:
         CUDA_CHECK(cudaSetDevice(options_.device));
         if (const DeviceBvh<T>* dev = built_on_device<T>(mesh, built, uploaded, upload)) return *dev;
         const auto bvh = mesh.bvh(&built);  // the mesh's own, built once
-        sign_.prepare(mesh);  // the winding sign shares the BVH
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
         // host_bvh_ holds the tree uploaded last, so no other mesh's tree can have its address.
         uploaded = !slot || host_bvh_ != bvh;
+        if (!uploaded) sign_.prepare(mesh);  // the same tree: its winding sign is kept
         if (uploaded) {
             device_float_.reset();
             device_double_.reset();
             upload.begin();
-            slot = std::make_unique<DeviceBvh<T>>(*bvh, mesh, sign_);
+            // The winding moments (on the host's threads, over this tree) while the tree and
+            // the mesh go up: neither waits for the other.
+            std::future<void> sign = std::async(std::launch::async, [&] { sign_.prepare(mesh); });
+            std::unique_ptr<DeviceBvh<T>> dev;
+            try {
+                dev = std::make_unique<DeviceBvh<T>>(*bvh, mesh);
+            } catch (...) {
+                sign.wait();
+                throw;
+            }
+            sign.get();
+            dev->add_winding(sign_, *bvh);
+            slot = std::move(dev);
             upload.end();
             host_bvh_ = bvh;
             device_mesh_ = 0;

@@ -196,6 +196,7 @@ __global__ void lbvh_sah(const BvhNode* nodes, int num_nodes, double node_cost, 
 
 /// The packed constants of the triangle in slot s, made here (pack_triangle() computes them
 /// bit for bit as the host's mesh buffers hold them): cheaper than uploading the host's.
+/// `out_f` and `slot_of` may be null (a double search without the float certificate).
 __global__ void lbvh_pack(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
                           PackedTriangle<float>* out_f, PackedTriangle<double>* out_d, int32_t* slot_of) {
     const int s = int(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -203,9 +204,9 @@ __global__ void lbvh_pack(const Vec3d* vertices, const Int3* triangles, const in
     const int32_t t = order[s];
     const Int3 tri = triangles[t];
     const Vec3d v0 = vertices[tri.x], v1 = vertices[tri.y], v2 = vertices[tri.z];
-    out_f[s] = pack_triangle<float>(v0, v1, v2);
+    if (out_f) out_f[s] = pack_triangle<float>(v0, v1, v2);
     out_d[s] = pack_triangle<double>(v0, v1, v2);
-    slot_of[t] = s;
+    if (slot_of) slot_of[t] = s;
 }
 
 void check_launch(const char* what) {
@@ -425,6 +426,13 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     d.bound = mesh.search_bound();  // made with the mesh (a host pass of 1-3 ms at 100k triangles)
     d.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
+}
+
+void pack_in_slot_order(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
+                        PackedTriangle<float>* packed_float, PackedTriangle<double>* packed_double, int32_t* slot_of) {
+    if (n <= 0) return;
+    lbvh_pack<<<blocks_for(n), kThreads>>>(vertices, triangles, order, n, packed_float, packed_double, slot_of);
+    check_launch("pack");
 }
 
 }  // namespace sdf::cuda

@@ -40,6 +40,14 @@ struct DeviceLbvh {
 /// Builds on the current device from the prepared mesh and its device vertices and
 /// triangles (`vertices`, `triangles`: a DeviceMesh<double>'s). Null when the mesh fits one
 /// leaf (no tree to build; the host build handles it). Throws on CUDA errors.
+/// The packed search constants of the triangle in each slot of `order` (slot -> triangle,
+/// `n` slots), made on the device from the double mesh (`vertices`, `triangles`: a
+/// DeviceMesh<double>'s) with the bits of the host's mesh buffers, and every triangle's
+/// slot; `packed_float` and `slot_of` may be null. For a tree built on the host, whose
+/// constants would otherwise be uploaded (29 MB at 100k triangles). Asynchronous (stream 0).
+void pack_in_slot_order(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
+                        PackedTriangle<float>* packed_float, PackedTriangle<double>* packed_double, int32_t* slot_of);
+
 std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const Vec3d* vertices, const Int3* triangles,
                                                  const GpuBvhBuildOptions& options = {});
 

@@ -27,6 +27,23 @@ public:
         view_.accuracy = SamplerSign::winding_options().accuracy;
     }
 
+    /// As upload(), but the winding BVH's tree is `tree`, whose nodes and triangle order are
+    /// already on the device (`nodes`, `triangle_index`): only the moments are copied.
+    void upload_moments(const SamplerSign& sign, const TriangleBvh& tree, const BvhNode* nodes,
+                        const int32_t* triangle_index, const MeshView<double>& mesh, cudaStream_t stream = 0) {
+        view_ = {};
+        const WindingSign* w = sign.winding_sign();
+        if (w == nullptr) return;
+        const WindingBvh& bvh = w->winding_bvh();
+        if (bvh.bvh.get() != &tree) {  // moments over another tree: theirs go up whole
+            upload(sign, mesh, stream);
+            return;
+        }
+        moments_.upload(bvh.moments, stream);
+        view_.view = {nodes, moments_.get(), triangle_index, mesh.vertices, mesh.triangles, int(tree.nodes.size())};
+        view_.accuracy = SamplerSign::winding_options().accuracy;
+    }
+
     /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
     /// `sign`'s mode is winding: nothing is copied; the arrays must outlive this view.
     void adopt(const SamplerSign& sign, const BvhNode* nodes, const WindingNode<double>* moments,
