@@ -26,8 +26,10 @@ struct SlotTerms {
     Vec3d centroid;               ///< (a + b + c) / 3
 };
 
-/// Nodes of moments per task of build_winding_bvh's parallel loop.
+/// Nodes of moments per task of build_winding_bvh's parallel loop (the light ones).
 constexpr int64_t kNodesPerTask = 64;
+/// Slots under a child from which its moments are a task of their own, scheduled largest first.
+constexpr int64_t kHeavySlots = 4096;
 
 class MomentBuilder {
 public:
@@ -51,12 +53,30 @@ public:
     /// Fills the moments of both children of every node. Each child's moments are summed over
     /// its own slots (not from its children's), so every node is independent of the others:
     /// the slot ranges first (one walk), then all nodes on all threads, the same bits as one.
+    ///
+    /// A child costs its slots, and pre-order puts the heaviest (a path of n, n/2, n/4, ...
+    /// slots) into the first task: the children of kHeavySlots or more go first, largest
+    /// first, one per task, then the rest, a node's two children together.
     void run() {
         ranges_of(0);
-        parallel_for(int64_t(bvh_.nodes.size()), kNodesPerTask, threads_, [&](int64_t begin, int64_t end) {
-            for (int64_t node = begin; node < end; ++node)
-                for (int c = 0; c < 2; ++c) out_[size_t(node)].child[c] = moments_of(ranges_[size_t(node)][c]);
-        });
+        auto slots_under = [&](int64_t child) {  // child = 2 node + c
+            const SlotRange r = ranges_[size_t(child / 2)][child % 2];
+            return int64_t(r.end - r.begin);
+        };
+        std::vector<int64_t> heavy, light;
+        for (int64_t child = 0; child < 2 * int64_t(bvh_.nodes.size()); ++child)
+            (slots_under(child) >= kHeavySlots ? heavy : light).push_back(child);
+        std::stable_sort(heavy.begin(), heavy.end(), [&](int64_t a, int64_t b) { return slots_under(a) > slots_under(b); });
+        auto fill = [&](const std::vector<int64_t>& children, int64_t per_task) {
+            parallel_for(int64_t(children.size()), per_task, threads_, [&](int64_t begin, int64_t end) {
+                for (int64_t k = begin; k < end; ++k) {
+                    const int64_t child = children[size_t(k)];
+                    out_[size_t(child / 2)].child[child % 2] = moments_of(ranges_[size_t(child / 2)][child % 2]);
+                }
+            });
+        };
+        fill(heavy, 1);
+        fill(light, 2 * kNodesPerTask);
     }
 
 private:
