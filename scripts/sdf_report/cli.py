@@ -26,8 +26,8 @@ waits" instead of the records under --results (the latest per machine of those g
 --publish), keeping the rest as it is (for a published report whose runs are not all on disk);
 --only-section peers likewise rewrites the peers section from the peers runs given (run
 directories or published files), or else the latest run of each peers experiment under
---results, and says so in it
-(the overview at the top keeps the runs of the last full report).
+--results, and says so in it; the overview at the top then lists those runs in place of the
+peers runs it listed (its other entries stay those of the last full report).
 Every run is validated against harness/schema/run_schema.json: a missing or mistyped key
 is an error naming the file and the key (--skip-invalid leaves such runs out instead).
 
@@ -121,7 +121,8 @@ def rewrite_section(args):
                              % ("among the runs given" if args.runs else "under " + args.results))
         peers.section(doc, runs)
         doc.paragraph("This section was rewritten alone on %s (scripts/make-report --only-section peers) from the "
-                      "runs %s; the overview at the top lists the runs of the last full report." % (
+                      "runs %s, and with it their entries in the overview at the top; the other entries there are "
+                      "those of the last full report." % (
                           datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                           ", ".join("%s %s" % (r.name, r.run_id) for r in runs)))
     heading = SECTION_HEADINGS[args.only_section]
@@ -129,6 +130,12 @@ def rewrite_section(args):
         markdown = f.read()
     with open(paths[1], encoding="utf-8") as f:
         page = f.read()
+    if args.only_section == "peers":
+        runs_doc = Document(args.output)
+        overview.rewritten(runs_doc, markdown, runs, REPO)
+        runs_html = runs_doc.html("").split("<body>", 1)[1].rsplit("</body>", 1)[0].strip("\n")
+        markdown = _replace(markdown, "\n## " + overview.HEADING, "\n## ", runs_doc.markdown().rstrip("\n"))
+        page = _replace(page, "\n<h2>" + overview.HEADING, "\n<h2>", runs_html, end="\n</body>", sep="\n")
     new_html = doc.html("").split("<body>", 1)[1].rsplit("</body>", 1)[0].strip("\n")
     write_text_atomically(paths[0], _replace(markdown, "\n## " + heading, "\n## ", doc.markdown().rstrip("\n")))
     write_text_atomically(paths[1], _replace(page, "\n<h2>" + heading, "\n<h2>", new_html, end="\n</body>", sep="\n"))

@@ -2,6 +2,7 @@
 the regression check when the run records one."""
 
 import os
+import re
 
 from .tables import Table, number
 
@@ -53,28 +54,87 @@ def source_text(run, repo):
     return os.path.relpath(path, repo) if path.startswith(repo + os.sep) else path
 
 
+HEADING = "Runs"
+HEADER = ["experiment", "kind", "run", "commit", "CPU", "GPU", "build", "load (start/end)", "check"]
+PUBLISHED = "%s is a published run ("
+LOADED = "Made on a loaded machine (load above its hardware threads): "
+LOAD_TEXT = ("Load: the 1-minute load average when the run started and ended; timings from a machine whose load "
+             "exceeds its hardware threads are not representative. Check: the regression check against the "
+             "run's baseline, when the run was made with --check and records it.")
+DIRTY_TEXT = ("Runs marked dirty were made from a work tree with uncommitted changes (or without git: commit "
+              "\"unknown\"; a tree without .git records the commit passed in as SDF_SOURCE_COMMIT, \"(passed in)\").")
+LOADED_TAIL = ". Their times and speedups are inflated or compressed by other work; errors and counts are unaffected."
+
+
+def row(run):
+    cpu, gpu = machine(run)
+    return [run.name, run.kind, run.run_id, commit(run), cpu, gpu, run.provenance["build"]["build_type"], load_text(run),
+            check_text(run)]
+
+
+def published_text(run, repo):
+    return (PUBLISHED + "%s, scripts/publish-gpu-results)%s") % (
+        run.name, source_text(run, repo), ": " + run.published["note"] if "note" in run.published else ".")
+
+
 def section(doc, runs, repo):
-    doc.heading(2, "Runs")
+    doc.heading(2, HEADING)
     if not runs:
         doc.note("No runs found. Run a study first, e.g. `build/bin/run-experiment configs/ci_smoke.json`.")
         return
-    table = Table(["experiment", "kind", "run", "commit", "CPU", "GPU", "build", "load (start/end)", "check"])
+    table = Table(HEADER)
     for r in runs:
-        cpu, gpu = machine(r)
-        table.add([r.name, r.kind, r.run_id, commit(r), cpu, gpu, r.provenance["build"]["build_type"], load_text(r),
-                   check_text(r)])
+        table.add(row(r))
     doc.table(table)
-    doc.paragraph("Load: the 1-minute load average when the run started and ended; timings from a machine whose load "
-                  "exceeds its hardware threads are not representative. Check: the regression check against the "
-                  "run's baseline, when the run was made with --check and records it.")
-    published = [r for r in runs if r.published is not None]
-    for r in published:
-        doc.paragraph("%s is a published run (%s, scripts/publish-gpu-results)%s" % (
-            r.name, source_text(r, repo), ": " + r.published["note"] if "note" in r.published else "."))
+    doc.paragraph(LOAD_TEXT)
+    for r in runs:
+        if r.published is not None:
+            doc.paragraph(published_text(r, repo))
     loaded = [r.name for r in runs if overloaded(r)]
     if loaded:
-        doc.note("Made on a loaded machine (load above its hardware threads): %s. Their times and speedups are "
-                 "inflated or compressed by other work; errors and counts are unaffected." % ", ".join(loaded))
-    if any(r.provenance["git"]["dirty"] for r in runs):
-        doc.note("Runs marked dirty were made from a work tree with uncommitted changes (or without git: commit "
-                 "\"unknown\"; a tree without .git records the commit passed in as SDF_SOURCE_COMMIT, \"(passed in)\").")
+        doc.note(LOADED + ", ".join(loaded) + LOADED_TAIL)
+
+
+def rewritten(doc, markdown, runs, repo):
+    """Fills `doc` with the overview of an existing report (its Markdown) in which the entries
+    of `runs`' experiments are made from `runs`: their table rows (in place; a new experiment's
+    after the last), their published-run paragraphs and their names in the loaded-machine note.
+    The other experiments' entries, whose runs may no longer be on disk, are kept as written."""
+    begin = markdown.index("## %s\n" % HEADING)
+    end = markdown.find("\n## ", begin)
+    lines = markdown[begin:len(markdown) if end < 0 else end].split("\n")
+    names = {r.name for r in runs}
+    table, published, loaded = [], {}, []
+    for line in lines:
+        if line.startswith("| ") and not line.startswith("| " + HEADER[0] + " |"):
+            table.append([c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line)[1:-1]])
+        elif " is a published run (" in line and not line.startswith("> "):
+            published[line.split(" is a published run (", 1)[0]] = line
+        elif line.startswith("> " + LOADED):
+            loaded = line[len("> " + LOADED):].split(LOADED_TAIL)[0].split(", ")
+    new_rows = {r.name: row(r) for r in runs}
+    rows = []
+    for cells in table:
+        if cells[0] not in names:
+            rows.append(cells)
+        elif cells[0] in new_rows:  # in its place
+            rows.append(new_rows.pop(cells[0]))
+    rows += list(new_rows.values())  # experiments the report did not have
+    for r in runs:
+        published.pop(r.name, None)
+        if r.published is not None:
+            published[r.name] = published_text(r, repo)
+    loaded = [n for n in loaded if n and n not in names] + [r.name for r in runs if overloaded(r)]
+    doc.heading(2, HEADING)
+    t = Table(HEADER)
+    for cells in rows:
+        t.add(cells)
+    doc.table(t)
+    doc.paragraph(LOAD_TEXT)
+    for cells in rows:
+        if cells[0] in published:
+            doc.paragraph(published[cells[0]])
+    if loaded:
+        doc.note(LOADED + ", ".join(loaded) + LOADED_TAIL)
+    if any("(dirty)" in cells[3] or cells[3].startswith("unknown") for cells in rows):
+        doc.note(DIRTY_TEXT)

@@ -120,7 +120,9 @@ def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
     later = tmp_path / "later"
     metrics = fake_runs.peers_metrics()
     metrics["summary"][0]["query_speedup"] = 7.25
-    run = fake_runs.write_run(later, "peers", "peers", metrics, run_id="r9")
+    run = fake_runs.write_run(later, "peers", "peers", metrics, run_id="r9", finished="2026-03-01T00:00:00Z")
+    old_overview = (out / "report.md").read_text().split("\n## ", 2)[1]
+    assert "| peers | peers | 2026-02-01T000000Z-00000000 |" in old_overview
     for _ in range(2):  # twice: still one section, in its place
         r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers", run)
         assert r.returncode == 0, r.stderr
@@ -130,9 +132,19 @@ def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
         with open(os.path.join(run, "manifest.json")) as f:
             run_id = json.load(f)["run_id"]
         assert "| 7.25 | 4.75 |" in md and "| 5 | 4.75 |" not in md  # the old run's summary row is gone
-        assert "rewritten alone" in md and "runs peers %s;" % run_id in md
+        assert "rewritten alone" in md and "runs peers %s, and with it their entries in the overview" % run_id in md
         assert "7.25" in html and html.count("<h2>Exact sampling against the peer libraries") == 1
         assert "## Where the user waits" in md and md.index("## Exact sampling") < md.index("## Where the user waits")
+        # the overview lists the new peers run in place of the old one, and keeps the others' rows
+        overview = md.split("\n## ", 2)[1]
+        assert overview.startswith("Runs\n")
+        assert overview.count("| peers | peers |") == 1 and "| peers | peers | 2026-03-01T000000Z-00000000 |" in overview
+        assert "2026-02-01T000000Z-00000000 | " in overview.split("| peers | peers |")[0]  # the rows before it kept
+        assert [line.split(" | ")[0] for line in overview.split("\n") if line.startswith("| ")] == \
+               [line.split(" | ")[0] for line in old_overview.split("\n") if line.startswith("| ")]
+        html_overview = html.split("<h2>Runs</h2>", 1)[1].split("<h2>", 1)[0]
+        assert "<td class=\"text\">2026-03-01T000000Z-00000000</td>" in html_overview
+        assert html_overview.count("<tr><td class=\"text\">peers</td>") == 1
     # no peers run: an error naming where it looked
     r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers")
     assert r.returncode != 0 and "no peers run under" in r.stderr
