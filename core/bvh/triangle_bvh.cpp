@@ -108,26 +108,54 @@ struct SubtreeTask {
 /// a built child's count is never negative.
 constexpr int32_t kTaskChild = -1;
 
-/// Top-down binned SAH. With `tasks` set (the top of the tree), nodes of more than
-/// kParallelBinning refs bin on several threads and nodes of at most `grain` refs become
-/// SubtreeTasks, built afterwards on all threads and spliced in (build_triangle_bvh). Every
-/// split is the one the one-threaded recursion makes, so the tree is the same bytes at any
-/// thread count (tests/cpu_reference/bvh/sah_build_test.cpp).
+/// What the top of the tree makes of one node: a leaf, a task, or a split at `mid`.
+struct TopSplit {
+    enum Kind { Leaf, Task, Inner } kind = Leaf;
+    Bounds3 box;
+    int mid = 0;
+};
+
+/// Top-down binned SAH: build() is the one-threaded recursion (the tree's nodes in
+/// pre-order). split_top() splits one node of the top of the tree (build_top(), which runs
+/// it on many nodes at once), binning on `threads` threads when the node has more than
+/// kParallelBinning refs. Every split is the one the recursion makes, so the tree is the same
+/// bytes at any thread count (tests/cpu_reference/bvh/sah_build_test.cpp).
 class Builder {
 public:
     Builder(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& nodes,
-            std::vector<SubtreeTask>* tasks = nullptr, int grain = 0, int threads = 1)
-        : refs_(refs), o_(o), stats_(stats), nodes_(nodes), tasks_(tasks), grain_(grain), threads_(threads) {}
+            int threads = 1)
+        : refs_(refs), o_(o), stats_(stats), nodes_(nodes), threads_(threads) {}
 
     BuiltChild build(int begin, int end, int depth) {
         Bounds3 box, centroids;
         bounds(begin, end, box, centroids);
         const int count = end - begin;
         if (count <= o_.max_leaf_size) return leaf(box, begin, count);
-        if (tasks_ && count <= grain_) {
-            tasks_->push_back({begin, end, depth, {}, {}});
-            return {box, int32_t(tasks_->size() - 1), kTaskChild};
+        return inner(box, begin, split(begin, end, depth, box, centroids), end, depth);
+    }
+
+    /// build()'s first step on one node of the top: a leaf, a task (at most `grain` refs) or
+    /// the split (its refs partitioned); nothing recorded in the statistics or the nodes.
+    TopSplit split_top(int begin, int end, int depth, int grain) {
+        TopSplit t;
+        Bounds3 centroids;
+        bounds(begin, end, t.box, centroids);
+        const int count = end - begin;
+        if (count <= o_.max_leaf_size) return t;
+        if (count <= grain) {
+            t.kind = TopSplit::Task;
+            return t;
         }
+        t.kind = TopSplit::Inner;
+        t.mid = split(begin, end, depth, t.box, centroids);
+        return t;
+    }
+
+private:
+    bool parallel(int count) const { return threads_ > 1 && count > kParallelBinning; }
+
+    /// Where a node of more than max_leaf_size refs splits, its refs partitioned there.
+    int split(int begin, int end, int depth, const Bounds3& box, const Bounds3& centroids) {
         // Leaves are small (GPU-friendly); SAH only chooses where to split.
         int mid = -1;
         if (depth < o_.median_split_depth) {
@@ -135,11 +163,8 @@ public:
             if (s.axis >= 0) mid = partition(begin, end, s);
         }
         if (mid <= begin || mid >= end) mid = median_partition(begin, end, centroids);
-        return inner(box, begin, mid, end, depth);
+        return mid;
     }
-
-private:
-    bool parallel(int count) const { return tasks_ && threads_ > 1 && count > kParallelBinning; }
 
     /// The node's box and the box of its refs' centroids (one thread: a pass this short
     /// gains nothing from more).
@@ -303,18 +328,19 @@ private:
     const BvhBuildOptions& o_;
     BvhBuildStats& stats_;
     std::vector<BvhNode>& nodes_;
-    std::vector<SubtreeTask>* tasks_;
-    int grain_, threads_;
+    int threads_;
 };
 
-std::vector<BuildRef> build_refs(const BvhBuildInput& mesh) {
+std::vector<BuildRef> build_refs(const BvhBuildInput& mesh, int threads) {
     std::vector<BuildRef> refs(mesh.triangles.size());
-    for (size_t i = 0; i < refs.size(); ++i) {
-        const Int3 t = mesh.triangles[i];
-        Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(mesh.vertices[size_t(t[k])]);
-        refs[i] = {b, b.center(), int32_t(i), {}};
-    }
+    parallel_for(int64_t(refs.size()), 8192, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const Int3 t = mesh.triangles[size_t(i)];
+            Bounds3 b;
+            for (int k = 0; k < 3; ++k) b.extend(mesh.vertices[size_t(t[k])]);
+            refs[size_t(i)] = {b, b.center(), int32_t(i), {}};
+        }
+    });
     return refs;
 }
 
@@ -344,10 +370,67 @@ int32_t splice(const std::vector<BvhNode>& top, int32_t t, std::vector<SubtreeTa
     return at;
 }
 
+/// The top of the tree, level by level, into `top` (children referenced by index; splice()
+/// puts them in pre-order): a level's nodes of more than kParallelBinning refs one after
+/// another, each binned on all threads, then its other nodes side by side, one thread each
+/// (they own disjoint ranges of refs). A node of at most `grain` refs becomes a SubtreeTask.
+/// Returns the root's child.
+BuiltChild build_top(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& top,
+                     std::vector<SubtreeTask>& tasks, int grain, int threads) {
+    struct Pending {
+        int begin, end, depth;
+        int32_t parent;  ///< its node in `top`, -1 for the root
+        int side;        ///< which child of it
+    };
+    std::vector<Pending> level{{0, int(refs.size()), 0, -1, 0}};
+    BuiltChild root;
+    while (!level.empty()) {
+        std::vector<TopSplit> done(level.size());
+        std::vector<size_t> small;
+        for (size_t k = 0; k < level.size(); ++k) {
+            const Pending& p = level[k];
+            if (p.end - p.begin > kParallelBinning) done[k] = Builder(refs, o, stats, top, threads).split_top(p.begin, p.end, p.depth, grain);
+            else small.push_back(k);
+        }
+        parallel_for(int64_t(small.size()), 1, threads, [&](int64_t k0, int64_t k1) {
+            for (int64_t k = k0; k < k1; ++k) {
+                const Pending& p = level[small[size_t(k)]];
+                done[small[size_t(k)]] = Builder(refs, o, stats, top).split_top(p.begin, p.end, p.depth, grain);
+            }
+        });
+        std::vector<Pending> next;
+        for (size_t k = 0; k < level.size(); ++k) {
+            const Pending& p = level[k];
+            const TopSplit& t = done[k];
+            const int count = p.end - p.begin;
+            BuiltChild child{t.box, p.begin, count};  // a leaf
+            if (t.kind == TopSplit::Leaf) {
+                ++stats.leaves;
+                stats.largest_leaf = std::max(stats.largest_leaf, count);
+            } else if (t.kind == TopSplit::Task) {
+                tasks.push_back({p.begin, p.end, p.depth, {}, {}});
+                child = {t.box, int32_t(tasks.size() - 1), kTaskChild};
+            } else {
+                stats.depth = std::max(stats.depth, p.depth + 1);
+                if (p.depth + 1 > kBvhMaxDepth)
+                    throw std::runtime_error("BVH build: depth exceeds kBvhMaxDepth = " + std::to_string(kBvhMaxDepth));
+                child = {t.box, int32_t(top.size()), 0};
+                top.emplace_back();
+                next.push_back({p.begin, t.mid, p.depth + 1, child.ref, 0});
+                next.push_back({t.mid, p.end, p.depth + 1, child.ref, 1});
+            }
+            if (p.parent < 0) root = child;
+            else write_child(top[size_t(p.parent)], p.side, child);
+        }
+        level = std::move(next);
+    }
+    return root;
+}
+
 /// The nodes of the whole tree in pre-order, and the root's child (a leaf if the mesh fits
-/// one). On one thread, one recursion; on several, the top of the tree first (its big nodes
-/// binned on all threads) down to subtrees of about n / (8 threads) refs, those subtrees on
-/// all threads, then spliced in pre-order.
+/// one). On one thread, one recursion; on several, the top of the tree first (build_top)
+/// down to subtrees of about n / (8 threads) refs, those subtrees on all threads, then
+/// spliced in pre-order.
 BuiltChild build_nodes(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats,
                        std::vector<BvhNode>& nodes) {
     const int n = int(refs.size());
@@ -356,7 +439,7 @@ BuiltChild build_nodes(std::vector<BuildRef>& refs, const BvhBuildOptions& o, Bv
     if (threads <= 1 || n <= grain) return Builder(refs, o, stats, nodes).build(0, n, 0);
     std::vector<SubtreeTask> tasks;
     std::vector<BvhNode> top;
-    const BuiltChild root = Builder(refs, o, stats, top, &tasks, grain, threads).build(0, n, 0);
+    const BuiltChild root = build_top(refs, o, stats, top, tasks, grain, threads);
     if (root.count > 0) return root;  // one leaf (max_leaf_size >= n); n > grain: never a task
     parallel_for(int64_t(tasks.size()), 1, threads, [&](int64_t k0, int64_t k1) {
         for (int64_t k = k0; k < k1; ++k) {
@@ -435,7 +518,8 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
     TriangleBvh bvh;
     bvh.float_bound = mesh.search_bound ? *mesh.search_bound
                                        : float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
-    std::vector<BuildRef> refs = build_refs(mesh);
+    const int threads = resolve_thread_count(options.threads);
+    std::vector<BuildRef> refs = build_refs(mesh, threads);
     const int n = int(refs.size());
     bvh.nodes.reserve(size_t(2 * n / std::max(1, options.max_leaf_size) + 1));
     // Nodes are numbered in pre-order, so the root is node 0; a mesh that fits one leaf gets
@@ -447,16 +531,18 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
         write_child(bvh.nodes[0], 1, BuiltChild{});
         bvh.stats.depth = 1;
     }
+    // The slots' triangles and their packed constants, gathered on every thread.
     bvh.triangle_index.resize(size_t(n));
-    for (int i = 0; i < n; ++i) bvh.triangle_index[size_t(i)] = refs[size_t(i)].triangle;
-    const auto& pf = mesh.packed_float;
-    const auto& pd = mesh.packed_double;
-    bvh.packed_float.reserve(size_t(n));  // reserve, not resize: no pass that clears them first
-    bvh.packed_double.reserve(size_t(n));
-    for (int i = 0; i < n; ++i) {
-        bvh.packed_float.push_back(pf[size_t(bvh.triangle_index[size_t(i)])]);
-        bvh.packed_double.push_back(pd[size_t(bvh.triangle_index[size_t(i)])]);
-    }
+    bvh.packed_float.resize(size_t(n));
+    bvh.packed_double.resize(size_t(n));
+    parallel_for(n, 8192, threads, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const int32_t t = refs[size_t(i)].triangle;
+            bvh.triangle_index[size_t(i)] = t;
+            bvh.packed_float[size_t(i)] = mesh.packed_float[size_t(t)];
+            bvh.packed_double[size_t(i)] = mesh.packed_double[size_t(t)];
+        }
+    });
     bvh.stats.nodes = int(bvh.nodes.size());
     bvh.stats.sah_cost = bvh_sah_cost(bvh.nodes, options.node_cost);
     bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

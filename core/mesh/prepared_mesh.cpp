@@ -330,8 +330,10 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
 
     if (options.detect_intersections && !out.triangles_.empty()) {
         // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.
-        out.bvh_slot_->tree = std::make_shared<const TriangleBvh>(build_triangle_bvh(out));
-        const SelfIntersections found = find_self_intersections(out, *out.bvh_slot_->tree, out.shell_of_);
+        BvhBuildOptions tree;
+        tree.threads = threads;
+        out.bvh_slot_->tree = std::make_shared<const TriangleBvh>(build_triangle_bvh(out, tree));
+        const SelfIntersections found = find_self_intersections(out, *out.bvh_slot_->tree, out.shell_of_, threads);
         out.intersecting_triangles_ = found.pairs;
         rep.intersections_checked = true;
         rep.self_intersecting_pairs = found.within_shell;

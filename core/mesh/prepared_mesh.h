@@ -28,8 +28,8 @@ struct MeshPreparationOptions {
     /// Look for intersecting triangle pairs (self-intersections, overlapping shells) with a
     /// BVH; costs about a BVH build (self_intersections.h).
     bool detect_intersections = true;
-    /// Threads of the preparation's passes (0 = all hardware threads); every result is the
-    /// same bytes at any count.
+    /// Threads of the preparation's passes, the BVH build and the self-intersection test
+    /// included (0 = all hardware threads); every result is the same bytes at any count.
     int threads = 0;
 };
 

@@ -198,11 +198,31 @@ void point_query_args(benchmark::internal::Benchmark* b) {
         ->ReportAggregatesOnly(true);
 }
 
+/// The host SAH build on range(0) threads (0: all), wall time.
 void BM_BvhBuild(benchmark::State& state, const std::string& file) {
     const auto mesh = load(file);
     if (!mesh) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
-    for (auto _ : state) benchmark::DoNotOptimize(build_triangle_bvh(*mesh).nodes.data());
+    BvhBuildOptions o;
+    o.threads = int(state.range(0));
+    for (auto _ : state) benchmark::DoNotOptimize(build_triangle_bvh(*mesh, o).nodes.data());
     state.counters["triangles"] = double(mesh->triangles().size());
+}
+
+/// prepare_mesh() of a loaded mesh on range(0) threads (0: all), wall time: welding,
+/// adjacency, pseudonormals, both precisions' buffers, the BVH and the self-intersection test.
+void BM_PrepareMesh(benchmark::State& state, const std::string& file) {
+    if (!load(file)) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    std::string dirs = std::getenv("SDF_DATA_PATH") ? std::getenv("SDF_DATA_PATH") : "";
+    dirs += std::string(":") + SDF_DATA_DIR_DEFAULT;
+    for (char& c : dirs) if (c == ';') c = ':';
+    std::stringstream ss(dirs);
+    TriangleMesh mesh;
+    for (std::string d; std::getline(ss, d, ':');)
+        if (!d.empty() && std::ifstream(d + "/" + file).good()) { mesh = load_obj(d + "/" + file); break; }
+    MeshPreparationOptions o;
+    o.threads = int(state.range(0));
+    for (auto _ : state) benchmark::DoNotOptimize(prepare_mesh(mesh, o).triangles().data());
+    state.counters["triangles"] = double(mesh.triangles.size());
 }
 
 /// The mesh of a GPU benchmark, or null after marking the benchmark skipped (no device, no file).
@@ -454,8 +474,10 @@ void cuda_args(benchmark::internal::Benchmark* b) {
     b->ArgNames({"res", "kernel", "double"})->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.5);
 }
 
-BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BvhBuild, bunny, std::string("bunny.obj"))->Arg(1)->Arg(0)->ArgName("threads")->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BvhBuild, dragon, std::string("dragon.obj"))->Arg(1)->Arg(0)->ArgName("threads")->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BvhBuild, dragon_legacy, std::string("dragon-legacy.obj"))->Arg(1)->Arg(0)->ArgName("threads")->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_PrepareMesh, dragon_legacy, std::string("dragon-legacy.obj"))->Arg(1)->Arg(0)->ArgName("threads")->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CpuBvh, bunny, std::string("bunny.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon, std::string("dragon.obj"))->Apply(cpu_args);
 BENCHMARK_CAPTURE(BM_CpuBvh, dragon_legacy, std::string("dragon-legacy.obj"))->Apply(cpu_args);
