@@ -1,7 +1,6 @@
 #include "core/bvh/triangle_bvh.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -92,9 +91,6 @@ struct BinGrid {
 /// kBinChunk refs, and merged in chunk order (the order of the refs, so the same bits).
 constexpr int kParallelBinning = 8192;
 constexpr int kBinChunk = 8192;
-/// Fewest threads on which a big node's box and partition are made in parallel (the
-/// partition reads the refs three times: on two threads one pass on one thread was faster).
-constexpr int kParallelPartitionThreads = 4;
 /// Fewest refs a subtree task gets (below it a task costs less than starting one).
 constexpr int kMinTaskRefs = 2048;
 /// Refs of a node from which its refs are binned into two sets of bins (bin_range()).
@@ -170,30 +166,12 @@ private:
         return mid;
     }
 
-    /// The node's box and the box of its refs' centroids; a big node's in chunks on all
-    /// threads (from kParallelPartitionThreads), merged in chunk order (the refs' order, so
-    /// the same bits: merged()).
+    /// The node's box and the box of its refs' centroids (one thread: a pass this short
+    /// gains nothing from more).
     void bounds(int begin, int end, Bounds3& box, Bounds3& centroids) const {
-        if (parallel(end - begin) && threads_ >= kParallelPartitionThreads) return parallel_bounds(begin, end, box, centroids);
         for (int i = begin; i < end; ++i) {
             box = merged(box, refs_[size_t(i)].box);
             centroids.extend(refs_[size_t(i)].centroid);
-        }
-    }
-
-    [[gnu::noinline]] void parallel_bounds(int begin, int end, Bounds3& box, Bounds3& centroids) const {
-        const int chunks = (end - begin + kBinChunk - 1) / kBinChunk;
-        std::vector<std::array<Bounds3, 2>> part(static_cast<size_t>(chunks));
-        parallel_for(chunks, 1, threads_, [&](int64_t k0, int64_t k1) {
-            for (int64_t k = k0; k < k1; ++k)
-                for (int i = begin + int(k) * kBinChunk; i < std::min(end, begin + int(k + 1) * kBinChunk); ++i) {
-                    part[size_t(k)][0] = merged(part[size_t(k)][0], refs_[size_t(i)].box);
-                    part[size_t(k)][1].extend(refs_[size_t(i)].centroid);
-                }
-        });
-        for (const auto& p : part) {
-            box = merged(box, p[0]);
-            centroids = merged(centroids, p[1]);
         }
     }
 
@@ -329,65 +307,11 @@ private:
         }
     }
 
-    /// The refs left of the split first, by the bins best_split() stored: std::partition's
-    /// order. A big node's on all threads, in the same order: std::partition (libstdc++'s,
-    /// for bidirectional iterators) swaps the k-th ref from the left that belongs right
-    /// with the k-th from the right that belongs left, until they meet at the split, so
-    /// the ranks of both (prefix counts over chunks) give every swap at once.
+    /// The refs left of the split first, by the bins best_split() stored.
     int partition(int begin, int end, const Split& s) {
-        // Three passes over the refs instead of one: worth it from kParallelPartitionThreads.
-        if (parallel(end - begin) && threads_ >= kParallelPartitionThreads) return parallel_partition(begin, end, s);
         auto first = refs_.begin() + begin, last = refs_.begin() + end;
         auto mid = std::partition(first, last, [&](const BuildRef& r) { return r.bin[s.axis] < s.bin; });
         return int(mid - refs_.begin());
-    }
-
-    [[gnu::noinline]] int parallel_partition(int begin, int end, const Split& s) {
-        const auto left = [&](const BuildRef& r) { return r.bin[s.axis] < s.bin; };
-        const int chunks = (end - begin + kBinChunk - 1) / kBinChunk;
-        auto chunk_begin = [&](int64_t k) { return begin + int(k) * kBinChunk; };
-        auto chunk_end = [&](int64_t k) { return std::min(end, begin + int(k + 1) * kBinChunk); };
-        std::vector<int> lefts(static_cast<size_t>(chunks));
-        parallel_for(chunks, 1, threads_, [&](int64_t k0, int64_t k1) {
-            for (int64_t k = k0; k < k1; ++k)
-                lefts[size_t(k)] = int(std::count_if(refs_.begin() + chunk_begin(k), refs_.begin() + chunk_end(k), left));
-        });
-        int mid = begin;
-        for (int c : lefts) mid += c;
-        // Per chunk: its refs before mid that belong right, its refs from mid on that belong left.
-        std::vector<int> wrong_left(static_cast<size_t>(chunks)), wrong_right(static_cast<size_t>(chunks));
-        parallel_for(chunks, 1, threads_, [&](int64_t k0, int64_t k1) {
-            for (int64_t k = k0; k < k1; ++k) {
-                int l = 0, r = 0;
-                for (int i = chunk_begin(k); i < chunk_end(k); ++i) {
-                    const bool goes_left = left(refs_[size_t(i)]);
-                    l += i < mid && !goes_left;
-                    r += i >= mid && goes_left;
-                }
-                wrong_left[size_t(k)] = l;
-                wrong_right[size_t(k)] = r;
-            }
-        });
-        // Ranks: from the left for the first kind, from the right for the second.
-        int swaps = 0;
-        std::vector<int> left_rank(static_cast<size_t>(chunks)), right_rank(static_cast<size_t>(chunks));
-        for (int k = 0; k < chunks; ++k) { left_rank[size_t(k)] = swaps; swaps += wrong_left[size_t(k)]; }
-        for (int k = chunks - 1, r = 0; k >= 0; --k) { right_rank[size_t(k)] = r; r += wrong_right[size_t(k)]; }
-        std::vector<int> from(static_cast<size_t>(swaps)), to(static_cast<size_t>(swaps));
-        parallel_for(chunks, 1, threads_, [&](int64_t k0, int64_t k1) {
-            for (int64_t k = k0; k < k1; ++k) {
-                int l = left_rank[size_t(k)], r = right_rank[size_t(k)] + wrong_right[size_t(k)];
-                for (int i = chunk_begin(k); i < chunk_end(k); ++i) {
-                    const bool goes_left = left(refs_[size_t(i)]);
-                    if (i < mid && !goes_left) from[size_t(l++)] = i;
-                    if (i >= mid && goes_left) to[size_t(--r)] = i;  // counted from the right
-                }
-            }
-        });
-        parallel_for(swaps, 4096, threads_, [&](int64_t k0, int64_t k1) {
-            for (int64_t k = k0; k < k1; ++k) std::swap(refs_[size_t(from[size_t(k)])], refs_[size_t(to[size_t(k)])]);
-        });
-        return mid;
     }
 
     /// Object median along the widest centroid axis: always splits, so the depth stays bounded.

@@ -144,8 +144,7 @@ double seconds_of_best_of_3(const std::function<void()>& f) {
 }
 
 // dragon-legacy (the 100k-triangle dragon of the timings in docs/bvh.md): the same tree on
-// 1, 2, 3 and 8 threads (from 4, big nodes make their boxes and partitions on all threads),
-// and both builds' wall times printed (never asserted).
+// 1, 2, 3 and 8 threads, and both builds' wall times printed (never asserted).
 TEST(SahBuild, SameTreeAsBeforeOnDragonLegacyWithTimes) {
     const std::string path = test::find_data_file("dragon-legacy.obj");
     if (path.empty()) GTEST_SKIP() << "dragon-legacy.obj not in SDF_DATA_PATH";
