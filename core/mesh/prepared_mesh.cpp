@@ -87,12 +87,12 @@ class EdgeUses {
 public:
     EdgeUses(const std::vector<Int3>& triangles, int num_vertices, int threads) {
         const size_t n = 3 * triangles.size();
-        std::vector<uint32_t> start(size_t(num_vertices) + 1, 0);
+        std::vector<size_t> start(size_t(num_vertices) + 1, 0);  // size_t: 3 uses a triangle
         for (const Int3& t : triangles)
             for (int e = 0; e < 3; ++e) ++start[size_t(std::min(t[e], t[(e + 1) % 3])) + 1];
         for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
         std::vector<Sorted> sorted(n);
-        std::vector<uint32_t> next(start.begin(), start.end() - 1);
+        std::vector<size_t> next(start.begin(), start.end() - 1);
         for (size_t i = 0; i < triangles.size(); ++i)
             for (int e = 0; e < 3; ++e) {
                 const int a = triangles[i][e], b = triangles[i][(e + 1) % 3];
