@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/bvh/triangle_bvh.h"
+#include "core/parallel/task_monitor.h"
 #include "core/sampling/certified_search.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler_results.h"
@@ -290,7 +291,12 @@ private:
             upload.begin();
             // The winding moments (on the host's threads, over this tree) while the tree and
             // the mesh go up: neither waits for the other.
-            std::future<void> sign = std::async(std::launch::async, [&] { sign_.prepare(mesh); });
+            // The caller's task monitor goes along: the sign's "auto" warning reaches Python's
+            // SdfWarning, and a stop request stops the moments.
+            std::future<void> sign = std::async(std::launch::async, [&, monitor = current_task_monitor()] {
+                const ScopedTaskMonitor scope(monitor);
+                sign_.prepare(mesh);
+            });
             std::unique_ptr<DeviceBvh<T>> dev;
             try {
                 dev = std::make_unique<DeviceBvh<T>>(*bvh, mesh);

@@ -14,6 +14,7 @@
 #include "core/mesh/exact_predicates.h"
 #include "core/mesh/self_intersections.h"
 #include "core/parallel/parallel_for.h"
+#include "core/parallel/task_monitor.h"
 
 namespace sdf {
 namespace {
@@ -98,10 +99,16 @@ public:
                 const int a = triangles[i][e], b = triangles[i][(e + 1) % 3];
                 sorted[next[size_t(std::min(a, b))]++] = {std::max(a, b), {int(i), e, a < b}};
             }
-        // Each vertex's uses by the larger id (stable), then the edges' first uses.
+        // Each vertex's uses by the larger id (stable), then the edges' first uses. A vertex
+        // has a handful of uses; one shared by many (a fan's centre) gets a merge sort.
         parallel_for(num_vertices, 4096, threads, [&](int64_t v0, int64_t v1) {
             for (int64_t v = v0; v < v1; ++v) {
                 const size_t lo = start[size_t(v)], hi = start[size_t(v) + 1];
+                if (hi - lo > 32) {
+                    std::stable_sort(sorted.begin() + ptrdiff_t(lo), sorted.begin() + ptrdiff_t(hi),
+                                     [](const Sorted& a, const Sorted& b) { return a.other < b.other; });
+                    continue;
+                }
                 for (size_t k = lo + 1; k < hi; ++k) {
                     const Sorted x = sorted[k];
                     size_t j = k;
@@ -321,7 +328,10 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     {
         // The two precisions' buffers at once, each pass on every thread.
         std::future<std::shared_ptr<MeshBuffers<float>>> floats =
-            std::async(std::launch::async, [&] { return make_buffers<float>(out, threads); });
+            std::async(std::launch::async, [&, monitor = current_task_monitor()] {
+                const ScopedTaskMonitor scope(monitor);  // the caller's stop requests
+                return make_buffers<float>(out, threads);
+            });
         out.double_buffers_ = make_buffers<double>(out, threads);
         out.float_buffers_ = floats.get();
     }

@@ -163,6 +163,10 @@ def main(argv=None):
         except (user_wait.UserWaitFileError, run_schema.RunFileError, run_schema.SchemaFileError) as e:
             print("make-report: error: %s" % e, file=sys.stderr)
             return 1
+        except overview.OverviewError as e:
+            print("make-report: error: %s: %s (make the whole report again instead: scripts/make-report%s)"
+                  % (os.path.join(args.output, "report.md"), e, " --publish" if args.publish else ""), file=sys.stderr)
+            return 1
         print("report: the section '%s' rewritten in %s" % (SECTION_HEADINGS[args.only_section], args.output))
         return 0
     try:

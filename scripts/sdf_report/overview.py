@@ -93,37 +93,55 @@ def section(doc, runs, repo):
     loaded = [r.name for r in runs if overloaded(r)]
     if loaded:
         doc.note(LOADED + ", ".join(loaded) + LOADED_TAIL)
+    if any(r.provenance["git"]["dirty"] for r in runs):
+        doc.note(DIRTY_TEXT)
+
+
+class OverviewError(Exception):
+    """An existing report's overview that cannot be read back (rewritten())."""
 
 
 def rewritten(doc, markdown, runs, repo):
     """Fills `doc` with the overview of an existing report (its Markdown) in which the entries
-    of `runs`' experiments are made from `runs`: their table rows (in place; a new experiment's
-    after the last), their published-run paragraphs and their names in the loaded-machine note.
-    The other experiments' entries, whose runs may no longer be on disk, are kept as written."""
-    begin = markdown.index("## %s\n" % HEADING)
+    of `runs`' experiments are made from `runs`: their table rows (where the experiment's
+    first row was; a new experiment's after the last), their published-run paragraphs and
+    their names in the loaded-machine note. The other experiments' entries, whose runs may no
+    longer be on disk, are kept as written. A report without an overview gets one of `runs`."""
+    begin = markdown.find("## %s\n" % HEADING)
+    if begin < 0:
+        section(doc, runs, repo)
+        return
     end = markdown.find("\n## ", begin)
     lines = markdown[begin:len(markdown) if end < 0 else end].split("\n")
     names = {r.name for r in runs}
     table, published, loaded = [], {}, []
-    for line in lines:
+    for number, line in enumerate(lines):
         if line.startswith("| ") and not line.startswith("| " + HEADER[0] + " |"):
-            table.append([c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line)[1:-1]])
+            cells = [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+            if len(cells) != len(HEADER):
+                raise OverviewError("the overview's table row %d has %d cells, expected %d (%s): %s"
+                                    % (len(table) + 1, len(cells), len(HEADER), ", ".join(HEADER), line))
+            table.append(cells)
         elif " is a published run (" in line and not line.startswith("> "):
-            published[line.split(" is a published run (", 1)[0]] = line
+            published.setdefault(line.split(" is a published run (", 1)[0], []).append(line)
         elif line.startswith("> " + LOADED):
             loaded = line[len("> " + LOADED):].split(LOADED_TAIL)[0].split(", ")
-    new_rows = {r.name: row(r) for r in runs}
+    new_rows = {}
+    for r in runs:
+        new_rows.setdefault(r.name, []).append(row(r))
     rows = []
     for cells in table:
         if cells[0] not in names:
             rows.append(cells)
-        elif cells[0] in new_rows:  # in its place
-            rows.append(new_rows.pop(cells[0]))
-    rows += list(new_rows.values())  # experiments the report did not have
+        elif cells[0] in new_rows:  # where the experiment's first row was
+            rows.extend(new_rows.pop(cells[0]))
+    for more in new_rows.values():  # experiments the report did not list
+        rows.extend(more)
+    for name in names:
+        published.pop(name, None)
     for r in runs:
-        published.pop(r.name, None)
         if r.published is not None:
-            published[r.name] = published_text(r, repo)
+            published.setdefault(r.name, []).append(published_text(r, repo))
     loaded = [n for n in loaded if n and n not in names] + [r.name for r in runs if overloaded(r)]
     doc.heading(2, HEADING)
     t = Table(HEADER)
@@ -131,9 +149,9 @@ def rewritten(doc, markdown, runs, repo):
         t.add(cells)
     doc.table(t)
     doc.paragraph(LOAD_TEXT)
-    for cells in rows:
-        if cells[0] in published:
-            doc.paragraph(published[cells[0]])
+    for name in dict.fromkeys(cells[0] for cells in rows):
+        for text in published.get(name, []):
+            doc.paragraph(text)
     if loaded:
         doc.note(LOADED + ", ".join(loaded) + LOADED_TAIL)
     if any("(dirty)" in cells[3] or cells[3].startswith("unknown") for cells in rows):

@@ -148,3 +148,48 @@ def test_only_section_peers_rewrites_that_section_from_the_runs_given(tmp_path):
     # no peers run: an error naming where it looked
     r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers")
     assert r.returncode != 0 and "no peers run under" in r.stderr
+
+
+def _mark_dirty(run):
+    path = os.path.join(run, "manifest.json")
+    with open(path) as f:
+        m = json.load(f)
+    m["provenance"]["git"]["dirty"] = True
+    with open(path, "w") as f:
+        json.dump(m, f)
+
+
+def test_overview_notes_dirty_runs_and_only_section_keeps_every_run_given(tmp_path):
+    fake_runs.full_tree(tmp_path / "results")
+    _mark_dirty(os.path.join(tmp_path / "results", "peers", "r1"))
+    out = tmp_path / "report"
+    assert make_report("--results", tmp_path / "results", "--output", out).returncode == 0
+    assert "> Runs marked dirty" in (out / "report.md").read_text()
+    # two peers runs given: both listed in the overview, where the peers row was
+    later = tmp_path / "later"
+    a = fake_runs.write_run(later, "peers", "peers", fake_runs.peers_metrics(), run_id="a", finished="2026-03-01T00:00:00Z")
+    b = fake_runs.write_run(later, "peers", "peers", fake_runs.peers_metrics(), run_id="b", finished="2026-03-02T00:00:00Z")
+    before = [line.split(" | ")[0] for line in (out / "report.md").read_text().split("\n## ", 2)[1].split("\n")
+              if line.startswith("| ")]
+    r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers", a, b)
+    assert r.returncode == 0, r.stderr
+    overview = (out / "report.md").read_text().split("\n## ", 2)[1]
+    names = [line.split(" | ")[0] for line in overview.split("\n") if line.startswith("| ")]
+    at = before.index("| peers")
+    assert names == before[:at] + ["| peers", "| peers"] + before[at + 1:]
+    assert "2026-03-01T000000Z-00000000" in overview and "2026-03-02T000000Z-00000000" in overview
+    assert "> Runs marked dirty" not in overview  # the dirty peers run is no longer listed
+
+
+def test_only_section_refuses_an_overview_it_cannot_read(tmp_path):
+    fake_runs.full_tree(tmp_path / "results")
+    out = tmp_path / "report"
+    assert make_report("--results", tmp_path / "results", "--output", out).returncode == 0
+    md = (out / "report.md").read_text()
+    md = md.replace("| peers | peers |", "| peers | peers | extra |", 1)
+    (out / "report.md").write_text(md)
+    run = os.path.join(tmp_path / "results", "peers", "r1")
+    r = make_report("--results", tmp_path / "empty", "--output", out, "--only-section", "peers", run)
+    assert r.returncode == 1
+    assert "report.md" in r.stderr and "expected 9" in r.stderr and "Traceback" not in r.stderr
+    assert (out / "report.md").read_text() == md  # left as it was

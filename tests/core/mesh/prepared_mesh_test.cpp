@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <random>
@@ -267,6 +268,18 @@ TriangleMesh every_case_mesh() {
     for (int k = 2; k < 6; ++k) m.triangles.push_back({fan, fan + 1, fan + k});
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
+    // A fan of 48 triangles around one vertex, in shuffled order, some reversed: a vertex with
+    // more uses than the adjacency's insertion sort takes (it merge-sorts those).
+    const int hub = int(m.vertices.size());
+    m.vertices.push_back({0, 0, 4});
+    for (int k = 0; k < 48; ++k) m.vertices.push_back({std::cos(k * 0.1309), std::sin(k * 0.1309), 4.0 + 0.01 * (k % 3)});
+    std::vector<Int3> fan_triangles;
+    for (int k = 0; k < 48; ++k) {
+        const int a = hub + 1 + k, b = hub + 1 + (k + 1) % 48;
+        fan_triangles.push_back(k % 5 == 0 ? Int3{hub, b, a} : Int3{hub, a, b});
+    }
+    std::shuffle(fan_triangles.begin(), fan_triangles.end(), rng);
+    m.triangles.insert(m.triangles.end(), fan_triangles.begin(), fan_triangles.end());
     const int soup = int(m.vertices.size());
     // Clusters of 8 vertices, 0.1 apart, with 24 triangles each over their own cluster: small
     // triangles whose edges are shared by 1, 2 or more of them, in either direction.
