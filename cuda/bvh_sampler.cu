@@ -284,8 +284,9 @@ private:
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
         // host_bvh_ holds the tree uploaded last, so no other mesh's tree can have its address.
         uploaded = !slot || host_bvh_ != bvh;
-        if (!uploaded) sign_.prepare(mesh);  // the same tree: its winding sign is kept
-        if (uploaded) {
+        if (!uploaded) {
+            sign_.prepare(mesh);  // the same tree: its winding sign is kept
+        } else {
             device_float_.reset();
             device_double_.reset();
             upload.begin();

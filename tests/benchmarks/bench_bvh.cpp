@@ -41,18 +41,24 @@
 namespace sdf {
 namespace {
 
-/// bunny.obj / dragon.obj from SDF_DATA_PATH or the build's default data directories.
-std::shared_ptr<PreparedMesh> load(const std::string& file) {
-    static std::map<std::string, std::shared_ptr<PreparedMesh>> cache;
-    if (cache.count(file)) return cache[file];
+/// The path of bunny.obj / dragon.obj in SDF_DATA_PATH or the build's default data
+/// directories; empty when none holds it.
+std::string find_mesh_file(const std::string& file) {
     std::string dirs = std::getenv("SDF_DATA_PATH") ? std::getenv("SDF_DATA_PATH") : "";
     dirs += std::string(":") + SDF_DATA_DIR_DEFAULT;
     for (char& c : dirs) if (c == ';') c = ':';
     std::stringstream ss(dirs);
     for (std::string d; std::getline(ss, d, ':');)
-        if (!d.empty() && std::ifstream(d + "/" + file).good())
-            return cache[file] = std::make_shared<PreparedMesh>(prepare_mesh(load_obj(d + "/" + file)));
-    return cache[file] = nullptr;
+        if (!d.empty() && std::ifstream(d + "/" + file).good()) return d + "/" + file;
+    return {};
+}
+
+/// That mesh, prepared once.
+std::shared_ptr<PreparedMesh> load(const std::string& file) {
+    static std::map<std::string, std::shared_ptr<PreparedMesh>> cache;
+    if (cache.count(file)) return cache[file];
+    const std::string path = find_mesh_file(file);
+    return cache[file] = path.empty() ? nullptr : std::make_shared<PreparedMesh>(prepare_mesh(load_obj(path)));
 }
 
 Lattice cubic_lattice(const PreparedMesh& mesh, int r) { return fit_lattice(LatticeType::CC, {r, r, r}, mesh.bounds(), 0.1); }
@@ -211,14 +217,9 @@ void BM_BvhBuild(benchmark::State& state, const std::string& file) {
 /// prepare_mesh() of a loaded mesh on range(0) threads (0: all), wall time: welding,
 /// adjacency, pseudonormals, both precisions' buffers, the BVH and the self-intersection test.
 void BM_PrepareMesh(benchmark::State& state, const std::string& file) {
-    if (!load(file)) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
-    std::string dirs = std::getenv("SDF_DATA_PATH") ? std::getenv("SDF_DATA_PATH") : "";
-    dirs += std::string(":") + SDF_DATA_DIR_DEFAULT;
-    for (char& c : dirs) if (c == ';') c = ':';
-    std::stringstream ss(dirs);
-    TriangleMesh mesh;
-    for (std::string d; std::getline(ss, d, ':');)
-        if (!d.empty() && std::ifstream(d + "/" + file).good()) { mesh = load_obj(d + "/" + file); break; }
+    const std::string path = find_mesh_file(file);
+    if (path.empty()) { state.SkipWithError((file + " not found: set SDF_DATA_PATH").c_str()); return; }
+    const TriangleMesh mesh = load_obj(path);
     MeshPreparationOptions o;
     o.threads = int(state.range(0));
     for (auto _ : state) benchmark::DoNotOptimize(prepare_mesh(mesh, o).triangles().data());
