@@ -44,13 +44,14 @@ Mesh surface_mesh(const PreparedMesh& m) {
 
 class CgalPeer final : public PeerAdapter {
 public:
-    std::string name() const override { return "cgal"; }
     std::string version() const override { return CGAL_VERSION_STR; }
-    bool exact() const override { return true; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice&, const std::vector<Vec3d>& points, int threads) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
+        const int threads = in.threads;
         PeerResult r;
-        r.is_signed = true;
+        r.sign = SignKind::Own;
         r.threads = threads;
         auto start = std::chrono::steady_clock::now();
         std::vector<Triangle> triangles;

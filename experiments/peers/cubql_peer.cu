@@ -67,12 +67,11 @@ constexpr int kTimedBuilds = 3;  // build_seconds is their median
 
 class CubqlPeer final : public PeerAdapter {
 public:
-    std::string name() const override { return "cubql"; }
     std::string version() const override { return std::string("snapshot ") + SDF_CUBQL_COMMIT; }
-    bool exact() const override { return true; }
-    bool on_gpu() const override { return true; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice&, const std::vector<Vec3d>& points, int) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
         PeerResult r;
         r.threads = 0;
         const int triangles = int(mesh.triangles().size());
@@ -141,6 +140,7 @@ public:
         cuBQL::cuda::free(bvh);
 
         r.query_seconds = 1e-3 * double(ms);
+        r.end_to_end_seconds = upload + r.query_seconds + download;
         r.distance.assign(host_distance.begin(), host_distance.end());
         cudaDeviceProp prop{};
         int device = 0;
@@ -150,7 +150,6 @@ public:
                      {"precision", "float"},
                      {"builder", "cuBQL::gpuBuilder, BuildConfig().enableSAH() (binary BVH)"},
                      {"query", "triangles::CPAT::runQuery, one thread per point, blocks of 128 (samples/s02)"},
-                     {"end_to_end_seconds", upload + r.query_seconds + download},
                      {"upload_seconds", upload},
                      {"download_seconds", download},
                      {"device", prop.name}};

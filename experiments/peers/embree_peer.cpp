@@ -79,11 +79,12 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 class EmbreePeer final : public PeerAdapter {
 public:
-    std::string name() const override { return "embree"; }
     std::string version() const override { return RTC_VERSION_STRING; }
-    bool exact() const override { return true; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice&, const std::vector<Vec3d>& points, int threads) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
+        const int threads = in.threads;
         PeerResult r;
         r.threads = threads;
         auto start = std::chrono::steady_clock::now();

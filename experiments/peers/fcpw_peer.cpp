@@ -33,11 +33,12 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 class FcpwPeer final : public PeerAdapter {
 public:
-    std::string name() const override { return "fcpw"; }
     std::string version() const override { return std::string("snapshot ") + SDF_FCPW_COMMIT + " (Enoki, SIMD width " + std::to_string(FCPW_SIMD_WIDTH) + ")"; }
-    bool exact() const override { return true; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice&, const std::vector<Vec3d>& points, int threads) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
+        const int threads = in.threads;
         PeerResult r;
         r.threads = threads;
         auto start = std::chrono::steady_clock::now();

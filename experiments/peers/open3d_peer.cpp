@@ -54,11 +54,12 @@ public:
         version_ = run_command(python_ + " -c 'import open3d; print(open3d.__version__, end=\"\")' 2>/dev/null");
     }
 
-    std::string name() const override { return "open3d"; }
     std::string version() const override { return version_; }
-    bool exact() const override { return true; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice&, const std::vector<Vec3d>& points, int threads) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
+        const int threads = in.threads;
         char dir_template[] = "/tmp/sdf-open3d-XXXXXX";
         if (!mkdtemp(dir_template)) throw std::runtime_error("open3d peer: mkdtemp failed");
         const std::string dir = dir_template;
@@ -80,7 +81,7 @@ public:
         std::filesystem::remove_all(dir);
 
         PeerResult r;
-        r.is_signed = true;
+        r.sign = SignKind::Own;
         r.threads = j["threads"].get<int>();
         r.build_seconds = j["build_seconds"].get<double>();
         r.query_seconds = j["signed_seconds"].get<double>();

@@ -32,14 +32,16 @@ public:
         std::call_once(once, [] { openvdb::initialize(); });
     }
 
-    std::string name() const override { return "openvdb"; }
     std::string version() const override { return openvdb::getLibraryVersionString(); }
-    bool exact() const override { return false; }
 
-    PeerResult run(const PreparedMesh& mesh, const Lattice& lattice, const std::vector<Vec3d>& points, int threads) override {
+    PeerResult run(const PeerInput& in) override {
+        const PreparedMesh& mesh = *in.mesh;
+        const std::vector<Vec3d>& points = *in.points;
+        const int threads = in.threads;
+        const Lattice& lattice = *in.lattice;
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
         PeerResult r;
-        r.is_signed = true;
+        r.sign = SignKind::Own;
         r.threads = threads;
         auto start = std::chrono::steady_clock::now();
         openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(lattice.spacing);
