@@ -314,7 +314,7 @@ private:
         for (int t : thread_counts) {
             input.threads = resolve_thread_count(t);
             peers::PeerResult r;
-            std::vector<double> build, query, end_to_end, cpu;
+            std::vector<double> build, query, end_to_end, cpu, build_cpu;
             for (int k = 0; k < repetitions_; ++k) {
                 const double cpu0 = peers::process_cpu_seconds();
                 r = m.adapter->run(input);
@@ -322,6 +322,7 @@ private:
                 query.push_back(r.query_seconds);
                 end_to_end.push_back(r.end_to_end_seconds);
                 cpu.push_back(r.cpu_seconds >= 0 ? r.cpu_seconds : peers::process_cpu_seconds() - cpu0);
+                build_cpu.push_back(r.build_cpu_seconds);
             }
             if (kind.name == std::string(reference_of(set.point_set)) && reference.empty()) reference = r.distance;
             nlohmann::json row_t = row;
@@ -336,7 +337,8 @@ private:
                 if (r.end_to_end_seconds >= 0) row_t["end_to_end_seconds"] = median_of(end_to_end) * scale;
             } else {
                 row_t["threads"] = r.threads;
-                row_t["cpu_seconds"] = median_of(cpu) * scale;  // a strided row's build is scaled too (brute force: tiny)
+                // A strided row's query scales to the set, its build does not.
+                row_t["cpu_seconds"] = median_of(build_cpu) + (median_of(cpu) - median_of(build_cpu)) * scale;
             }
             // The row's sign: ours, what the mode resolved to; a peer's, its table row's (checked).
             if (kind.sign != peers::SignKind::Mode && r.sign != kind.sign)

@@ -116,6 +116,7 @@ public:
             r.end_to_end_seconds = seconds_since(start);
             r.query_seconds = timings.kernel;
         }
+        r.build_cpu_seconds = cpu;
         r.cpu_seconds = cpu + process_cpu_seconds() - cpu0;
         r.notes = std::string(sampler_.about) + "; sign " + sdf->sign_mode() + "; build: the construction of MeshSdf" +
                   (host_tree ? " + the mesh's host BVH build" : "");

@@ -61,6 +61,7 @@ struct PeerResult {
     double end_to_end_seconds = -1; ///< GPU methods: the query with the points' and results' transfers; < 0: none
     int threads = 1;                ///< threads the method actually used
     double cpu_seconds = -1;        ///< CPU time of build + query over all threads, if the adapter measures it (else the loop does)
+    double build_cpu_seconds = 0;   ///< the build's part of cpu_seconds, where known (a strided row scales only the rest)
     std::string notes;              ///< what the row's times and reference mean (our rows)
     nlohmann::json details = nlohmann::json::object();  ///< band width, sign method, split times
     bool is_signed() const { return sign != SignKind::None; }

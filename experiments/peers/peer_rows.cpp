@@ -112,17 +112,7 @@ std::vector<Json> summarise_case(const Json& rows, const std::string& label, con
         const Json* mine = fastest(ours_passing);
         const Json* best = fastest(peers_passing);
         if (!mine || !best) {
-            std::string why;
-            if (!mine) {
-                why = "no row of ours passes its check (";
-                for (size_t k = 0; k < excluded.size(); ++k)
-                    why += (k ? "; " : "") + excluded[k]["method"].get<std::string>() + " [" + excluded[k]["sign"].get<std::string>() +
-                           "]: " + excluded[k]["check"].get<std::string>();
-                why += ")";
-            } else {
-                why = "no peer passes its check";
-            }
-            s["not_compared"] = why;
+            s["not_compared"] = !mine ? "no row of ours passes its check" : "no peer passes its check";
             out.push_back(s);
             continue;
         }
@@ -155,18 +145,18 @@ std::string summary_text(const Json& s) {
     std::string text;
     if (s.contains("not_compared")) {
         text = "    => no comparison, " + where + ": " + s["not_compared"].get<std::string>() + "\n";
-        return text;
-    }
-    std::snprintf(line, sizeof line, "    => %s [%s] vs fastest exact peer %s [%s], %s: %.2fx query, %.2fx build+query (goal %.1fx)\n",
-                  s["ours"].get<std::string>().c_str(), s["ours_sign"].get<std::string>().c_str(),
-                  s["fastest_exact_peer"].get<std::string>().c_str(), s["fastest_exact_peer_sign"].get<std::string>().c_str(),
-                  where.c_str(), s["query_speedup"].get<double>(), s["total_speedup"].get<double>(), s["goal"].get<double>());
-    text = line;
-    if (s.contains("fastest_exact_signed_peer") && s["fastest_exact_signed_peer"] != s["fastest_exact_peer"]) {
-        std::snprintf(line, sizeof line, "       fastest exact signed peer %s [%s]: %.2fx query\n",
-                      s["fastest_exact_signed_peer"].get<std::string>().c_str(),
-                      s["fastest_exact_signed_peer_sign"].get<std::string>().c_str(), s["query_speedup_vs_signed"].get<double>());
-        text += line;
+    } else {
+        std::snprintf(line, sizeof line, "    => %s [%s] vs fastest exact peer %s [%s], %s: %.2fx query, %.2fx build+query (goal %.1fx)\n",
+                      s["ours"].get<std::string>().c_str(), s["ours_sign"].get<std::string>().c_str(),
+                      s["fastest_exact_peer"].get<std::string>().c_str(), s["fastest_exact_peer_sign"].get<std::string>().c_str(),
+                      where.c_str(), s["query_speedup"].get<double>(), s["total_speedup"].get<double>(), s["goal"].get<double>());
+        text = line;
+        if (s.contains("fastest_exact_signed_peer") && s["fastest_exact_signed_peer"] != s["fastest_exact_peer"]) {
+            std::snprintf(line, sizeof line, "       fastest exact signed peer %s [%s]: %.2fx query\n",
+                          s["fastest_exact_signed_peer"].get<std::string>().c_str(),
+                          s["fastest_exact_signed_peer_sign"].get<std::string>().c_str(), s["query_speedup_vs_signed"].get<double>());
+            text += line;
+        }
     }
     if (s.contains("excluded"))
         for (const Json& e : s["excluded"])

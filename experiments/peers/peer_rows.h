@@ -51,7 +51,7 @@ std::string sign_label(const nlohmann::json& row);
 /// every point) against the fastest peer that passes, query and build + query, the fastest
 /// signed peer beside it, every side's sign, and our rows that fail their check ("excluded":
 /// never the basis of a ratio). Where no row of ours passes, the entry has no ratios and says
-/// why ("not_compared"), as where no peer passes. Keys with no row of ours or no peer row are
+/// so ("not_compared"), as where no peer passes. Keys with no row of ours or no peer row are
 /// left out. `goal` is the speedup the case aims at.
 std::vector<nlohmann::json> summarise_case(const nlohmann::json& rows, const std::string& label, const std::string& resolution,
                                            const std::vector<nlohmann::json>& thread_keys, double goal);
