@@ -5,8 +5,24 @@ Open3D, OpenVDB, FCPW, cuBQL), on lattices and on arbitrary point sets, from "pe
 from .overview import machine
 from .tables import Table, count, number, rate
 
-HEADER = ["mesh, points", "method", "by", "threads", "build (s)", "query (s)", "CPU (s)", "points/s", "max |d error|",
+HEADER = ["mesh, points", "method", "by", "threads", "sign", "build (s)", "query (s)", "CPU (s)", "points/s", "max |d error|",
           "sign disagreements", "passes check", "notes"]
+
+
+def sign_label(row):
+    """The row's sign: pseudonormal, winding, unsigned, or the peer's own rule (as the
+    experiment's sign_label, experiments/peers/peer_rows.cpp); runs from before "sign" was
+    recorded: signed or unsigned."""
+    sign = row.get("sign")
+    if sign is None:
+        if "signed" in row:
+            return "signed" if row["signed"] else "unsigned"
+        return "unsigned" if isinstance(row.get("sign_disagreements"), str) else "signed"
+    if sign == "none":
+        return "unsigned"
+    if sign == "own":
+        return "own: " + row.get("sign_method", "?")
+    return sign
 
 
 def _check(row):
@@ -36,9 +52,9 @@ def rows_table(metrics):
         where = "%s %s" % (row["mesh"], row["resolution"])
         method = row["method"] + (" " + row["version"] if "version" in row else "")
         if "status" in row:
-            table.add([where, method, row["by"], "-", "-", "-", "-", "-", "-", "-", "-", row["status"]])
+            table.add([where, method, row["by"], "-", "-", "-", "-", "-", "-", "-", "-", "-", row["status"]])
             continue
-        table.add([where, method, row["by"], str(row["threads"]), number(row["build_seconds"]),
+        table.add([where, method, row["by"], str(row["threads"]), sign_label(row), number(row["build_seconds"]),
                    number(row["query_seconds"]), number(row["cpu_seconds"]) if "cpu_seconds" in row else "-",
                    rate(row["points_per_second"]), number(row["max_abs_error"]), str(row["sign_disagreements"]),
                    _check(row), _notes(row)])
@@ -46,30 +62,56 @@ def rows_table(metrics):
 
 
 def _fastest(s, checked):
-    """The fastest exact peer, saying when it returns no sign or when exactness was not checked."""
+    """The fastest exact peer with its sign, or the older runs' notes (exactness not checked,
+    unsigned)."""
     name = s["fastest_exact_peer"]
     if not checked:
         return name + " (exactness not checked: run before passes_check)"
+    if "fastest_exact_peer_sign" in s:
+        return "%s [%s]" % (name, s["fastest_exact_peer_sign"])
     if s.get("fastest_exact_peer_signed") is False:
         return name + " (unsigned: returns no sign)"
     return name
 
 
+def _ours(s):
+    """Our row of the comparison with its sign; older runs' summaries could rest on a row that
+    failed its check, which is said."""
+    ours = s.get("ours", "bvh_cpu")
+    if "ours_sign" in s:
+        ours += " [%s]" % s["ours_sign"]
+    if s.get("ours_passes_check") is False:
+        ours += " (fails check: %s)" % s.get("ours_check", "?")
+    return ours
+
+
+def _excluded(s):
+    return "; ".join("%s [%s]: %s" % (e["method"], e["sign"], e["check"]) for e in s.get("excluded", [])) or "-"
+
+
 def summary_table(metrics):
-    """Our BVH against the fastest peer that passes the check (same points, same threads)."""
+    """Our fastest row that passes its check against the fastest peer that passes (same points,
+    same threads); where none of ours passes, no ratio (not_compared)."""
     checked = any("passes_check" in row for row in metrics["rows"])
     table = Table(["mesh, points", "threads", "ours", "fastest exact peer", "speedup (query)", "speedup (build + query)",
-                   "CPU-time ratio", "goal", "fastest exact signed peer (query speedup)"])
+                   "CPU-time ratio", "goal", "fastest exact signed peer (query speedup)",
+                   "our rows that fail their check (not compared)"])
     for s in metrics.get("summary", []):
-        signed = ("%s (%s)" % (s["fastest_exact_signed_peer"], number(s["query_speedup_vs_signed"]))
-                  if "fastest_exact_signed_peer" in s else "-")
-        ours = s.get("ours", "bvh_cpu")
-        if s.get("ours_passes_check") is False:
-            ours += " (fails check: %s)" % s.get("ours_check", "?")
-        table.add(["%s %s" % (s["mesh"], s["resolution"]), str(s["threads"]), ours, _fastest(s, checked),
+        where = "%s %s" % (s["mesh"], s["resolution"])
+        if "not_compared" in s:
+            table.add([where, str(s["threads"]), "-", "not compared: " + s["not_compared"], "-", "-", "-", number(s["goal"]),
+                       "-", _excluded(s)])
+            continue
+        signed = "-"
+        if "fastest_exact_signed_peer" in s:
+            peer = s["fastest_exact_signed_peer"]
+            if "fastest_exact_signed_peer_sign" in s:
+                peer += " [%s]" % s["fastest_exact_signed_peer_sign"]
+            signed = "%s (%s)" % (peer, number(s["query_speedup_vs_signed"]))
+        table.add([where, str(s["threads"]), _ours(s), _fastest(s, checked),
                    number(s["query_speedup"]) + (" (end to end)" if s.get("compared_time") == "end_to_end_seconds" else ""),
                    number(s["total_speedup"]),
-                   number(s["cpu_time_ratio"]) if "cpu_time_ratio" in s else "-", number(s["goal"]), signed])
+                   number(s["cpu_time_ratio"]) if "cpu_time_ratio" in s else "-", number(s["goal"]), signed, _excluded(s)])
     return table
 
 
@@ -96,8 +138,10 @@ def section(doc, runs):
                   "exact field (the CPU BVH, equal to brute force; on point sets our CPU BVH query, checked against "
                   "the brute force on strided points). 'passes check' = max |d error| within the run's tolerance "
                   "(1e-5 x the bounding-box diagonal) and, for signed methods, no wrong sign farther than that from "
-                  "the surface; unsigned peers pass as 'yes (unsigned)', and the summary says when the fastest peer "
-                  "returns no sign. CPU (s) = process CPU time of build + query over all threads (robust to other load "
+                  "the surface; unsigned peers pass as 'yes (unsigned)'. The summary compares only rows that pass their "
+                  "checks (our rows that fail are listed beside it, never the basis of a ratio; runs before this rule "
+                  "say 'fails check' where theirs was), and names every side's sign: pseudonormal, winding, unsigned, "
+                  "or the peer's own rule. CPU (s) = process CPU time of build + query over all threads (robust to other load "
                   "on a shared machine). GPU rows are CUDA-event times of the query with the points on the device "
                   "(our point-set GPU rows: the device time of the Morton sort, search and finalize; 'end to end' = with "
                   "transfers); 'unavailable' = no GPU on the machine of the run; 'not built' = the peer's package or "

@@ -223,6 +223,52 @@ def peers_point_set_metrics():
             "regression": {"dragon/uniform_box/1000/2/bvh_cpu_vs_fastest_peer": {"value": 3.0, "kind": "speedup"}}}
 
 
+def peers_honest_metrics():
+    """A point-set run whose rows record their sign and whose summary compares only rows that
+    pass their checks: our pseudonormal row fails (18 wrong signs), the exact-sign row is the
+    basis at 16 threads, and at 1 thread nothing of ours passes."""
+    base = {"mesh": "dragon", "resolution": "gaussian_surface(0.01)/1000", "points": 1000, "triangles": 100000,
+            "point_set": {"kind": "gaussian_surface", "count": 1000, "sigma": 0.01, "seed": 2}}
+    wrong = "18 wrong signs farther than the tolerance"
+
+    def timed(method, by, threads, query, sign, passes, check, **extra):
+        row = dict(base, method=method, by=by, threads=threads, build_seconds=0.1, query_seconds=query,
+                   total_seconds=0.1 + query, points_per_second=1000 / query, cpu_seconds=query, max_abs_error=0.0,
+                   max_abs_error_unsigned=0.0, mean_abs_error=0.0, compared_points=1000, check_tolerance=1e-4,
+                   sign=sign, signed=sign != "none", passes_check=passes, check=check, exact=True,
+                   sign_disagreements="n/a (unsigned)" if sign == "none" else (0 if passes else 18), **extra)
+        if sign != "none":
+            row["sign_disagreements_beyond_tolerance"] = 0 if passes else 18
+        return row
+
+    rows = [timed("bvh_cpu_exact_sign", "ours", 16, 3.53, "winding", True, "exact, signed", notes="the reference"),
+            timed("bvh_cpu", "ours", 16, 1.0, "pseudonormal", False, wrong, notes="sign pseudonormal"),
+            timed("fcpw", "peer", 16, 3.03, "none", True, "exact, unsigned (no sign returned)", version="snapshot abc",
+                  details={}),
+            timed("cgal", "peer", 16, 20.0, "own", False, "5 wrong signs", version="5.5.1", details={},
+                  sign_method="Side_of_triangle_mesh (ray casting)"),
+            timed("bvh_cpu", "ours", 1, 8.0, "pseudonormal", False, wrong, notes="sign pseudonormal"),
+            timed("fcpw", "peer", 1, 40.0, "none", True, "exact, unsigned (no sign returned)", version="snapshot abc",
+                  details={})]
+    excluded = [{"method": "bvh_cpu", "sign": "pseudonormal", "check": wrong}]
+    summary = [{"mesh": "dragon", "resolution": base["resolution"], "threads": 16, "goal": 3.0, "excluded": excluded,
+                "ours": "bvh_cpu_exact_sign", "ours_sign": "winding", "ours_passes_check": True,
+                "fastest_exact_peer": "fcpw", "fastest_exact_peer_signed": False, "fastest_exact_peer_sign": "unsigned",
+                "compared_time": "query_seconds", "query_speedup": 3.03 / 3.53, "total_speedup": 3.13 / 3.63,
+                "cpu_time_ratio": 3.03 / 3.53},
+               {"mesh": "dragon", "resolution": base["resolution"], "threads": 1, "goal": 3.0, "excluded": excluded,
+                "not_compared": "no row of ours passes its check"}]
+    return {"peers": {"fcpw": {"version": "snapshot abc", "exact": True, "gpu": False, "sign": "none", "sign_method": ""},
+                      "cgal": {"version": "5.5.1", "exact": True, "gpu": False, "sign": "own",
+                               "sign_method": "Side_of_triangle_mesh (ray casting)"}},
+            "machine": {"hardware_threads": 16}, "meshes": {"dragon": mesh("dragon", "/x/dragon.obj", 100000, 50000)},
+            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh.md", "our_sign": "auto",
+                      "our_sign_point_sets": "pseudonormal"},
+            "rows": rows, "summary": summary,
+            "regression": {"dragon/gaussian_surface(0.01)/1000/16/bvh_cpu_exact_sign_vs_fastest_peer":
+                           {"value": 3.03 / 3.53, "kind": "speedup"}}}
+
+
 def write_run(results, name, kind, metrics, run_id="r1", **manifest_args):
     """results/<name>/<run_id>/ with manifest.json and metrics.json; returns its path."""
     path = os.path.join(str(results), name, run_id)

@@ -14,6 +14,8 @@ from sdf_report import runs
     ("speedup", fake_runs.speedup_metrics()),
     ("analytic", fake_runs.analytic_metrics()),
     ("peers", fake_runs.peers_metrics()),
+    ("peers", fake_runs.peers_point_set_metrics()),
+    ("peers", fake_runs.peers_honest_metrics()),
 ])
 def test_fake_runs_match_the_schema_strictly(schema, kind, metrics):
     runs.validate(fake_runs.manifest("x", kind), metrics, "manifest.json", "metrics.json", schema, strict=True)

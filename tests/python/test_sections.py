@@ -130,9 +130,11 @@ def test_missing_grid_image_is_a_note(tmp_path, schema):
 def test_peers_rows_status_rows_and_summary(tmp_path, schema):
     run = load(tmp_path, schema, "peers", "peers", fake_runs.peers_metrics())
     md = render(peers.section, tmp_path, [run])
-    assert "| bunny 64x64x64 | bvh_cpu | ours | 2 | 0.05 | 0.5 | 1 | 5.24e+05 | 0 | 0 | - |  |" in md
-    assert "| bunny 64x64x64 | bvh_gpu | ours | - | - | - | - | - | - | - | - | unavailable (no CUDA device" in md
-    assert "| bunny 64x64x64 | embree 4.0 | peer | 2 | 0.1 | 2.5 | 5 | 1.05e+05 | 1.000e-07 | n/a (unsigned) | - |  |" in md
+    # a run from before rows recorded their sign: signed or unsigned, from the sign disagreements
+    assert "| bunny 64x64x64 | bvh_cpu | ours | 2 | signed | 0.05 | 0.5 | 1 | 5.24e+05 | 0 | 0 | - |  |" in md
+    assert "| bunny 64x64x64 | bvh_gpu | ours | - | - | - | - | - | - | - | - | - | unavailable (no CUDA device" in md
+    assert ("| bunny 64x64x64 | embree 4.0 | peer | 2 | unsigned | 0.1 | 2.5 | 5 | 1.05e+05 | 1.000e-07 | n/a (unsigned) "
+            "| - |  |") in md
     assert "narrow band: max \\|d error\\| 0.001 inside (1,000 points), 0.25 outside" in md
     # A run from before passes_check: the summary says its fastest peer was not checked.
     assert ("| bunny 64x64x64 | 2 | bvh_cpu | embree (exactness not checked: run before passes_check) | 5 | 4.75 | 5 | "
@@ -148,6 +150,22 @@ def test_peers_point_sets_check_column_and_unsigned_fastest_peer(tmp_path, schem
     assert "| dragon uniform_box/1000 | 2 | bvh_cpu | fcpw (unsigned: returns no sign) | 3 | 2.33 | 2.33 | 3 | - |" in md
     assert "| 1 | bvh_cpu (fails check: 3 wrong signs farther than the tolerance from the surface) | fcpw" in md
     assert "not built: this build has no CUDA backend" in md
+
+
+def test_peers_summary_compares_only_rows_that_pass_and_names_every_sign(tmp_path, schema):
+    run = load(tmp_path, schema, "peers", "peers", fake_runs.peers_honest_metrics())
+    md = render(peers.section, tmp_path, [run])
+    # every row says its sign
+    assert "| dragon gaussian_surface(0.01)/1000 | bvh_cpu | ours | 16 | pseudonormal | 0.1 | 1 |" in md
+    assert "| bvh_cpu_exact_sign | ours | 16 | winding |" in md
+    assert "| fcpw snapshot abc | peer | 16 | unsigned |" in md
+    assert "| cgal 5.5.1 | peer | 16 | own: Side_of_triangle_mesh (ray casting) |" in md
+    # the ratio rests on the exact-sign row, the failing pseudonormal row is listed beside it
+    assert ("| dragon gaussian_surface(0.01)/1000 | 16 | bvh_cpu_exact_sign [winding] | fcpw [unsigned] | 0.8584 | 0.8623 "
+            "| 0.8584 | 3 | - | bvh_cpu [pseudonormal]: 18 wrong signs farther than the tolerance |") in md
+    # no row of ours passes at 1 thread: no ratio
+    assert ("| dragon gaussian_surface(0.01)/1000 | 1 | - | not compared: no row of ours passes its check | - | - | - | 3 "
+            "| - | bvh_cpu [pseudonormal]: 18 wrong signs farther than the tolerance |") in md
 
 
 def test_a_grid_that_marks_its_twin_briefly_is_labelled_once_in_full():
