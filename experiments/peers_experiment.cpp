@@ -267,6 +267,9 @@ private:
             if (selected(*m.kind, set.point_set)) time_method(ctx, label, mesh, set, points, m, reference);
         std::vector<nlohmann::json> thread_keys;
         for (int t : threads_) thread_keys.push_back(resolve_thread_count(t));
+        // All cores too: the exact-sign reference runs there whatever "threads" says.
+        const nlohmann::json all_cores = resolve_thread_count(0);
+        if (std::count(thread_keys.begin(), thread_keys.end(), all_cores) == 0) thread_keys.push_back(all_cores);
         thread_keys.push_back("GPU");
         for (const nlohmann::json& s : peers::summarise_case(ctx.metrics["rows"], label, set.name, thread_keys, goal)) {
             *ctx.log << peers::summary_text(s);
