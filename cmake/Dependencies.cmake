@@ -80,7 +80,13 @@ if(NOT SDF_ENABLE_CUDA STREQUAL "OFF")
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
-      set(CMAKE_CUDA_ARCHITECTURES 90 CACHE STRING "CUDA architectures (90 = H100/H200)")
+      # Every current NVIDIA GPU: machine code for Turing (75: T4, RTX 20xx), Ampere (80: A100;
+      # 86: A10, RTX 30xx), Ada (89: L4, L40, RTX 40xx) and Hopper (90: H100, H200), and PTX of
+      # 90 that the driver compiles for newer GPUs (Blackwell) on first use. The code uses no
+      # architecture-specific instruction, so every entry runs the same kernels. One
+      # architecture builds faster: -DCMAKE_CUDA_ARCHITECTURES=90 (or native).
+      set(CMAKE_CUDA_ARCHITECTURES "75-real;80-real;86-real;89-real;90-real;90-virtual"
+          CACHE STRING "CUDA architectures: machine code for sm_75 to sm_90, PTX for newer GPUs")
     endif()
     enable_language(CUDA)
     find_package(CUDAToolkit REQUIRED)

@@ -45,6 +45,15 @@ endmacro()
 
 if(SDF_HAVE_CUDA)
   _sdf_part(cuda ON "CUDA ${CMAKE_CUDA_COMPILER_VERSION} (${CMAKE_CUDA_COMPILER}), architectures ${CMAKE_CUDA_ARCHITECTURES}; a GPU is used when present")
+  # The architectures as a list ("90-real": machine code for sm_90, "90-virtual": PTX that
+  # newer GPUs compile when they load it), so that a caller can check its GPU against it.
+  set(_sdf_archs "[]")
+  set(_sdf_i 0)
+  foreach(_sdf_arch IN LISTS CMAKE_CUDA_ARCHITECTURES)
+    string(JSON _sdf_archs SET "${_sdf_archs}" ${_sdf_i} "\"${_sdf_arch}\"")
+    math(EXPR _sdf_i "${_sdf_i} + 1")
+  endforeach()
+  string(JSON _sdf_parts SET "${_sdf_parts}" cuda architectures "${_sdf_archs}")
 elseif(SDF_ENABLE_CUDA STREQUAL "OFF")
   _sdf_part(cuda OFF "turned off (SDF_ENABLE_CUDA=OFF): CPU backend only")
 else()

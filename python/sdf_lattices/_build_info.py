@@ -12,7 +12,9 @@ def build_info():
     the package's files; cmake/Packaging.cmake writes it): version, build_type, cpu_target,
     compiler, python, and optional: for each of cuda, mpi, openvdb and openimageio a dict
     {"found": bool, "detail": str}: the version found, or why it is missing and which Debian
-    packages add it. Whether a GPU is present now is cuda_available()'s answer.
+    packages add it; cuda's dict also has "architectures", the CUDA architectures compiled in
+    (CMake's names: "90-real" is machine code for sm_90, "90-virtual" PTX that newer GPUs
+    compile when they load it). Whether a GPU is present now is cuda_available()'s answer.
     """
     try:
         with open(_PATH, encoding="utf-8") as f:
