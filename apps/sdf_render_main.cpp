@@ -29,7 +29,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"

@@ -23,7 +23,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
@@ -192,7 +192,7 @@ int main(int argc, char** argv) {
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
         if (!quiet) std::cerr << plan.describe();
-        // The front ends' one field source (experiments/common/field_source.h), without a cache:
+        // The front ends' one field source (harness/study/field_source.h), without a cache:
         // its sampler samples the slabs this tool streams to disk.
         sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
         const sdf::StreamResult r = sdf::sample_streamed(source.sampler(), options, mesh, lattice, stream, mesh_provenance);

@@ -51,7 +51,7 @@
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
 #include "core/statistics.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "harness/experiment/experiment.h"
 #include "experiments/peers/peer.h"
 #include "harness/config/lattice_spec.h"

@@ -26,7 +26,7 @@
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
 #include "core/statistics.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
 #include "harness/experiment/experiment.h"
 #include "harness/config/mesh_spec.h"

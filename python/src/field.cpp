@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/sampler_spec.h"
@@ -418,7 +418,7 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         task.total = request.lattice.num_points();
         task.label = "sampling '" + mesh->name() + "'";
         task.progress = progress;
-        // The front ends' one field path (experiments/common/field_source.h): no cache, this
+        // The front ends' one field path (harness/study/field_source.h): no cache, this
         // process's sampler; an allocation that fails names the mesh, the lattice and the bytes.
         FieldSource source(nullptr, request.options, "sample()", SamplerReach::ThisProcess);
         std::ostream no_log(nullptr);
