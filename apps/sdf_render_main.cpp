@@ -73,14 +73,11 @@ Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 SamplerOptions sampler_options(const Options& o) { return o.sampler.options({{"progress", !o.quiet}}); }
 
 /// The field of `mesh` on `lattice`: from the field cache when it holds it, else sampled and
-/// stored there, by the experiments' FieldSource (the same key, log and sign warning).
+/// stored there, by the studies' FieldSource (the same key, log and sign warning).
 SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, const Options& o) {
     const std::optional<FieldCache> cache =
         o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
-    RunContext context;
-    context.config_path = "sdf-render";
-    context.fields = cache ? &*cache : nullptr;
-    FieldSource source(context, sampler_options(o));
+    FieldSource source(cache ? &*cache : nullptr, sampler_options(o), "the command line: sampler");
     return source.get(mesh, lattice, "field " + mesh.name(), std::cerr).field;
 }
 
