@@ -46,7 +46,7 @@ using namespace sdf;
 
 struct Options {
     std::string input, mesh_file;
-    std::string lattice = "bcc";
+    std::string lattice = lattice_type_name(LatticeType::BCC);
     std::vector<int> resolution;
     std::vector<int> cc_resolution{80, 80, 80}, bcc_resolution{64, 64, 128};
     double margin = 0.1;
@@ -81,12 +81,10 @@ SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, cons
     return source.get(mesh, lattice, "field " + mesh.name(), std::cerr).field;
 }
 
-Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const std::vector<int>& res, double margin) {
+Lattice mesh_lattice(const PreparedMesh& mesh, LatticeType type, const std::vector<int>& res, double margin) {
     if (res.size() != 3) throw std::invalid_argument("a resolution needs 3 integers, e.g. 80,80,80");
-    const bool bcc = type == "bcc";
     const Int3 r{res[0], res[1], res[2]};
-    return fit_lattice(bcc ? LatticeType::BCC : LatticeType::CC, bcc ? bcc_primary_from_notation(r) : r, mesh.bounds(),
-                       margin);
+    return fit_lattice(type, type == LatticeType::BCC ? bcc_primary_from_notation(r) : r, mesh.bounds(), margin);
 }
 
 /// The explicit camera's flags, checked with messages that name them (the codec then reads
@@ -184,8 +182,10 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
             mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), "."));
     } else {
         mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
-        const std::vector<int> res = !o.resolution.empty() ? o.resolution : (o.lattice == "cc" ? o.cc_resolution : o.bcc_resolution);
-        field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
+        const LatticeType type = lattice_type_named(o.lattice);
+        const std::vector<int> res =
+            !o.resolution.empty() ? o.resolution : (type == LatticeType::CC ? o.cc_resolution : o.bcc_resolution);
+        field = obtain_field(*mesh, mesh_lattice(*mesh, type, res, o.margin), o);
     }
     if (spec.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
     const Bounds3 bounds = mesh ? mesh->bounds() : field_solid_bounds(field);
@@ -233,8 +233,8 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
 int run_grid(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     if (is_field_file(o.input)) throw std::invalid_argument("--grid needs a mesh INPUT (it samples CC and BCC fields)");
     const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
-    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, "cc", o.cc_resolution, o.margin), o);
-    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, "bcc", o.bcc_resolution, o.margin), o);
+    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::CC, o.cc_resolution, o.margin), o);
+    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::BCC, o.bcc_resolution, o.margin), o);
     FigureOptions fo = figure_options(spec);  // panels, rows, heat-map scale, downsampling
     fo.render = render_options(o, spec);
     fo.mesh.threads = o.threads;
@@ -280,7 +280,7 @@ int main(int argc, char** argv) {
     Options o;
     app.add_option("input", o.input, "field file (NAME.json) or mesh (OBJ on the data path, or shape:NAME)")->required();
     app.add_option("--mesh", o.mesh_file, "field input: the mesh, for --reference and framing");
-    app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember(lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", o.resolution, "mesh input: resolution, BCC in thesis notation (64,64,128); default "
                                                  "--cc-resolution or --bcc-resolution")->delimiter(',')->expected(3);
     app.add_option("--cc-resolution", o.cc_resolution, "CC resolution (grid, and the default for --lattice cc)")

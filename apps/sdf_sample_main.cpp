@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/quoted_alternatives.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
 #include "harness/study/field_source.h"
@@ -62,7 +63,7 @@ int main(int argc, char** argv) {
     CLI::App app{"Samples the exact signed distance of a mesh on a CC or BCC lattice slab by slab, streaming the "
                  "field file to disk under a memory budget."};
     sdf::add_version_flag(app, "sdf-sample");
-    std::string mesh_arg, out_path, lattice_type = "cc";
+    std::string mesh_arg, out_path, lattice_type = sdf::lattice_type_name(sdf::LatticeType::CC);
     std::string budget_text, channels_text = "distance,gradient,closest_triangle";
     std::string dtype = "float32";
     std::vector<int> resolution;
@@ -71,7 +72,8 @@ int main(int argc, char** argv) {
     sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
     bool overwrite = false, dry_run = false, quiet = false;
     app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME")->required();
-    app.add_option("--lattice", lattice_type, "cc or bcc")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("--lattice", lattice_type, "lattice type: " + sdf::quoted_alternatives(sdf::lattice_type_names()))
+        ->check(CLI::IsMember(sdf::lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", resolution,
                    "N or NX NY NZ: CC points per axis; BCC in the thesis's notation Rx Ry 2Rz (N: N N 2N)")
         ->required()
@@ -135,7 +137,8 @@ int main(int argc, char** argv) {
         nlohmann::json lattice_json = {{"type", lattice_type}};
         if (resolution.size() == 1) {
             const int n = resolution[0];
-            lattice_json["resolution"] = lattice_type == "bcc" ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
+            const bool bcc = sdf::lattice_type_named(lattice_type) == sdf::LatticeType::BCC;  // thesis notation Rx Ry 2Rz
+            lattice_json["resolution"] = bcc ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
         } else {
             lattice_json["resolution"] = resolution;
         }

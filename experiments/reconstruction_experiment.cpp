@@ -91,7 +91,7 @@ public:
                                                  [&](const LatticeSpec& l) { return l.type == p.lattice; });
                 if (!present)
                     config.fail("render", std::string(render_->panels.empty() ? "the thesis's figures need" : "the panels need") +
-                                              " a " + (p.lattice == LatticeType::CC ? "CC" : "BCC") +
+                                              " a " + lattice_type_label(p.lattice) +
                                               " lattice in \"lattices\" (panel " + p.letter + ": " + p.interpolator + "/" +
                                               p.derivatives + ")");
             }
