@@ -27,6 +27,7 @@
 #include <iostream>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
 #include "harness/study/field_source.h"
@@ -278,7 +279,7 @@ int main(int argc, char** argv) {
     CLI::App app{"Ray-casts reconstructed distance fields (docs/raycast.md): one image per view, or the thesis grid."};
     sdf::add_version_flag(app, "sdf-render");
     Options o;
-    app.add_option("input", o.input, "field file (NAME.json) or mesh (OBJ on the data path, or shape:NAME)")->required();
+    app.add_option("input", o.input, "field file (NAME.json) or mesh (" + mesh_formats_help() + ", on the data path; or shape:NAME)")->required();
     app.add_option("--mesh", o.mesh_file, "field input: the mesh, for --reference and framing");
     app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember(lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", o.resolution, "mesh input: resolution, BCC in thesis notation (64,64,128); default "

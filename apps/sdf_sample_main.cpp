@@ -22,6 +22,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/quoted_alternatives.h"
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
 #include "harness/study/field_source.h"
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
     int max_planes = 0;
     sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
     bool overwrite = false, dry_run = false, quiet = false;
-    app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME")->required();
+    app.add_option("mesh", mesh_arg, "mesh file (" + sdf::mesh_formats_help() + ") or shape:NAME")->required();
     app.add_option("--lattice", lattice_type, "lattice type: " + sdf::quoted_alternatives(sdf::lattice_type_names()))
         ->check(CLI::IsMember(sdf::lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", resolution,
