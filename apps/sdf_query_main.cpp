@@ -2,8 +2,8 @@
 //           [--precision float|double] [--sign auto|pseudonormal|winding] [--out FILE]
 //
 // One result per input point, in input order: "d gx gy gz tri" (signed distance, exact
-// gradient, 0-based closest triangle in the file's face order). MESH is a mesh file (OBJ,
-// PLY, STL, OFF, optionally gzip-compressed; a relative name is looked up in the current
+// gradient, 0-based closest triangle in the file's face order). MESH is a mesh file (a format
+// of core/mesh/load_mesh.h's mesh_formats(), optionally gzip-compressed; a relative name is looked up in the current
 // directory, then on the data search path: harness/config/mesh_spec.h) or shape:NAME;
 // POINTS has "x y z" per line ('-' = stdin) or is a .npy file of shape (N, 3), N >= 1 (no
 // points is an error naming the input: most often the wrong file). Results go to
@@ -20,6 +20,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
 #include "harness/config/mesh_spec.h"
@@ -62,7 +63,7 @@ int main(int argc, char** argv) {
     std::string mesh_arg, points_path, out_path;
     bool quiet = false, overwrite = false;
     sdf::SamplerCli sampler;
-    app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME (sphere, box, torus, "
+    app.add_option("mesh", mesh_arg, "mesh file (" + sdf::mesh_formats_help() + ") or shape:NAME (sphere, box, torus, "
                                      "pawn, soccer_ball)")
         ->required();
     app.add_option("points", points_path,

@@ -27,9 +27,10 @@
 #include <iostream>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/sha256.h"
 #include "core/parallel/progress.h"
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"
@@ -46,7 +47,7 @@ using namespace sdf;
 
 struct Options {
     std::string input, mesh_file;
-    std::string lattice = "bcc";
+    std::string lattice = lattice_type_name(LatticeType::BCC);
     std::vector<int> resolution;
     std::vector<int> cc_resolution{80, 80, 80}, bcc_resolution{64, 64, 128};
     double margin = 0.1;
@@ -73,23 +74,18 @@ Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 SamplerOptions sampler_options(const Options& o) { return o.sampler.options({{"progress", !o.quiet}}); }
 
 /// The field of `mesh` on `lattice`: from the field cache when it holds it, else sampled and
-/// stored there, by the experiments' FieldSource (the same key, log and sign warning).
+/// stored there, by the studies' FieldSource (the same key, log and sign warning).
 SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, const Options& o) {
     const std::optional<FieldCache> cache =
         o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
-    RunContext context;
-    context.config_path = "sdf-render";
-    context.fields = cache ? &*cache : nullptr;
-    FieldSource source(context, sampler_options(o));
+    FieldSource source(cache ? &*cache : nullptr, sampler_options(o), "the command line: sampler");
     return source.get(mesh, lattice, "field " + mesh.name(), std::cerr).field;
 }
 
-Lattice mesh_lattice(const PreparedMesh& mesh, const std::string& type, const std::vector<int>& res, double margin) {
+Lattice mesh_lattice(const PreparedMesh& mesh, LatticeType type, const std::vector<int>& res, double margin) {
     if (res.size() != 3) throw std::invalid_argument("a resolution needs 3 integers, e.g. 80,80,80");
-    const bool bcc = type == "bcc";
     const Int3 r{res[0], res[1], res[2]};
-    return fit_lattice(bcc ? LatticeType::BCC : LatticeType::CC, bcc ? bcc_primary_from_notation(r) : r, mesh.bounds(),
-                       margin);
+    return fit_lattice(type, type == LatticeType::BCC ? bcc_primary_from_notation(r) : r, mesh.bounds(), margin);
 }
 
 /// The explicit camera's flags, checked with messages that name them (the codec then reads
@@ -187,8 +183,10 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
             mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), "."));
     } else {
         mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
-        const std::vector<int> res = !o.resolution.empty() ? o.resolution : (o.lattice == "cc" ? o.cc_resolution : o.bcc_resolution);
-        field = obtain_field(*mesh, mesh_lattice(*mesh, o.lattice, res, o.margin), o);
+        const LatticeType type = lattice_type_named(o.lattice);
+        const std::vector<int> res =
+            !o.resolution.empty() ? o.resolution : (type == LatticeType::CC ? o.cc_resolution : o.bcc_resolution);
+        field = obtain_field(*mesh, mesh_lattice(*mesh, type, res, o.margin), o);
     }
     if (spec.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
     const Bounds3 bounds = mesh ? mesh->bounds() : field_solid_bounds(field);
@@ -236,8 +234,8 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
 int run_grid(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     if (is_field_file(o.input)) throw std::invalid_argument("--grid needs a mesh INPUT (it samples CC and BCC fields)");
     const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
-    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, "cc", o.cc_resolution, o.margin), o);
-    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, "bcc", o.bcc_resolution, o.margin), o);
+    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::CC, o.cc_resolution, o.margin), o);
+    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::BCC, o.bcc_resolution, o.margin), o);
     FigureOptions fo = figure_options(spec);  // panels, rows, heat-map scale, downsampling
     fo.render = render_options(o, spec);
     fo.mesh.threads = o.threads;
@@ -281,9 +279,9 @@ int main(int argc, char** argv) {
     CLI::App app{"Ray-casts reconstructed distance fields (docs/raycast.md): one image per view, or the thesis grid."};
     sdf::add_version_flag(app, "sdf-render");
     Options o;
-    app.add_option("input", o.input, "field file (NAME.json) or mesh (OBJ on the data path, or shape:NAME)")->required();
+    app.add_option("input", o.input, "field file (NAME.json) or mesh (" + mesh_formats_help() + ", on the data path; or shape:NAME)")->required();
     app.add_option("--mesh", o.mesh_file, "field input: the mesh, for --reference and framing");
-    app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("--lattice", o.lattice, "mesh input: lattice type")->check(CLI::IsMember(lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", o.resolution, "mesh input: resolution, BCC in thesis notation (64,64,128); default "
                                                  "--cc-resolution or --bcc-resolution")->delimiter(',')->expected(3);
     app.add_option("--cc-resolution", o.cc_resolution, "CC resolution (grid, and the default for --lattice cc)")

@@ -21,9 +21,11 @@
 #include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
+#include "core/quoted_alternatives.h"
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/parallel/progress.h"
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/mesh_spec.h"
@@ -62,7 +64,7 @@ int main(int argc, char** argv) {
     CLI::App app{"Samples the exact signed distance of a mesh on a CC or BCC lattice slab by slab, streaming the "
                  "field file to disk under a memory budget."};
     sdf::add_version_flag(app, "sdf-sample");
-    std::string mesh_arg, out_path, lattice_type = "cc";
+    std::string mesh_arg, out_path, lattice_type = sdf::lattice_type_name(sdf::LatticeType::CC);
     std::string budget_text, channels_text = "distance,gradient,closest_triangle";
     std::string dtype = "float32";
     std::vector<int> resolution;
@@ -70,8 +72,9 @@ int main(int argc, char** argv) {
     int max_planes = 0;
     sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
     bool overwrite = false, dry_run = false, quiet = false;
-    app.add_option("mesh", mesh_arg, "mesh file (OBJ, PLY, STL, OFF, optionally .gz) or shape:NAME")->required();
-    app.add_option("--lattice", lattice_type, "cc or bcc")->check(CLI::IsMember({"cc", "bcc"}))->capture_default_str();
+    app.add_option("mesh", mesh_arg, "mesh file (" + sdf::mesh_formats_help() + ") or shape:NAME")->required();
+    app.add_option("--lattice", lattice_type, "lattice type: " + sdf::quoted_alternatives(sdf::lattice_type_names()))
+        ->check(CLI::IsMember(sdf::lattice_type_names()))->capture_default_str();
     app.add_option("--resolution", resolution,
                    "N or NX NY NZ: CC points per axis; BCC in the thesis's notation Rx Ry 2Rz (N: N N 2N)")
         ->required()
@@ -135,7 +138,8 @@ int main(int argc, char** argv) {
         nlohmann::json lattice_json = {{"type", lattice_type}};
         if (resolution.size() == 1) {
             const int n = resolution[0];
-            lattice_json["resolution"] = lattice_type == "bcc" ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
+            const bool bcc = sdf::lattice_type_named(lattice_type) == sdf::LatticeType::BCC;  // thesis notation Rx Ry 2Rz
+            lattice_json["resolution"] = bcc ? std::vector<int>{n, n, 2 * n} : std::vector<int>{n, n, n};
         } else {
             lattice_json["resolution"] = resolution;
         }
@@ -192,7 +196,7 @@ int main(int argc, char** argv) {
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
         if (!quiet) std::cerr << plan.describe();
-        // The front ends' one field source (experiments/common/field_source.h), without a cache:
+        // The front ends' one field source (harness/study/field_source.h), without a cache:
         // its sampler samples the slabs this tool streams to disk.
         sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
         const sdf::StreamResult r = sdf::sample_streamed(source.sampler(), options, mesh, lattice, stream, mesh_provenance);

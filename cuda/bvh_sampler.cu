@@ -452,7 +452,7 @@ private:
     template <typename T, typename Sink>
     std::pair<int64_t, int64_t> run_blocks(const DeviceBvh<T>& dev, const Lattice& lattice, const LatticeSlab& slab,
                                            EventTimer& compute, Sink sink) {
-        GridBlock blocks[2];
+        GridBlock blocks[kMaxSamplingBlocks];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0, pieces = 0;
         reset_certificate(dev);

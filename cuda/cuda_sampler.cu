@@ -301,7 +301,7 @@ private:
         Engine<T> engine(mesh, options_, kernel_, sign_);
         const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, largest_lattice_coordinate(lattice), engine);
         auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh, field); };
-        GridBlock blocks[2];
+        GridBlock blocks[kMaxSamplingBlocks];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
         for (int b = 0; b < nblocks; ++b) {

@@ -25,7 +25,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/reconstruction/analytic_study.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
 #include "harness/experiment/experiment.h"
 

@@ -43,7 +43,7 @@
 #include "core/winding/sign_mode.h"
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "experiments/peers/peer.h"
 #include "experiments/peers/peer_rows.h"
 #include "harness/config/lattice_spec.h"

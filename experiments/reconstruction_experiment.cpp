@@ -33,10 +33,10 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/raycast/views.h"
 #include "core/reconstruction/reconstruction.h"
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "experiments/common/probes.h"
 #include "experiments/common/reconstruction_list.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"
 #include "harness/provenance/provenance.h"
@@ -91,7 +91,7 @@ public:
                                                  [&](const LatticeSpec& l) { return l.type == p.lattice; });
                 if (!present)
                     config.fail("render", std::string(render_->panels.empty() ? "the thesis's figures need" : "the panels need") +
-                                              " a " + (p.lattice == LatticeType::CC ? "CC" : "BCC") +
+                                              " a " + lattice_type_label(p.lattice) +
                                               " lattice in \"lattices\" (panel " + p.letter + ": " + p.interpolator + "/" +
                                               p.derivatives + ")");
             }

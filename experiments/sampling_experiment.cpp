@@ -14,8 +14,8 @@
 #include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
-#include "experiments/common/field_source.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/field_source.h"
+#include "harness/study/study_inputs.h"
 #include "harness/distributed/distributed.h"
 #include "harness/experiment/experiment.h"
 #include "harness/io/field_file.h"

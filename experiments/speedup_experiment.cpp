@@ -25,8 +25,9 @@
 #include "core/lattice/lattice_fitting.h"
 #include "experiments/common/lattice_points.h"
 #include "experiments/common/mesh_cases.h"
+#include "core/quoted_alternatives.h"
 #include "core/statistics.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "experiments/common/thesis_tables.h"
 #include "harness/experiment/experiment.h"
 #include "harness/config/mesh_spec.h"
@@ -57,11 +58,14 @@ public:
         base_dir_ = context.config_dir;
         margin_ = read_domain_margin(config);
         cases_ = read_mesh_cases(config, search_path_, base_dir_);
-        const auto types = config.optional<std::vector<std::string>>("lattice_types", {"cc"}, "[\"cc\"], [\"bcc\"] or both");
-        if (types.empty()) config.fail("lattice_types", "expected \"cc\", \"bcc\" or both, got []");
+        const std::string kinds = quoted_alternatives(lattice_type_names());
+        const auto types = config.optional<std::vector<std::string>>(
+            "lattice_types", {lattice_type_name(LatticeType::CC)}, "an array of lattice types (" + kinds + ")");
+        if (types.empty()) config.fail("lattice_types", "expected a non-empty array of " + kinds + ", got []");
         for (const std::string& t : types) {
-            if (t != "cc" && t != "bcc") config.fail("lattice_types", "expected \"cc\" or \"bcc\", got \"" + t + "\"");
-            lattice_types_.push_back(t == "cc" ? LatticeType::CC : LatticeType::BCC);
+            const LatticeKind* kind = find_lattice_kind(t);
+            if (!kind) config.fail("lattice_types", "expected " + kinds + ", got \"" + t + "\"");
+            lattice_types_.push_back(kind->type);
         }
         std::vector<JsonReader> backends = config.objects("backends");
         if (backends.empty()) config.fail("backends", "expected at least one backend, got []");

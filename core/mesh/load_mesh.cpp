@@ -45,6 +45,9 @@ bool first_token_is(std::string_view bytes, bool (*test)(std::string_view)) {
 bool is_ply_magic(std::string_view w) { return w == "ply"; }
 bool is_off_magic(std::string_view w) { return w.size() >= 3 && w.size() <= 7 && w.substr(w.size() - 3) == "OFF"; }
 
+bool is_ply(std::string_view bytes) { return first_token_is(bytes, is_ply_magic); }
+bool is_off(std::string_view bytes) { return first_token_is(bytes, is_off_magic); }
+
 bool is_binary_stl(std::string_view bytes) {
     if (bytes.size() < 84) return false;
     uint32_t n = 0;
@@ -52,12 +55,22 @@ bool is_binary_stl(std::string_view bytes) {
     return bytes.size() == 84 + 50 * uint64_t(n);
 }
 
+bool is_stl(std::string_view bytes) { return is_binary_stl(bytes) || is_ascii_stl_start(bytes); }
+
 /// An OBJ statement ("v ", "f ", "vn ", "o ", ...) starting one of the first lines.
-bool looks_like_obj(const std::string& bytes) {
-    TextCursor words(std::string_view(bytes).substr(0, 1 << 16));
+bool looks_like_obj(std::string_view bytes) {
+    TextCursor words(bytes.substr(0, 1 << 16));
     words.hash_comments = true;
     std::string_view w;
     return words.next(w) && (w == "v" || w == "vn" || w == "vt" || w == "f" || w == "o" || w == "g" || w == "mtllib" || w == "s");
+}
+
+/// The format whose row lists `extension`, or null.
+const MeshFormatRow* format_by_extension(const std::string& extension) {
+    for (const MeshFormatRow& row : mesh_formats())
+        for (const char* e : row.extensions)
+            if (e && extension == e) return &row;
+    return nullptr;
 }
 
 /// The line (1-based) of byte `at`, for messages.
@@ -70,8 +83,8 @@ int64_t line_of(std::string_view bytes, size_t at) {
 /// zeros after its first megabyte), and a binary STL or binary PLY may not outgrow the size
 /// its header declares.
 ContentCheck content_check(const std::string& path) {
-    return [path, ext = inner_extension(path), ply_header_read = false](std::string_view so_far,
-                                                                        size_t new_from) mutable -> ContentLimit {
+    return [path, named = format_by_extension(inner_extension(path)), ply_header_read = false](
+               std::string_view so_far, size_t new_from) mutable -> ContentLimit {
         const size_t bom = so_far.size() - without_utf8_bom(so_far).size();
         if (first_token_is(so_far.substr(bom), is_ply_magic)) {
             // Text up to "end_header", binary data after it in binary PLY.
@@ -87,8 +100,10 @@ ContentCheck content_check(const std::string& path) {
             return *limit;
         }
         const bool off = first_token_is(so_far.substr(bom), is_off_magic);
-        if (!off && so_far.size() >= 84 && ext != "obj" && ext != "off" && ext != "ply" &&
-            (holds_binary_bytes(so_far) || (ext == "stl" && !is_ascii_stl_start(so_far)))) {
+        // A binary STL unless the extension names another format.
+        const bool named_stl = named && named->format == MeshFormat::Stl;
+        if (!off && so_far.size() >= 84 && (!named || named_stl) &&
+            (holds_binary_bytes(so_far) || (named_stl && !is_ascii_stl_start(so_far)))) {
             uint32_t n = 0;
             std::memcpy(&n, so_far.data() + 80, 4);
             return {84 + 50 * uint64_t(n), "what its binary STL header declares: " + std::to_string(n) +
@@ -124,31 +139,55 @@ size_t text_end(const std::string& bytes, MeshFormat format) {
 
 }  // namespace
 
-const char* mesh_format_name(MeshFormat format) {
+const std::vector<MeshFormatRow>& mesh_formats() {
+    // Content is tested in this order: PLY's and OFF's magic lines before binary STL's exact
+    // size, which a text file could match by chance.
+    static const std::vector<MeshFormatRow> rows = {
+        {MeshFormat::Obj, "OBJ", "", {"obj", nullptr}, nullptr, looks_like_obj, load_obj_text},
+        {MeshFormat::Ply, "PLY", " (ascii and binary)", {"ply", nullptr}, is_ply, nullptr, read_ply},
+        {MeshFormat::Off, "OFF", "", {"off", nullptr}, is_off, nullptr, read_off},
+        {MeshFormat::Stl, "STL", " (ascii and binary)", {"stl", nullptr}, is_stl, nullptr, read_stl},
+    };
+    return rows;
+}
+
+const MeshFormatRow& mesh_format(MeshFormat format) {
+    // No default: a MeshFormat without its case is a -Wswitch warning (an error in developer builds).
+    size_t row = 0;
     switch (format) {
-        case MeshFormat::Obj: return "OBJ";
-        case MeshFormat::Ply: return "PLY";
-        case MeshFormat::Stl: return "STL";
-        case MeshFormat::Off: return "OFF";
+        case MeshFormat::Obj: row = 0; break;
+        case MeshFormat::Ply: row = 1; break;
+        case MeshFormat::Off: row = 2; break;
+        case MeshFormat::Stl: row = 3; break;
     }
-    return "?";
+    return mesh_formats().at(row);
+}
+
+const char* mesh_format_name(MeshFormat format) { return mesh_format(format).name; }
+
+std::string mesh_formats_help() {
+    std::string s;
+    for (const MeshFormatRow& row : mesh_formats()) s += std::string(s.empty() ? "" : ", ") + row.name;
+    return s + ", optionally .gz";
+}
+
+std::string mesh_formats_supported() {
+    std::string s;
+    for (const MeshFormatRow& row : mesh_formats()) s += std::string(s.empty() ? "" : ", ") + row.name + row.variants;
+    return s + ", each optionally .gz";
 }
 
 MeshFormat detect_mesh_format(const std::string& path, const std::string& bytes) {
-    if (first_token_is(bytes, is_ply_magic)) return MeshFormat::Ply;
-    if (first_token_is(bytes, is_off_magic)) return MeshFormat::Off;
-    if (is_binary_stl(bytes)) return MeshFormat::Stl;
-    if (is_ascii_stl_start(bytes)) return MeshFormat::Stl;
+    for (const MeshFormatRow& row : mesh_formats())
+        if (row.definite && row.definite(bytes)) return row.format;
     const std::string ext = inner_extension(path);
-    if (ext == "obj") return MeshFormat::Obj;
-    if (ext == "ply") return MeshFormat::Ply;
-    if (ext == "stl") return MeshFormat::Stl;
-    if (ext == "off") return MeshFormat::Off;
-    if (looks_like_obj(bytes)) return MeshFormat::Obj;
+    if (const MeshFormatRow* named = format_by_extension(ext)) return named->format;
+    for (const MeshFormatRow& row : mesh_formats())
+        if (row.likely && row.likely(bytes)) return row.format;
     throw std::runtime_error(path + ": unsupported mesh format " +
                              (ext.empty() ? std::string("(no extension, and the content is not recognised)")
                                           : "'" + ext + "' (by its extension; the content is not recognised either)") +
-                             "; supported: OBJ, PLY (ascii and binary), STL (ascii and binary), OFF, each optionally .gz");
+                             "; supported: " + mesh_formats_supported());
 }
 
 TriangleMesh load_mesh_file(const std::string& path) {
@@ -164,12 +203,7 @@ TriangleMesh load_mesh_file(const std::string& path) {
     lone_cr_to_lf(file.bytes, text_end(file.bytes, format));
     TriangleMesh mesh;
     try {
-        switch (format) {
-            case MeshFormat::Obj: mesh = load_obj_text(file.bytes, path); break;
-            case MeshFormat::Ply: mesh = read_ply(file.bytes, path); break;
-            case MeshFormat::Stl: mesh = read_stl(file.bytes, path); break;
-            case MeshFormat::Off: mesh = read_off(file.bytes, path); break;
-        }
+        mesh = mesh_format(format).read(file.bytes, path);
     } catch (const std::bad_alloc&) {
         throw_mesh_error(path, "", std::string("not enough memory to read the ") + mesh_format_name(format) + " mesh (" +
                                        std::to_string(file.bytes.size()) + " bytes" + (file.gzip ? " decompressed" : "") +

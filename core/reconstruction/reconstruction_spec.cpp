@@ -48,13 +48,16 @@ std::vector<std::string> interpolator_names() {
 }
 
 std::string interpolator_help() {
-    std::string cc, bcc;
-    for_each_interpolator([&](auto interp) {
-        using I = decltype(interp);
-        std::string& list = I::lattice_type() == LatticeType::CC ? cc : bcc;
-        list += (list.empty() ? "" : ", ") + std::string(I::name());
-    });
-    return cc + " (CC); " + bcc + " (BCC)";
+    std::string help;
+    for (const LatticeKind& kind : kLatticeKinds) {
+        std::string list;
+        for_each_interpolator([&](auto interp) {
+            using I = decltype(interp);
+            if (I::lattice_type() == kind.type) list += (list.empty() ? "" : ", ") + std::string(I::name());
+        });
+        if (!list.empty()) help += (help.empty() ? "" : "; ") + list + " (" + kind.label + ")";
+    }
+    return help;
 }
 
 InterpolatorKind parse_interpolator(const std::string& name) {
@@ -108,8 +111,8 @@ void validate_reconstruction(const ReconstructionSpec& spec, const Lattice& latt
     const std::string name = interpolator_name(spec.interpolator);
     const LatticeType needed = interpolator_lattice(spec.interpolator);
     if (lattice.type != needed)
-        throw std::invalid_argument("interpolator '" + name + "' needs a " + (needed == LatticeType::CC ? "CC" : "BCC") +
-                                    " field; this field is " + (lattice.type == LatticeType::CC ? "CC" : "BCC") + " (" +
+        throw std::invalid_argument("interpolator '" + name + "' needs a " + lattice_type_label(needed) +
+                                    " field; this field is " + lattice_type_label(lattice.type) + " (" +
                                     lattice_notation(lattice) + ")");
     const auto valid = valid_derivative_sources(spec.interpolator);
     if (std::find(valid.begin(), valid.end(), spec.derivatives) == valid.end()) {

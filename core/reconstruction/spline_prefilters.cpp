@@ -15,7 +15,7 @@ constexpr int64_t kChunk = 4096;
 
 void check_values(const Lattice& l, const std::vector<double>& values, LatticeType type, int min_resolution,
                   const char* filter) {
-    const char* lattice_name = type == LatticeType::CC ? "CC" : "BCC";
+    const char* lattice_name = lattice_type_label(type);
     if (l.type != type)
         throw std::invalid_argument(std::string(filter) + " prefilter: needs a " + lattice_name + " lattice");
     for (int i = 0; i < 3; ++i)

@@ -16,7 +16,7 @@ SamplerReport sampler_provenance(const std::string& backend, const std::string& 
     r.precision = precision_name(options.precision);
     r.points_computed = points_computed;
     r.details["sign"] = sign.provenance();
-    if (lattice.type == LatticeType::BCC) r.details["bcc_strategy"] = bcc_strategy_name(options.bcc_strategy);
+    if (lattice_kind(lattice.type).cosets > 1) r.details["bcc_strategy"] = bcc_strategy_name(options.bcc_strategy);
     if (options.band_width > 0) r.details["band_width"] = options.band_width;
     return r;
 }

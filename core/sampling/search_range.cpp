@@ -64,7 +64,7 @@ void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Prec
     require_mesh_in_range(mesh, precision);
     // The primary grid's box, widened by a spacing: it holds every point of either lattice.
     const Vec3d h{lattice.spacing, lattice.spacing, lattice.spacing};
-    const std::string which = "the lattice " + std::string(lattice.type == LatticeType::BCC ? "bcc" : "cc") +
+    const std::string which = "the lattice " + std::string(lattice_type_name(lattice.type)) +
                               " of spacing " + number(lattice.spacing);
     require_point_in_range(lattice.domain_min() - h, precision, which);
     require_point_in_range(lattice.domain_max() + h, precision, which);

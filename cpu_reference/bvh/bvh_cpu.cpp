@@ -518,7 +518,7 @@ private:
         sign_.prepare(mesh);  // over the same BVH: only the winding moments are added
         const auto query_start = std::chrono::steady_clock::now();
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
-        GridBlock blocks[2];
+        GridBlock blocks[kMaxSamplingBlocks];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         const double w = options_.band_width;
         const BandSkip band = band_skip(mesh, w);

@@ -138,7 +138,7 @@ private:
         require_band_width(options_.band_width, "sampler band_width");
         sign_.prepare(mesh);
         SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
-        GridBlock blocks[2];
+        GridBlock blocks[kMaxSamplingBlocks];
         const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
         int64_t computed = 0;
         CertificateCounters counters;

@@ -1,6 +1,6 @@
 #include "experiments/common/mesh_cases.h"
 
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 
 namespace sdf {
 namespace {

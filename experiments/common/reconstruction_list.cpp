@@ -14,8 +14,7 @@ size_t find_lattice(JsonReader& r, const std::string& name, const std::vector<La
         if (labels[i] == name) return i;
     std::vector<size_t> of_type;
     for (size_t i = 0; i < lattices.size(); ++i)
-        if ((name == "cc" && lattices[i].type == LatticeType::CC) || (name == "bcc" && lattices[i].type == LatticeType::BCC))
-            of_type.push_back(i);
+        if (name == lattice_type_name(lattices[i].type)) of_type.push_back(i);
     const std::string list = quoted_alternatives(labels);
     if (of_type.size() == 1) return of_type[0];
     if (of_type.size() > 1)

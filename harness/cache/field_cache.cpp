@@ -23,11 +23,10 @@ std::string exact(double v) {
 }  // namespace
 
 nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l, const SamplerOptions& o) {
-    const bool bcc = l.type == LatticeType::BCC;
     return {{"what", "sampled_field"},
             {"code_version", kFieldCodeVersion},
             {"mesh_sha256", mesh_sha256},
-            {"lattice", {{"type", bcc ? "bcc" : "cc"},
+            {"lattice", {{"type", lattice_type_name(l.type)},
                          {"origin", {exact(l.origin.x), exact(l.origin.y), exact(l.origin.z)}},
                          {"spacing", exact(l.spacing)},
                          {"resolution", {l.resolution.x, l.resolution.y, l.resolution.z}}}},

@@ -7,11 +7,9 @@
 
 namespace sdf {
 
-const char* lattice_type_name(LatticeType t) { return t == LatticeType::CC ? "cc" : "bcc"; }
-
 LatticeSpec parse_lattice_spec(JsonReader& r) {
     LatticeSpec spec;
-    spec.type = r.choice("type", {"cc", "bcc"}, "cc") == "cc" ? LatticeType::CC : LatticeType::BCC;
+    spec.type = lattice_type_named(r.choice("type", lattice_type_names(), lattice_type_name(LatticeType::CC)));
     const bool has_res = r.has("resolution"), has_samples = r.has("samples");
     if (has_res == has_samples) r.fail(has_res ? "samples" : "resolution", "give exactly one of \"resolution\" and \"samples\"");
     if (has_res) {

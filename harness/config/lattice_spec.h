@@ -28,7 +28,7 @@ struct LatticeSpec {
 LatticeSpec parse_lattice_spec(JsonReader& r);
 /// The lattice of `spec` around `bounds` (margin as in fit_lattice).
 Lattice build_lattice(const LatticeSpec& spec, const Bounds3& bounds, double default_margin);
-const char* lattice_type_name(LatticeType t);
+// Lattice types by name: lattice_type_name(), lattice_type_named() (kernels/lattice/lattice_kinds.h).
 
 /// The resolution `spec` will have (CC resolution or BCC primary), known without a mesh.
 Int3 lattice_spec_resolution(const LatticeSpec& spec);

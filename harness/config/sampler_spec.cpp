@@ -185,7 +185,8 @@ nlohmann::json sampler_result_identity(const SamplerOptions& o, LatticeType latt
     for_each_sampler_option(o, [&](const OptionField& f, const auto& v) {
         if (f.role == OptionRole::Result) j[f.name] = encode(v);
     });
-    if (lattice_type != LatticeType::BCC) j["bcc_strategy"] = "-";
+    // The strategy chooses how a lattice of several cosets is cut into blocks; one coset has none.
+    if (lattice_kind(lattice_type).cosets == 1) j["bcc_strategy"] = "-";
     return j;
 }
 

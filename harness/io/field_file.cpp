@@ -77,7 +77,7 @@ std::vector<double> read_channel(const std::string& header_path, JsonReader& cha
 
 nlohmann::json lattice_to_json(const Lattice& l) {
     const int z = l.type == LatticeType::BCC ? 2 * l.resolution.z : l.resolution.z;
-    return {{"type", l.type == LatticeType::CC ? "cc" : "bcc"},
+    return {{"type", lattice_type_name(l.type)},
             {"origin", {l.origin.x, l.origin.y, l.origin.z}},
             {"spacing", l.spacing},
             {"resolution", {l.resolution.x, l.resolution.y, z}},
@@ -88,7 +88,7 @@ nlohmann::json lattice_to_json(const Lattice& l) {
 Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     JsonReader r(j, file, "lattice");
     Lattice l;
-    l.type = r.choice("type", {"cc", "bcc"}, "cc") == "cc" ? LatticeType::CC : LatticeType::BCC;
+    l.type = lattice_type_named(r.choice("type", lattice_type_names(), lattice_type_name(LatticeType::CC)));
     const auto origin = r.required<std::vector<double>>("origin", "an array of 3 numbers");
     l.spacing = r.required<double>("spacing", "a positive number");
     const auto res = r.required<std::vector<int>>("resolution", "an array of 3 positive integers");

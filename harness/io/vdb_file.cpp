@@ -22,7 +22,7 @@ openvdb::math::Transform::Ptr grid_transform(const VolumeGrid& g) {
 }
 
 void add_metadata(openvdb::GridBase& grid, const SampledField& field, const VolumeGrid& g) {
-    grid.insertMeta("sdf_lattice", openvdb::StringMetadata(field.lattice.type == LatticeType::CC ? "cc" : "bcc"));
+    grid.insertMeta("sdf_lattice", openvdb::StringMetadata(lattice_type_name(field.lattice.type)));
     if (!g.part.empty()) grid.insertMeta("sdf_subgrid", openvdb::StringMetadata(g.part));
     grid.insertMeta("sdf_units", openvdb::StringMetadata("mesh units; distance negative inside"));
 }

@@ -179,7 +179,7 @@ std::string npz_bytes(const SampledField& field, const std::string& path, FieldD
         members.push_back({g.part.empty() ? "origin" : "origin_" + g.part, npy_bytes(FieldDtype::Float64, {3}, origin, 3)});
     }
     members.push_back({"spacing", npy_bytes(FieldDtype::Float64, {}, &field.lattice.spacing, 1)});
-    members.push_back({"lattice", npy_string(field.lattice.type == LatticeType::CC ? "cc" : "bcc")});
+    members.push_back({"lattice", npy_string(lattice_type_name(field.lattice.type))});
     return zip_stored(path, members);
 }
 

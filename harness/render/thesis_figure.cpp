@@ -167,7 +167,7 @@ ThesisFigure render_thesis_figure(const SampledField* cc, const SampledField* bc
         if (!chosen || chosen->lattice.type != spec.lattice)
             throw std::invalid_argument("thesis figure: panel " + spec.letter + " (" + spec.interpolator + "/" +
                                         spec.derivatives + ") needs a " +
-                                        (spec.lattice == LatticeType::CC ? "CC" : "BCC") + " field");
+                                        lattice_type_label(spec.lattice) + " field");
         const SampledField& field = *chosen;
         FigurePanel p;
         p.spec = spec;

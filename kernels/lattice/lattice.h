@@ -18,10 +18,9 @@
 #include <cstdint>
 
 #include "kernels/core/vec3.h"
+#include "kernels/lattice/lattice_kinds.h"
 
 namespace sdf {
-
-enum class LatticeType : int { CC = 0, BCC = 1 };
 
 struct Lattice {
     LatticeType type{LatticeType::CC};

@@ -62,7 +62,7 @@ inline int64_t slab_point_count(const Lattice& lattice, const LatticeSlab& slab)
 /// storage. The whole lattice gets exactly sampling_blocks(); a part of a BCC lattice is
 /// sampled as two grids whatever the strategy (strategy A computes the same positions and
 /// discards the rest, so the samples are the same). Returns the number of blocks.
-inline int slab_sampling_blocks(const Lattice& lattice, BccStrategy strategy, const LatticeSlab& slab, GridBlock out[2]) {
+inline int slab_sampling_blocks(const Lattice& lattice, BccStrategy strategy, const LatticeSlab& slab, GridBlock out[kMaxSamplingBlocks]) {
     if (is_whole_lattice(lattice, slab)) return sampling_blocks(lattice, strategy, out);
     const int nz = slab.z_end - slab.z_begin;
     out[0] = GridBlock{{0, 0, 2 * slab.z_begin}, 2, {lattice.resolution.x, lattice.resolution.y, nz}, 0, false};

@@ -45,20 +45,27 @@ struct GridBlock {
     }
 };
 
-/// The blocks that sample `lattice` (at most 2). Returns the number of blocks.
-inline int sampling_blocks(const Lattice& lattice, BccStrategy strategy, GridBlock out[2]) {
-    if (lattice.type == LatticeType::CC) {
-        out[0] = GridBlock{{0, 0, 0}, 2, lattice.resolution, 0, false};
-        return 1;
+/// The most blocks a lattice is sampled as: one per coset (BCC strategy B), so a new lattice
+/// kind changes its row of kLatticeKinds only.
+inline constexpr int kMaxSamplingBlocks = kMaxLatticeCosets;
+
+/// The blocks that sample `lattice` (at most kMaxSamplingBlocks). Returns the number of blocks.
+inline int sampling_blocks(const Lattice& lattice, BccStrategy strategy, GridBlock out[kMaxSamplingBlocks]) {
+    switch (lattice.type) {
+        case LatticeType::CC:
+            out[0] = GridBlock{{0, 0, 0}, 2, lattice.resolution, 0, false};
+            return 1;
+        case LatticeType::BCC:
+            if (strategy == BccStrategy::DoubleResolution) {
+                const Int3 r = lattice.resolution;
+                out[0] = GridBlock{{0, 0, 0}, 1, {2 * r.x, 2 * r.y, 2 * r.z}, 0, true};
+                return 1;
+            }
+            out[0] = GridBlock{{0, 0, 0}, 2, lattice.resolution, 0, false};
+            out[1] = GridBlock{{1, 1, 1}, 2, lattice.secondary_resolution(), lattice.primary_count(), false};
+            return lattice.secondary_count() > 0 ? 2 : 1;
     }
-    if (strategy == BccStrategy::DoubleResolution) {
-        const Int3 r = lattice.resolution;
-        out[0] = GridBlock{{0, 0, 0}, 1, {2 * r.x, 2 * r.y, 2 * r.z}, 0, true};
-        return 1;
-    }
-    out[0] = GridBlock{{0, 0, 0}, 2, lattice.resolution, 0, false};
-    out[1] = GridBlock{{1, 1, 1}, 2, lattice.secondary_resolution(), lattice.primary_count(), false};
-    return lattice.secondary_count() > 0 ? 2 : 1;
+    return 0;  // not reached: every lattice type has its case
 }
 
 }  // namespace sdf

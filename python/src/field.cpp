@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/config/sampler_spec.h"
@@ -69,7 +69,8 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
             for (const py::handle item : resolution) r.push_back(integer_argument(item, "resolution[" + std::to_string(r.size()) + "]"));
         } else {
             const int64_t n = integer_argument(resolution, "resolution");
-            r = type == "bcc" ? std::vector<int64_t>{n, n, 2 * n} : std::vector<int64_t>{n, n, n};
+            const LatticeKind* kind = find_lattice_kind(type);  // unknown: parse_lattice_spec names it
+            r = kind && kind->type == LatticeType::BCC ? std::vector<int64_t>{n, n, 2 * n} : std::vector<int64_t>{n, n, n};
         }
         j["resolution"] = r;
     }
@@ -136,7 +137,7 @@ Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing
 }  // namespace
 
 Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
-    const LatticeType type = choose("lattice", a.type, {"cc", "bcc"}) == "bcc" ? LatticeType::BCC : LatticeType::CC;
+    const LatticeType type = lattice_type_named(choose("lattice", a.type, lattice_type_names()));
     const bool framed = !a.bounds.is_none() || !a.spacing.is_none() || !a.origin.is_none();
     const double margin = a.margin.is_none() ? 0.1 : number_argument(a.margin, "margin");
     if (!(margin >= 0 && std::isfinite(margin)))
@@ -296,7 +297,7 @@ void require_real_dtype(const py::object& o, const std::string& name) {
 /// arrays are shaped, on the lattice of origin and spacing.
 Field field_from_arrays(const py::object& values, const py::object& origin, double spacing, const std::string& lattice,
                         const py::object& gradient, const py::object& triangle) {
-    const bool bcc = choose("lattice", lattice, {"cc", "bcc"}) == "bcc";
+    const bool bcc = lattice_type_named(choose("lattice", lattice, lattice_type_names())) == LatticeType::BCC;
     if (!(spacing >= std::numeric_limits<double>::min() && std::isfinite(spacing)))
         throw std::invalid_argument("spacing: expected a finite distance > 0 (and not subnormal), got " + number_text(spacing));
     // Every channel as a list of C-order arrays, one per grid.
@@ -418,7 +419,7 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         task.total = request.lattice.num_points();
         task.label = "sampling '" + mesh->name() + "'";
         task.progress = progress;
-        // The front ends' one field path (experiments/common/field_source.h): no cache, this
+        // The front ends' one field path (harness/study/field_source.h): no cache, this
         // process's sampler; an allocation that fails names the mesh, the lattice and the bytes.
         FieldSource source(nullptr, request.options, "sample()", SamplerReach::ThisProcess);
         std::ostream no_log(nullptr);
@@ -457,11 +458,11 @@ Field(values, origin, spacing, lattice="cc", gradient=None, triangle=None) makes
 your own arrays, shaped as above (BCC: (primary, secondary) tuples), on the lattice of
 origin (the first primary point) and spacing h: it reconstructs, renders and writes as a
 sampled one.)")
-        .def(py::init(&field_from_arrays), py::arg("values"), py::arg("origin"), py::arg("spacing"), py::arg("lattice") = "cc",
+        .def(py::init(&field_from_arrays), py::arg("values"), py::arg("origin"), py::arg("spacing"), py::arg("lattice") = lattice_type_name(LatticeType::CC),
              py::arg("gradient") = py::none(), py::arg("triangle") = py::none())
         .def("points", &Field::points,
              "points() -> array or (primary, secondary): the world position of every lattice point, shape (nz, ny, nx, 3) per grid.")
-        .def_property_readonly("lattice", [](const Field& f) { return f.lattice().type == LatticeType::BCC ? "bcc" : "cc"; },
+        .def_property_readonly("lattice", [](const Field& f) { return lattice_type_name(f.lattice().type); },
                                "'cc' or 'bcc'.")
         .def_property_readonly("origin", [](const Field& f) {
             const Vec3d o = f.lattice().origin;
@@ -510,7 +511,7 @@ outside the lattice's domain get: "nan" (the default: NaN value and gradient), "
 reconstruction at the nearest point of the domain, as sdf-eval gives) or "error"
 (ValueError naming the first such point). The last reconstruction is kept for the next call.)")
         .def("__repr__", [](const Field& f) {
-            return "<sdf_lattices.Field " + std::string(f.lattice().type == LatticeType::BCC ? "bcc " : "cc ") +
+            return "<sdf_lattices.Field " + std::string(lattice_type_name(f.lattice().type)) + " " +
                    lattice_notation(f.lattice()) + ", " + std::to_string(f.lattice().num_points()) + " points>";
         });
 
@@ -537,7 +538,7 @@ rank returns the whole field, bit for bit the one a single process samples; its
 sampler["distributed"] records the slabs, hosts and per-rank seconds. A failure on any rank
 (or arguments that differ from rank 0's) raises on every rank. distributed=False samples on
 this rank alone (no other rank takes part).)" "\n\n" + sampler_keywords_doc();
-    m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
+    m.def("sample", &sample, py::arg("mesh"), py::arg("lattice") = lattice_type_name(LatticeType::CC), py::arg("resolution") = py::none(),
           py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
           py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
           py::arg("distributed") = true, sample_doc.c_str());

@@ -140,7 +140,7 @@ private:
 
 /// A lattice as sample()'s arguments frame it (Python objects; None where not given).
 struct LatticeArguments {
-    std::string type;  ///< "cc" or "bcc"
+    std::string type;  ///< a lattice type's name (kernels/lattice/lattice_kinds.h)
     py::object resolution, samples, margin, bounds, spacing, origin;
 };
 

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/sampling/sampler_table.h"
@@ -168,14 +169,15 @@ check_intersections looks for intersecting triangle pairs (costs about a BVH bui
     m.def("cuda_available", &cuda_backend_available,
           "True when this build has the CUDA backend and a GPU is present (what backend=\"auto\" picks).");
 
-    m.def("load_mesh", &load_prepared, py::arg("path"), py::arg("weld_tolerance") = 0.0,
-          py::arg("check_intersections") = true,
-          R"(load_mesh(path, weld_tolerance=0.0, check_intersections=True) -> Mesh
+    // The formats from their one table (core/mesh/load_mesh.h).
+    static const std::string load_mesh_doc = R"(load_mesh(path, weld_tolerance=0.0, check_intersections=True) -> Mesh
 
-Loads and prepares a mesh file as sdf-query does: OBJ, PLY (ASCII and binary), STL (ASCII and
-binary), OFF, each optionally gzip-compressed, found in the current directory and then on the
-data search path ($SDF_DATA_PATH, data/meshes, ../shared/meshes); or a procedural shape,
-"shape:sphere", "shape:box", "shape:torus", "shape:pawn", "shape:soccer_ball".)");
+Loads and prepares a mesh file as sdf-query does: )" + mesh_formats_supported() + R"(, found in the
+current directory and then on the data search path ($SDF_DATA_PATH, data/meshes,
+../shared/meshes); or a procedural shape, "shape:sphere", "shape:box", "shape:torus",
+"shape:pawn", "shape:soccer_ball".)";
+    m.def("load_mesh", &load_prepared, py::arg("path"), py::arg("weld_tolerance") = 0.0,
+          py::arg("check_intersections") = true, load_mesh_doc.c_str());
 }
 
 }  // namespace sdf

@@ -169,7 +169,7 @@ Distance, gradient, closest triangle, closest point and barycentric coordinates 
 ((N, 3) array), and with winding=True the generalized winding number. progress: True (a
 tqdm bar when tqdm is installed, else lines on sys.stderr), or a callable progress(done,
 total). Ctrl-C stops a long query within a fraction of a second (KeyboardInterrupt).)")
-        .def("sample", &sample_bound, py::arg("lattice") = "cc", py::arg("resolution") = py::none(),
+        .def("sample", &sample_bound, py::arg("lattice") = lattice_type_name(LatticeType::CC), py::arg("resolution") = py::none(),
              py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
              py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
              R"(sample(lattice="cc", resolution=None, samples=None, margin=None, bounds=None, spacing=None, origin=None, progress=None) -> Field

@@ -206,7 +206,7 @@ TEST(Neighbours, CcCoversTheThreeByThreeBlockOnce) {
 TEST(SamplingBlocks, CcIsOneDirectBlock) {
     const Lattice l = make(LatticeType::CC, {3, 4, 5});
     for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
-        GridBlock b[2];
+        GridBlock b[kMaxSamplingBlocks];
         ASSERT_EQ(sampling_blocks(l, s, b), 1);
         EXPECT_EQ(b[0].first, (Int3{0, 0, 0}));
         EXPECT_EQ(b[0].step, 2);
@@ -223,7 +223,7 @@ TEST(SamplingBlocks, CcIsOneDirectBlock) {
 
 TEST(SamplingBlocks, BccTwoGridsArePrimaryAndShiftedSecondary) {
     const Lattice l = make(LatticeType::BCC, {3, 4, 5});
-    GridBlock b[2];
+    GridBlock b[kMaxSamplingBlocks];
     ASSERT_EQ(sampling_blocks(l, BccStrategy::TwoGrids, b), 2);
     EXPECT_EQ(b[0].first, (Int3{0, 0, 0}));
     EXPECT_EQ(b[0].step, 2);
@@ -248,14 +248,14 @@ TEST(SamplingBlocks, BccTwoGridsArePrimaryAndShiftedSecondary) {
 }
 
 TEST(SamplingBlocks, BccTwoGridsWithoutSecondaryIsOneBlock) {
-    GridBlock b[2];
+    GridBlock b[kMaxSamplingBlocks];
     EXPECT_EQ(sampling_blocks(make(LatticeType::BCC, {3, 3, 1}), BccStrategy::TwoGrids, b), 1);
 }
 
 TEST(SamplingBlocks, BccDoubleResolutionMapsExactlyTheBccPoints) {
     for (const Int3& r : {Int3{3, 4, 5}, Int3{2, 2, 2}, Int3{6, 6, 6}}) {
         const Lattice l = make(LatticeType::BCC, r);
-        GridBlock b[2];
+        GridBlock b[kMaxSamplingBlocks];
         ASSERT_EQ(sampling_blocks(l, BccStrategy::DoubleResolution, b), 1);
         const GridBlock& g = b[0];
         EXPECT_TRUE(g.scatter);
@@ -291,7 +291,7 @@ TEST(SamplingBlocks, BccDoubleResolutionMapsExactlyTheBccPoints) {
 // grid, and strategy comparisons follow the thesis.
 TEST(SamplingBlocks, BccDoubleResolutionIsTheThesisGrid) {
     const Lattice l = make(LatticeType::BCC, {16, 16, 16});
-    GridBlock b[2];
+    GridBlock b[kMaxSamplingBlocks];
     ASSERT_EQ(sampling_blocks(l, BccStrategy::DoubleResolution, b), 1);
     EXPECT_EQ(b[0].resolution, (Int3{32, 32, 32}));
     EXPECT_EQ(b[0].step, 1);

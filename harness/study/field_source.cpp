@@ -1,4 +1,4 @@
-#include "experiments/common/field_source.h"
+#include "harness/study/field_source.h"
 
 #include <cstdio>
 #include <iostream>
@@ -6,7 +6,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/sampling/sampler_sign.h"
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 #include "harness/cache/field_cache.h"
 #include "harness/distributed/distributed.h"
 #include "harness/io/field_file.h"

@@ -1,4 +1,4 @@
-#include "experiments/common/study_inputs.h"
+#include "harness/study/study_inputs.h"
 
 #include <iostream>
 

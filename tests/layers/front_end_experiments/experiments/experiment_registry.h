@@ -1,0 +1,2 @@
+// The one experiments/ header a front end may include.
+#pragma once
