@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -58,104 +59,162 @@ struct Projection {
     }
 };
 
-/// The corners that are not strictly convex, bucketed on a uniform grid of the projection
-/// plane, so that an ear test looks only at those in its triangle's box: O(1) corners per
-/// test for polygons whose corners are spread evenly, instead of all of them. A test whose
-/// box covers more cells than there are such corners walks their list instead, so no test
-/// costs more than the plain scan.
-class ReflexGrid {
+/// The corners that are not strictly convex (the set S of the ear test), in a k-d tree of
+/// tight boxes built over those of the start, so that an ear test visits only the boxes
+/// its triangle may reach: a box is skipped when one of the triangle's edges has every
+/// corner of the box outside it by more than that edge's rounding error, so every corner
+/// the plain scan's computed test could accept is still tested (the same answers). A
+/// corner that leaves S is unmarked (the counts of live corners let empty boxes be
+/// skipped); one that joins S later (only in a polygon that is not simple) goes to a list
+/// of its own, scanned first.
+class ReflexCorners {
 public:
-    ReflexGrid(const std::vector<Vec3d>& p, const Projection& proj) : u_(proj.u), v_(proj.v), cell_of_(p.size(), -1) {
-        double lo[2] = {p[0][u_], p[0][v_]}, hi[2] = {lo[0], lo[1]};
-        for (const Vec3d& q : p) {
-            lo[0] = std::min(lo[0], q[u_]); hi[0] = std::max(hi[0], q[u_]);
-            lo[1] = std::min(lo[1], q[v_]); hi[1] = std::max(hi[1], q[v_]);
-        }
-        // About one cell per corner, square where the box allows.
-        const double w = hi[0] - lo[0], h = hi[1] - lo[1], n = double(p.size());
-        const double aspect = w > 0 && h > 0 && std::isfinite(w / h) ? std::clamp(w / h, 1.0 / n, n) : 1.0;
-        cells_[0] = w > 0 ? int(std::clamp(std::sqrt(n * aspect), 1.0, n)) : 1;
-        cells_[1] = h > 0 ? int(std::clamp(n / cells_[0], 1.0, n)) : 1;
-        for (int k = 0; k < 2; ++k) {
-            origin_[k] = lo[k];
-            const double extent = hi[k] - lo[k];
-            scale_[k] = extent > 0 ? double(cells_[k]) / extent : 0.0;
-        }
-        head_.assign(size_t(cells_[0]) * size_t(cells_[1]), -1);
-        next_.assign(p.size(), -1);
-        prev_.assign(p.size(), -1);
-        position_.assign(p.size(), -1);
+    ReflexCorners(const std::vector<Vec3d>& p, const Projection& proj, std::vector<int> initial)
+        : p_(p), proj_(proj), member_(p.size(), 0), slot_(p.size(), -1), extra_position_(p.size(), -1),
+          items_(std::move(initial)), leaf_of_(items_.size(), -1) {
+        for (const int i : items_) member_[size_t(i)] = 1;
+        if (!items_.empty()) build(0, int(items_.size()), -1);
+        for (size_t s = 0; s < items_.size(); ++s) slot_[size_t(items_[s])] = int(s);
     }
 
-    bool contains(int i) const { return cell_of_[size_t(i)] >= 0; }
+    bool contains(int i) const { return member_[size_t(i)] != 0; }
 
-    void insert(int i, const Vec3d& q) {
+    void insert(int i) {
         if (contains(i)) return;
-        const int c = cell(q[u_], 0) + cells_[0] * cell(q[v_], 1);
-        cell_of_[size_t(i)] = c;
-        prev_[size_t(i)] = -1;
-        next_[size_t(i)] = head_[size_t(c)];
-        if (next_[size_t(i)] >= 0) prev_[size_t(next_[size_t(i)])] = i;
-        head_[size_t(c)] = i;
-        position_[size_t(i)] = int(all_.size());
-        all_.push_back(i);
+        member_[size_t(i)] = 1;
+        if (slot_[size_t(i)] >= 0) return count(i, +1);
+        extra_position_[size_t(i)] = int(extra_.size());
+        extra_.push_back(i);
     }
 
     void erase(int i) {
         if (!contains(i)) return;
-        const int c = cell_of_[size_t(i)];
-        if (prev_[size_t(i)] >= 0) next_[size_t(prev_[size_t(i)])] = next_[size_t(i)];
-        else head_[size_t(c)] = next_[size_t(i)];
-        if (next_[size_t(i)] >= 0) prev_[size_t(next_[size_t(i)])] = prev_[size_t(i)];
-        cell_of_[size_t(i)] = -1;
-        const int last = all_.back();
-        all_[size_t(position_[size_t(i)])] = last;
-        position_[size_t(last)] = position_[size_t(i)];
-        all_.pop_back();
-        position_[size_t(i)] = -1;
+        member_[size_t(i)] = 0;
+        if (slot_[size_t(i)] >= 0) return count(i, -1);
+        const int last = extra_.back();
+        extra_[size_t(extra_position_[size_t(i)])] = last;
+        extra_position_[size_t(last)] = extra_position_[size_t(i)];
+        extra_.pop_back();
+        extra_position_[size_t(i)] = -1;
     }
 
-    /// Calls stop(j) for the corners whose position may lie in the box of a, b, c (every
-    /// corner that does, perhaps others); returns the first j for which stop(j) is true, or -1.
+    /// The first corner j of S (in no particular order) that the triangle (a, b, c) may hold
+    /// and for which stop(j) is true, or -1; every corner of S that it may hold is offered.
     template <typename Stop>
     int find(const Vec3d& a, const Vec3d& b, const Vec3d& c, Stop stop) const {
-        const int x0 = cell(std::min({a[u_], b[u_], c[u_]}), 0), x1 = cell(std::max({a[u_], b[u_], c[u_]}), 0);
-        const int y0 = cell(std::min({a[v_], b[v_], c[v_]}), 1), y1 = cell(std::max({a[v_], b[v_], c[v_]}), 1);
-        if (double(x1 - x0 + 1) * double(y1 - y0 + 1) > double(all_.size())) {
-            for (const int j : all_)
-                if (stop(j)) return j;
-            return -1;
+        for (const int j : extra_)
+            if (stop(j)) return j;
+        if (nodes_.empty() || nodes_[0].alive == 0) return -1;
+        const Vec3d* corners[3] = {&a, &b, &c};
+        Edge edges[3];
+        for (int k = 0; k < 3; ++k) edges[k] = edge(*corners[k], *corners[(k + 1) % 3]);
+        int stack[64 * 2];
+        int top = 0;
+        stack[top++] = 0;
+        while (top > 0) {
+            const Node& n = nodes_[size_t(stack[--top])];
+            if (n.alive == 0 || outside(n, edges)) continue;
+            if (n.child[0] < 0) {
+                for (int s = n.begin; s < n.end; ++s) {
+                    const int j = items_[size_t(s)];
+                    if (member_[size_t(j)] && stop(j)) return j;
+                }
+                continue;
+            }
+            stack[top++] = n.child[0];
+            stack[top++] = n.child[1];
         }
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x)
-                for (int j = head_[size_t(x + cells_[0] * y)]; j >= 0; j = next_[size_t(j)])
-                    if (stop(j)) return j;
         return -1;
     }
 
 private:
-    /// The cell column (k = 0) or row (k = 1) of a coordinate: non-decreasing in it, so the
-    /// cells of a box's corners bound the cells of every point inside it.
-    int cell(double x, int k) const {
-        const double t = (x - origin_[k]) * scale_[k];
-        if (!(t > 0)) return 0;  // NaN (0 * infinity) too
-        return t >= double(cells_[k]) ? cells_[k] - 1 : int(t);
+    struct Node {
+        double lo[2], hi[2];  ///< the tight box of its corners, in the projection's (u, v)
+        int begin, end;       ///< its corners: items_[begin, end)
+        int child[2] = {-1, -1};
+        int parent;
+        int alive;            ///< corners of S among them
+    };
+    /// The half-plane orient(e0, e1, q) >= 0 that the ear test asks, as the projection computes it.
+    struct Edge {
+        double au, av, du, dv, sign, magnitude;
+    };
+
+    double u(const Vec3d& q) const { return q[proj_.u]; }
+    double v(const Vec3d& q) const { return q[proj_.v]; }
+
+    Edge edge(const Vec3d& e0, const Vec3d& e1) const {
+        const double du = u(e1) - u(e0), dv = v(e1) - v(e0);
+        return {u(e0), v(e0), du, dv, proj_.sign, std::abs(du) + std::abs(dv)};
     }
 
-    int u_, v_;
-    int cells_[2] = {1, 1};
-    double origin_[2] = {0, 0}, scale_[2] = {0, 0};
-    std::vector<int> head_;            ///< first corner of each cell, -1 if none
-    std::vector<int> next_, prev_;     ///< the cell's list
-    std::vector<int> cell_of_;         ///< each corner's cell, -1 when not in the grid
-    std::vector<int> all_, position_;  ///< every corner in the grid, and each one's place there
+    /// True when every point of the box is outside one of the edges by more than the
+    /// rounding of the ear test's orient() (a few units of 2^-52 of the products: 16 used).
+    bool outside(const Node& n, const Edge (&edges)[3]) const {
+        constexpr double kRounding = 16 * std::numeric_limits<double>::epsilon();
+        for (const Edge& e : edges) {
+            double most = -std::numeric_limits<double>::infinity(), reach = 0;
+            for (int k = 0; k < 4; ++k) {
+                const double qu = (k & 1 ? n.hi[0] : n.lo[0]) - e.au, qv = (k & 2 ? n.hi[1] : n.lo[1]) - e.av;
+                most = std::max(most, e.sign * (e.du * qv - e.dv * qu));
+                reach = std::max(reach, std::abs(qu) + std::abs(qv));
+            }
+            if (most < -2 * kRounding * e.magnitude * reach) return true;
+        }
+        return false;
+    }
+
+    void count(int i, int change) {
+        for (int n = leaf_of_[size_t(slot_[size_t(i)])]; n >= 0; n = nodes_[size_t(n)].parent) nodes_[size_t(n)].alive += change;
+    }
+
+    int build(int begin, int end, int parent) {
+        const int index = int(nodes_.size());
+        nodes_.push_back(Node{});
+        Node n;
+        n.begin = begin;
+        n.end = end;
+        n.parent = parent;
+        n.alive = end - begin;
+        n.lo[0] = n.lo[1] = std::numeric_limits<double>::infinity();
+        n.hi[0] = n.hi[1] = -std::numeric_limits<double>::infinity();
+        for (int s = begin; s < end; ++s) {
+            const Vec3d& q = p_[size_t(items_[size_t(s)])];
+            n.lo[0] = std::min(n.lo[0], u(q)); n.hi[0] = std::max(n.hi[0], u(q));
+            n.lo[1] = std::min(n.lo[1], v(q)); n.hi[1] = std::max(n.hi[1], v(q));
+        }
+        if (end - begin <= kLeafSize) {
+            for (int s = begin; s < end; ++s) leaf_of_[size_t(s)] = index;
+        } else {
+            // Halves along the longer side (the median): a depth of log2(n / kLeafSize).
+            const int axis = n.hi[0] - n.lo[0] >= n.hi[1] - n.lo[1] ? proj_.u : proj_.v;
+            const int mid = begin + (end - begin) / 2;
+            std::nth_element(items_.begin() + begin, items_.begin() + mid, items_.begin() + end,
+                             [&](int x, int y) { return p_[size_t(x)][axis] < p_[size_t(y)][axis]; });
+            n.child[0] = build(begin, mid, index);
+            n.child[1] = build(mid, end, index);
+        }
+        nodes_[size_t(index)] = n;
+        return index;
+    }
+
+    static constexpr int kLeafSize = 8;
+    const std::vector<Vec3d>& p_;
+    Projection proj_;
+    std::vector<char> member_;       ///< in S
+    std::vector<int> slot_;          ///< place in items_, -1 for corners not in the tree
+    std::vector<int> extra_position_;
+    std::vector<int> items_;         ///< the tree's corners, each node's a range
+    std::vector<int> leaf_of_;       ///< the leaf of each slot of items_
+    std::vector<Node> nodes_;
+    std::vector<int> extra_;         ///< corners of S not in the tree (joined later)
 };
 
 /// Ear clipping of one polygon (corners without consecutive repeats), as described in the header.
 ///
 /// What a test depends on is kept track of, so that no test is repeated in vain: a corner's
 /// ear test depends on its two neighbours (it is tested again when one of them is clipped)
-/// and on the set S of live corners that are not strictly convex (ReflexGrid). A corner
+/// and on the set S of live corners that are not strictly convex (ReflexCorners). A corner
 /// that is no ear because of a corner j of S stays none until j leaves S (is clipped or turns
 /// convex: then the corner waits in `recheck_`); one that is no ear by its own shape stays
 /// none until a neighbour changes. So when no ear is known (`ears_` empty), retesting only
@@ -166,12 +225,8 @@ class EarClipper {
 public:
     EarClipper(const std::vector<Vec3d>& p, const std::vector<int>& ids, Projection proj, std::vector<Int3>& out)
         : p_(p), ids_(ids), proj_(proj), out_(out), prev_(p.size()), next_(p.size()), alive_(p.size(), true),
-          key_(p.size(), -1.0), blocked_(p.size()), reflex_(p, proj), monitor_(current_task_monitor()) {
-        const int n = int(p.size());
-        for (int i = 0; i < n; ++i) { prev_[size_t(i)] = (i + n - 1) % n; next_[size_t(i)] = (i + 1) % n; }
-        for (int i = 0; i < n; ++i)
-            if (!convex(i)) reflex_.insert(i, p_[size_t(i)]);
-        left_ = n;
+          key_(p.size(), -1.0), blocked_(p.size()), reflex_(p, proj, start_links()), monitor_(current_task_monitor()) {
+        left_ = int(p.size());
     }
 
     /// Clips every ear; returns false when the polygon ran out of ears (not simple).
@@ -200,6 +255,16 @@ public:
 private:
     static constexpr int kEar = -1, kOwnShape = -2;
 
+    /// Links every corner to its neighbours; returns the corners that are not strictly convex.
+    std::vector<int> start_links() {
+        const int n = int(p_.size());
+        for (int i = 0; i < n; ++i) { prev_[size_t(i)] = (i + n - 1) % n; next_[size_t(i)] = (i + 1) % n; }
+        std::vector<int> reflex;
+        for (int i = 0; i < n; ++i)
+            if (!convex(i)) reflex.push_back(i);
+        return reflex;
+    }
+
     void clip(int tip) {
         const int a = prev_[size_t(tip)], c = next_[size_t(tip)];
         emit(a, tip, c);
@@ -211,7 +276,7 @@ private:
         --left_;
         for (const int corner : {a, c}) {
             // In a polygon that is not simple, a corner may turn either way.
-            if (!convex(corner)) reflex_.insert(corner, p_[size_t(corner)]);
+            if (!convex(corner)) reflex_.insert(corner);
             else leave_reflex(corner);
         }
         update(a);
@@ -312,7 +377,7 @@ private:
     std::set<std::pair<double, int>> ears_;  ///< (squared cut length, rank): shortest cut first
     std::vector<std::vector<int>> blocked_;   ///< the corners each corner of S blocked when last tested
     std::vector<int> recheck_;                ///< corners whose blocker left S
-    ReflexGrid reflex_;                       ///< S: live corners not strictly convex
+    ReflexCorners reflex_;                    ///< S: live corners not strictly convex
     TaskMonitor* monitor_;
     int left_ = 0;
 };
