@@ -10,7 +10,7 @@
 //    distances equal to the analytic ones (L prism) and to each other (2,000 points).
 //  - Issue 38: the grid clipper gives the triangles of the quadratic one it replaced
 //    (reference_ear_clipping.h) on random simple, comb, keyhole, collinear and
-//    self-crossing polygons; a 40,000-corner star is triangulated (it took 29 s) and stops
+//    self-crossing polygons; a 40,000-corner star and comb are triangulated (29 s before) and stop
 //    on request; a cylinder with 300-corner caps reads alike in every format, its centre
 //    inside (OBJ corners beyond 255: tinyobjloader's unsigned char count), and an OFF
 //    polygon on the last line is not taken for a truncated file.
@@ -261,6 +261,14 @@ TEST(TriangulatePolygon, FortyThousandCornersAndAStopRequest) {
     std::vector<std::pair<double, double>> uv;
     for (const Vec3d& q : star(40000)) uv.push_back({q.x, q.y});
     expect_valid_triangulation(place(uv, {5, 6, 7}, {0, 1, 0}, {1, 0, 0}), "40,000-corner star");
+    // A comb of 10,000 teeth: its base corners' ears span the whole comb, past every tooth.
+    uv = {{0, 0}, {20000, 0}};
+    for (int k = 9999; k >= 0; --k)
+        for (const auto& q : {std::pair{2.0 * k + 2, 3.0}, {2.0 * k + 1.5, 3.0}, {2.0 * k + 1.5, 1.0}, {2.0 * k + 1, 1.0}})
+            uv.push_back(q);
+    uv.resize(uv.size() - 2);
+    uv.push_back({0, 3});
+    expect_valid_triangulation(place(uv, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}), "40,001-corner comb");
     // A stop request (Ctrl-C in Python) ends the clipping.
     const std::vector<Vec3d> v = star(40000);
     std::vector<int> corners(v.size());
