@@ -96,12 +96,27 @@ void check_camera_flags(const Options& o) {
     if (o.eye.empty() && o.target.empty()) return;
     if (o.eye.size() != 3 || o.target.size() != 3)
         throw std::invalid_argument("--eye and --target are both needed for an explicit camera");
-    // A zero up vector, or one along the line of sight, leaves the camera's roll undefined.
+    const auto text = [](const std::vector<double>& v) {
+        std::string t;
+        for (const double x : v) {
+            char number[32];
+            std::snprintf(number, sizeof number, "%.6g", x);
+            t += (t.empty() ? "" : ",") + std::string(number);
+        }
+        return t;
+    };
+    // Each problem by its name: a NaN or overflowing eye is no "up parallel to the view".
+    for (const auto& [flag, v] : {std::pair{"--eye", &o.eye}, {"--target", &o.target}, {"--up", &o.up}})
+        for (const double x : *v)
+            if (!std::isfinite(x))
+                throw std::invalid_argument(std::string(flag) + " " + text(*v) + ": expected three finite numbers");
     const Vec3d forward = vec3(o.target) - vec3(o.eye);
+    if (!std::isfinite(length_squared(forward)) || !std::isfinite(length_squared(vec3(o.up))))
+        return;  // distances beyond double's range: the camera's check names them (views.cpp, make_camera)
     if (length_squared(forward) == 0.0) throw std::invalid_argument("--eye and --target are the same point");
+    // A zero up vector, or one along the line of sight, leaves the camera's roll undefined.
     if (length_squared(cross(forward, vec3(o.up))) == 0.0)
-        throw std::invalid_argument("--up " + std::to_string(o.up[0]) + "," + std::to_string(o.up[1]) + "," +
-                                    std::to_string(o.up[2]) +
+        throw std::invalid_argument("--up " + text(o.up) +
                                     " is zero or parallel to the line of sight; expected a direction that fixes "
                                     "the camera's roll");
 }
@@ -174,7 +189,25 @@ nlohmann::json provenance(const Options& o, const nlohmann::json& resolved, cons
             {"input", o.input}};
 }
 
+/// Every file run_single() writes, checked before anything is sampled or rendered (the
+/// folder exists and is writable, no file is replaced without --overwrite).
+void require_single_targets(const Options& o, const RenderSpec& spec) {
+    const Overwrite overwrite = o.overwrite ? Overwrite::Allow : Overwrite::Forbid;
+    for (const ViewRequest& v : spec.views) {
+        const std::string out = spec.views.size() > 1 ? with_suffix(o.out, "_" + v.name) : o.out;
+        std::vector<std::string> targets = {out};
+        if (!o.no_exr) targets.push_back(with_suffix(out, "", ".exr"));
+        if (spec.reference) {
+            targets.push_back(with_suffix(out, "_reference"));
+            if (!o.no_exr) targets.push_back(with_suffix(out, "_reference", ".exr"));
+            targets.push_back(with_suffix(out, "", ".metrics.json"));
+        }
+        for (const std::string& t : targets) require_writable_target(t, overwrite);
+    }
+}
+
 int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
+    require_single_targets(o, spec);
     std::optional<PreparedMesh> mesh;
     SampledField field;
     if (is_field_file(o.input)) {
@@ -233,6 +266,11 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
 
 int run_grid(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     if (is_field_file(o.input)) throw std::invalid_argument("--grid needs a mesh INPUT (it samples CC and BCC fields)");
+    // The output folder before anything is sampled or rendered.
+    if (fs::exists(o.out_dir) && !fs::is_directory(o.out_dir))
+        throw std::runtime_error("--out-dir " + o.out_dir + ": is not a folder; expected a folder for the figures");
+    fs::create_directories(o.out_dir);
+    require_writable_target((fs::path(o.out_dir) / "probe").string(), Overwrite::Allow);
     const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
     const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::CC, o.cc_resolution, o.margin), o);
     const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::BCC, o.bcc_resolution, o.margin), o);

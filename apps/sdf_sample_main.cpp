@@ -181,17 +181,29 @@ int main(int argc, char** argv) {
         const sdf::StreamPlan plan = sdf::plan_streamed_sampling(lattice, stream);
         doing = "sampling " + mesh_arg + " on " + sdf::lattice_notation(lattice) + ", " + std::to_string(plan.points) + " points";
         planned_bytes = plan.peak_estimate;
+        // What the run checks before sampling; the dry run checks it too and says so.
+        const auto require_runnable = [&] {
+            sdf::require_plan_fits_machine(plan.peak_estimate, stream.memory_budget, "--memory-budget");
+            require_output_space(plan, out_path);
+        };
         if (dry_run) {
-            std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision)
-                      << (band > 0 ? ", band " + std::to_string(band) : std::string()) << "\n"
-                      << plan.describe() << "out: " << out_path << "\n";
+            std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision);
+            if (band > 0) std::cout << ", band " << band;
+            std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
             if (!vdb_path.empty())
                 std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
                           << " active (its grids hold the band's points, outside the budget)\n";
+            try {
+                sdf::require_writable_target(out_path, stream.write.overwrite);
+                if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
+                require_runnable();
+            } catch (const std::exception& e) {
+                std::cerr << "sdf-sample: error: the run would be refused: " << e.what() << "\n";
+                return 1;
+            }
             return 0;
         }
-        sdf::require_plan_fits_machine(plan.peak_estimate, stream.memory_budget, "--memory-budget");
-        require_output_space(plan, out_path);
+        require_runnable();
         // Temporaries of an interrupted earlier run in the output folder (their process is gone).
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);

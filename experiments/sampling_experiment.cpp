@@ -34,6 +34,13 @@ public:
         uint8_ = out.optional<bool>("uint8", false, "true or false");
         read_volume_formats(out);
         out.finish();
+        // A band the field files cannot store is refused in the plan, not after sampling.
+        try {
+            require_representable_band(inputs_.sampler.band_width, dtype_, "band_width");
+        } catch (const std::invalid_argument& e) {
+            config.fail("sampler", std::string(e.what()) + " (output.dtype \"" +
+                                       (dtype_ == FieldDtype::Float32 ? "float32" : "float64") + "\")");
+        }
     }
 
     MemoryNeed memory_need(const RunContext&) const override {

@@ -36,8 +36,19 @@ namespace {
 /// decimal integers, not 0, negative ones (relative: -1 is the last vertex so far) within
 /// the vertices before the line, positive ones within the file's vertices; an error quotes
 /// the index as written and names the line.
-std::vector<Vec3d> read_vertex_lines(std::string_view text, const std::string& path) {
+///
+/// Debian's tinyobjloader (2.0.0rc10) also stores a face's corner count in an unsigned char:
+/// a face of 256 corners reads as 0 corners, one of 300 as 44, while all its indices are
+/// kept. So the corners of every `f` line are counted here too (`corner_counts`, in file
+/// order), and tinyobjloader's flat index list is cut into faces by these counts.
+struct ObjLines {
     std::vector<Vec3d> vertices;
+    std::vector<int64_t> corner_counts;  ///< of each `f` line, in file order
+};
+
+ObjLines read_obj_lines(std::string_view text, const std::string& path) {
+    ObjLines lines;
+    std::vector<Vec3d>& vertices = lines.vertices;
     struct FaceReference {
         int line;
         int64_t index;
@@ -48,6 +59,7 @@ std::vector<Vec3d> read_vertex_lines(std::string_view text, const std::string& p
     for (size_t at = 0; at < text.size();) {
         // A line ends at "\n", "\r\n" or a lone "\r" (classic Mac OS), as tinyobjloader reads it.
         const size_t end = std::min(text.find_first_of("\r\n", at), text.size());
+        const size_t line_start = at;
         TextCursor ss(text.substr(at, end - at));
         at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
         ++number;
@@ -55,7 +67,14 @@ std::vector<Vec3d> read_vertex_lines(std::string_view text, const std::string& p
         if (!ss.next(tag)) continue;
         if (tag == "f") {
             std::string_view token;
+            // A face line as tinyobjloader sees one: "f" after spaces or tabs, then a space or tab.
+            const std::string_view line = text.substr(line_start, end - line_start);
+            const size_t after = size_t(tag.data() - line.data()) + 1;
+            const bool face = line.find_first_not_of(" \t") == after - 1 && after < line.size() &&
+                              (line[after] == ' ' || line[after] == '\t');
+            int64_t* corners = face ? &lines.corner_counts.emplace_back(0) : nullptr;
             while (ss.next(token)) {
+                if (corners) ++*corners;
                 const std::string_view index_part = token.substr(0, token.find('/'));
                 int64_t index = 0;
                 const auto fail = [&](const std::string& why) {
@@ -95,7 +114,7 @@ std::vector<Vec3d> read_vertex_lines(std::string_view text, const std::string& p
                                  sdf::quoted(largest_positive[0].token) + " refers to vertex " +
                                  std::to_string(largest_positive[0].index) + ", but the file has " +
                                  std::to_string(vertices.size()) + " vertices");
-    return vertices;
+    return lines;
 }
 
 /// tinyobjloader skips faces with fewer than 3 vertices or with invalid indices and only
@@ -126,43 +145,52 @@ struct ParsedObj {
     std::string warnings;
 };
 
-/// The mesh tinyobjloader parsed, with the index checks of load_obj() and every polygon
-/// triangulated by polygon_triangulation.h (as PLY, OFF and STL polygons are).
-TriangleMesh mesh_from_parse(const ParsedObj& parsed, std::vector<Vec3d> vertices, const std::string& path) {
+/// The mesh tinyobjloader parsed, its faces cut by the corner counts of read_obj_lines()
+/// (tinyobjloader's own counts are checked modulo 256), with the index checks of load_obj()
+/// and every polygon triangulated by polygon_triangulation.h (as PLY, OFF and STL polygons are).
+TriangleMesh mesh_from_parse(const ParsedObj& parsed, ObjLines lines, const std::string& path) {
     reject_dropped_faces(path, parsed.warnings);
 
     TriangleMesh mesh;
     mesh.name = stem_of(path);
     mesh.source = path;
-    if (parsed.attrib.vertices.size() != 3 * vertices.size())
+    if (parsed.attrib.vertices.size() != 3 * lines.vertices.size())
         throw std::runtime_error(path + ": tinyobjloader found " + std::to_string(parsed.attrib.vertices.size() / 3) +
-                                 " vertices but the file has " + std::to_string(vertices.size()) + " `v` lines");
-    mesh.vertices = std::move(vertices);
+                                 " vertices but the file has " + std::to_string(lines.vertices.size()) + " `v` lines");
+    mesh.vertices = std::move(lines.vertices);
 
+    const auto inconsistent = [&](const std::string& what) {
+        throw std::runtime_error(path + ": the `f` lines and tinyobjloader's faces disagree (" + what +
+                                 "); expected `f` lines of vertex indices only");
+    };
+    size_t face = 0;  // the `f` line, 0-based, across every shape
     std::vector<int> polygon;
     for (const tinyobj::shape_t& shape : parsed.shapes) {
-        const auto& faces = shape.mesh.num_face_vertices;
+        const auto& counts = shape.mesh.num_face_vertices;
         size_t offset = 0;
-        for (size_t f = 0; f < faces.size(); ++f) {
-            const size_t n = faces[f];
-            if (offset + n > shape.mesh.indices.size())
-                throw std::runtime_error(path + ": tinyobjloader's face list of shape '" + shape.name + "' is inconsistent");
-            polygon.resize(n);
-            for (size_t k = 0; k < n; ++k) {
+        for (size_t f = 0; f < counts.size(); ++f, ++face) {
+            if (face >= lines.corner_counts.size()) inconsistent("more faces than `f` lines");
+            const int64_t n = lines.corner_counts[face];
+            if (n < 3)  // tinyobjloader warns of these ("Degenerated face"), refused above
+                throw std::runtime_error(path + ": face " + std::to_string(face) + " has " + std::to_string(n) +
+                                         " vertices; expected 3 or more");
+            if (counts[f] != static_cast<unsigned char>(n) || uint64_t(n) > shape.mesh.indices.size() - offset)
+                inconsistent("face " + std::to_string(face) + " has " + std::to_string(n) + " corners");
+            polygon.resize(size_t(n));
+            for (size_t k = 0; k < size_t(n); ++k) {
                 const int v = shape.mesh.indices[offset + k].vertex_index;
                 if (v < 0 || size_t(v) >= mesh.vertices.size())
-                    throw std::runtime_error(path + ": face " + std::to_string(f) + " of shape '" + shape.name +
-                                             "' refers to vertex " + std::to_string(int64_t(v) + 1) +
-                                             ", but the file has " + std::to_string(mesh.vertices.size()) + " vertices");
+                    throw std::runtime_error(path + ": face " + std::to_string(face) + " refers to vertex " +
+                                             std::to_string(int64_t(v) + 1) + ", but the file has " +
+                                             std::to_string(mesh.vertices.size()) + " vertices");
                 polygon[k] = v;
             }
-            if (n < 3)  // tinyobjloader warns of these ("Degenerated face"), refused above
-                throw std::runtime_error(path + ": face " + std::to_string(f) + " of shape '" + shape.name + "' has " +
-                                         std::to_string(n) + " vertices; expected 3 or more");
             triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);
-            offset += n;
+            offset += size_t(n);
         }
+        if (offset != shape.mesh.indices.size()) inconsistent("the corners do not add up");
     }
+    if (face != lines.corner_counts.size()) inconsistent("more `f` lines than faces");
     if (mesh.triangles.empty())
         throw std::runtime_error(path + ": no triangles found (expected `f` lines with 3 or more vertices)");
     return mesh;
@@ -180,7 +208,7 @@ TriangleMesh load_obj_text(const std::string& bytes, const std::string& path) {
     // A byte-order mark would glue itself to the first `v` and shift every index by one.
     reject_wide_encodings(bytes, path, "OBJ file");
     const std::string_view text = without_utf8_bom(bytes);
-    std::vector<Vec3d> vertices = read_vertex_lines(text, path);
+    ObjLines lines = read_obj_lines(text, path);
     ParsedObj parsed;
     MemoryStreamBuffer buffer(text);
     std::istream in(&buffer);
@@ -193,7 +221,7 @@ TriangleMesh load_obj_text(const std::string& bytes, const std::string& path) {
     if (!tinyobj::LoadObj(&parsed.attrib, &parsed.shapes, &materials, &parsed.warnings, &error, &in, &material_reader,
                           /*triangulate=*/false, /*default_vcols_fallback=*/false))
         throw std::runtime_error(path + ": cannot parse OBJ: " + error);
-    return mesh_from_parse(parsed, std::move(vertices), path);
+    return mesh_from_parse(parsed, std::move(lines), path);
 }
 
 }  // namespace sdf

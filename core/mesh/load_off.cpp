@@ -60,7 +60,12 @@ public:
             int64_t n = 0;
             if (!parse_int(w, n) || n < 3)
                 face_fail(vertices, faces, f, "face " + std::to_string(f) + " has vertex count " + quoted(w) + "; expected 3 or more");
-            if (uint64_t(n) > text_.bytes_left() + 64) fail("face " + std::to_string(f) + " declares " + std::to_string(n) + " vertices, more than the file holds");
+            // A face's indices are on its line, each a digit and a separator at least (checked
+            // before the corners are allocated).
+            if (uint64_t(n) > (line_.bytes_left() + 1) / 2)
+                face_fail(vertices, faces, f, "face " + std::to_string(f) + " declares " + std::to_string(n) +
+                                                  " vertices, more than its line holds (" +
+                                                  std::to_string(line_.bytes_left()) + " bytes after the count)");
             polygon.resize(size_t(n));
             for (int& v : polygon) v = index(f, vertices, faces);
             triangulate_polygon(mesh.vertices, polygon, mesh.triangles, mesh.polygon_stats);

@@ -25,9 +25,12 @@
 /// Ear clipping (Meisters 1975) is a few dozen lines here and needs no dependency: no C++
 /// earcut or polygon triangulator is packaged in Debian 12 apart from CGAL, whose
 /// constrained Delaunay triangulation would bring Boost, GMP and MPFR for faces that
-/// are mostly quads. Cost: each ear test scans the corners that are not convex, so O(n r)
-/// for a polygon of n corners, r of them reflex: linear for the convex caps of CAD
-/// cylinders, whatever their size.
+/// are mostly quads. Cost: the corners that are not convex sit in a k-d tree, so an ear
+/// test looks only at those its triangle may reach, and a corner is tested again only when
+/// a neighbour is clipped or the corner that blocked it leaves (issue 38): O(n log n) in
+/// practice (a 40,000-corner star or comb: a fraction of a second; the plain O(n r) scan
+/// took 29 s), the same triangles as the plain scan. A long clipping
+/// stops on the calling thread's stop request (task_monitor.h: Ctrl-C in Python).
 #pragma once
 
 #include <vector>

@@ -202,6 +202,7 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     rep.input_vertices = int(mesh.vertices.size());
     rep.input_triangles = int(mesh.triangles.size());
     rep.polygons = mesh.polygon_stats;
+    if (options.keep_input) out.input_ = std::make_shared<const PreparedMesh::InputArrays>(PreparedMesh::InputArrays{mesh.vertices, mesh.triangles});
 
     // Weld, then drop triangles with a repeated vertex or exactly zero area.
     std::vector<Vec3d> welded;

@@ -31,6 +31,10 @@ struct MeshPreparationOptions {
     /// Threads of the preparation's passes, the BVH build and the self-intersection test
     /// included (0 = all hardware threads); every result is the same bytes at any count.
     int threads = 0;
+    /// Keep the input's vertices and triangles (input_vertices(), input_triangles()): the
+    /// numbering of query results, for callers that have no other copy (the Python module's
+    /// meshes read from files).
+    bool keep_input = false;
 };
 
 /// What preparation found; printed in summaries and stored in field headers.
@@ -91,6 +95,10 @@ public:
     const std::vector<Int3>& triangles() const { return triangles_; }
     /// Index of each triangle in the input's face order.
     const std::vector<int>& source_triangle() const { return source_triangle_; }
+    /// The input's vertices and triangles as given to prepare_mesh() (a file's triangulated
+    /// faces), the numbering of source_triangle(); empty unless MeshPreparationOptions::keep_input.
+    const std::vector<Vec3d>& input_vertices() const { return input_->vertices; }
+    const std::vector<Int3>& input_triangles() const { return input_->triangles; }
     const std::vector<Vec3d>& face_normals() const { return face_normals_; }      ///< unit
     /// 3 per triangle, unit; edge e = (v_e, v_(e+1)%3).
     const std::vector<Vec3d>& edge_normals() const { return edge_normals_; }
@@ -131,6 +139,11 @@ private:
     std::vector<Vec3d> vertices_;
     std::vector<Int3> triangles_;
     std::vector<int> source_triangle_;
+    struct InputArrays {
+        std::vector<Vec3d> vertices;
+        std::vector<Int3> triangles;
+    };
+    std::shared_ptr<const InputArrays> input_ = std::make_shared<const InputArrays>();
     std::vector<Vec3d> face_normals_, edge_normals_, vertex_normals_;
     std::vector<int> shell_of_;
     std::vector<std::pair<int, int>> intersecting_triangles_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -37,6 +38,14 @@ const NamedView& find_named_view(const std::string& name) {
                                 " or an explicit camera (eye, target, up, fov)");
 }
 
+std::string number_text(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
+
+bool finite(const Vec3d& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
 std::string vec_text(const Vec3d& v) {
     std::ostringstream s;
     s << "[" << v.x << ", " << v.y << ", " << v.z << "]";
@@ -48,8 +57,16 @@ void check_size_and_fov(const std::string& view, int width, int height, double f
         throw std::invalid_argument("view '" + view + "': image size " + std::to_string(width) + "x" +
                                     std::to_string(height) + " is not positive");
     if (!(fov > 0 && fov < 180))
-        throw std::invalid_argument("view '" + view + "': fov " + std::to_string(fov) +
-                                    " degrees is outside (0, 180)");
+        throw std::invalid_argument("view '" + view + "': fov " + number_text(fov) + " degrees is outside (0, 180)");
+    // Neighbouring pixels' rays differ by about 2 tan(fov / 2) / size: below ~1e-12 they
+    // are the same ray in double (and a fitted eye flies off beyond double's range).
+    const double step = 2 * std::tan(fov * M_PI / 360.0) / double(std::max(width, height));
+    if (!(step > 1e-12))
+        throw std::invalid_argument("view '" + view + "': fov " + number_text(fov) + " degrees is too small for a " +
+                                    std::to_string(width) + "x" + std::to_string(height) +
+                                    " image: neighbouring pixels' rays would differ by " + number_text(step) +
+                                    " radians, below double precision; expected a fov of at least " +
+                                    number_text(1e-12 * double(std::max(width, height)) * 180.0 / M_PI) + " degrees");
 }
 
 /// Distance from `centre` along `direction` at which every point projects inside the image.
@@ -97,6 +114,10 @@ CameraSpec fit_named_view(const ViewRequest& request, const std::vector<Vec3d>& 
                            fitted_distance(points, c.target, v.direction, v.up, request.fov_y_degrees,
                                            double(width) / height, request.margin);
     c.up = v.up;
+    if (!finite(c.eye))
+        throw std::invalid_argument("view '" + request.name + "': the bounds " + vec_text(bounds.min) + " to " +
+                                    vec_text(bounds.max) + " cannot be framed at fov " + number_text(request.fov_y_degrees) +
+                                    " degrees: the fitted eye's distance overflows double; expected a larger fov");
     return c;
 }
 
@@ -151,7 +172,18 @@ CameraSpec resolve_view(const ViewRequest& request, const std::vector<Vec3d>& po
 
 PinholeCamera<double> make_camera(const CameraSpec& spec) {
     check_size_and_fov(spec.name, spec.width, spec.height, spec.fov_y_degrees);
+    // Each problem by its name (a NaN or overflowing eye used to read as "up parallel").
+    for (const auto& [what, v] : {std::pair{"eye", spec.eye}, {"target", spec.target}, {"up", spec.up}})
+        if (!finite(v))
+            throw std::invalid_argument("view '" + spec.name + "': " + what + " " + vec_text(v) +
+                                        " is not finite; expected three finite numbers");
     const Vec3d forward = spec.target - spec.eye;
+    if (!std::isfinite(length(forward)))
+        throw std::invalid_argument("view '" + spec.name + "': eye " + vec_text(spec.eye) + " and target " +
+                                    vec_text(spec.target) + " are too far apart: their distance overflows double");
+    if (!std::isfinite(length(spec.up)))
+        throw std::invalid_argument("view '" + spec.name + "': up " + vec_text(spec.up) +
+                                    " is too long: its length overflows double; expected a direction such as [0, 1, 0]");
     if (!(length(forward) > 0))
         throw std::invalid_argument("view '" + spec.name + "': eye " + vec_text(spec.eye) + " equals target " +
                                     vec_text(spec.target));

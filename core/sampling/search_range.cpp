@@ -75,13 +75,13 @@ void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& po
     for (size_t i = 0; i < points.size(); ++i)
         if (!std::isfinite(points[i].x + points[i].y + points[i].z) ||
             largest_magnitude(points[i]) > largest_search_coordinate(precision))
-            require_point_in_range(points[i], precision, "query point " + std::to_string(i + 1));
+            require_point_in_range(points[i], precision, "query points: row " + std::to_string(i));
 }
 
 void require_search_range(const PreparedMesh& mesh, Precision precision) { require_mesh_in_range(mesh, precision); }
 
 void require_query_point_in_range(const Vec3d& p, int64_t index, Precision precision) {
-    require_point_in_range(p, precision, "query point " + std::to_string(index + 1));
+    require_point_in_range(p, precision, "query points: row " + std::to_string(index));
 }
 
 }  // namespace sdf

@@ -21,6 +21,26 @@ std::string ContentCache::default_root() {
     return (fs::path(SDF_SOURCE_DIR) / "cache").string();
 }
 
+void ContentCache::require_usable_root(const std::string& root, const std::string& option) {
+    std::error_code ec;
+    // The root, or else the nearest of its ancestors that exists, must be a directory.
+    for (fs::path p = fs::absolute(root, ec); !p.empty(); p = p.parent_path()) {
+        const fs::file_status status = fs::status(p, ec);
+        if (status.type() == fs::file_type::not_found) {
+            if (p == p.parent_path()) break;
+            continue;
+        }
+        // A directory, or a path that cannot be examined (the write will say why, if it fails).
+        if (status.type() == fs::file_type::directory || status.type() == fs::file_type::none ||
+            status.type() == fs::file_type::unknown)
+            return;
+        const bool is_root = p == fs::absolute(root, ec);
+        throw std::runtime_error(option + " " + root + ": " + (is_root ? "" : p.string() + " ") +
+                                 (status.type() == fs::file_type::regular ? "is a regular file" : "is not a directory") +
+                                 "; expected a directory for the field cache (or a path where one can be made)");
+    }
+}
+
 std::string ContentCache::key_hash(const nlohmann::json& key) {
     const std::string text = key.dump();
     return sha256_hex(text.data(), text.size());

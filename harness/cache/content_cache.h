@@ -34,6 +34,10 @@ public:
     static std::string default_root();
 
     const std::string& root() const { return root_; }
+    /// Refuses (std::runtime_error naming `root` and `option`) a cache root that cannot hold
+    /// entries: a path that is not a directory, or under something that is not one. Checked
+    /// when a run is planned, before anything is sampled (a cache is written after sampling).
+    static void require_usable_root(const std::string& root, const std::string& option);
     static std::string key_hash(const nlohmann::json& key);
     std::string entry_path(const std::string& kind, const nlohmann::json& key) const;
 

@@ -172,10 +172,13 @@ std::vector<char> field_channel_bytes(const SampledField& field, const FieldChan
         } else {
             for (size_t i = 0; i < count * c; ++i) {
                 if constexpr (std::is_same_v<Stored, float>)
-                    if (std::abs(values[at + i]) > double(std::numeric_limits<float>::max()) && std::isfinite(values[at + i]))
-                        throw std::range_error(channel.path + ": value " + std::to_string(values[at + i]) + " of point " +
-                                               std::to_string((at + i) / c) + " is beyond float32's range (3.40282e38); "
+                    if (std::abs(values[at + i]) > double(std::numeric_limits<float>::max()) && std::isfinite(values[at + i])) {
+                        char value[32];  // %.6g: 1e300 as "1e+300", not its 301 digits
+                        std::snprintf(value, sizeof value, "%.6g", double(values[at + i]));
+                        throw std::range_error(channel.path + ": value " + value + " of point " +
+                                               std::to_string((at + i) / c) + " is beyond float32's range (3.40282e+38); "
                                                "write float64");
+                    }
                 const Stored v = Stored(values[at + i]);
                 std::memcpy(bytes.data() + i * sizeof(Stored), &v, sizeof(Stored));
             }

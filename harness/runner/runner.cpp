@@ -298,6 +298,9 @@ int run_experiment(const RunnerOptions& options) {
         throw std::logic_error("run_experiment: no experiment registry given (RunnerOptions::experiments)");
     const LoadedConfig config = load_config(options.config_path);
     const std::string cache_root = options.cache_dir.empty() ? ContentCache::default_root() : options.cache_dir;
+    // Refused here, in the plan and the dry run alike, not after the first field is sampled.
+    if (!options.no_cache)
+        ContentCache::require_usable_root(cache_root, options.cache_dir.empty() ? "the cache directory" : "--cache-dir");
     const FieldCache fields(cache_root);
     const ContentCache cache(cache_root);
     std::vector<PlannedRun> runs =

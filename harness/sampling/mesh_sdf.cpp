@@ -9,6 +9,7 @@
 #include "core/sampling/sampler_sign.h"
 #include "harness/sampling/sampler_table.h"
 #include "kernels/distance/closest_point_on_triangle.h"
+#include "kernels/winding/solid_angle.h"
 
 namespace sdf {
 
@@ -127,16 +128,31 @@ ClosestPointOnMesh MeshSdf::closest_point(const Vec3d& p, int32_t triangle) cons
     return out;
 }
 
-std::vector<double> MeshSdf::winding_numbers(const std::vector<Vec3d>& points, int threads) const {
+std::vector<double> MeshSdf::winding_numbers(const std::vector<Vec3d>& points, int threads, Winding evaluation,
+                                             std::vector<double>* error_bound) const {
+    std::vector<double> w(points.size());
+    if (evaluation == Winding::Exact) {
+        const MeshView<double> view = mesh_->buffers<double>().view();
+        // Chunks of about a million solid angles: a stop request is honoured within one.
+        const int64_t chunk = std::max<int64_t>(1, (int64_t(1) << 20) / std::max<int64_t>(1, view.num_triangles));
+        parallel_for(int64_t(points.size()), chunk, threads, [&](int64_t begin, int64_t end) {
+            for (int64_t i = begin; i < end; ++i) w[size_t(i)] = winding_number_exact(view, points[size_t(i)]);
+        });
+        return w;
+    }
     std::shared_ptr<const WindingSign> winding;
     {
         std::lock_guard<std::mutex> lock(winding_mutex_);
         if (!winding_) winding_ = std::make_shared<const WindingSign>(*mesh_, SamplerSign::winding_options());
         winding = winding_;
     }
-    std::vector<double> w(points.size());
+    if (error_bound) error_bound->assign(points.size(), 0.0);
     parallel_for(int64_t(points.size()), 256, threads, [&](int64_t begin, int64_t end) {
-        for (int64_t i = begin; i < end; ++i) w[size_t(i)] = winding->estimate(points[size_t(i)]).value;
+        for (int64_t i = begin; i < end; ++i) {
+            const WindingEstimate<double> e = winding->estimate(points[size_t(i)]);
+            w[size_t(i)] = e.value;
+            if (error_bound) (*error_bound)[size_t(i)] = e.error_bound;
+        }
     });
     return w;
 }

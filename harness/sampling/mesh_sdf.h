@@ -74,11 +74,23 @@ public:
     void closest_points(const HostPoints& points, const int32_t* triangle, double* point, double* barycentric,
                         int threads) const;
 
+    /// How winding_numbers() evaluates.
+    enum class Winding {
+        /// Barill et al.'s fast evaluation with the winding sign's accuracy
+        /// (SamplerSign::winding_options: beta 2, order 2), whose side of 1/2 is the winding
+        /// sign; its data are built on the first call. Not exact: off by up to a few
+        /// hundredths near overlapping parts; each value comes with a rigorous bound of its
+        /// truncation error (fast_winding_number.h, rounding aside).
+        Fast,
+        /// The direct sum of every triangle's exact solid angle (Van Oosterom & Strackee,
+        /// kernels/winding/solid_angle.h): O(triangles) per point.
+        Exact,
+    };
     /// The generalized winding number of every point (Jacobson et al. 2013): about 1 inside a
-    /// closed outward mesh, 0 outside, fractional near holes. The fast evaluation with the
-    /// winding sign's accuracy (SamplerSign::winding_options), whose side of 1/2 is the
-    /// winding sign; its data are built on the first call.
-    std::vector<double> winding_numbers(const std::vector<Vec3d>& points, int threads) const;
+    /// closed outward mesh, 0 outside, fractional near holes. With Fast, `error_bound` (may be
+    /// null) receives each value's bound: |value - exact| <= bound, rounding aside.
+    std::vector<double> winding_numbers(const std::vector<Vec3d>& points, int threads, Winding evaluation = Winding::Fast,
+                                        std::vector<double>* error_bound = nullptr) const;
 
 private:
     std::shared_ptr<const PreparedMesh> mesh_;

@@ -48,6 +48,8 @@ class Mesh:
     vertices: ArrayF
     faces: ArrayI
     source_triangle: ArrayI
+    input_vertices: ArrayF
+    input_faces: ArrayI
     bounds: Tuple[Vec3, Vec3]
     closed: bool
     consistently_oriented: bool
@@ -64,6 +66,7 @@ class QueryResult:
     closest_point: ArrayF
     barycentric: ArrayF
     winding: Optional[ArrayF]
+    winding_error_bound: Optional[ArrayF]
     sign: str
     sampler: str
     timings_seconds: Dict[str, float]
@@ -111,7 +114,7 @@ class SDF:
     build_seconds: float
     backend: str
     device: int
-    def query(self, points: Any, winding: bool = False, progress: Progress = None,
+    def query(self, points: Any, winding: Union[bool, str] = False, progress: Progress = None,
               differentiable: bool = False) -> Union[QueryResult, DeviceQueryResult]: ...
     def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
                margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
@@ -121,7 +124,7 @@ class SDF:
 def as_mesh(mesh: MeshLike) -> Mesh: ...
 def cuda_available() -> bool: ...
 def load_mesh(path: str, weld_tolerance: float = 0.0, check_intersections: bool = True) -> Mesh: ...
-def query(mesh: MeshLike, points: Any, progress: Progress = None, winding: bool = False,
+def query(mesh: MeshLike, points: Any, progress: Progress = None, winding: Union[bool, str] = False,
           **sampler: Unpack[SamplerKeywords]) -> Union[QueryResult, DeviceQueryResult]: ...
 def sdf(mesh: MeshLike, points: Any, **sampler: Unpack[SamplerKeywords]) -> Any: ...
 def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,

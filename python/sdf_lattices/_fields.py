@@ -41,8 +41,70 @@ def _read_npz(path):
     raise ValueError(f"{path}: not an sdf_lattices .npz field (its 'lattice' entry is missing or neither 'cc' nor 'bcc')")
 
 
+def _check_vti_sizes(path):
+    """Checks every raw appended array of a .vti against its extent and the file's size
+    before VTK reads it: VTK's reader fills a short array silently (values up to 3.7e19 from
+    a file cut inside its gradient array). ValueError naming the array otherwise. Files that
+    are not raw appended (inline, base64, compressed) are left to VTK."""
+    import re
+
+    bad = f"{path}: not a readable VTK ImageData XML file: "
+    size = os.path.getsize(path)
+    with open(path, "rb") as f:
+        head = f.read(1 << 20)
+    marker = re.search(rb"<AppendedData[^>]*>", head)
+    if marker is None or b'encoding="raw"' not in marker.group(0):
+        return
+    xml = head[:marker.start()]
+    if b"compressor=" in xml:
+        return
+    underscore = head.find(b"_", marker.end())
+    if underscore < 0:
+        raise ValueError(bad + f"the appended data has no '_' start mark (truncated?)")
+    data_start = underscore + 1
+    header = re.search(rb'header_type="(UInt32|UInt64)"', xml)
+    header_bytes = 8 if header is None or header.group(1) == b"UInt64" else 4
+    extent = re.search(rb'WholeExtent="([^"]*)"', xml)
+    if extent is None:
+        raise ValueError(bad + f"no WholeExtent (not a VTK ImageData file written by Field.write)")
+    e = [int(t) for t in extent.group(1).split()]
+    if len(e) != 6:
+        raise ValueError(bad + f"WholeExtent holds {len(e)} numbers; expected 6")
+    points = 1
+    for k in range(3):
+        points *= max(0, e[2 * k + 1] - e[2 * k] + 1)
+    item = {b"Float32": 4, b"Float64": 8, b"Int32": 4, b"Int64": 8, b"UInt8": 1, b"Int8": 1, b"UInt16": 2,
+            b"Int16": 2, b"UInt32": 4, b"UInt64": 8}
+    for array in re.finditer(rb"<DataArray\b[^>]*>", xml):
+        a = array.group(0)
+        if b'format="appended"' not in a:
+            continue
+        attr = {k.decode(): v.decode() for k, v in re.findall(rb'(\w+)="([^"]*)"', a)}
+        name = attr.get("Name", "?")
+        components = int(attr.get("NumberOfComponents", "1"))
+        dtype = attr.get("type", "").encode()
+        if dtype not in item:
+            continue
+        expected = points * components * item[dtype]
+        at = data_start + int(attr.get("offset", "0"))
+        if at + header_bytes > size:
+            raise ValueError(bad + f"array '{name}' starts at byte {at}, beyond the file's {size} bytes "
+                             "(truncated?)")
+        with open(path, "rb") as f:
+            f.seek(at)
+            declared = int.from_bytes(f.read(header_bytes), "little")
+        if declared != expected:
+            raise ValueError(bad + f"array '{name}' declares {declared} bytes; its {points} points x {components} "
+                             f"component(s) of {dtype.decode()} need {expected}")
+        if at + header_bytes + expected > size:
+            raise ValueError(bad + f"array '{name}' needs {expected} bytes from byte {at + header_bytes}, but the "
+                             f"file ends after {size} bytes (truncated: {at + header_bytes + expected - size} "
+                             "bytes missing)")
+
+
 def _read_vti_grid(path):
     """(distance [nz, ny, nx], gradient [nz, ny, nx, 3] or None, origin, spacing) of one .vti."""
+    _check_vti_sizes(path)
     try:
         import vtk
         from vtk.util.numpy_support import vtk_to_numpy

@@ -13,3 +13,18 @@ class SdfWarning(UserWarning):
 class MeshWarning(SdfWarning):
     """A warning of mesh preparation: open, non-manifold, inconsistently oriented, flipped or
     self-intersecting (the mesh's `warnings`)."""
+
+
+def warn_at_caller(message, category=SdfWarning):
+    """warnings.warn(message, category) attributed to the first frame outside this package:
+    the caller's line (a fixed stacklevel pointed at "sys:1" from a top-level call, or into
+    the package when the call came through its Python parts, e.g. SDF(path) loading the mesh)."""
+    import os
+    import sys
+    import warnings
+
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+        level, frame = level + 1, frame.f_back
+    warnings.warn(message, category, stacklevel=level + 1)

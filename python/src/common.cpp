@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/quoted_alternatives.h"
+#include "harness/resources/memory_budget.h"
 
 namespace sdf {
 
@@ -22,9 +23,27 @@ DoubleArray points_argument(const py::object& value) {
                               (is_array ? " of dtype " + std::string(py::str(py::array(value).dtype())) : ""));
     };
     if (is_array && std::string("biuf").find(py::array(value).dtype().kind()) == std::string::npos) throw refuse();
+    if (is_array) {
+        // A numeric array converts unless memory runs out: say so, with the size (ensure()
+        // would swallow NumPy's MemoryError and leave a TypeError about the type).
+        const py::array in = py::reinterpret_borrow<py::array>(value);
+        try {
+            return DoubleArray::ensure(py::module_::import("numpy").attr("asarray")(value, "float64", "C"));
+        } catch (py::error_already_set& e) {
+            if (!e.matches(PyExc_MemoryError)) throw;
+            raise_memory_error("points: out of memory converting " + std::to_string(in.size()) + " values of dtype " +
+                               std::string(py::str(in.dtype())) + " to float64 (" +
+                               format_bytes(uint64_t(in.size()) * sizeof(double)) + ")");
+        }
+    }
     DoubleArray a = DoubleArray::ensure(value);
     if (!a) throw refuse();
     return a;
+}
+
+void raise_memory_error(const std::string& message) {
+    PyErr_SetString(PyExc_MemoryError, message.c_str());
+    throw py::error_already_set();
 }
 
 std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument) {

@@ -29,6 +29,9 @@ const std::string& choose(const std::string& argument, const std::string& value,
 /// TypeError naming the argument "points" and the type otherwise.
 DoubleArray points_argument(const py::object& value);
 
+/// Raises MemoryError with `message` (which says what ran out of memory, and how much).
+[[noreturn]] void raise_memory_error(const std::string& message);
+
 /// An (N, 3) array of finite doubles as points; ValueError naming `argument` otherwise.
 std::vector<Vec3d> points_from_array(const DoubleArray& a, const std::string& argument);
 

@@ -227,12 +227,29 @@ py::tuple Field::reconstruct(const py::object& points_in, const std::string& int
     choose("outside", outside, {"nan", "clamp", "error"});
     if (!(sigma2 > 0 && std::isfinite(sigma2)))
         throw std::invalid_argument("sigma2: expected a finite variance > 0, got " + number_text(sigma2));
-    const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
+    const DoubleArray array = points_argument(points_in);
+    // What a call holds per point: the points, the samples and the two result arrays.
+    const auto out_of_memory = [&] {
+        const uint64_t n = array.ndim() == 2 ? uint64_t(array.shape(0)) : uint64_t(array.size());
+        raise_memory_error("reconstruct(): out of memory for " + std::to_string(n) + " points (about " +
+                           format_bytes(n * (sizeof(Vec3d) + sizeof(ReconstructedSample<double>) + 4 * sizeof(double))) +
+                           "); reconstruct fewer points per call");
+    };
+    std::vector<Vec3d> points;
+    std::vector<ReconstructedSample<double>> samples;
     const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
-    TaskOptions task;
-    task.total = int64_t(points.size());
-    task.label = "reconstructing";
-    const std::vector<ReconstructedSample<double>> samples = run_task([&] { return r->evaluate(points, threads); }, task);
+    try {
+        points = points_from_array(array, "points");
+        TaskOptions task;
+        task.total = int64_t(points.size());
+        task.label = "reconstructing";
+        samples = run_task([&] { return r->evaluate(points, threads); }, task);
+    } catch (const std::bad_alloc&) {
+        out_of_memory();
+    } catch (py::error_already_set& e) {
+        if (e.matches(PyExc_MemoryError)) out_of_memory();
+        throw;
+    }
     const size_t n = samples.size();
     if (outside == "error")
         for (size_t i = 0; i < n; ++i)

@@ -20,6 +20,7 @@ MeshHolder prepare(TriangleMesh mesh, double weld_tolerance, bool check_intersec
     MeshPreparationOptions o;
     o.weld_tolerance = weld_tolerance;
     o.detect_intersections = check_intersections;
+    o.keep_input = true;  // Mesh.input_vertices and input_faces: the numbering of query results
     if (!(weld_tolerance >= 0)) throw std::invalid_argument("weld_tolerance: expected a distance >= 0");
     TaskOptions task;
     task.total = int64_t(mesh.triangles.size());
@@ -27,8 +28,9 @@ MeshHolder prepare(TriangleMesh mesh, double weld_tolerance, bool check_intersec
     MeshHolder prepared = run_task([&] { return std::make_shared<PreparedMesh>(prepare_mesh(mesh, o)); }, task);
     const std::vector<std::string> warnings = prepared->warnings();
     if (!warnings.empty()) {
-        const py::object category = py::module_::import("sdf_lattices._warnings").attr("MeshWarning");
-        for (const std::string& w : warnings) py::module_::import("warnings").attr("warn")(w, category, 2);
+        const py::module_ module = py::module_::import("sdf_lattices._warnings");
+        const py::object category = module.attr("MeshWarning"), warn = module.attr("warn_at_caller");
+        for (const std::string& w : warnings) warn(w, category);  // at the caller's line
     }
     return prepared;
 }
@@ -59,15 +61,23 @@ MeshHolder mesh_from_arrays(const py::array& vertices_in, const py::array& faces
     m.vertices = points_from_array(vertices, "vertices");
     if (faces.ndim() != 2 || faces.shape(1) != 3)
         throw std::invalid_argument("faces: expected an array of shape (M, 3) of vertex indices");
-    const auto f = faces.unchecked<2>();
     const int64_t nv = int64_t(m.vertices.size());
+    const auto refuse_index = [&](py::ssize_t i, int c, const std::string& value) {
+        throw std::invalid_argument("faces[" + std::to_string(i) + ", " + std::to_string(c) + "] = " + value +
+                                    " is not a vertex index; expected 0 <= index < " + std::to_string(nv));
+    };
+    if (kind == 'u' && faces_in.dtype().itemsize() == 8) {  // uint64 beyond int64's range would read negative
+        const auto u = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(faces_in);
+        const auto uf = u.unchecked<2>();
+        for (py::ssize_t i = 0; i < u.shape(0); ++i)
+            for (int c = 0; c < 3; ++c)
+                if (uf(i, c) >= uint64_t(nv)) refuse_index(i, c, std::to_string(uf(i, c)));
+    }
+    const auto f = faces.unchecked<2>();
     m.triangles.resize(size_t(faces.shape(0)));
     for (py::ssize_t i = 0; i < faces.shape(0); ++i)
         for (int c = 0; c < 3; ++c) {
-            if (f(i, c) < 0 || f(i, c) >= nv)
-                throw std::invalid_argument("faces[" + std::to_string(i) + ", " + std::to_string(c) + "] = " +
-                                            std::to_string(f(i, c)) + " is not a vertex index; expected 0 <= index < " +
-                                            std::to_string(nv));
+            if (f(i, c) < 0 || f(i, c) >= nv) refuse_index(i, c, std::to_string(f(i, c)));
             (&m.triangles[size_t(i)].x)[c] = int(f(i, c));
         }
     m.content_sha256 = geometry_sha256(m);
@@ -117,6 +127,21 @@ check_intersections looks for intersecting triangle pairs (costs about a BVH bui
                 }
             });
         }, "(M, 3) int32: the prepared triangles (indices into vertices), oriented outward where closed.")
+        .def_property_readonly("input_vertices", [](const PreparedMesh& p) {
+            return vec3_array(p.input_vertices().data(), p.input_vertices().size(), {py::ssize_t(p.input_vertices().size())});
+        }, "(N_in, 3) float64: the vertices as given (the arrays, or as read from the file), before welding.")
+        .def_property_readonly("input_faces", [](const PreparedMesh& p) {
+            const auto& t = p.input_triangles();
+            return new_array<int32_t>({py::ssize_t(t.size()), 3}, [&](int32_t* out) {
+                for (size_t i = 0; i < t.size(); ++i) {
+                    out[3 * i] = t[i].x;
+                    out[3 * i + 1] = t[i].y;
+                    out[3 * i + 2] = t[i].z;
+                }
+            });
+        }, "(M_in, 3) int32: the triangles as given (a file's polygons triangulated), indices into input_vertices: "
+           "the numbering of query()'s .triangle and .barycentric, so that closest_point = sum_k barycentric[:, k] * "
+           "input_vertices[input_faces[triangle, k]] (up to rounding; up to weld_tolerance where vertices were welded).")
         .def_property_readonly("source_triangle", [](const PreparedMesh& p) {
             const auto& s = p.source_triangle();
             return new_array<int32_t>({py::ssize_t(s.size())}, [&](int32_t* out) { std::copy(s.begin(), s.end(), out); });

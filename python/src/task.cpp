@@ -9,9 +9,9 @@ py::object progress_reporter(const py::object& progress, const std::string& labe
 
 void raise_warnings(const std::vector<std::string>& warnings) {
     if (warnings.empty()) return;
-    const py::object category = py::module_::import("sdf_lattices._warnings").attr("SdfWarning");
-    const py::object warn = py::module_::import("warnings").attr("warn");
-    for (const std::string& text : warnings) warn(text, category, 3);
+    const py::module_ module = py::module_::import("sdf_lattices._warnings");
+    const py::object category = module.attr("SdfWarning"), warn = module.attr("warn_at_caller");
+    for (const std::string& text : warnings) warn(text, category);  // at the caller's line
 }
 
 }  // namespace sdf

@@ -1,6 +1,7 @@
 // A deterministic fuzz battery for every reader of outside input (issue 11): mesh files of
 // every format (OBJ, ASCII and binary PLY and STL, OFF, gzip; polygon faces, ASCII STL in
-// capitals and on one line, classic Mac line ends, gzip members: issue 26), points files (text and .npy),
+// capitals and on one line, classic Mac line ends, gzip members: issue 26; polygons of
+// 256+ corners in every format: issue 38), points files (text and .npy),
 // field headers and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
 // are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
 // huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
@@ -265,6 +266,73 @@ TEST_F(FuzzReaders, MeshFilesUnderTheReaderRules) {
              o.detect_intersections = false;
              prepare_mesh(load_mesh_file(path), o);
          });
+}
+
+/// A prism over a convex polygon of n corners (n > 255: beyond a uchar count and
+/// tinyobjloader's unsigned char), as OBJ, OFF, ASCII or binary PLY (list counts "uint") or
+/// ASCII STL with polygon facets.
+std::string wide_polygon_prism(const std::string& format, int n) {
+    std::vector<Vec3d> v;
+    for (int z = 0; z < 2; ++z)
+        for (int k = 0; k < n; ++k)
+            v.push_back({std::cos(6.283185307179586 * k / n), std::sin(6.283185307179586 * k / n), double(z)});
+    std::vector<std::vector<int>> faces;
+    std::vector<int> bottom, top;
+    for (int k = 0; k < n; ++k) {
+        bottom.push_back((n - k) % n);
+        top.push_back(n + k);
+        faces.push_back({k, (k + 1) % n, n + (k + 1) % n, n + k});
+    }
+    faces.push_back(bottom);
+    faces.push_back(top);
+    std::string s;
+    if (format == "stl") {
+        s = "solid wide\n";
+        for (const auto& f : faces) {
+            s += "facet normal 0 0 0\nouter loop\n";
+            for (int i : f) s += "vertex " + test::g17(v[size_t(i)].x) + " " + test::g17(v[size_t(i)].y) + " " + test::g17(v[size_t(i)].z) + "\n";
+            s += "endloop\nendfacet\n";
+        }
+        return s + "endsolid wide\n";
+    }
+    const bool binary = format == "binary ply";
+    if (format == "off") s = "OFF\n" + std::to_string(v.size()) + " " + std::to_string(faces.size()) + " 0\n";
+    if (format == "ply" || binary)
+        s = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") + " 1.0\nelement vertex " +
+            std::to_string(v.size()) + "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
+            std::to_string(faces.size()) + "\nproperty list uint int vertex_indices\nend_header\n";
+    for (const Vec3d& p : v) {
+        if (binary) for (int k = 0; k < 3; ++k) test::put<double>(s, p[k], false);
+        else s += (format == "obj" ? "v " : "") + test::g17(p.x) + " " + test::g17(p.y) + " " + test::g17(p.z) + "\n";
+    }
+    for (const auto& f : faces) {
+        if (binary) {
+            test::put<uint32_t>(s, uint32_t(f.size()), false);
+            for (int i : f) test::put<int32_t>(s, i, false);
+            continue;
+        }
+        s += format == "obj" ? "f" : std::to_string(f.size());
+        for (int i : f) s += " " + std::to_string(format == "obj" ? i + 1 : i);
+        s += "\n";
+    }
+    return s;
+}
+
+// Issue 38: polygons of 256 and 300 corners in every format (OBJ's were cut modulo 256, an
+// OFF cap on the last line was refused as truncated). The seeds read whole: 2n + 2(n - 2)
+// triangles.
+TEST_F(FuzzReaders, PolygonsOfMoreThan255CornersInEveryFormat) {
+    const std::vector<std::pair<std::string, std::string>> formats = {
+        {"w.obj", "obj"}, {"w.off", "off"}, {"w.ply", "ply"}, {"wb.ply", "binary ply"}, {"w.stl", "stl"}};
+    for (size_t k = 0; k < formats.size(); ++k)
+        for (const int n : {256, 300}) {
+            const std::string seed = wide_polygon_prism(formats[k].second, n);
+            const std::string path = at(std::to_string(n) + formats[k].first);
+            test::write_file(path, seed);
+            EXPECT_EQ(load_mesh_file(path).triangles.size(), size_t(2 * n + 2 * (n - 2))) << path;
+            const auto [parsed, refused] = fuzz(path, seed, kPerSeed / 3, 9000 + 10 * k + size_t(n), load_and_prepare);
+            EXPECT_GT(refused, 0) << path;
+        }
 }
 
 TEST_F(FuzzReaders, PointsFiles) {

@@ -22,11 +22,13 @@
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
 #include "harness/config/json_reader.h"
+#include "harness/io/field_file.h"
 #include "harness/io/points_file.h"
 #include "harness/provenance/version.h"
 #include "harness_test_util.h"
 
-#if !defined(SDF_QUERY_EXE) || !defined(SDF_EVAL_EXE) || !defined(SDF_RENDER_EXE) || !defined(RUN_EXPERIMENT_EXE)
+#if !defined(SDF_QUERY_EXE) || !defined(SDF_EVAL_EXE) || !defined(SDF_RENDER_EXE) || !defined(RUN_EXPERIMENT_EXE) || \
+    !defined(SDF_SAMPLE_EXE)
 #error "the tools' paths must be defined by CMake"
 #endif
 
@@ -101,6 +103,7 @@ protected:
     ShellResult eval(const std::string& args) const { return run(SDF_EVAL_EXE, args); }
     ShellResult render(const std::string& args) const { return run(SDF_RENDER_EXE, args); }
     ShellResult experiment(const std::string& args) const { return run(RUN_EXPERIMENT_EXE, args); }
+    ShellResult sample(const std::string& args) const { return run(SDF_SAMPLE_EXE, args); }
 
     /// A tiny config sampling `mesh` (a file name or "shape:box").
     std::string config(const std::string& rel, const std::string& mesh, const std::string& resolution = "[4, 4, 4]",
@@ -311,7 +314,7 @@ TEST_F(Trust, FarPointsGetTheOutsideSignAndDistancesToTheirPrecision) {
     write("farther.txt", "0 0 0\n1e20 0 0\n");
     const ShellResult refused = query("shape:sphere farther.txt");
     EXPECT_EQ(refused.code, 1);
-    EXPECT_TRUE(Contains(refused.err, "query point 2 has a coordinate of magnitude 1e+20, beyond the float search's "
+    EXPECT_TRUE(Contains(refused.err, "query points: row 1 has a coordinate of magnitude 1e+20, beyond the float search's "
                                       "range of 1.15e+18"))
         << refused.err;
     EXPECT_TRUE(Contains(refused.err, "use precision double"));
@@ -672,6 +675,103 @@ TEST_F(Trust, ImageMetadataNamesTheFinalRunNotItsStagingDirectory) {
         EXPECT_EQ(summary.at("provenance").at("run"), "pics/" + id) << e.path();
     }
     EXPECT_GE(summaries, 1);
+}
+
+// ---- Issue 38: refused before the work, each problem by its name ---------------------------
+
+TEST_F(Trust, RunExperimentRefusesABandItsFieldFilesCannotStoreInThePlan) {
+    // 1e-300 is no float32 (the default output dtype): it was sampled and cached first, then
+    // refused when the field was written, on every rerun; and --dry-run said nothing.
+    write("band.json", R"({"name": "band", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [4, 4, 4]}],
+        "sampler": {"threads": 1, "progress": false, "band_width": 1e-300}})");
+    for (const std::string dry : {" --dry-run", ""}) {
+        const ShellResult r = experiment("band.json --output-root out" + dry);
+        EXPECT_NE(r.code, 0) << dry;
+        EXPECT_TRUE(Contains(r.err, "band_width: 1e-300 cannot be stored in float32")) << dry << ": " << r.err;
+        EXPECT_FALSE(Contains(r.out, "sampling with")) << dry << ": " << r.out;
+        EXPECT_FALSE(fs::exists(at("cache"))) << dry << ": a field was cached";
+    }
+}
+
+TEST_F(Trust, RunExperimentRefusesACacheDirThatIsAFileInThePlan) {
+    config("c.json", "shape:box");
+    write("taken", "a regular file\n");
+    for (const std::string dry : {" --dry-run", ""}) {
+        const ShellResult r = experiment("c.json --output-root out --cache-dir taken" + dry);
+        EXPECT_NE(r.code, 0) << dry;
+        EXPECT_TRUE(Contains(r.err, "--cache-dir taken: is a regular file")) << dry << ": " << r.err;
+        EXPECT_FALSE(Contains(r.out, "sampling with")) << dry << ": " << r.out;
+        EXPECT_FALSE(fs::exists(at("out"))) << dry;
+    }
+    write("dir/file", "x");
+    const ShellResult under = experiment("c.json --output-root out --cache-dir dir/file/cache --dry-run");
+    EXPECT_NE(under.code, 0);
+    EXPECT_TRUE(Contains(under.err, "is a regular file")) << under.err;
+}
+
+TEST_F(Trust, SdfSampleDryRunReportsTheBudgetTheRunRefuses) {
+    // 50 MB available, a 1 GB budget for a 128^3 lattice: the run refuses it; so must the dry run.
+    const std::string args = "shape:box --resolution 128 --memory-budget 1G --out f.json --quiet";
+    const ShellResult dry = test::run_in(dir_, "SDF_MEMORY_AVAILABLE=50000000 " + quote(SDF_SAMPLE_EXE) + " " + args + " --dry-run");
+    const ShellResult real = test::run_in(dir_, "SDF_MEMORY_AVAILABLE=50000000 " + quote(SDF_SAMPLE_EXE) + " " + args);
+    EXPECT_NE(real.code, 0);
+    EXPECT_TRUE(Contains(real.err, "exceeds the")) << real.err;
+    EXPECT_NE(dry.code, 0) << dry.out;
+    EXPECT_TRUE(Contains(dry.err, "the run would be refused")) << dry.err;
+    EXPECT_TRUE(Contains(dry.err, "exceeds the")) << dry.err;
+    EXPECT_FALSE(fs::exists(at("f.json")));
+}
+
+TEST_F(Trust, SdfRenderChecksItsOutputBeforeSampling) {
+    const ShellResult r = render("shape:box --resolution 8,8,8 --size 16 --out nowhere/box.png --quiet");
+    EXPECT_NE(r.code, 0);
+    EXPECT_TRUE(Contains(r.err, "nowhere/box.png: the folder")) << r.err;
+    EXPECT_FALSE(fs::exists(at("cache"))) << "a field was sampled (and cached) before the output was checked";
+    write("taken.png", "x");
+    const ShellResult exists = render("shape:box --resolution 8,8,8 --size 16 --out taken.png --quiet");
+    EXPECT_NE(exists.code, 0);
+    EXPECT_TRUE(Contains(exists.err, "taken.png: already exists")) << exists.err;
+    EXPECT_FALSE(fs::exists(at("cache")));
+}
+
+TEST_F(Trust, SdfRenderNamesTheCameraProblem) {
+    const std::string base = "shape:box --resolution 8,8,8 --size 16 --no-cache --quiet ";
+    struct Case {
+        std::string args, expected;
+    };
+    const std::vector<Case> cases = {
+        {"--eye nan,0,0 --target 0,0,0 --out a.png", "--eye nan,0,0: expected three finite numbers"},
+        {"--eye 1e308,1e308,1e308 --target -1e308,-1e308,-1e308 --out b.png", "are too far apart"},
+        {"--fov 1e-12 --out c.png", "is too small for a 16x16 image"},
+    };
+    for (const Case& c : cases) {
+        const ShellResult r = render(base + c.args);
+        EXPECT_NE(r.code, 0) << c.args;
+        EXPECT_TRUE(Contains(r.err, c.expected)) << c.args << ": " << r.err;
+        EXPECT_FALSE(Contains(r.err, "parallel")) << c.args << ": " << r.err;
+    }
+}
+
+TEST(TrustMessages, AFloat32RangeRefusalPrintsAReadableNumber) {
+    SampledField f;
+    f.lattice.type = LatticeType::CC;
+    f.lattice.spacing = 1;
+    f.lattice.resolution = {2, 1, 1};
+    f.distance = {0.5, 1e300};
+    f.gradient = {{1, 0, 0}, {1, 0, 0}};
+    f.closest_triangle = {0, 0};
+    const test::ScratchDir dir("sdf_trust_float32");
+    FieldWriteOptions o;
+    o.dtype = FieldDtype::Float32;
+    try {
+        write_field(dir.at("f.json"), f, o);
+        ADD_FAILURE() << "1e300 was written as float32";
+    } catch (const std::exception& e) {
+        const std::string what = e.what();
+        EXPECT_TRUE(Contains(what, "value 1e+300 of point 1 is beyond float32's range")) << what;
+        EXPECT_LT(what.size(), 300u) << what;
+    }
 }
 
 }  // namespace

@@ -117,7 +117,7 @@ def test_gpu_points_errors_are_clear(bound):
         bound.query(torch.zeros((10, 3), dtype=torch.int32, device="cuda"))
     bad = torch.zeros((10, 3), dtype=torch.float64, device="cuda")
     bad[6, 1] = float("nan")
-    with pytest.raises(ValueError, match="query point 7"):
+    with pytest.raises(ValueError, match="query points: row 6 "):
         bound.query(bad)
     with pytest.raises(ValueError, match="winding"):
         bound.query(torch.zeros((4, 3), device="cuda"), winding=True)

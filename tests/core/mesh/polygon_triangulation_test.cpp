@@ -8,6 +8,12 @@
 //    written as OBJ, OFF, ASCII and binary PLY and ASCII STL by writers of this file: every
 //    format reads to the same triangles, a closed mesh without self-intersections, and
 //    distances equal to the analytic ones (L prism) and to each other (2,000 points).
+//  - Issue 38: the grid clipper gives the triangles of the quadratic one it replaced
+//    (reference_ear_clipping.h) on random simple, comb, keyhole, collinear and
+//    self-crossing polygons; a 40,000-corner star and comb are triangulated (29 s before) and stop
+//    on request; a cylinder with 300-corner caps reads alike in every format, its centre
+//    inside (OBJ corners beyond 255: tinyobjloader's unsigned char count), and an OFF
+//    polygon on the last line is not taken for a truncated file.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,8 +27,10 @@
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/polygon_triangulation.h"
 #include "core/mesh/prepared_mesh.h"
+#include "core/parallel/task_monitor.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/core/mesh/mesh_file_writers.h"
+#include "tests/core/mesh/reference_ear_clipping.h"
 #include "tests/test_util/scratch_dir.h"
 
 namespace sdf {
@@ -175,6 +183,104 @@ TEST(TriangulatePolygon, RepeatedCornersAndPolygonsWithoutArea) {
         EXPECT_EQ(length(cross(v[size_t(t.y)] - v[size_t(t.x)], v[size_t(t.z)] - v[size_t(t.x)])), 0.0);
 }
 
+/// Triangulates `p` with the clipper and with the quadratic reference: the same triangles
+/// in the same order, and the same counts.
+void expect_reference_triangles(const std::vector<Vec3d>& v, const std::string& what) {
+    std::vector<int> corners(v.size());
+    for (size_t i = 0; i < v.size(); ++i) corners[i] = int(i);
+    std::vector<Int3> fast, slow;
+    PolygonStats fast_stats, slow_stats;
+    triangulate_polygon(v, corners, fast, fast_stats);
+    reference::triangulate_polygon(v, corners, slow, slow_stats);
+    ASSERT_EQ(fast.size(), slow.size()) << what;
+    for (size_t i = 0; i < fast.size(); ++i) ASSERT_EQ(fast[i], slow[i]) << what << ": triangle " << i;
+    EXPECT_EQ(fast_stats.not_simple, slow_stats.not_simple) << what;
+    EXPECT_EQ(fast_stats.non_planar, slow_stats.non_planar) << what;
+}
+
+std::vector<Vec3d> in_plane(const std::vector<std::pair<double, double>>& uv, Vec3d origin, Vec3d e1, Vec3d e2) {
+    return place(uv, origin, e1, e2).vertices;
+}
+
+TEST(TriangulatePolygon, SameTrianglesAsTheQuadraticClipper) {
+    std::mt19937_64 rng(38);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const auto tilted = [&] {
+        const Vec3d e1 = normalize_or_zero(Vec3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        return std::make_pair(e1, normalize_or_zero(cross(Vec3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5}, e1)));
+    };
+    for (int trial = 0; trial < 400; ++trial) {
+        const int n = 4 + int(rng() % (trial < 300 ? 60 : 700));
+        std::vector<std::pair<double, double>> uv;
+        const int kind = trial % 5;
+        for (int i = 0; i < n; ++i) {
+            const double angle = 2 * kPi * (i + (kind == 1 ? 0.0 : 0.8 * u(rng))) / n;
+            double r = 0.2 + u(rng);
+            if (kind == 1) r = i % 2 ? 1.0 : 0.5;                    // a regular star: ties of every kind
+            if (kind == 2) r = std::round(r * 4) / 4;                // radii on a grid: collinear corners
+            uv.push_back({r * std::cos(angle), r * std::sin(angle)});
+            if (kind == 3) uv.back() = {std::round(uv.back().first * 8) / 8, std::round(uv.back().second * 8) / 8};
+        }
+        if (kind == 4) {  // a polygon that crosses itself: corners anywhere
+            for (auto& q : uv) q = {u(rng), u(rng)};
+        }
+        const auto [e1, e2] = tilted();
+        expect_reference_triangles(in_plane(uv, {u(rng) * 100, -50, 3}, e1, e2), "trial " + std::to_string(trial));
+        if (::testing::Test::HasFatalFailure()) return;
+    }
+    // Combs of many teeth, both orientations, and a keyhole (a corner visited twice).
+    for (int teeth : {3, 40, 300}) {
+        std::vector<std::pair<double, double>> uv = {{0, 0}, {2.0 * teeth, 0}};
+        for (int k = teeth - 1; k >= 0; --k)
+            for (const auto& q : {std::pair{2.0 * k + 2, 3.0}, {2.0 * k + 1.5, 3.0}, {2.0 * k + 1.5, 1.0}, {2.0 * k + 1, 1.0}})
+                uv.push_back(q);
+        uv.resize(uv.size() - 2);
+        uv.push_back({0, 3});
+        expect_reference_triangles(in_plane(uv, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}), "comb " + std::to_string(teeth));
+        std::reverse(uv.begin(), uv.end());
+        expect_reference_triangles(in_plane(uv, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}), "reversed comb " + std::to_string(teeth));
+    }
+    const std::vector<std::pair<double, double>> keyhole = {{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 2}, {1, 2},
+                                                            {1, 3}, {3, 3}, {3, 1}, {1, 1}, {1, 2}, {0, 2}};
+    expect_reference_triangles(in_plane(keyhole, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}), "keyhole");
+}
+
+/// A star of n corners, every other one reflex.
+std::vector<Vec3d> star(int n) {
+    std::vector<Vec3d> v;
+    for (int i = 0; i < n; ++i) {
+        const double r = i % 2 ? 1.0 : 0.9, angle = 2 * kPi * i / n;
+        v.push_back({r * std::cos(angle), r * std::sin(angle), 0.25});
+    }
+    return v;
+}
+
+TEST(TriangulatePolygon, FortyThousandCornersAndAStopRequest) {
+    // The quadratic clipper took 29 s for one such polygon; no timing is asserted here
+    // (benchmarks measure speed), the suite's time limit would show a relapse.
+    std::vector<std::pair<double, double>> uv;
+    for (const Vec3d& q : star(40000)) uv.push_back({q.x, q.y});
+    expect_valid_triangulation(place(uv, {5, 6, 7}, {0, 1, 0}, {1, 0, 0}), "40,000-corner star");
+    // A comb of 10,000 teeth: its base corners' ears span the whole comb, past every tooth.
+    uv = {{0, 0}, {20000, 0}};
+    for (int k = 9999; k >= 0; --k)
+        for (const auto& q : {std::pair{2.0 * k + 2, 3.0}, {2.0 * k + 1.5, 3.0}, {2.0 * k + 1.5, 1.0}, {2.0 * k + 1, 1.0}})
+            uv.push_back(q);
+    uv.resize(uv.size() - 2);
+    uv.push_back({0, 3});
+    expect_valid_triangulation(place(uv, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}), "40,001-corner comb");
+    // A stop request (Ctrl-C in Python) ends the clipping.
+    const std::vector<Vec3d> v = star(40000);
+    std::vector<int> corners(v.size());
+    for (size_t i = 0; i < v.size(); ++i) corners[i] = int(i);
+    TaskMonitor monitor;
+    monitor.request_stop();
+    ScopedTaskMonitor scope(&monitor);
+    std::vector<Int3> tris;
+    PolygonStats stats;
+    EXPECT_THROW(triangulate_polygon(v, corners, tris, stats), TaskStopped);
+}
+
 // ---- the same polygons in every format ----------------------------------------------------
 
 struct PolygonMesh {
@@ -205,10 +311,14 @@ std::string off_of(const PolygonMesh& m) {
 }
 
 std::string ply_of(const PolygonMesh& m, bool binary) {
+    size_t largest = 0;
+    for (const auto& f : m.faces) largest = std::max(largest, f.size());
+    const bool wide = largest > 255;  // a count beyond uchar: uint
     std::string s = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") + " 1.0\nelement vertex " +
                     std::to_string(m.vertices.size()) +
                     "\nproperty double x\nproperty double y\nproperty double z\nelement face " +
-                    std::to_string(m.faces.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+                    std::to_string(m.faces.size()) + "\nproperty list " + (wide ? "uint" : "uchar") +
+                    " int vertex_indices\nend_header\n";
     for (const Vec3d& p : m.vertices) {
         if (!binary) s += test::g17(p.x) + " " + test::g17(p.y) + " " + test::g17(p.z) + "\n";
         else for (int k = 0; k < 3; ++k) test::put<double>(s, p[k], false);
@@ -219,7 +329,8 @@ std::string ply_of(const PolygonMesh& m, bool binary) {
             for (int i : f) s += " " + std::to_string(i);
             s += "\n";
         } else {
-            test::put<uint8_t>(s, uint8_t(f.size()), false);
+            if (wide) test::put<uint32_t>(s, uint32_t(f.size()), false);
+            else test::put<uint8_t>(s, uint8_t(f.size()), false);
             for (int i : f) test::put<int32_t>(s, i, false);
         }
     }
@@ -363,6 +474,45 @@ TEST_F(PolygonFormats, NonPlanarQuadsAreCutAlikeAndReported) {
         const std::vector<PointSample> d = distances(prepared, points);
         if (reference.empty()) { reference = d; continue; }
         for (size_t i = 0; i < points.size(); ++i) ASSERT_EQ(d[i].distance, reference[i].distance) << name << " point " << i;
+    }
+}
+
+TEST_F(PolygonFormats, CylinderWithCapsOf300CornersInEveryFormat) {
+    // Radius 1, z in [0, 1]: the centre is 0.5 from both caps and 1 from the side. OBJ read
+    // it outside (+0.9998: tinyobjloader counted the caps' 300 corners as 44).
+    std::vector<std::pair<double, double>> ring;
+    for (int k = 0; k < 300; ++k) ring.push_back({std::cos(2 * kPi * k / 300), std::sin(2 * kPi * k / 300)});
+    const auto read = read_every_format(prism(ring));
+    expect_same_triangles(read);
+    const std::vector<Vec3d> points = {{0, 0, 0.5}, {0, 0, 1.25}, {0.1, -0.2, 0.1}};
+    const std::vector<double> truth = {-0.5, 0.25, -0.1};
+    for (const auto& [name, mesh] : read) {
+        EXPECT_EQ(mesh.triangles.size(), 2u * 300 + 2u * 298) << name;
+        const PreparedMesh prepared = prepare_mesh(mesh);
+        expect_closed_and_clean(prepared, name);
+        const std::vector<PointSample> d = distances(prepared, points);
+        for (size_t i = 0; i < points.size(); ++i) EXPECT_NEAR(d[i].distance, truth[i], 1e-12) << name << " point " << i;
+    }
+    // 256 corners: tinyobjloader's count 0 ("face has 0 vertices").
+    ring.resize(256);
+    for (int k = 0; k < 256; ++k) ring[size_t(k)] = {std::cos(2 * kPi * k / 256), std::sin(2 * kPi * k / 256)};
+    expect_same_triangles(read_every_format(prism(ring)));
+}
+
+TEST_F(PolygonFormats, OffPolygonOnTheLastLineLongerThanTheBytesAfterIt) {
+    // The 65-gon cap is the file's last line: 65 corners, fewer bytes after its line.
+    std::vector<std::pair<double, double>> ring;
+    for (int k = 0; k < 65; ++k) ring.push_back({std::cos(2 * kPi * k / 65), std::sin(2 * kPi * k / 65)});
+    const PolygonMesh m = prism(ring);
+    const TriangleMesh mesh = load_mesh_file(write("cap.off", off_of(m)));
+    EXPECT_EQ(mesh.triangles.size(), 2u * 65 + 2u * 63);
+    // A count its line cannot hold is still refused before anything is allocated.
+    const std::string bad = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n";
+    try {
+        load_mesh_file(write("bad.off", bad));
+        ADD_FAILURE() << "a face of 2e9 corners on a short line was read";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("more than its line holds"), std::string::npos) << e.what();
     }
 }
 
