@@ -31,14 +31,16 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
     }
     alignas(64) T q[kTriangleBlock];
     alignas(64) T ranked[kTriangleBlock];  ///< q less sliver_excess(): what candidates are ranked by
+    constexpr bool kDouble = sizeof(T) == sizeof(double);  // float has no interior slivers
     const int n = soa.size();
     const std::vector<int>& slivers = soa.interior_slivers();
     auto sliver = slivers.begin();
     for (int start = 0; start < n; start += kTriangleBlock) {
         const int len = std::min(kTriangleBlock, n - start);
-        // This block's slivers, re-evaluated after the vector loop (squared_distance()).
+        // This block's slivers (double only), re-evaluated after the vector loop (squared_distance()).
         const auto slivers_begin = sliver;
-        while (sliver != slivers.end() && *sliver < start + len) ++sliver;
+        if constexpr (kDouble)
+            while (sliver != slivers.end() && *sliver < start + len) ++sliver;
         const auto slivers_end = sliver;
         for (int p = 0; p < count; ++p) {
             const T x = px[p], y = py[p], z = pz[p];
@@ -59,10 +61,13 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
                     block_ranked = r < block_ranked ? r : block_ranked;
                 }
             }
-            if (slivers_begin != slivers_end) {  // double only: float has no interior slivers
-                for (auto k = slivers_begin; k != slivers_end; ++k) q[*k - start] = sliver_squared_distance(soa[*k], x, y, z);
-                block_min = std::numeric_limits<T>::infinity();
-                for (int i = 0; i < len; ++i) block_min = q[i] < block_min ? q[i] : block_min;
+            if constexpr (kDouble) {
+                if (slivers_begin != slivers_end) {
+                    for (auto k = slivers_begin; k != slivers_end; ++k)
+                        q[*k - start] = sliver_squared_distance(soa[*k], x, y, z);
+                    block_min = std::numeric_limits<T>::infinity();
+                    for (int i = 0; i < len; ++i) block_min = q[i] < block_min ? q[i] : block_min;
+                }
             }
             if (block_min < best_q[p]) {
                 int i = 0;
