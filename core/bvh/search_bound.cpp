@@ -21,6 +21,16 @@ double rho_of(double u, double smallest_sin2) {
     return gamma_n(32, u) + branch * branch;
 }
 
+/// The share of rho of double's slivers searched through their interior
+/// (sliver_squared_distance, packed_triangle.h): each edge function is off by at most about
+/// 24 u M in distance, and a point misjudged by it lies within (2 x that) / sin of the
+/// triangle (sin: of its smallest angle); (64 u)^2 / S covers it, S their smallest sin^2
+/// (at least kRobustSliverSin2, so at most 2^-47).
+double rho_of_slivers(double smallest_sin2) {
+    const double error = 64.0 * 0x1p-53;
+    return smallest_sin2 < 1.0 ? error * error / smallest_sin2 : 0.0;
+}
+
 }  // namespace
 
 FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles,
@@ -30,7 +40,7 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
     // edges only). Float-only slivers carry their own bound (sliver_excess). Minima and
     // maxima of non-NaN values: the same whatever the chunks.
     struct Extremes {
-        double sin2_float = 1.0, sin2_double = 1.0, longest = 0.0, coordinate = 0.0;
+        double sin2_float = 1.0, sin2_double = 1.0, sin2_sliver = 1.0, longest = 0.0, coordinate = 0.0;
     };
     constexpr int64_t kChunk = 16384;
     const int64_t n = int64_t(triangles.size()), nv = int64_t(vertices.size());
@@ -44,7 +54,12 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
                 const Vec3d v0 = vertices[size_t(t.x)], e0 = vertices[size_t(t.y)] - v0, e1 = vertices[size_t(t.z)] - v0;
                 const double a = dot(e0, e0), b = dot(e0, e1), c = dot(e1, e1), g = a - 2.0 * b + c;
                 x.longest = std::max(x.longest, std::sqrt(a) + std::sqrt(c));
-                if (std::isnan(packed_double[size_t(i)].sb)) continue;  // a sliver: never "inside" in either precision
+                const PackedTriangle<double>& pd = packed_double[size_t(i)];
+                if (is_interior_sliver(pd)) {  // its own sin^2, from its accurate area (ta = 2 |E0 x E1|)
+                    const double area2 = 0.5 * pd.ta;
+                    x.sin2_sliver = std::min(x.sin2_sliver, detail::smallest_sin2(area2 * area2, pd.a, pd.c, pd.g));
+                }
+                if (std::isnan(pd.sb)) continue;  // a sliver: never "inside" in either precision's branch-free form
                 const double det = a * c - b * b;
                 const double sin2 = std::min({det / (a * c), det / (a * g), det / (c * g)});
                 x.sin2_double = std::min(x.sin2_double, sin2);
@@ -56,8 +71,9 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
             }
         }
     });
-    double sin2_float = 1.0, sin2_double = 1.0, longest = 0.0, coordinate = 0.0;
+    double sin2_float = 1.0, sin2_double = 1.0, sin2_sliver = 1.0, longest = 0.0, coordinate = 0.0;
     for (const Extremes& x : part) {
+        sin2_sliver = std::min(sin2_sliver, x.sin2_sliver);
         sin2_float = std::min(sin2_float, x.sin2_float);
         sin2_double = std::min(sin2_double, x.sin2_double);
         longest = std::max(longest, x.longest);
@@ -65,9 +81,14 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
     }
     // pack_triangle() computes the same sin^2 in double; the margins cover its rounding.
     FloatSearchBound b;
+    const double slivers = rho_of_slivers(sin2_sliver * (1.0 - 1e-6));
     b.rho = rho_of(0x1p-24, sin2_float * (1.0 - 1e-6)) + rho_of(0x1p-53, sin2_double * (1.0 - 1e-6)) +
             3.0 * (0x1p-24 + 0x1p-53);
     b.rho_double = rho_of(0x1p-53, sin2_double * (1.0 - 1e-6)) + 3.0 * 0x1p-53;
+    if (slivers > 0.0) {  // added only where there are some, so every other mesh's bound keeps its bits
+        b.rho += slivers;
+        b.rho_double += slivers;
+    }
     b.two_l = 2.0 * longest;
     b.coordinate = coordinate;
     b.usable = std::isfinite(b.two_l) && std::isfinite(b.coordinate) && std::sqrt(2.0 * b.rho) < 0.25;

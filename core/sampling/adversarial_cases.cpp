@@ -1,5 +1,6 @@
 #include "core/sampling/adversarial_cases.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -77,7 +78,80 @@ TriangleMesh slivers() {
     return m;
 }
 
+/// One group of make_sliver_zoo(): the sliver, then its neighbours folded 0.05 L below its plane.
+struct SliverGroup {
+    Vec3d sliver[3];
+};
+
+SliverGroup add_sliver_group(TriangleMesh& m, Vec3d o, double length, double degrees, bool cap) {
+    const double theta = degrees * (3.14159265358979323846 / 180.0);
+    auto at = [&](double x, double y, double z) {
+        m.vertices.push_back(o + Vec3d(x, y, z) * length);
+        return int(m.vertices.size()) - 1;
+    };
+    SliverGroup g;
+    if (!cap) {  // a needle: angle theta at the apex A; the neighbours share its three edges
+        const int a = at(0, 0, 0), b = at(std::cos(0.5 * theta), std::sin(0.5 * theta), 0),
+                  c = at(std::cos(0.5 * theta), -std::sin(0.5 * theta), 0);
+        const int d = at(0.3, 0.2, -0.05), e = at(0.3, -0.2, -0.05), f = at(1.2, 0, -0.05);
+        m.triangles.push_back({a, c, b});
+        m.triangles.push_back({a, b, d});
+        m.triangles.push_back({a, e, c});
+        m.triangles.push_back({c, f, b});
+    } else {  // a cap: angles theta at A and about 0.59 theta at B, C near their edge
+        const int a = at(0, 0, 0), b = at(1, 0, 0), c = at(0.37, 0.37 * std::tan(theta), 0);
+        const int gv = at(0.5, -0.3, -0.05), h = at(0.5, 0.3, -0.05);
+        m.triangles.push_back({a, b, c});
+        m.triangles.push_back({a, gv, b});
+        m.triangles.push_back({a, c, h});
+        m.triangles.push_back({c, b, h});
+    }
+    const Int3 t = m.triangles[m.triangles.size() - 4];
+    g.sliver[0] = m.vertices[size_t(t.x)];
+    g.sliver[1] = m.vertices[size_t(t.y)];
+    g.sliver[2] = m.vertices[size_t(t.z)];
+    return g;
+}
+
+/// Points around a sliver of length L: on it, 1e-9 L .. 0.3 L above and below it, just
+/// beside its edges in its plane, and around its vertices.
+void add_sliver_points(std::vector<Vec3d>& points, const SliverGroup& g, double length, Random& rng, int count) {
+    const Vec3d a = g.sliver[0], b = g.sliver[1], c = g.sliver[2];
+    const Vec3d n = normalize_or_zero(cross(b - a, c - a));
+    for (int i = 0; i < count; ++i) {
+        const double u = rng.uniform(), v = rng.uniform() * (1.0 - u), kind = rng.uniform();
+        const Vec3d on = a + (b - a) * u + (c - a) * v;
+        const double height = rng.uniform() < 0.2 ? 0.0 : (rng.uniform() < 0.5 ? -1 : 1) * length * rng.log_between(1e-9, 0.3);
+        if (kind < 0.5) {
+            points.push_back(on + n * height);
+        } else if (kind < 0.8) {  // beside an edge, in the plane or above it
+            const Vec3d p = rng.uniform() < 0.5 ? a + (b - a) * u : (rng.uniform() < 0.5 ? a + (c - a) * u : b + (c - b) * u);
+            const Vec3d side = normalize_or_zero(cross(n, rng.direction())) * (length * rng.log_between(1e-12, 1e-2));
+            points.push_back(p + side + n * (rng.uniform() < 0.5 ? 0.0 : height));
+        } else {  // around a vertex
+            const Vec3d p = kind < 0.87 ? a : (kind < 0.94 ? b : c);
+            points.push_back(p + rng.direction() * (length * rng.log_between(1e-10, 0.5)));
+        }
+    }
+}
+
 }  // namespace
+
+AdversarialCase make_sliver_zoo(double length, uint64_t seed, int points_per_sliver) {
+    AdversarialCase z;
+    TriangleMesh& m = z.mesh;
+    Random rng{seed};
+    int group = 0;
+    for (const bool cap : {false, true}) {
+        for (const double degrees : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
+            const Vec3d o(3.0 * length * group++, 0.0, 0.0);
+            add_sliver_points(z.points, add_sliver_group(m, o, length, degrees, cap), length, rng, points_per_sliver);
+        }
+    }
+    m.name = length >= 1.0 ? "sliver_zoo_long" : "sliver_zoo_short";
+    m.source = "adversarial:" + m.name;
+    return z;
+}
 
 TriangleMesh make_fan_plate(int per_side, double half, Vec3d center) {
     TriangleMesh m;
@@ -171,6 +245,10 @@ std::vector<AdversarialCase> adversarial_cases(uint64_t seed, int points_per_cas
         c.mesh = std::move(m);
         cases.push_back(std::move(c));
     }
+    // Slivers of every size (1e-2 .. 1e-8 degrees, needles and caps, 100 and 1e-3 long) beside
+    // neighbours, with points on, around and just beside them.
+    for (const double length : {100.0, 1e-3})
+        cases.push_back(make_sliver_zoo(length, s++, std::max(1, points_per_case / 14)));
     return cases;
 }
 

@@ -6,7 +6,7 @@
 ///
 /// Meshes: a unit cube whose faces are split by a diagonal; a CAD-like closed plate (large
 /// planar faces triangulated as fans, strips along sides with collinear edges); a strip of
-/// thin slivers near the sliver threshold; copies of the cube and the plate 1e3 and 1e5 from
+/// thin slivers near the sliver threshold; slivers of every size (make_sliver_zoo); copies of the cube and the plate 1e3 and 1e5 from
 /// the origin; a box with a sphere 5e-4 above its face and a nested inner box. Points: near
 /// edges (the cube's diagonals among them), vertices and faces, 1e-5 .. 1e-2 (relative to
 /// the mesh) above them, plus a few farther out. Reproducible from a seed (SplitMix64).
@@ -30,7 +30,14 @@ struct AdversarialCase {
 /// boundary vertices a side, the sides strips of two triangles a boundary segment.
 TriangleMesh make_fan_plate(int per_side, double half, Vec3d center = {});
 
-/// Every case, `points_per_case` points each.
+/// Slivers of every size beside neighbours: needles (angle at the apex) and caps (angles at
+/// both ends of the long edge) of 1e-2, 1e-3, ..., 1e-8 degrees, `length` long, one group a
+/// 3 `length` step along x, each with neighbours folded 0.05 `length` below its plane along
+/// its edges; points on each sliver, 1e-9 .. 0.3 `length` above and below it, beside its
+/// edges and around its vertices (issue 38: such slivers were ranked by their edges only).
+AdversarialCase make_sliver_zoo(double length, uint64_t seed, int points_per_sliver);
+
+/// Every case, `points_per_case` points each (the sliver zoos about that many in all).
 std::vector<AdversarialCase> adversarial_cases(uint64_t seed, int points_per_case);
 
 /// Points near the features of `mesh` (edges, vertices, faces), as adversarial_cases() draws them.

@@ -6,11 +6,12 @@
 /// radius in order, keeping the least (Q_d, triangle index). Here the same triangles, in the
 /// same order (the winner first), are copied into structure-of-arrays form, their Q_d computed
 /// by the same squared_distance() in an `omp simd` loop (the same operations per lane, no
-/// contraction: the same bits), and the least is then chosen by the same comparisons in the
-/// same order. The lattices' points re-rank several candidates almost everywhere (the
+/// contraction: the same bits; its branch-free form there, the few slivers after), and the
+/// least is then chosen by the same comparisons in the same order. The lattices' points re-rank several candidates almost everywhere (the
 /// triangles around a nearest vertex or edge tie), so this loop is hot.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 
@@ -27,6 +28,9 @@ inline void double_squared_distances(const PackedTriangle<double>* packed, const
     constexpr int kFields = int(sizeof(PackedTriangle<double>) / sizeof(double));
     static_assert(kFields == 24 && sizeof(PackedTriangle<double>) == kFields * sizeof(double),
                   "PackedTriangle<double>: 24 doubles, no padding (the copy below relies on it)");
+    static_assert(offsetof(PackedTriangle<double>, sb) == 13 * sizeof(double) &&
+                      offsetof(PackedTriangle<double>, ta) == 14 * sizeof(double),
+                  "fields 13 and 14 are sb and ta (the sliver test below)");
     alignas(64) double f[kFields][kRerankChunk];
     for (int i = 0; i < n; ++i) {
         double row[kFields];
@@ -38,8 +42,11 @@ inline void double_squared_distances(const PackedTriangle<double>* packed, const
         const PackedTriangle<double> t{f[0][i],  f[1][i],  f[2][i],  f[3][i],  f[4][i],  f[5][i],  f[6][i],  f[7][i],
                                        f[8][i],  f[9][i],  f[10][i], f[11][i], f[12][i], f[13][i], f[14][i], f[15][i],
                                        f[16][i], f[17][i], f[18][i], f[19][i], f[20][i], f[21][i], f[22][i], f[23][i]};
-        q[i] = squared_distance(t, px, py, pz);
+        q[i] = branch_free_squared_distance(t, px, py, pz);
     }
+    // squared_distance() of the slivers (sb NaN, ta not: is_interior_sliver), out of the vector loop.
+    for (int i = 0; i < n; ++i)
+        if (f[13][i] != f[13][i] && f[14][i] == f[14][i]) q[i] = sliver_squared_distance(packed[slots[i]], px, py, pz);
 }
 
 /// rerank_in_double() for BVH slots or triangle indices (`index_of`), its result bit for bit.

@@ -31,9 +31,17 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
     }
     alignas(64) T q[kTriangleBlock];
     alignas(64) T ranked[kTriangleBlock];  ///< q less sliver_excess(): what candidates are ranked by
+    constexpr bool kDouble = sizeof(T) == sizeof(double);  // float has no interior slivers
     const int n = soa.size();
+    const std::vector<int>& slivers = soa.interior_slivers();
+    auto sliver = slivers.begin();
     for (int start = 0; start < n; start += kTriangleBlock) {
         const int len = std::min(kTriangleBlock, n - start);
+        // This block's slivers (double only), re-evaluated after the vector loop (squared_distance()).
+        const auto slivers_begin = sliver;
+        if constexpr (kDouble)
+            while (sliver != slivers.end() && *sliver < start + len) ++sliver;
+        const auto slivers_end = sliver;
         for (int p = 0; p < count; ++p) {
             const T x = px[p], y = py[p], z = pz[p];
             T block_min = std::numeric_limits<T>::infinity(), block_ranked = block_min;
@@ -44,13 +52,21 @@ void nearest_triangles_vectorized(const TriangleSoA<T>& soa, int count, const T*
                                           f[6][j],  f[7][j],  f[8][j],  f[9][j],  f[10][j], f[11][j],
                                           f[12][j], f[13][j], f[14][j], f[15][j], f[16][j], f[17][j],
                                           f[18][j], f[19][j], f[20][j], f[21][j], f[22][j], f[23][j]};
-                const T d = squared_distance(t, x, y, z);
+                const T d = branch_free_squared_distance(t, x, y, z);
                 q[i] = d;
                 block_min = d < block_min ? d : block_min;
                 if constexpr (Near::kKeeps) {
                     const T r = d - sliver_excess(t);
                     ranked[i] = r;
                     block_ranked = r < block_ranked ? r : block_ranked;
+                }
+            }
+            if constexpr (kDouble) {
+                if (slivers_begin != slivers_end) {
+                    for (auto k = slivers_begin; k != slivers_end; ++k)
+                        q[*k - start] = sliver_squared_distance(soa[*k], x, y, z);
+                    block_min = std::numeric_limits<T>::infinity();
+                    for (int i = 0; i < len; ++i) block_min = q[i] < block_min ? q[i] : block_min;
                 }
             }
             if (block_min < best_q[p]) {

@@ -19,10 +19,14 @@ public:
         for (size_t i = 0; i < packed.size(); ++i) {
             const T* src = reinterpret_cast<const T*>(&packed[i]);
             for (int f = 0; f < kFields; ++f) fields_[f][i] = src[f];
+            if (is_interior_sliver(packed[i])) interior_slivers_.push_back(int(i));
         }
     }
 
     int size() const { return size_; }
+    /// The triangles (ascending) whose squared_distance() is sliver_squared_distance(): the
+    /// vector loops run the branch-free form and then re-evaluate these.
+    const std::vector<int>& interior_slivers() const { return interior_slivers_; }
     const T* field(int f) const { return fields_[f].data(); }
 
     /// Reassembles triangle i; inside a loop the compiler keeps each field in a register.
@@ -36,6 +40,7 @@ public:
 private:
     int size_;
     std::vector<T> fields_[kFields];
+    std::vector<int> interior_slivers_;
 };
 
 }  // namespace sdf

@@ -160,6 +160,44 @@ SDF_CPU_GPU SDF_INLINE void offer_within(const T* qs, const T* radius, int32_t j
     }
 }
 
+/// squared_distance() in its two forms, for loops whose triangle is the same in every lane:
+/// the branch is taken once per triangle, and the lane loop stays one vector loop.
+struct BranchFreeDistance {
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE T operator()(const PackedTriangle<T>& t, T x, T y, T z) const {
+        return branch_free_squared_distance(t, x, y, z);
+    }
+};
+struct SliverDistance {
+    template <typename T>
+    SDF_CPU_GPU SDF_INLINE T operator()(const PackedTriangle<T>& t, T x, T y, T z) const {
+        return sliver_squared_distance(t, x, y, z);
+    }
+};
+
+/// Tests every lane against triangle `tri` (BVH slot j) with `distance`; qs[k] = Q less the
+/// sliver excess (for the offers). Returns whether a best changed.
+template <typename T, int K, bool kKeeps, typename Distance>
+SDF_CPU_GPU SDF_INLINE int test_lanes(const PackedTriangle<T>& tri, int32_t j, int32_t triangle, T excess,
+                                      BvhPacket<T, K>& pk, T* qs, Distance distance) {
+    int improved = 0;
+#if !SDF_IS_GPU_CODE
+#pragma omp simd reduction(| : improved)
+#endif
+    for (int k = 0; k < K; ++k) {
+        const T q = distance(tri, pk.x[k], pk.y[k], pk.z[k]);
+        // The tie rule of closest_triangle_bvh.h (wins_tie), lane by lane.
+        const bool better = q < pk.best_q[k] ||
+                            (q == pk.best_q[k] && (pk.best_triangle[k] < 0 || triangle < pk.best_triangle[k]));
+        improved |= int(better);
+        pk.best_q[k] = better ? q : pk.best_q[k];
+        pk.best_slot[k] = better ? j : pk.best_slot[k];
+        pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
+        if constexpr (kKeeps) qs[k] = q - excess;
+    }
+    return improved;
+}
+
 /// Tests every point of the packet against leaf triangles [first, first + count), offering
 /// those within a lane's radius to `near`; returns the new largest radius of the packet.
 template <typename T, int K, typename Near>
@@ -171,20 +209,10 @@ SDF_CPU_GPU SDF_INLINE T scan_leaf_offering(const BvhView<T>& bvh, int32_t first
         const int32_t triangle = bvh.triangle_index[j];
         const T excess = Near::kKeeps ? sliver_excess(tri) : T(0);
         T qs[K];
-#if !SDF_IS_GPU_CODE
-#pragma omp simd reduction(| : improved)
-#endif
-        for (int k = 0; k < K; ++k) {
-            const T q = squared_distance(tri, pk.x[k], pk.y[k], pk.z[k]);
-            // The tie rule of closest_triangle_bvh.h (wins_tie), lane by lane.
-            const bool better = q < pk.best_q[k] ||
-                                (q == pk.best_q[k] && (pk.best_triangle[k] < 0 || triangle < pk.best_triangle[k]));
-            improved |= int(better);
-            pk.best_q[k] = better ? q : pk.best_q[k];
-            pk.best_slot[k] = better ? j : pk.best_slot[k];
-            pk.best_triangle[k] = better ? triangle : pk.best_triangle[k];
-            if constexpr (Near::kKeeps) qs[k] = q - excess;
-        }
+        bool sliver = false;  // squared_distance(): double's slivers by sliver_squared_distance()
+        if constexpr (sizeof(T) == sizeof(double)) sliver = is_interior_sliver(tri);
+        if (sliver) improved |= test_lanes<T, K, Near::kKeeps>(tri, j, triangle, excess, pk, qs, SliverDistance{});
+        else improved |= test_lanes<T, K, Near::kKeeps>(tri, j, triangle, excess, pk, qs, BranchFreeDistance{});
         if constexpr (Near::kKeeps) offer_within<T, K>(qs, pk.radius, j, near);
     }
 #if !SDF_IS_GPU_CODE

@@ -35,18 +35,21 @@
 ///     precision takes, the exact values of the branches differ by at most delta^2: a point
 ///     declared inside lies within delta of the triangle, one declared outside within delta
 ///     of an edge (so its edge distance exceeds the plane distance by at most delta^2).
-///     With S the smallest sin^2 of the triangles a precision searches inside (slivers are
-///     never "inside"): at most 64 gamma_5^2 M^2 / S^2 (gamma_5: the double constants' own
+///     With S the smallest sin^2 of the triangles a precision searches inside by (s, t)
+///     (slivers never are): at most 64 gamma_5^2 M^2 / S^2 (gamma_5: the double constants' own
 ///     relative error, about 4 u_double / S, added to u). Float treats triangles with
 ///     sin^2 < kFloatSliverSin2 as slivers, so its S is at least 1e-2 and this term stays
-///     below the arithmetic one.
-///  4. Float slivers. A triangle searched inside in double but by its edges in float: the
-///     edge distance exceeds the plane distance by at most the squared inradius, which the
-///     packed float triangle carries (sliver_excess, x): there Q_f - x <= Q_d + E and
-///     Q_d <= Q_f + E, and candidates are ranked by Q_f - x.
+///     below the arithmetic one. Double's slivers decide "inside" by edge functions
+///     (sliver_squared_distance, packed_triangle.h): at most (64 u)^2 M^2 / S_sliver, S_sliver
+///     their smallest sin^2 (>= kRobustSliverSin2).
+///  4. Float slivers. Every triangle float searches by its edges (sliver_excess, x): the edge
+///     distance exceeds the distance by at most the squared inradius, which the packed float
+///     triangle carries: there Q_f - x <= Q_d + E and Q_d <= Q_f + E, and candidates are
+///     ranked by Q_f - x.
 ///  Together, for float and double alike (double's terms with u = 2^-53):
 ///     |Q_f - Q_d| <= E(M) = rho M^2 + 2 d0 M + d0^2   (beyond x for float-only slivers),
-///     rho = sum over both precisions of (gamma_32 + 64 gamma_5^2 / S^2) + 3 u.
+///     rho = sum over both precisions of (gamma_32 + 64 gamma_5^2 / S^2) + 3 u
+///           + (64 u_double)^2 / S_sliver where double has slivers.
 /// M itself: a triangle that matters has Q_d <= D = Q_d(w) <= q + E, so its distance is at
 /// most sqrt(q + 2E) and |B - P| at most that plus its diameter (<= |E0| + |E1|); with
 /// L = max over the mesh of |E0| + |E1| and sqrt(E) <= sqrt(rho) M + d0 / sqrt(rho):
