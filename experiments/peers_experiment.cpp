@@ -79,15 +79,15 @@ double process_cpu_seconds() {
 
 /// Our point-set rows' build time: the mesh's BVH, its own build time (the tree is built once
 /// per mesh, by its preparation or here, and then shared by every sampler), plus what the
-/// sampler's first call sets up (winding moments, upload): what a user without a built tree
+/// sampler's binding builds (winding moments, upload): what a user without a built tree
 /// waits, as the peers' builds are.
 /// `host_tree` false: the sampler builds its own tree (the CUDA sampler's device build), so
 /// the host tree's time is not its.
-template <class FirstCall>
-double our_build_seconds(const PreparedMesh& mesh, FirstCall first_call, bool host_tree = true) {
+template <class Bind>
+double our_build_seconds(const PreparedMesh& mesh, Bind bind, bool host_tree = true) {
     const double tree = mesh.bvh()->stats.seconds;
     const auto start = std::chrono::steady_clock::now();
-    first_call();
+    bind();
     return (host_tree ? tree : 0.0) + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -225,7 +225,8 @@ public:
                                 {"our_sign_point_sets", sign_mode_name(point_set_sign_)},
                                 {"our_gpu_bvh_build", bvh_build_site_name(gpu_bvh_build_)}};
         for (const MeshCase& c : cases_) {
-            const PreparedMesh mesh = load_case_mesh(c, search_path_, base_dir_, ctx);
+            mesh_ = std::make_shared<const PreparedMesh>(load_case_mesh(c, search_path_, base_dir_, ctx));
+            const PreparedMesh& mesh = *mesh_;
             ctx.metrics["meshes"][c.label] = describe_prepared_mesh(mesh);
             sign_ = lattice_sign_;
             for (int64_t samples : c.samples) run_lattice_case(ctx, c, mesh, samples);
@@ -335,14 +336,14 @@ private:
             o.threads = t;
             o.sign = sign_;
             o.progress = false;
-            auto sampler = make_sampler(o);
             std::vector<double> query, total;
             SampledField f;
-            bool built_here = false;  // the mesh's BVH built by these calls (else by its preparation)
             const double cpu0 = process_cpu_seconds();
+            const auto sampler = make_sampler(o)->bind(mesh_);  // the winding moments (and the mesh's BVH, if not built yet)
+            bool built_here = false;  // the mesh's BVH built by this binding (else by its preparation)
             for (int r = 0; r < repetitions_; ++r) {
-                f = sampler->sample(mesh, lattice);  // over the mesh's BVH (build_seconds: its build time)
-                built_here = built_here || f.sampler.details.at("bvh")["built_by_this_call"].get<bool>();
+                f = sampler->sample(lattice);  // over the mesh's BVH (build_seconds: its build time)
+                built_here = f.sampler.details.at("bvh")["built_by_bind"].get<bool>();
                 query.push_back(f.timings.kernel);
                 total.push_back(f.timings.total);
             }
@@ -376,16 +377,16 @@ private:
             o.threads = t;
             o.sign = sign_;
             o.progress = false;
-            auto sampler = make_sampler(o);
+            std::unique_ptr<BoundSampler> sampler;
             // The sign's data (and the mesh's BVH, if not built yet): the build time.
-            const double build = our_build_seconds(mesh, [&] { sampler->query(mesh, {points[0]}); });
+            const double build = our_build_seconds(mesh, [&] { sampler = make_sampler(o)->bind(mesh_); });
             auto start = std::chrono::steady_clock::now();
             std::vector<double> secs;
             std::vector<PointSample> res;
             const double cpu0 = process_cpu_seconds();
             for (int r = 0; r < repetitions_; ++r) {
                 start = std::chrono::steady_clock::now();
-                res = sampler->query(mesh, points);
+                res = sampler->query(points);
                 secs.push_back(seconds(start));
             }
             const double cpu = (process_cpu_seconds() - cpu0) / repetitions_;
@@ -419,13 +420,13 @@ private:
             o.threads = t;
             o.sign = sign_;
             o.progress = false;
-            auto sampler = make_sampler(o);
+            const auto sampler = make_sampler(o)->bind(mesh_);
             std::vector<double> secs;
             std::vector<PointSample> res;
             const double cpu0 = process_cpu_seconds();
             for (int r = 0; r < repetitions_; ++r) {
                 const auto start = std::chrono::steady_clock::now();
-                res = sampler->query(mesh, pts);
+                res = sampler->query(pts);
                 secs.push_back(seconds(start));
             }
             std::vector<double> d;
@@ -462,12 +463,12 @@ private:
         o.sign = sign_;
         o.bvh_build = gpu_bvh_build_;
         o.progress = false;
-        auto sampler = make_sampler(o);
-        sampler->sample(mesh, lattice);  // warm-up: module load, uploads (and the BVH build)
+        const auto sampler = make_sampler(o)->bind(mesh_);  // uploads (and the BVH build)
+        sampler->sample(lattice);  // warm-up: module load, first allocations
         std::vector<double> kernel, total;
         SampledField f;
         for (int r = 0; r < repetitions_; ++r) {
-            f = sampler->sample(mesh, lattice);
+            f = sampler->sample(lattice);
             kernel.push_back(f.timings.kernel);
             total.push_back(f.timings.total);
         }
@@ -482,7 +483,7 @@ private:
     }
 
     /// Our GPU BVH's query() on a point set, after a warm-up call: the device time of the
-    /// Morton sort, search and double finalize (Sampler::last_query_timings, CUDA events;
+    /// Morton sort, search and double finalize (BoundSampler::query's timings, CUDA events;
     /// the points already on the device, as the GPU peers' query time), and the wall time
     /// of the call with the transfers and the host's scatter as end-to-end time.
     void run_gpu_query(RunContext& ctx, const std::string& label, const PreparedMesh& mesh, const QuerySet& set,
@@ -498,7 +499,7 @@ private:
         // The process's first CUDA sampler loads the kernels' modules and fills the device's
         // memory pool: a sampler made and dropped first, as the cuBQL peer builds once before
         // it times its build.
-        make_sampler(o)->query(mesh, {points[0]});
+        make_sampler(o)->bind(mesh_)->query({points[0]});
         // The timed first calls of three new samplers (their medians; a build of a few
         // milliseconds varies by as much), as cuBQL's three builds: the mesh's upload, the
         // tree where the device builds it, one search; the host tree's build time is added
@@ -507,12 +508,15 @@ private:
         // excludes its triangles' upload: for a device tree, its build from the mesh on the
         // device (bvh.build_seconds); for a host tree, the whole first call.
         const Lattice tiny = fit_lattice(LatticeType::CC, {2, 2, 2}, mesh.bounds(), 0.1);
-        std::unique_ptr<Sampler> sampler;
+        std::unique_ptr<BoundSampler> sampler;
         std::vector<double> first_calls, builds;
         for (int k = 0; k < kTimedBuilds; ++k) {
-            sampler = make_sampler(o);
-            const double first_call = our_build_seconds(mesh, [&] { sampler->query(mesh, {points[0]}); }, false);
-            const nlohmann::json tree = sampler->sample(mesh, tiny).sampler.details.at("bvh");
+            sampler.reset();
+            const double first_call = our_build_seconds(mesh, [&] {
+                sampler = make_sampler(o)->bind(mesh_);
+                sampler->query({points[0]});
+            }, false);
+            const nlohmann::json tree = sampler->sample(tiny).sampler.details.at("bvh");
             const bool device_tree = tree.value("built_on", "host") == "device";
             first_calls.push_back(first_call + (device_tree ? 0.0 : mesh.bvh()->stats.seconds));
             builds.push_back(device_tree ? tree.at("build_seconds").get<double>() : first_calls.back());
@@ -524,9 +528,10 @@ private:
         std::vector<PointSample> res;
         for (int r = 0; r < repetitions_; ++r) {
             start = std::chrono::steady_clock::now();
-            res = sampler->query(mesh, points);
+            SamplingTimings timings;
+            res = sampler->query(points, &timings);
             secs.push_back(seconds(start));
-            device.push_back(sampler->last_query_timings().kernel);
+            device.push_back(timings.kernel);
         }
         std::vector<double> d(res.size());
         for (size_t i = 0; i < res.size(); ++i) d[i] = res[i].distance;
@@ -629,12 +634,12 @@ private:
             o.threads = 0;
             o.sign = lattice_sign_;
             o.progress = false;
-            auto sampler = make_sampler(o);
-            const double build = our_build_seconds(mesh, [&] { sampler->query(mesh, {points[0]}); });
+            std::unique_ptr<BoundSampler> sampler;
+            const double build = our_build_seconds(mesh, [&] { sampler = make_sampler(o)->bind(mesh_); });
             auto start = std::chrono::steady_clock::now();
             const double cpu0 = process_cpu_seconds();
             start = std::chrono::steady_clock::now();
-            for (const PointSample& r : sampler->query(mesh, points)) reference.push_back(r.distance);
+            for (const PointSample& r : sampler->query(points)) reference.push_back(r.distance);
             nlohmann::json row = base_row(c.label, set, mesh, "bvh_cpu_exact_sign", "ours");
             set_times(row, build, seconds(start), set.count);
             row["cpu_seconds"] = process_cpu_seconds() - cpu0;
@@ -757,6 +762,7 @@ private:
     SignMode lattice_sign_ = SignMode::Auto, point_set_sign_ = SignMode::Auto;
     std::vector<std::string> point_set_meshes_;
     std::vector<peers::PeerEntry> peers_;
+    std::shared_ptr<const PreparedMesh> mesh_;  ///< the current case's mesh, which our samplers are bound to
 };
 
 }  // namespace

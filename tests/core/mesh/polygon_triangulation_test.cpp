@@ -24,6 +24,7 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/core/mesh/mesh_file_writers.h"
 #include "tests/test_util/scratch_dir.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -297,7 +298,7 @@ protected:
         o.precision = Precision::Double;
         o.progress = false;
         o.threads = 1;
-        return make_cpu_brute_force_sampler(o)->query(mesh, points);
+        return make_cpu_brute_force_sampler(o)->bind(share(mesh))->query(points);
     }
 };
 
