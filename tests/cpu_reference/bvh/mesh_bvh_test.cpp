@@ -102,6 +102,24 @@ TEST(MeshBvh, SamplersAndCallsShareTheMeshTree) {
     EXPECT_EQ(b.sampler.details.at("bvh").at("build_seconds").get<double>(), mesh.bvh()->stats.seconds);
 }
 
+/// A bound sampler shares its mesh's ownership: the caller may drop its own pointer, and the
+/// fields stay those of a fresh binding bit for bit. Binding no mesh is refused.
+TEST(MeshBvh, ABoundSamplerOwnsItsMesh) {
+    auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(make_torus(1.0, 0.3, 24, 12), without_intersection_check()));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {9, 10, 11}, mesh->bounds(), 0.1);
+    const std::weak_ptr<const PreparedMesh> watch = mesh;
+    for (SignMode sign : {SignMode::Winding, SignMode::Pseudonormal}) {
+        const auto bound = make_cpu_bvh_sampler(quiet(sign))->bind(mesh);
+        const SampledField expected = bound->sample(lattice);
+        mesh.reset();
+        EXPECT_FALSE(watch.expired());
+        expect_same_field(bound->sample(lattice), expected);
+        mesh = bound->shared_mesh();
+    }
+    EXPECT_THROW(make_cpu_bvh_sampler(quiet(SignMode::Auto))->bind(nullptr), std::invalid_argument);
+    EXPECT_THROW(make_cpu_brute_force_sampler(quiet(SignMode::Auto))->bind(nullptr), std::invalid_argument);
+}
+
 /// A mesh made where another was, from the same input (same name, content hash, triangle
 /// count and bounds: all a cache keyed by mesh identity compared), but prepared otherwise:
 /// inward, or flipped outward. A sampler that saw the first must not reuse its tree or its
