@@ -92,9 +92,9 @@ int main(int argc, char** argv) {
     }
     if (quiet) sdf::ProgressReporter::set_globally_enabled(false);
     try {
-        const sdf::PreparedMesh mesh = sdf::prepare_mesh(
-            sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
-        for (const std::string& w : mesh.warnings()) std::cerr << "sdf-query: warning: " << w << "\n";
+        const auto mesh = std::make_shared<const sdf::PreparedMesh>(sdf::prepare_mesh(
+            sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), ".")));
+        for (const std::string& w : mesh->warnings()) std::cerr << "sdf-query: warning: " << w << "\n";
         const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
         const sdf::PointQueryResult result = sdf::query_points(mesh, points, options);
         const sdf::Overwrite mode = overwrite ? sdf::Overwrite::Allow : sdf::Overwrite::Forbid;

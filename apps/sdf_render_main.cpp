@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_mesh.h"
@@ -75,11 +76,11 @@ SamplerOptions sampler_options(const Options& o) { return o.sampler.options({{"p
 
 /// The field of `mesh` on `lattice`: from the field cache when it holds it, else sampled and
 /// stored there, by the studies' FieldSource (the same key, log and sign warning).
-SampledField obtain_field(const PreparedMesh& mesh, const Lattice& lattice, const Options& o) {
+SampledField obtain_field(const std::shared_ptr<const PreparedMesh>& mesh, const Lattice& lattice, const Options& o) {
     const std::optional<FieldCache> cache =
         o.no_cache ? std::nullopt : std::optional<FieldCache>(o.cache_dir.empty() ? ContentCache::default_root() : o.cache_dir);
     FieldSource source(cache ? &*cache : nullptr, sampler_options(o), "the command line: sampler");
-    return source.get(mesh, lattice, "field " + mesh.name(), std::cerr).field;
+    return source.get(mesh, lattice, "field " + mesh->name(), std::cerr).field;
 }
 
 Lattice mesh_lattice(const PreparedMesh& mesh, LatticeType type, const std::vector<int>& res, double margin) {
@@ -208,18 +209,19 @@ void require_single_targets(const Options& o, const RenderSpec& spec) {
 
 int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& resolved) {
     require_single_targets(o, spec);
-    std::optional<PreparedMesh> mesh;
+    std::shared_ptr<const PreparedMesh> mesh;
     SampledField field;
     if (is_field_file(o.input)) {
         field = read_field(o.input);
         if (!o.mesh_file.empty())
-            mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), "."));
+            mesh = std::make_shared<const PreparedMesh>(
+                prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), ".")));
     } else {
-        mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
+        mesh = std::make_shared<const PreparedMesh>(prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), ".")));
         const LatticeType type = lattice_type_named(o.lattice);
         const std::vector<int> res =
             !o.resolution.empty() ? o.resolution : (type == LatticeType::CC ? o.cc_resolution : o.bcc_resolution);
-        field = obtain_field(*mesh, mesh_lattice(*mesh, type, res, o.margin), o);
+        field = obtain_field(mesh, mesh_lattice(*mesh, type, res, o.margin), o);
     }
     if (spec.reference && !mesh) throw std::invalid_argument("--reference needs the mesh: give a mesh INPUT or --mesh");
     const Bounds3 bounds = mesh ? mesh->bounds() : field_solid_bounds(field);
@@ -271,9 +273,11 @@ int run_grid(const Options& o, const RenderSpec& spec, const nlohmann::json& res
         throw std::runtime_error("--out-dir " + o.out_dir + ": is not a folder; expected a folder for the figures");
     fs::create_directories(o.out_dir);
     require_writable_target((fs::path(o.out_dir) / "probe").string(), Overwrite::Allow);
-    const PreparedMesh mesh = prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), "."));
-    const SampledField cc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::CC, o.cc_resolution, o.margin), o);
-    const SampledField bcc = obtain_field(mesh, mesh_lattice(mesh, LatticeType::BCC, o.bcc_resolution, o.margin), o);
+    const auto shared_mesh =
+        std::make_shared<const PreparedMesh>(prepare_mesh(load_mesh(mesh_spec_from_argument(o.input), data_search_path(), ".")));
+    const PreparedMesh& mesh = *shared_mesh;
+    const SampledField cc = obtain_field(shared_mesh, mesh_lattice(mesh, LatticeType::CC, o.cc_resolution, o.margin), o);
+    const SampledField bcc = obtain_field(shared_mesh, mesh_lattice(mesh, LatticeType::BCC, o.bcc_resolution, o.margin), o);
     FigureOptions fo = figure_options(spec);  // panels, rows, heat-map scale, downsampling
     fo.render = render_options(o, spec);
     fo.mesh.threads = o.threads;

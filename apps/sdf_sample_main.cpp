@@ -18,6 +18,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
@@ -171,8 +172,9 @@ int main(int argc, char** argv) {
             sdf::require_writable_target(out_path, stream.write.overwrite);
             if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
         }
-        const sdf::PreparedMesh mesh =
-            sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), "."));
+        const auto shared_mesh = std::make_shared<const sdf::PreparedMesh>(
+            sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), ".")));
+        const sdf::PreparedMesh& mesh = *shared_mesh;
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-sample: warning: " << w << "\n";
         const sdf::Lattice lattice = sdf::build_lattice(spec, mesh.bounds(), margin);
         stream.fixed_bytes = sdf::estimate_fixed_bytes(mesh);
@@ -209,9 +211,9 @@ int main(int argc, char** argv) {
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
         if (!quiet) std::cerr << plan.describe();
         // The front ends' one field source (harness/study/field_source.h), without a cache:
-        // its sampler samples the slabs this tool streams to disk.
+        // its sampler, bound to the mesh, samples the slabs this tool streams to disk.
         sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
-        const sdf::StreamResult r = sdf::sample_streamed(source.sampler(), options, mesh, lattice, stream, mesh_provenance);
+        const sdf::StreamResult r = sdf::sample_streamed(source.bound(shared_mesh), options, lattice, stream, mesh_provenance);
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
                   << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds

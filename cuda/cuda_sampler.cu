@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <mutex>
 #include <string>
 
 #include "core/bvh/triangle_bvh.h"
-#include "core/sampling/certified_search.h"
-#include "core/sampling/narrow_band.h"
+#include "core/sampling/backend_sampler.h"
 #include "core/sampling/sampler_results.h"
 #include "cuda/certify_kernel.cuh"
 #include "cuda/cuda_check.h"
@@ -36,18 +36,15 @@ class Engine {
 public:
     using Sink = std::function<void(const HostPieceResults&)>;
 
-    /// `sign` is prepared for `mesh`: in winding mode its moments are uploaded too.
-    Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel, const SamplerSign& sign)
-        : host_(mesh.buffers<T>()), exact_host_(mesh.buffers<double>()), options_(options), kernel_(kernel) {
+    /// Over the bound sampler's device mesh and winding data (uploaded at binding).
+    Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel, const DeviceMesh<double>& device_mesh,
+           const DeviceWinding& winding)
+        : host_(mesh.buffers<T>()), options_(options), kernel_(kernel), mesh_(device_mesh), winding_(winding) {
         CUDA_CHECK(cudaSetDevice(options.device));
         cudaDeviceProp prop{};
         CUDA_CHECK(cudaGetDeviceProperties(&prop, options.device));
         sms_ = prop.multiProcessorCount;
         max_threads_per_sm_ = prop.maxThreadsPerMultiProcessor;
-        upload_.begin();
-        mesh_ = std::make_unique<DeviceMesh<double>>(exact_host_);
-        winding_.upload(sign, mesh_->view());
-        upload_.end();
         const size_t free_bytes = free_device_memory();
         budget_ = size_t(0.8 * double(free_bytes));
         num_triangles_ = int(host_.triangles.size());
@@ -197,7 +194,7 @@ private:
         }
         compute_.begin();
         if (certifier_) certifier_->certify(piece, point_coordinate_, best_i.get());
-        launch_finalize_samples(n, mesh_->view(), piece, best_i.get(),
+        launch_finalize_samples(n, mesh_.view(), piece, best_i.get(),
                                 winding_.view(), options_.band_width, out.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples");
         compute_.end();
@@ -241,10 +238,10 @@ private:
             CUDA_CHECK_LAUNCH("nearest_triangle_thesis");
         }
         if (winding_.view().enabled())
-            finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+            finalize_thesis_samples<T, true><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_.view(), piece, minima,
                                                                                                   winding_.view(), options_.band_width, out.outputs());
         else
-            finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_->view(), piece, minima,
+            finalize_thesis_samples<T, false><<<blocks_for(n, kFinalizeThreads), kFinalizeThreads>>>(mesh_.view(), piece, minima,
                                                                                                    winding_.view(), options_.band_width, out.outputs());
         CUDA_CHECK_LAUNCH("finalize_thesis_samples");
         compute_.end();
@@ -255,11 +252,10 @@ private:
     }
 
     const MeshBuffers<T>& host_;          ///< search data in precision T
-    const MeshBuffers<double>& exact_host_;  ///< for the final evaluation
     SamplerOptions options_;
     CudaKernel kernel_;
-    std::unique_ptr<DeviceMesh<double>> mesh_;
-    DeviceWinding winding_;
+    const DeviceMesh<double>& mesh_;      ///< for the final evaluation
+    const DeviceWinding& winding_;
     DeviceBuffer<PackedTriangle<T>> packed_;
     std::vector<T> thesis_triangles_;
     EventTimer upload_, compute_, download_;
@@ -272,45 +268,57 @@ private:
     int64_t pieces_ = 0;
 };
 
-class CudaBruteForceSampler final : public Sampler {
+class BoundCudaBruteForce final : public BackendSampler {
 public:
-    explicit CudaBruteForceSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
-        kernel_ = kernel_from_name(kCudaBruteForceKernels, options.kernel, "CUDA brute-force");
-    }
-
-    std::string name() const override { return std::string("cuda/brute_force/") + kernel_name(); }
-
-    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
-        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab) : sample_as<double>(mesh, lattice, slab);
-    }
-
-    std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
-        require_search_range(mesh, points, options_.precision);
-        return options_.precision == Precision::Float ? query_as<float>(mesh, points) : query_as<double>(mesh, points);
+    /// Uploads the double mesh and, in winding mode, the sign's moments; the tuned float
+    /// search's certificate is built over the mesh's BVH (certify_kernel.cuh). The packed
+    /// triangles of the search are planned per call against the GPU memory free then.
+    BoundCudaBruteForce(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, CudaKernel kernel)
+        : BackendSampler(std::move(mesh), options, "cuda", "brute_force", kernel_name(kCudaBruteForceKernels, kernel)),
+          kernel_(kernel) {
+        sign_.prepare(this->mesh());
+        CUDA_CHECK(cudaSetDevice(options.device));
+        device_mesh_ = std::make_unique<DeviceMesh<double>>(this->mesh().buffers<double>());
+        winding_.upload(sign_, device_mesh_->view());
+        // The thesis's kernel stays as the thesis wrote it (uncertified), double is the reference.
+        if (float_search() && kernel_ == CudaKernel::Tuned)
+            certifier_ = std::make_unique<DeviceCertifier>(*this->mesh().bvh(), this->mesh());
     }
 
 private:
-    const char* kernel_name() const { return sdf::kernel_name(kCudaBruteForceKernels, kernel_); }
+    SampledField sample_blocks(SlabRun& run) const override {
+        const std::lock_guard<std::mutex> lock(mutex_);  // the certifier's counters
+        return with_precision(options_.precision, [&](auto zero) { return sample_as<decltype(zero)>(run); });
+    }
+
+    std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
+                                          CertificateCounters& certificate) const override {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return with_precision(options_.precision, [&](auto zero) { return query_as<decltype(zero)>(points, certificate); });
+    }
+
+    /// The certifier reset for a run over points of largest |coordinate| `point_coordinate`.
+    template <typename T>
+    const DeviceCertifier* certifier_for(double point_coordinate, Engine<T>& engine) const {
+        if (!certifier_) return nullptr;
+        certifier_->reset();
+        engine.certify_with(certifier_.get(), point_coordinate);
+        return certifier_.get();
+    }
 
     template <typename T>
-    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
-        require_band_width(options_.band_width, "sampler band_width");
-        const auto start = std::chrono::steady_clock::now();
-        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
-        sign_.prepare(mesh);
-        Engine<T> engine(mesh, options_, kernel_, sign_);
-        const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, largest_lattice_coordinate(lattice), engine);
-        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh, field); };
-        GridBlock blocks[kMaxSamplingBlocks];
-        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
-        int64_t computed = 0;
-        for (int b = 0; b < nblocks; ++b) {
-            const GridBlock block = blocks[b];
+    SampledField sample_as(SlabRun& run) const {
+        const Lattice& lattice = run.lattice;
+        SampledField field = unfilled_field(mesh(), lattice, run.slab, options_.precision);
+        Engine<T> engine(mesh(), options_, kernel_, *device_mesh_, winding_);
+        const DeviceCertifier* certifier = certifier_for<T>(largest_lattice_coordinate(lattice), engine);
+        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh(), field); };
+        for (const GridBlock& block : run) {
             if (kernel_ == CudaKernel::Tuned) {
                 engine.run_tuned(block.count(), [&](int64_t begin, int64_t count) {
                     return GridRangePiece{lattice, block, begin, count};
                 }, sink);
-                computed += block.count();
+                run.computed += block.count();
             } else {
                 GridRegionPiece piece{lattice, block, {}, 0, 0};
                 const int r = GridRegionPiece::kRegion;
@@ -324,37 +332,27 @@ private:
                     engine.run_thesis(piece, sink);
                 }
                 // Padding threads do the work too (thesis: "a few threads that are not performing necessary work").
-                computed += regions * GridRegionPiece::kRegionPoints;
+                run.computed += regions * GridRegionPiece::kRegionPoints;
             }
         }
-        field.timings.upload = engine.upload_seconds();
-        field.timings.kernel = engine.kernel_seconds();
-        field.timings.download = engine.download_seconds();
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
-        field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler.details["plan"] = engine.plan();
-        field.sampler.details["device"] = describe_device(options_.device);
-        CertificateCounters certificate;
-        if (certifier) certifier->read(certificate);
-        record_certificate(field.timings, certificate);
-        field.sampler.search_certificate = certificate_provenance(std::is_same_v<T, float>, certifier != nullptr, certificate);
-        if (options_.band_width > 0)
-            field.sampler.band = narrow_band_provenance(options_.band_width, count_narrow_band(field), "post-processed");
+        run.device.upload = engine.upload_seconds();
+        run.device.kernel = engine.kernel_seconds();
+        run.device.download = engine.download_seconds();
+        run.details["plan"] = engine.plan();
+        run.details["device"] = describe_device(options_.device);
+        if (certifier) certifier->read(run.certificate);
+        run.certified = certifier != nullptr;
         return field;
     }
 
     template <typename T>
-    std::vector<PointSample> query_as(const PreparedMesh& mesh, const std::vector<Vec3d>& points) {
+    std::vector<PointSample> query_as(const std::vector<Vec3d>& points, CertificateCounters& certificate) const {
         std::vector<PointSample> out(points.size());
-        if (points.empty()) return out;
-        sign_.prepare(mesh);
-        Engine<T> engine(mesh, options_, kernel_, sign_);
-        const double coordinate = largest_coordinate(points);
-        const std::unique_ptr<DeviceCertifier> certifier = certifier_for<T>(mesh, coordinate, engine);
+        Engine<T> engine(mesh(), options_, kernel_, *device_mesh_, winding_);
+        const DeviceCertifier* certifier = certifier_for<T>(largest_coordinate(points), engine);
         DeviceBuffer<Vec3d> device_points;
         device_points.upload(points);
-        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh, out); };
+        auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh(), out); };
         const int64_t n = int64_t(points.size());
         if (kernel_ == CudaKernel::Tuned) {
             engine.run_tuned(n, [&](int64_t begin, int64_t count) { return PointListPiece{device_points.get(), begin, count}; },
@@ -364,34 +362,22 @@ private:
             for (int64_t begin = 0; begin < n; begin += step)
                 engine.run_thesis(PointListPiece{device_points.get(), begin, std::min(step, n - begin)}, sink);
         }
-        query_timings_ = {};
-        if (certifier) {
-            CertificateCounters certificate;
-            certifier->read(certificate);
-            record_certificate(query_timings_, certificate);
-        }
+        if (certifier) certifier->read(certificate);
         return out;
     }
 
-    /// The tuned float search is certified through the mesh's BVH (certify_kernel.cuh); the
-    /// thesis's kernel stays as the thesis wrote it (uncertified), double is the reference.
-    template <typename T>
-    std::unique_ptr<DeviceCertifier> certifier_for(const PreparedMesh& mesh, double point_coordinate, Engine<T>& engine) {
-        if (!std::is_same_v<T, float> || kernel_ != CudaKernel::Tuned) return nullptr;
-        auto certifier = std::make_unique<DeviceCertifier>(*mesh.bvh(), mesh);
-        engine.certify_with(certifier.get(), point_coordinate);
-        return certifier;
-    }
-
-    SamplerOptions options_;
-    CudaKernel kernel_ = CudaKernel::Tuned;
-    SamplerSign sign_;
+    CudaKernel kernel_;
+    std::unique_ptr<DeviceMesh<double>> device_mesh_;
+    DeviceWinding winding_;
+    std::unique_ptr<DeviceCertifier> certifier_;  ///< float "tuned" only
+    mutable std::mutex mutex_;                    ///< calls share the certifier's device counters
 };
 
 }  // namespace
 
 std::unique_ptr<Sampler> make_cuda_brute_force_sampler(const SamplerOptions& options) {
-    return std::make_unique<CudaBruteForceSampler>(options);
+    return std::make_unique<BackendFactory<BoundCudaBruteForce, CudaKernel>>(options, "cuda", "brute_force",
+                                                                             kCudaBruteForceKernels, "CUDA brute-force");
 }
 
 }  // namespace sdf::cuda

@@ -143,7 +143,8 @@ public:
 
     void run(RunContext& ctx) override {
         std::ostream& log = *ctx.log;
-        const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
+        const auto shared_mesh = std::make_shared<const PreparedMesh>(load_prepared_mesh(inputs_, log));
+        const PreparedMesh& mesh = *shared_mesh;
         ctx.metrics["mesh"] = describe_prepared_mesh(mesh);
         ctx.inputs["mesh"] = {{"source", mesh.source()}, {"sha256", mesh.content_sha256()}};
         FieldSource source(ctx, inputs_.sampler);
@@ -153,7 +154,7 @@ public:
         double h_ref = 0;
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
             const Lattice l = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
-            ObtainedField got = source.get(mesh, l, inputs_.lattice_labels[i], log);
+            ObtainedField got = source.get(shared_mesh, l, inputs_.lattice_labels[i], log);
             nlohmann::json d = got.describe();
             d["label"] = inputs_.lattice_labels[i];
             ctx.metrics["lattices"].push_back(d);
@@ -183,8 +184,8 @@ public:
         // Probes with exact values, then the errors of each reconstruction.
         const DomainBox<double> box = common_domain(recons);
         std::string probe_log;
-        const ProbeSet probes = make_probes(mesh, box, probes_.band * h_ref, probes_, source.sampler(), inputs_.sampler,
-                                            ctx.cache, &probe_log);
+        const auto bound = [&]() -> const BoundSampler& { return source.bound(shared_mesh); };
+        const ProbeSet probes = make_probes(mesh, box, probes_.band * h_ref, probes_, bound, inputs_.sampler, ctx.cache, &probe_log);
         log << "  " << probe_log << "\n";
         int64_t in_band = 0;
         for (size_t i = 0; i < probes.points.size(); ++i) in_band += probes.in_band(i);

@@ -66,7 +66,8 @@ public:
 
     void run(RunContext& ctx) override {
         std::ostream& log = *ctx.log;
-        const PreparedMesh mesh = load_prepared_mesh(inputs_, log);
+        const auto shared_mesh = std::make_shared<const PreparedMesh>(load_prepared_mesh(inputs_, log));
+        const PreparedMesh& mesh = *shared_mesh;
         const MeshProvenance described = describe_prepared_mesh(mesh);
         ctx.metrics["mesh"] = described;
         ctx.inputs["mesh"] = described;
@@ -74,7 +75,7 @@ public:
         const std::string fields_dir = (std::filesystem::path(ctx.output_dir) / "fields").string();
         for (size_t i = 0; i < inputs_.lattices.size(); ++i) {
             const Lattice lattice = build_lattice(inputs_.lattices[i], mesh.bounds(), inputs_.margin);
-            ObtainedField got = source.get(mesh, lattice, inputs_.lattice_labels[i], log);
+            ObtainedField got = source.get(shared_mesh, lattice, inputs_.lattice_labels[i], log);
             SampledField& field = got.field;
             field.mesh = described;
             const std::string stem = mesh.name() + "-" + inputs_.lattice_labels[i];

@@ -1,7 +1,6 @@
 #include "core/mesh/prepared_mesh.h"
 
 #include <algorithm>
-#include <atomic>
 #include <future>
 #include <cmath>
 #include <numeric>
@@ -192,9 +191,7 @@ std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m, int threads)
 }  // namespace
 
 PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options) {
-    static std::atomic<uint64_t> next_id{1};  // 0: no mesh
     PreparedMesh out;
-    out.id_ = next_id.fetch_add(1);
     out.name_ = mesh.name;
     out.source_ = mesh.source;
     out.content_sha256_ = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;

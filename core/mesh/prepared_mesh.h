@@ -83,11 +83,6 @@ struct MeshBuffers {
 /// Copies share the buffers and the BVH (the same content).
 class PreparedMesh {
 public:
-    /// This mesh's identity, for what a sampler keeps per mesh without holding its BVH (the
-    /// CUDA sampler's device-built tree): given by prepare_mesh(), shared by copies (the same
-    /// content), never another mesh's in this process, unlike an address, which a mesh made
-    /// after this one is freed may get.
-    uint64_t id() const { return id_; }
     const std::string& name() const { return name_; }
     const std::string& source() const { return source_; }                  ///< file path or "shape:NAME"
     const std::string& content_sha256() const { return content_sha256_; }  ///< of the input file or geometry
@@ -134,7 +129,6 @@ private:
     friend PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options);
     PreparedMesh() = default;
 
-    uint64_t id_ = 0;
     std::string name_, source_, content_sha256_;
     std::vector<Vec3d> vertices_;
     std::vector<Int3> triangles_;

@@ -21,18 +21,12 @@ const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
 }
 
 const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
-    choice_ = choose_sign_mode(mesh.report(), requested_);  // cheap, and never another mesh's
+    choice_ = choose_sign_mode(mesh.report(), requested_);
     external_moments_on_.clear();
-    if (choice_.mode != SignMode::Winding) {
-        winding_.reset();
-        return choice_;
-    }
-    std::shared_ptr<const TriangleBvh> bvh = mesh.bvh();
-    // winding_ holds the tree it was built over, so that tree cannot have been freed and its
-    // address reused: the same tree means this mesh or a copy (sharing its buffers).
-    if (winding_ && winding_->winding_bvh().bvh == bvh) return choice_;
+    winding_.reset();
+    if (choice_.mode != SignMode::Winding) return choice_;
     if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
-    winding_ = std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options());
+    winding_ = std::make_shared<const WindingSign>(mesh, mesh.bvh(), winding_options());
     return choice_;
 }
 

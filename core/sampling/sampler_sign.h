@@ -1,8 +1,8 @@
 /// @file sampler_sign.h
 /// @brief The sign step every sampler shares (CPU and CUDA): resolve the requested sign mode
-/// for the mesh (auto: choose_sign_mode on its preparation report, with a warning on stderr
-/// that says why when it picks winding), build the winding sign once per mesh, and record
-/// the choice in the field's provenance. Distances and gradients stay exact; in winding mode
+/// for the mesh when the sampler is bound to it (auto: choose_sign_mode on its preparation
+/// report, with a warning on stderr that says why when it picks winding), build the winding
+/// sign then, and record the choice in the field's provenance. Distances and gradients stay exact; in winding mode
 /// only their side changes (with_sign), in pseudonormal mode nothing does.
 #pragma once
 
@@ -21,10 +21,9 @@ class SamplerSign {
 public:
     explicit SamplerSign(SignMode requested = SignMode::Auto) : requested_(requested) {}
 
-    /// Resolves the mode for `mesh` (from its own report, on every call) and, for winding,
-    /// builds its WindingSign over the mesh's BVH, kept while the mesh stays the same (the
-    /// warning is written once per WindingSign built). Not thread-safe: call it before the
-    /// parallel loop.
+    /// Resolves the mode for `mesh` (from its own report) and, for winding, builds its
+    /// WindingSign over the mesh's BVH (the warning is written then). Called once, when a
+    /// sampler is bound to the mesh (core/sampling/backend_sampler.h); not thread-safe.
     const SignModeChoice& prepare(const PreparedMesh& mesh);
 
     /// Resolves the mode as prepare() does but builds no host winding sign: for a sampler

@@ -1,6 +1,5 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 
-#include <chrono>
 #include <stdexcept>
 #include <type_traits>
 
@@ -8,8 +7,7 @@
 #include "core/parallel/progress.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "cpu_reference/sampling/nearest_triangle_cpu.h"
-#include "core/sampling/certified_search.h"
-#include "core/sampling/narrow_band.h"
+#include "core/sampling/backend_sampler.h"
 #include "core/sampling/sampler_results.h"
 #include "kernels/distance/signed_distance.h"
 
@@ -96,88 +94,63 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
     });
 }
 
-class CpuBruteForceSampler final : public Sampler {
+class BoundCpuBruteForce final : public BackendSampler {
 public:
-    explicit CpuBruteForceSampler(const SamplerOptions& options) : options_(options), sign_(options.sign) {
-        kernel_ = kernel_from_name(kCpuBruteForceKernels, options.kernel, "CPU brute-force");
-        active_cpu_kernels();  // a bad SDF_CPU_ISA is reported here, before any work
-    }
-
-    std::string name() const override { return std::string("cpu/brute_force/") + kernel_name(); }
-
-    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
-        return options_.precision == Precision::Float ? sample_as<float>(mesh, lattice, slab)
-                                                      : sample_as<double>(mesh, lattice, slab);
-    }
-
-    std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
-        require_search_range(mesh, points, options_.precision);
-        std::vector<PointSample> out(points.size());
-        sign_.prepare(mesh);
-        CertificateCounters counters;
-        const double coordinate = largest_coordinate(points, options_.threads);
-        auto run = [&](auto zero) {
-            using T = decltype(zero);
-            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()), coordinate,
-                               counters, [&](int64_t i) { return points[size_t(i)]; },
-                               [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   out[size_t(i)] = point_sample(mesh, s.distance, s.gradient, s.triangle);
-                               });
-        };
-        if (options_.precision == Precision::Float) run(0.0f); else run(0.0);
-        record_certificate(query_timings_, counters);
-        return out;
+    BoundCpuBruteForce(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, CpuKernel kernel)
+        : BackendSampler(std::move(mesh), options, "cpu", "brute_force", kernel_name(kCpuBruteForceKernels, kernel)),
+          kernel_(kernel) {
+        sign_.prepare(this->mesh());
     }
 
 private:
-    const char* kernel_name() const { return sdf::kernel_name(kCpuBruteForceKernels, kernel_); }
-
-    template <typename T>
-    SampledField sample_as(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
-        const auto start = std::chrono::steady_clock::now();
-        require_band_width(options_.band_width, "sampler band_width");
-        sign_.prepare(mesh);
-        SampledField field = unfilled_field(mesh, lattice, slab, options_.precision);
-        GridBlock blocks[kMaxSamplingBlocks];
-        const int nblocks = slab_sampling_blocks(lattice, options_.bcc_strategy, slab, blocks);
-        int64_t computed = 0;
-        CertificateCounters counters;
-        const double coordinate = largest_lattice_coordinate(lattice);
-        for (int b = 0; b < nblocks; ++b) {
-            const GridBlock block = blocks[b];
-            evaluate_points<T>(mesh, kernel_, sign_, options_.threads, options_.progress, block.count(), coordinate, counters,
-                               [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
+    std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
+                                          CertificateCounters& certificate) const override {
+        std::vector<PointSample> out(points.size());
+        const double coordinate = largest_coordinate(points, options_.threads);
+        with_precision(options_.precision, [&](auto zero) {
+            using T = decltype(zero);
+            evaluate_points<T>(mesh(), kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()), coordinate,
+                               certificate, [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
-                                   const int64_t out = block.output_index(lattice, i);
-                                   if (out < 0) return;  // strategy A: not a BCC point
-                                   store_sample(field, out, mesh, s.distance, s.gradient, s.triangle);
+                                   out[size_t(i)] = point_sample(mesh(), s.distance, s.gradient, s.triangle);
                                });
-            computed += block.count();
+        });
+        return out;
+    }
+
+    SampledField sample_blocks(SlabRun& run) const override {
+        const Lattice& lattice = run.lattice;
+        SampledField field = unfilled_field(mesh(), lattice, run.slab, options_.precision);
+        const double coordinate = largest_lattice_coordinate(lattice);
+        for (const GridBlock& block : run) {
+            with_precision(options_.precision, [&](auto zero) {
+                evaluate_points<decltype(zero)>(
+                    mesh(), kernel_, sign_, options_.threads, options_.progress, block.count(), coordinate, run.certificate,
+                    [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
+                    [&](int64_t i, const SignedDistanceSample<double>& s) {
+                        const int64_t out = block.output_index(lattice, i);
+                        if (out < 0) return;  // strategy A: not a BCC point
+                        store_sample(field, out, mesh(), s.distance, s.gradient, s.triangle);
+                    });
+            });
+            run.computed += block.count();
         }
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        field.timings.total = seconds;
-        field.timings.kernel = seconds;
-        field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
-        field.sampler = sampler_provenance("cpu", "brute_force", kernel_name(), options_, lattice, computed, sign_);
-        field.sampler.details["threads"] = resolve_thread_count(options_.threads);
-        record_certificate(field.timings, counters);
-        field.sampler.search_certificate =
-            certificate_provenance(options_.precision == Precision::Float, kernel_ == CpuKernel::Vectorized, counters);
-        if (options_.band_width > 0)  // brute force tests every pair anyway: the band by post-processing
-            field.sampler.band =
-                narrow_band_provenance(options_.band_width, apply_narrow_band(field, options_.band_width), "post-processed");
+        run.details["threads"] = resolve_thread_count(options_.threads);
+        run.certified = kernel_ == CpuKernel::Vectorized;
+        run.band_applied = false;  // brute force tests every pair anyway: the band by post-processing
         return field;
     }
 
-    SamplerOptions options_;
-    CpuKernel kernel_ = CpuKernel::Vectorized;
-    SamplerSign sign_;
+    CpuKernel kernel_;
 };
 
 }  // namespace
 
 std::unique_ptr<Sampler> make_cpu_brute_force_sampler(const SamplerOptions& options) {
-    return std::make_unique<CpuBruteForceSampler>(options);
+    auto sampler = std::make_unique<BackendFactory<BoundCpuBruteForce, CpuKernel>>(options, "cpu", "brute_force",
+                                                                                   kCpuBruteForceKernels, "CPU brute-force");
+    active_cpu_kernels();  // a bad SDF_CPU_ISA is reported here, before any work
+    return sampler;
 }
 
 }  // namespace sdf

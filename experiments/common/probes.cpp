@@ -130,7 +130,8 @@ double angle_degrees(const Vec3d& exact_gradient, const Vec3d& got) {
 }  // namespace
 
 ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
-                     Sampler& sampler, const SamplerOptions& o, const ContentCache* cache, std::string* log_line) {
+                     const std::function<const BoundSampler&()>& sampler, const SamplerOptions& o, const ContentCache* cache,
+                     std::string* log_line) {
     const nlohmann::json key = cache_key(mesh, box, band_width, spec, o);
     if (cache)
         if (const auto dir = cache->find("probes", key)) {
@@ -141,15 +142,16 @@ ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, dou
     s.band_width = band_width;
     s.points = place_probes(mesh, box, band_width, spec);
     s.domain_count = spec.domain_probes;
-    const std::vector<PointSample> exact_samples = sampler.query(mesh, s.points);
+    const BoundSampler& bound = sampler();
+    const std::vector<PointSample> exact_samples = bound.query(s.points);
     for (const PointSample& q : exact_samples) {
         s.distance.push_back(q.distance);
         s.gradient.push_back(q.gradient);
     }
-    if (log_line) *log_line = "probes: exact distances computed with " + sampler.name();
+    if (log_line) *log_line = "probes: exact distances computed with " + bound.name();
     if (cache) {
         const std::vector<double> raw = pack(s);
-        const nlohmann::json info = {{"count", s.points.size()}, {"domain_count", s.domain_count}, {"sampler", sampler.name()}};
+        const nlohmann::json info = {{"count", s.points.size()}, {"domain_count", s.domain_count}, {"sampler", bound.name()}};
         cache->store("probes", key, info, [&](const std::string& dir) {
             write_file_atomically(dir + "/probes.f64", raw.data(), raw.size() * sizeof(double));
         });

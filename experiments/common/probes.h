@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,12 +44,12 @@ struct ProbeSet {
     bool in_band(size_t i) const { return std::abs(distance[i]) <= band_width; }
 };
 
-/// Places the probes in `box` and computes their exact distances with `sampler` (or takes
-/// the whole set from `cache` when it holds it; a null cache is not used). `log_line`
-/// receives one line saying which.
+/// Places the probes in `box` and computes their exact distances with the sampler bound to
+/// the mesh that `sampler()` gives, called only then (or takes the whole set from `cache`
+/// when it holds it; a null cache is not used). `log_line` receives one line saying which.
 ProbeSet make_probes(const PreparedMesh& mesh, const DomainBox<double>& box, double band_width, const ProbeSpec& spec,
-                     Sampler& sampler, const SamplerOptions& sampler_options, const ContentCache* cache,
-                     std::string* log_line);
+                     const std::function<const BoundSampler&()>& sampler, const SamplerOptions& sampler_options,
+                     const ContentCache* cache, std::string* log_line);
 
 /// Error figures of reconstructed samples against the exact values at the probes:
 ///   domain: rms, max_abs, mean_abs over the domain probes;

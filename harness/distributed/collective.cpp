@@ -76,7 +76,9 @@ void broadcast_field(SampledField& field) {
     throw std::runtime_error(outcome.at("error").get<std::string>());
 }
 
-SampledField collective_root(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+SampledField collective_root(const std::shared_ptr<const PreparedMesh>& shared_mesh,
+                             const std::function<SamplingRequest()>& setup) {
+    const PreparedMesh& mesh = *shared_mesh;
     Session& s = session();
     s.held.valid = false;
     const std::string host = s.self["host"].get<std::string>();
@@ -114,8 +116,8 @@ SampledField collective_root(const PreparedMesh& mesh, const std::function<Sampl
     } else {
         gathered = sample_and_gather(
             [&](const LatticeSlab& slab) {
-                const std::unique_ptr<Sampler> sampler = make_sampler(options_for_this_rank(mine.options));
-                return sample_part(*sampler, mesh, mine.lattice, slab);
+                const std::unique_ptr<BoundSampler> sampler = make_sampler(options_for_this_rank(mine.options))->bind(shared_mesh);
+                return sample_part(*sampler, mine.lattice, slab);
             },
             mine.lattice, plan, field);
     }
@@ -143,7 +145,9 @@ SampledField collective_root(const PreparedMesh& mesh, const std::function<Sampl
     return field;
 }
 
-SampledField collective_worker(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+SampledField collective_worker(const std::shared_ptr<const PreparedMesh>& shared_mesh,
+                               const std::function<SamplingRequest()>& setup) {
+    const PreparedMesh& mesh = *shared_mesh;
     const Session& s = session();
     const std::string host = s.self["host"].get<std::string>();
     nlohmann::json status = {{"ok", true}, {"rank", s.rank}, {"host", host}};
@@ -171,10 +175,10 @@ SampledField collective_worker(const PreparedMesh& mesh, const std::function<Sam
                 require_same_keys("sampler", sampler_options_to_json(mine.options), options);
                 if (slabs.size() != size_t(s.size)) throw std::runtime_error("the request holds no slab for this rank");
                 slab = slabs[size_t(s.rank)];
-                const std::unique_ptr<Sampler> sampler = make_sampler(options_for_this_rank(mine.options));
+                const std::unique_ptr<BoundSampler> sampler = make_sampler(options_for_this_rank(mine.options))->bind(shared_mesh);
                 const auto t0 = std::chrono::steady_clock::now();
                 maybe_inject_failure(s.rank);
-                part = sample_part(*sampler, mesh, mine.lattice, slab);
+                part = sample_part(*sampler, mine.lattice, slab);
                 const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 status["part"] = describe_part(part, s.rank, host, slab, seconds);
                 status["sampler"] = part.sampler;
@@ -240,10 +244,10 @@ void finish_collective_distribution() {
     if (!finalized) MPI_Finalize();
 }
 
-SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+SampledField sample_collectively(const std::shared_ptr<const PreparedMesh>& mesh, const std::function<SamplingRequest()>& setup) {
     if (!distributed_active() || !session().collective) {
         const SamplingRequest request = setup();
-        return make_sampler(request.options)->sample(mesh, request.lattice);
+        return sample_once(*make_sampler(request.options), mesh, request.lattice);
     }
     // One exchange at a time (MPI_THREAD_SERIALIZED; the messages of two would interleave).
     static std::mutex one_at_a_time;

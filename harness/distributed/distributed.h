@@ -68,8 +68,9 @@ void require_same_settings_on_every_rank(const nlohmann::json& settings);
 /// Returns the process exit code.
 int serve_distributed_requests();
 
-/// The root's sampler for fields: splits every lattice over the ranks. Its query() runs on
-/// the root alone. Without a distributed run: make_sampler(options).
+/// The root's sampler for fields: bound to a mesh, it splits every lattice over the ranks
+/// (the workers prepare the mesh the root shared with them, share_mesh_with_workers); its
+/// query() runs on the root alone. Without a distributed run: make_sampler(options).
 std::unique_ptr<Sampler> make_field_sampler(const SamplerOptions& options);
 
 /// Keeps the mesh as loaded (before preparation) for the workers, who prepare it the same
@@ -132,13 +133,13 @@ struct SamplingRequest {
 /// prepared counts) and the same request, which `setup` builds on each rank (an exception
 /// there is that rank's failure). Rank 0 plans the slabs (plan_slabs), every rank samples its
 /// own, rank 0 gathers them and broadcasts the whole field: every rank returns the same
-/// field, bit for bit the one make_sampler(options)->sample(mesh, lattice) gives, with
+/// field, bit for bit the one make_sampler(options)->bind(mesh)->sample(lattice) gives, with
 /// sampler.distributed recording the slabs, hosts and per-rank seconds. A failure on any rank
 /// (setup, sampling, arguments that differ from rank 0's) makes every rank throw: the
 /// failing ranks' own exception where every rank failed in setup with the same message
 /// (a bad argument: its type is kept), else std::runtime_error naming each failed rank and
-/// its host. Without a distributed run: setup(), then make_sampler(options)->sample().
-SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup);
+/// its host. Without a distributed run: setup(), then sample_once(*make_sampler(options), ...).
+SampledField sample_collectively(const std::shared_ptr<const PreparedMesh>& mesh, const std::function<SamplingRequest()>& setup);
 
 /// This process for the Python module's distributed(): mpi (the build has it), started_by
 /// (see start_collective_distribution), rank, size, host, local rank and size, threads,

@@ -27,9 +27,9 @@ void fail_here_if_asked() {}
 std::string start_collective_distribution() { return ""; }
 void finish_collective_distribution() {}
 void abort_distributed(int) {}
-SampledField sample_collectively(const PreparedMesh& mesh, const std::function<SamplingRequest()>& setup) {
+SampledField sample_collectively(const std::shared_ptr<const PreparedMesh>& mesh, const std::function<SamplingRequest()>& setup) {
     const SamplingRequest request = setup();
-    return make_sampler(request.options)->sample(mesh, request.lattice);
+    return sample_once(*make_sampler(request.options), mesh, request.lattice);
 }
 nlohmann::json distributed_info() {
     char host[256] = {};

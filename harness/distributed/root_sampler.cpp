@@ -19,21 +19,23 @@ namespace sdf {
 namespace mpi {
 namespace {
 
-class DistributedSampler final : public Sampler {
+/// The root's sampler bound to a mesh: whole lattices are cut into slabs over the ranks,
+/// anything else (a slab, points) is sampled by this rank's own bound sampler.
+class BoundDistributedSampler final : public BoundSampler {
 public:
-    explicit DistributedSampler(const SamplerOptions& options)
-        : options_(options), local_(make_sampler(options_for_this_rank(options))) {}
+    BoundDistributedSampler(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, const Sampler& local)
+        : BoundSampler(mesh), options_(options), local_(local.bind(std::move(mesh))) {}
 
-    std::string name() const override {
-        return local_->name() + " on " + std::to_string(session().size) + " MPI ranks";
+    std::string name() const override { return local_->name() + " on " + std::to_string(session().size) + " MPI ranks"; }
+    const SignModeChoice& sign() const override { return local_->sign(); }
+
+    std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings) const override {
+        return local_->query(points, timings);
     }
 
-    std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d>& points) override {
-        return local_->query(mesh, points);
-    }
-
-    SampledField sample_slab(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) override {
-        if (!is_whole_lattice(lattice, slab)) return local_->sample_slab(mesh, lattice, slab);
+    SampledField sample_slab(const Lattice& lattice, const LatticeSlab& slab) const override {
+        if (!is_whole_lattice(lattice, slab)) return local_->sample_slab(lattice, slab);
+        const PreparedMesh& mesh = this->mesh();
         Session& s = session();
         s.held.valid = false;  // the workers drop the last field's slabs on this request
         const auto start = std::chrono::steady_clock::now();
@@ -42,8 +44,8 @@ public:
         const SlabPlan plan = plan_slabs(mesh, lattice, options_, s.size);
         send_requests(mesh, lattice, plan);
         const auto sampling_start = std::chrono::steady_clock::now();
-        const Gathered gathered = sample_and_gather(
-            [&](const LatticeSlab& mine) { return sample_part(*local_, mesh, lattice, mine); }, lattice, plan, field);
+        const Gathered gathered =
+            sample_and_gather([&](const LatticeSlab& mine) { return sample_part(*local_, lattice, mine); }, lattice, plan, field);
         if (!gathered.failures.empty()) throw std::runtime_error(failure_message(lattice_notation(lattice), gathered.failures));
         const auto end = std::chrono::steady_clock::now();
         s.fields.push_back(finish_provenance(field, options_, plan, gathered, std::chrono::duration<double>(end - start).count(),
@@ -53,7 +55,7 @@ public:
     }
 
 private:
-    void send_requests(const PreparedMesh& mesh, const Lattice& lattice, const SlabPlan& plan) {
+    void send_requests(const PreparedMesh& mesh, const Lattice& lattice, const SlabPlan& plan) const {
         Session& s = session();
         ByteWriter out;
         out.put(int32_t(Command::Sample));
@@ -74,6 +76,24 @@ private:
         s.mesh_sent = mesh.content_sha256();
     }
 
+    SamplerOptions options_;
+    std::unique_ptr<BoundSampler> local_;
+};
+
+class DistributedSampler final : public Sampler {
+public:
+    explicit DistributedSampler(const SamplerOptions& options)
+        : options_(options), local_(make_sampler(options_for_this_rank(options))) {}
+
+    std::string name() const override {
+        return local_->name() + " on " + std::to_string(session().size) + " MPI ranks";
+    }
+
+    std::unique_ptr<BoundSampler> bind(std::shared_ptr<const PreparedMesh> mesh) const override {
+        return std::make_unique<BoundDistributedSampler>(std::move(mesh), options_, *local_);
+    }
+
+private:
     SamplerOptions options_;
     std::unique_ptr<Sampler> local_;
 };

@@ -39,13 +39,13 @@ void receive_part(SampledField& field, const Lattice& lattice, const LatticeSlab
 
 }  // namespace
 
-SampledField sample_part(Sampler& sampler, const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab) {
+SampledField sample_part(const BoundSampler& sampler, const Lattice& lattice, const LatticeSlab& slab) {
     if (slab.z_end <= slab.z_begin) {
         SampledField empty;
         empty.lattice = lattice;
         return empty;
     }
-    return sampler.sample_slab(mesh, lattice, slab);
+    return sampler.sample_slab(lattice, slab);
 }
 
 nlohmann::json describe_part(const SampledField& part, int rank, const std::string& host, const LatticeSlab& slab,

@@ -15,8 +15,8 @@
 
 namespace sdf::mpi {
 
-/// Samples `slab` with `sampler` (nothing for an empty slab).
-SampledField sample_part(Sampler& sampler, const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& slab);
+/// Samples `slab` with `sampler`, bound to its mesh (nothing for an empty slab).
+SampledField sample_part(const BoundSampler& sampler, const Lattice& lattice, const LatticeSlab& slab);
 
 /// What a rank reports of its slab (the manifest's distributed.slabs[i]).
 nlohmann::json describe_part(const SampledField& part, int rank, const std::string& host, const LatticeSlab& slab,

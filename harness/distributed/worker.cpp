@@ -5,7 +5,7 @@
 // the root's Write request, when it writes the slab into the field files (parallel_write.h).
 #include <chrono>
 #include <cstring>
-#include <optional>
+#include <memory>
 
 #include "core/mesh/prepared_mesh.h"
 #include "harness/config/sampler_spec.h"
@@ -40,21 +40,24 @@ public:
             const std::vector<LatticeSlab> slabs = in.get_vector<LatticeSlab>();
             const std::string sha = in.get_string();
             if (in.get<uint8_t>() != 0) {
+                bound_.reset();  // the last mesh's sampler and device memory first
                 mesh_.reset();
-                mesh_.emplace(prepare_mesh(get_mesh(in)));  // as the root's load_prepared_mesh()
+                mesh_ = std::make_shared<const PreparedMesh>(prepare_mesh(get_mesh(in)));  // as the root's load_prepared_mesh()
             }
             if (!mesh_ || mesh_->content_sha256() != sha)
                 throw std::runtime_error("has no prepared mesh " + sha.substr(0, 12) + " (protocol error)");
             if (slabs.size() != size_t(s.size)) throw std::runtime_error("the request holds no slab for this rank");
             slab = slabs[size_t(s.rank)];
+            // Bound once per mesh and options: a study's lattices of one mesh reuse its tree and uploads.
             const std::string key = sampler_options_to_json(options).dump();
-            if (!sampler_ || key != sampler_key_) {
-                sampler_ = make_sampler(options);
+            if (!bound_ || key != sampler_key_) {
+                bound_.reset();
+                bound_ = make_sampler(options)->bind(mesh_);
                 sampler_key_ = key;
             }
             const auto start = std::chrono::steady_clock::now();
             maybe_inject_failure(s.rank);
-            part = sample_part(*sampler_, *mesh_, lattice, slab);
+            part = sample_part(*bound_, lattice, slab);
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             status["part"] = describe_part(part, s.rank, s.self["host"].get<std::string>(), slab, seconds);
             status["sampler"] = part.sampler;
@@ -111,8 +114,8 @@ private:
     LatticeSlab slab_;
     Lattice lattice_;
     bool holds_part_ = false;
-    std::optional<PreparedMesh> mesh_;
-    std::unique_ptr<Sampler> sampler_;
+    std::shared_ptr<const PreparedMesh> mesh_;
+    std::unique_ptr<BoundSampler> bound_;  ///< bound to mesh_ with the options of sampler_key_
     std::string sampler_key_;
 };
 

@@ -18,21 +18,15 @@ MeshSdf::MeshSdf(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions&
     if (!mesh_) throw std::invalid_argument("MeshSdf: no mesh");
     const auto start = std::chrono::steady_clock::now();
     if (unsigned_distance_) options_.sign = SignMode::Pseudonormal;  // magnitudes are every mode's
-    sampler_ = make_sampler(options_);
-    sampler_name_ = sampler_->name();
+    bound_ = make_sampler(options_)->bind(mesh_);  // the BVH, winding data and device upload
+    sampler_name_ = bound_->name();
     if (unsigned_distance_) {
         sign_mode_ = "none";
         sign_reason_ = "unsigned distance requested";
     } else {
-        const SignModeChoice choice = choose_sign_mode(mesh_->report(), options_.sign);  // as SamplerSign::prepare
-        sign_mode_ = sign_mode_name(choice.mode);
-        sign_reason_ = choice.reason;
+        sign_mode_ = sign_mode_name(bound_->sign().mode);
+        sign_reason_ = bound_->sign().reason;
     }
-    // One query builds everything a query of this mesh needs: the mesh's BVH (unless its
-    // preparation or another sampler built it), the sampler's winding data and device
-    // upload; an empty one would not reach the GPU's upload.
-    const Bounds3& b = mesh_->bounds();
-    sampler_->query(*mesh_, {(b.min + b.max) * 0.5});
     prepared_of_input_.assign(size_t(mesh_->report().input_triangles), -1);
     const std::vector<int>& source = mesh_->source_triangle();
     for (size_t t = 0; t < source.size(); ++t) prepared_of_input_[size_t(source[t])] = int32_t(t);
@@ -42,30 +36,26 @@ MeshSdf::MeshSdf(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions&
 MeshSdf::~MeshSdf() = default;
 
 std::vector<PointSample> MeshSdf::query(const std::vector<Vec3d>& points) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<PointSample> samples = sampler_->query(*mesh_, points);
+    std::vector<PointSample> samples = bound_->query(points);
     if (unsigned_distance_) make_unsigned(samples);
     return samples;
 }
 
 void MeshSdf::query_device(const DevicePoints& points, const DeviceQueryResults& results) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!sampler_->query_device(*mesh_, points, results))
+    if (!bound_->query_device(points, results))
         throw std::invalid_argument("points on a GPU need an SDF whose backend is cuda; this one's sampler is '" +
                                     sampler_name_ + "'");
 }
 
 void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings) const {
-    std::lock_guard<std::mutex> lock(mutex_);
     const auto start = std::chrono::steady_clock::now();
-    // The sampler's timings of this call; a sampler that keeps none (the CPU's) gets the call's wall time as total.
+    // The sampler's timings of this call; a sampler that measures no total gets the call's wall time.
     auto record = [&] {
-        if (!timings) return;
-        *timings = sampler_->last_query_timings();
-        if (timings->total <= 0) timings->total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (timings && timings->total <= 0)
+            timings->total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     if (!unsigned_distance_) {
-        sampler_->query_host(*mesh_, points, results);
+        bound_->query_host(points, results, timings);
         record();
         return;
     }
@@ -76,7 +66,7 @@ void MeshSdf::query_host(const HostPoints& points, const HostQueryResults& resul
         own_distance.resize(size_t(std::max<int64_t>(points.count, 0)));
         r.distance = own_distance.data();
     }
-    sampler_->query_host(*mesh_, points, r);
+    bound_->query_host(points, r, timings);
     record();
     if (!r.distance) return;
     parallel_for(points.count, int64_t(1) << 16, options_.threads, [&](int64_t b, int64_t e) {
@@ -102,8 +92,7 @@ void MeshSdf::closest_points(const HostPoints& points, const int32_t* triangle, 
 }
 
 SampledField MeshSdf::sample(const Lattice& lattice) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    SampledField field = sampler_->sample(*mesh_, lattice);
+    SampledField field = bound_->sample(lattice);
     if (unsigned_distance_) {
         make_unsigned(field);
         field.sampler.details["sign"] = {{"requested", "none"}, {"mode", "none"}, {"reason", sign_reason_}};

@@ -1,10 +1,10 @@
 /// @file mesh_sdf.h
-/// @brief Build once, query many times: a prepared mesh bound to one sampler. Making the
-/// object builds what every query of the mesh needs, the BVH, the winding data (when the
-/// sign is the winding number's) and on the GPU the device upload, as fcpw's Scene::build()
-/// and NanoVDB's MeshToGrid do; query() and sample() then only search. `sdf-query`
-/// (point_query.h) and the Python module's SDF class both use it, and the numbers are the
-/// sampler's own: bit for bit those of Sampler::query() and Sampler::sample().
+/// @brief Build once, query many times: a prepared mesh bound to one sampler, a thin owner
+/// of the BoundSampler (core/sampling/sampler.h) that Sampler::bind() makes: its
+/// construction is the binding, which builds what every query of the mesh needs (the BVH,
+/// the winding data when the sign is the winding number's, on the GPU the device upload);
+/// query() and sample() then only search. `sdf-query` (point_query.h) and the Python
+/// module's SDF class both use it, and the numbers are the bound sampler's own, bit for bit.
 ///
 /// Beyond the sampler's distance, gradient and closest triangle it gives what users of a
 /// distance query expect: the closest point with its barycentric coordinates on the closest
@@ -51,7 +51,8 @@ public:
     /// Wall time of the construction (BVH, winding data, upload), seconds.
     double build_seconds() const { return build_seconds_; }
 
-    /// Samples arbitrary points, returned in input order. Thread-safe (calls are serialised).
+    /// Samples arbitrary points, returned in input order. Thread-safe (the bound sampler's
+    /// queries are const; the GPU's serialise themselves).
     std::vector<PointSample> query(const std::vector<Vec3d>& points) const;
     /// Samples points in GPU memory, writing the results there in input order
     /// (core/sampling/device_query.h): bit for bit query()'s, with no host copy of either.
@@ -96,11 +97,10 @@ private:
     std::shared_ptr<const PreparedMesh> mesh_;
     SamplerOptions options_;
     bool unsigned_distance_;
-    std::unique_ptr<Sampler> sampler_;
+    std::unique_ptr<BoundSampler> bound_;
     std::string sampler_name_, sign_mode_, sign_reason_;
     double build_seconds_ = 0;
     std::vector<int32_t> prepared_of_input_;  ///< input face -> prepared triangle (-1: dropped)
-    mutable std::mutex mutex_;                ///< the sampler keeps per-call state
     mutable std::mutex winding_mutex_;
     mutable std::shared_ptr<const WindingSign> winding_;
 };

@@ -14,11 +14,9 @@ SamplerOptions point_query_sampler_options(const PointQueryOptions& options) {
     return s;
 }
 
-PointQueryResult query_points(const PreparedMesh& mesh, const std::vector<Vec3d>& points,
+PointQueryResult query_points(std::shared_ptr<const PreparedMesh> mesh, const std::vector<Vec3d>& points,
                               const PointQueryOptions& options) {
-    // The caller owns the mesh for the call: the bound object borrows it.
-    const MeshSdf sdf(std::shared_ptr<const PreparedMesh>(&mesh, [](const PreparedMesh*) {}),
-                      point_query_sampler_options(options));
+    const MeshSdf sdf(std::move(mesh), point_query_sampler_options(options));
     PointQueryResult result;
     result.sampler = sdf.sampler_name();
     result.sign = sdf.sign_mode();

@@ -8,6 +8,7 @@
 /// narrow band) do not apply to points.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,7 +36,7 @@ struct PointQueryResult {
 
 /// Queries every point through a MeshSdf bound for this call (mesh_sdf.h: hold one to
 /// query a mesh many times); throws std::runtime_error when the chosen backend cannot run here.
-PointQueryResult query_points(const PreparedMesh& mesh, const std::vector<Vec3d>& points,
+PointQueryResult query_points(std::shared_ptr<const PreparedMesh> mesh, const std::vector<Vec3d>& points,
                               const PointQueryOptions& options);
 
 }  // namespace sdf

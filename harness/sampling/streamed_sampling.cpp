@@ -239,8 +239,8 @@ StreamPlan plan_streamed_sampling(const Lattice& lattice, const StreamOptions& o
     return plan;
 }
 
-StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
-                             const Lattice& lattice, const StreamOptions& options, const MeshProvenance& mesh_provenance) {
+StreamResult sample_streamed(const BoundSampler& sampler, const SamplerOptions& sampler_options, const Lattice& lattice,
+                             const StreamOptions& options, const MeshProvenance& mesh_provenance) {
     const auto start = Clock::now();
     const double w = sampler_options.band_width;
     require_band_width(w, "band width");
@@ -296,7 +296,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         const auto slab_start = Clock::now();
         std::optional<StoredSlab> stored;
         try {
-            if (stored_layout) stored = sampler.sample_slab_stored(mesh, lattice, slab, *stored_layout);
+            if (stored_layout) stored = sampler.sample_slab_stored(lattice, slab, *stored_layout);
         } catch (const std::bad_alloc&) {
             throw std::runtime_error(slab_out_of_memory(slab));
         }
@@ -329,7 +329,7 @@ StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_opt
         }
         std::shared_ptr<SampledField> field;
         try {
-            field = std::make_shared<SampledField>(sampler.sample_slab(mesh, lattice, slab));
+            field = std::make_shared<SampledField>(sampler.sample_slab(lattice, slab));
         } catch (const std::bad_alloc&) {
             throw std::runtime_error(slab_out_of_memory(slab));
         }

@@ -98,12 +98,12 @@ struct StreamResult {
     int64_t vdb_active_points = 0;  ///< of the .vdb output, when asked for
 };
 
-/// Samples `lattice` slab by slab with `sampler` and writes the field file of
+/// Samples `lattice` slab by slab with `sampler` (bound to its mesh) and writes the field file of
 /// options.header_path. `mesh_provenance` becomes the header's "mesh". With
 /// options.band_width > 0 in the sampler, each slab is banded (apply_narrow_band, which leaves
 /// a sampler's own band alone). Refuses existing targets first unless overwriting, and a band
 /// the output's dtype cannot hold (require_representable_band).
-StreamResult sample_streamed(Sampler& sampler, const SamplerOptions& sampler_options, const PreparedMesh& mesh,
-                             const Lattice& lattice, const StreamOptions& options, const MeshProvenance& mesh_provenance);
+StreamResult sample_streamed(const BoundSampler& sampler, const SamplerOptions& sampler_options, const Lattice& lattice,
+                             const StreamOptions& options, const MeshProvenance& mesh_provenance);
 
 }  // namespace sdf

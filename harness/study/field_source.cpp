@@ -34,7 +34,7 @@ FieldSource::FieldSource(const FieldCache* cache, SamplerOptions options, std::s
 
 FieldSource::~FieldSource() = default;
 
-Sampler& FieldSource::sampler() {
+const BoundSampler& FieldSource::bound(const std::shared_ptr<const PreparedMesh>& mesh) {
     if (!sampler_) {
         try {
             // Split over the ranks of a distributed run, or this process's alone.
@@ -43,7 +43,12 @@ Sampler& FieldSource::sampler() {
             throw std::runtime_error(where_ + ": " + e.what());
         }
     }
-    return *sampler_;
+    // bound_ holds its mesh, so the comparison is of owners, never of a freed mesh's address.
+    if (!bound_ || bound_->shared_mesh() != mesh) {
+        bound_.reset();  // the last mesh's device memory first
+        bound_ = sampler_->bind(mesh);
+    }
+    return *bound_;
 }
 
 std::string FieldSource::status(const PreparedMesh& mesh, const Lattice& lattice) const {
@@ -52,8 +57,9 @@ std::string FieldSource::status(const PreparedMesh& mesh, const Lattice& lattice
     return cache_->contains(key) ? "cached " + ContentCache::key_hash(key).substr(0, 12) : "to sample";
 }
 
-ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice, const std::string& label,
-                               std::ostream& log) {
+ObtainedField FieldSource::get(const std::shared_ptr<const PreparedMesh>& shared_mesh, const Lattice& lattice,
+                               const std::string& label, std::ostream& log) {
+    const PreparedMesh& mesh = *shared_mesh;
     ObtainedField out;
     const nlohmann::json key = field_cache_key(mesh.content_sha256(), lattice, options_);
     out.cache_key = ContentCache::key_hash(key);
@@ -68,9 +74,10 @@ ObtainedField FieldSource::get(const PreparedMesh& mesh, const Lattice& lattice,
             return out;
         }
     }
-    log << "  " << what << ": sampling with " << sampler().name() << " ..." << std::endl;
+    const BoundSampler& sampler = bound(shared_mesh);
+    log << "  " << what << ": sampling with " << sampler.name() << " ..." << std::endl;
     try {
-        out.field = sampler().sample(mesh, lattice);
+        out.field = sampler.sample(lattice);
     } catch (const std::bad_alloc&) {  // a limit the memory plan could not see: name what and how much
         const MemoryNeed need = whole_lattice_sampling_need(lattice, mesh.name());
         throw std::runtime_error(out_of_memory_message(need.what + " for " + label, need.host_bytes));

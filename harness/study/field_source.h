@@ -2,7 +2,8 @@
 /// @brief The one "field from cache or sampler" path of every front end: run-experiment's
 /// studies and sdf-render (with the field cache), sdf-sample (its sampler, for the streamed
 /// slabs) and the Python module's sample() (no cache). A field comes from the field cache
-/// when it holds it, else it is sampled (the sampler is made on first use) and stored in the
+/// when it holds it, else it is sampled (the sampler is made and bound to the mesh on first
+/// use, and kept while the same mesh is asked for) and stored in the
 /// cache at once, so an interrupted run resumes without sampling again; an allocation that
 /// fails while sampling names the mesh, the lattice and the bytes.
 #pragma once
@@ -43,15 +44,18 @@ public:
     /// "cached" or "to sample" (with "--no-cache" when the cache is off), for plans.
     std::string status(const PreparedMesh& mesh, const Lattice& lattice) const;
     /// The field of `mesh` on `lattice`; `label` names it in the log.
-    ObtainedField get(const PreparedMesh& mesh, const Lattice& lattice, const std::string& label, std::ostream& log);
-    /// The sampler (made on first use), e.g. for exact distances at probe points.
-    Sampler& sampler();
+    ObtainedField get(const std::shared_ptr<const PreparedMesh>& mesh, const Lattice& lattice, const std::string& label,
+                      std::ostream& log);
+    /// The sampler bound to `mesh` (made and bound on first use; bound again when another
+    /// mesh is asked for), e.g. for exact distances at probe points or streamed slabs.
+    const BoundSampler& bound(const std::shared_ptr<const PreparedMesh>& mesh);
     const SamplerOptions& options() const { return options_; }
 
 private:
     const FieldCache* cache_;
     SamplerOptions options_;
     std::unique_ptr<Sampler> sampler_;
+    std::unique_ptr<BoundSampler> bound_;  ///< sampler_ bound to the mesh of the last call
     std::string where_;  ///< "<config>: key 'sampler'", for errors of the sampler's making
     SamplerReach reach_;
 };

@@ -441,14 +441,14 @@ Field sample(const py::object& mesh_in, const std::string& lattice, const py::ob
         FieldSource source(nullptr, request.options, "sample()", SamplerReach::ThisProcess);
         std::ostream no_log(nullptr);
         SampledField field = run_task([&] {
-            return source.get(*mesh, request.lattice, "sample() of '" + mesh->name() + "'", no_log).field;
+            return source.get(mesh, request.lattice, "sample() of '" + mesh->name() + "'", no_log).field;
         }, task);
         if (unsigned_distance) make_field_unsigned(field);
         return field_for_mesh(std::move(field), *mesh);
     }
     TaskOptions task;
     task.background = false;  // MPI stays on the thread that started it
-    SampledField field = run_task([&] { return sample_collectively(*mesh, setup); }, task);
+    SampledField field = run_task([&] { return sample_collectively(mesh, setup); }, task);
     if (unsigned_distance) make_field_unsigned(field);
     return field_for_mesh(std::move(field), *mesh);
 }

@@ -92,10 +92,10 @@ void BM_CpuBvh(benchmark::State& state, const std::string& file) {
     o.threads = int(state.range(1));
     o.kernel = kKernels[state.range(2)];
     o.progress = false;
-    auto sampler = make_cpu_bvh_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);  // builds and caches the BVH
+    const auto sampler = make_cpu_bvh_sampler(o)->bind(mesh);  // the mesh's BVH (if not built yet) and sign data
+    SampledField f = sampler->sample(lattice);
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
@@ -116,9 +116,8 @@ void BM_CpuBvhPointQuery(benchmark::State& state, const std::string& file) {
     o.threads = int(state.range(1));
     o.kernel = kKernels[state.range(2)];
     o.progress = false;
-    auto sampler = make_cpu_bvh_sampler(o);
-    sampler->query(*mesh, {points[0]});  // builds and caches the BVH
-    for (auto _ : state) benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
+    const auto sampler = make_cpu_bvh_sampler(o)->bind(mesh);  // the mesh's BVH (if not built yet) and sign data
+    for (auto _ : state) benchmark::DoNotOptimize(sampler->query(points).data());
     state.counters["queries/s"] = benchmark::Counter(double(points.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["points"] = double(points.size());
     state.counters["threads"] = double(resolve_thread_count(o.threads));
@@ -253,10 +252,10 @@ void BM_CudaBvh(benchmark::State& state, const std::string& file) {
     const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
     SamplerOptions o = cuda_bvh_options(kKernels[state.range(1)]);
     o.precision = state.range(2) ? Precision::Double : Precision::Float;
-    auto sampler = make_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);  // warm-up: module load, BVH upload
+    const auto sampler = make_sampler(o)->bind(mesh);  // the BVH upload
+    SampledField f = sampler->sample(lattice);  // warm-up: module load
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
@@ -291,19 +290,19 @@ std::vector<Vec3d> benchmark_points(const PreparedMesh& mesh, int64_t count, boo
 
 /// Arbitrary points (issue 14): uniform in the mesh's box (kind 0) or Gaussian around
 /// surface points, sigma = 1% of the diagonal (kind 1); the device time of the Morton sort,
-/// search and finalize (Sampler::last_query_timings), float search.
+/// search and finalize (BoundSampler::query's timings), float search.
 void BM_CudaBvhPoints(benchmark::State& state, const std::string& file) {
     const auto mesh = load_for_cuda(state, file);
     if (!mesh) return;
     const int64_t n = state.range(0);
     const std::vector<Vec3d> points = benchmark_points(*mesh, n, state.range(1) != 0);
-    auto sampler = make_sampler(cuda_bvh_options(kKernels[state.range(2)]));
-    sampler->query(*mesh, points);  // warm-up: BVH upload
+    const auto sampler = make_sampler(cuda_bvh_options(kKernels[state.range(2)]))->bind(mesh);  // the BVH upload
+    SamplingTimings t;
+    sampler->query(points, &t);  // warm-up: module load
     for (auto _ : state) {
-        benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
-        state.SetIterationTime(sampler->last_query_timings().kernel);
+        benchmark::DoNotOptimize(sampler->query(points, &t).data());
+        state.SetIterationTime(t.kernel);
     }
-    const SamplingTimings& t = sampler->last_query_timings();
     state.counters["points"] = double(n);
     state.counters["queries_per_second"] = t.kernel > 0 ? double(n) / t.kernel : 0.0;
     state.counters["end_to_end_seconds"] = t.total;
@@ -317,10 +316,10 @@ void BM_CudaBvhBand(benchmark::State& state, const std::string& file) {
     const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
     SamplerOptions o = cuda_bvh_options(kKernels[state.range(2)]);
     o.band_width = double(state.range(1)) * lattice.spacing;
-    auto sampler = make_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);
+    const auto sampler = make_sampler(o)->bind(mesh);
+    SampledField f = sampler->sample(lattice);
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
@@ -391,16 +390,17 @@ void BM_CudaBvhFirstQuery(benchmark::State& state, const std::string& file) {
     SamplerOptions o = cuda_bvh_options("warp");
     o.bvh_build = state.range(0) ? BvhBuildSite::Device : BvhBuildSite::Host;
     const std::vector<Vec3d> one = {mesh->bounds().center()};
-    make_sampler(o)->query(*mesh, one);
+    make_sampler(o)->bind(mesh)->query(one);
     SamplingTimings last;
+    double bind_seconds = 0;
     for (auto _ : state) {
-        auto sampler = make_sampler(o);
         const auto start = std::chrono::steady_clock::now();
-        benchmark::DoNotOptimize(sampler->query(*mesh, one).data());
+        const auto sampler = make_sampler(o)->bind(mesh);  // the mesh's upload and the build
+        bind_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        benchmark::DoNotOptimize(sampler->query(one, &last).data());
         state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        last = sampler->last_query_timings();
     }
-    state.counters["upload_and_build_ms"] = 1e3 * last.upload;  // CUDA events: the mesh's upload and the build
+    state.counters["upload_and_build_ms"] = 1e3 * bind_seconds;  // the binding's wall time: the mesh's upload and the build
     state.counters["search_ms"] = 1e3 * last.kernel;
 }
 
@@ -412,10 +412,10 @@ void BM_CudaBvhOnTree(benchmark::State& state, const std::string& file) {
     const Lattice lattice = cubic_lattice(*mesh, int(state.range(0)));
     SamplerOptions o = cuda_bvh_options("warp");
     o.bvh_build = state.range(1) ? BvhBuildSite::Device : BvhBuildSite::Host;
-    auto sampler = make_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);
+    const auto sampler = make_sampler(o)->bind(mesh);
+    SampledField f = sampler->sample(lattice);
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);
@@ -430,14 +430,15 @@ void BM_CudaBvhPointsOnTree(benchmark::State& state, const std::string& file) {
     const std::vector<Vec3d> points = benchmark_points(*mesh, state.range(0), state.range(1) != 0);
     SamplerOptions o = cuda_bvh_options("warp");
     o.bvh_build = state.range(2) ? BvhBuildSite::Device : BvhBuildSite::Host;
-    auto sampler = make_sampler(o);
-    sampler->query(*mesh, points);
+    const auto sampler = make_sampler(o)->bind(mesh);
+    SamplingTimings t;
+    sampler->query(points, &t);
     for (auto _ : state) {
-        benchmark::DoNotOptimize(sampler->query(*mesh, points).data());
-        state.SetIterationTime(sampler->last_query_timings().kernel);
+        benchmark::DoNotOptimize(sampler->query(points, &t).data());
+        state.SetIterationTime(t.kernel);
     }
     state.counters["points"] = double(points.size());
-    state.counters["queries_per_second"] = double(points.size()) / sampler->last_query_timings().kernel;
+    state.counters["queries_per_second"] = double(points.size()) / t.kernel;
 }
 
 /// The tuned CUDA brute force on the same lattices (float), for the BVH's speedup.
@@ -450,10 +451,10 @@ void BM_CudaBrute(benchmark::State& state, const std::string& file) {
     o.backend = "cuda";
     o.method = "brute_force";
     o.progress = false;
-    auto sampler = make_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);  // warm-up
+    const auto sampler = make_sampler(o)->bind(mesh);
+    SampledField f = sampler->sample(lattice);  // warm-up
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     set_counters(state, *mesh, lattice, f);

@@ -10,6 +10,7 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "kernels/distance/signed_distance.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -66,11 +67,11 @@ void BM_CpuSamplerSingleThread(benchmark::State& state) {
     SamplerOptions options;
     options.threads = 1;
     options.progress = false;
-    auto sampler = make_cpu_brute_force_sampler(options);
+    const auto sampler = make_cpu_brute_force_sampler(options)->bind(share(mesh));
     Lattice lattice{LatticeType::CC, {-1.5, -1.5, -1.5}, 3.0 / 15, {16, 16, 16}};
     double pairs = 0;
     for (auto _ : state) {
-        SampledField f = sampler->sample(mesh, lattice);
+        SampledField f = sampler->sample(lattice);
         pairs += f.timings.point_triangle_pairs;
     }
     state.counters["pairs/s"] = benchmark::Counter(pairs, benchmark::Counter::kIsRate);

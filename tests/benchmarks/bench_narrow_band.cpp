@@ -16,6 +16,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "harness/build_config.h"
 #include "harness/sampling/streamed_sampling.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -53,10 +54,10 @@ void BM_CpuBvhBand(benchmark::State& state) {
     const Lattice lattice = cube_lattice(*mesh, int(state.range(0)));
     SamplerOptions o = cpu_bvh_options();
     o.band_width = double(state.range(1)) * lattice.spacing;
-    auto sampler = make_cpu_bvh_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);  // builds and caches the BVH
+    const auto sampler = make_cpu_bvh_sampler(o)->bind(share(mesh));  // the BVH (if not built yet) and sign data
+    SampledField f = sampler->sample(lattice);
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     const double points = double(lattice.num_points());
@@ -76,7 +77,7 @@ void BM_StreamedSampling(benchmark::State& state) {
     if (!mesh) { state.SkipWithError("dragon.obj not found: set SDF_DATA_PATH"); return; }
     const Lattice lattice = cube_lattice(*mesh, int(state.range(0)));
     const SamplerOptions o = cpu_bvh_options();
-    auto sampler = make_cpu_bvh_sampler(o);
+    const auto sampler = make_cpu_bvh_sampler(o)->bind(share(mesh));
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "bench_narrow_band_stream";
     std::filesystem::create_directories(dir);
     StreamOptions s;
@@ -88,7 +89,7 @@ void BM_StreamedSampling(benchmark::State& state) {
     s.progress = false;
     StreamResult result;
     for (auto _ : state) {
-        result = sample_streamed(*sampler, o, *mesh, lattice, s, {});
+        result = sample_streamed(*sampler, o, lattice, s, {});
         state.SetIterationTime(result.seconds);
     }
     std::filesystem::remove_all(dir);

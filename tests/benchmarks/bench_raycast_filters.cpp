@@ -20,6 +20,7 @@
 #include "core/raycast/views.h"
 #include "harness/render/render_backend.h"
 #include "harness/sampling/sampler_table.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -37,7 +38,7 @@ const SampledField& field_for(LatticeType type) {
         o.backend = "cpu";
         o.method = "bvh";
         o.progress = false;
-        return make_sampler(o)->sample(pawn(), fit_lattice(t, resolution, pawn().bounds(), 0.1));
+        return sample_once(*make_sampler(o), share(pawn()), fit_lattice(t, resolution, pawn().bounds(), 0.1));
     };
     static const SampledField cc = sample(LatticeType::CC, {64, 64, 64});
     static const SampledField bcc = sample(LatticeType::BCC, {51, 51, 51});

@@ -24,6 +24,7 @@
 #include "core/parallel/parallel_for.h"
 #include "core/winding/winding_sign.h"
 #include "harness/build_config.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -68,10 +69,10 @@ void BM_UnsignedBvh(benchmark::State& state) {
     o.method = "bvh";
     o.threads = int(state.range(1));
     o.progress = false;
-    auto sampler = make_cpu_bvh_sampler(o);
-    SampledField f = sampler->sample(*mesh, lattice);  // builds the BVH
+    const auto sampler = make_cpu_bvh_sampler(o)->bind(share(mesh));  // the BVH (if not built yet) and sign data
+    SampledField f = sampler->sample(lattice);
     for (auto _ : state) {
-        f = sampler->sample(*mesh, lattice);
+        f = sampler->sample(lattice);
         state.SetIterationTime(f.timings.kernel);
     }
     count(state, lattice.num_points(), o.threads);

@@ -12,6 +12,7 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "harness/distributed/slab_plan.h"
 #include "harness/sampling/sampler_table.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -105,7 +106,7 @@ TEST(LatticeSlab, EverySamplerSamplesASlabAsTheWholeLattice) {
                     o.progress = false;
                     const auto sampler = make_sampler(o);
                     for (const Lattice& lattice : test_lattices(mesh)) {
-                        const SampledField whole = sampler->sample(mesh, lattice);
+                        const SampledField whole = sampler->bind(share(mesh))->sample(lattice);
                         // Cuts at every plane count from one to all, and a balanced plan.
                         std::vector<LatticeSlab> slabs;
                         for (int z = 0; z < lattice.resolution.z; ++z) slabs.push_back({z, std::min(lattice.resolution.z, z + 1 + z % 3)});
@@ -114,7 +115,7 @@ TEST(LatticeSlab, EverySamplerSamplesASlabAsTheWholeLattice) {
                             const std::string what = sampler->name() + " " + precision_name(precision) + " " +
                                                      bcc_strategy_name(strategy) + " " + lattice_notation(lattice) +
                                                      " planes [" + std::to_string(s.z_begin) + ", " + std::to_string(s.z_end) + ")";
-                            expect_same_samples(whole, sampler->sample_slab(mesh, lattice, s), lattice, s, what);
+                            expect_same_samples(whole, sampler->bind(share(mesh))->sample_slab(lattice, s), lattice, s, what);
                         }
                     }
                 }

@@ -17,6 +17,7 @@
 #include "core/winding/winding_sign.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -152,14 +153,14 @@ TEST(CudaBvhBuild, NeedleFansEqualTheDoubleBruteForceOnEitherTree) {
         ref.precision = Precision::Double;
         ref.sign = SignMode::Pseudonormal;
         ref.progress = false;
-        const std::vector<PointSample> want = make_sampler(ref)->query(mesh, fan.points);
+        const std::vector<PointSample> want = make_sampler(ref)->bind(share(mesh))->query(fan.points);
         for (BvhBuildSite site : {BvhBuildSite::Host, BvhBuildSite::Device})
             for (Precision precision : {Precision::Float, Precision::Double})
                 for (const auto& [kernel, id] : cuda::kCudaBvhKernels) {
                     SamplerOptions o = gpu_options(site, precision);
                     o.sign = SignMode::Pseudonormal;
                     o.kernel = kernel;
-                    const std::vector<PointSample> got = make_sampler(o)->query(mesh, fan.points);
+                    const std::vector<PointSample> got = make_sampler(o)->bind(share(mesh))->query(fan.points);
                     const std::string what = std::string(bvh_build_site_name(site)) + " " +
                                              (precision == Precision::Float ? "float " : "double ") + kernel;
                     int64_t bad = 0;
@@ -185,7 +186,7 @@ TEST(CudaBvhBuild, FieldsAndQueriesOnTheDeviceTreeEqualTheHostTree) {
             auto device = make_sampler(gpu_options(BvhBuildSite::Device, precision));
             SideCount n;
             for (const Lattice& lattice : {cc, bcc}) {
-                const SampledField fh = host->sample(mesh, lattice), fd = device->sample(mesh, lattice);
+                const SampledField fh = host->bind(share(mesh))->sample(lattice), fd = device->bind(share(mesh))->sample(lattice);
                 EXPECT_EQ(fh.sampler.details["bvh"]["built_on"], "host") << c.name;
                 EXPECT_EQ(fd.sampler.details["bvh"]["built_on"], "device") << c.name;
                 const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision);
@@ -198,7 +199,7 @@ TEST(CudaBvhBuild, FieldsAndQueriesOnTheDeviceTreeEqualTheHostTree) {
                 }
             }
             const std::vector<Vec3d> pts = query_points(mesh, 4001);
-            const auto qh = host->query(mesh, pts), qd = device->query(mesh, pts);
+            const auto qh = host->bind(share(mesh))->query(pts), qd = device->bind(share(mesh))->query(pts);
             for (size_t i = 0; i < pts.size(); ++i) {
                 compare(qh[i].distance, qh[i].gradient, qh[i].triangle, qd[i].distance, qd[i].gradient, qd[i].triangle,
                         winding, n, c.name + " points " + precision_name(precision), i);
@@ -219,8 +220,8 @@ TEST(CudaBvhBuild, WindingSidesOnTheLegacyDragon) {
     const PreparedMesh mesh = prepare_mesh(load_obj(path));
     const bool winding = choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Winding;
     const Lattice lattice = fit_lattice(LatticeType::CC, {128, 128, 128}, mesh.bounds(), 0.1);
-    const SampledField fh = make_sampler(gpu_options(BvhBuildSite::Host, Precision::Float))->sample(mesh, lattice);
-    const SampledField fd = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->sample(mesh, lattice);
+    const SampledField fh = make_sampler(gpu_options(BvhBuildSite::Host, Precision::Float))->bind(share(mesh))->sample(lattice);
+    const SampledField fd = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->bind(share(mesh))->sample(lattice);
     SideCount n;
     for (int64_t i = 0; i < fh.size(); ++i) {
         const size_t k = size_t(i);
@@ -240,21 +241,21 @@ TEST(CudaBvhBuild, AutoBuildsOnTheDeviceWhereTheFieldCannotChange) {
     const PreparedMesh bowl = test::open_bowl();                   // open: winding
     const Lattice l1 = fit_lattice(LatticeType::CC, {12, 12, 12}, solid.bounds(), 0.1);
     const Lattice l2 = fit_lattice(LatticeType::CC, {12, 12, 12}, bowl.bounds(), 0.1);
-    const SampledField a = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->sample(solid, l1);
+    const SampledField a = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->bind(share(solid))->sample(l1);
     EXPECT_EQ(a.sampler.details["bvh"]["built_on"], "device");
-    const SampledField a2 = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Double))->sample(solid, l1);
+    const SampledField a2 = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Double))->bind(share(solid))->sample(l1);
     EXPECT_EQ(a2.sampler.details["bvh"]["built_on"], "device");  // the double search is tree-independent too
-    const SampledField b = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->sample(bowl, l2);
+    const SampledField b = make_sampler(gpu_options(BvhBuildSite::Auto, Precision::Float))->bind(share(bowl))->sample(l2);
     EXPECT_EQ(b.sampler.details["bvh"]["built_on"], "host");
     EXPECT_TRUE(b.sampler.details["bvh"].contains("device_build_skipped"));
-    const SampledField c = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->sample(bowl, l2);
+    const SampledField c = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->bind(share(bowl))->sample(l2);
     EXPECT_EQ(c.sampler.details["bvh"]["built_on"], "device");
     EXPECT_EQ(c.sampler.details["sign"]["winding"]["moments_built_on"], "device");
-    // A repeated call reuses the device tree.
-    auto sampler = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float));
-    const SampledField first = sampler->sample(solid, l1), second = sampler->sample(solid, l1);
-    EXPECT_TRUE(first.sampler.details["bvh"]["built_by_this_call"].get<bool>());
-    EXPECT_FALSE(second.sampler.details["bvh"]["built_by_this_call"].get<bool>());
+    // The binding builds the device tree; repeated calls search it.
+    const auto bound = make_sampler(gpu_options(BvhBuildSite::Device, Precision::Float))->bind(share(solid));
+    const SampledField first = bound->sample(l1), second = bound->sample(l1);
+    EXPECT_TRUE(first.sampler.details["bvh"]["built_by_bind"].get<bool>());
+    EXPECT_EQ(first.sampler.details["bvh"], second.sampler.details["bvh"]);
     EXPECT_EQ(first.distance, second.distance);
 }
 

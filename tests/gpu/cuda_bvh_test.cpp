@@ -18,6 +18,7 @@
 #include "cuda/bvh_sampler.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -48,11 +49,11 @@ TEST(CudaBvh, EqualsCpuBruteForceOnEveryMeshBothPrecisions) {
             const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds(), 0.1);
             const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds(), 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
-                const SampledField cpu = make_sampler(options("cpu", "brute_force", precision))->sample(m.mesh, lattice);
+                const SampledField cpu = make_sampler(options("cpu", "brute_force", precision))->bind(share(m.mesh))->sample(lattice);
                 for (const auto& [kernel, id] : cuda::kCudaBvhKernels)
                     for (BccStrategy s : {BccStrategy::TwoGrids, BccStrategy::DoubleResolution}) {
                         if (lattice.type == LatticeType::CC && s == BccStrategy::DoubleResolution) continue;
-                        const SampledField gpu = make_sampler(options("cuda", "bvh", precision, kernel, s))->sample(m.mesh, lattice);
+                        const SampledField gpu = make_sampler(options("cuda", "bvh", precision, kernel, s))->bind(share(m.mesh))->sample(lattice);
                         const std::string what = m.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
                                                  " " + kernel + " " + bcc_strategy_name(s);
                         test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
@@ -70,9 +71,9 @@ TEST(CudaBvh, SlabsDoNotChangeTheResult) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
     const Lattice lattice = fit_lattice(LatticeType::BCC, {24, 25, 26}, mesh.bounds(), 0.1);
     SamplerOptions o = options("cuda", "bvh", Precision::Float);
-    const SampledField whole = make_sampler(o)->sample(mesh, lattice);
+    const SampledField whole = make_sampler(o)->bind(share(mesh))->sample(lattice);
     o.max_points_per_piece = 1000;  // a few z-layers per slab
-    const SampledField split = make_sampler(o)->sample(mesh, lattice);
+    const SampledField split = make_sampler(o)->bind(share(mesh))->sample(lattice);
     EXPECT_GT(split.sampler.details.at("plan")["pieces"].get<int>(), 2);
     EXPECT_EQ(whole.distance, split.distance);
     EXPECT_EQ(whole.closest_triangle, split.closest_triangle);
@@ -95,9 +96,9 @@ TEST(CudaBvh, PointQueriesEqualTheCpu) {
             }
         }
         for (Precision precision : {Precision::Float, Precision::Double}) {
-            const auto cpu = make_sampler(options("cpu", "bvh", precision))->query(m.mesh, pts);
+            const auto cpu = make_sampler(options("cpu", "bvh", precision))->bind(share(m.mesh))->query(pts);
             for (const char* kernel : {"warp", "candidates"}) {
-                const auto gpu = make_sampler(options("cuda", "bvh", precision, kernel))->query(m.mesh, pts);
+                const auto gpu = make_sampler(options("cuda", "bvh", precision, kernel))->bind(share(m.mesh))->query(pts);
                 test::FieldComparer cmp(m.mesh, test::epsilon_of(precision), 1e-12, 1e-13, 1e-8);
                 cmp.samples(pts, cpu, gpu, m.name + " points " + precision_name(precision) + " " + kernel);
                 if (HasFatalFailure()) return;
@@ -136,11 +137,11 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
                     for (const auto& [method, kernel] : samplers) {
                         SamplerOptions o = options("cuda", method, precision, kernel);
                         o.sign = sign;
-                        const SampledField full = make_sampler(o)->sample(mesh, lattice);
+                        const SampledField full = make_sampler(o)->bind(share(mesh))->sample(lattice);
                         for (double fraction : {0.02, 0.1}) {
                             const double w = fraction * mesh.bounds().diagonal();
                             o.band_width = w;
-                            const SampledField band = make_sampler(o)->sample(mesh, lattice);
+                            const SampledField band = make_sampler(o)->bind(share(mesh))->sample(lattice);
                             const SampledField expected = banded(full, w);
                             const std::string what = cases[which].name + " " + lattice_notation(lattice) + " " + method + "/" + kernel + " " +
                                                      precision_name(precision) + (sign == SignMode::Winding ? " winding" : "") +
@@ -173,22 +174,22 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
     }
 }
 
-TEST(CudaBvh, RepeatedCallsReuseTheUploadedBvh) {
+TEST(CudaBvh, RepeatedCallsOfABoundSamplerEqualEachOther) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
     const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, mesh.bounds(), 0.1);
-    auto sampler = make_sampler(options("cuda", "bvh", Precision::Float));
-    const SampledField first = sampler->sample(mesh, lattice);
-    const SampledField second = sampler->sample(mesh, lattice);
-    EXPECT_TRUE(first.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
-    EXPECT_FALSE(second.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
+    const auto bound = make_sampler(options("cuda", "bvh", Precision::Float))->bind(share(mesh));  // the upload
+    const SampledField first = bound->sample(lattice);
+    const SampledField second = bound->sample(lattice);
+    EXPECT_EQ(first.sampler.details.at("bvh"), second.sampler.details.at("bvh"));
     EXPECT_EQ(first.distance, second.distance);
+    EXPECT_EQ(first.closest_triangle, second.closest_triangle);
 }
 
-/// The device copies follow the mesh's own tree (PreparedMesh::bvh(), or the device build's,
-/// kept for the mesh's id()): a second sampler of one mesh builds no host tree, and a mesh
-/// made at a freed mesh's address from the same input (same name, hash, triangle count and
-/// bounds), but flipped outward, gets its own tree, upload, winding sign and certifier: its
-/// fields equal a fresh sampler's bit for bit.
+/// A binding's device copies are of its mesh's own tree (PreparedMesh::bvh(), or the device
+/// build's): a second binding of one mesh builds no host tree, and a mesh made at a freed
+/// mesh's address from the same input (same name, hash, triangle count and bounds), but
+/// flipped outward, gets its own tree, upload, winding sign and certifier: its fields equal
+/// a fresh sampler's bit for bit.
 TEST(CudaBvh, AMeshAtAFreedMeshsAddressGetsItsOwnUpload) {
     TriangleMesh inward = make_icosphere(2);
     for (Int3& t : inward.triangles) std::swap(t.y, t.z);
@@ -202,25 +203,24 @@ TEST(CudaBvh, AMeshAtAFreedMeshsAddressGetsItsOwnUpload) {
             SCOPED_TRACE(std::string(method) + " " + sign_mode_name(sign));
             SamplerOptions o = options("cuda", method, Precision::Float);
             o.sign = sign;
-            const SampledField expected = make_sampler(o)->sample(fresh, lattice);
+            const SampledField expected = make_sampler(o)->bind(share(fresh))->sample(lattice);
             auto sampler = make_sampler(o);
             alignas(PreparedMesh) unsigned char storage[sizeof(PreparedMesh)];
             PreparedMesh* first = new (storage) PreparedMesh(prepare_mesh(inward, keep_inward));
-            sampler->sample(*first, lattice);
+            sampler->bind(share(first))->sample(lattice);
             first->~PreparedMesh();
             PreparedMesh* second = new (storage) PreparedMesh(prepare_mesh(inward, flip));
             ASSERT_EQ(static_cast<void*>(second), static_cast<void*>(first));
-            const SampledField got = sampler->sample(*second, lattice);
+            const SampledField got = sampler->bind(share(second))->sample(lattice);
             EXPECT_EQ(got.distance, expected.distance);
             EXPECT_EQ(got.closest_triangle, expected.closest_triangle);
             if (std::string(method) == "bvh") {
-                EXPECT_TRUE(got.sampler.details.at("bvh")["built_by_this_call"].get<bool>());
-                EXPECT_TRUE(got.sampler.details.at("bvh")["uploaded_by_this_call"].get<bool>());
+                EXPECT_TRUE(got.sampler.details.at("bvh")["built_by_bind"].get<bool>());
                 // Another sampler of the same mesh shares its host tree (a tree built on the
                 // device, bvh_build auto with the pseudonormal sign, is each sampler's own).
-                const SampledField other = make_sampler(o)->sample(*second, lattice);
+                const SampledField other = make_sampler(o)->bind(share(second))->sample(lattice);
                 const nlohmann::json& tree = other.sampler.details.at("bvh");
-                EXPECT_EQ(tree.at("built_by_this_call").get<bool>(), tree.value("built_on", "host") == "device");
+                EXPECT_EQ(tree.at("built_by_bind").get<bool>(), tree.value("built_on", "host") == "device");
                 EXPECT_EQ(other.distance, expected.distance);
             }
             second->~PreparedMesh();
@@ -250,7 +250,7 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
         ref.method = "brute_force";
         ref.precision = Precision::Double;
         ref.progress = false;
-        const std::vector<PointSample> want = make_sampler(ref)->query(mesh, c.points);
+        const std::vector<PointSample> want = make_sampler(ref)->bind(share(mesh))->query(c.points);
         for (const auto& [kernel, id] : cuda::kCudaBvhKernels) {
             SamplerOptions o = ref;
             o.backend = "cuda";
@@ -258,22 +258,23 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             o.precision = Precision::Float;
             o.kernel = kernel;
             auto sampler = make_sampler(o);
-            const std::vector<PointSample> got = sampler->query(mesh, c.points);
+            SamplingTimings timings;
+            const std::vector<PointSample> got = sampler->bind(share(mesh))->query(c.points, &timings);
             int64_t bad = 0;
             for (size_t i = 0; i < got.size(); ++i)
                 bad += !(got[i].triangle == want[i].triangle && same(got[i].distance, want[i].distance) &&
                          same(got[i].gradient.x, want[i].gradient.x) && same(got[i].gradient.y, want[i].gradient.y) &&
                          same(got[i].gradient.z, want[i].gradient.z));
             std::printf("%-32s %-10s re-ranked %lld of %lld, full double %lld\n", c.mesh.name.c_str(), kernel,
-                        (long long)sampler->last_query_timings().reranked_points,
-                        (long long)sampler->last_query_timings().certified_points,
-                        (long long)sampler->last_query_timings().full_double_points);
+                        (long long)timings.reranked_points,
+                        (long long)timings.certified_points,
+                        (long long)timings.full_double_points);
             EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
-            EXPECT_EQ(sampler->last_query_timings().certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
+            EXPECT_EQ(timings.certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
             // warp fuses the certificate (kernels/bvh/streamed_certificate.h): no point ever
             // needs the full double search.
             if (id == cuda::BvhGpuKernel::Warp) {
-                EXPECT_EQ(sampler->last_query_timings().full_double_points, 0) << c.mesh.name << " " << kernel;
+                EXPECT_EQ(timings.full_double_points, 0) << c.mesh.name << " " << kernel;
             }
         }
         if (c.mesh.name != "cube" && c.mesh.name != "fan_plate") continue;
@@ -289,14 +290,14 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             lattice.spacing = 2.2 / 22.0;
             lattice.resolution = {23, 23, 5};
         }
-        const SampledField want_field = make_sampler(ref)->sample(mesh, lattice);
+        const SampledField want_field = make_sampler(ref)->bind(share(mesh))->sample(lattice);
         for (const auto& [kernel, id] : cuda::kCudaBvhKernels) {
             SamplerOptions o = ref;
             o.backend = "cuda";
             o.method = "bvh";
             o.precision = Precision::Float;
             o.kernel = kernel;
-            const SampledField got = make_sampler(o)->sample(mesh, lattice);
+            const SampledField got = make_sampler(o)->bind(share(mesh))->sample(lattice);
             ASSERT_EQ(got.distance.size(), want_field.distance.size());
             int64_t bad = 0;
             for (size_t i = 0; i < got.distance.size(); ++i)

@@ -11,6 +11,7 @@
 #include "cuda/device_buffer.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -49,14 +50,14 @@ TEST(CudaDeviceMemory, AnswersAreUnchangedWhenTheDefaultPoolKeepsEverything) {
     o.method = "bvh";
     o.progress = false;
     const std::vector<Vec3d> points = {{0.1, 0.2, 0.3}, {1.5, -0.2, 0.4}, {0.0, 0.0, 0.0}};
-    const std::vector<PointSample> first = make_sampler(o)->query(mesh, points);
+    const std::vector<PointSample> first = make_sampler(o)->bind(share(mesh))->query(points);
     int device = 0;
     cudaMemPool_t pool{};
     ASSERT_EQ(cudaGetDevice(&device), cudaSuccess);
     ASSERT_EQ(cudaDeviceGetDefaultMemPool(&pool, device), cudaSuccess);
     uint64_t keep_all = UINT64_MAX;  // what cuBQL's peer sets
     ASSERT_EQ(cudaMemPoolSetAttribute(pool, cudaMemPoolAttrReleaseThreshold, &keep_all), cudaSuccess);
-    const std::vector<PointSample> second = make_sampler(o)->query(mesh, points);
+    const std::vector<PointSample> second = make_sampler(o)->bind(share(mesh))->query(points);
     ASSERT_EQ(first.size(), second.size());
     for (size_t i = 0; i < first.size(); ++i) {
         EXPECT_EQ(first[i].distance, second[i].distance) << i;

@@ -12,6 +12,7 @@
 
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -78,7 +79,7 @@ TEST(CudaDeviceQuery, EqualsTheHostQueryBitForBit) {
         }
     for (Precision precision : {Precision::Float, Precision::Double}) {
         auto sampler = make_sampler(cuda_options(precision));
-        const std::vector<PointSample> truth = sampler->query(mesh, points), truth_float = sampler->query(mesh, as_float);
+        const std::vector<PointSample> truth = sampler->bind(share(mesh))->query(points), truth_float = sampler->bind(share(mesh))->query(as_float);
         struct Case { const char* what; const void* xyz; bool float32; int64_t row, col; const std::vector<PointSample>* truth; };
         double* d_rows = to_device(rows);
         double* d_columns = to_device(column_major);
@@ -89,7 +90,7 @@ TEST(CudaDeviceQuery, EqualsTheHostQueryBitForBit) {
         for (const Case& c : cases) {
             DeviceOutputs out(n);
             DevicePoints dp{c.xyz, c.float32, int64_t(n), c.row, c.col, 0, nullptr};
-            ASSERT_TRUE(sampler->query_device(mesh, dp, out.results())) << c.what;
+            ASSERT_TRUE(sampler->bind(share(mesh))->query_device(dp, out.results())) << c.what;
             const std::vector<double> d = to_host(out.distance, n), g = to_host(out.gradient, 3 * n);
             const std::vector<int32_t> t = to_host(out.triangle, n);
             for (size_t i = 0; i < n; ++i) {
@@ -104,7 +105,7 @@ TEST(CudaDeviceQuery, EqualsTheHostQueryBitForBit) {
         // Only the distance: the other outputs are skipped.
         DeviceOutputs out(n);
         DeviceQueryResults only_distance{out.distance, nullptr, nullptr};
-        ASSERT_TRUE(sampler->query_device(mesh, DevicePoints{d_rows, false, int64_t(n), 3, 1, 0, nullptr}, only_distance));
+        ASSERT_TRUE(sampler->bind(share(mesh))->query_device(DevicePoints{d_rows, false, int64_t(n), 3, 1, 0, nullptr}, only_distance));
         EXPECT_EQ(to_host(out.distance, n)[17], truth[17].distance);
         cudaFree(d_rows);
         cudaFree(d_columns);
@@ -134,14 +135,14 @@ TEST(CudaDeviceQuery, HostArraysEqualTheHostQueryBitForBit) {
         }
     }
     auto sampler = make_sampler(cuda_options(Precision::Float));
-    const std::vector<PointSample> truth = sampler->query(mesh, points), truth_float = sampler->query(mesh, as_float);
+    const std::vector<PointSample> truth = sampler->bind(share(mesh))->query(points), truth_float = sampler->bind(share(mesh))->query(as_float);
     struct Case { const char* what; HostPoints points; const std::vector<PointSample>* truth; };
     const Case cases[] = {{"float32 rows", HostPoints{rows32.data(), true, int64_t(n), 3, 1}, &truth_float},
                           {"float64 N x 4", HostPoints{padded64.data(), false, int64_t(n), 4, 1}, &truth}};
     for (const Case& c : cases) {
         std::vector<double> d(n), g(3 * n);
         std::vector<int32_t> t(n);
-        sampler->query_host(mesh, c.points, HostQueryResults{d.data(), g.data(), t.data()});
+        sampler->bind(share(mesh))->query_host(c.points, HostQueryResults{d.data(), g.data(), t.data()});
         for (size_t i = 0; i < n; ++i) {
             const PointSample& e = (*c.truth)[i];
             ASSERT_EQ(std::memcmp(&d[i], &e.distance, sizeof(double)), 0) << c.what << " point " << i;
@@ -153,7 +154,7 @@ TEST(CudaDeviceQuery, HostArraysEqualTheHostQueryBitForBit) {
     rows32[3 * 1234 + 2] = std::nanf("");
     std::vector<double> d(n);
     try {
-        sampler->query_host(mesh, HostPoints{rows32.data(), true, int64_t(n), 3, 1}, HostQueryResults{d.data(), nullptr, nullptr});
+        sampler->bind(share(mesh))->query_host(HostPoints{rows32.data(), true, int64_t(n), 3, 1}, HostQueryResults{d.data(), nullptr, nullptr});
         ADD_FAILURE() << "a NaN point was accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("row 1234 is not three finite numbers"), std::string::npos) << e.what();
@@ -169,7 +170,7 @@ TEST(CudaDeviceQuery, RefusesAPointThatIsNotFiniteByItsIndex) {
     DeviceOutputs out(100);
     auto sampler = make_sampler(cuda_options(Precision::Float));
     try {
-        sampler->query_device(mesh, DevicePoints{d, false, 100, 3, 1, 0, nullptr}, out.results());
+        sampler->bind(share(mesh))->query_device(DevicePoints{d, false, 100, 3, 1, 0, nullptr}, out.results());
         ADD_FAILURE() << "a NaN point was accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("query points: row 41 "), std::string::npos) << e.what();

@@ -15,6 +15,7 @@
 #include "harness/config/mesh_spec.h"
 #include "harness/sampling/sampler_table.h"
 #include "kernels/distance/closest_point_on_triangle.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -106,7 +107,7 @@ SampledField sample(const PreparedMesh& mesh, const Lattice& lattice, const std:
     o.bcc_strategy = strategy;
     o.precision = precision;
     o.progress = false;
-    return make_sampler(o)->sample(mesh, lattice);
+    return make_sampler(o)->bind(share(mesh))->sample(lattice);
 }
 
 TEST(CudaSampler, BothKernelsAgreeWithTheCpuReferenceOnEveryMesh) {
@@ -153,7 +154,7 @@ TEST(CudaSampler, SplittingLatticesAndMeshesDoesNotChangeTheResult) {
         o.progress = false;
         o.max_points_per_piece = 1000;       // many pieces (thesis: one 32^3 region per piece)
         o.max_triangles_per_chunk = 700;     // several triangle chunks per piece
-        const SampledField split = make_sampler(o)->sample(mesh, lattice);
+        const SampledField split = make_sampler(o)->bind(share(mesh))->sample(lattice);
         EXPECT_GT(split.sampler.details.at("plan")["pieces"].get<int>(), 1) << kernel;
         EXPECT_GT(split.sampler.details.at("plan")["triangle_chunks"].get<int>(), 1) << kernel;
         EXPECT_EQ(whole.distance, split.distance) << kernel;
@@ -171,11 +172,11 @@ TEST(CudaSampler, PointQueriesMatchTheCpu) {
     o.backend = "cpu";
     o.method = "brute_force";
     o.progress = false;
-    const auto cpu = make_sampler(o)->query(mesh, pts);
+    const auto cpu = make_sampler(o)->bind(share(mesh))->query(pts);
     o.backend = "cuda";
     for (const char* kernel : {"thesis", "tuned"}) {
         o.kernel = kernel;
-        const auto gpu = make_sampler(o)->query(mesh, pts);
+        const auto gpu = make_sampler(o)->bind(share(mesh))->query(pts);
         ASSERT_EQ(gpu.size(), pts.size());
         for (size_t i = 0; i < pts.size(); ++i)
             ASSERT_NEAR(gpu[i].distance, cpu[i].distance, 1e-5 * mesh.bounds().diagonal()) << kernel << " " << i;
@@ -209,7 +210,7 @@ TEST(CudaSampler, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
         ref.method = "brute_force";
         ref.precision = Precision::Double;
         ref.progress = false;
-        const std::vector<PointSample> want = make_sampler(ref)->query(mesh, c.points);
+        const std::vector<PointSample> want = make_sampler(ref)->bind(share(mesh))->query(c.points);
         for (const char* kernel : {"tuned"}) {
             SamplerOptions o = ref;
             o.backend = "cuda";
@@ -217,18 +218,19 @@ TEST(CudaSampler, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
             o.precision = Precision::Float;
             o.kernel = kernel;
             auto sampler = make_sampler(o);
-            const std::vector<PointSample> got = sampler->query(mesh, c.points);
+            SamplingTimings timings;
+            const std::vector<PointSample> got = sampler->bind(share(mesh))->query(c.points, &timings);
             int64_t bad = 0;
             for (size_t i = 0; i < got.size(); ++i)
                 bad += !(got[i].triangle == want[i].triangle && same(got[i].distance, want[i].distance) &&
                          same(got[i].gradient.x, want[i].gradient.x) && same(got[i].gradient.y, want[i].gradient.y) &&
                          same(got[i].gradient.z, want[i].gradient.z));
             std::printf("%-32s %-10s re-ranked %lld of %lld, full double %lld\n", c.mesh.name.c_str(), kernel,
-                        (long long)sampler->last_query_timings().reranked_points,
-                        (long long)sampler->last_query_timings().certified_points,
-                        (long long)sampler->last_query_timings().full_double_points);
+                        (long long)timings.reranked_points,
+                        (long long)timings.certified_points,
+                        (long long)timings.full_double_points);
             EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
-            EXPECT_EQ(sampler->last_query_timings().certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
+            EXPECT_EQ(timings.certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
         }
         if (c.mesh.name != "cube") continue;
         Lattice lattice;  // 40 x 40 x 3 points, the lowest layer 1e-4 above the top face
@@ -236,14 +238,14 @@ TEST(CudaSampler, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
         lattice.origin = {-0.5123, -0.5077, 0.5 + 1e-4};
         lattice.spacing = 1.0 / 37.0;
         lattice.resolution = {40, 40, 3};
-        const SampledField want_field = make_sampler(ref)->sample(mesh, lattice);
+        const SampledField want_field = make_sampler(ref)->bind(share(mesh))->sample(lattice);
         for (const char* kernel : {"tuned"}) {
             SamplerOptions o = ref;
             o.backend = "cuda";
             o.method = "brute_force";
             o.precision = Precision::Float;
             o.kernel = kernel;
-            const SampledField got = make_sampler(o)->sample(mesh, lattice);
+            const SampledField got = make_sampler(o)->bind(share(mesh))->sample(lattice);
             ASSERT_EQ(got.distance.size(), want_field.distance.size());
             int64_t bad = 0;
             for (size_t i = 0; i < got.distance.size(); ++i)

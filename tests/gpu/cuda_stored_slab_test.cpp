@@ -12,6 +12,7 @@
 #include "harness/io/field_file.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -60,8 +61,8 @@ TEST(CudaStoredSlab, EqualsTheWrittenBytesOfSampleSlab) {
                                                      std::to_string(slab.z_begin) + ".." + std::to_string(slab.z_end) +
                                                      (layout.float32 ? " float32" : " float64") + (layout.gradient ? " +g" : "") +
                                                      (layout.closest_triangle ? " +t" : "");
-                            const SampledField field = sampler->sample_slab(mesh, lattice, slab);
-                            const std::optional<StoredSlab> stored = sampler->sample_slab_stored(mesh, lattice, slab, layout);
+                            const SampledField field = sampler->bind(share(mesh))->sample_slab(lattice, slab);
+                            const std::optional<StoredSlab> stored = sampler->bind(share(mesh))->sample_slab_stored(lattice, slab, layout);
                             ASSERT_TRUE(stored.has_value()) << what;
                             ASSERT_EQ(stored->points, field.size()) << what;
                             EXPECT_EQ(stored->info.sampler.details.at("stored_on_device"), true) << what;
@@ -97,10 +98,10 @@ TEST(CudaStoredSlab, AHeldSlabKeepsItsBytesWhileTheNextIsSampled) {
     const Lattice lattice = fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds(), 0.1);
     auto sampler = make_sampler(gpu_options(Precision::Float, BccStrategy::TwoGrids, 0.0));
     const StoredLayout layout;
-    const StoredSlab first = *sampler->sample_slab_stored(mesh, lattice, {0, 10}, layout);
+    const StoredSlab first = *sampler->bind(share(mesh))->sample_slab_stored(lattice, {0, 10}, layout);
     const std::vector<char> copy(first.distance, first.distance + first.points * 4);
-    const StoredSlab second = *sampler->sample_slab_stored(mesh, lattice, {10, 20}, layout);
-    const StoredSlab third = *sampler->sample_slab_stored(mesh, lattice, {5, 15}, layout);
+    const StoredSlab second = *sampler->bind(share(mesh))->sample_slab_stored(lattice, {10, 20}, layout);
+    const StoredSlab third = *sampler->bind(share(mesh))->sample_slab_stored(lattice, {5, 15}, layout);
     EXPECT_NE(first.distance, second.distance);  // first is still held: another buffer
     EXPECT_NE(first.distance, third.distance);
     EXPECT_EQ(std::memcmp(first.distance, copy.data(), copy.size()), 0);

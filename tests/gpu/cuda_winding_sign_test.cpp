@@ -17,6 +17,7 @@
 #include "core/winding/winding_sign.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/sampling/sampler_table.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -66,10 +67,10 @@ SamplerOptions options(const std::string& backend, const std::string& method, co
 TEST(CudaWindingSign, EqualsTheCpuSignWhereTheBoundDecides) {
     for (const NamedMesh& m : meshes()) {
         const Lattice lattice = fit_lattice(LatticeType::BCC, m.resolution, m.mesh.bounds(), 0.1);
-        const SampledField cpu = make_sampler(options("cpu", "bvh", "", SignMode::Auto))->sample(m.mesh, lattice);
+        const SampledField cpu = make_sampler(options("cpu", "bvh", "", SignMode::Auto))->bind(share(m.mesh))->sample(lattice);
         ASSERT_EQ(cpu.sampler.details.at("sign").at("mode"), "winding") << m.name;
         const SampledField pseudonormal =
-            make_sampler(options("cpu", "bvh", "", SignMode::Pseudonormal))->sample(m.mesh, lattice);
+            make_sampler(options("cpu", "bvh", "", SignMode::Pseudonormal))->bind(share(m.mesh))->sample(lattice);
         // The bound at each point, from the CPU's fast evaluation at the samplers' accuracy.
         const WindingSign reference(m.mesh, SamplerSign::winding_options());
         std::vector<signed char> certain_side(size_t(lattice.num_points()), -1);
@@ -90,7 +91,7 @@ TEST(CudaWindingSign, EqualsTheCpuSignWhereTheBoundDecides) {
         const std::pair<const char*, const char*> gpu_samplers[] = {
             {"brute_force", "tuned"}, {"brute_force", "thesis"}, {"bvh", "warp"}, {"bvh", "brick"}};
         for (const auto& [method, kernel] : gpu_samplers) {
-            const SampledField gpu = make_sampler(options("cuda", method, kernel, SignMode::Auto))->sample(m.mesh, lattice);
+            const SampledField gpu = make_sampler(options("cuda", method, kernel, SignMode::Auto))->bind(share(m.mesh))->sample(lattice);
             const std::string what = m.name + " cuda/" + method + "/" + kernel;
             EXPECT_EQ(gpu.sampler.details.at("sign").at("mode"), "winding") << what;
             int64_t checked = 0, undecided_differ = 0;
@@ -120,9 +121,9 @@ TEST(CudaWindingSign, QueriedPointsEqualTheCpu) {
     for (int i = 0; i <= 80; ++i)
         for (int j = 0; j <= 8; ++j) points.push_back({-1.3 + 2.6 * i / 80.0, -0.4 + 0.8 * j / 8.0, 0.05});
     const WindingSign reference(mesh, SamplerSign::winding_options());
-    const auto cpu = make_sampler(options("cpu", "brute_force", "", SignMode::Winding))->query(mesh, points);
+    const auto cpu = make_sampler(options("cpu", "brute_force", "", SignMode::Winding))->bind(share(mesh))->query(points);
     for (const char* method : {"brute_force", "bvh"}) {
-        const auto gpu = make_sampler(options("cuda", method, "", SignMode::Winding))->query(mesh, points);
+        const auto gpu = make_sampler(options("cuda", method, "", SignMode::Winding))->bind(share(mesh))->query(points);
         for (size_t i = 0; i < points.size(); ++i) {
             const WindingEstimate<double> e = reference.estimate(points[i]);
             if (!(std::abs(e.value - 0.5) > e.error_bound) || gpu[i].distance == 0) continue;

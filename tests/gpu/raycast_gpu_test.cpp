@@ -18,6 +18,7 @@
 #include "core/raycast/image_metrics.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "harness/render/render_backend.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -38,8 +39,8 @@ const std::vector<FieldCase>& fields() {
         SamplerOptions so;
         so.progress = false;
         auto sampler = make_cpu_brute_force_sampler(so);
-        c.push_back({"pawn", sampler->sample(pawn, fit_lattice(LatticeType::CC, {40, 40, 40}, pawn.bounds(), 0.1)),
-                     sampler->sample(pawn, fit_lattice(LatticeType::BCC, {32, 32, 32}, pawn.bounds(), 0.1)), pawn.bounds()});
+        c.push_back({"pawn", sampler->bind(share(pawn))->sample(fit_lattice(LatticeType::CC, {40, 40, 40}, pawn.bounds(), 0.1)),
+                     sampler->bind(share(pawn))->sample(fit_lattice(LatticeType::BCC, {32, 32, 32}, pawn.bounds(), 0.1)), pawn.bounds()});
         return c;
     }();
     return cases;

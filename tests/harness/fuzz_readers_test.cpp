@@ -37,6 +37,7 @@
 #include "harness/runner/runner.h"
 #include "harness_test_util.h"
 #include "tests/core/mesh/mesh_file_writers.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -451,11 +452,11 @@ TEST(FuzzSearch, CertifiedFloatSearchOnAdversarialCases) {
         o.method = "brute_force";
         o.precision = Precision::Double;
         o.progress = false;
-        const std::vector<PointSample> want = make_sampler(o)->query(mesh, c.points);
+        const std::vector<PointSample> want = make_sampler(o)->bind(share(mesh))->query(c.points);
         o.precision = Precision::Float;
         for (const char* method : {"brute_force", "bvh"}) {
             o.method = method;
-            const std::vector<PointSample> got = make_sampler(o)->query(mesh, c.points);
+            const std::vector<PointSample> got = make_sampler(o)->bind(share(mesh))->query(c.points);
             for (size_t i = 0; i < got.size(); ++i)
                 ASSERT_TRUE(got[i].triangle == want[i].triangle && got[i].distance == want[i].distance &&
                             std::signbit(got[i].distance) == std::signbit(want[i].distance))

@@ -17,6 +17,7 @@
 #include "core/parallel/task_monitor.h"
 #include "harness/sampling/mesh_sdf.h"
 #include "harness/sampling/sampler_table.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -50,7 +51,7 @@ TEST(MeshSdf, QueriesEqualTheSamplersBitForBitCallAfterCall) {
     for (const std::string method : {"bvh", "brute_force"})
         for (SignMode sign : {SignMode::Auto, SignMode::Pseudonormal, SignMode::Winding}) {
             const MeshSdf bound(torus(), cpu(method, sign));
-            const std::vector<PointSample> ref = make_sampler(cpu(method, sign))->query(*torus(), points);
+            const std::vector<PointSample> ref = make_sampler(cpu(method, sign))->bind(share(torus()))->query(points);
             for (int call = 0; call < 3; ++call) {
                 const std::vector<PointSample> got = bound.query(points);
                 ASSERT_EQ(got.size(), ref.size());
@@ -75,7 +76,7 @@ TEST(MeshSdf, BoundObjectsOfOneMeshShareItsTree) {
     const MeshSdf second(mesh, cpu("bvh", SignMode::Winding));
     const Lattice lattice = fit_lattice(LatticeType::CC, {8, 8, 8}, mesh->bounds(), 0.1);
     const SampledField field = second.sample(lattice);
-    EXPECT_FALSE(field.sampler.details.at("bvh").at("built_by_this_call").get<bool>());
+    EXPECT_FALSE(field.sampler.details.at("bvh").at("built_by_bind").get<bool>());
     EXPECT_EQ(mesh->bvh(), tree);
 }
 
@@ -83,7 +84,7 @@ TEST(MeshSdf, FieldsEqualTheSamplersBitForBit) {
     const Lattice lattice = fit_lattice(LatticeType::BCC, {9, 8, 7}, torus()->bounds(), 0.1);
     const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto));
     const SampledField a = bound.sample(lattice);
-    const SampledField b = make_sampler(cpu("bvh", SignMode::Auto))->sample(*torus(), lattice);
+    const SampledField b = make_sampler(cpu("bvh", SignMode::Auto))->bind(share(torus()))->sample(lattice);
     ASSERT_EQ(a.distance.size(), b.distance.size());
     for (size_t i = 0; i < a.distance.size(); ++i) {
         ASSERT_TRUE(same_bits(a.distance[i], b.distance[i])) << i;

@@ -22,6 +22,7 @@
 #include <openvdb/openvdb.h>
 #endif
 #include "harness/io/volume_formats.h"
+#include "tests/test_util/shared_mesh.h"
 
 #if !defined(SDF_SAMPLE_EXE) || !defined(RUN_EXPERIMENT_EXE)
 #error "SDF_SAMPLE_EXE and RUN_EXPERIMENT_EXE must be defined by CMake"
@@ -46,19 +47,19 @@ SamplerOptions sampler_options(double band) {
     return o;
 }
 
-/// A CPU sampler that also gives its slabs as stored bytes (Sampler::sample_slab_stored), made
-/// by the field writer's own conversion: the streamed writer's bytes path, tested without a GPU.
-class StoringSampler final : public Sampler {
+/// A bound CPU sampler that also gives its slabs as stored bytes (BoundSampler::
+/// sample_slab_stored), made by the field writer's own conversion: the streamed writer's
+/// bytes path, tested without a GPU.
+class StoringSampler final : public BoundSampler {
 public:
-    StoringSampler(std::unique_ptr<Sampler> inner, double band) : inner_(std::move(inner)), band_(band) {}
+    StoringSampler(std::unique_ptr<BoundSampler> inner, double band)
+        : BoundSampler(inner->shared_mesh()), inner_(std::move(inner)), band_(band) {}
     std::string name() const override { return inner_->name(); }
-    SampledField sample_slab(const PreparedMesh& m, const Lattice& l, const LatticeSlab& s) override {
-        return inner_->sample_slab(m, l, s);
-    }
-    std::vector<PointSample> query(const PreparedMesh& m, const std::vector<Vec3d>& p) override { return inner_->query(m, p); }
-    std::optional<StoredSlab> sample_slab_stored(const PreparedMesh& m, const Lattice& l, const LatticeSlab& s,
-                                                 const StoredLayout& layout) override {
-        auto field = std::make_shared<SampledField>(inner_->sample_slab(m, l, s));
+    const SignModeChoice& sign() const override { return inner_->sign(); }
+    SampledField sample_slab(const Lattice& l, const LatticeSlab& s) const override { return inner_->sample_slab(l, s); }
+    std::vector<PointSample> query(const std::vector<Vec3d>& p, SamplingTimings* t) const override { return inner_->query(p, t); }
+    std::optional<StoredSlab> sample_slab_stored(const Lattice& l, const LatticeSlab& s, const StoredLayout& layout) const override {
+        auto field = std::make_shared<SampledField>(inner_->sample_slab(l, s));
         const NarrowBandCounts counts = apply_narrow_band(*field, band_);
         const FieldDtype dtype = layout.float32 ? FieldDtype::Float32 : FieldDtype::Float64;
         auto bytes = std::make_shared<std::vector<std::vector<char>>>();
@@ -80,10 +81,10 @@ public:
         ++stored_slabs;
         return stored;
     }
-    int stored_slabs = 0;
+    mutable int stored_slabs = 0;
 
 private:
-    std::unique_ptr<Sampler> inner_;
+    std::unique_ptr<BoundSampler> inner_;
     double band_;
 };
 
@@ -107,7 +108,7 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
                                                  " band " + std::to_string(band) + (gradient_and_triangle ? " all channels" : " distance only") +
                                                  (stored_slabs ? ", stored slabs" : ", fields");
                         const std::string tag = std::to_string(n++);
-                        SampledField field = make_cpu_bvh_sampler(sampler_options(band))->sample(mesh, lattice);
+                        SampledField field = make_cpu_bvh_sampler(sampler_options(band))->bind(share(mesh))->sample(lattice);
                         FieldWriteOptions write;
                         write.dtype = dtype;
                         write.closest_triangle = gradient_and_triangle != 0;
@@ -125,9 +126,9 @@ TEST(StreamedSampling, ChannelFilesEqualTheInMemoryWriterByteForByte) {
                         stream.memory_budget = stream.fixed_bytes + 2 * 2 * uint64_t(plane) * kStreamBytesPerPoint;
                         stream.progress = false;
                         const SamplerOptions options = sampler_options(band);
-                        std::unique_ptr<Sampler> sampler = make_cpu_bvh_sampler(options);
+                        std::unique_ptr<BoundSampler> sampler = make_cpu_bvh_sampler(options)->bind(share(mesh));
                         if (stored_slabs) sampler = std::make_unique<StoringSampler>(std::move(sampler), band);
-                        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, describe_prepared_mesh(mesh));
+                        const StreamResult r = sample_streamed(*sampler, options, lattice, stream, describe_prepared_mesh(mesh));
                         EXPECT_GE(r.plan.slabs, 4) << what;
                         if (stored_slabs) {
                             EXPECT_EQ(static_cast<StoringSampler&>(*sampler).stored_slabs, r.plan.slabs) << what;
@@ -194,7 +195,7 @@ TEST(StreamedSampling, NarrowBandVdbEqualsTheInMemoryExport) {
     for (const Lattice& lattice : {cc, bcc}) {
         const std::string tag = std::to_string(n++), what = lattice_notation(lattice);
         const double w = 2.0 * lattice.spacing;
-        const SampledField field = make_cpu_bvh_sampler(sampler_options(w))->sample(mesh, lattice);
+        const SampledField field = make_cpu_bvh_sampler(sampler_options(w))->bind(share(mesh))->sample(lattice);
         VolumeWriteOptions v;
         v.vdb_band = 2.0;
         write_field_as(field, dir.at("memory" + tag + ".vdb"), VolumeFormat::Vdb, v);
@@ -207,8 +208,8 @@ TEST(StreamedSampling, NarrowBandVdbEqualsTheInMemoryExport) {
         stream.vdb_path = dir.at("streamed" + tag + ".vdb");
         stream.vdb_band = w;
         const SamplerOptions options = sampler_options(w);
-        auto sampler = make_cpu_bvh_sampler(options);
-        const StreamResult r = sample_streamed(*sampler, options, mesh, lattice, stream, {});
+        const auto sampler = make_cpu_bvh_sampler(options)->bind(share(mesh));
+        const StreamResult r = sample_streamed(*sampler, options, lattice, stream, {});
         EXPECT_GE(r.plan.slabs, 5) << what;
         EXPECT_GT(r.vdb_active_points, 100) << what;
         EXPECT_LE(r.vdb_active_points, count_narrow_band(field).in_band) << what;
@@ -235,8 +236,8 @@ TEST(StreamedSampling, RefusesSmallBudgetsAndExistingOutputs) {
     stream.progress = false;
     dir.write("f.distance.raw", "someone's data");
     const SamplerOptions options = sampler_options(0);
-    auto sampler = make_cpu_bvh_sampler(options);
-    EXPECT_THROW(sample_streamed(*sampler, options, torus(), lattice, stream, {}), std::runtime_error);
+    const auto sampler = make_cpu_bvh_sampler(options)->bind(share(torus()));
+    EXPECT_THROW(sample_streamed(*sampler, options, lattice, stream, {}), std::runtime_error);
     EXPECT_EQ(test::read_text(dir.at("f.distance.raw")), "someone's data");
     EXPECT_FALSE(fs::exists(dir.at("f.json")));
 }

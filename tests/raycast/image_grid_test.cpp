@@ -15,6 +15,7 @@
 #include "harness/render/netpbm.h"
 #include "harness/render/thesis_figure.h"
 #include "tests/test_util/scratch_dir.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -167,8 +168,8 @@ TEST(ThesisFigure, FivePanelsReferenceAndErrorRowsOnASmallPawn) {
     SamplerOptions so;
     so.progress = false;
     auto sampler = make_cpu_brute_force_sampler(so);
-    const SampledField cc = sampler->sample(mesh, fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds(), 0.1));
-    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {16, 16, 16}, mesh.bounds(), 0.1));
+    const SampledField cc = sampler->bind(share(mesh))->sample(fit_lattice(LatticeType::CC, {20, 20, 20}, mesh.bounds(), 0.1));
+    const SampledField bcc = sampler->bind(share(mesh))->sample(fit_lattice(LatticeType::BCC, {16, 16, 16}, mesh.bounds(), 0.1));
     FigureOptions options;
     options.render.progress = false;
     options.mesh.progress = false;
@@ -221,7 +222,7 @@ TEST(ThesisFigure, ConfiguredPanelsOnlyTheBccField) {
     SamplerOptions so;
     so.progress = false;
     auto sampler = make_cpu_brute_force_sampler(so);
-    const SampledField bcc = sampler->sample(mesh, fit_lattice(LatticeType::BCC, {12, 12, 12}, mesh.bounds(), 0.1));
+    const SampledField bcc = sampler->bind(share(mesh))->sample(fit_lattice(LatticeType::BCC, {12, 12, 12}, mesh.bounds(), 0.1));
     FigureOptions options;
     options.render.progress = false;
     options.mesh.progress = false;

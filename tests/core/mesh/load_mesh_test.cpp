@@ -20,6 +20,7 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/core/mesh/mesh_file_writers.h"
 #include "tests/test_util/scratch_dir.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -66,7 +67,7 @@ std::vector<PointSample> distances(const TriangleMesh& mesh) {
     o.precision = Precision::Double;
     o.progress = false;
     o.threads = 1;
-    return make_cpu_brute_force_sampler(o)->query(prepare_mesh(mesh), points);
+    return make_cpu_brute_force_sampler(o)->bind(share(prepare_mesh(mesh)))->query(points);
 }
 
 TEST_P(MeshFormats, ReadBackEqualsTheObjAndGivesIdenticalDistances) {

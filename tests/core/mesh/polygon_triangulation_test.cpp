@@ -32,6 +32,7 @@
 #include "tests/core/mesh/mesh_file_writers.h"
 #include "tests/core/mesh/reference_ear_clipping.h"
 #include "tests/test_util/scratch_dir.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -408,7 +409,7 @@ protected:
         o.precision = Precision::Double;
         o.progress = false;
         o.threads = 1;
-        return make_cpu_brute_force_sampler(o)->query(mesh, points);
+        return make_cpu_brute_force_sampler(o)->bind(share(mesh))->query(points);
     }
 };
 

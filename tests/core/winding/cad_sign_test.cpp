@@ -15,6 +15,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/test_util/cad_models.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -63,8 +64,8 @@ TEST(CadSign, AutoKeepsThePseudonormalSignWithoutAWarning) {
             for (const Vec3d& g : inside_grid) points.push_back(place.apply(g));
             for (const Vec3d& g : outside_grid) points.push_back(place.apply(g));
             std::vector<PointSample> bvh, brute;
-            EXPECT_EQ(captured_cerr([&] { bvh = make_cpu_bvh_sampler(auto_sign())->query(mesh, points); }), "");
-            brute = make_cpu_brute_force_sampler(auto_sign())->query(mesh, points);
+            EXPECT_EQ(captured_cerr([&] { bvh = make_cpu_bvh_sampler(auto_sign())->bind(share(mesh))->query(points); }), "");
+            brute = make_cpu_brute_force_sampler(auto_sign())->bind(share(mesh))->query(points);
             for (size_t i = 0; i < points.size(); ++i) {
                 const bool inside = i < inside_grid.size();
                 ASSERT_EQ(bvh[i].distance < 0, inside) << mesh.source() << " point " << i;

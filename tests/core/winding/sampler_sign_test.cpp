@@ -19,6 +19,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -98,7 +99,7 @@ TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
     const Lattice lattice = fit_lattice(LatticeType::BCC, {20, 12, 24}, mesh.bounds(), 0.15);
     for (const Backend& b : kCpuSamplers) {
         SampledField winding, pseudonormal;
-        const std::string warning = captured_cerr([&] { winding = b.make(options(SignMode::Auto))->sample(mesh, lattice); });
+        const std::string warning = captured_cerr([&] { winding = b.make(options(SignMode::Auto))->bind(share(mesh))->sample(lattice); });
         EXPECT_NE(warning.find("warning: sign auto"), std::string::npos) << b.name << ": " << warning;
         EXPECT_NE(warning.find("3 shells"), std::string::npos) << b.name << ": " << warning;
         EXPECT_NE(warning.find("winding number"), std::string::npos) << b.name << ": " << warning;
@@ -111,7 +112,7 @@ TEST(SamplerSign, AutoPicksWindingOnOverlappingPartsWithAWarning) {
         EXPECT_EQ("warning: " + auto_sign_warning(winding.sampler, mesh) + "\n", warning) << b.name;
 
         const std::string quiet =
-            captured_cerr([&] { pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice); });
+            captured_cerr([&] { pseudonormal = b.make(options(SignMode::Pseudonormal))->bind(share(mesh))->sample(lattice); });
         EXPECT_EQ(quiet.find("warning"), std::string::npos) << b.name << ": " << quiet;
         EXPECT_EQ(pseudonormal.sampler.details.at("sign").at("mode"), "pseudonormal");
         EXPECT_EQ(auto_sign_warning(pseudonormal.sampler, mesh), "");
@@ -145,8 +146,8 @@ TEST(SamplerSign, QueriedPointsTakeTheWindingSignToo) {
         for (int j = 0; j <= 6; ++j) points.push_back({-1.3 + 2.6 * i / 60.0, -0.35 + 0.7 * j / 6.0, 0.05});
     for (const Backend& b : kCpuSamplers) {
         std::vector<PointSample> winding, pseudonormal;
-        captured_cerr([&] { winding = b.make(options(SignMode::Auto))->query(mesh, points); });
-        pseudonormal = b.make(options(SignMode::Pseudonormal))->query(mesh, points);
+        captured_cerr([&] { winding = b.make(options(SignMode::Auto))->bind(share(mesh))->query(points); });
+        pseudonormal = b.make(options(SignMode::Pseudonormal))->bind(share(mesh))->query(points);
         int judged = 0;
         for (size_t i = 0; i < points.size(); ++i) {
             expect_same_up_to_sign(winding[i].distance, winding[i].gradient, winding[i].triangle, pseudonormal[i].distance,
@@ -165,12 +166,12 @@ TEST(SamplerSign, ClosedSingleShellMeshKeepsThePseudonormalSign) {
     const Lattice lattice = fit_lattice(LatticeType::CC, {24, 24, 12}, mesh.bounds(), 0.1);
     for (const Backend& b : kCpuSamplers) {
         SampledField automatic, pseudonormal, winding;
-        const std::string log = captured_cerr([&] { automatic = b.make(options(SignMode::Auto))->sample(mesh, lattice); });
+        const std::string log = captured_cerr([&] { automatic = b.make(options(SignMode::Auto))->bind(share(mesh))->sample(lattice); });
         EXPECT_EQ(log.find("warning"), std::string::npos) << b.name << ": " << log;
         EXPECT_EQ(automatic.sampler.details.at("sign").at("mode"), "pseudonormal") << b.name;
         EXPECT_FALSE(automatic.sampler.details.at("sign").contains("winding")) << b.name;
-        pseudonormal = b.make(options(SignMode::Pseudonormal))->sample(mesh, lattice);
-        winding = b.make(options(SignMode::Winding))->sample(mesh, lattice);
+        pseudonormal = b.make(options(SignMode::Pseudonormal))->bind(share(mesh))->sample(lattice);
+        winding = b.make(options(SignMode::Winding))->bind(share(mesh))->sample(lattice);
         EXPECT_EQ(winding.sampler.details.at("sign").at("reason"), "winding requested") << b.name;
         int judged = 0;
         for (int64_t i = 0; i < lattice.num_points(); ++i) {

@@ -20,6 +20,7 @@
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/with_sign.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -121,7 +122,7 @@ TEST(WindingNumber, OverlappingPartsCountTheirDepthAndSignTheUnion) {
     o.progress = false;
     o.sign = SignMode::Pseudonormal;  // auto would pick the winding sign here
     const std::vector<Vec3d> points = random_points(3000, {-1.5, -0.8, -0.8}, {1.5, 0.8, 0.8}, 5);
-    const std::vector<PointSample> pseudonormal = make_cpu_brute_force_sampler(o)->query(mesh, points);
+    const std::vector<PointSample> pseudonormal = make_cpu_brute_force_sampler(o)->bind(share(mesh))->query(points);
     int tested = 0, pseudonormal_wrong = 0;
     for (size_t i = 0; i < points.size(); ++i) {
         const Vec3d& p = points[i];
@@ -220,7 +221,7 @@ TEST(WindingSign, ClosedMeshesAgreeWithThePseudonormalSignOffExactTies) {
         o.precision = Precision::Double;
         o.progress = false;
         o.sign = SignMode::Pseudonormal;
-        const std::vector<PointSample> s = make_cpu_brute_force_sampler(o)->query(mesh, points);
+        const std::vector<PointSample> s = make_cpu_brute_force_sampler(o)->bind(share(mesh))->query(points);
         for (size_t i = 0; i < points.size(); ++i) {
             if (std::abs(s[i].distance) < 1e-12) continue;
             ASSERT_EQ(sign.inside(points[i]), s[i].distance < 0) << shape.name << " point " << i;

@@ -11,6 +11,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -50,8 +51,8 @@ TEST(CpuBvh, EqualsBruteForceOnLatticesOfEveryMesh) {
             const Lattice cc = fit_lattice(LatticeType::CC, {r, r + 1, r + 2}, m.mesh.bounds(), 0.1);
             const Lattice bcc = fit_lattice(LatticeType::BCC, {r - 3, r - 2, r - 1}, m.mesh.bounds(), 0.1);
             for (const Lattice& lattice : {cc, bcc}) {
-                const SampledField brute = make_cpu_brute_force_sampler(options(precision))->sample(m.mesh, lattice);
-                const SampledField bvh = make_cpu_bvh_sampler(options(precision))->sample(m.mesh, lattice);
+                const SampledField brute = make_cpu_brute_force_sampler(options(precision))->bind(share(m.mesh))->sample(lattice);
+                const SampledField bvh = make_cpu_bvh_sampler(options(precision))->bind(share(m.mesh))->sample(lattice);
                 test::FieldComparer cmp(m.mesh, test::epsilon_of(precision));
                 const std::string what = m.name + " " + lattice_notation(lattice) + " " + precision_name(precision);
                 cmp.fields(brute, bvh, what);
@@ -69,9 +70,9 @@ TEST(CpuBvh, EqualsBruteForceOnRandomPoints) {
         const auto pts = random_points_around(m.mesh, big ? 1500 : 5000, 17);
         for (Precision precision : {Precision::Float, Precision::Double}) {
             if (big && precision == Precision::Double) continue;  // covered on lattices above
-            const auto brute = make_cpu_brute_force_sampler(options(precision))->query(m.mesh, pts);
+            const auto brute = make_cpu_brute_force_sampler(options(precision))->bind(share(m.mesh))->query(pts);
             for (const char* kernel : {"brick", "seeded", "unseeded"}) {
-                const auto bvh = make_cpu_bvh_sampler(options(precision, kernel))->query(m.mesh, pts);
+                const auto bvh = make_cpu_bvh_sampler(options(precision, kernel))->bind(share(m.mesh))->query(pts);
                 test::FieldComparer cmp(m.mesh, test::epsilon_of(precision));
                 const std::string what = m.name + " random " + precision_name(precision) + " " + kernel;
                 cmp.samples(pts, brute, bvh, what);
@@ -126,12 +127,12 @@ TEST(CpuBvh, MortonPacketQueryEqualsPerPointQueryBitForBit) {
             const auto pts = set == 0 ? random_points_around(mesh, 3001, 5) : gaussian_points_near_surface(mesh, 3001, 0.01 * diag, 6);
             const std::string what = meshes[which].name + (set == 0 ? " uniform" : " gaussian");
             for (Precision precision : {Precision::Float, Precision::Double}) {
-                const auto seeded = make_cpu_bvh_sampler(options(precision, "seeded", 1))->query(mesh, pts);
-                const auto packets = make_cpu_bvh_sampler(options(precision, "brick", 2))->query(mesh, pts);
+                const auto seeded = make_cpu_bvh_sampler(options(precision, "seeded", 1))->bind(share(mesh))->query(pts);
+                const auto packets = make_cpu_bvh_sampler(options(precision, "brick", 2))->bind(share(mesh))->query(pts);
                 expect_identical(seeded, packets, what + " " + precision_name(precision));
-                const auto one_thread = make_cpu_bvh_sampler(options(precision, "brick", 1))->query(mesh, pts);
+                const auto one_thread = make_cpu_bvh_sampler(options(precision, "brick", 1))->bind(share(mesh))->query(pts);
                 expect_identical(one_thread, packets, what + " 1 vs 2 threads");
-                const auto brute = make_cpu_brute_force_sampler(options(precision))->query(mesh, pts);
+                const auto brute = make_cpu_brute_force_sampler(options(precision))->bind(share(mesh))->query(pts);
                 test::FieldComparer cmp(mesh, test::epsilon_of(precision));
                 cmp.samples(pts, brute, packets, what + " packets vs brute force");
                 if (HasFatalFailure()) return;
@@ -143,10 +144,10 @@ TEST(CpuBvh, MortonPacketQueryEqualsPerPointQueryBitForBit) {
 TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
     const Lattice lattice = fit_lattice(LatticeType::BCC, {17, 18, 19}, mesh.bounds(), 0.1);
-    const SampledField two = make_cpu_bvh_sampler(options(Precision::Float, "", 1))->sample(mesh, lattice);
-    const SampledField two_threads = make_cpu_bvh_sampler(options(Precision::Float, "", 2))->sample(mesh, lattice);
+    const SampledField two = make_cpu_bvh_sampler(options(Precision::Float, "", 1))->bind(share(mesh))->sample(lattice);
+    const SampledField two_threads = make_cpu_bvh_sampler(options(Precision::Float, "", 2))->bind(share(mesh))->sample(lattice);
     const SampledField doubled =
-        make_cpu_bvh_sampler(options(Precision::Float, "", 0, BccStrategy::DoubleResolution))->sample(mesh, lattice);
+        make_cpu_bvh_sampler(options(Precision::Float, "", 0, BccStrategy::DoubleResolution))->bind(share(mesh))->sample(lattice);
     EXPECT_EQ(two.distance, two_threads.distance);
     EXPECT_EQ(two.closest_triangle, two_threads.closest_triangle);
     // Strategy A sees the same points in another order (other seeds): equal up to ties.
@@ -159,11 +160,11 @@ double work_seeded_or_zero(const SampledField& f) { return f.sampler.details.at(
 TEST(CpuBvh, BrickSeededAndUnseededKernelsAgreeAndCoherenceSavesWork) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
     const Lattice lattice = fit_lattice(LatticeType::CC, {32, 32, 32}, mesh.bounds(), 0.1);
-    const SampledField seeded = make_cpu_bvh_sampler(options(Precision::Float, "seeded"))->sample(mesh, lattice);
-    const SampledField unseeded = make_cpu_bvh_sampler(options(Precision::Float, "unseeded"))->sample(mesh, lattice);
+    const SampledField seeded = make_cpu_bvh_sampler(options(Precision::Float, "seeded"))->bind(share(mesh))->sample(lattice);
+    const SampledField unseeded = make_cpu_bvh_sampler(options(Precision::Float, "unseeded"))->bind(share(mesh))->sample(lattice);
     test::FieldComparer cmp(mesh, test::epsilon_of(Precision::Float));
     cmp.fields(unseeded, seeded, "pawn seeded vs unseeded");
-    const SampledField brick = make_cpu_bvh_sampler(options(Precision::Float, "brick"))->sample(mesh, lattice);
+    const SampledField brick = make_cpu_bvh_sampler(options(Precision::Float, "brick"))->bind(share(mesh))->sample(lattice);
     test::FieldComparer cmp_brick(mesh, test::epsilon_of(Precision::Float));
     cmp_brick.fields(unseeded, brick, "pawn brick vs unseeded");
     EXPECT_LT(brick.sampler.details.at("bvh")["node_visits_per_point"].get<double>(), work_seeded_or_zero(seeded));

@@ -19,6 +19,7 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "kernels/bvh/streamed_certificate.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -53,9 +54,7 @@ std::vector<PointSample> query(const std::string& method, Precision precision, c
                                const PreparedMesh& mesh, const std::vector<Vec3d>& points, SamplingTimings* timings = nullptr) {
     const SamplerOptions o = options(precision, kernel);
     auto sampler = method == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
-    std::vector<PointSample> out = sampler->query(mesh, points);
-    if (timings) *timings = sampler->last_query_timings();
-    return out;
+    return sampler->bind(share(mesh))->query(points, timings);
 }
 
 // A long point list's largest |coordinate| (the bound of every certified query) is taken in
@@ -214,9 +213,9 @@ TEST(CertifiedSearch, FloatLatticesEqualDoubleBruteForce) {
             lattice.spacing = 2.2 / 23.0;
             lattice.resolution = {24, 24, 6};
         }
-        const SampledField want = make_cpu_brute_force_sampler(options(Precision::Double, "vectorized"))->sample(mesh, lattice);
+        const SampledField want = make_cpu_brute_force_sampler(options(Precision::Double, "vectorized"))->bind(share(mesh))->sample(lattice);
         for (const char* kernel : {"brick", "seeded", "unseeded"}) {
-            const SampledField got = make_cpu_bvh_sampler(options(Precision::Float, kernel))->sample(mesh, lattice);
+            const SampledField got = make_cpu_bvh_sampler(options(Precision::Float, kernel))->bind(share(mesh))->sample(lattice);
             int64_t bad = 0;
             for (size_t i = 0; i < got.distance.size(); ++i)
                 bad += !(got.closest_triangle[i] == want.closest_triangle[i] && same_bits(got.distance[i], want.distance[i]));
@@ -225,7 +224,7 @@ TEST(CertifiedSearch, FloatLatticesEqualDoubleBruteForce) {
             std::printf("%-10s lattice %-9s re-ranked %lld of %lld points\n", c.mesh.name.c_str(), kernel,
                         (long long)got.timings.reranked_points, (long long)got.timings.certified_points);
         }
-        const SampledField brute = make_cpu_brute_force_sampler(options(Precision::Float, "vectorized"))->sample(mesh, lattice);
+        const SampledField brute = make_cpu_brute_force_sampler(options(Precision::Float, "vectorized"))->bind(share(mesh))->sample(lattice);
         for (size_t i = 0; i < brute.distance.size(); ++i)
             ASSERT_TRUE(brute.closest_triangle[i] == want.closest_triangle[i] && same_bits(brute.distance[i], want.distance[i])) << i;
     }

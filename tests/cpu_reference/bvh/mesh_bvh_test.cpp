@@ -16,6 +16,7 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -48,7 +49,7 @@ void expect_same_field(const SampledField& a, const SampledField& b) {
     EXPECT_EQ(a.closest_triangle, b.closest_triangle);
 }
 
-bool built_by_this_call(const SampledField& f) { return f.sampler.details.at("bvh").at("built_by_this_call").get<bool>(); }
+bool built_by_bind(const SampledField& f) { return f.sampler.details.at("bvh").at("built_by_bind").get<bool>(); }
 
 TEST(MeshBvh, BuiltOnceOnFirstUseAndSharedByCopies) {
     const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.3, 24, 12), without_intersection_check());
@@ -91,14 +92,32 @@ TEST(MeshBvh, ConcurrentFirstCallsBuildOnce) {
 TEST(MeshBvh, SamplersAndCallsShareTheMeshTree) {
     const PreparedMesh mesh = prepare_mesh(make_torus(1.0, 0.3, 24, 12), without_intersection_check());
     const Lattice lattice = fit_lattice(LatticeType::CC, {10, 11, 12}, mesh.bounds(), 0.1);
-    const SampledField a = make_cpu_bvh_sampler(quiet(SignMode::Winding))->sample(mesh, lattice);
-    EXPECT_TRUE(built_by_this_call(a));
-    const SampledField b = make_cpu_bvh_sampler(quiet(SignMode::Winding))->sample(mesh, lattice);  // another sampler
-    EXPECT_FALSE(built_by_this_call(b));
+    const SampledField a = make_cpu_bvh_sampler(quiet(SignMode::Winding))->bind(share(mesh))->sample(lattice);
+    EXPECT_TRUE(built_by_bind(a));
+    const SampledField b = make_cpu_bvh_sampler(quiet(SignMode::Winding))->bind(share(mesh))->sample(lattice);  // another sampler, bound again
+    EXPECT_FALSE(built_by_bind(b));
     expect_same_field(a, b);
     // The provenance's build time is the tree's own, whichever call built it.
     EXPECT_EQ(a.sampler.details.at("bvh").at("build_seconds"), b.sampler.details.at("bvh").at("build_seconds"));
     EXPECT_EQ(b.sampler.details.at("bvh").at("build_seconds").get<double>(), mesh.bvh()->stats.seconds);
+}
+
+/// A bound sampler shares its mesh's ownership: the caller may drop its own pointer, and the
+/// fields stay those of a fresh binding bit for bit. Binding no mesh is refused.
+TEST(MeshBvh, ABoundSamplerOwnsItsMesh) {
+    auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(make_torus(1.0, 0.3, 24, 12), without_intersection_check()));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {9, 10, 11}, mesh->bounds(), 0.1);
+    const std::weak_ptr<const PreparedMesh> watch = mesh;
+    for (SignMode sign : {SignMode::Winding, SignMode::Pseudonormal}) {
+        const auto bound = make_cpu_bvh_sampler(quiet(sign))->bind(mesh);
+        const SampledField expected = bound->sample(lattice);
+        mesh.reset();
+        EXPECT_FALSE(watch.expired());
+        expect_same_field(bound->sample(lattice), expected);
+        mesh = bound->shared_mesh();
+    }
+    EXPECT_THROW(make_cpu_bvh_sampler(quiet(SignMode::Auto))->bind(nullptr), std::invalid_argument);
+    EXPECT_THROW(make_cpu_brute_force_sampler(quiet(SignMode::Auto))->bind(nullptr), std::invalid_argument);
 }
 
 /// A mesh made where another was, from the same input (same name, content hash, triangle
@@ -116,25 +135,25 @@ TEST(MeshBvh, AMeshAtAFreedMeshsAddressGetsItsOwnTree) {
 
     for (SignMode sign : {SignMode::Winding, SignMode::Pseudonormal}) {
         SCOPED_TRACE(sign_mode_name(sign));
-        const SampledField expected = make_cpu_bvh_sampler(quiet(sign))->sample(fresh, lattice);
-        const SampledField expected_brute = make_cpu_brute_force_sampler(quiet(sign))->sample(fresh, lattice);
+        const SampledField expected = make_cpu_bvh_sampler(quiet(sign))->bind(share(fresh))->sample(lattice);
+        const SampledField expected_brute = make_cpu_brute_force_sampler(quiet(sign))->bind(share(fresh))->sample(lattice);
         auto bvh_sampler = make_cpu_bvh_sampler(quiet(sign));
         auto brute_sampler = make_cpu_brute_force_sampler(quiet(sign));
 
         alignas(PreparedMesh) unsigned char storage[sizeof(PreparedMesh)];
         PreparedMesh* first = new (storage) PreparedMesh(prepare_mesh(inward, keep_inward));
         ASSERT_FALSE(first->report().flipped);
-        const SampledField before = bvh_sampler->sample(*first, lattice);
-        brute_sampler->sample(*first, lattice);
+        const SampledField before = bvh_sampler->bind(share(first))->sample(lattice);
+        brute_sampler->bind(share(first))->sample(lattice);
         first->~PreparedMesh();
         PreparedMesh* second = new (storage) PreparedMesh(prepare_mesh(inward, flip));
         ASSERT_EQ(static_cast<void*>(second), static_cast<void*>(first));
         ASSERT_EQ(second->content_sha256(), fresh.content_sha256());
 
-        const SampledField after = bvh_sampler->sample(*second, lattice);
-        EXPECT_TRUE(built_by_this_call(after));  // the second mesh's own tree
+        const SampledField after = bvh_sampler->bind(share(second))->sample(lattice);
+        EXPECT_TRUE(built_by_bind(after));  // the second mesh's own tree
         expect_same_field(after, expected);
-        expect_same_field(brute_sampler->sample(*second, lattice), expected_brute);
+        expect_same_field(brute_sampler->bind(share(second))->sample(lattice), expected_brute);
         if (sign == SignMode::Winding) {
             // The inward mesh's winding number is -1 inside: the centre is outside there.
             const size_t centre = size_t(lattice.num_points() / 2);

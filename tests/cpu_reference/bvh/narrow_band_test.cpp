@@ -16,6 +16,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -63,17 +64,17 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
         const Lattice bcc = fit_lattice(LatticeType::BCC, {15, 16, 17}, c.mesh.bounds(), 0.3);
         for (Precision precision : {Precision::Float, Precision::Double})
             for (const Lattice& lattice : {cc, bcc}) {
-                const SampledField full_bvh = make_cpu_bvh_sampler(options(precision, 0, c.sign))->sample(c.mesh, lattice);
-                const SampledField full_brute = make_cpu_brute_force_sampler(options(precision, 0, c.sign))->sample(c.mesh, lattice);
+                const SampledField full_bvh = make_cpu_bvh_sampler(options(precision, 0, c.sign))->bind(share(c.mesh))->sample(lattice);
+                const SampledField full_brute = make_cpu_brute_force_sampler(options(precision, 0, c.sign))->bind(share(c.mesh))->sample(lattice);
                 for (double spacings : {0.5, 2.0, 6.0}) {
                     const double w = spacings * lattice.spacing;
                     const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
                                              " w = " + std::to_string(spacings) + " h";
-                    const SampledField bvh = make_cpu_bvh_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
+                    const SampledField bvh = make_cpu_bvh_sampler(options(precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
                     expect_banded(full_bvh, bvh, w, what + " bvh");
                     EXPECT_EQ(bvh.sampler.band->how, "bricks skipped by the distance bound") << what;
                     EXPECT_GT(bvh.sampler.band->bricks_skipped, 0) << what;
-                    const SampledField brute = make_cpu_brute_force_sampler(options(precision, w, c.sign))->sample(c.mesh, lattice);
+                    const SampledField brute = make_cpu_brute_force_sampler(options(precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
                     expect_banded(full_brute, brute, w, what + " brute force");
                     EXPECT_EQ(brute.sampler.band->how, "post-processed") << what;
                     if (HasFailure()) return;
@@ -88,14 +89,14 @@ TEST(NarrowBand, PseudonormalSignOnAnOpenMeshAndPointKernelsPostProcess) {
     const double w = 1.5 * lattice.spacing;
     // Forced pseudonormal on an open mesh: its sign may change off the surface, so no brick
     // is skipped on a probe's sign.
-    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Pseudonormal))->sample(mesh, lattice);
-    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Pseudonormal))->sample(mesh, lattice);
+    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Pseudonormal))->bind(share(mesh))->sample(lattice);
+    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Pseudonormal))->bind(share(mesh))->sample(lattice);
     expect_banded(full, banded, w, "bowl forced pseudonormal");
     EXPECT_EQ(banded.sampler.band->how, "post-processed");
     EXPECT_EQ(banded.sampler.band->bricks_skipped, 0);
     for (const char* kernel : {"seeded", "unseeded"}) {
-        const SampledField k_full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding, kernel))->sample(mesh, lattice);
-        const SampledField k_band = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding, kernel))->sample(mesh, lattice);
+        const SampledField k_full = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding, kernel))->bind(share(mesh))->sample(lattice);
+        const SampledField k_band = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding, kernel))->bind(share(mesh))->sample(lattice);
         expect_banded(k_full, k_band, w, std::string("bowl kernel ") + kernel);
     }
 }
@@ -104,8 +105,8 @@ TEST(NarrowBand, FewPointsAreComputedWhenMostOfTheLatticeIsOutsideTheBand) {
     const PreparedMesh mesh = prepare_mesh(make_icosphere(3, 1.0));
     const Lattice lattice = fit_lattice(LatticeType::CC, {64, 64, 64}, mesh.bounds(), 0.5);
     const double w = lattice.spacing;
-    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0))->sample(mesh, lattice);
-    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w))->sample(mesh, lattice);
+    const SampledField full = make_cpu_bvh_sampler(options(Precision::Float, 0))->bind(share(mesh))->sample(lattice);
+    const SampledField banded = make_cpu_bvh_sampler(options(Precision::Float, w))->bind(share(mesh))->sample(lattice);
     expect_banded(full, banded, w, "sphere 64^3 w = h");
     ASSERT_TRUE(banded.sampler.band.has_value());
     const BandReport& band = *banded.sampler.band;
@@ -128,7 +129,7 @@ TEST(NarrowBand, RefusesBadWidthsByName) {
         for (int bvh : {0, 1}) {
             auto sampler = bvh ? make_cpu_bvh_sampler(options(Precision::Float, w)) : make_cpu_brute_force_sampler(options(Precision::Float, w));
             try {
-                sampler->sample(mesh, lattice);
+                sampler->bind(share(mesh))->sample(lattice);
                 ADD_FAILURE() << "band width " << w << " accepted";
             } catch (const std::invalid_argument& e) {
                 EXPECT_NE(std::string(e.what()).find("band_width"), std::string::npos) << e.what();

@@ -24,6 +24,7 @@
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "core/winding/winding_sign.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -336,7 +337,7 @@ TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
     const std::vector<Vec3d> pts = query_points(mesh, 256);
     SamplerOptions reference = float_options("vectorized");
     reference.precision = Precision::Double;
-    const std::vector<PointSample> want = make_cpu_brute_force_sampler(reference)->query(mesh, pts);
+    const std::vector<PointSample> want = make_cpu_brute_force_sampler(reference)->bind(share(mesh))->query(pts);
     auto same_sample = [](const PointSample& a, const PointSample& b) {
         return a.triangle == b.triangle && same_bits(a.distance, b.distance) && same_bits(a.gradient.x, b.gradient.x) &&
                same_bits(a.gradient.y, b.gradient.y) && same_bits(a.gradient.z, b.gradient.z);
@@ -345,18 +346,19 @@ TEST(CpuIsa, CertifiedSamplersEqualTheDoubleBruteForce) {
     for (const Run r : {Run{"brute_force", "vectorized"}, Run{"bvh", "brick"}, Run{"bvh", "seeded"}, Run{"bvh", "unseeded"}}) {
         const SamplerOptions o = float_options(r.kernel);
         auto sampler = std::string(r.method) == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
-        const std::vector<PointSample> got = sampler->query(mesh, pts);
+        SamplingTimings timings;
+        const std::vector<PointSample> got = sampler->bind(share(mesh))->query(pts, &timings);
         int64_t bad = 0;
         for (size_t i = 0; i < pts.size(); ++i) bad += !same_sample(got[i], want[i]);
         EXPECT_EQ(bad, 0) << active_cpu_kernels().isa << " " << r.method << "/" << r.kernel;
-        EXPECT_GT(sampler->last_query_timings().reranked_points, 0);
+        EXPECT_GT(timings.reranked_points, 0);
     }
     const Lattice lattice{LatticeType::CC, {-1.25, -1.25, -1.25}, 0.125, {21, 21, 21}};
-    const SampledField lattice_want = make_cpu_brute_force_sampler(reference)->sample(mesh, lattice);
+    const SampledField lattice_want = make_cpu_brute_force_sampler(reference)->bind(share(mesh))->sample(lattice);
     for (const Run r : {Run{"brute_force", "vectorized"}, Run{"bvh", "brick"}, Run{"bvh", "seeded"}, Run{"bvh", "unseeded"}}) {
         const SamplerOptions o = float_options(r.kernel);
         auto sampler = std::string(r.method) == "bvh" ? make_cpu_bvh_sampler(o) : make_cpu_brute_force_sampler(o);
-        const SampledField got = sampler->sample(mesh, lattice);
+        const SampledField got = sampler->bind(share(mesh))->sample(lattice);
         ASSERT_EQ(got.distance.size(), lattice_want.distance.size());
         int64_t bad = 0;
         for (size_t i = 0; i < got.distance.size(); ++i)

@@ -11,6 +11,7 @@
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -30,7 +31,7 @@ std::vector<PointSample> query(const PreparedMesh& mesh, const std::vector<Vec3d
     o.threads = threads;
     o.kernel = kernel;
     o.progress = false;
-    return make_cpu_brute_force_sampler(o)->query(mesh, pts);
+    return make_cpu_brute_force_sampler(o)->bind(share(mesh))->query(pts);
 }
 
 /// Largest gap between an icosphere mesh and its sphere: r minus the smallest distance from
@@ -178,9 +179,9 @@ TEST(CpuBruteForce, BccStrategiesGiveIdenticalFields) {
     SamplerOptions o;
     o.progress = false;
     o.bcc_strategy = BccStrategy::TwoGrids;
-    const SampledField b = make_cpu_brute_force_sampler(o)->sample(mesh, lattice);
+    const SampledField b = make_cpu_brute_force_sampler(o)->bind(share(mesh))->sample(lattice);
     o.bcc_strategy = BccStrategy::DoubleResolution;
-    const SampledField a = make_cpu_brute_force_sampler(o)->sample(mesh, lattice);
+    const SampledField a = make_cpu_brute_force_sampler(o)->bind(share(mesh))->sample(lattice);
     ASSERT_EQ(a.size(), lattice.num_points());
     EXPECT_EQ(a.distance, b.distance);
     EXPECT_EQ(a.gradient, b.gradient);
@@ -196,9 +197,9 @@ TEST(CpuBruteForce, OneThreadAndManyThreadsAreBitIdentical) {
     SamplerOptions o;
     o.progress = false;
     o.threads = 1;
-    const SampledField one = make_cpu_brute_force_sampler(o)->sample(mesh, lattice);
+    const SampledField one = make_cpu_brute_force_sampler(o)->bind(share(mesh))->sample(lattice);
     o.threads = 5;
-    const SampledField many = make_cpu_brute_force_sampler(o)->sample(mesh, lattice);
+    const SampledField many = make_cpu_brute_force_sampler(o)->bind(share(mesh))->sample(lattice);
     EXPECT_EQ(one.distance, many.distance);
     EXPECT_EQ(one.gradient, many.gradient);
     EXPECT_EQ(one.closest_triangle, many.closest_triangle);

@@ -1,0 +1,196 @@
+/// @file bvh_cpu_search.h
+/// @brief The CPU BVH sampler's searches (bvh_cpu.h), shared by its lattice bricks
+/// (bvh_cpu_bricks.h) and its point packets (bvh_cpu_points.h): the certified float search's
+/// context, the sign of a packet's lanes, the one-point path and the packet search. Included
+/// by the sampler's translation units only.
+#pragma once
+
+#include <atomic>
+#include <cmath>
+#include <type_traits>
+
+#include "core/bvh/triangle_bvh.h"
+#include "core/parallel/parallel_for.h"
+#include "core/parallel/progress.h"
+#include "core/sampling/certified_search.h"
+#include "core/sampling/sampler_sign.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/dispatch/cpu_kernels.h"
+#include "kernels/distance/signed_distance.h"
+
+namespace sdf::cpu_bvh {
+
+/// Points per parallel_for chunk: long enough that most seeds come from the x-neighbour.
+constexpr int64_t kBvhChunk = 256;
+
+/// Lattice bricks of 4 x 2 x 2 points share one packet traversal (kCpuPacketLanes).
+constexpr int kBrickX = 4, kBrickY = 2, kBrickZ = 2, kBrick = kBrickX * kBrickY * kBrickZ;
+static_assert(kBrick == kCpuPacketLanes, "a brick is one packet of the dispatched kernel");
+/// Packets of arbitrary points per parallel_for chunk.
+constexpr int64_t kBrickChunk = 16;
+/// Rows of lattice bricks (along x) per parallel_for chunk: a row's first brick is seeded by
+/// the first brick of the row before it, and a narrow band's probes are shared along x and y.
+constexpr int64_t kChunkRows = 8;
+
+using BvhKernel = CpuBvhKernel;
+
+/// A run's search counts, summed over threads: BVH nodes visited, point-triangle tests, and
+/// the certificate's counts (the run's own, certified_search.h).
+struct QueryCounters {
+    explicit QueryCounters(CertificateCounters& c) : certificate(c) {}
+    std::atomic<int64_t> nodes{0}, triangles{0};
+    CertificateCounters& certificate;
+};
+
+/// A thread's counts of certified points, added to the run's CertificateCounters at the end.
+struct LocalCertificate {
+    int64_t points = 0, reranked = 0, full_double = 0;
+    void add_to(CertificateCounters& c) const {
+        c.points += points;
+        c.reranked += reranked;
+        c.full_double += full_double;
+    }
+};
+
+/// The certified float search's context (search_certificate.h): the slack of every point of
+/// the run, the double constants for re-ranking and the kernels of the widest ISA the CPU
+/// has (cpu_kernels.h). `T` double: the search is the reference.
+template <typename T>
+struct Certifier {
+    static constexpr bool kActive = std::is_same_v<T, float>;
+    SearchSlack<float> slack;
+    BvhView<double> exact;
+    const CpuCertifiedKernels& kernels = certified_cpu_kernels();
+
+    Certifier(const PreparedMesh& mesh, const TriangleBvh& bvh, double point_coordinate) : exact(bvh.view<double>()) {
+        if constexpr (kActive)
+            slack = make_search_slack(bvh.float_bound ? *bvh.float_bound : float_search_bound(mesh), point_coordinate);
+    }
+
+    /// Starts loading the double constants of the candidates (three cache lines each, in an
+    /// array apart from the float ones): a packet's lanes then wait for memory together.
+    template <int N>
+    void prefetch(const NearCandidates<float, N>& near) const {
+        for (int i = 0; i < near.count; ++i) {
+            const char* at = reinterpret_cast<const char*>(exact.packed + near.slot[i]);
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + 64);
+            __builtin_prefetch(at + 128);
+        }
+    }
+
+    /// The double search's winner (BVH slot) at p from the float search's winner and its
+    /// candidates; counts what it took.
+    int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
+                    const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters) const {
+        Rerank r = kernels.rerank(exact.packed, view.triangle_index, p, winner, slack.radius(best_q), near.slot, near.q,
+                                  near.count, near.dropped);
+        if (r.overflow) {
+            AllNear all{slack, {}, {}};
+            const Vec3f pt(p);
+            BvhStats uncounted;
+            const BvhHit<float> hit = kernels.closest_triangle_all(view, pt, seed_hit(view, winner, pt), uncounted, all);
+            r = kernels.rerank(exact.packed, view.triangle_index, p, hit.slot, slack.radius(hit.distance_squared),
+                               all.slot.data(), all.q.data(), int(all.slot.size()), NAN);
+            r.reranked = true;
+            ++counters.full_double;
+        }
+        ++counters.points;
+        counters.reranked += r.reranked;
+        return r.slot;
+    }
+};
+
+/// The sign of a packet's lanes. With the samplers' winding sign (uncertified: the fast
+/// value's side), the fast winding numbers of all kCpuPacketLanes lanes come from one
+/// traversal (fast_winding_packet.h), each lane's value the bits WindingSign::inside()
+/// computes; otherwise each point gets SamplerSign::apply().
+class PacketSign {
+public:
+    explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
+        const WindingSign* w = sign.winding() ? sign.winding_sign() : nullptr;
+        winding_ = w != nullptr && !w->options().certify ? w : nullptr;
+    }
+
+    /// Evaluates the sides of the packet's points `position` (all kCpuPacketLanes lanes).
+    void prepare(const Vec3d* position) {
+        if (winding_ == nullptr) return;
+        double px[kCpuPacketLanes], py[kCpuPacketLanes], pz[kCpuPacketLanes], w[kCpuPacketLanes];
+        for (int k = 0; k < kCpuPacketLanes; ++k) {
+            px[k] = position[k].x;
+            py[k] = position[k].y;
+            pz[k] = position[k].z;
+        }
+        kernel_(winding_->view(), px, py, pz, winding_->options().accuracy, w);
+        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::inside()
+    }
+
+    /// Lane k's sample `s` at p with its sign (after prepare() of its packet).
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, int k, const Vec3d& p) const {
+        return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p);
+    }
+
+private:
+    const SamplerSign& sign_;
+    const WindingSign* winding_ = nullptr;  ///< non-null: packets of winding numbers
+    WindingPacketFn kernel_ = active_cpu_kernels().winding_numbers_packet;
+    bool inside_[kCpuPacketLanes] = {};
+};
+
+/// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
+/// In a chunk, point i is seeded with point i-1's triangle when `seeded` (any triangle is
+/// a valid seed: its distance only bounds the search radius).
+template <typename T, typename PositionFn, typename EmitFn>
+void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, bool seeded, int threads, bool progress,
+                     int64_t n, double point_coordinate, QueryCounters& counters, PositionFn pos, EmitFn emit) {
+    const BvhView<T> view = bvh.view<T>();
+    const MeshView<double> exact = mesh.buffers<double>().view();
+    const Certifier<T> certifier(mesh, bvh, point_coordinate);
+    const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the widest ISA the CPU has
+    ProgressReporter reporter("sampling " + mesh.name() + " (bvh)", n, progress);
+    parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
+        BvhStats stats;
+        LocalCertificate certified;
+        int32_t previous = -1;
+        for (int64_t i = begin; i < end; ++i) {
+            const Vec3d p = pos(i);
+            const Vec3<T> pt(p);
+            const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
+            int32_t slot;
+            if constexpr (Certifier<T>::kActive) {
+                CpuCertifiedNear near{certifier.slack, {}};
+                const BvhHit<float> hit = certifier.kernels.closest_triangle(view, pt, seed, stats, near);
+                previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
+                certifier.prefetch(near.near);
+                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified);
+            } else {
+                slot = previous = closest_triangle(view, pt, seed, stats).slot;
+            }
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
+        }
+        certified.add_to(counters.certificate);
+        counters.nodes += stats.nodes;
+        counters.triangles += stats.triangles;
+        reporter.advance(end - begin);
+    });
+}
+
+/// One packet search (closest_triangles_packet.h): `slot` receives the winner of each of the
+/// first `count` lanes, certified for float (`position`: the lanes' exact points).
+template <typename T>
+void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
+                   BvhPacket<T, kCpuPacketLanes>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
+    if constexpr (Certifier<T>::kActive) {
+        CpuPacketCertifiedNear near;
+        near.slack = certifier.slack;
+        certifier.kernels.closest_triangles_packet(view, pk, stats, near);
+        for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
+        for (int k = 0; k < count; ++k)
+            slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
+    } else {
+        cpu_kernels<T>().closest_triangles_packet(view, pk, stats);
+        for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];
+    }
+}
+
+}  // namespace sdf::cpu_bvh
