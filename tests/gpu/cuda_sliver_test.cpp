@@ -15,6 +15,7 @@
 #include "cuda/cuda_sampler.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/test_util/exact_distance.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -62,12 +63,12 @@ TEST(CudaSliver, TheTwoTrianglesOfTheIssue) {
     lattice.resolution = {2, 1, 2};
     for (const GpuSearch& s : every_gpu_search()) {
         auto sampler = make_sampler(options_of("cuda", s.method, s.kernel, s.precision));
-        const std::vector<PointSample> got = sampler->query(mesh, points);
+        const std::vector<PointSample> got = sampler->bind(share(mesh))->query(points);
         for (size_t i = 0; i < points.size(); ++i) {
             EXPECT_NEAR(std::abs(got[i].distance), want[i], 1e-13) << s.name() << " point " << i;
             EXPECT_EQ(got[i].triangle, 1) << s.name() << " point " << i;
         }
-        const SampledField f = sampler->sample(mesh, lattice);
+        const SampledField f = sampler->bind(share(mesh))->sample(lattice);
         for (size_t i = 0; i < f.distance.size(); ++i) {
             EXPECT_NEAR(std::abs(f.distance[i]), lattice.position(int64_t(i)).z < -0.5 ? 1.0 : 0.0, 1e-13) << s.name() << " " << i;
             EXPECT_EQ(f.closest_triangle[i], 1) << s.name() << " lattice point " << i;
@@ -80,9 +81,9 @@ TEST(CudaSliver, EverySearchEqualsTheCpuDoubleBruteForceOnSliversOfEverySize) {
         const AdversarialCase zoo = make_sliver_zoo(length, 38, 40);
         const PreparedMesh mesh = prepare_mesh(zoo.mesh);
         const std::vector<PointSample> want =
-            make_sampler(options_of("cpu", "brute_force", "vectorized", Precision::Double))->query(mesh, zoo.points);
+            make_sampler(options_of("cpu", "brute_force", "vectorized", Precision::Double))->bind(share(mesh))->query(zoo.points);
         for (const GpuSearch& s : every_gpu_search()) {
-            const std::vector<PointSample> got = make_sampler(options_of("cuda", s.method, s.kernel, s.precision))->query(mesh, zoo.points);
+            const std::vector<PointSample> got = make_sampler(options_of("cuda", s.method, s.kernel, s.precision))->bind(share(mesh))->query(zoo.points);
             int64_t bad = 0;
             for (size_t i = 0; i < got.size(); ++i) {
                 bool ok = got[i].triangle == want[i].triangle && same_bits(got[i].distance, want[i].distance);

@@ -17,6 +17,7 @@
 #include "kernels/bvh/aabb_distance.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/exact_distance.h"
+#include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
@@ -74,13 +75,13 @@ TEST(SliverSearch, TheTwoTrianglesOfTheIssue) {
     lattice.resolution = {2, 1, 2};  // (66|67, 0, -1|0): on the sliver or 1 below it
     for (const Search& s : every_search()) {
         for (SignMode sign : {SignMode::Pseudonormal, SignMode::Winding}) {
-            const std::vector<PointSample> got = sampler_of(s, sign)->query(mesh, points);
+            const std::vector<PointSample> got = sampler_of(s, sign)->bind(share(mesh))->query(points);
             for (size_t i = 0; i < points.size(); ++i) {
                 EXPECT_NEAR(std::abs(got[i].distance), want[i], 1e-13) << name_of(s) << " point " << i;
                 EXPECT_EQ(got[i].triangle, 1) << name_of(s) << " point " << i;
             }
         }
-        const SampledField f = sampler_of(s)->sample(mesh, lattice);
+        const SampledField f = sampler_of(s)->bind(share(mesh))->sample(lattice);
         for (size_t i = 0; i < f.distance.size(); ++i) {
             const Vec3d p = lattice.position(int64_t(i));
             EXPECT_NEAR(std::abs(f.distance[i]), p.z < -0.5 ? 1.0 : 0.0, 1e-13) << name_of(s) << " lattice point " << i;
@@ -119,9 +120,9 @@ TEST(SliverSearch, EverySearchIsExactOnSliversOfEverySize) {
         const double longest = 1.3 * length;
         std::vector<ExactNearest> exact;
         for (const Vec3d& p : zoo.points) exact.push_back(exact_nearest(zoo.mesh, p));
-        const std::vector<PointSample> reference = sampler_of({"brute_force", "vectorized", Precision::Double})->query(mesh, zoo.points);
+        const std::vector<PointSample> reference = sampler_of({"brute_force", "vectorized", Precision::Double})->bind(share(mesh))->query(zoo.points);
         for (const Search& s : every_search()) {
-            const std::vector<PointSample> got = sampler_of(s)->query(mesh, zoo.points);
+            const std::vector<PointSample> got = sampler_of(s)->bind(share(mesh))->query(zoo.points);
             int64_t not_least = 0, not_its_distance = 0, not_double = 0;
             for (size_t i = 0; i < zoo.points.size(); ++i) {
                 const ExactNearest& e = exact[i];
@@ -214,7 +215,7 @@ void check_sliver_centroids(const std::string& name, const PreparedMesh& mesh, s
     for (const Search& s : every_search()) {
         if (std::string(s.kernel) == "eberly" || (std::string(s.method) == "brute_force" && mesh.triangles().size() > 20000))
             continue;  // the brute force only on small meshes (the BVH equals it elsewhere)
-        const std::vector<PointSample> got = sampler_of(s)->query(mesh, points);
+        const std::vector<PointSample> got = sampler_of(s)->bind(share(mesh))->query(points);
         int64_t bad = 0;
         double worst = 0;
         for (size_t i = 0; i < points.size(); ++i) {
