@@ -149,7 +149,8 @@ TEST(MethodTable, NamesAreUniqueAndOurCpuSamplersRunAsAdapters) {
     in.our_sign = SignMode::Pseudonormal;
     for (const char* name : {"bvh_cpu", "bvh_cpu_exact_sign", "bvh_cpu_per_point", "brute_cpu"}) {
         SCOPED_TRACE(name);
-        const MethodKind& kind = method_kind(name);
+        const std::string method = name;  // a named string: GCC 13 warns of a temporary's reference
+        const MethodKind& kind = method_kind(method);
         EXPECT_EQ(kind.by, By::Ours);
         EXPECT_EQ(kind.sign, SignKind::Mode);
         std::string why_not;
