@@ -43,7 +43,9 @@ void BoundCudaBvh::upload_host_tree() {
     dev->add_winding(sign_, *bvh);
     if constexpr (std::is_same_v<T, float>) tree_float_ = std::move(dev);
     else tree_double_ = std::move(dev);
-    const std::string skipped = bvh_stats_.value("device_build_skipped", std::string());
+    // Null until build_on_device() said why it did not build (nlohmann's value() throws on null).
+    const std::string skipped =
+        bvh_stats_.is_object() ? bvh_stats_.value("device_build_skipped", std::string()) : std::string();
     bvh_stats_ = bvh->stats.to_json();
     bvh_stats_["built_on"] = "host";
     if (!skipped.empty()) bvh_stats_["device_build_skipped"] = skipped;

@@ -24,7 +24,11 @@ struct GpuSearch {
     std::string method, kernel;
     Precision precision;
     std::string name() const { return method + "/" + kernel + (precision == Precision::Double ? " double" : " float"); }
-    bool certified() const { return !(method == "brute_force" && kernel == "thesis" && precision == Precision::Float); }
+    /// The thesis's kernel ranks by Eberly's closest point, not by the packed distance of the
+    /// other searches: like the CPU's "eberly" kernel, in double it is held to the least exact
+    /// squared distance within the double search's bound (2^-44 M^2), not to the other
+    /// searches' tie-breaking bits; in float it is uncertified (2^-20 M^2).
+    bool eberly_ranked() const { return method == "brute_force" && kernel == "thesis"; }
 };
 
 std::vector<GpuSearch> every_gpu_search() {
@@ -87,13 +91,13 @@ TEST(CudaSliver, EverySearchEqualsTheCpuDoubleBruteForceOnSliversOfEverySize) {
             int64_t bad = 0;
             for (size_t i = 0; i < got.size(); ++i) {
                 bool ok = got[i].triangle == want[i].triangle && same_bits(got[i].distance, want[i].distance);
-                if (!s.certified()) {  // near-ties of the float ranking: within 2^-20 M^2 in exact squared distance
+                if (s.eberly_ranked()) {  // near-ties of its ranking, in exact squared distance
                     const Int3 a = zoo.mesh.triangles[size_t(got[i].triangle)], b = zoo.mesh.triangles[size_t(want[i].triangle)];
                     const auto& v = zoo.mesh.vertices;
                     const double qa = CGAL::to_double(test::exact_squared_distance(zoo.points[i], v[size_t(a.x)], v[size_t(a.y)], v[size_t(a.z)]));
                     const double qb = CGAL::to_double(test::exact_squared_distance(zoo.points[i], v[size_t(b.x)], v[size_t(b.y)], v[size_t(b.z)]));
                     const double m = std::sqrt(qb) + 2.6 * length;
-                    ok = qa - qb <= 0x1p-20 * m * m;
+                    ok = qa - qb <= (s.precision == Precision::Double ? 0x1p-44 : 0x1p-20) * m * m;
                 }
                 if (!ok && bad++ < 3)
                     std::printf("  %s %s point %zu: triangle %d d %.17g, CPU double %d d %.17g\n", zoo.mesh.name.c_str(),
