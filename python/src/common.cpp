@@ -27,13 +27,20 @@ DoubleArray points_argument(const py::object& value) {
         // A numeric array converts unless memory runs out: say so, with the size (ensure()
         // would swallow NumPy's MemoryError and leave a TypeError about the type).
         const py::array in = py::reinterpret_borrow<py::array>(value);
+        const std::string converting = "points: out of memory converting " + std::to_string(in.size()) + " values of dtype " +
+                                       std::string(py::str(in.dtype())) + " to float64 (" +
+                                       format_bytes(uint64_t(in.size()) * sizeof(double)) + ")";
+        // The size checked before NumPy allocates: where the kernel overcommits memory, an
+        // allocation larger than the machine succeeds and the copy is then killed, not refused.
+        const bool copies = !(in.dtype().is(py::dtype::of<double>()) && (in.flags() & py::array::c_style));
+        const uint64_t available = host_memory_available();
+        if (copies && available > 0 && uint64_t(in.size()) > available / sizeof(double))
+            raise_memory_error(converting + ", more than the " + format_bytes(available) + " available");
         try {
             return DoubleArray::ensure(py::module_::import("numpy").attr("asarray")(value, "float64", "C"));
         } catch (py::error_already_set& e) {
             if (!e.matches(PyExc_MemoryError)) throw;
-            raise_memory_error("points: out of memory converting " + std::to_string(in.size()) + " values of dtype " +
-                               std::string(py::str(in.dtype())) + " to float64 (" +
-                               format_bytes(uint64_t(in.size()) * sizeof(double)) + ")");
+            raise_memory_error(converting);
         }
     }
     DoubleArray a = DoubleArray::ensure(value);
