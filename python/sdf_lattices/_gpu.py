@@ -222,10 +222,10 @@ def install(core):
 
     module_query.__doc__ = host_module_query.__doc__ + "\n\nGPU points stay on the GPU (see SDF.query)."
 
-    def module_sdf(mesh, points, **sampler):
+    def module_sdf(mesh, points, progress=None, **sampler):
         if is_device_array(points):
-            return sdf_query(core.SDF(mesh, **sampler), points).distance
-        return host_sdf(mesh, points, **sampler)
+            return sdf_query(core.SDF(mesh, **sampler), points, progress=progress).distance
+        return host_sdf(mesh, points, progress=progress, **sampler)
 
     module_sdf.__doc__ = host_sdf.__doc__ + "\n\nGPU points stay on the GPU: the distances are an array of their library."
 

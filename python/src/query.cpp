@@ -285,18 +285,19 @@ double.
           py::arg("mesh"), py::arg("points"), py::arg("progress") = py::none(), py::arg("winding") = false,
           query_doc.c_str());
 
-    static const std::string sdf_function_doc = R"(sdf(mesh, points, **sampler) -> numpy.ndarray
+    static const std::string sdf_function_doc = R"(sdf(mesh, points, progress=None, **sampler) -> numpy.ndarray
 
 The signed distance of points ((N, 3) array) to mesh, (N,) float64: the one-liner
-SDF(mesh, **sampler).query(points).distance. mesh: anything SDF takes (an
-sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D).
+SDF(mesh, **sampler).query(points, progress=progress).distance. mesh: anything SDF takes
+(an sdf_lattices.Mesh, a file path, (vertices, faces), trimesh, Open3D). progress: None or
+False (silent), True (a bar or lines on stderr), or a callable progress(done, total).
 
 )" + sampler_keywords_doc();
-    m.def("sdf", [](const py::object& mesh, const py::object& points, const py::kwargs& sampler) {
-              const SdfHolder s = bind_mesh_sdf(mesh, read_sampler_keywords("sdf()", sampler, {"mesh", "points"}));
-              return query_bound(s, points, py::bool_(false), py::none()).distance;
+    m.def("sdf", [](const py::object& mesh, const py::object& points, const py::object& progress, const py::kwargs& sampler) {
+              const SdfHolder s = bind_mesh_sdf(mesh, read_sampler_keywords("sdf()", sampler, {"mesh", "points", "progress"}));
+              return query_bound(s, points, py::bool_(false), progress).distance;
           },
-          py::arg("mesh"), py::arg("points"), sdf_function_doc.c_str());
+          py::arg("mesh"), py::arg("points"), py::arg("progress") = py::none(), sdf_function_doc.c_str());
 }
 
 }  // namespace sdf

@@ -200,3 +200,14 @@ def test_one_bad_row_is_named_alike_in_every_message(box):
         box.query(nan_row)
     with pytest.raises(ValueError, match=r"query points: row 1 has a coordinate of magnitude 1e\+20"):
         sl.SDF(sl.Mesh(BOX_V, BOX_F), backend="cpu", precision="float").query(far_row)
+
+
+def test_sdf_takes_progress_as_query_does():
+    # Issue 39: sl.sdf refused progress= for every value while its message listed it as valid.
+    mesh = sl.as_mesh((BOX_V, BOX_F))
+    points = np.random.default_rng(39).uniform(-1.0, 2.0, (20000, 3))
+    want = sl.query(mesh, points).distance
+    calls = []
+    for progress in (None, False, lambda done, total: calls.append((done, total))):
+        np.testing.assert_array_equal(sl.sdf(mesh, points, progress=progress), want)
+    assert calls and calls[-1] == (20000, 20000)
