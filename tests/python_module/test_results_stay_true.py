@@ -211,3 +211,10 @@ def test_sdf_takes_progress_as_query_does():
     for progress in (None, False, lambda done, total: calls.append((done, total))):
         np.testing.assert_array_equal(sl.sdf(mesh, points, progress=progress), want)
     assert calls and calls[-1] == (20000, 20000)
+
+
+def test_the_vdb_refusal_does_not_call_a_field_file_lossless(tmp_path):
+    # Issue 39: the message called a field file (float32 unless the Field is float64) "lossless".
+    with pytest.raises(ValueError) as raised:
+        sl.read_field(str(tmp_path / "f.vdb"))
+    assert "lossless" not in str(raised.value) and "at the field's dtype" in str(raised.value)
