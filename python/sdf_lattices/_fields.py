@@ -153,8 +153,8 @@ def read_field(path):
     """read_field(path) -> Field
 
     Reads a field in any format Field.write writes, by the path's extension: ".json" (the
-    field file, docs/field-format.md: every point at the dtype it was written in, float32 or
-    float64, with closest triangles and provenance),
+    field file, docs/field-format.md: every point at the dtype it was written with, float32
+    by default, float64 with write(..., dtype="float64"), with closest triangles and provenance),
     ".npz" and ".vti" (values and gradients on their lattice; BCC .vti as NAME.primary.vti
     and NAME.secondary.vti beside the NAME.vti given). ".npy" holds values without their
     lattice and ".vdb" only a narrow band of them: both raise ValueError saying how to read
@@ -181,5 +181,6 @@ def read_field(path):
     if ext == ".vdb":
         raise ValueError(f"{path}: a .vdb file holds the field only in a narrow band (every other voxel is the "
                          "background value), so it cannot be read back as the sampled Field: open it with pyopenvdb, "
-                         "or write .json or .npz, which keep every point of the lattice at the field's dtype")
+                         "or write .json or .npz, which keep every point of the lattice (float32 by default; "
+                         "write(..., dtype=\"float64\") keeps every bit)")
     raise ValueError(f"{path}: unknown field file extension '{ext}'; read_field reads {_FORMATS}")

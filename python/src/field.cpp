@@ -484,14 +484,15 @@ sampled one.)")
         .def_property_readonly("origin", [](const Field& f) {
             const Vec3d o = f.lattice().origin;
             return py::make_tuple(o.x, o.y, o.z);
-        }, "World position of the first (primary) lattice point.")
+        }, "World position (x, y, z) of the first (primary) lattice point, values[0, 0, 0].")
         .def_property_readonly("spacing", [](const Field& f) { return f.lattice().spacing; },
                                "h: the distance between neighbouring primary points along an axis.")
         .def_property_readonly("resolution", [](const Field& f) {
             const Int3 r = f.lattice().resolution;
             const int nz = f.lattice().type == LatticeType::BCC ? 2 * r.z : r.z;
             return py::make_tuple(r.x, r.y, nz);
-        }, "(nx, ny, nz) for CC; (Rx, Ry, 2Rz), the thesis's notation, for BCC.")
+        }, "(nx, ny, nz) for CC; (Rx, Ry, 2Rz), the thesis's notation, for BCC: x first, while the arrays "
+           "(values, gradient, triangle) are indexed [z, y, x], shape (nz, ny, nx).")
         .def_property_readonly("notation", [](const Field& f) { return lattice_notation(f.lattice()); },
                                "'32x32x32' or, BCC, '26x26x52'.")
         .def_property_readonly("num_points", [](const Field& f) { return f.lattice().num_points(); }, "Lattice points in all.")
@@ -499,7 +500,10 @@ sampled one.)")
                                "The origin of each CC sub-grid: one tuple (CC), or (primary, secondary) (BCC).")
         .def_property_readonly("lattice_info", [](const Field& f) { return json_to_python(lattice_to_json(f.lattice())); },
                                "The lattice as a field file's header stores it (dict).")
-        .def_property_readonly("values", &Field::values, "Signed distance (or the stored scalar), float64, read-only views as described above.")
+        .def_property_readonly("values", &Field::values,
+                               "Signed distance (or the stored scalar), float64, read-only views as described above, indexed "
+                               "[z, y, x]: values[k, j, i] is the point origin + spacing * (i, j, k), while origin and "
+                               "resolution are (x, y, z).")
         .def_property_readonly("gradient", &Field::gradient, "Gradient, float64, shape (..., 3) per sub-grid (read-only views); None when absent.")
         .def_property_readonly("triangle", &Field::triangle, "Closest triangle per point, int32 (read-only views); None when absent.")
         .def_property_readonly("precision", [](const Field& f) { return precision_name(f.field().precision); },

@@ -217,4 +217,14 @@ def test_the_vdb_refusal_does_not_call_a_field_file_lossless(tmp_path):
     # Issue 39: the message called a field file (float32 unless the Field is float64) "lossless".
     with pytest.raises(ValueError) as raised:
         sl.read_field(str(tmp_path / "f.vdb"))
-    assert "lossless" not in str(raised.value) and "at the field's dtype" in str(raised.value)
+    assert "lossless" not in str(raised.value) and 'dtype="float64"' in str(raised.value)
+
+
+def test_the_arrays_axis_order_is_said_where_users_look():
+    # Issue 39: values are indexed [z, y, x] while resolution and origin are (x, y, z).
+    for attribute in ("values", "resolution", "origin"):
+        doc = getattr(sl.Field, attribute).__doc__
+        assert "[z, y, x]" in doc or "values[0, 0, 0]" in doc, attribute
+    f = sl.Field(np.arange(24.0).reshape(2, 3, 4), (0.0, 0.0, 0.0), 1.0)
+    assert f.resolution == (4, 3, 2) and f.values.shape == (2, 3, 4)
+    np.testing.assert_array_equal(f.points()[1, 2, 3], [3.0, 2.0, 1.0])
