@@ -29,6 +29,9 @@ from ._gpu import DeviceQueryResult  # noqa: F401
 # GPU tensors (PyTorch, CuPy, JAX) in and out without copies: SDF.query, query and sdf take
 # them (sdf_lattices._gpu).
 query, sdf = _gpu.install(_core)
+# Wrong keywords and types named in words, not as pybind11's signature dumps (_arguments.py).
+from . import _arguments  # noqa: E402
+render = _arguments.install(_core)
 
 from . import data  # noqa: E402,F401  (ML training data: sdf_lattices.data.sample_near_surface, ...)
 from ._build_info import build_info  # noqa: E402,F401  (what the build found: CUDA, MPI, OpenVDB, OpenImageIO)

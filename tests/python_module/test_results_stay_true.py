@@ -228,3 +228,15 @@ def test_the_arrays_axis_order_is_said_where_users_look():
     f = sl.Field(np.arange(24.0).reshape(2, 3, 4), (0.0, 0.0, 0.0), 1.0)
     assert f.resolution == (4, 3, 2) and f.values.shape == (2, 3, 4)
     np.testing.assert_array_equal(f.points()[1, 2, 3], [3.0, 2.0, 1.0])
+
+
+def test_wrong_arguments_are_named_not_dumped(tmp_path):
+    # Issue 39: SDF.sample(band_width=...) and render(path) gave pybind11's signature dumps.
+    s = sl.SDF(sl.as_mesh((BOX_V, BOX_F)))
+    with pytest.raises(TypeError, match=r"SDF.sample\(\): unexpected keyword 'band_width'.*SDF\(mesh, band_width=\.\.\.\)"):
+        s.sample(band_width=0.1)
+    with pytest.raises(TypeError, match=r"render\(\): field: expected an sdf_lattices.Field .* got str: read it first"):
+        sl.render(str(tmp_path / "x.json"))
+    f = s.sample(resolution=8)  # the wrapped calls still work, with their own keywords
+    assert sl.render(f, size=16).shape[:2] == (16, 16)
+    assert s.sample.__doc__ == sl._core.SDF.sample.__doc__
