@@ -15,6 +15,9 @@ const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
     external_moments_on_.clear();
+    counts_at_prepare_ = {};
+    external_counts_ = {};
+    mesh_scale_ = winding_scale(mesh);
     if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
         report_warning(auto_sign_text(mesh, choice_.reason));
     return choice_;
@@ -23,6 +26,8 @@ const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
 const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);  // cheap, and never another mesh's
     external_moments_on_.clear();
+    external_counts_ = {};
+    mesh_scale_ = winding_scale(mesh);
     if (choice_.mode != SignMode::Winding) {
         winding_.reset();
         return choice_;
@@ -30,29 +35,44 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
     std::shared_ptr<const TriangleBvh> bvh = mesh.bvh();
     // winding_ holds the tree it was built over, so that tree cannot have been freed and its
     // address reused: the same tree means this mesh or a copy (sharing its buffers).
-    if (winding_ && winding_->winding_bvh().bvh == bvh) return choice_;
-    if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
-    winding_ = std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options());
+    if (!(winding_ && winding_->winding_bvh().bvh == bvh)) {
+        if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
+        winding_ = std::make_shared<const WindingSign>(mesh, std::move(bvh), winding_options());
+    }
+    counts_at_prepare_ = winding_->counts();
     return choice_;
 }
+
+WindingSignCounts SamplerSign::counts() const {
+    WindingSignCounts c = external_counts_;
+    if (winding_) c += winding_->counts() - counts_at_prepare_;
+    return c;
+}
+
+namespace {
+
+nlohmann::json winding_accuracy_json(const WindingSignOptions& o) {
+    nlohmann::json j = {{"beta", o.accuracy.beta}, {"order", o.accuracy.order}, {"certified", o.certify}};
+    if (o.certify)
+        j["certification"] = {{"refine_factor", o.certification.refine_factor},
+                              {"refinements", o.certification.refinements},
+                              {"ties", "outside"}};
+    return j;
+}
+
+}  // namespace
 
 nlohmann::json SamplerSign::provenance() const {
     nlohmann::json p = {{"requested", sign_mode_name(requested_)},
                         {"mode", sign_mode_name(choice_.mode)},
                         {"reason", choice_.reason}};
     if (winding_) {
-        const WindingSignOptions o = winding_options();
-        p["winding"] = {{"beta", o.accuracy.beta},
-                        {"order", o.accuracy.order},
-                        {"certified", o.certify},
-                        {"moments_seconds", winding_->winding_bvh().seconds}};
+        p["winding"] = winding_accuracy_json(winding_options());
+        p["winding"]["moments_seconds"] = winding_->winding_bvh().seconds;
     } else if (winding() && !external_moments_on_.empty()) {
-        const WindingSignOptions o = winding_options();
-        p["winding"] = {{"beta", o.accuracy.beta},
-                        {"order", o.accuracy.order},
-                        {"certified", o.certify},
-                        {"moments_seconds", external_moments_seconds_},
-                        {"moments_built_on", external_moments_on_}};
+        p["winding"] = winding_accuracy_json(winding_options());
+        p["winding"]["moments_seconds"] = external_moments_seconds_;
+        p["winding"]["moments_built_on"] = external_moments_on_;
     }
     return p;
 }

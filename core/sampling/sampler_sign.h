@@ -53,9 +53,18 @@ public:
     /// "moments_seconds"}: for the field's sampler provenance.
     nlohmann::json provenance() const;
 
-    /// The accuracy every backend's fast winding sign uses (WindingSignOptions' default:
-    /// beta 2, order 2, uncertified), so that CPU and CUDA decide the same side.
+    /// The winding sign every backend uses (WindingSignOptions' default: certified, first
+    /// evaluation beta 2, order 2, then certified_winding.h's ladder): every backend and tree
+    /// gives the exact side of 1/2 of the winding number, ties outside.
     static WindingSignOptions winding_options() { return {}; }
+
+    /// Points signed by the winding number since prepare(), by how their side was decided:
+    /// the host WindingSign's, plus what a device added with add_counts().
+    WindingSignCounts counts() const;
+    /// Adds points a device signed (its counters, read back after its kernels).
+    void add_counts(const WindingSignCounts& c) { external_counts_ += c; }
+    /// The prepared mesh's largest |coordinate| (WindingView::scale, for device views).
+    double mesh_scale() const { return mesh_scale_; }
 
 private:
     SignMode requested_;
@@ -63,6 +72,8 @@ private:
     std::shared_ptr<const WindingSign> winding_;
     double external_moments_seconds_ = 0;
     std::string external_moments_on_;  ///< empty: the moments are winding_'s
+    WindingSignCounts counts_at_prepare_, external_counts_;
+    double mesh_scale_ = 0;
 };
 
 /// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler

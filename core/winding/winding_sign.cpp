@@ -42,14 +42,21 @@ WindingSign::WindingSign(const PreparedMesh& mesh, const WindingSignOptions& opt
     : WindingSign(mesh, mesh.bvh(), options) {}
 
 WindingSign::WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options)
-    : options_(options), winding_(build_winding_bvh(mesh, std::move(bvh))) {
+    : WindingSign(mesh, build_winding_bvh(mesh, std::move(bvh)), options) {}
+
+WindingSign::WindingSign(const PreparedMesh& mesh, WindingBvh winding, const WindingSignOptions& options)
+    : options_(options), winding_(std::move(winding)), stripes_(new Stripe[kStripes]) {
     if (!(options.accuracy.beta > 1.0))
         throw std::invalid_argument("winding sign: beta must be > 1 (the far field needs d > r), got " +
                                     std::to_string(options.accuracy.beta));
     if (options.accuracy.order != 1 && options.accuracy.order != 2)
         throw std::invalid_argument("winding sign: order must be 1 or 2, got " + std::to_string(options.accuracy.order));
-    if (options.certify && !(options.refine_factor > 1.0))
-        throw std::invalid_argument("winding sign: refine_factor must be > 1, got " + std::to_string(options.refine_factor));
+    if (options.certify && !(options.certification.refine_factor > 1.0))
+        throw std::invalid_argument("winding sign: refine_factor must be > 1, got " +
+                                    std::to_string(options.certification.refine_factor));
+    if (options.certify && options.certification.refinements < 0)
+        throw std::invalid_argument("winding sign: refinements must be >= 0, got " +
+                                    std::to_string(options.certification.refinements));
     view_ = winding_.view<double>(mesh);
 }
 
@@ -57,21 +64,44 @@ WindingEstimate<double> WindingSign::estimate(const Vec3d& p, const WindingAccur
     return fast_winding_number(view_, p, accuracy);
 }
 
-bool WindingSign::inside(const Vec3d& p) const {
-    WindingEstimate<double> e = estimate(p);
-    if (!options_.certify) return e.value > 0.5;
-    const auto certain = [](const WindingEstimate<double>& x) { return std::abs(x.value - 0.5) > x.error_bound; };
-    if (certain(e)) return e.value > 0.5;
-    ++refined_;
-    WindingAccuracy<double> finer = options_.accuracy;
-    for (int k = 0; k < options_.max_refinements; ++k) {
-        finer.beta *= options_.refine_factor;
-        e = estimate(p, finer);
-        if (certain(e)) return e.value > 0.5;
+namespace {
+
+int stripe_of_this_thread() {
+    static std::atomic<int> next{0};
+    thread_local const int stripe = next.fetch_add(1, std::memory_order_relaxed);
+    return stripe;
+}
+
+}  // namespace
+
+void WindingSign::count(WindingStage stage, int64_t n) const {
+    stripes_[stripe_of_this_thread() % kStripes].n[int(stage)].fetch_add(n, std::memory_order_relaxed);
+}
+
+WindingSignCounts WindingSign::counts() const {
+    WindingSignCounts c;
+    for (int k = 0; k < kStripes; ++k)
+        for (int s = 0; s < kWindingStages; ++s) c.add(WindingStage(s), stripes_[k].n[s].load(std::memory_order_relaxed));
+    return c;
+}
+
+WindingSide WindingSign::side(const Vec3d& p) const {
+    if (!options_.certify) {
+        const WindingSide s{fast_winding_number(view_, p, options_.accuracy).value > 0.5, WindingStage::Fast};
+        count(s.stage);
+        return s;
     }
-    ++exact_;
-    finer.beta = std::numeric_limits<double>::infinity();
-    return estimate(p, finer).value > 0.5;
+    const WindingSide s = certified_winding_side(view_, p, options_.accuracy, options_.certification);
+    count(s.stage);
+    return s;
+}
+
+WindingSide WindingSign::side_after(const Vec3d& p, double fast_value, double fast_bound) const {
+    WindingSide s{fast_value > 0.5, WindingStage::Fast};
+    if (options_.certify && !winding_decides(WindingEstimate<double>{fast_value, fast_bound, 0}))
+        s = certified_winding_refine(view_, p, options_.accuracy, options_.certification);
+    count(s.stage);
+    return s;
 }
 
 }  // namespace sdf
