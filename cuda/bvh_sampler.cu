@@ -318,20 +318,16 @@ private:
         return *slot;
     }
 
-    /// The BVH built on the device (bvh_build "device", or "auto" with the pseudonormal
-    /// sign, whose field does not depend on the tree: docs/bvh.md, "Build on the GPU");
+    /// The BVH built on the device (bvh_build "device" or "auto": the field does not depend
+    /// on the tree, docs/bvh.md, "Build on the GPU", and docs/winding.md, the certified sign);
     /// null where the host builds it (also when the device tree is too deep: said in the
     /// provenance's bvh.device_build_skipped).
     template <typename T>
     const DeviceBvh<T>* built_on_device(const PreparedMesh& mesh, bool& built, bool& uploaded, EventTimer& upload) {
         device_build_skipped_.clear();
+        // Auto builds on the device for either sign: the pseudonormal sign and the certified
+        // winding sign (kernels/winding/certified_winding.h) do not depend on the tree.
         if (options_.bvh_build == BvhBuildSite::Host) return nullptr;
-        if (options_.bvh_build == BvhBuildSite::Auto) {
-            if (choose_sign_mode(mesh.report(), options_.sign).mode != SignMode::Pseudonormal)
-                device_build_skipped_ = "bvh_build auto with the winding sign: its fast winding number may take the "
-                                        "other side of 1/2 on another tree, so the host tree keeps the field unchanged";
-            if (!device_build_skipped_.empty()) return nullptr;
-        }
         // A mesh's id() is never another mesh's, even one made where a freed mesh was.
         const uint64_t key = mesh.id();
         std::unique_ptr<DeviceBvh<T>>& slot = slot_of<T>();
@@ -597,6 +593,7 @@ private:
         read_certificate(dev, certificate);
         record_certificate(field.timings, certificate);
         field.sampler.search_certificate = certificate_provenance(std::is_same_v<T, float>, true, certificate);
+        dev.winding.record_counts(field.sampler);  // the certified winding sign's counters (beside the search's)
     }
 
     BandReport band_provenance(const PreparedMesh& mesh, const NarrowBandCounts& counts) const {

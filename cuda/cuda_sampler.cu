@@ -254,6 +254,11 @@ private:
         return h;
     }
 
+public:
+    /// The certified winding sign's counters of this engine's kernels into `report`.
+    void record_winding_counts(SamplerReport& report) const { winding_.record_counts(report); }
+
+private:
     const MeshBuffers<T>& host_;          ///< search data in precision T
     const MeshBuffers<double>& exact_host_;  ///< for the final evaluation
     SamplerOptions options_;
@@ -333,6 +338,7 @@ private:
         field.timings.point_triangle_pairs = double(computed) * double(mesh.triangles().size());
         field.timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         field.sampler = sampler_provenance("cuda", "brute_force", kernel_name(), options_, lattice, computed, sign_);
+        engine.record_winding_counts(field.sampler);
         field.sampler.details["plan"] = engine.plan();
         field.sampler.details["device"] = describe_device(options_.device);
         CertificateCounters certificate;

@@ -1,9 +1,11 @@
 /// @file device_winding.h
 /// @brief A SamplerSign's winding BVH on the GPU: its nodes, per-node moments (double) and
 /// triangle order, next to a DeviceMesh<double> whose vertices and triangles it shares;
-/// empty (pseudonormal mode) when the sign did not resolve to winding.
+/// empty (pseudonormal mode) when the sign did not resolve to winding. Also the device's
+/// counters of the certified sign (how each point's side was decided), read into the report.
 #pragma once
 
+#include "core/sampling/sampler_report.h"
 #include "core/sampling/sampler_sign.h"
 #include "cuda/device_buffer.h"
 #include "cuda/winding_sign_kernel.cuh"
@@ -24,7 +26,7 @@ public:
         triangle_index_.upload(bvh.bvh->triangle_index, stream);
         view_.view = {nodes_.get(), moments_.get(), triangle_index_.get(), mesh.vertices, mesh.triangles,
                       int(bvh.bvh->nodes.size())};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, stream);
     }
 
     /// As upload(), but the winding BVH's tree is `tree`, whose nodes and triangle order are
@@ -41,7 +43,7 @@ public:
         }
         moments_.upload(bvh.moments, stream);
         view_.view = {nodes, moments_.get(), triangle_index, mesh.vertices, mesh.triangles, int(tree.nodes.size())};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, stream);
     }
 
     /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
@@ -51,15 +53,46 @@ public:
         view_ = {};
         if (!sign.winding()) return;
         view_.view = {nodes, moments, triangle_index, mesh.vertices, mesh.triangles, num_nodes};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, 0);
     }
 
     const WindingSignView& view() const { return view_; }
 
+    /// Puts the points the device signed since the upload (or the last call) into `report`
+    /// (SamplerReport::winding_sign, added to what the host counted) and zeroes the counters.
+    /// Synchronises stream 0. Nothing in pseudonormal mode.
+    void record_counts(SamplerReport& report) const {
+        if (!view_.enabled() || counts_.get() == nullptr) return;
+        unsigned long long c[kWindingStages] = {};
+        counts_.download(c, kWindingStages);
+        CUDA_CHECK(cudaStreamSynchronize(0));
+        CUDA_CHECK(cudaMemset(counts_.get(), 0, kWindingStages * sizeof(unsigned long long)));
+        WindingSignReport r = report.winding_sign.value_or(WindingSignReport{});
+        r.fast += int64_t(c[int(WindingStage::Fast)]);
+        r.refined += int64_t(c[int(WindingStage::Refined)]);
+        r.direct += int64_t(c[int(WindingStage::Direct)]);
+        r.ties += int64_t(c[int(WindingStage::Tie)]);
+        report.winding_sign = r;
+    }
+
 private:
+    /// The certification, the rounding bounds' mesh figures and zeroed counters.
+    void finish(const SamplerSign& sign, const MeshView<double>& mesh, cudaStream_t stream) {
+        const WindingSignOptions o = SamplerSign::winding_options();
+        view_.accuracy = o.accuracy;
+        view_.certify = o.certify;
+        view_.certification = o.certification;
+        view_.view.num_triangles = mesh.num_triangles;
+        view_.view.scale = sign.mesh_scale();
+        if (counts_.get() == nullptr) counts_.allocate(kWindingStages);
+        CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), stream));
+        view_.counts = counts_.get();
+    }
+
     DeviceBuffer<BvhNode> nodes_;
     DeviceBuffer<WindingNode<double>> moments_;
     DeviceBuffer<int32_t> triangle_index_;
+    DeviceBuffer<unsigned long long> counts_;
     WindingSignView view_;
 };
 

@@ -17,6 +17,7 @@
 #include "core/sampling/sampler_results.h"
 #include "kernels/core/morton.h"
 #include "kernels/distance/signed_distance.h"
+#include "kernels/winding/certified_winding_packet.h"
 
 namespace sdf {
 namespace {
@@ -99,28 +100,44 @@ struct Certifier {
     }
 };
 
-/// The sign of a packet's lanes. With the samplers' winding sign (uncertified: the fast
-/// value's side), the fast winding numbers of all kCpuPacketLanes lanes come from one
-/// traversal (fast_winding_packet.h), each lane's value the bits WindingSign::inside()
-/// computes; otherwise each point gets SamplerSign::apply().
+/// The sign of a packet's lanes. With the samplers' winding sign (certified: the exact side,
+/// certified_winding_packet.h) the sides of the packet's lanes come from one traversal per
+/// stage of the certified ladder, each lane's side and stage what WindingSign::side() gives
+/// its point; uncertified (measurements), the fast winding numbers of all kCpuPacketLanes
+/// lanes come from one traversal (fast_winding_packet.h), each lane's value the bits
+/// WindingSign::side() computes; otherwise each point gets SamplerSign::apply().
 class PacketSign {
 public:
     explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
-        const WindingSign* w = sign.winding() ? sign.winding_sign() : nullptr;
-        winding_ = w != nullptr && !w->options().certify ? w : nullptr;
+        winding_ = sign.winding() ? sign.winding_sign() : nullptr;
     }
 
-    /// Evaluates the sides of the packet's points `position` (all kCpuPacketLanes lanes).
-    void prepare(const Vec3d* position) {
+    /// Evaluates the sides of the packet's points `position`: the first `count` lanes are
+    /// points (counted), the others spare.
+    void prepare(const Vec3d* position, int count) {
         if (winding_ == nullptr) return;
+        const WindingSignOptions& o = winding_->options();
+        if (o.certify) {
+            WindingSide side[kCpuPacketLanes];
+            certified_winding_sides_packet<kCpuPacketLanes>(winding_->view(), position, count, o.accuracy, o.certification, side);
+            int64_t stages[kWindingStages] = {};
+            for (int k = 0; k < count; ++k) {
+                inside_[k] = side[k].inside;
+                ++stages[int(side[k].stage)];
+            }
+            for (int s = 0; s < kWindingStages; ++s)
+                if (stages[s] > 0) winding_->count(WindingStage(s), stages[s]);
+            return;
+        }
         double px[kCpuPacketLanes], py[kCpuPacketLanes], pz[kCpuPacketLanes], w[kCpuPacketLanes];
         for (int k = 0; k < kCpuPacketLanes; ++k) {
             px[k] = position[k].x;
             py[k] = position[k].y;
             pz[k] = position[k].z;
         }
-        kernel_(winding_->view(), px, py, pz, winding_->options().accuracy, w);
-        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::inside()
+        kernel_(winding_->view(), px, py, pz, o.accuracy, w);
+        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::side()
+        winding_->count(WindingStage::Fast, count);
     }
 
     /// Lane k's sample `s` at p with its sign (after prepare() of its packet).
@@ -353,7 +370,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
-            packet_sign.prepare(br.position);
+            packet_sign.prepare(br.position, br.count);
             for (int k = 0; k < br.count; ++k)
                 emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
                                                                                 view.triangle_index[slot[k]]),
@@ -451,7 +468,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
             search_packet(view, certifier, position, count, pk, stats, certified, slot);
-            packet_sign.prepare(position);
+            packet_sign.prepare(position, count);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];

@@ -56,8 +56,8 @@ struct WindingSide {
 
 /// The refinement ladder after the fast evaluation (the same on every backend).
 struct WindingCertification {
-    double refine_factor = 4.0;  ///< beta grows by this factor per refinement
-    int refinements = 2;         ///< then the direct sum
+    double refine_factor = 2.0;  ///< beta grows by this factor per refinement (4, 8, 16)
+    int refinements = 3;         ///< then the direct sum
 };
 
 /// What the rounding bounds need of the mesh: 128 u (n + 8) and X (largest |coordinate|).
@@ -123,28 +123,34 @@ SDF_CPU_GPU SDF_INLINE void certified_leaf(CertifiedSum& sum, const WindingView<
     add_solid_angles(sum, s, e);
 }
 
-/// The far-field term of one child with its certified bound (truncation and rounding);
-/// false when q is not far enough (the opening rule of far_field()).
-SDF_CPU_GPU SDF_INLINE bool certified_far_field(const WindingMoments<double>& m, const Vec3d& q,
-                                                const WindingAccuracy<double>& acc, const WindingRounding& rnd,
-                                                double& value, double& bound) {
+/// The far-field term of one child at y = p~ - q, d2 = |y|^2 (q far: d2 > far_limit), with
+/// its certified bound (truncation and rounding): the one formula of certified_far_field()
+/// and of the CPU's packets (certified_winding_packet.h).
+SDF_CPU_GPU SDF_INLINE void certified_far_term(const WindingMoments<double>& m, const Vec3d& y, double d2, int order,
+                                               const WindingRounding& rnd, double& value, double& bound) {
     const double u = kWindingUnitRoundoff;
-    const Vec3d y = m.center - q;
-    const double d2 = length_squared(y);
-    if (!(d2 > far_limit(m, acc))) return false;
     const double d = sqrt(d2), inv_d = 1.0 / d, inv_d3 = inv_d * inv_d * inv_d;
-    value = far_field_value(m, y, inv_d, inv_d3, acc.order);
+    value = far_field_value(m, y, inv_d, inv_d3, order);
     const double r = m.radius * (1.0 + 8.0 * u) + 4.0 * u * rnd.scale;
     const double t = r * inv_d * (1.0 + 4.0 * u);
     const double mass = (m.area + rnd.n_factor * r * r) * inv_d * inv_d;
     const double rounding = rnd.n_factor * (m.area + r * r) * (1.0 + rnd.scale * inv_d) * inv_d * inv_d;
-    if (!(t < 0.75)) {  // the radius's rounding ate the margin (a far-away tiny cluster): no bound
-        bound = HUGE_VAL;
-        return true;
-    }
     const double one_minus_t = 1.0 - t;
-    const double series = acc.order >= 2 ? t * t * (3.0 - 2.0 * t) : t * (2.0 - t);
+    const double series = order >= 2 ? t * t * (3.0 - 2.0 * t) : t * (2.0 - t);
     bound = (mass * series / (one_minus_t * one_minus_t) + rounding) * inverse_four_pi<double>() * (1.0 + 16.0 * u);
+    // The radius's rounding ate the margin (a far-away tiny cluster): no bound.
+    if (!(t < 0.75)) bound = INFINITY;
+}
+
+/// The far-field term of one child with its certified bound; false when q is not far enough
+/// (the opening rule of far_field()).
+SDF_CPU_GPU SDF_INLINE bool certified_far_field(const WindingMoments<double>& m, const Vec3d& q,
+                                                const WindingAccuracy<double>& acc, const WindingRounding& rnd,
+                                                double& value, double& bound) {
+    const Vec3d y = m.center - q;
+    const double d2 = length_squared(y);
+    if (!(d2 > far_limit(m, acc))) return false;
+    certified_far_term(m, y, d2, acc.order, rnd, value, bound);
     return true;
 }
 

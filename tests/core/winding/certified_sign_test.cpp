@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <vector>
@@ -22,31 +23,12 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/certified_winding.h"
+#include "kernels/winding/certified_winding_packet.h"
+#include "tests/core/winding/exact_winding_long.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
 namespace {
-
-/// w(p) by Van Oosterom & Strackee in long double over every triangle, in mesh order.
-long double exact_winding_long(const PreparedMesh& m, const Vec3d& p) {
-    const long double pi4 = 4.0L * 3.141592653589793238462643383279502884L;
-    long double sum = 0;
-    for (const Int3& t : m.triangles()) {
-        long double a[3], b[3], c[3];
-        for (int k = 0; k < 3; ++k) {
-            a[k] = (long double)m.vertices()[size_t(t.x)][k] - p[k];
-            b[k] = (long double)m.vertices()[size_t(t.y)][k] - p[k];
-            c[k] = (long double)m.vertices()[size_t(t.z)][k] - p[k];
-        }
-        auto dot = [](const long double* x, const long double* y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
-        const long double bc[3] = {b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]};
-        const long double la = std::sqrt(dot(a, a)), lb = std::sqrt(dot(b, b)), lc = std::sqrt(dot(c, c));
-        const long double num = dot(a, bc);
-        const long double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-        sum += 2.0L * std::atan2(num, den);
-    }
-    return sum / pi4;
-}
 
 double distance_to_mesh(const PreparedMesh& m, const Vec3d& p) {
     double best = 1e300;
@@ -227,6 +209,37 @@ TEST(CertifiedWindingSign, TheBoundHolds) {
             const WindingEstimate<double> d = certified_winding_direct(sah.view(), p);
             ASSERT_LE(std::abs(double(d.value - w)), d.error_bound) << c.mesh.name();
             EXPECT_LT(d.error_bound, 1e-9) << c.mesh.name();  // off the surface the direct sum is tight
+        }
+    }
+}
+
+/// The CPU BVH sampler's packets (certified_winding_packet.h): every lane's side and stage,
+/// and its first estimate bit for bit, are the point's own.
+TEST(CertifiedWindingSign, PacketLanesEqualThePointEvaluation) {
+    constexpr int K = 16;
+    for (const Case& c : cases()) {
+        const WindingSign sah(c.mesh);
+        const std::vector<Vec3d> pts = test_points(c, 600, 17);
+        for (size_t first = 0; first < pts.size(); first += K) {
+            const int count = int(std::min<size_t>(K, pts.size() - first));
+            Vec3d p[K];
+            int64_t lanes[K];
+            for (int k = 0; k < K; ++k) {
+                p[k] = pts[first + size_t(k < count ? k : 0)];
+                lanes[k] = k < count;
+            }
+            WindingSide side[K];
+            certified_winding_sides_packet<K>(sah.view(), p, count, sah.options().accuracy, sah.options().certification, side);
+            double value[K], bound[K];
+            certified_winding_numbers_packet<K>(sah.view(), p, lanes, sah.options().accuracy, value, bound);
+            for (int k = 0; k < count; ++k) {
+                const WindingSide s = certified_winding_side(sah.view(), p[k], sah.options().accuracy, sah.options().certification);
+                ASSERT_EQ(side[k].inside, s.inside) << c.mesh.name() << " point " << first + size_t(k);
+                ASSERT_EQ(side[k].stage, s.stage) << c.mesh.name() << " point " << first + size_t(k);
+                const WindingEstimate<double> e = certified_winding_number(sah.view(), p[k], sah.options().accuracy);
+                ASSERT_EQ(std::memcmp(&value[k], &e.value, sizeof(double)), 0) << c.mesh.name();
+                ASSERT_EQ(std::memcmp(&bound[k], &e.error_bound, sizeof(double)), 0) << c.mesh.name();
+            }
         }
     }
 }
