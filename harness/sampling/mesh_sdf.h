@@ -75,9 +75,11 @@ public:
                         int threads) const;
 
     /// The generalized winding number of every point (Jacobson et al. 2013): about 1 inside a
-    /// closed outward mesh, 0 outside, fractional near holes. The fast evaluation with the
-    /// winding sign's accuracy (SamplerSign::winding_options), whose side of 1/2 is the
-    /// winding sign; its data are built on the first call.
+    /// closed outward mesh, 0 outside, fractional near holes. The fast evaluation at the
+    /// winding sign's first accuracy (SamplerSign::winding_options: beta 2, order 2); the
+    /// winding sign itself is the certified side of 1/2 of the exact w (certified_winding.h),
+    /// which this value may miss where it is within its error bound of 1/2. Its data are
+    /// built on the first call.
     std::vector<double> winding_numbers(const std::vector<Vec3d>& points, int threads) const;
 
 private:
