@@ -736,6 +736,7 @@ private:
             compute.end();
         }
         read_certificate(dev, certificate);
+        dev.winding.discard_counts();  // a query has no report: its points are not the next sampling's
     }
 
     void record_query_timings(const PreparedMesh& mesh, int64_t n, const EventTimer& upload, const EventTimer& compute,

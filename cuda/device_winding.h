@@ -75,6 +75,12 @@ public:
         report.winding_sign = r;
     }
 
+    /// Zeroes the counters without reading them (after point queries, which have no report).
+    void discard_counts() const {
+        if (view_.enabled() && counts_.get() != nullptr)
+            CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), 0));
+    }
+
 private:
     /// The certification, the rounding bounds' mesh figures and zeroed counters.
     void finish(const SamplerSign& sign, const MeshView<double>& mesh, cudaStream_t stream) {
