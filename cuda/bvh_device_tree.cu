@@ -1,5 +1,5 @@
-// The CUDA BVH sampler's binding: the tree built on the device (bvh_build "device", or
-// "auto" with the pseudonormal sign) or on the host and uploaded, with the winding sign's
+// The CUDA BVH sampler's binding: the tree built on the device (bvh_build "device" or
+// "auto", with either sign) or on the host and uploaded, with the winding sign's
 // moments and the float search's certificate beside it (bvh_device_tree.cuh).
 #include <future>
 #include <string>
@@ -51,18 +51,15 @@ void BoundCudaBvh::upload_host_tree() {
     if (!skipped.empty()) bvh_stats_["device_build_skipped"] = skipped;
 }
 
-/// The BVH built on the device (bvh_build "device", or "auto" with the pseudonormal sign,
-/// whose field does not depend on the tree: docs/bvh.md, "Build on the GPU"); false where
+/// The BVH built on the device (bvh_build "device" or "auto": the field does not depend on
+/// the tree, docs/bvh.md, "Build on the GPU", and docs/winding.md, the certified sign); false where
 /// the host builds it, with the reason in the provenance's bvh.device_build_skipped (also
 /// when the device tree is too deep).
 template <typename T>
 bool BoundCudaBvh::build_on_device() {
     if (options_.bvh_build == BvhBuildSite::Host) return false;
-    if (options_.bvh_build == BvhBuildSite::Auto && choose_sign_mode(mesh().report(), options_.sign).mode != SignMode::Pseudonormal) {
-        bvh_stats_["device_build_skipped"] = "bvh_build auto with the winding sign: its fast winding number may take the "
-                                             "other side of 1/2 on another tree, so the host tree keeps the field unchanged";
-        return false;
-    }
+    // Auto builds on the device for either sign: the pseudonormal sign and the certified
+    // winding sign (kernels/winding/certified_winding.h) do not depend on the tree.
     // The whole mesh first: its normals' copy from pageable memory beside the build (another
     // host thread, another stream) made the build 1.5-2 ms slower and the first call no
     // faster (H100, docs/gpu-notes.md).

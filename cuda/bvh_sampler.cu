@@ -93,6 +93,7 @@ template <typename T, typename Sink>
 int64_t BoundCudaBvh::run_blocks(const DeviceBvh<T>& dev, SlabRun& run, EventTimer& compute, Sink sink) const {
     int64_t pieces = 0;
     reset_certificate(dev);
+    dev.winding.reset_counts();
     if (kernel_ == BvhGpuKernel::Candidates)
         CUDA_CHECK(cudaMemset(candidate_stats_.get(), 0, 4 * sizeof(unsigned long long)));
     for (const GridBlock& block : run) {
@@ -140,6 +141,7 @@ void BoundCudaBvh::record_run(SlabRun& run, const DeviceBvh<T>& dev, const Event
     }
     // The float search's certificate (certify_kernel.cuh); double searches are the reference.
     read_certificate(dev, run.certificate);
+    dev.winding.read_counts(run.winding);  // the certified winding sign's, beside the search's
     run.band_skips = (kernel_ == BvhGpuKernel::Warp || kernel_ == BvhGpuKernel::Candidates) && band_skips_possible();
 }
 

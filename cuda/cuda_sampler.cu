@@ -312,6 +312,7 @@ private:
         SampledField field = unfilled_field(mesh(), lattice, run.slab, options_.precision);
         Engine<T> engine(mesh(), options_, kernel_, *device_mesh_, winding_);
         const DeviceCertifier* certifier = certifier_for<T>(largest_lattice_coordinate(lattice), engine);
+        winding_.reset_counts();
         auto sink = [&](const HostPieceResults& h) { scatter_batch(h, mesh(), field); };
         for (const GridBlock& block : run) {
             if (kernel_ == CudaKernel::Tuned) {
@@ -341,6 +342,7 @@ private:
         run.details["plan"] = engine.plan();
         run.details["device"] = describe_device(options_.device);
         if (certifier) certifier->read(run.certificate);
+        winding_.read_counts(run.winding);
         run.certified = certifier != nullptr;
         return field;
     }
@@ -370,7 +372,7 @@ private:
     std::unique_ptr<DeviceMesh<double>> device_mesh_;
     DeviceWinding winding_;
     std::unique_ptr<DeviceCertifier> certifier_;  ///< float "tuned" only
-    mutable std::mutex mutex_;                    ///< calls share the certifier's device counters
+    mutable std::mutex mutex_;                    ///< calls share the certifier's and the winding sign's device counters
 };
 
 }  // namespace

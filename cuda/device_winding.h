@@ -1,7 +1,9 @@
 /// @file device_winding.h
 /// @brief A SamplerSign's winding BVH on the GPU: its nodes, per-node moments (double) and
 /// triangle order, next to a DeviceMesh<double> whose vertices and triangles it shares;
-/// empty (pseudonormal mode) when the sign did not resolve to winding.
+/// empty (pseudonormal mode) when the sign did not resolve to winding. Also the device's
+/// counters of the certified sign (how each point's side was decided), read into a sampling's
+/// counters (SlabRun::winding) and from there into its report.
 #pragma once
 
 #include "core/sampling/sampler_sign.h"
@@ -24,7 +26,7 @@ public:
         triangle_index_.upload(bvh.bvh->triangle_index, stream);
         view_.view = {nodes_.get(), moments_.get(), triangle_index_.get(), mesh.vertices, mesh.triangles,
                       int(bvh.bvh->nodes.size())};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, stream);
     }
 
     /// As upload(), but the winding BVH's tree is `tree`, whose nodes and triangle order are
@@ -41,7 +43,7 @@ public:
         }
         moments_.upload(bvh.moments, stream);
         view_.view = {nodes, moments_.get(), triangle_index, mesh.vertices, mesh.triangles, int(tree.nodes.size())};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, stream);
     }
 
     /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
@@ -51,15 +53,48 @@ public:
         view_ = {};
         if (!sign.winding()) return;
         view_.view = {nodes, moments, triangle_index, mesh.vertices, mesh.triangles, num_nodes};
-        view_.accuracy = SamplerSign::winding_options().accuracy;
+        finish(sign, mesh, 0);
     }
 
     const WindingSignView& view() const { return view_; }
 
+    /// Zeroes the device's counters of the certified sign: before a sampling (its calls are
+    /// serialised by the bound sampler, which owns this). Nothing in pseudonormal mode.
+    void reset_counts(cudaStream_t stream = 0) const {
+        if (view_.enabled() && counts_.get() != nullptr)
+            CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), stream));
+    }
+
+    /// Adds the points the device signed since reset_counts() to `run` (a sampling's
+    /// counters, backend_sampler.h's SlabRun). Synchronises `stream`. Nothing in pseudonormal mode.
+    void read_counts(SharedWindingCounts& run, cudaStream_t stream = 0) const {
+        if (!view_.enabled() || counts_.get() == nullptr) return;
+        unsigned long long c[kWindingStages] = {};
+        counts_.download(c, kWindingStages, stream);
+        CUDA_CHECK(cudaStreamSynchronize(stream));
+        WindingSignCounts counts;
+        for (int s = 0; s < kWindingStages; ++s) counts.add(WindingStage(s), int64_t(c[s]));
+        run.add(counts);
+    }
+
 private:
+    /// The certification, the rounding bounds' mesh figures and zeroed counters.
+    void finish(const SamplerSign& sign, const MeshView<double>& mesh, cudaStream_t stream) {
+        const WindingSignOptions o = SamplerSign::winding_options();
+        view_.accuracy = o.accuracy;
+        view_.certify = o.certify;
+        view_.certification = o.certification;
+        view_.view.num_triangles = mesh.num_triangles;
+        view_.view.scale = sign.mesh_scale();
+        if (counts_.get() == nullptr) counts_.allocate(kWindingStages);
+        CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), stream));
+        view_.counts = counts_.get();
+    }
+
     DeviceBuffer<BvhNode> nodes_;
     DeviceBuffer<WindingNode<double>> moments_;
     DeviceBuffer<int32_t> triangle_index_;
+    DeviceBuffer<unsigned long long> counts_;  ///< kWindingStages: the current sampling's (scratch)
     WindingSignView view_;
 };
 

@@ -61,7 +61,7 @@ constexpr int kWarpWindingMinBlocks = 4;
 /// becomes the band's value with its sign, gradient 0 and kOutsideBandTriangle; `nearest`
 /// may then also hold the search's outside-band codes (bvh_candidates_kernel.cuh), whose
 /// points get the same values without a triangle.
-/// The winding numbers are found per warp (warp_fast_winding_value: every thread of the block,
+/// The winding sides are found per warp (warp_winding_inside: every thread of the block,
 /// in the piece or not, reaches that call; blocks are whole warps), or with `PerThread` by
 /// each thread alone (the same bits: the measurement baseline, SDF_CUDA_WINDING_PER_THREAD).
 template <typename Piece, bool Winding, bool PerThread = false>
@@ -74,22 +74,29 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
     if (in_piece) out.output_index[i] = o;
     const Vec3d p = o >= 0 ? piece.position(i) : Vec3d(0.0);
     const int n = o >= 0 ? nearest[i] : -1;
-    double w = 0.0;
+    bool winding_inside = false;
     if constexpr (Winding) {
         const bool wants = o >= 0 && (n >= 0 || n == kOutsideBandSignPerPoint);
-        if constexpr (PerThread) w = wants ? fast_winding_number(sign.view, p, sign.accuracy).value : 0.0;
-        else w = warp_fast_winding_value(sign.view, p, wants, sign.accuracy);
+        if constexpr (PerThread) {
+            if (wants) {
+                const WindingSide side = winding_side(sign, p);
+                count_winding_stage(sign, side.stage);
+                winding_inside = side.inside;
+            }
+        } else {
+            winding_inside = warp_winding_inside(sign, p, wants);
+        }
     }
     if (o < 0) return;
     if (n >= 0) {
         SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, n);
-        if constexpr (Winding) s = with_sign(s, w > 0.5);  // apply_winding_sign()'s side
+        if constexpr (Winding) s = with_sign(s, winding_inside);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
         return;
     }
     bool inside = n == kOutsideBandInside;  // a brick wholly outside the band
     if constexpr (Winding) {
-        if (n == kOutsideBandSignPerPoint) inside = w > 0.5;
+        if (n == kOutsideBandSignPerPoint) inside = winding_inside;
     }
     out.distance[i] = inside ? -band_width : band_width;
     out.gradient[i] = Vec3d(0.0);

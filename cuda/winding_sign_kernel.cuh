@@ -1,11 +1,14 @@
 /// @file winding_sign_kernel.cuh
 /// @brief The winding-number sign in the CUDA finalize kernels (sign mode "winding",
-/// core/sampling/sampler_sign.h): the fast winding number (kernels/winding/
-/// fast_winding_number.h, Barill et al. 2018) over the uploaded BVH and its moments, at the
-/// CPU WindingSign's accuracy, decides the side; distance and gradient keep their exact
-/// magnitude and direction (with_sign).
+/// core/sampling/sampler_sign.h): the certified side of 1/2 of the exact winding number
+/// (kernels/winding/certified_winding.h: the fast winding number of Barill et al. 2018 over
+/// the uploaded BVH and its moments with its rigorous bound, the stricter opening rules, the
+/// direct sum, ties outside), the CPU WindingSign's ladder, so every tree gives the same
+/// side; distance and gradient keep their exact magnitude and direction (with_sign). The
+/// points are counted by how they were decided (`counts`, four counters).
 #pragma once
 
+#include "kernels/winding/certified_winding.h"
 #include "kernels/winding/fast_winding_number.h"
 #include "kernels/winding/with_sign.h"
 
@@ -15,13 +18,30 @@ namespace sdf::cuda {
 struct WindingSignView {
     WindingView<double> view{};
     WindingAccuracy<double> accuracy{};
+    bool certify = true;  ///< false: the fast value's side (WindingSignOptions::certify)
+    WindingCertification certification{};
+    unsigned long long* counts = nullptr;  ///< kWindingStages counters (device), or null
     SDF_CPU_GPU bool enabled() const { return view.nodes != nullptr; }
 };
 
-/// `s` (evaluated at p) with the side w(p) > 1/2, as WindingSign::inside on the CPU.
+/// Counts one point decided at `stage` (one thread alone).
+__device__ inline void count_winding_stage(const WindingSignView& w, WindingStage stage) {
+    if (w.counts != nullptr) atomicAdd(&w.counts[int(stage)], 1ull);
+}
+
+/// The side of p, as WindingSign::side on the CPU (one thread alone).
+__device__ inline WindingSide winding_side(const WindingSignView& w, const Vec3d& p) {
+    if (!w.certify) return {fast_winding_number(w.view, p, w.accuracy).value > 0.5, WindingStage::Fast};
+    return certified_winding_side(w.view, p, w.accuracy, w.certification);
+}
+
+/// `s` (evaluated at p) with the side of w(p) against 1/2, as WindingSign::inside on the CPU.
 __device__ inline SignedDistanceSample<double> apply_winding_sign(const WindingSignView& w, const SignedDistanceSample<double>& s,
                                                                   const Vec3d& p) {
-    return w.enabled() ? with_sign(s, fast_winding_number(w.view, p, w.accuracy).value > 0.5) : s;
+    if (!w.enabled()) return s;
+    const WindingSide side = winding_side(w, p);
+    count_winding_stage(w, side.stage);
+    return with_sign(s, side.inside);
 }
 
 /// The fast winding number of every lane's point, fast_winding_number(v, p, acc).value bit for
@@ -70,6 +90,72 @@ __device__ inline double warp_fast_winding_value(const WindingView<double>& v, c
         }
     }
     return value;
+}
+
+/// The certified estimate (certified_winding_number's value and bound, bit for bit) of every
+/// lane's point, found by the whole warp in one traversal as warp_fast_winding_value() finds
+/// the value. Every lane of the warp must call it; a lane without a point passes wants = false.
+__device__ inline WindingEstimate<double> warp_certified_winding(const WindingView<double>& v, const Vec3d& p, bool wants,
+                                                                 const WindingAccuracy<double>& acc) {
+    constexpr unsigned kWarp = 0xffffffffu;
+    const unsigned lane_bit = 1u << (threadIdx.x & 31u);
+    const WindingRounding rnd = winding_rounding(v, p);
+    CertifiedSum sum;
+    int opened = 0;
+    int32_t stack_node[kBvhMaxDepth + 1];
+    unsigned stack_lanes[kBvhMaxDepth + 1];
+    stack_lanes[0] = __ballot_sync(kWarp, wants);
+    if (stack_lanes[0] == 0) return certified_estimate(sum, rnd, opened);
+    stack_node[0] = 0;
+    int top = 1;
+    while (top > 0) {  // warp-uniform, as in warp_fast_winding_value()
+        --top;
+        const int32_t node = stack_node[top];
+        const bool active = (stack_lanes[top] & lane_bit) != 0;
+        opened += active;
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            bool open = false;
+            if (active) {
+                double term, bound;
+                if (certified_far_field(v.moments[node].child[c], p, acc, rnd, term, bound)) sum.add(term, bound);
+                else open = true;
+            }
+            const unsigned opened_lanes = __ballot_sync(kWarp, open);
+            if (opened_lanes == 0) continue;
+            if (bvh_child_is_leaf(n, c)) {
+                if (open) certified_leaf(sum, v, n.ref[c], n.count[c], p);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack_node[top] = n.ref[c];
+                stack_lanes[top] = opened_lanes;
+                ++top;
+            }
+        }
+    }
+    return certified_estimate(sum, rnd, opened);
+}
+
+/// The side of every lane's point (WindingSign::side's bits) with the warp's traversal for the
+/// first evaluation; the lanes it does not decide refine alone (certified_winding_refine).
+/// Counts the warp's points by stage, one atomic per stage and warp. Every lane must call it.
+__device__ inline bool warp_winding_inside(const WindingSignView& w, const Vec3d& p, bool wants) {
+    constexpr unsigned kWarp = 0xffffffffu;
+    WindingSide side{false, WindingStage::Fast};
+    if (!w.certify) {
+        side.inside = warp_fast_winding_value(w.view, p, wants, w.accuracy) > 0.5;
+    } else {
+        const WindingEstimate<double> e = warp_certified_winding(w.view, p, wants, w.accuracy);
+        side.inside = e.value > 0.5;
+        if (wants && !winding_decides(e)) side = certified_winding_refine(w.view, p, w.accuracy, w.certification);
+    }
+    __syncwarp(kWarp);
+    if (w.counts != nullptr)
+        for (int s = 0; s < kWindingStages; ++s) {
+            const unsigned lanes = __ballot_sync(kWarp, wants && int(side.stage) == s);
+            if (lanes != 0 && (threadIdx.x & 31u) == 0) atomicAdd(&w.counts[s], (unsigned long long)__popc(lanes));
+        }
+    return side.inside;
 }
 
 }  // namespace sdf::cuda

@@ -50,6 +50,10 @@ void BackendSampler::finish_slab(SampledField& field, SlabRun& run, std::optiona
     for (auto it = run.details.begin(); it != run.details.end(); ++it) field.sampler.details[it.key()] = it.value();
     record_certificate(t, run.certificate);
     field.sampler.search_certificate = certificate_provenance(float_search(), run.certified, run.certificate);
+    if (sign_.winding()) {
+        const WindingSignCounts c = run.winding.load();
+        field.sampler.winding_sign = WindingSignReport{c.fast, c.refined, c.direct, c.ties};
+    }
     if (w > 0) {
         BandReport report = narrow_band_provenance(
             w, *band, run.band_skips ? "bricks skipped by the distance bound" : "post-processed");

@@ -1,8 +1,8 @@
 /// @file backend_sampler.h
 /// @brief The steps every backend's bound sampler shares (CPU and CUDA, brute force and
 /// BVH), written once: the sign resolved at binding (SamplerSign), the range checks, the
-/// slab's sampling blocks, the timings, the certificate's counters, the narrow band's
-/// counts and the provenance (SamplerReport). A backend supplies its kernels through two
+/// slab's sampling blocks, the timings, the certificate's counters, the certified winding
+/// sign's counters, the narrow band's counts and the provenance (SamplerReport). A backend supplies its kernels through two
 /// hooks: sample_blocks() fills a field from a slab's blocks, query_points() answers a
 /// point list; what they did comes back in a SlabRun (or the query's timings).
 #pragma once
@@ -49,6 +49,7 @@ struct SlabRun {
 
     int64_t computed = 0;             ///< points searched; pairs = computed x triangles (brute-force equivalent)
     CertificateCounters certificate;  ///< the float search's certificate (certified_search.h)
+    SharedWindingCounts winding;      ///< winding sign: the points signed, by how their side was decided
     bool certified = true;            ///< false: a float search that keeps its own winner (thesis, Eberly)
     SamplingTimings device;           ///< upload, kernel, download; kernel 0: the run's wall time
     /// The narrow band: the kernels stored banded values (counted afterwards), or they stored
@@ -84,7 +85,7 @@ protected:
                                                   CertificateCounters& certificate) const = 0;
 
     /// The shared ending of a slab (also of a slab stored by the backend: `field` then holds
-    /// no arrays and `band` its counts): timings, provenance, certificate, band.
+    /// no arrays and `band` its counts): timings, provenance, certificate, winding counters, band.
     void finish_slab(SampledField& field, SlabRun& run, std::optional<NarrowBandCounts> band = std::nullopt) const;
 
     const SamplerOptions& options() const { return options_; }

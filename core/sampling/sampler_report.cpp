@@ -22,6 +22,10 @@ void merge_certificate(CertificateReport& into, const CertificateReport& part) {
     into.full_double_search += part.full_double_search;
 }
 
+nlohmann::json winding_sign_to_json(const WindingSignReport& w) {
+    return {{"points", w.points()}, {"fast", w.fast}, {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}};
+}
+
 nlohmann::json band_to_json(const BandReport& b) {
     nlohmann::json j = {{"width", b.width}, {"points_in_band", b.points_in_band}, {"points_outside", b.points_outside}, {"how", b.how}};
     if (b.counts_skips) {
@@ -115,6 +119,19 @@ CertificateReport certificate_from_json(const nlohmann::json& j) {
     return c;
 }
 
+WindingSignReport winding_sign_from_json(const nlohmann::json& j) {
+    const Keys k(j, "sampler.winding_sign");
+    WindingSignReport w;
+    w.fast = k.integer("fast");
+    w.refined = k.integer("refined");
+    w.direct = k.integer("direct");
+    w.ties = k.integer("ties");
+    if (k.integer("points") != w.points())
+        throw std::runtime_error("sampler.winding_sign.points: expected fast + refined + direct + ties = " +
+                                 std::to_string(w.points()) + ", got " + j.at("points").dump());
+    return w;
+}
+
 }  // namespace
 
 void SamplerReport::merge(const SamplerReport& part) {
@@ -128,6 +145,14 @@ void SamplerReport::merge(const SamplerReport& part) {
     else if (part.band) band = part.band;
     if (search_certificate && part.search_certificate) merge_certificate(*search_certificate, *part.search_certificate);
     else if (part.search_certificate) search_certificate = part.search_certificate;
+    if (winding_sign && part.winding_sign) {
+        winding_sign->fast += part.winding_sign->fast;
+        winding_sign->refined += part.winding_sign->refined;
+        winding_sign->direct += part.winding_sign->direct;
+        winding_sign->ties += part.winding_sign->ties;
+    } else if (part.winding_sign) {
+        winding_sign = part.winding_sign;
+    }
     if (backend.empty()) {
         backend = part.backend;
         method = part.method;
@@ -151,6 +176,7 @@ void to_json(nlohmann::json& j, const SamplerReport& r) {
     }
     if (r.band) j["band"] = band_to_json(*r.band);
     if (r.search_certificate) j["search_certificate"] = certificate_to_json(*r.search_certificate);
+    if (r.winding_sign) j["winding_sign"] = winding_sign_to_json(*r.winding_sign);
 }
 
 void from_json(const nlohmann::json& j, SamplerReport& r) {
@@ -167,7 +193,9 @@ void from_json(const nlohmann::json& j, SamplerReport& r) {
     }
     if (k.has("band")) r.band = band_from_json(j.at("band"));
     if (k.has("search_certificate")) r.search_certificate = certificate_from_json(j.at("search_certificate"));
-    for (const char* key : {"backend", "method", "kernel", "precision", "points_computed", "band", "search_certificate"})
+    if (k.has("winding_sign")) r.winding_sign = winding_sign_from_json(j.at("winding_sign"));
+    for (const char* key : {"backend", "method", "kernel", "precision", "points_computed", "band", "search_certificate",
+                            "winding_sign"})
         r.details.erase(key);
 }
 

@@ -14,7 +14,8 @@
 ///   "band": {"width", "points_in_band", "points_outside", "how"
 ///            [, "probes", "bricks_skipped", "points_skipped"]},
 ///   "search_certificate": {"certified"[, "note"]
-///            [, "points", "reranked_in_double", "full_double_search", "reranked_fraction"]}
+///            [, "points", "reranked_in_double", "full_double_search", "reranked_fraction"]},
+///   "winding_sign": {"points", "fast", "refined", "direct", "ties"}
 /// An empty report (a field made from arrays, a default SampledField) is JSON null.
 #pragma once
 
@@ -46,14 +47,23 @@ struct CertificateReport {
     int64_t points = 0, reranked_in_double = 0, full_double_search = 0;
 };
 
+/// The certified winding sign (kernels/winding/certified_winding.h): points signed by the
+/// winding number, by how their side was decided: by the fast evaluation's bound, by a
+/// stricter opening rule, by the direct sum, or a tie (outside).
+struct WindingSignReport {
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0;
+    int64_t points() const { return fast + refined + direct + ties; }
+};
+
 struct SamplerReport {
     std::string backend, method, kernel, precision;  ///< empty: not made by a sampler
     int64_t points_computed = 0;
     std::optional<BandReport> band;
     std::optional<CertificateReport> search_certificate;
+    std::optional<WindingSignReport> winding_sign;  ///< in winding sign mode
     nlohmann::json details = nlohmann::json::object();  ///< every other key (see the file's comment)
 
-    bool empty() const { return backend.empty() && !band && !search_certificate && details.empty(); }
+    bool empty() const { return backend.empty() && !band && !search_certificate && !winding_sign && details.empty(); }
 
     /// Adds the report of another part of the same lattice (a slab, a rank's slab), sampled
     /// with the same options: the counters are summed (points computed, the band's counts,

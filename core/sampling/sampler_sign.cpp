@@ -15,6 +15,7 @@ const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
     external_moments_on_.clear();
+    mesh_scale_ = winding_scale(mesh);
     if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
         report_warning(auto_sign_text(mesh, choice_.reason));
     return choice_;
@@ -24,29 +25,37 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     external_moments_on_.clear();
     winding_.reset();
+    mesh_scale_ = winding_scale(mesh);
     if (choice_.mode != SignMode::Winding) return choice_;
     if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
     winding_ = std::make_shared<const WindingSign>(mesh, mesh.bvh(), winding_options());
     return choice_;
 }
 
+namespace {
+
+nlohmann::json winding_accuracy_json(const WindingSignOptions& o) {
+    nlohmann::json j = {{"beta", o.accuracy.beta}, {"order", o.accuracy.order}, {"certified", o.certify}};
+    if (o.certify)
+        j["certification"] = {{"refine_factor", o.certification.refine_factor},
+                              {"refinements", o.certification.refinements},
+                              {"ties", "outside"}};
+    return j;
+}
+
+}  // namespace
+
 nlohmann::json SamplerSign::provenance() const {
     nlohmann::json p = {{"requested", sign_mode_name(requested_)},
                         {"mode", sign_mode_name(choice_.mode)},
                         {"reason", choice_.reason}};
     if (winding_) {
-        const WindingSignOptions o = winding_options();
-        p["winding"] = {{"beta", o.accuracy.beta},
-                        {"order", o.accuracy.order},
-                        {"certified", o.certify},
-                        {"moments_seconds", winding_->winding_bvh().seconds}};
+        p["winding"] = winding_accuracy_json(winding_options());
+        p["winding"]["moments_seconds"] = winding_->winding_bvh().seconds;
     } else if (winding() && !external_moments_on_.empty()) {
-        const WindingSignOptions o = winding_options();
-        p["winding"] = {{"beta", o.accuracy.beta},
-                        {"order", o.accuracy.order},
-                        {"certified", o.certify},
-                        {"moments_seconds", external_moments_seconds_},
-                        {"moments_built_on", external_moments_on_}};
+        p["winding"] = winding_accuracy_json(winding_options());
+        p["winding"]["moments_seconds"] = external_moments_seconds_;
+        p["winding"]["moments_built_on"] = external_moments_on_;
     }
     return p;
 }

@@ -43,18 +43,27 @@ public:
     /// The winding sign of the prepared mesh; null unless the mode resolved to winding.
     const WindingSign* winding_sign() const { return winding_.get(); }
 
-    /// `s` (evaluated at p) with the winding number's side in winding mode; unchanged otherwise.
-    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p) const {
-        return winding() ? with_sign(s, winding_->inside(p)) : s;
+    /// `s` (evaluated at p) with the winding number's certified side in winding mode, the
+    /// point counted in `counts` by how its side was decided; unchanged otherwise.
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p,
+                                       WindingSignCounts& counts) const {
+        if (!winding()) return s;
+        const WindingSide side = winding_->side(p);
+        counts.add(side.stage);
+        return with_sign(s, side.inside);
     }
 
     /// {"requested", "mode", "reason"} and, in winding mode, "winding": {"beta", "order",
     /// "moments_seconds"}: for the field's sampler provenance.
     nlohmann::json provenance() const;
 
-    /// The accuracy every backend's fast winding sign uses (WindingSignOptions' default:
-    /// beta 2, order 2, uncertified), so that CPU and CUDA decide the same side.
+    /// The winding sign every backend uses (WindingSignOptions' default: certified, first
+    /// evaluation beta 2, order 2, then certified_winding.h's ladder): every backend and tree
+    /// gives the exact side of 1/2 of the winding number, ties outside.
     static WindingSignOptions winding_options() { return {}; }
+
+    /// The prepared mesh's largest |coordinate| (WindingView::scale, for device views).
+    double mesh_scale() const { return mesh_scale_; }
 
 private:
     SignMode requested_;
@@ -62,6 +71,7 @@ private:
     std::shared_ptr<const WindingSign> winding_;
     double external_moments_seconds_ = 0;
     std::string external_moments_on_;  ///< empty: the moments are winding_'s
+    double mesh_scale_ = 0;
 };
 
 /// "sign auto for mesh 'NAME' (SOURCE): REASON" when `sampler` (a field's sampler

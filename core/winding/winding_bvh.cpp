@@ -177,14 +177,22 @@ template <>
 WindingView<double> WindingBvh::view<double>(const PreparedMesh& mesh) const {
     const MeshBuffers<double>& b = mesh.buffers<double>();
     return {bvh->nodes.data(), moments.data(), bvh->triangle_index.data(), b.vertices.data(), b.triangles.data(),
-            int(bvh->nodes.size())};
+            int(bvh->nodes.size()), int(b.triangles.size()), winding_scale(mesh)};
 }
 
 template <>
 WindingView<float> WindingBvh::view<float>(const PreparedMesh& mesh) const {
     const MeshBuffers<float>& b = mesh.buffers<float>();
     return {bvh->nodes.data(), moments_float.data(), bvh->triangle_index.data(), b.vertices.data(), b.triangles.data(),
-            int(bvh->nodes.size())};
+            int(bvh->nodes.size()), int(b.triangles.size()), float(winding_scale(mesh))};
+}
+
+double winding_scale(const PreparedMesh& mesh) {
+    const Bounds3 b = mesh.bounds();
+    double s = 0;
+    if (b.empty()) return s;
+    for (int k = 0; k < 3; ++k) s = std::max(s, std::max(std::abs(b.min[k]), std::abs(b.max[k])));
+    return s;
 }
 
 }  // namespace sdf

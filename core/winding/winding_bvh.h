@@ -33,4 +33,7 @@ WindingBvh build_winding_bvh(const PreparedMesh& mesh, std::shared_ptr<const Tri
 /// Over the mesh's own BVH (PreparedMesh::bvh()).
 WindingBvh build_winding_bvh(const PreparedMesh& mesh);
 
+/// The mesh's largest |coordinate| (WindingView::scale: the certified bounds' X).
+double winding_scale(const PreparedMesh& mesh);
+
 }  // namespace sdf

@@ -42,14 +42,21 @@ WindingSign::WindingSign(const PreparedMesh& mesh, const WindingSignOptions& opt
     : WindingSign(mesh, mesh.bvh(), options) {}
 
 WindingSign::WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options)
-    : options_(options), winding_(build_winding_bvh(mesh, std::move(bvh))) {
+    : WindingSign(mesh, build_winding_bvh(mesh, std::move(bvh)), options) {}
+
+WindingSign::WindingSign(const PreparedMesh& mesh, WindingBvh winding, const WindingSignOptions& options)
+    : options_(options), winding_(std::move(winding)) {
     if (!(options.accuracy.beta > 1.0))
         throw std::invalid_argument("winding sign: beta must be > 1 (the far field needs d > r), got " +
                                     std::to_string(options.accuracy.beta));
     if (options.accuracy.order != 1 && options.accuracy.order != 2)
         throw std::invalid_argument("winding sign: order must be 1 or 2, got " + std::to_string(options.accuracy.order));
-    if (options.certify && !(options.refine_factor > 1.0))
-        throw std::invalid_argument("winding sign: refine_factor must be > 1, got " + std::to_string(options.refine_factor));
+    if (options.certify && !(options.certification.refine_factor > 1.0))
+        throw std::invalid_argument("winding sign: refine_factor must be > 1, got " +
+                                    std::to_string(options.certification.refine_factor));
+    if (options.certify && options.certification.refinements < 0)
+        throw std::invalid_argument("winding sign: refinements must be >= 0, got " +
+                                    std::to_string(options.certification.refinements));
     view_ = winding_.view<double>(mesh);
 }
 
@@ -57,21 +64,18 @@ WindingEstimate<double> WindingSign::estimate(const Vec3d& p, const WindingAccur
     return fast_winding_number(view_, p, accuracy);
 }
 
-bool WindingSign::inside(const Vec3d& p) const {
-    WindingEstimate<double> e = estimate(p);
-    if (!options_.certify) return e.value > 0.5;
-    const auto certain = [](const WindingEstimate<double>& x) { return std::abs(x.value - 0.5) > x.error_bound; };
-    if (certain(e)) return e.value > 0.5;
-    ++refined_;
-    WindingAccuracy<double> finer = options_.accuracy;
-    for (int k = 0; k < options_.max_refinements; ++k) {
-        finer.beta *= options_.refine_factor;
-        e = estimate(p, finer);
-        if (certain(e)) return e.value > 0.5;
+WindingSide WindingSign::side(const Vec3d& p) const {
+    if (!options_.certify) {
+        return {fast_winding_number(view_, p, options_.accuracy).value > 0.5, WindingStage::Fast};
     }
-    ++exact_;
-    finer.beta = std::numeric_limits<double>::infinity();
-    return estimate(p, finer).value > 0.5;
+    return certified_winding_side(view_, p, options_.accuracy, options_.certification);
+}
+
+WindingSide WindingSign::side_after(const Vec3d& p, double fast_value, double fast_bound) const {
+    WindingSide s{fast_value > 0.5, WindingStage::Fast};
+    if (options_.certify && !winding_decides(WindingEstimate<double>{fast_value, fast_bound, 0}))
+        s = certified_winding_refine(view_, p, options_.accuracy, options_.certification);
+    return s;
 }
 
 }  // namespace sdf

@@ -9,6 +9,7 @@
 
 #include "core/winding/sign_mode.h"
 #include "core/winding/winding_bvh.h"
+#include "kernels/winding/certified_winding.h"
 
 namespace sdf {
 
@@ -23,16 +24,57 @@ struct SignModeChoice {
 SignModeChoice choose_sign_mode(const MeshReport& report, SignMode requested = SignMode::Auto);
 
 struct WindingSignOptions {
-    /// Beta and order of the fast evaluation. Barill et al.'s default (beta 2, order 2)
-    /// costs about a fifth of the unsigned BVH query on the dragon (docs in the report).
+    /// Beta and order of the first (fast) evaluation: Barill et al.'s default, beta 2, order 2.
     WindingAccuracy<double> accuracy;
-    /// Certify every sign against the rigorous error bound: where |w - 1/2| is within it,
-    /// evaluate again with beta times refine_factor (up to `max_refinements` times), then
-    /// exactly. The bound is pessimistic (it sums worst cases over the accepted children),
-    /// so certification costs several fast evaluations; off, the sign is the fast value's.
-    bool certify = false;
-    double refine_factor = 2.0;
-    int max_refinements = 3;
+    /// Certify every sign (certified_winding.h): the side of 1/2 of the exact winding number,
+    /// proven by the fast evaluation's rigorous bound, else by `certification`'s stricter
+    /// opening rules, else by the direct sum; ties (w within the direct sum's bound of 1/2)
+    /// outside. Off: the fast value's side (tree-dependent; kept for measurements).
+    bool certify = true;
+    WindingCertification certification;
+};
+
+/// Points signed, by how their side was decided (certified_winding.h's ladder).
+struct WindingSignCounts {
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0;
+    void add(WindingStage stage, int64_t n = 1) {
+        switch (stage) {
+        case WindingStage::Fast: fast += n; break;
+        case WindingStage::Refined: refined += n; break;
+        case WindingStage::Direct: direct += n; break;
+        case WindingStage::Tie: ties += n; break;
+        }
+    }
+    int64_t points() const { return fast + refined + direct + ties; }
+    WindingSignCounts& operator+=(const WindingSignCounts& o) {
+        fast += o.fast;
+        refined += o.refined;
+        direct += o.direct;
+        ties += o.ties;
+        return *this;
+    }
+    WindingSignCounts operator-(const WindingSignCounts& o) const {
+        return {fast - o.fast, refined - o.refined, direct - o.direct, ties - o.ties};
+    }
+    bool operator==(const WindingSignCounts& o) const {
+        return fast == o.fast && refined == o.refined && direct == o.direct && ties == o.ties;
+    }
+};
+
+/// WindingSignCounts that several threads add to (each its own, once per chunk): a
+/// sampling's counters (core/sampling/backend_sampler.h's SlabRun).
+struct SharedWindingCounts {
+    std::atomic<int64_t> n[kWindingStages] = {};
+    void add(const WindingSignCounts& c) {
+        n[int(WindingStage::Fast)] += c.fast;
+        n[int(WindingStage::Refined)] += c.refined;
+        n[int(WindingStage::Direct)] += c.direct;
+        n[int(WindingStage::Tie)] += c.ties;
+    }
+    WindingSignCounts load() const {
+        return {n[int(WindingStage::Fast)].load(), n[int(WindingStage::Refined)].load(),
+                n[int(WindingStage::Direct)].load(), n[int(WindingStage::Tie)].load()};
+    }
 };
 
 /// The CPU winding-number sign of one mesh: build once, call inside() from any thread.
@@ -40,20 +82,25 @@ class WindingSign {
 public:
     /// Over the mesh's own BVH (PreparedMesh::bvh()).
     WindingSign(const PreparedMesh& mesh, const WindingSignOptions& options = {});
-    /// Over `bvh`, a BVH of `mesh` (mesh.bvh(), or a tree built with other options).
+    /// Over `bvh`, a BVH of `mesh` (mesh.bvh(), the host emulation of the GPU's tree, ...).
     WindingSign(const PreparedMesh& mesh, std::shared_ptr<const TriangleBvh> bvh, const WindingSignOptions& options = {});
+    /// Over a tree of `mesh` with its moments already computed (e.g. the GPU build's host
+    /// emulation, core/bvh/lbvh.h, whose moments are the device's bits).
+    WindingSign(const PreparedMesh& mesh, WindingBvh winding, const WindingSignOptions& options = {});
 
-    /// True when w(p) > 1/2: the fast value's side of 1/2, or with `certify` the side
-    /// proven by the error bound (beta raised where needed, last the exact sum).
-    bool inside(const Vec3d& p) const;
+    /// The side of p and how it was decided: certified, or the fast value's side. Callers
+    /// count the stages (WindingSignCounts) where they report them: the sign keeps no
+    /// per-call state, so concurrent samplings of one bound sampler count apart.
+    WindingSide side(const Vec3d& p) const;
+    /// The same, given the first evaluation's value and bound at p (certified_winding_number
+    /// at options().accuracy, whose bits a packet's lanes have).
+    WindingSide side_after(const Vec3d& p, double fast_value, double fast_bound) const;
+    /// True when w(p) > 1/2 (side(p).inside).
+    bool inside(const Vec3d& p) const { return side(p).inside; }
 
-    /// The fast evaluation at `accuracy` (beta = +infinity: the exact sum).
+    /// The fast evaluation at `accuracy` (beta = +infinity: the exact sum), uncertified bound.
     WindingEstimate<double> estimate(const Vec3d& p, const WindingAccuracy<double>& accuracy) const;
     WindingEstimate<double> estimate(const Vec3d& p) const { return estimate(p, options_.accuracy); }
-
-    /// With `certify`: points whose sign needed a larger beta, or the exact sum.
-    int64_t refined() const { return refined_.load(); }
-    int64_t exact_evaluations() const { return exact_.load(); }
 
     const WindingBvh& winding_bvh() const { return winding_; }
     /// What inside() evaluates: for evaluations of several points at once that must give the
@@ -65,7 +112,6 @@ private:
     WindingSignOptions options_;
     WindingBvh winding_;
     WindingView<double> view_;
-    mutable std::atomic<int64_t> refined_{0}, exact_{0};
 };
 
 }  // namespace sdf

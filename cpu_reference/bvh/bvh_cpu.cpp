@@ -34,7 +34,8 @@ private:
     std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
                                           CertificateCounters& certificate) const override {
         std::vector<PointSample> out(points.size());
-        QueryCounters counters(certificate);
+        SharedWindingCounts unreported;  // a query has no report
+        QueryCounters counters(certificate, unreported);
         const double coordinate = largest_coordinate(points, options_.threads);
         with_precision(options_.precision, [&](auto zero) {
             using T = decltype(zero);
@@ -55,7 +56,7 @@ private:
         const Lattice& lattice = run.lattice;
         SampledField field = unfilled_field(mesh(), lattice, run.slab, options_.precision);
         const double w = options_.band_width;
-        QueryCounters counters(run.certificate);
+        QueryCounters counters(run.certificate, run.winding);
         BandCounters band_counters;
         for (const GridBlock& block : run) {
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {

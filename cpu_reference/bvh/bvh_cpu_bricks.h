@@ -156,7 +156,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     for (int k = 0; k < br.count; ++k) skip = skip && !exact.outside_box(br.position[k]);
                 if (skip) {
                     for (int k = 0; k < br.count; ++k)
-                        emit_outside(br.local[k], band.winding ? band.winding->inside(br.position[k]) : ball.negative);
+                        emit_outside(br.local[k], band.winding ? packet_sign.inside(br.position[k]) : ball.negative);
                     ++skipped_bricks;
                     skipped_points += br.count;
                     continue;
@@ -174,7 +174,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
-            packet_sign.prepare(br.position);
+            packet_sign.prepare(br.position, br.count);
             for (int k = 0; k < br.count; ++k)
                 emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
                                                                                 view.triangle_index[slot[k]]),
@@ -186,6 +186,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 for (int k = 0; k < kBrick; ++k) row_seed[k] = pk.best_slot[k];
         }
         certified.add_to(counters.certificate);
+        packet_sign.add_to(counters.winding);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         band_counters.probes += probes;

@@ -58,7 +58,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
             search_packet(view, certifier, position, count, pk, stats, certified, slot);
-            packet_sign.prepare(position);
+            packet_sign.prepare(position, count);
             for (int k = 0; k < count; ++k) {
                 const int64_t i = int64_t(order[size_t(first + k)]);
                 const Vec3d& p = points[size_t(i)];
@@ -68,6 +68,7 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             done += count;
         }
         certified.add_to(counters.certificate);
+        packet_sign.add_to(counters.winding);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(done);

@@ -34,12 +34,13 @@ constexpr int64_t kChunkRows = 8;
 
 using BvhKernel = CpuBvhKernel;
 
-/// A run's search counts, summed over threads: BVH nodes visited, point-triangle tests, and
-/// the certificate's counts (the run's own, certified_search.h).
+/// A run's search counts, summed over threads: BVH nodes visited, point-triangle tests, the
+/// certificate's counts (the run's own, certified_search.h) and the winding sign's.
 struct QueryCounters {
-    explicit QueryCounters(CertificateCounters& c) : certificate(c) {}
+    QueryCounters(CertificateCounters& c, SharedWindingCounts& w) : certificate(c), winding(w) {}
     std::atomic<int64_t> nodes{0}, triangles{0};
     CertificateCounters& certificate;
+    SharedWindingCounts& winding;
 };
 
 /// A thread's counts of certified points, added to the run's CertificateCounters at the end.
@@ -101,40 +102,69 @@ struct Certifier {
     }
 };
 
-/// The sign of a packet's lanes. With the samplers' winding sign (uncertified: the fast
-/// value's side), the fast winding numbers of all kCpuPacketLanes lanes come from one
-/// traversal (fast_winding_packet.h), each lane's value the bits WindingSign::inside()
-/// computes; otherwise each point gets SamplerSign::apply().
+/// The sign of a packet's lanes. With the samplers' winding sign (certified: the exact side,
+/// certified_winding_packet.h) the sides of the packet's lanes come from one traversal per
+/// stage of the certified ladder, each lane's side and stage what WindingSign::side() gives
+/// its point; uncertified (measurements), the fast winding numbers of all kCpuPacketLanes
+/// lanes come from one traversal (fast_winding_packet.h), each lane's value the bits
+/// WindingSign::side() computes; otherwise each point gets SamplerSign::apply(). The points
+/// are counted by stage here, and added to the run's counters by add_to() (once per chunk).
 class PacketSign {
 public:
     explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
-        const WindingSign* w = sign.winding() ? sign.winding_sign() : nullptr;
-        winding_ = w != nullptr && !w->options().certify ? w : nullptr;
+        winding_ = sign.winding() ? sign.winding_sign() : nullptr;
     }
 
-    /// Evaluates the sides of the packet's points `position` (all kCpuPacketLanes lanes).
-    void prepare(const Vec3d* position) {
+    /// Evaluates the sides of the packet's points `position`: the first `count` lanes are
+    /// points (counted), the others spare.
+    void prepare(const Vec3d* position, int count) {
         if (winding_ == nullptr) return;
+        const WindingSignOptions& o = winding_->options();
+        if (o.certify) {
+            WindingSide side[kCpuPacketLanes];
+            certified_kernel_(winding_->view(), position, count, o.accuracy, o.certification, side);
+            for (int k = 0; k < count; ++k) {
+                inside_[k] = side[k].inside;
+                counts_.add(side[k].stage);
+            }
+            return;
+        }
         double px[kCpuPacketLanes], py[kCpuPacketLanes], pz[kCpuPacketLanes], w[kCpuPacketLanes];
         for (int k = 0; k < kCpuPacketLanes; ++k) {
             px[k] = position[k].x;
             py[k] = position[k].y;
             pz[k] = position[k].z;
         }
-        kernel_(winding_->view(), px, py, pz, winding_->options().accuracy, w);
-        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::inside()
+        kernel_(winding_->view(), px, py, pz, o.accuracy, w);
+        for (int k = 0; k < kCpuPacketLanes; ++k) inside_[k] = w[k] > 0.5;  // WindingSign::side()
+        counts_.add(WindingStage::Fast, count);
     }
 
     /// Lane k's sample `s` at p with its sign (after prepare() of its packet).
-    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, int k, const Vec3d& p) const {
-        return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p);
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, int k, const Vec3d& p) {
+        return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p, counts_);
+    }
+
+    /// The side of one point outside the packets (a narrow band's skipped brick), counted.
+    bool inside(const Vec3d& p) {
+        const WindingSide side = winding_->side(p);
+        counts_.add(side.stage);
+        return side.inside;
+    }
+
+    /// Adds the points counted so far to `run` and starts again.
+    void add_to(SharedWindingCounts& run) {
+        run.add(counts_);
+        counts_ = {};
     }
 
 private:
     const SamplerSign& sign_;
     const WindingSign* winding_ = nullptr;  ///< non-null: packets of winding numbers
     WindingPacketFn kernel_ = active_cpu_kernels().winding_numbers_packet;
+    CertifiedWindingPacketFn certified_kernel_ = active_cpu_kernels().winding_sides_packet;
     bool inside_[kCpuPacketLanes] = {};
+    WindingSignCounts counts_;
 };
 
 /// Evaluates n points in order: pos(i) gives the position, emit(i, sample) takes the result.
@@ -151,6 +181,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     parallel_for(n, kBvhChunk, threads, [&](int64_t begin, int64_t end) {
         BvhStats stats;
         LocalCertificate certified;
+        WindingSignCounts signed_points;
         int32_t previous = -1;
         for (int64_t i = begin; i < end; ++i) {
             const Vec3d p = pos(i);
@@ -166,9 +197,10 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             } else {
                 slot = previous = closest_triangle(view, pt, seed, stats).slot;
             }
-            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p));
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p, signed_points));
         }
         certified.add_to(counters.certificate);
+        counters.winding.add(signed_points);
         counters.nodes += stats.nodes;
         counters.triangles += stats.triangles;
         reporter.advance(end - begin);

@@ -3,7 +3,8 @@
 ///
 /// The loops (the vectorised and the Eberly brute force, the BVH point and packet
 /// traversals of kernels/bvh, in their plain and certified forms, the certified search's
-/// re-ranking in double, and the packet of fast winding numbers) are compiled once per ISA level by cpu_kernels_isa.cpp into a
+/// re-ranking in double, the packet of fast winding numbers and the packet of certified
+/// winding sides) are compiled once per ISA level by cpu_kernels_isa.cpp into a
 /// CpuKernelSet of function pointers; the samplers call them through cpu_kernels<T>() and
 /// certified_cpu_kernels(), which use the set chosen once per process: the widest level this
 /// CPU supports, or the one the environment variable SDF_CPU_ISA (v2, v3, v4) forces. Every
@@ -22,6 +23,7 @@
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/distance/search_certificate.h"
 #include "kernels/distance/signed_distance.h"
+#include "kernels/winding/certified_winding_packet.h"
 #include "kernels/winding/fast_winding_packet.h"
 
 namespace sdf {
@@ -94,12 +96,18 @@ struct CpuCertifiedKernels {
 using WindingPacketFn = void (*)(const WindingView<double>& v, const double* px, const double* py, const double* pz,
                                  const WindingAccuracy<double>& acc, double* value);
 
+/// certified_winding_sides_packet() (certified_winding_packet.h) for kCpuPacketLanes points.
+using CertifiedWindingPacketFn = void (*)(const WindingView<double>& v, const Vec3d* p, int count,
+                                          const WindingAccuracy<double>& acc, const WindingCertification& cert,
+                                          WindingSide* side);
+
 struct CpuKernelSet {
     const char* isa;  ///< "x86-64-v4", or the build's -march value in a single-target build
     CpuKernels<float> float_kernels;
     CpuKernels<double> double_kernels;
     CpuCertifiedKernels certified;
     WindingPacketFn winding_numbers_packet;
+    CertifiedWindingPacketFn winding_sides_packet;
 
     template <typename T>
     const CpuKernels<T>& get() const {

@@ -47,10 +47,11 @@ int certify_brute_force(const CpuCertifiedKernels& kernels, const TriangleSoA<fl
 /// is certified (search_certificate.h), so its triangle is the double search's; the Eberly
 /// kernel's float search is not (it ranks by its own formula), so a float run of it differs
 /// from a double run where it resolved a near-tie differently. In winding mode `sign` then
-/// gives each sample the winding number's side.
+/// gives each sample the winding number's certified side, counted in `winding`.
 template <typename T, typename PositionFn, typename EmitFn>
 void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSign& sign, int threads, bool progress,
-                     int64_t n, double point_coordinate, CertificateCounters& counters, PositionFn pos, EmitFn emit) {
+                     int64_t n, double point_coordinate, CertificateCounters& counters, SharedWindingCounts& winding,
+                     PositionFn pos, EmitFn emit) {
     const MeshBuffers<T>& buffers = mesh.buffers<T>();
     const MeshView<T> view = buffers.view();
     const MeshView<double> exact = mesh.buffers<double>().view();
@@ -86,10 +87,12 @@ void evaluate_points(const PreparedMesh& mesh, CpuKernel kernel, const SamplerSi
         } else {
             for (int k = 0; k < count; ++k) best[k] = plain.nearest_triangle_eberly(view, Vec3<T>(px[k], py[k], pz[k]));
         }
+        WindingSignCounts signed_points;
         for (int k = 0; k < count; ++k) {
             const Vec3d p = pos(begin + k);
-            emit(begin + k, sign.apply(signed_distance_to_triangle(exact, p, best[k]), p));
+            emit(begin + k, sign.apply(signed_distance_to_triangle(exact, p, best[k]), p, signed_points));
         }
+        winding.add(signed_points);
         reporter.advance(count);
     });
 }
@@ -107,10 +110,11 @@ private:
                                           CertificateCounters& certificate) const override {
         std::vector<PointSample> out(points.size());
         const double coordinate = largest_coordinate(points, options_.threads);
+        SharedWindingCounts unreported;  // a query has no report
         with_precision(options_.precision, [&](auto zero) {
             using T = decltype(zero);
             evaluate_points<T>(mesh(), kernel_, sign_, options_.threads, options_.progress, int64_t(points.size()), coordinate,
-                               certificate, [&](int64_t i) { return points[size_t(i)]; },
+                               certificate, unreported, [&](int64_t i) { return points[size_t(i)]; },
                                [&](int64_t i, const SignedDistanceSample<double>& s) {
                                    out[size_t(i)] = point_sample(mesh(), s.distance, s.gradient, s.triangle);
                                });
@@ -125,7 +129,7 @@ private:
         for (const GridBlock& block : run) {
             with_precision(options_.precision, [&](auto zero) {
                 evaluate_points<decltype(zero)>(
-                    mesh(), kernel_, sign_, options_.threads, options_.progress, block.count(), coordinate, run.certificate,
+                    mesh(), kernel_, sign_, options_.threads, options_.progress, block.count(), coordinate, run.certificate, run.winding,
                     [&](int64_t i) { return lattice.position_of_coords(block.coords(i)); },
                     [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const int64_t out = block.output_index(lattice, i);

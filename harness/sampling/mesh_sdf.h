@@ -77,11 +77,13 @@ public:
 
     /// How winding_numbers() evaluates.
     enum class Winding {
-        /// Barill et al.'s fast evaluation with the winding sign's accuracy
-        /// (SamplerSign::winding_options: beta 2, order 2), whose side of 1/2 is the winding
-        /// sign; its data are built on the first call. Not exact: off by up to a few
-        /// hundredths near overlapping parts; each value comes with a rigorous bound of its
-        /// truncation error (fast_winding_number.h, rounding aside).
+        /// Barill et al.'s fast evaluation at the winding sign's first accuracy
+        /// (SamplerSign::winding_options: beta 2, order 2); its data are built on the first
+        /// call. Not exact: off by up to a few hundredths near overlapping parts; each value
+        /// comes with a rigorous bound of its truncation error (fast_winding_number.h,
+        /// rounding aside). The winding sign is not this value's side of 1/2 but the
+        /// certified side of the exact w (certified_winding.h), which this value may miss
+        /// where it is within its bound of 1/2.
         Fast,
         /// The direct sum of every triangle's exact solid angle (Van Oosterom & Strackee,
         /// kernels/winding/solid_angle.h): O(triangles) per point.

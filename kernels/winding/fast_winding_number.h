@@ -41,6 +41,8 @@ struct WindingView {
     const Vec3<T>* vertices = nullptr;
     const Int3* triangles = nullptr;
     int num_nodes = 0;
+    int num_triangles = 0;  ///< of the mesh: the direct sum's range and the rounding bounds' n
+    T scale{};              ///< the mesh's largest |coordinate|, for the rounding bounds (certified_winding.h)
 };
 
 /// Accuracy of the fast evaluation: beta (> 1) and the expansion order (1 or 2).

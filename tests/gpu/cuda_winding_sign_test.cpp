@@ -1,15 +1,15 @@
-// The CUDA samplers' winding-number sign (sign mode "winding", cuda/winding_sign_kernel.cuh)
-// against the CPU's (WindingSign, core/winding/winding_sign.h) on a mesh of overlapping
-// closed parts (two spheres and a box through them) and on dragon-legacy.obj (self-
-// intersecting; when the data path has it): with sign "auto" both resolve to winding, and at
-// every lattice point where the fast winding number is farther from 1/2 than its rigorous
-// error bound (so the side is certain), every CUDA sampler's sign equals the CPU's and the
-// bound's, and |distance| stays the pseudonormal run's. Elsewhere (a thin shell around the
-// surface) disagreements are counted and printed, not asserted.
+// The CUDA samplers' certified winding sign (sign mode "winding", cuda/winding_sign_kernel.cuh,
+// kernels/winding/certified_winding.h) against the CPU's (WindingSign) on a mesh of
+// overlapping closed parts (two spheres and a box through them) and on dragon-legacy.obj
+// (self-intersecting; when the data path has it): with sign "auto" both resolve to winding,
+// and every CUDA sampler's field equals the CPU BVH sampler's bit for bit at every lattice
+// point, each side on its own tree (the device's PLOC tree with its device-built moments,
+// the host's SAH tree); point queries too.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -64,53 +64,49 @@ SamplerOptions options(const std::string& backend, const std::string& method, co
     return o;
 }
 
-TEST(CudaWindingSign, EqualsTheCpuSignWhereTheBoundDecides) {
+/// Bit equality of two fields (distance, gradient, triangle).
+void expect_same_bits(const SampledField& a, const SampledField& b, const std::string& what) {
+    ASSERT_EQ(a.distance.size(), b.distance.size()) << what;
+    for (size_t k = 0; k < a.distance.size(); ++k) {
+        ASSERT_EQ(std::memcmp(&a.distance[k], &b.distance[k], sizeof(double)), 0)
+            << what << " point " << k << ": " << a.distance[k] << " vs " << b.distance[k];
+        ASSERT_EQ(std::memcmp(&a.gradient[k], &b.gradient[k], sizeof(Vec3d)), 0) << what << " point " << k;
+        ASSERT_EQ(a.closest_triangle[k], b.closest_triangle[k]) << what << " point " << k;
+    }
+}
+
+/// The certified sign (certified_winding.h) is the exact side on every backend and tree: every
+/// CUDA sampler's field equals the CPU BVH sampler's bit for bit (certified float searches:
+/// the same triangle; the certified winding sign: the same side), the BVH sampler's on the
+/// device's own tree (bvh_build "device": PLOC with its moments built on the GPU) and on the
+/// host's SAH tree alike; and each counts every winding-signed point once.
+TEST(CudaWindingSign, EveryCudaSamplerAndTreeEqualsTheCpuBitForBit) {
     for (const NamedMesh& m : meshes()) {
         const Lattice lattice = fit_lattice(LatticeType::BCC, m.resolution, m.mesh.bounds(), 0.1);
         const SampledField cpu = make_sampler(options("cpu", "bvh", "", SignMode::Auto))->bind(share(m.mesh))->sample(lattice);
         ASSERT_EQ(cpu.sampler.details.at("sign").at("mode"), "winding") << m.name;
-        const SampledField pseudonormal =
-            make_sampler(options("cpu", "bvh", "", SignMode::Pseudonormal))->bind(share(m.mesh))->sample(lattice);
-        // The bound at each point, from the CPU's fast evaluation at the samplers' accuracy.
-        const WindingSign reference(m.mesh, SamplerSign::winding_options());
-        std::vector<signed char> certain_side(size_t(lattice.num_points()), -1);
-        int64_t decided = 0;
-        for (int64_t i = 0; i < lattice.num_points(); ++i) {
-            const WindingEstimate<double> e = reference.estimate(lattice.position(i));
-            if (std::abs(e.value - 0.5) > e.error_bound) {
-                certain_side[size_t(i)] = e.value > 0.5 ? 1 : 0;
-                ++decided;
-            }
-        }
-        // The bound is pessimistic (docs/winding.md: at beta 2 it decides a few percent of the
-        // dragon's lattice), so only a part of the points is checked.
-        EXPECT_GT(decided, 0) << m.name;
-        std::printf("%s: the bound decides %lld of %lld points\n", m.name.c_str(), (long long)decided,
-                    (long long)lattice.num_points());
-        const double tie_tolerance = 1e-6 * length(m.mesh.bounds().extent());
-        const std::pair<const char*, const char*> gpu_samplers[] = {
-            {"brute_force", "tuned"}, {"brute_force", "thesis"}, {"bvh", "warp"}, {"bvh", "brick"}};
-        for (const auto& [method, kernel] : gpu_samplers) {
-            const SampledField gpu = make_sampler(options("cuda", method, kernel, SignMode::Auto))->bind(share(m.mesh))->sample(lattice);
-            const std::string what = m.name + " cuda/" + method + "/" + kernel;
+        ASSERT_TRUE(cpu.sampler.winding_sign.has_value()) << m.name;
+        EXPECT_EQ(cpu.sampler.winding_sign->points(), lattice.num_points()) << m.name;
+        struct Gpu {
+            const char* method;
+            const char* kernel;
+            BvhBuildSite build;
+        };
+        const Gpu gpu_samplers[] = {{"brute_force", "tuned", BvhBuildSite::Auto}, {"brute_force", "thesis", BvhBuildSite::Auto},
+                                    {"bvh", "warp", BvhBuildSite::Host},          {"bvh", "warp", BvhBuildSite::Device},
+                                    {"bvh", "brick", BvhBuildSite::Device},       {"bvh", "warp", BvhBuildSite::Auto}};
+        for (const Gpu& g : gpu_samplers) {
+            SamplerOptions o = options("cuda", g.method, g.kernel, SignMode::Auto);
+            o.bvh_build = g.build;
+            const SampledField gpu = make_sampler(o)->bind(share(m.mesh))->sample(lattice);
+            const std::string what = m.name + " cuda/" + g.method + "/" + g.kernel + " bvh_build " + bvh_build_site_name(g.build);
             EXPECT_EQ(gpu.sampler.details.at("sign").at("mode"), "winding") << what;
-            int64_t checked = 0, undecided_differ = 0;
-            for (int64_t i = 0; i < lattice.num_points(); ++i) {
-                const size_t k = size_t(i);
-                // The float search may break a near-tie for another triangle (cuda_bvh_test.cpp).
-                ASSERT_NEAR(std::abs(gpu.distance[k]), std::abs(pseudonormal.distance[k]), tie_tolerance) << what << " point " << i;
-                if (gpu.distance[k] == 0 || cpu.distance[k] == 0) continue;
-                const bool gpu_inside = gpu.distance[k] < 0, cpu_inside = cpu.distance[k] < 0;
-                if (certain_side[k] < 0) {
-                    undecided_differ += int(gpu_inside != cpu_inside);
-                    continue;
-                }
-                ++checked;
-                ASSERT_EQ(cpu_inside, certain_side[k] == 1) << what << " CPU, point " << i;
-                ASSERT_EQ(gpu_inside, cpu_inside) << what << " point " << i;
-            }
-            std::printf("%-40s %lld points, %lld decided by the bound and equal; %lld undecided differ from the CPU\n",
-                        what.c_str(), (long long)lattice.num_points(), (long long)checked, (long long)undecided_differ);
+            if (std::string(g.kernel) != "thesis") expect_same_bits(gpu, cpu, what);  // thesis: uncertified float search
+            ASSERT_TRUE(gpu.sampler.winding_sign.has_value()) << what;
+            EXPECT_EQ(gpu.sampler.winding_sign->points(), lattice.num_points()) << what;
+            const WindingSignReport& c = *gpu.sampler.winding_sign;
+            std::printf("%-60s equal bit for bit; winding sign: fast %lld, refined %lld, direct %lld, ties %lld\n",
+                        what.c_str(), (long long)c.fast, (long long)c.refined, (long long)c.direct, (long long)c.ties);
         }
     }
 }
@@ -121,15 +117,20 @@ TEST(CudaWindingSign, QueriedPointsEqualTheCpu) {
     for (int i = 0; i <= 80; ++i)
         for (int j = 0; j <= 8; ++j) points.push_back({-1.3 + 2.6 * i / 80.0, -0.4 + 0.8 * j / 8.0, 0.05});
     const WindingSign reference(mesh, SamplerSign::winding_options());
-    const auto cpu = make_sampler(options("cpu", "brute_force", "", SignMode::Winding))->bind(share(mesh))->query(points);
-    for (const char* method : {"brute_force", "bvh"}) {
-        const auto gpu = make_sampler(options("cuda", method, "", SignMode::Winding))->bind(share(mesh))->query(points);
-        for (size_t i = 0; i < points.size(); ++i) {
-            const WindingEstimate<double> e = reference.estimate(points[i]);
-            if (!(std::abs(e.value - 0.5) > e.error_bound) || gpu[i].distance == 0) continue;
-            ASSERT_EQ(gpu[i].distance < 0, cpu[i].distance < 0) << method << " point " << i;
+    const auto cpu = make_sampler(options("cpu", "bvh", "", SignMode::Winding))->bind(share(mesh))->query(points);
+    for (size_t i = 0; i < points.size(); ++i)
+        if (cpu[i].distance != 0) ASSERT_EQ(cpu[i].distance < 0, reference.inside(points[i])) << "point " << i;
+    for (const BvhBuildSite build : {BvhBuildSite::Host, BvhBuildSite::Device})
+        for (const char* method : {"brute_force", "bvh"}) {
+            SamplerOptions o = options("cuda", method, "", SignMode::Winding);
+            o.bvh_build = build;
+            const auto gpu = make_sampler(o)->bind(share(mesh))->query(points);
+            for (size_t i = 0; i < points.size(); ++i) {
+                ASSERT_EQ(std::memcmp(&gpu[i].distance, &cpu[i].distance, sizeof(double)), 0) << method << " point " << i;
+                ASSERT_EQ(std::memcmp(&gpu[i].gradient, &cpu[i].gradient, sizeof(Vec3d)), 0) << method << " point " << i;
+                ASSERT_EQ(gpu[i].triangle, cpu[i].triangle) << method << " point " << i;
+            }
         }
-    }
 }
 
 }  // namespace

@@ -125,5 +125,40 @@ TEST(MeshProvenance, OneRecordReadBackWholeAndTheEarlierShortOneIntoItsReport) {
     EXPECT_THROW((void)nlohmann::json({{"name", "x"}, {"vertices", "many"}}).get<MeshProvenance>(), std::runtime_error);
 }
 
+/// The certified winding sign's counters (kernels/winding/certified_winding.h): summed by
+/// merge, written with their total, read back, and a total that does not add up is refused.
+TEST(SamplerReport, WindingSignCountersMergeAndRoundTrip) {
+    SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
+    a.winding_sign = WindingSignReport{90, 8, 1, 1};
+    b.winding_sign = WindingSignReport{45, 5, 0, 0};
+    SamplerReport whole;
+    whole.merge(a);
+    whole.merge(SamplerReport());
+    whole.merge(b);
+    ASSERT_TRUE(whole.winding_sign.has_value());
+    EXPECT_EQ(whole.winding_sign->fast, 135);
+    EXPECT_EQ(whole.winding_sign->refined, 13);
+    EXPECT_EQ(whole.winding_sign->direct, 1);
+    EXPECT_EQ(whole.winding_sign->ties, 1);
+    const nlohmann::json j = whole;
+    EXPECT_EQ(j.at("winding_sign").at("points"), 150);
+    const SamplerReport back = j.get<SamplerReport>();
+    ASSERT_TRUE(back.winding_sign.has_value());
+    EXPECT_EQ(back.winding_sign->points(), 150);
+    EXPECT_EQ(back.winding_sign->ties, 1);
+    EXPECT_FALSE(back.details.contains("winding_sign"));
+    nlohmann::json bad = j;
+    bad["winding_sign"]["points"] = 151;
+    try {
+        (void)bad.get<SamplerReport>();
+        FAIL() << "a total that does not add up was read";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("sampler.winding_sign.points"), std::string::npos) << e.what();
+    }
+    bad = j;
+    bad["winding_sign"]["fast"] = "many";
+    EXPECT_THROW((void)bad.get<SamplerReport>(), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace sdf

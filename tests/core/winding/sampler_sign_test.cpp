@@ -10,6 +10,7 @@
 #include <cmath>
 #include <iostream>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "core/lattice/lattice_fitting.h"
@@ -159,6 +160,53 @@ TEST(SamplerSign, QueriedPointsTakeTheWindingSignToo) {
         }
         EXPECT_GT(judged, 300) << b.name;
     }
+}
+
+/// The certified winding sign's counters (SamplerReport::winding_sign) are each sampling's
+/// own: one bound sampler sampling the same lattice from two threads at once, with point
+/// queries between, reports every point of each field once, the same counts for both and for
+/// both CPU samplers (the BVH's packets decide each point at the stage the brute force's
+/// point evaluation does), the narrow band's skipped points included.
+TEST(SamplerSign, EachSamplingCountsItsOwnPoints) {
+    const PreparedMesh mesh = prepare_mesh(Parts().mesh);
+    const Lattice lattice = fit_lattice(LatticeType::CC, {24, 16, 16}, mesh.bounds(), 0.15);
+    std::vector<Vec3d> points;
+    for (int i = 0; i < 500; ++i) points.push_back(lattice.position(i * 7 % lattice.num_points()));
+    WindingSignCounts first;
+    for (const Backend& b : kCpuSamplers)
+        for (double band : {0.0, 0.05}) {
+            SamplerOptions o = options(SignMode::Winding);
+            o.band_width = band;
+            o.threads = 1;
+            const auto bound = b.make(o)->bind(share(mesh));
+            SampledField f1, f2;
+            std::thread t1([&] { f1 = bound->sample(lattice); });
+            std::thread t2([&] {
+                (void)bound->query(points);
+                f2 = bound->sample(lattice);
+                (void)bound->query(points);
+            });
+            t1.join();
+            t2.join();
+            const std::string what = std::string(b.name) + " band " + std::to_string(band);
+            ASSERT_TRUE(f1.sampler.winding_sign.has_value()) << what;
+            ASSERT_TRUE(f2.sampler.winding_sign.has_value()) << what;
+            const WindingSignReport& c1 = *f1.sampler.winding_sign;
+            const WindingSignReport& c2 = *f2.sampler.winding_sign;
+            EXPECT_EQ(c1.points(), lattice.num_points()) << what;
+            EXPECT_EQ(c1.fast, c2.fast) << what;
+            EXPECT_EQ(c1.refined, c2.refined) << what;
+            EXPECT_EQ(c1.direct, c2.direct) << what;
+            EXPECT_EQ(c1.ties, c2.ties) << what;
+            EXPECT_GT(c1.fast, 0) << what;
+            EXPECT_GT(c1.refined + c1.direct + c1.ties, 0) << what;  // the ladder is exercised
+            EXPECT_EQ(f1.distance, f2.distance) << what;
+            const WindingSignCounts c{c1.fast, c1.refined, c1.direct, c1.ties};
+            if (first.points() == 0) first = c;
+            EXPECT_EQ(c, first) << what;
+        }
+    const SampledField pseudonormal = make_cpu_bvh_sampler(options(SignMode::Pseudonormal))->bind(share(mesh))->sample(lattice);
+    EXPECT_FALSE(pseudonormal.sampler.winding_sign.has_value());
 }
 
 TEST(SamplerSign, ClosedSingleShellMeshKeepsThePseudonormalSign) {
