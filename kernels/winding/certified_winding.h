@@ -82,14 +82,22 @@ SDF_CPU_GPU SDF_INLINE double solid_angle_rounding(double numerator, double deno
     return (kWindingPi * E / R + 8.0 * kWindingPi * u) * (1.0 + 8.0 * u);
 }
 
+/// N, D and S = |a||b||c| of one triangle seen from p: the one formula of
+/// certified_solid_angle() and of the CPU's packets (certified_winding_packet.h).
+SDF_CPU_GPU SDF_INLINE void certified_solid_angle_terms(const Vec3d& p, const Vec3d& v0, const Vec3d& v1, const Vec3d& v2,
+                                                        double& numerator, double& denominator, double& S) {
+    const Vec3d a = v0 - p, b = v1 - p, c = v2 - p;
+    const double la = length(a), lb = length(b), lc = length(c);
+    numerator = dot(a, cross(b, c));
+    S = la * lb * lc;
+    denominator = S + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+}
+
 /// Omega of one triangle seen from p, with the bound on its rounding.
 SDF_CPU_GPU SDF_INLINE double certified_solid_angle(const Vec3d& p, const Vec3d& v0, const Vec3d& v1, const Vec3d& v2,
                                                     double& error) {
-    const Vec3d a = v0 - p, b = v1 - p, c = v2 - p;
-    const double la = length(a), lb = length(b), lc = length(c);
-    const double numerator = dot(a, cross(b, c));
-    const double S = la * lb * lc;
-    const double denominator = S + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    double numerator, denominator, S;
+    certified_solid_angle_terms(p, v0, v1, v2, numerator, denominator, S);
     error = solid_angle_rounding(numerator, denominator, S);
     return 2.0 * atan2(numerator, denominator);
 }

@@ -13,17 +13,58 @@
 
 namespace sdf {
 
-/// The certified estimate of the lanes in `lanes` (1: evaluate) into value/bound.
+namespace detail {
+
+/// Adds the leaf's solid angles (slots [first, first + count)) with their rounding bounds to
+/// the lanes in `open`, as certified_leaf() does for one point: N, D and S for all lanes in a
+/// vector loop, atan2 and the bound (hypot) the scalar library calls of the open lanes.
 template <int K>
-inline void certified_winding_numbers_packet(const WindingView<double>& v, const Vec3d* p, const int64_t* lanes,
-                                             const WindingAccuracy<double>& acc, double* value_out, double* bound_out) {
-    WindingRounding rnd[K];
-    CertifiedSum sum[K];
+inline void add_certified_leaf(const WindingView<double>& v, int32_t first, int32_t count, const double* px,
+                               const double* py, const double* pz, const int64_t* open, double* value, double* bound) {
+    double s[K], e[K];
+    for (int k = 0; k < K; ++k) s[k] = e[k] = 0.0;
+    for (int32_t slot = first; slot < first + count; ++slot) {
+        const Int3 t = v.triangles[v.triangle_index[slot]];
+        const Vec3d v0 = v.vertices[t.x], v1 = v.vertices[t.y], v2 = v.vertices[t.z];
+        double numerator[K], denominator[K], S[K];
+#pragma omp simd
+        for (int k = 0; k < K; ++k)
+            certified_solid_angle_terms(Vec3d(px[k], py[k], pz[k]), v0, v1, v2, numerator[k], denominator[k], S[k]);
+        for (int k = 0; k < K; ++k)
+            if (open[k]) {
+                const double err = solid_angle_rounding(numerator[k], denominator[k], S[k]);
+                s[k] += 2.0 * atan2(numerator[k], denominator[k]);
+                e[k] += err + kWindingUnitRoundoff * fabs(s[k]);
+            }
+    }
+    for (int k = 0; k < K; ++k)
+        if (open[k]) {
+            CertifiedSum sum{value[k], bound[k]};
+            add_solid_angles(sum, s[k], e[k]);
+            value[k] = sum.value;
+            bound[k] = sum.bound;
+        }
+}
+
+}  // namespace detail
+
+/// The certified estimate of the lanes in `lanes` (1: evaluate) into value/bound, at
+/// expansion order `Order` (a constant, so that the far-field lane loop has no branch and
+/// vectorises, as fast_winding_packet.h's), on local copies of the points and sums.
+template <int K, int Order>
+inline void certified_winding_numbers_packet_at(const WindingView<double>& v, const Vec3d* p, const int64_t* lanes,
+                                                const WindingAccuracy<double>& acc, double* value_out, double* bound_out) {
+    double px[K], py[K], pz[K], scale[K], value[K], bound[K];
     int32_t stack_node[kBvhMaxDepth + 1];
     int64_t stack_lanes[kBvhMaxDepth + 1][K];
     int64_t any = 0;
+    const double n_factor = winding_rounding(v, p[0]).n_factor;  // the mesh's: the same for every lane
     for (int k = 0; k < K; ++k) {
-        rnd[k] = winding_rounding(v, p[k]);
+        px[k] = p[k].x;
+        py[k] = p[k].y;
+        pz[k] = p[k].z;
+        scale[k] = winding_rounding(v, p[k]).scale;
+        value[k] = bound[k] = 0.0;
         stack_lanes[0][k] = lanes[k];
         any |= lanes[k];
     }
@@ -38,26 +79,33 @@ inline void certified_winding_numbers_packet(const WindingView<double>& v, const
         for (int c = 0; c < 2; ++c) {
             const WindingMoments<double>& m = v.moments[node].child[c];
             const double limit = far_limit(m, acc);
-            int64_t open[K];
-            int64_t any_open = 0;
+            int64_t add[K], open[K];
+            int64_t any_add = 0, any_open = 0;
+#pragma omp simd reduction(| : any_add, any_open)
             for (int k = 0; k < K; ++k) {
-                open[k] = 0;
-                if (!active[k]) continue;
-                const Vec3d y = m.center - p[k];
-                const double d2 = length_squared(y);
-                if (d2 > limit) {
-                    double term, bound;
-                    certified_far_term(m, y, d2, acc.order, rnd[k], term, bound);
-                    sum[k].add(term, bound);
-                } else {
-                    open[k] = 1;
-                    any_open = 1;
+                const Vec3d y = m.center - Vec3d(px[k], py[k], pz[k]);
+                const int64_t far = int64_t(length_squared(y) > limit);
+                add[k] = active[k] & far;
+                open[k] = active[k] & (far ^ 1);
+                any_add |= add[k];
+                any_open |= open[k];
+            }
+            if (any_add) {
+#pragma omp simd
+                for (int k = 0; k < K; ++k) {
+                    const Vec3d y = m.center - Vec3d(px[k], py[k], pz[k]);
+                    double term, term_bound;
+                    certified_far_term(m, y, length_squared(y), Order, WindingRounding{n_factor, scale[k]}, term, term_bound);
+                    // CertifiedSum::add, selected (never adding zero: -0 would become +0)
+                    const double sum = value[k] + term;
+                    const double sum_bound = bound[k] + (term_bound + kWindingUnitRoundoff * fabs(sum));
+                    value[k] = add[k] ? sum : value[k];
+                    bound[k] = add[k] ? sum_bound : bound[k];
                 }
             }
             if (!any_open) continue;
             if (bvh_child_is_leaf(n, c)) {
-                for (int k = 0; k < K; ++k)
-                    if (open[k]) certified_leaf(sum[k], v, n.ref[c], n.count[c], p[k]);
+                detail::add_certified_leaf<K>(v, n.ref[c], n.count[c], px, py, pz, open, value, bound);
             } else {
                 SDF_DCHECK(top <= kBvhMaxDepth);
                 stack_node[top] = n.ref[c];
@@ -67,10 +115,19 @@ inline void certified_winding_numbers_packet(const WindingView<double>& v, const
         }
     }
     for (int k = 0; k < K; ++k) {
-        const WindingEstimate<double> e = certified_estimate(sum[k], rnd[k], 0);
+        const WindingEstimate<double> e = certified_estimate(CertifiedSum{value[k], bound[k]}, WindingRounding{n_factor, scale[k]}, 0);
         value_out[k] = e.value;
         bound_out[k] = e.error_bound;
     }
+}
+
+/// The certified estimate of the lanes in `lanes` (1: evaluate) into value/bound: lane k
+/// equals certified_winding_number(v, p_k, acc) bit for bit.
+template <int K>
+inline void certified_winding_numbers_packet(const WindingView<double>& v, const Vec3d* p, const int64_t* lanes,
+                                             const WindingAccuracy<double>& acc, double* value_out, double* bound_out) {
+    if (acc.order >= 2) certified_winding_numbers_packet_at<K, 2>(v, p, lanes, acc, value_out, bound_out);
+    else certified_winding_numbers_packet_at<K, 1>(v, p, lanes, acc, value_out, bound_out);
 }
 
 /// The certified sides of the first `count` lanes of p: certified_winding_side() of each,

@@ -390,7 +390,7 @@ const PreparedMesh& holed_mesh() {
 /// WindingSign's own evaluation of its point, at every level and the chosen one, at the
 /// samplers' accuracy and others: on lattice-like bricks (coherent lanes, as the samplers
 /// run it), on packets of scattered points (lanes that open different nodes), on vertices
-/// and far away.
+/// and far away. The same for the packet of certified sides (certified_winding_packet.h).
 TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
     if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
     constexpr int K = kCpuPacketLanes;
@@ -415,7 +415,7 @@ TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
             options.accuracy = acc;
             const WindingSign sign(*mesh, options);
             for (const CpuKernelSet* set : sets) {
-                int64_t bad = 0, between = 0;
+                int64_t bad = 0, between = 0, certified_bad = 0, refined = 0;
                 for (size_t first = 0; first < pts.size(); first += K) {
                     double px[K], py[K], pz[K], value[K];
                     for (int k = 0; k < K; ++k) {
@@ -429,8 +429,25 @@ TEST(CpuIsa, WindingPacketEqualsThePointEvaluationAtEveryLevel) {
                         bad += !same_bits(value[k], want);
                         between += want > 0.05 && want < 0.95;
                     }
+                    // The certified sides (certified_winding_packet.h): each lane's side and
+                    // stage, and its first estimate bit for bit, are its point's own.
+                    WindingSide side[K];
+                    set->winding_sides_packet(sign.view(), &pts[first], K, acc, options.certification, side);
+                    int64_t lanes[K];
+                    double certified[K], certified_bound[K];
+                    for (int k = 0; k < K; ++k) lanes[k] = 1;
+                    certified_winding_numbers_packet<K>(sign.view(), &pts[first], lanes, acc, certified, certified_bound);
+                    for (int k = 0; k < K; ++k) {
+                        const WindingSide want = certified_winding_side(sign.view(), pts[first + size_t(k)], acc, options.certification);
+                        certified_bad += side[k].inside != want.inside || side[k].stage != want.stage;
+                        const WindingEstimate<double> e = certified_winding_number(sign.view(), pts[first + size_t(k)], acc);
+                        certified_bad += !same_bits(certified[k], e.value) || !same_bits(certified_bound[k], e.error_bound);
+                        refined += want.stage != WindingStage::Fast;
+                    }
                 }
                 EXPECT_EQ(bad, 0) << set->isa << " beta " << acc.beta << " order " << acc.order;
+                EXPECT_EQ(certified_bad, 0) << set->isa << " beta " << acc.beta << " order " << acc.order;
+                EXPECT_GT(refined, 0) << set->isa << " beta " << acc.beta << ": the ladder should be exercised";
                 if (mesh == &holed_mesh()) {
                     EXPECT_GT(between, 100) << "the holes should give fractional winding numbers";
                 }
