@@ -37,7 +37,9 @@ int BoundCudaBvh::layers_per_slab(const GridBlock& block) const {
 template <typename T>
 BandSearch BoundCudaBvh::band_search(const DeviceBvh<T>& dev) const {
     const bool winding = dev.winding.view().enabled();
-    return {options_.band_width, dev.mesh->view(), winding, winding || solid()};
+    const FloatSearchBound& bound = mesh().search_bound();
+    const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
+    return {options_.band_width, dev.mesh->view(), winding, winding || solid(), reach};
 }
 
 template <typename T>

@@ -111,6 +111,8 @@ private:
         band.probe_sign = !sign_.winding() && solid();
         // Float searches choose among triangles within a few ulps (2^-24) of the minimum.
         band.relative_margin = float_search() ? 1e-5 : 1e-12;
+        const FloatSearchBound& bound = mesh().search_bound();
+        band.sliver_reach = float_search() ? bound.sliver_reach_float : bound.sliver_reach_double;
         const MeshView<double> exact = mesh().buffers<double>().view();
         for (const Vec3d& v : {exact.box_lo, exact.box_hi})
             band.coordinate_scale = std::max({band.coordinate_scale, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
