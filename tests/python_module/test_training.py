@@ -193,6 +193,24 @@ def test_barycentric_of_matches_the_querys_weights(torus_arrays):
     assert np.abs(w - r.barycentric).max() < 1e-9
 
 
+def test_vertex_gradient_with_weights_computed_as_on_a_gpu(torus_arrays):
+    """The GPU path (no barycentric from the query: computed from c = p - d * g) run on the CPU:
+    the same vertex gradients as with the query's weights, to rounding."""
+    v, f = torus_arrays
+    p = _smooth_points(v, f, 300, seed=16)
+    vertices = torch.tensor(v, requires_grad=True)
+    bound = sl.SDF((vertices, f))
+    r = bound.query(p)
+    grads = []
+    for weights in (torch.tensor(r.barycentric), None):
+        vertices.grad = None
+        d = _torch.differentiable_distance(bound, torch.tensor(p), torch.tensor(r.distance), torch.tensor(r.gradient),
+                                           torch.tensor(r.triangle), weights)
+        d.sum().backward()
+        grads.append(vertices.grad.numpy().copy())
+    assert np.abs(grads[0]).max() > 0.1 and np.abs(grads[0] - grads[1]).max() < 1e-9
+
+
 # ---- refit ---------------------------------------------------------------------------------------
 
 def _deformed(v, t):
