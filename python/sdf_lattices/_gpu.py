@@ -269,7 +269,10 @@ def install(core):
         if differentiable:
             if not _torch.is_tensor(points):
                 _refuse_differentiable(points)
-            result = host_query(self, _torch.as_numpy(points), winding=winding, progress=progress)
+            if winding:
+                raise ValueError("winding=True: winding numbers are a QueryResult output; differentiable=True returns "
+                                 "distance, gradient and triangle tensors (query the winding numbers without it)")
+            result = host_query(self, _torch.as_numpy(points), progress=progress)
             return _host_differentiable(self, points, result, dtype)
         return host_query(self, _torch.as_numpy(points), winding=winding, progress=progress, dtype=dtype)
 

@@ -84,6 +84,8 @@ def test_cpu_tensor_points_that_require_grad_are_read_without_differentiable(tor
     r.distance.sum().backward()  # float32 points get float32 gradients
     with pytest.raises(TypeError, match="torch tensor"):
         bound.query(p, differentiable=True)
+    with pytest.raises(ValueError, match="winding"):
+        bound.query(points, differentiable=True, winding=True)
 
 
 def test_unsigned_distance_points_gradient(torus_arrays):
