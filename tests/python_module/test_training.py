@@ -336,6 +336,31 @@ def test_float32_outputs_are_the_float64_results_rounded(torus_arrays):
         sl.sdf((v, f), p, dtype="double-ish")
 
 
+def test_the_gpu_paths_post_processing_on_cpu_tensors(torus_arrays):
+    """What the GPU path does with a device query's float64 tensors (unsigned flip, autograd,
+    dtype: sdf_lattices._gpu._finish), run on CPU tensors through a stand-in of the device view."""
+    import types
+    from sdf_lattices import _gpu
+    v, f = torus_arrays
+    p = _smooth_points(v, f, 50, seed=17)
+    view = types.SimpleNamespace(library="torch", cast=lambda a, dtype: a.to(getattr(torch, dtype)), result=lambda a: a)
+    for sign in ("auto", "none"):
+        vertices = torch.tensor(v, requires_grad=True)
+        bound = sl.SDF((vertices, f), sign=sign)
+        signed = sl.query((v, f), p)  # the device path's raw output is the signed one
+        points = torch.tensor(p, requires_grad=True)
+        r = _gpu._finish(bound, view, points, torch.tensor(signed.distance), torch.tensor(signed.gradient),
+                         torch.tensor(signed.triangle), True, "float32")
+        host = bound.query(p)
+        assert r.distance.dtype == torch.float32 and same_bits(r.distance.detach().numpy(), host.distance.astype(np.float32))
+        assert same_bits(r.gradient.numpy(), host.gradient.astype(np.float32))
+        r.distance.sum().backward()
+        assert same_bits(points.grad.numpy(), host.gradient)
+        reference = torch.tensor(v, requires_grad=True)
+        sl.sdf((reference, f), torch.tensor(p), differentiable=True, sign=sign).sum().backward()
+        assert np.abs(vertices.grad.numpy() - reference.grad.numpy()).max() < 1e-9
+
+
 # ---- CUDA (skipped without a GPU) -----------------------------------------------------------
 
 cuda = pytest.mark.skipif(not _cuda(), reason="no CUDA device, or no CUDA backend in this build")
