@@ -310,6 +310,19 @@ def test_query_batch_torch_and_errors(batch):
         sl.query_batch(sdfs[:2], [points[0], np.zeros((3, 2))])
 
 
+@pytest.mark.parametrize("options", [{}, {"surface_fraction": 0.1, "sign": "winding", "precision": "float",
+                                      "dtype": "float32"}])
+def test_data_sample_batch_through_query_batch_equals_sample_near_surface(options):
+    from sdf_lattices import data
+    v, f = box_arrays()
+    meshes = ["shape:torus", (v, f), "shape:sphere"]
+    batch = data.sample_batch(meshes, 3000, seed=30, **options)
+    for i, mesh in enumerate(meshes):
+        one = data.sample_near_surface(mesh, 3000, seed=30 + i, **options)
+        for name in data.Samples.ARRAYS:
+            assert same_bits(getattr(batch, name)[i], getattr(one, name)), name
+
+
 # ---- float32 outputs ------------------------------------------------------------------------
 
 def test_float32_outputs_are_the_float64_results_rounded(torus_arrays):
