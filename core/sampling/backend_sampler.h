@@ -67,6 +67,8 @@ public:
     /// The shared steps around sample_blocks(): band width checked, the slab's blocks, the
     /// timings, the provenance, the certificate and the band.
     SampledField sample_slab(const Lattice& lattice, const LatticeSlab& slab) const final;
+    /// Only the band's blocks, through query_points() (sparse_band_sampler.h).
+    SparseBandField sample_band_sparse(const Lattice& lattice, double width) const override;
     /// The range checks around query_points(), and the call's timings.
     std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings = nullptr) const final;
 
