@@ -69,7 +69,7 @@ SparseBandField BackendSampler::sample_band_sparse(const Lattice& lattice, doubl
     SparseBandPlan plan;
     plan.precision = options_.precision;
     plan.threads = options_.threads;
-    SparseBandField band = sample_sparse_band(*this, lattice, width, plan);
+    SparseBandField band = sample_sparse_band(*this, lattice, width, plan, band_block_kernel(width));
     band.sampler.backend = backend_;
     band.sampler.method = method_;
     band.sampler.kernel = kernel_;

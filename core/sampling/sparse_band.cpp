@@ -138,35 +138,61 @@ SampledField SparseBandField::densify(int64_t max_points) const {
         throw std::length_error("densifying a sparse band of " + std::to_string(n) + " lattice points (" +
                                 std::to_string(dense_bytes(lattice)) + " bytes) exceeds the limit of " +
                                 std::to_string(max_points) + " points");
-    SampledField field;
-    field.lattice = lattice;
-    field.precision = precision;
+    SampledField field = densify_slab(whole_lattice_slab(lattice));
     field.timings = timings;
     field.sampler = sampler;
     field.mesh = mesh;
-    field.resize(n);
-    parallel_for(layout_.block_count(), 256, 0, [&](int64_t begin, int64_t end) {
-        int64_t a = std::lower_bound(active.begin(), active.end(), begin) - active.begin();
-        int64_t m = std::lower_bound(mixed.begin(), mixed.end(), begin) - mixed.begin();
-        for (int64_t id = begin; id < end; ++id) {
-            const bool is_active = a < int64_t(active.size()) && active[size_t(a)] == id;
-            const bool is_mixed = !is_active && m < int64_t(mixed.size()) && mixed[size_t(m)] == id;
-            for (int local = 0; local < kBandBlockPoints; ++local) {
-                const int64_t out = layout_.storage_index(id, local);
-                if (out < 0) continue;
-                if (is_active) {
-                    const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
-                    field.distance[size_t(out)] = distance[v];
-                    field.gradient[size_t(out)] = gradient[v];
-                    field.closest_triangle[size_t(out)] = closest_triangle[v];
-                } else {
-                    store_outside_band(field, out, is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id), width);
+    return field;
+}
+
+SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
+    if (slab.z_begin < 0 || slab.z_end > lattice.resolution.z || slab.z_begin >= slab.z_end)
+        throw std::invalid_argument("densify_slab: planes [" + std::to_string(slab.z_begin) + ", " +
+                                    std::to_string(slab.z_end) + ") are not a slab of a lattice of " +
+                                    std::to_string(lattice.resolution.z) + " planes");
+    SampledField field;
+    field.lattice = lattice;
+    field.precision = precision;
+    field.resize(slab_point_count(lattice, slab));
+    // Each coset's planes of the slab are one contiguous range of storage (its part), and of
+    // the slab's compact order.
+    int64_t part_base = 0;
+    for (int c = 0; c < layout_.cosets(); ++c) {
+        const BandCoset& s = layout_.coset(c);
+        const StorageRange range = slab_storage(lattice, slab, c);
+        const int planes = c == 0 ? slab.z_end - slab.z_begin : slab_secondary_planes(lattice, slab);
+        if (planes > 0) {
+            const int k0 = slab.z_begin, k1 = slab.z_begin + planes;  // the coset's planes [k0, k1)
+            const int bz0 = k0 / kBandBlockDim, bz1 = (k1 - 1) / kBandBlockDim;
+            const int64_t row_blocks = int64_t(s.blocks.x) * s.blocks.y;
+            parallel_for(int64_t(bz1 - bz0 + 1) * row_blocks, 64, 0, [&](int64_t begin, int64_t end) {
+                const int64_t first_id = s.first_block + int64_t(bz0) * row_blocks + begin;
+                int64_t a = std::lower_bound(active.begin(), active.end(), first_id) - active.begin();
+                int64_t m = std::lower_bound(mixed.begin(), mixed.end(), first_id) - mixed.begin();
+                for (int64_t id = first_id; id < first_id + (end - begin); ++id) {
+                    const bool is_active = a < int64_t(active.size()) && active[size_t(a)] == id;
+                    const bool is_mixed = !is_active && m < int64_t(mixed.size()) && mixed[size_t(m)] == id;
+                    for (int local = 0; local < kBandBlockPoints; ++local) {
+                        const int64_t storage = layout_.storage_index(id, local);
+                        if (storage < range.offset || storage >= range.offset + range.count) continue;  // padding, other planes
+                        const int64_t out = part_base + (storage - range.offset);
+                        if (is_active) {
+                            const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
+                            field.distance[size_t(out)] = distance[v];
+                            field.gradient[size_t(out)] = gradient[v];
+                            field.closest_triangle[size_t(out)] = closest_triangle[v];
+                        } else {
+                            store_outside_band(field, out, is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id),
+                                               width);
+                        }
+                    }
+                    if (is_active) ++a;
+                    if (is_mixed) ++m;
                 }
-            }
-            if (is_active) ++a;
-            if (is_mixed) ++m;
+            });
         }
-    });
+        part_base += range.count;
+    }
     return field;
 }
 

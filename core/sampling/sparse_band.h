@@ -33,6 +33,7 @@
 
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampled_field.h"
+#include "kernels/lattice/lattice_slab.h"
 
 namespace sdf {
 
@@ -153,6 +154,10 @@ struct SparseBandField {
     /// as a dense sampler with SamplerOptions::band_width = W stores it (provenance copied).
     /// Throws std::length_error naming the size when the lattice has more than `max_points`.
     SampledField densify(int64_t max_points = INT64_MAX) const;
+    /// The same for one slab of the lattice (kernels/lattice/lattice_slab.h), in the slab's
+    /// compact order (sample_slab()'s): a dense field file written slab by slab under a
+    /// memory budget, without the whole lattice in memory. Provenance not copied.
+    SampledField densify_slab(const LatticeSlab& slab) const;
     /// Bytes densify() allocates for a lattice (distance, gradient, closest triangle).
     static int64_t dense_bytes(const Lattice& lattice);
 

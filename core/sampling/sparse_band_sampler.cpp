@@ -216,7 +216,7 @@ void query_in_batches(const BoundSampler& sampler, const std::vector<Vec3d>& poi
 }  // namespace
 
 SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& lattice, double width,
-                                   const SparseBandPlan& plan) {
+                                   const SparseBandPlan& plan, const BandBlockKernel& blocks) {
     const Clock::time_point start = Clock::now();
     const PreparedMesh& mesh = sampler.mesh();
     require_search_range(mesh, lattice, plan.precision);
@@ -242,6 +242,12 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     int64_t points_computed = 0;
     for (size_t first = 0; first < out.active.size(); first += size_t(blocks_per_batch)) {
         const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
+        if (blocks) {
+            for (size_t a = first; a < last; ++a)
+                for (int local = 0; local < kBandBlockPoints; ++local) points_computed += layout.storage_index(out.active[a], local) >= 0;
+            blocks(out, first, last);
+            continue;
+        }
         std::vector<Vec3d> points;
         std::vector<size_t> slot;  // value index of each point
         points.reserve((last - first) * kBandBlockPoints);
@@ -267,6 +273,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
         });
     }
     steps["active_points_seconds"] = seconds_since(t);
+    steps["active_points_by"] = blocks ? "the backend's block kernel" : "point queries";
 
     // 3. The outside.
     t = Clock::now();

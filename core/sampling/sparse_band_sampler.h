@@ -6,9 +6,11 @@
 ///    covers the rounding of the cells' bounds and of the band test's distance), rasterised
 ///    into the blocks whose cells it meets (a bit per block). A point with |d| <= W lies in
 ///    such a block; a block outside it has no triangle in its cell.
-/// 2. Their lattice points, in batches, through BoundSampler::query: the certified search, the
-///    sign rule and the evaluation of the dense path at the same positions (Lattice::
-///    position_of_coords), then the band's rule of narrow_band.h.
+/// 2. Their lattice points, in batches: through the backend's block kernel where it has one
+///    (the CPU BVH: its dense brick kernel with the band's brick skip, block by block), else
+///    through BoundSampler::query: the certified search, the sign rule and the evaluation of
+///    the dense path at the same positions (Lattice::position_of_coords), then the band's
+///    rule of narrow_band.h.
 /// 3. The outside, cell by cell of an octree over the inactive blocks: a cell that meets no
 ///    triangle and whose side is proven uniform is one sign, queried at one lattice point of
 ///    the cell with the dense rule; a single block that is not proven uniform is queried at
@@ -29,6 +31,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sparse_band.h"
@@ -43,8 +46,13 @@ struct SparseBandPlan {
     int64_t batch_points = int64_t(1) << 20; ///< lattice points per query call
 };
 
-/// Samples the band of width `width` > 0 of `lattice` with `sampler`'s point queries.
+/// A backend's block kernel: fills the values of the active blocks [first, last) of `band`
+/// (band.active) as its dense lattice kernel with the band of band.width fills those points.
+using BandBlockKernel = std::function<void(SparseBandField& band, size_t first, size_t last)>;
+
+/// Samples the band of width `width` > 0 of `lattice`: the active blocks with `blocks`, or,
+/// when it is empty, with `sampler`'s point queries; the outside with its point queries.
 SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& lattice, double width,
-                                   const SparseBandPlan& plan = {});
+                                   const SparseBandPlan& plan = {}, const BandBlockKernel& blocks = {});
 
 }  // namespace sdf
