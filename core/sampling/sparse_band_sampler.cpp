@@ -119,6 +119,8 @@ public:
 
     std::vector<Cell> uniform;      ///< cells of inactive blocks with one side
     std::vector<int64_t> per_point; ///< inactive blocks queried at every point
+    mutable int64_t refused_by_evaluation = 0;  ///< cells whose |w~ - 1/2| is within the evaluation's bound
+    mutable int64_t refused_by_gradient = 0;    ///< cells where w may cross 1/2 by the Biot-Savart bound
 
     void run() {
         const int top = 16;  // blocks per axis of the first cells
@@ -176,15 +178,30 @@ private:
         layout_.cell_box(layout_.block_id(cell.coset, {cell.hi.x - 1, cell.hi.y - 1, cell.hi.z - 1}), unused, hi);
         const Vec3d centre = (lo + hi) * 0.5;
         const double delta = 0.5 * length(hi - lo);
-        double g = 0;  // 4 pi |grad w| bound in the cell (Biot-Savart)
+        // The fast evaluation's bound is pessimistic (worst cases summed): a larger beta where
+        // it does not decide, as WindingSign's certification does.
+        WindingAccuracy<double> accuracy = winding_->options().accuracy;
+        WindingEstimate<double> w = winding_->estimate(centre, accuracy);
+        for (int k = 0; k < 3 && !(std::abs(w.value - 0.5) > w.error_bound + 0.05); ++k) {
+            accuracy.beta *= 3;
+            w = winding_->estimate(centre, accuracy);
+        }
+        const double room = std::abs(w.value - 0.5) - w.error_bound - 1e-9;  // what w may change by in the cell
+        if (!(room > 0)) {
+            ++refused_by_evaluation;
+            return false;
+        }
+        const double limit = room * 4 * 3.14159265358979323846 / delta;  // on 4 pi |grad w| (Biot-Savart)
+        double g = 0;
         for (const BoundaryEdge& e : edges_) {
             const double d = point_segment_distance(centre, e.a, e.b) - delta;
-            if (!(d > 0)) return false;
-            g += e.weight / (d * d);
+            g += d > 0 ? e.weight / (d * d) : limit;
+            if (!(g < limit)) {
+                ++refused_by_gradient;
+                return false;
+            }
         }
-        const WindingEstimate<double> w = winding_->estimate(centre);
-        const double change = g / (4 * 3.14159265358979323846) * delta;
-        return std::abs(w.value - 0.5) > w.error_bound + change + 1e-9;
+        return true;
     }
 
     const BandLayout& layout_;
@@ -368,6 +385,8 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"tiles", counts.tiles},
                                           {"inside_tiles", counts.inside_tiles},
                                           {"uniform_cells", int64_t(classify.uniform.size())},
+                                          {"cells_refused_by_evaluation", classify.refused_by_evaluation},
+                                          {"cells_refused_by_gradient", classify.refused_by_gradient},
                                           {"points_signed_per_point", per_point_points},
                                           {"outside_rule", rule_name},
                                           {"boundary_edges", int64_t(boundary_edge_count)},

@@ -170,6 +170,24 @@ TEST(SparseBand, HolesGiveMixedBlocksWithTheDenseSides) {
     EXPECT_LT(sparse.memory_bytes(), size_t(SparseBandField::dense_bytes(lattice)));
 }
 
+// Slabs of the sparse band (sdf-sample writes the field file slab by slab from it) equal the
+// dense sampler's slabs, in their compact order.
+TEST(SparseBand, SlabsEqualTheDenseSlabs) {
+    const PreparedMesh bowl = test::open_bowl();
+    for (LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        const Lattice lattice = fit_lattice(type, {37, 35, 33}, bowl.bounds(), 0.5);
+        const double w = 1.5 * lattice.spacing;
+        const auto dense = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding))->bind(share(bowl));
+        const SparseBandField sparse =
+            make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding))->bind(share(bowl))->sample_band_sparse(lattice, w);
+        for (const LatticeSlab slab : {LatticeSlab{0, 5}, LatticeSlab{5, 17}, LatticeSlab{17, 32}, LatticeSlab{32, 33}})
+            expect_same_field(dense->sample_slab(lattice, slab), sparse.densify_slab(slab),
+                              std::string(lattice_type_name(type)) + " slab " + std::to_string(slab.z_begin));
+        EXPECT_THROW(sparse.densify_slab({3, 3}), std::invalid_argument);
+        EXPECT_THROW(sparse.densify_slab({0, 34}), std::invalid_argument);
+    }
+}
+
 TEST(SparseBand, RefusesToDensifyPastTheLimitAndBadWidths) {
     const PreparedMesh torus = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
     const Lattice lattice = fit_lattice(LatticeType::CC, {20, 20, 20}, torus.bounds(), 0.3);
