@@ -393,6 +393,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"steps", steps},
                                           {"memory_bytes", int64_t(out.memory_bytes())}};
     out.timings.total = seconds_since(start);
+    if (out.timings.kernel <= 0) out.timings.kernel = out.timings.total;  // a host backend: its wall time, as BackendSampler's slabs
     out.timings.point_triangle_pairs = double(out.sampler.points_computed) * double(mesh.triangles().size());
     return out;
 }
