@@ -12,6 +12,7 @@
 #include "harness/build_config.h"
 #include "harness/distributed/mpi_transport.h"
 #include "harness/distributed/wire_codec.h"
+#include "harness/sampling/device_selection.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
 #endif
@@ -44,8 +45,10 @@ nlohmann::json describe_this_process(int rank) {
     self["gpu"] = nullptr;
 #if SDF_HAVE_CUDA
     if (devices > 0) {
-        const int device = local_rank % devices;
-        self["gpu"] = {{"device", device}, {"name", cuda::describe_device(device).value("name", std::string("?"))}};
+        const int device = local_rank % devices;  // the default selection's (device_selection.h)
+        const nlohmann::json d = cuda::describe_device(device);
+        self["gpu"] = {{"device", device}, {"name", d.value("name", std::string("?"))},
+                       {"pci_bus_id", d.value("pci_bus_id", std::string("?"))}};
     }
 #endif
     return self;
@@ -67,7 +70,9 @@ bool launched_by_mpi() {
 SamplerOptions options_for_this_rank(SamplerOptions o) {
     const Session& s = session();
     const int devices = cuda_devices();
-    if (o.backend == "cuda" && devices > 0) o.device = (o.device + s.self.value("local_rank", 0)) % devices;
+    // Local rank r of the host's ranks takes its share of the visible GPUs
+    // (device_selection.h): GPU (device + r) % count by default, a share of "devices".
+    o = place_rank_on_devices(o, s.self.value("local_rank", 0), s.self.value("local_size", 1), devices);
     if (o.threads == 0) o.threads = std::max(1, resolve_thread_count(0) / std::max(1, s.self.value("local_size", 1)));
     if (s.rank != 0) o.progress = false;  // one progress line per run: the root's
     return o;

@@ -15,11 +15,20 @@
 namespace sdf {
 namespace {
 
-/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str or None; the codec
-/// then checks it against the key's domain.
+/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str, None, or a list or
+/// tuple of those (devices=[0, 1]); the codec then checks it against the key's domain.
 nlohmann::json keyword_json(const std::string& call, const std::string& key, const py::handle& value) {
     PyObject* v = value.ptr();
     if (value.is_none()) return nullptr;
+    if (PyList_Check(v) || PyTuple_Check(v)) {
+        nlohmann::json items = nlohmann::json::array();
+        for (const py::handle item : value) {
+            if (PyList_Check(item.ptr()) || PyTuple_Check(item.ptr()))
+                throw py::type_error(call + ": key '" + key + "': expected a flat list, got " + std::string(py::repr(value)));
+            items.push_back(keyword_json(call, key, item));
+        }
+        return items;
+    }
     if (PyBool_Check(v)) return v == Py_True;
     if (PyIndex_Check(v)) {
         int overflow = 0;
@@ -31,7 +40,7 @@ nlohmann::json keyword_json(const std::string& call, const std::string& key, con
     }
     if (PyFloat_Check(v) || py::hasattr(value, "__float__")) return value.cast<double>();
     if (PyUnicode_Check(v)) return value.cast<std::string>();
-    throw py::type_error(call + ": key '" + key + "': expected a str, a number or a bool, got " +
+    throw py::type_error(call + ": key '" + key + "': expected a str, a number, a bool or a list, got " +
                          std::string(Py_TYPE(v)->tp_name) + " " + std::string(py::repr(value)));
 }
 
