@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <exception>
 #include <stdexcept>
 #include <thread>
@@ -80,7 +81,7 @@ void on_each_device(const std::vector<int>& devices, size_t n, const std::functi
         if (!errors[i]) continue;
         try {
             std::rethrow_exception(errors[i]);
-        } catch (const std::invalid_argument& e) {
+        } catch (const std::invalid_argument&) {
             throw;  // the caller's mistake (a point out of range): the same message as one device
         } catch (const std::exception& e) {
             throw std::runtime_error("CUDA device " + std::to_string(devices[i]) + ": " + e.what());
@@ -171,6 +172,74 @@ public:
         return field;
     }
 
+    /// sdf-sample's path: each device's stored bytes (where its sampler makes them) copied to
+    /// their places in one buffer; nullopt where the samplers store nothing (then sample_slab).
+    std::optional<StoredSlab> sample_slab_stored(const Lattice& lattice, const LatticeSlab& slab,
+                                                 const StoredLayout& layout) const override {
+        const auto t0 = std::chrono::steady_clock::now();
+        std::string why_not;
+        const int parts = device_parts(slab_point_count(lattice, slab), int(bound_.size()), min_points_, why_not);
+        if (parts == 1 || slab.z_end - slab.z_begin < 2) {
+            if (why_not.empty()) why_not = "one z-plane";
+            std::optional<StoredSlab> one = bound_[0]->sample_slab_stored(lattice, slab, layout);
+            if (one)
+                one->info.sampler.details["devices"] = {
+                    {"count", bound_.size()}, {"split", false}, {"why_not", why_not},
+                    {"parts", {with_planes(part_record(describe_(devices_[0]), one->info.timings, seconds_since(t0), one->points), slab)}}};
+            return one;
+        }
+        std::string estimate;
+        const std::vector<double> cost = plane_costs(mesh(), lattice, options_, estimate, slab);
+        const std::vector<LatticeSlab> subs = split_slab(cost, slab, parts);
+        const int64_t points = slab_point_count(lattice, slab);
+        const size_t vb = layout.value_bytes();
+        auto bytes = std::make_shared<std::vector<char>>(size_t(points) * layout.bytes_per_point());
+        char* distance = bytes->data();
+        char* gradient = layout.gradient ? distance + size_t(points) * vb : nullptr;
+        char* triangle = layout.closest_triangle ? distance + size_t(points) * vb * (layout.gradient ? 4 : 1) : nullptr;
+        std::vector<std::optional<StoredSlab>> got(subs.size());
+        std::vector<nlohmann::json> records(subs.size());
+        on_each_device(devices_, subs.size(), [&](size_t i) {
+            const auto start = std::chrono::steady_clock::now();
+            got[i] = bound_[i]->sample_slab_stored(lattice, subs[i], layout);
+            if (!got[i]) return;
+            const StoredSlab& part = *got[i];
+            int64_t from = 0;
+            for (int p = 0; p < 2; ++p) {
+                const StorageRange r = sub_slab_storage(lattice, slab, subs[i], p);
+                const size_t n = size_t(r.count), at = size_t(r.offset), f = size_t(from);
+                std::memcpy(distance + at * vb, part.distance + f * vb, n * vb);
+                if (gradient) std::memcpy(gradient + 3 * at * vb, part.gradient + 3 * f * vb, 3 * n * vb);
+                if (triangle) std::memcpy(triangle + at * 4, part.closest_triangle + f * 4, n * 4);
+                from += r.count;
+            }
+            records[i] = with_planes(part_record(describe_(devices_[i]), part.info.timings, seconds_since(start), part.points), subs[i]);
+            got[i]->storage.reset();  // the device's pinned bytes go back to its sampler now
+        });
+        for (const auto& g : got)
+            if (!g) return std::nullopt;  // these samplers store nothing: sample_slab() then
+        StoredSlab out;
+        SamplerReport merged;
+        SamplingTimings timings;
+        for (const auto& g : got) {  // in slab order: the details are the first part's
+            merged.merge(g->info.sampler);
+            add_part_timings(timings, g->info.timings);
+            out.band.in_band += g->band.in_band;
+            out.band.outside += g->band.outside;
+        }
+        out.info = std::move(got[0]->info);  // lattice, precision, mesh
+        out.info.sampler = std::move(merged);
+        out.info.timings = timings;
+        out.info.sampler.details["devices"] = {{"count", bound_.size()}, {"split", true}, {"cost_estimate", estimate}, {"parts", records}};
+        out.info.timings.total = seconds_since(t0);
+        out.points = points;
+        out.distance = distance;
+        out.gradient = gradient;
+        out.closest_triangle = triangle;
+        out.storage = bytes;
+        return out;
+    }
+
     std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings) const override {
         std::string why_not;
         const int parts = device_parts(int64_t(points.size()), int(bound_.size()), min_points_, why_not);
@@ -252,6 +321,7 @@ public:
             SamplerOptions one = options;
             one.device = d;
             one.devices = DeviceSelection{};
+            one.progress = options.progress && samplers_.empty();  // one progress line: the first device's
             samplers_.push_back(make_one(one));
         }
     }

@@ -90,8 +90,30 @@ TEST(MultiGpu, TwoDevicesInOneProcessGiveOneDevicesBytes) {
                 ASSERT_EQ(d.at("parts").size(), 2u) << what;
                 EXPECT_EQ(d.at("parts")[0].at("device").at("index"), 0);
                 EXPECT_EQ(d.at("parts")[1].at("device").at("index"), 1);
-                if (band == 0) EXPECT_EQ(b.sampler.points_computed, a.sampler.points_computed) << what;
+                if (band == 0) {
+                    EXPECT_EQ(b.sampler.points_computed, a.sampler.points_computed) << what;
+                }
             }
+}
+
+// sdf-sample's path: the slab's bytes as the field file stores them, made on each device.
+TEST(MultiGpu, TwoDevicesStoreOneDevicesFileBytes) {
+    for (const Lattice& lattice : lattices())
+        for (const bool float32 : {true, false}) {
+            const StoredLayout layout{float32, true, true};
+            SamplerOptions two = on("bvh", 0);
+            two.devices.list = {0, 1};
+            const LatticeSlab slab{5, lattice.resolution.z - 3};
+            const auto a = make_sampler(on("bvh", 0))->bind(torus())->sample_slab_stored(lattice, slab, layout);
+            const auto b = make_sampler(two)->bind(torus())->sample_slab_stored(lattice, slab, layout);
+            ASSERT_TRUE(a && b);
+            ASSERT_EQ(a->points, b->points);
+            const size_t n = size_t(a->points), vb = layout.value_bytes();
+            EXPECT_EQ(0, std::memcmp(a->distance, b->distance, n * vb));
+            EXPECT_EQ(0, std::memcmp(a->gradient, b->gradient, 3 * n * vb));
+            EXPECT_EQ(0, std::memcmp(a->closest_triangle, b->closest_triangle, n * 4));
+            EXPECT_TRUE(b->info.sampler.details.at("devices").at("split").get<bool>());
+        }
 }
 
 TEST(MultiGpu, TwoDevicesAnswerPointQueriesAsOne) {

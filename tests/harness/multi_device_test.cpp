@@ -219,7 +219,9 @@ TEST(MultiDeviceSampler, FieldsEqualOneDevicesByteForByte) {
                 expect_same_bytes(one, many, what);
                 // The BVH's brick skip depends on where a slab cuts the bricks (as for MPI
                 // ranks, docs/distributed.md): with a band only the band's counts must agree.
-                if (band == 0) EXPECT_EQ(many.sampler.points_computed, one.sampler.points_computed) << what;
+                if (band == 0) {
+                    EXPECT_EQ(many.sampler.points_computed, one.sampler.points_computed) << what;
+                }
                 if (one.sampler.band) {
                     ASSERT_TRUE(many.sampler.band) << what;
                     EXPECT_EQ(many.sampler.band->points_in_band, one.sampler.band->points_in_band) << what;
