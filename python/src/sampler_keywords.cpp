@@ -15,12 +15,14 @@
 namespace sdf {
 namespace {
 
-/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str, None, or a list or
-/// tuple of those (devices=[0, 1]); the codec then checks it against the key's domain.
+/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str, None, or for a key
+/// that takes a list (devices=[0, 1]) a list or tuple of those; the codec then checks it
+/// against the key's domain.
 nlohmann::json keyword_json(const std::string& call, const std::string& key, const py::handle& value) {
     PyObject* v = value.ptr();
     if (value.is_none()) return nullptr;
-    if (PyList_Check(v) || PyTuple_Check(v)) {
+    static const nlohmann::json defaults = sampler_options_to_json(SamplerOptions{});
+    if ((PyList_Check(v) || PyTuple_Check(v)) && defaults.contains(key) && defaults.at(key).is_array()) {
         nlohmann::json items = nlohmann::json::array();
         for (const py::handle item : value) {
             if (PyList_Check(item.ptr()) || PyTuple_Check(item.ptr()))
@@ -40,7 +42,7 @@ nlohmann::json keyword_json(const std::string& call, const std::string& key, con
     }
     if (PyFloat_Check(v) || py::hasattr(value, "__float__")) return value.cast<double>();
     if (PyUnicode_Check(v)) return value.cast<std::string>();
-    throw py::type_error(call + ": key '" + key + "': expected a str, a number, a bool or a list, got " +
+    throw py::type_error(call + ": key '" + key + "': expected a str, a number or a bool, got " +
                          std::string(Py_TYPE(v)->tp_name) + " " + std::string(py::repr(value)));
 }
 

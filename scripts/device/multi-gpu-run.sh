@@ -43,9 +43,9 @@ row() {  # label, command...: runs it, times it, appends the field's timings to 
     local t0=$(date +%s.%N)
     "$@" --no-cache --quiet --output-root "$FIELDS" > "$OUT/$label.log" 2>&1
     local rc=$? t1=$(date +%s.%N)
-    python3 - "$label" "$rc" "$(echo "$t1 - $t0" | bc)" "$FIELDS" >> "$OUT/rows.txt" <<'PY'
+    python3 - "$label" "$rc" "$t0" "$t1" "$FIELDS" >> "$OUT/rows.txt" <<'PY'
 import glob, json, sys
-label, rc, wall, root = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
+label, rc, wall, root = sys.argv[1], int(sys.argv[2]), float(sys.argv[4]) - float(sys.argv[3]), sys.argv[5]
 m = glob.glob(f"{root}/*/*/metrics.json")
 if rc != 0 or not m:
     print(f"| {label} | failed (exit {rc}) | | | | |"); sys.exit()

@@ -131,7 +131,7 @@ if [ "$case_name" = gpu ]; then
     # byte, each rank on its own device. Skipped (77) below two visible GPUs.
     gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU' || true)
     [ "${gpus:-0}" -ge 2 ] || { echo "$gpus GPU(s) visible, this test needs 2: skipped"; exit 77; }
-    sed -e 's/"backend": "cpu"/"backend": "cuda"/' -e 's/\[11, 9, 13\]/[80, 80, 80]/' -e 's/\[8, 7, 18\]/[48, 48, 96]/' \
+    sed -e 's/"backend": "cpu"/"backend": "cuda"/' -e 's/\[11, 9, 13\]/[96, 96, 96]/' -e 's/\[8, 7, 18\]/[64, 64, 128]/' \
         "$work/mpi_fields.json" > "$work/gpu.json"
     sed 's/"backend": "cuda"/"backend": "cuda", "devices": "all"/' "$work/gpu.json" > "$work/gpu_all.json"
     sed -i 's/"name": "mpi_fields"/"name": "mpi_fields_all"/' "$work/gpu_all.json"
