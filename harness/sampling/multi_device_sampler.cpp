@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstring>
 #include <exception>
+#include <future>
 #include <stdexcept>
 #include <thread>
 
@@ -141,7 +142,13 @@ public:
         std::string estimate;
         const std::vector<double> cost = plane_costs(mesh(), lattice, options_, estimate, slab);
         const std::vector<LatticeSlab> subs = split_slab(cost, slab, parts);
-        SampledField field = unfilled_field(mesh(), lattice, slab, options_.precision);
+        // The field's arrays (36 bytes a point, each page mapped at its first write) are made
+        // on another thread while the devices compute, as one device's sampler does.
+        require_search_range(mesh(), lattice, options_.precision);
+        SampledField field;
+        const std::shared_future<void> made = std::async(std::launch::async, [&] {
+            field = unfilled_field(mesh(), lattice, slab, options_.precision);
+        }).share();
         std::vector<SamplerReport> reports(subs.size());
         std::vector<SamplingTimings> timings(subs.size());
         std::vector<nlohmann::json> records(subs.size());
@@ -149,6 +156,7 @@ public:
         on_each_device(devices_, subs.size(), [&](size_t i) {
             const auto start = std::chrono::steady_clock::now();
             SampledField part = bound_[i]->sample_slab(lattice, subs[i]);
+            made.get();
             int64_t from = 0;
             for (int p = 0; p < 2; ++p) {  // its primary, then its secondary points
                 const StorageRange r = sub_slab_storage(lattice, slab, subs[i], p);
@@ -162,6 +170,7 @@ public:
             records[i] = with_planes(part_record(describe_(devices_[i]), part.timings, seconds_since(start), part.size()), subs[i]);
             if (i == 0) provenance = part.mesh;
         });
+        made.get();  // rethrows a failed allocation (also when every device failed first)
         SamplerReport merged;
         for (const SamplerReport& r : reports) merged.merge(r);  // in slab order: the details are the first part's
         merged.details["devices"] = {{"count", bound_.size()}, {"split", true}, {"cost_estimate", estimate}, {"parts", records}};
