@@ -147,7 +147,7 @@ void BoundCudaBvh::record_run(SlabRun& run, const DeviceBvh<T>& dev, const Event
 
 SampledField BoundCudaBvh::sample_blocks(SlabRun& run) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     return with_precision(options_.precision, [&](auto zero) { return sample_as<decltype(zero)>(run); });
 }
 
@@ -198,7 +198,7 @@ SampledField BoundCudaBvh::sample_as(SlabRun& run) const {
 std::optional<StoredSlab> BoundCudaBvh::sample_slab_stored(const Lattice& lattice, const LatticeSlab& slab,
                                                            const StoredLayout& layout) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     SlabRun run(lattice, slab, options_.bcc_strategy);
     StoredSlab stored = with_precision(options_.precision, [&](auto zero) { return sample_stored_as<decltype(zero)>(run, layout); });
     finish_slab(stored.info, run, stored.band);

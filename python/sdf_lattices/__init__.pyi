@@ -33,6 +33,7 @@ class SamplerKeywords(TypedDict, total=False):
     threads: int                  # 0 = all cores
     bcc_strategy: str             # "two_grids", "double_resolution"
     device: int                   # CUDA device ordinal
+    devices: Union[str, Sequence[int]]  # "all" or [0, 1]: several GPUs of this process; [] = device
     max_points_per_piece: int     # 0 = automatic
     max_triangles_per_chunk: int  # 0 = automatic
     points_per_thread: int        # 0, 1, 2, 4, 8
