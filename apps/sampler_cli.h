@@ -26,7 +26,7 @@ public:
         std::string& text = texts_[key];
         CLI::Option* option = app.add_option(flag, text, help);
         const nlohmann::json& d = defaults.at(key);
-        option->type_name(d.is_string() ? "TEXT" : d.is_boolean() ? "BOOL" : d.is_number_integer() ? "INT" : "FLOAT");
+        option->type_name(d.is_string() ? "TEXT" : d.is_boolean() ? "BOOL" : d.is_number_integer() ? "INT" : d.is_array() ? "LIST" : "FLOAT");
         if (!(d.is_string() && d.get<std::string>().empty()))
             option->default_str(d.is_string() ? d.get<std::string>() : d.dump());
         const std::vector<std::string> choices = sampler_option_choices(key);
@@ -43,7 +43,7 @@ public:
         for (const auto& [key, option] : options_) {
             if (option->count() == 0) continue;
             const std::string& text = texts_.at(key);
-            if (defaults.at(key).is_string()) {
+            if (defaults.at(key).is_string() || defaults.at(key).is_array()) {  // a list's text ("0,1", "all") too
                 j[key] = text;
             } else {
                 nlohmann::json parsed = nlohmann::json::parse(text, nullptr, false);

@@ -74,6 +74,10 @@ int main(int argc, char** argv) {
     sampler.add(app, "--backend", "backend", "sampler backend (auto: cuda when a GPU is present, else cpu)");
     sampler.add(app, "--kernel", "kernel", "backend kernel (" + sdf::sampler_kernels_help() + ")");
     sampler.add(app, "--threads", "threads", "CPU threads (0 = all)");
+    sampler.add(app, "--device", "device", "CUDA device ordinal (with the default --devices)");
+    sampler.add(app, "--devices", "devices",
+                "several GPUs of this machine: all, or a list such as 0,1 (the work split over them, the results "
+                "one GPU's bit for bit)");
     sampler.add(app, "--precision", "precision", "float or double");
     sampler.add(app, "--sign", "sign",
                 "sign mode: pseudonormal, winding (generalized winding number > 1/2), or auto (pseudonormal where "

@@ -1,6 +1,6 @@
 // sdf-sample MESH --resolution N|NX NY NZ --out NAME.json [--lattice cc|bcc] [--margin F]
 //            [--method bvh|brute_force] [--backend auto|cpu|cuda] [--precision float|double]
-//            [--sign auto|pseudonormal|winding] [--band W] [--memory-budget SIZE]
+//            [--sign auto|pseudonormal|winding] [--band W [--sparse]] [--memory-budget SIZE]
 //            [--channels distance,gradient,closest_triangle] [--dtype float32|float64]
 //            [--overwrite] [--dry-run] [--quiet]
 //
@@ -9,7 +9,9 @@
 // peak memory stays under the budget whatever the lattice's size
 // (harness/sampling/streamed_sampling.h, docs/large-lattices.md). The channel files equal
 // the in-memory writer's byte for byte. --dry-run prints the plan (slabs, memory, output
-// size) and exits.
+// size) and exits. --sparse (with --band W) samples only the blocks of 8^3 points within W of a
+// triangle and signs the rest per block (core/sampling/sparse_band_sampler.h); the field file,
+// the same bytes, is then written slab by slab from the sparse band.
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
@@ -34,6 +36,7 @@
 #include "harness/io/atomic_file.h"
 #include "harness/resources/memory_budget.h"
 #include "harness/sampling/sampler_table.h"
+#include "harness/sampling/sparse_band_slabs.h"
 #include "harness/sampling/streamed_sampling.h"
 
 namespace {
@@ -72,7 +75,7 @@ int main(int argc, char** argv) {
     double margin = 0.1;
     int max_planes = 0;
     sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
-    bool overwrite = false, dry_run = false, quiet = false;
+    bool overwrite = false, dry_run = false, quiet = false, sparse = false;
     app.add_option("mesh", mesh_arg, "mesh file (" + sdf::mesh_formats_help() + ") or shape:NAME")->required();
     app.add_option("--lattice", lattice_type, "lattice type: " + sdf::quoted_alternatives(sdf::lattice_type_names()))
         ->check(CLI::IsMember(sdf::lattice_type_names()))->capture_default_str();
@@ -88,11 +91,18 @@ int main(int argc, char** argv) {
     sampler.add(app, "--backend", "backend", "cpu, cuda, or auto (cuda when a GPU is present)");
     sampler.add(app, "--kernel", "kernel", "backend kernel (" + sdf::sampler_kernels_help() + ")");
     sampler.add(app, "--threads", "threads", "CPU threads (0 = all)");
+    sampler.add(app, "--device", "device", "CUDA device ordinal (with the default --devices)");
+    sampler.add(app, "--devices", "devices",
+                "several GPUs of this machine: all, or a list such as 0,1 (the work split over them, the results "
+                "one GPU's bit for bit)");
     sampler.add(app, "--precision", "precision", "float or double");
     sampler.add(app, "--sign", "sign", "sign mode: auto, pseudonormal or winding");
     sampler.add(app, "--band", "band_width",
                 "narrow band width in mesh units: exact values where |d| <= W, elsewhere +-W, gradient 0 and "
                 "closest_triangle -2 (0: no band)");
+    app.add_flag("--sparse", sparse,
+                 "with --band W: sample only the blocks of 8^3 points within W of a triangle and sign the rest per "
+                 "block (work and memory grow with the band); the outputs are the same bytes");
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
     app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
@@ -152,6 +162,7 @@ int main(int argc, char** argv) {
         sdf::require_representable_band(band, dtype == "float32" ? sdf::FieldDtype::Float32 : sdf::FieldDtype::Float64,
                                         "--band");
         if (!vdb_path.empty()) sdf::require_representable_band(band, sdf::FieldDtype::Float32, "--band (the .vdb stores float32)");
+        if (sparse && !(band > 0)) throw std::invalid_argument("--sparse: expected a narrow band, --band W with W > 0");
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return sdf::kExitCommandLineError;
@@ -190,7 +201,7 @@ int main(int argc, char** argv) {
         };
         if (dry_run) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision);
-            if (band > 0) std::cout << ", band " << band;
+            if (band > 0) std::cout << ", band " << band << (sparse ? " (sparse: the band's memory is added when sampled)" : "");
             std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
             if (!vdb_path.empty())
                 std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
@@ -213,7 +224,22 @@ int main(int argc, char** argv) {
         // The front ends' one field source (harness/study/field_source.h), without a cache:
         // its sampler, bound to the mesh, samples the slabs this tool streams to disk.
         sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);
-        const sdf::StreamResult r = sdf::sample_streamed(source.bound(shared_mesh), options, lattice, stream, mesh_provenance);
+        const sdf::BoundSampler& bound = source.bound(shared_mesh);
+        std::unique_ptr<sdf::SparseBandSlabs> sparse_slabs;
+        if (sparse) {
+            doing = "sampling the sparse band of " + mesh_arg + " on " + sdf::lattice_notation(lattice);
+            sdf::SparseBandField sparse_band = bound.sample_band_sparse(lattice, band);
+            sparse_band.mesh = mesh_provenance;
+            stream.fixed_bytes += sparse_band.memory_bytes();  // held while the slabs are written
+            sparse_slabs = std::make_unique<sdf::SparseBandSlabs>(bound, std::move(sparse_band));
+            const sdf::SparseBandCounts c = sparse_slabs->band().counts();
+            std::cout << "sparse band: " << c.active_blocks << " of " << c.blocks << " blocks of 8^3 active ("
+                      << c.active_points << " points searched, " << c.band_points << " in the band), " << c.tiles
+                      << " tiles (" << c.inside_tiles << " inside), " << c.mixed_blocks << " mixed; "
+                      << sdf::format_bytes(sparse_slabs->band().memory_bytes()) << ", " << sparse_slabs->band().timings.total
+                      << " s\n";
+        }
+        const sdf::StreamResult r = sdf::sample_streamed(sparse_slabs ? *sparse_slabs : bound, options, lattice, stream, mesh_provenance);
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
                   << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds

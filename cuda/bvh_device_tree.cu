@@ -12,7 +12,7 @@ namespace sdf::cuda {
 
 BoundCudaBvh::BoundCudaBvh(std::shared_ptr<const PreparedMesh> mesh, const SamplerOptions& options, BvhGpuKernel kernel)
     : BackendSampler(std::move(mesh), options, "cuda", "bvh", kernel_name(kCudaBvhKernels, kernel)), kernel_(kernel) {
-    CUDA_CHECK(cudaSetDevice(options.device));
+    const DeviceGuard on_device(options.device);
     with_precision(options.precision, [&](auto zero) {
         using T = decltype(zero);
         if (!build_on_device<T>()) upload_host_tree<T>();

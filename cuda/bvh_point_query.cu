@@ -104,7 +104,7 @@ E* grow(DeviceBuffer<E>& buffer, size_t count) {
 std::vector<PointSample> BoundCudaBvh::query_points(const std::vector<Vec3d>& points, SamplingTimings& timings,
                                                     CertificateCounters& certificate) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     return with_precision(options_.precision,
                           [&](auto zero) { return query_as<decltype(zero)>(points, timings, certificate); });
 }
@@ -125,7 +125,7 @@ void BoundCudaBvh::query_device_locked(const DevicePoints& points, const DeviceQ
     if (points.count < 0 || (points.count > 0 && points.xyz == nullptr))
         throw std::invalid_argument("CUDA BVH sampler: no device points (count " + std::to_string(points.count) + ")");
     if (points.count == 0) return;
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     with_precision(options_.precision, [&](auto zero) { query_device_as<decltype(zero)>(points, results, timings); });
 }
 
@@ -134,7 +134,7 @@ void BoundCudaBvh::query_host(const HostPoints& points, const HostQueryResults& 
     const std::lock_guard<std::mutex> lock(mutex_);
     const auto start = std::chrono::steady_clock::now();
     require_finite_points(points, "points", options_.threads);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard current(options_.device);
     std::vector<Vec3d> gathered;  // only for rows that are not one block of bytes
     const void* source = points.xyz;
     size_t bytes = points.bytes();

@@ -37,7 +37,9 @@ int BoundCudaBvh::layers_per_slab(const GridBlock& block) const {
 template <typename T>
 BandSearch BoundCudaBvh::band_search(const DeviceBvh<T>& dev) const {
     const bool winding = dev.winding.view().enabled();
-    return {options_.band_width, dev.mesh->view(), winding, winding || solid()};
+    const FloatSearchBound& bound = mesh().search_bound();
+    const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
+    return {options_.band_width, dev.mesh->view(), winding, winding || solid(), reach};
 }
 
 template <typename T>
@@ -147,7 +149,7 @@ void BoundCudaBvh::record_run(SlabRun& run, const DeviceBvh<T>& dev, const Event
 
 SampledField BoundCudaBvh::sample_blocks(SlabRun& run) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     return with_precision(options_.precision, [&](auto zero) { return sample_as<decltype(zero)>(run); });
 }
 
@@ -198,7 +200,7 @@ SampledField BoundCudaBvh::sample_as(SlabRun& run) const {
 std::optional<StoredSlab> BoundCudaBvh::sample_slab_stored(const Lattice& lattice, const LatticeSlab& slab,
                                                            const StoredLayout& layout) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    CUDA_CHECK(cudaSetDevice(options_.device));
+    const DeviceGuard on_device(options_.device);
     SlabRun run(lattice, slab, options_.bcc_strategy);
     StoredSlab stored = with_precision(options_.precision, [&](auto zero) { return sample_stored_as<decltype(zero)>(run, layout); });
     finish_slab(stored.info, run, stored.band);

@@ -152,6 +152,9 @@ struct BandSearch {
     /// pseudonormal sign forced on an open mesh can change sides away from the surface
     /// (beyond a rim), so there no brick is skipped.
     bool skip_bricks = false;
+    /// How much farther than the true nearest the search's nearest may be, through slivers
+    /// ranked by their edges (FloatSearchBound::sliver_reach_*): lowers the centre's bound.
+    double sliver_reach = 0;
 };
 
 /// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
@@ -187,7 +190,7 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
     const double scale = fmax(fmax(fabs(double(c.x)), fabs(double(c.y))), fabs(double(c.z)));
     const double dc = sqrt(double(seed.distance_squared)), r = sqrt(double(r2));
     const double slack = 64.0 * double(std::numeric_limits<T>::epsilon()) * (scale + dc + r) + 1e-300;
-    if (!(dc - r - slack > band.width)) return 0;
+    if (!(dc - r - slack - band.sliver_reach > band.width)) return 0;
     if (band.winding_sign) return kOutsideBandSignPerPoint;
     const SignedDistanceSample<double> s = signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[seed.slot]);
     return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;

@@ -1,6 +1,8 @@
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 
+#include <string>
+
 namespace sdf::cuda {
 
 int device_count() {
@@ -19,7 +21,11 @@ nlohmann::json describe_device(int device) {
     CUDA_CHECK(cudaDriverGetVersion(&driver));
     CUDA_CHECK(cudaRuntimeGetVersion(&runtime));
     auto version = [](int v) { return std::to_string(v / 1000) + "." + std::to_string((v % 1000) / 10); };
-    return {{"name", prop.name},
+    char bus[32] = {0};
+    CUDA_CHECK(cudaDeviceGetPCIBusId(bus, int(sizeof bus), device));
+    return {{"index", device},
+            {"name", prop.name},
+            {"pci_bus_id", std::string(bus)},
             {"compute_capability", std::to_string(prop.major) + "." + std::to_string(prop.minor)},
             {"multiprocessors", prop.multiProcessorCount},
             {"global_memory_bytes", prop.totalGlobalMem},

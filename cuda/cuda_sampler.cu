@@ -15,6 +15,7 @@
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
 #include "cuda/device_buffer.h"
+#include "cuda/device_guard.h"
 #include "cuda/device_mesh.h"
 #include "cuda/device_winding.h"
 #include "cuda/finalize_kernel.cuh"
@@ -39,8 +40,10 @@ public:
     /// Over the bound sampler's device mesh and winding data (uploaded at binding).
     Engine(const PreparedMesh& mesh, const SamplerOptions& options, CudaKernel kernel, const DeviceMesh<double>& device_mesh,
            const DeviceWinding& winding)
-        : host_(mesh.buffers<T>()), options_(options), kernel_(kernel), mesh_(device_mesh), winding_(winding) {
-        CUDA_CHECK(cudaSetDevice(options.device));
+        : host_(mesh.buffers<T>()), options_(options), kernel_(kernel), mesh_(device_mesh), winding_(winding),
+          upload_(options.device), compute_(options.device), download_(options.device) {
+        // The caller (the bound sampler) has made options.device current; the timers' events
+        // are made there too (issue 36: they were made on device 0 before).
         cudaDeviceProp prop{};
         CUDA_CHECK(cudaGetDeviceProperties(&prop, options.device));
         sms_ = prop.multiProcessorCount;
@@ -277,7 +280,7 @@ public:
         : BackendSampler(std::move(mesh), options, "cuda", "brute_force", kernel_name(kCudaBruteForceKernels, kernel)),
           kernel_(kernel) {
         sign_.prepare(this->mesh());
-        CUDA_CHECK(cudaSetDevice(options.device));
+        const DeviceGuard on_device(options.device);
         device_mesh_ = std::make_unique<DeviceMesh<double>>(this->mesh().buffers<double>());
         winding_.upload(sign_, device_mesh_->view());
         // The thesis's kernel stays as the thesis wrote it (uncertified), double is the reference.
@@ -288,12 +291,14 @@ public:
 private:
     SampledField sample_blocks(SlabRun& run) const override {
         const std::lock_guard<std::mutex> lock(mutex_);  // the certifier's counters
+        const DeviceGuard on_device(options_.device);
         return with_precision(options_.precision, [&](auto zero) { return sample_as<decltype(zero)>(run); });
     }
 
     std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
                                           CertificateCounters& certificate) const override {
         const std::lock_guard<std::mutex> lock(mutex_);
+        const DeviceGuard on_device(options_.device);
         return with_precision(options_.precision, [&](auto zero) { return query_as<decltype(zero)>(points, certificate); });
     }
 

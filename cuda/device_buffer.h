@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cuda/cuda_check.h"
+#include "cuda/device_guard.h"
 
 namespace sdf::cuda {
 
@@ -51,20 +52,28 @@ public:
     }
     /// The memory is allocated and freed in stream 0's order: a copy on another stream into
     /// a fresh allocation first waits for stream 0, and work on another stream must be done
-    /// before the buffer is released.
+    /// before the buffer is released. A fresh allocation is on the current device; copies
+    /// into and out of an allocated buffer run on its own device (a stream of the caller's
+    /// must be that device's).
     void upload(const T* host, size_t count, cudaStream_t stream = 0) {
         if (count > count_) {
             allocate(count);
             if (stream != 0) CUDA_CHECK(cudaStreamSynchronize(0));
         }
-        if (count > 0) CUDA_CHECK(cudaMemcpyAsync(ptr_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream));
+        if (count == 0) return;
+        const DeviceGuard on(device_);
+        CUDA_CHECK(cudaMemcpyAsync(ptr_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream));
     }
     void upload(const std::vector<T>& host, cudaStream_t stream = 0) { upload(host.data(), host.size(), stream); }
     void download(T* host, size_t count, cudaStream_t stream = 0) const {
-        if (count > 0) CUDA_CHECK(cudaMemcpyAsync(host, ptr_, count * sizeof(T), cudaMemcpyDeviceToHost, stream));
+        if (count == 0) return;
+        const DeviceGuard on(device_);
+        CUDA_CHECK(cudaMemcpyAsync(host, ptr_, count * sizeof(T), cudaMemcpyDeviceToHost, stream));
     }
     T* get() const { return ptr_; }
     size_t size() const { return count_; }
+    /// The device the memory is on (the current one when it was allocated).
+    int device() const { return device_; }
 
 private:
     T* ptr_ = nullptr;
@@ -92,10 +101,14 @@ private:
     size_t bytes_ = 0;
 };
 
-/// Accumulates the time between begin() and end() pairs on one stream, in seconds.
+/// Accumulates the time between begin() and end() pairs on one stream, in seconds. Its
+/// events belong to the device it was made on (the current one, or `device`); begin() and
+/// end() record them there, on that device's stream.
 class EventTimer {
 public:
-    EventTimer() {
+    EventTimer() : EventTimer(current_device()) {}
+    explicit EventTimer(int device) : device_(device) {
+        const DeviceGuard on(device_);
         CUDA_CHECK(cudaEventCreate(&start_));
         CUDA_CHECK(cudaEventCreate(&stop_));
     }
@@ -106,8 +119,12 @@ public:
     EventTimer(const EventTimer&) = delete;
     EventTimer& operator=(const EventTimer&) = delete;
 
-    void begin(cudaStream_t stream = 0) { CUDA_CHECK(cudaEventRecord(start_, stream)); }
+    void begin(cudaStream_t stream = 0) {
+        const DeviceGuard on(device_);
+        CUDA_CHECK(cudaEventRecord(start_, stream));
+    }
     void end(cudaStream_t stream = 0) {
+        const DeviceGuard on(device_);
         CUDA_CHECK(cudaEventRecord(stop_, stream));
         CUDA_CHECK(cudaEventSynchronize(stop_));
         float ms = 0;
@@ -115,8 +132,10 @@ public:
         seconds_ += 1e-3 * ms;
     }
     double seconds() const { return seconds_; }
+    int device() const { return device_; }
 
 private:
+    int device_ = 0;
     cudaEvent_t start_{}, stop_{};
     double seconds_ = 0;
 };

@@ -75,7 +75,7 @@ RenderedImage render_field_view_cuda(const LatticeFieldView<float>& view, Interp
     if (options.repetitions < 1)
         throw std::invalid_argument("render_field_view_cuda: repetitions must be >= 1, got " +
                                     std::to_string(options.repetitions));
-    CUDA_CHECK(cudaSetDevice(options.device));
+    const DeviceGuard on_device(options.device);
     RenderedImage image(camera.width, camera.height);
     EventTimer upload, download;
     upload.begin();

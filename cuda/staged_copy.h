@@ -83,8 +83,17 @@ public:
 
 private:
     /// The events, made at the first copy: on the caller's device then (its sampler has set
-    /// it), not on whichever device was current when the sampler was made.
+    /// it), not on whichever device was current when the sampler was made; made again if a
+    /// later copy runs on another device (an event records on its own device's streams only).
     void make_events() {
+        const int device = current_device();
+        if (device != events_device_) {
+            for (cudaEvent_t& e : done_) {
+                if (e) cudaEventDestroy(e);
+                e = nullptr;
+            }
+            events_device_ = device;
+        }
         for (cudaEvent_t& e : done_)
             if (!e) CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
     }
@@ -111,6 +120,7 @@ private:
 
     std::unique_ptr<PinnedBytes> pinned_[2];
     cudaEvent_t done_[2]{};
+    int events_device_ = -1;  ///< the device of done_
 };
 
 }  // namespace sdf::cuda

@@ -41,6 +41,7 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
     // maxima of non-NaN values: the same whatever the chunks.
     struct Extremes {
         double sin2_float = 1.0, sin2_double = 1.0, sin2_sliver = 1.0, longest = 0.0, coordinate = 0.0;
+        double reach_float = 0.0, reach_double = 0.0;  ///< squared inradii of edges-only slivers
     };
     constexpr int64_t kChunk = 16384;
     const int64_t n = int64_t(triangles.size()), nv = int64_t(vertices.size());
@@ -55,6 +56,12 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
                 const double a = dot(e0, e0), b = dot(e0, e1), c = dot(e1, e1), g = a - 2.0 * b + c;
                 x.longest = std::max(x.longest, std::sqrt(a) + std::sqrt(c));
                 const PackedTriangle<double>& pd = packed_double[size_t(i)];
+                x.reach_float = std::max(x.reach_float, double(sliver_excess(packed_float[size_t(i)])));
+                if (std::isnan(pd.sb) && !is_interior_sliver(pd)) {  // double's edges-only sliver
+                    const double area2 = length(accurate_triangle_cross(vertices[size_t(t.x)], vertices[size_t(t.y)], vertices[size_t(t.z)]));
+                    const double perimeter = std::sqrt(a) + std::sqrt(c) + std::sqrt(g);
+                    if (perimeter > 0.0) x.reach_double = std::max(x.reach_double, area2 / perimeter * (area2 / perimeter));
+                }
                 if (is_interior_sliver(pd)) {  // its own sin^2, from its accurate area (ta = 2 |E0 x E1|)
                     const double area2 = 0.5 * pd.ta;
                     x.sin2_sliver = std::min(x.sin2_sliver, detail::smallest_sin2(area2 * area2, pd.a, pd.c, pd.g));
@@ -72,7 +79,10 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
         }
     });
     double sin2_float = 1.0, sin2_double = 1.0, sin2_sliver = 1.0, longest = 0.0, coordinate = 0.0;
+    double reach_float = 0.0, reach_double = 0.0;
     for (const Extremes& x : part) {
+        reach_float = std::max(reach_float, x.reach_float);
+        reach_double = std::max(reach_double, x.reach_double);
         sin2_sliver = std::min(sin2_sliver, x.sin2_sliver);
         sin2_float = std::min(sin2_float, x.sin2_float);
         sin2_double = std::min(sin2_double, x.sin2_double);
@@ -90,6 +100,8 @@ FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const st
         b.rho_double += slivers;
     }
     b.two_l = 2.0 * longest;
+    b.sliver_reach_float = std::sqrt(reach_float) * 1.01;  // the inradius, rounded up
+    b.sliver_reach_double = std::sqrt(reach_double) * 1.01;
     b.coordinate = coordinate;
     b.usable = std::isfinite(b.two_l) && std::isfinite(b.coordinate) && std::sqrt(2.0 * b.rho) < 0.25;
     return b;

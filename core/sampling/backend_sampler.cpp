@@ -4,6 +4,7 @@
 
 #include "core/sampling/sampler_results.h"
 #include "core/sampling/search_range.h"
+#include "core/sampling/sparse_band_sampler.h"
 
 namespace sdf {
 
@@ -65,6 +66,18 @@ void BackendSampler::finish_slab(SampledField& field, SlabRun& run, std::optiona
         }
         field.sampler.band = report;
     }
+}
+
+SparseBandField BackendSampler::sample_band_sparse(const Lattice& lattice, double width) const {
+    require_band_width(width, "sparse band width");
+    SparseBandPlan plan;
+    plan.precision = options_.precision;
+    plan.threads = options_.threads;
+    SparseBandField band = sample_sparse_band(*this, lattice, width, plan, band_block_kernel(width));
+    band.sampler.backend = backend_;
+    band.sampler.method = method_;
+    band.sampler.kernel = kernel_;
+    return band;
 }
 
 std::vector<PointSample> BackendSampler::query(const std::vector<Vec3d>& points, SamplingTimings* timings) const {

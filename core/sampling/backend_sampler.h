@@ -21,6 +21,7 @@
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampler.h"
 #include "core/sampling/sampler_sign.h"
+#include "core/sampling/sparse_band_sampler.h"
 
 namespace sdf {
 
@@ -68,6 +69,8 @@ public:
     /// The shared steps around sample_blocks(): band width checked, the slab's blocks, the
     /// timings, the provenance, the certificate and the band.
     SampledField sample_slab(const Lattice& lattice, const LatticeSlab& slab) const final;
+    /// Only the band's blocks, through query_points() (sparse_band_sampler.h).
+    SparseBandField sample_band_sparse(const Lattice& lattice, double width) const override;
     /// The range checks around query_points(), and the call's timings.
     std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings = nullptr) const final;
 
@@ -83,6 +86,14 @@ protected:
     /// what the backend measures, `certificate` the float search's counts.
     virtual std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings& timings,
                                                   CertificateCounters& certificate) const = 0;
+
+    /// The kernel that fills a sparse band's active blocks (sparse_band_sampler.h) as the
+    /// backend's dense lattice kernel with a band of `width` fills those points; empty: the
+    /// shared path queries their points with query_points().
+    virtual BandBlockKernel band_block_kernel(double width) const {
+        (void)width;
+        return {};
+    }
 
     /// The shared ending of a slab (also of a slab stored by the backend: `field` then holds
     /// no arrays and `band` its counts): timings, provenance, certificate, winding counters, band.

@@ -20,6 +20,7 @@
 #include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler_options.h"
+#include "core/sampling/sparse_band.h"
 #include "core/sampling/stored_slab.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/lattice/lattice_slab.h"
@@ -64,6 +65,12 @@ public:
         (void)lattice, (void)slab, (void)layout;
         return std::nullopt;
     }
+    /// The narrow band of width `width` > 0 of the lattice, sparse (core/sampling/sparse_band.h,
+    /// issue 35): densified, it is sample()'s field with SamplerOptions::band_width = width,
+    /// byte for byte. The backends (BackendSampler) sample only the band's blocks with their
+    /// point kernels (core/sampling/sparse_band_sampler.h); this default samples the whole
+    /// lattice and sparsifies it (refused when the sampler's own band is narrower).
+    virtual SparseBandField sample_band_sparse(const Lattice& lattice, double width) const;
     /// Samples arbitrary points, returned in input order. `timings` (may be null) receives
     /// this call's timings where the sampler measures them (GPU: `kernel` = the device's
     /// sort, search and finalize, `upload`/`download` the transfers; every sampler: the

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/sampling/sampled_field.h"
 #include "core/winding/sign_mode.h"
@@ -25,6 +26,18 @@ namespace sdf {
 
 /// Where a GPU sampler's BVH is built (SamplerOptions::bvh_build).
 enum class BvhBuildSite { Auto, Host, Device };
+
+/// The GPUs one process drives (SamplerOptions::devices; docs/distributed.md): by default the
+/// one of SamplerOptions::device, as before; "all" every visible device; or these ordinals.
+/// Several devices split a lattice into z-slabs and a point list into pieces, one host thread
+/// and one bound sampler per device (harness/sampling/multi_device_sampler.h); every point's
+/// result is the one device's, bit for bit.
+struct DeviceSelection {
+    bool all = false;
+    std::vector<int> list;  ///< empty (and not all): the one SamplerOptions::device
+    bool is_default() const { return !all && list.empty(); }
+    bool operator==(const DeviceSelection& o) const { return all == o.all && list == o.list; }
+};
 
 struct SamplerOptions {
     std::string backend = "auto";  ///< "auto", or a backend of the sampler table ("cpu", "cuda")
@@ -37,7 +50,8 @@ struct SamplerOptions {
     int threads = 0;               ///< CPU threads; 0 = all
     BccStrategy bcc_strategy = BccStrategy::TwoGrids;
     bool progress = true;
-    int device = 0;                ///< CUDA device ordinal
+    int device = 0;                ///< CUDA device ordinal (with the default `devices`)
+    DeviceSelection devices;       ///< several GPUs in this process ("all", a list); default: `device`
     // GPU work sizes; 0 = chosen from the device's memory and multiprocessor count.
     int64_t max_points_per_piece = 0;  ///< lattice points per GPU piece (memory split)
     int max_triangles_per_chunk = 0;   ///< triangles resident on the GPU at a time
@@ -69,6 +83,7 @@ enum class OptionDomain {
     PointsPerThread,  ///< 0, 1, 2, 4 or 8
     Flag,             ///< true or false
     Width,            ///< a finite length >= 0 in mesh units
+    Devices,          ///< "all", or a list of distinct device ordinals ([] = the one `device`)
 };
 
 struct OptionField {
@@ -79,7 +94,7 @@ struct OptionField {
 };
 
 /// The number of rows below; the codec checks it against the struct's field count.
-inline constexpr std::size_t kSamplerOptionFields = 14;
+inline constexpr std::size_t kSamplerOptionFields = 15;
 
 /// Calls f(OptionField, member) for every field of `o`, in the order above. `O` is
 /// SamplerOptions or const SamplerOptions.
@@ -96,6 +111,8 @@ void for_each_sampler_option(O& o, F&& f) {
     f(OptionField{"bcc_strategy", R::Result, D::Named, "a BCC strategy"}, o.bcc_strategy);
     f(OptionField{"progress", R::Execution, D::Flag, "true or false"}, o.progress);
     f(OptionField{"device", R::Execution, D::Count, "a CUDA device ordinal"}, o.device);
+    f(OptionField{"devices", R::Execution, D::Devices, "\"all\" or a list of distinct CUDA device ordinals such as [0, 1]"},
+      o.devices);
     f(OptionField{"max_points_per_piece", R::Execution, D::Count, "a point count (0 = automatic)"},
       o.max_points_per_piece);
     f(OptionField{"max_triangles_per_chunk", R::Execution, D::Count, "a triangle count (0 = automatic)"},

@@ -99,12 +99,59 @@ private:
         return field;
     }
 
+    /// A sparse band's active blocks through the dense path's brick kernel (with its brick
+    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's.
+    BandBlockKernel band_block_kernel(double width) const override {
+        if (kernel_ != BvhKernel::Brick) return {};
+        const BandSkip band = band_skip(width);
+        if (!band.enabled()) return {};  // a pseudonormal sign off a solid: every point searched by the queries
+        return [this, band](SparseBandField& out, size_t first, size_t last) {
+            const BandLayout& layout = out.layout();
+            const Lattice& lattice = out.lattice;
+            CertificateCounters certificate;
+            SharedWindingCounts winding;  // a sparse band's report has no winding counters (as queries)
+            QueryCounters counters(certificate, winding);
+            BandCounters band_counters;
+            parallel_for(int64_t(last - first), 8, options_.threads, [&](int64_t begin, int64_t end) {
+                for (size_t a = first + size_t(begin); a < first + size_t(end); ++a) {
+                    const BandBlockCoords b = layout.block_coords(out.active[a]);
+                    const BandCoset& coset = layout.coset(b.coset);
+                    const Int3 p0{b.block.x * kBandBlockDim, b.block.y * kBandBlockDim, b.block.z * kBandBlockDim};
+                    const Int3 r{std::min(kBandBlockDim, coset.points.x - p0.x), std::min(kBandBlockDim, coset.points.y - p0.y),
+                                 std::min(kBandBlockDim, coset.points.z - p0.z)};
+                    const GridBlock block{{coset.first.x + 2 * p0.x, coset.first.y + 2 * p0.y, coset.first.z + 2 * p0.z}, 2, r, 0, false};
+                    const size_t base = a * kBandBlockPoints;
+                    const auto slot = [&](int64_t i) {
+                        const int x = int(i % r.x), y = int((i / r.x) % r.y), z = int(i / (int64_t(r.x) * r.y));
+                        return base + size_t(x + kBandBlockDim * (y + kBandBlockDim * z));
+                    };
+                    auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
+                        const size_t v = slot(i);
+                        if (outside_band(s.distance, band.width)) {
+                            out.distance[v] = std::signbit(s.distance) ? -band.width : band.width;
+                            return;
+                        }
+                        out.distance[v] = s.distance;
+                        out.gradient[v] = s.gradient;
+                        out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
+                    };
+                    auto emit_outside = [&](int64_t i, bool negative) { out.distance[slot(i)] = negative ? -band.width : band.width; };
+                    with_precision(options_.precision, [&](auto zero) {
+                        using T = decltype(zero);
+                        evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters, emit,
+                                           emit_outside);
+                    });
+                }
+            });
+        };
+    }
+
     /// The brick skip of the band: with the winding sign (each point's own), or with the
     /// pseudonormal sign where the mesh is the solid that makes it one side per ball; a
     /// pseudonormal sign requested on any other mesh computes every point (and bands them
     /// afterwards), as does the "seeded"/"unseeded" kernel.
-    BandSkip band_skip() const {
-        const double w = options_.band_width;
+    BandSkip band_skip() const { return band_skip(options_.band_width); }
+    BandSkip band_skip(double w) const {
         BandSkip band;
         band.width = w;
         if (w <= 0) return band;
@@ -112,6 +159,8 @@ private:
         band.probe_sign = !sign_.winding() && solid();
         // Float searches choose among triangles within a few ulps (2^-24) of the minimum.
         band.relative_margin = float_search() ? 1e-5 : 1e-12;
+        const FloatSearchBound& bound = mesh().search_bound();
+        band.sliver_reach = float_search() ? bound.sliver_reach_float : bound.sliver_reach_double;
         const MeshView<double> exact = mesh().buffers<double>().view();
         for (const Vec3d& v : {exact.box_lo, exact.box_hi})
             band.coordinate_scale = std::max({band.coordinate_scale, std::abs(v.x), std::abs(v.y), std::abs(v.z)});

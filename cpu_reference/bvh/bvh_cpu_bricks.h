@@ -72,6 +72,9 @@ struct BandSkip {
     const WindingSign* winding = nullptr;
     double relative_margin = 0;  ///< of D + the coordinates' magnitude
     double coordinate_scale = 0; ///< largest |coordinate| of the mesh's box
+    /// The search's nearest triangle may be a sliver's neighbour up to this much farther than
+    /// the true nearest (FloatSearchBound::sliver_reach_*): the probe's D is lowered by it.
+    double sliver_reach = 0;
     bool enabled() const { return width > 0 && (probe_sign || winding != nullptr); }
 };
 
@@ -145,7 +148,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
-                    ball = {c, d - band.width - margin, s.distance < 0};
+                    ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0};
                     below = ball;
                     ++probes;
                 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 #include <utility>
 
@@ -85,6 +86,8 @@ template <class T>
 nlohmann::json encode(const T& v) {
     if constexpr (std::is_enum_v<T>)
         return name_of(v);
+    else if constexpr (std::is_same_v<T, DeviceSelection>)
+        return v.all ? nlohmann::json("all") : nlohmann::json(v.list);
     else
         return v;
 }
@@ -102,6 +105,15 @@ struct FieldReader {
             default:  // the kernel: checked against its row once backend and method are known
                 v = r.optional<std::string>(f.name, v, std::string(f.expected) + " (" + sampler_kernels_help() + ")");
         }
+    }
+
+    void operator()(const OptionField& f, DeviceSelection& v) const {
+        if (!r.has(f.name)) return;
+        std::string error;
+        const std::optional<DeviceSelection> read = parse_device_selection(r.raw(f.name), error);
+        if (!read) r.fail(f.name, "expected " + std::string(f.expected) + " (or [] for the one \"device\"): " + error);
+        v = *read;
+        r.record(f.name, encode(v));
     }
 
     template <class T>
@@ -148,6 +160,49 @@ void check_kernel(const JsonReader& r, const SamplerOptions& o, bool backend_was
 }
 
 }  // namespace
+
+std::optional<DeviceSelection> parse_device_selection(const nlohmann::json& value, std::string& error) {
+    DeviceSelection out;
+    nlohmann::json list = value;
+    if (value.is_string()) {  // "all", or the command line's "0,1" / "[0, 1]"
+        std::string text = value.get<std::string>();
+        if (text == "all") {
+            out.all = true;
+            return out;
+        }
+        text.erase(std::remove_if(text.begin(), text.end(), [](char c) { return c == ' ' || c == '[' || c == ']'; }),
+                   text.end());
+        list = nlohmann::json::array();
+        size_t at = 0;
+        while (!text.empty() && at <= text.size()) {
+            const size_t comma = std::min(text.find(',', at), text.size());
+            const std::string item = text.substr(at, comma - at);
+            if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos || item.size() > 9) {
+                error = "got " + value.dump() + ": \"" + item + "\" is not a device ordinal";
+                return std::nullopt;
+            }
+            list.push_back(std::stoi(item));
+            at = comma + 1;
+        }
+    }
+    if (!list.is_array()) {
+        error = "got " + value.dump();
+        return std::nullopt;
+    }
+    for (const nlohmann::json& d : list) {
+        if (!d.is_number_integer() || d.get<int64_t>() < 0 || d.get<int64_t>() > 1'000'000) {
+            error = "got " + value.dump() + ": " + d.dump() + " is not a device ordinal (an integer >= 0)";
+            return std::nullopt;
+        }
+        const int ordinal = d.get<int>();
+        if (std::find(out.list.begin(), out.list.end(), ordinal) != out.list.end()) {
+            error = "got " + value.dump() + ": device " + std::to_string(ordinal) + " is listed twice";
+            return std::nullopt;
+        }
+        out.list.push_back(ordinal);
+    }
+    return out;
+}
 
 std::string sampler_kernels_help() {
     std::string help;

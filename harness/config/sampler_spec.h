@@ -4,7 +4,7 @@
 ///   {"backend": "auto" | "cpu" | "cuda", "method": "bvh" | "brute_force", "kernel": "...",
 ///    "precision": "float" | "double", "sign": "auto" | "pseudonormal" | "winding",
 ///    "threads": 0, "bcc_strategy": "two_grids" | "double_resolution", "progress": true,
-///    "device": 0, "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
+///    "device": 0, "devices": "all" | [0, 1] | [], "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
 ///    "points_per_thread": 0, "band_width": 0, "bvh_build": "auto" | "host" | "device"}
 /// and every other place options travel as JSON: the tools' command lines, the Python
 /// module's keywords, the MPI wire, the run's manifest, the field cache's key. Every absent
@@ -18,6 +18,7 @@
 /// harness code; the field table it is generated from is core's.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,11 @@ SamplerOptions sampler_options_from_json(const nlohmann::json& j, const std::str
 /// Every field, by name (enums by their names); sampler_options_from_json reads it back to
 /// the same options (with "auto" resolved).
 nlohmann::json sampler_options_to_json(const SamplerOptions& o);
+
+/// SamplerOptions::devices from its JSON: "all", a list of distinct ordinals >= 0 ([]: the
+/// one "device"), or the command line's text of either ("all", "0,1", "[0, 1]"); nullopt with
+/// `error` saying what is wrong.
+std::optional<DeviceSelection> parse_device_selection(const nlohmann::json& value, std::string& error);
 
 /// The fields that decide the sampled values (OptionRole::Result), for the field cache's
 /// key: every field of that role, so a new one is keyed once it has its row. The BCC

@@ -3,15 +3,18 @@
 // MPI, the settings check, runs mode's broadcast and gather.
 #include "harness/distributed/mpi_session.h"
 
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 #include "core/parallel/parallel_for.h"
 #include "harness/build_config.h"
 #include "harness/distributed/mpi_transport.h"
 #include "harness/distributed/wire_codec.h"
+#include "harness/sampling/device_selection.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
 #endif
@@ -39,13 +42,21 @@ nlohmann::json describe_this_process(int rank) {
     self["local_rank"] = local_rank;
     self["local_size"] = local_size;
     self["threads"] = std::max(1, resolve_thread_count(0) / std::max(1, local_size));
+    // The cores this rank may run on: Open MPI binds each rank to one core by default when
+    // -np <= 2 (to a socket above), so a rank's host threads (the field's pages, the pinned
+    // copies, the CPU sampler) would all share that core (issue 36).
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    if (sched_getaffinity(0, sizeof allowed, &allowed) == 0) self["cores_allowed"] = CPU_COUNT(&allowed);
     const int devices = cuda_devices();
     self["gpus_on_host"] = devices;
     self["gpu"] = nullptr;
 #if SDF_HAVE_CUDA
     if (devices > 0) {
-        const int device = local_rank % devices;
-        self["gpu"] = {{"device", device}, {"name", cuda::describe_device(device).value("name", std::string("?"))}};
+        const int device = local_rank % devices;  // the default selection's (device_selection.h)
+        const nlohmann::json d = cuda::describe_device(device);
+        self["gpu"] = {{"device", device}, {"name", d.value("name", std::string("?"))},
+                       {"pci_bus_id", d.value("pci_bus_id", std::string("?"))}};
     }
 #endif
     return self;
@@ -67,7 +78,9 @@ bool launched_by_mpi() {
 SamplerOptions options_for_this_rank(SamplerOptions o) {
     const Session& s = session();
     const int devices = cuda_devices();
-    if (o.backend == "cuda" && devices > 0) o.device = (o.device + s.self.value("local_rank", 0)) % devices;
+    // Local rank r of the host's ranks takes its share of the visible GPUs
+    // (device_selection.h): GPU (device + r) % count by default, a share of "devices".
+    o = place_rank_on_devices(o, s.self.value("local_rank", 0), s.self.value("local_size", 1), devices);
     if (o.threads == 0) o.threads = std::max(1, resolve_thread_count(0) / std::max(1, s.self.value("local_size", 1)));
     if (s.rank != 0) o.progress = false;  // one progress line per run: the root's
     return o;
@@ -85,6 +98,18 @@ void join_ranks() {
     }
     s.processes.push_back(s.self);
     for (int r = 1; r < s.size; ++r) s.processes.push_back(nlohmann::json::parse(receive_string(r, kTagHello)));
+    for (const nlohmann::json& p : s.processes) {
+        const int allowed = p.value("cores_allowed", 0), threads = p.value("threads", 1);
+        if (allowed > 0 && allowed < threads) {
+            std::fprintf(stderr,
+                         "warning: rank %d may run on %d core%s of its host's %d for its %d threads (mpirun binds each rank "
+                         "to one core by default for -np <= 2): its host work runs on %s; start it with "
+                         "mpirun --bind-to none, or --map-by slot:PE=%d\n",
+                         p.value("rank", 0), allowed, allowed == 1 ? "" : "s", resolve_thread_count(0), threads,
+                         allowed == 1 ? "that core" : "those cores", threads);
+            break;  // one line: every rank was started alike
+        }
+    }
 }
 
 namespace {

@@ -111,6 +111,17 @@ std::unique_ptr<Sampler> make_field_sampler(const SamplerOptions& options) {
 
 void share_mesh_with_workers(const TriangleMesh& mesh) {
     if (!distributed_active()) return;
-    session().meshes.emplace(mesh.content_sha256, mesh);
+    Session& s = session();
+    s.meshes.emplace(mesh.content_sha256, mesh);
+    // Only where the workers serve requests (run-experiment's slabs, not the Python module's
+    // collective calls or runs mode): the mesh goes now, so each worker prepares it (welding,
+    // checks, its BVH) while the root prepares its own, not after the first Sample request.
+    if (s.rank != 0 || s.released || s.collective || s.distribution != Distribution::LatticeSlabs) return;
+    if (s.mesh_sent == mesh.content_sha256) return;
+    ByteWriter out;
+    out.put(int32_t(Command::Mesh));
+    put_mesh(out, mesh);
+    for (int r = 1; r < s.size; ++r) send_bytes(out.bytes().data(), out.bytes().size(), r, kTagCommand);
+    s.mesh_sent = mesh.content_sha256;
 }
 }  // namespace sdf

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/sampling/sampler.h"
-#include "harness/distributed/slab_plan.h"
+#include "harness/sampling/slab_plan.h"
 
 namespace sdf::mpi {
 

@@ -26,7 +26,10 @@ static_assert(std::is_trivially_copyable_v<Lattice>, "lattices are sent as bytes
 static_assert(sizeof(Vec3d) == 3 * sizeof(double), "gradients are sent as packed doubles");
 
 /// What the root asks of a worker (the first int32 of every kTagCommand message).
-enum class Command : int32_t { Sample = 1, Quit = 2, Write = 3 };
+/// Mesh: a mesh the root has loaded, sent before it is sampled so that the workers prepare it
+/// while the root prepares its own (issue 36: they prepared it after the first Sample request,
+/// inside the sampling's time).
+enum class Command : int32_t { Sample = 1, Quit = 2, Write = 3, Mesh = 4 };
 
 /// Flat little-endian encoding of a request.
 class ByteWriter {

@@ -39,17 +39,15 @@ public:
             lattice = in.get<Lattice>();
             const std::vector<LatticeSlab> slabs = in.get_vector<LatticeSlab>();
             const std::string sha = in.get_string();
-            if (in.get<uint8_t>() != 0) {
-                bound_.reset();  // the last mesh's sampler and device memory first
-                mesh_.reset();
-                mesh_ = std::make_shared<const PreparedMesh>(prepare_mesh(get_mesh(in)));  // as the root's load_prepared_mesh()
-            }
+            if (in.get<uint8_t>() != 0) prepare(in);
             if (!mesh_ || mesh_->content_sha256() != sha)
-                throw std::runtime_error("has no prepared mesh " + sha.substr(0, 12) + " (protocol error)");
+                throw std::runtime_error(!mesh_error_.empty() ? mesh_error_
+                                                              : "has no prepared mesh " + sha.substr(0, 12) + " (protocol error)");
             if (slabs.size() != size_t(s.size)) throw std::runtime_error("the request holds no slab for this rank");
             slab = slabs[size_t(s.rank)];
             // Bound once per mesh and options: a study's lattices of one mesh reuse its tree and uploads.
             const std::string key = sampler_options_to_json(options).dump();
+            const auto bind_start = std::chrono::steady_clock::now();
             if (!bound_ || key != sampler_key_) {
                 bound_.reset();
                 bound_ = make_sampler(options)->bind(mesh_);
@@ -60,6 +58,11 @@ public:
             part = sample_part(*bound_, lattice, slab);
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             status["part"] = describe_part(part, s.rank, s.self["host"].get<std::string>(), slab, seconds);
+            // What this request waited for besides its slab: the binding (tree, uploads) of a
+            // new mesh or options, and a mesh prepared on arrival.
+            status["part"]["bind_seconds"] = std::chrono::duration<double>(start - bind_start).count();
+            status["part"]["prepare_seconds"] = prepared_in_request_;
+            prepared_in_request_ = 0;
             status["sampler"] = part.sampler;
         } catch (const std::exception& e) {
             status["ok"] = false;
@@ -104,7 +107,35 @@ public:
         send_string(status.dump(), 0, kTagStatus);
     }
 
+    /// Handles a Mesh request (sent when the root loads it): prepares it now; a failure is
+    /// this rank's answer to the next Sample request.
+    void mesh(const std::string& request) {
+        try {
+            ByteReader in(request);
+            in.get<int32_t>();  // the command
+            prepare(in);
+        } catch (const std::exception& e) {
+            mesh_error_ = e.what();
+        }
+        prepared_in_request_ = 0;
+    }
+
 private:
+    /// The mesh read from `in`, prepared as the root's load_prepared_mesh() prepares it.
+    void prepare(ByteReader& in) {
+        bound_.reset();  // the last mesh's sampler and device memory first
+        mesh_.reset();
+        mesh_error_.clear();
+        const auto start = std::chrono::steady_clock::now();
+        try {
+            mesh_ = std::make_shared<const PreparedMesh>(prepare_mesh(get_mesh(in)));
+        } catch (const std::exception& e) {
+            mesh_error_ = e.what();
+            throw;
+        }
+        prepared_in_request_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+
     void release() {
         holds_part_ = false;
         part_ = SampledField();
@@ -115,6 +146,8 @@ private:
     Lattice lattice_;
     bool holds_part_ = false;
     std::shared_ptr<const PreparedMesh> mesh_;
+    std::string mesh_error_;            ///< why the last mesh sent could not be prepared
+    double prepared_in_request_ = 0;    ///< seconds the current Sample request spent preparing its mesh
     std::unique_ptr<BoundSampler> bound_;  ///< bound to mesh_ with the options of sampler_key_
     std::string sampler_key_;
 };
@@ -133,6 +166,7 @@ int serve_distributed_requests() {
         std::memcpy(&command, request.data(), sizeof command);
         if (Command(command) == Command::Quit) return 0;
         if (Command(command) == Command::Write) worker.write(request);
+        else if (Command(command) == Command::Mesh) worker.mesh(request);
         else worker.sample(request);
     }
 }

@@ -9,6 +9,8 @@
 #include "cuda/bvh_sampler.h"
 #include "cuda/cuda_sampler.h"
 #include "harness/build_config.h"
+#include "harness/sampling/device_selection.h"
+#include "harness/sampling/multi_device_sampler.h"
 #include "harness/sampling/streamed_sampling.h"
 #if SDF_HAVE_CUDA
 #include "cuda/cuda_device.h"
@@ -110,7 +112,27 @@ std::unique_ptr<Sampler> make_sampler(const SamplerOptions& options) {
                                  "SDF_ENABLE_CUDA=AUTO or ON)");
     if (kind.on_gpu && !cuda_backend_available())
         throw std::runtime_error("sampler.backend \"" + resolved.backend + "\": no CUDA device is present on this machine");
+    if (!kind.on_gpu) {
+        // The CPU samplers use the host's threads; "all" GPUs of a machine without one (the
+        // backend "auto" resolved to cpu) asks for nothing more, a list of GPUs for what
+        // this backend cannot do.
+        if (!resolved.devices.all && !resolved.devices.list.empty())
+            throw std::invalid_argument("sampler.devices: a list of CUDA devices needs the backend cuda; the backend is \"" +
+                                        resolved.backend + "\"");
+        resolved.devices = DeviceSelection{};
+        return kind.make(resolved);
+    }
+#if SDF_HAVE_CUDA
+    const std::vector<int> devices = resolve_devices(resolved, cuda::device_count());
+    if (devices.size() == 1) {
+        resolved.device = devices[0];
+        resolved.devices = DeviceSelection{};
+        return kind.make(resolved);
+    }
+    return make_multi_device_sampler(resolved, devices, kind.make, [](int device) { return cuda::describe_device(device); });
+#else
     return kind.make(resolved);
+#endif
 }
 
 }  // namespace sdf

@@ -18,7 +18,7 @@
 
 namespace sdf {
 
-/// How the slab planner of a distributed run (harness/distributed/slab_plan.h) estimates the
+/// How the slab planner of a distributed run (harness/sampling/slab_plan.h) estimates the
 /// cost of a lattice plane.
 enum class CostModel {
     PerPoint,   ///< every point costs the same (brute force: every triangle per point)

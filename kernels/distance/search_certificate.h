@@ -75,6 +75,12 @@ struct FloatSearchBound {
     /// rho of double alone (|Q_d - Q| <= rho_double M^2: double's points and vertices are
     /// exact, d0 = 0), for the double search's pruning margin (PruneMargin below).
     double rho_double = 0;
+    /// The largest inradius of the triangles the float search ranks by their edges only
+    /// (sliver_excess), and of those double ranks so (sin^2 below kRobustSliverSin2): a
+    /// search's nearest triangle may lie farther than the true nearest by up to this, so a
+    /// distance bound taken from one search (the narrow band's probes) is lowered by it.
+    double sliver_reach_float = 0;
+    double sliver_reach_double = 0;
 };
 
 /// How far beyond a search's radius a box must still be entered for the search to return

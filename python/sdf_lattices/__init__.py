@@ -26,9 +26,9 @@ from ._warnings import MeshWarning, SdfWarning  # noqa: F401
 from . import _gpu
 from ._gpu import DeviceQueryResult  # noqa: F401
 
-# GPU tensors (PyTorch, CuPy, JAX) in and out without copies: SDF.query, query and sdf take
-# them (sdf_lattices._gpu).
-query, sdf = _gpu.install(_core)
+# GPU tensors (PyTorch, CuPy, JAX) in and out without copies: SDF.query, query, sdf and
+# query_batch take them (sdf_lattices._gpu); torch autograd on the CPU and CUDA (_torch.py).
+query, sdf, query_batch = _gpu.install(_core)
 # Wrong keywords and types named in words, not as pybind11's signature dumps (_arguments.py).
 from . import _arguments  # noqa: E402
 render = _arguments.install(_core)

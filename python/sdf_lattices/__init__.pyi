@@ -13,6 +13,8 @@ build_commit: str
 
 Vec3 = Tuple[float, float, float]
 ArrayF = npt.NDArray[np.float64]
+ArrayR = Union[npt.NDArray[np.float64], npt.NDArray[np.float32]]  # float32 with dtype="float32"
+DType = Union[str, type, np.dtype]  # "float64" (the default) or "float32"
 ArrayI = npt.NDArray[np.int32]
 Progress = Union[None, bool, Callable[[int, int], Any]]
 MeshLike = Union["Mesh", str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike], Any]
@@ -31,6 +33,7 @@ class SamplerKeywords(TypedDict, total=False):
     threads: int                  # 0 = all cores
     bcc_strategy: str             # "two_grids", "double_resolution"
     device: int                   # CUDA device ordinal
+    devices: Union[str, Sequence[int]]  # "all" or [0, 1]: several GPUs of this process; [] = device
     max_points_per_piece: int     # 0 = automatic
     max_triangles_per_chunk: int  # 0 = automatic
     points_per_thread: int        # 0, 1, 2, 4, 8
@@ -60,11 +63,11 @@ class Mesh:
     report: Dict[str, Any]
 
 class QueryResult:
-    distance: ArrayF
-    gradient: ArrayF
+    distance: ArrayR
+    gradient: ArrayR
     triangle: ArrayI
-    closest_point: ArrayF
-    barycentric: ArrayF
+    closest_point: ArrayR
+    barycentric: ArrayR
     winding: Optional[ArrayF]
     winding_error_bound: Optional[ArrayF]
     sign: str
@@ -73,7 +76,8 @@ class QueryResult:
     def __len__(self) -> int: ...
 
 class DeviceQueryResult:
-    """Results of GPU points: arrays of the input's library (torch, cupy, jax) on its device."""
+    """Results of GPU points (and of torch points with differentiable=True, CPU too): arrays of
+    the input's library (torch, cupy, jax) on its device; the distance differentiable."""
     distance: Any
     gradient: Any
     triangle: Any
@@ -115,7 +119,8 @@ class SDF:
     backend: str
     device: int
     def query(self, points: Any, winding: Union[bool, str] = False, progress: Progress = None,
-              differentiable: bool = False) -> Union[QueryResult, DeviceQueryResult]: ...
+              differentiable: bool = False, dtype: DType = "float64") -> Union[QueryResult, DeviceQueryResult]: ...
+    def refit(self, new_vertices: Any) -> "SDF": ...
     def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
                margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
                spacing: Optional[float] = None, origin: Optional[Sequence[float]] = None,
@@ -125,8 +130,12 @@ def as_mesh(mesh: MeshLike) -> Mesh: ...
 def cuda_available() -> bool: ...
 def load_mesh(path: str, weld_tolerance: float = 0.0, check_intersections: bool = True) -> Mesh: ...
 def query(mesh: MeshLike, points: Any, progress: Progress = None, winding: Union[bool, str] = False,
+          differentiable: bool = False, dtype: DType = "float64",
           **sampler: Unpack[SamplerKeywords]) -> Union[QueryResult, DeviceQueryResult]: ...
-def sdf(mesh: MeshLike, points: Any, progress: Progress = None, **sampler: Unpack[SamplerKeywords]) -> Any: ...
+def sdf(mesh: MeshLike, points: Any, progress: Progress = None, differentiable: bool = False, dtype: DType = "float64",
+        **sampler: Unpack[SamplerKeywords]) -> Any: ...
+def query_batch(sdfs: Sequence[SDF], points: Sequence[Any], progress: Progress = None, dtype: DType = "float64",
+                differentiable: bool = False) -> List[Union[QueryResult, DeviceQueryResult]]: ...
 def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
            samples: Optional[int] = None, margin: Optional[float] = None,
            bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,

@@ -33,16 +33,24 @@ def _open3d_tensor_arrays(obj):
     return _tensor_array(positions), _tensor_array(indices)
 
 
+def _array(x):
+    """x as a NumPy array; a torch tensor on any device, also one that requires grad, through
+    detach().cpu() (its gradients are sdf_lattices._torch's business)."""
+    if type(x).__module__.split(".")[0] == "torch" and hasattr(x, "detach"):
+        x = x.detach().cpu()
+    return np.asarray(x)
+
+
 def mesh_arrays(obj):
     """(vertices, faces) of a mesh-like object, or None when it is not one."""
     if isinstance(obj, (tuple, list)) and len(obj) == 2:
-        return np.asarray(obj[0]), np.asarray(obj[1])
+        return _array(obj[0]), _array(obj[1])
     if hasattr(obj, "vertex") and hasattr(obj, "triangle"):  # open3d.t.geometry.TriangleMesh
         return _open3d_tensor_arrays(obj)
     if hasattr(obj, "vertices") and hasattr(obj, "triangles"):  # open3d.geometry.TriangleMesh
         return np.asarray(obj.vertices), np.asarray(obj.triangles)
     if hasattr(obj, "vertices") and hasattr(obj, "faces"):  # trimesh.Trimesh and the like
-        return np.asarray(obj.vertices), np.asarray(obj.faces)
+        return _array(obj.vertices), _array(obj.faces)
     return None
 
 

@@ -22,6 +22,7 @@ bits of a Gaussian offset (NumPy's log and cos against the C library's).
 """
 import os
 import tempfile
+import types
 from typing import NamedTuple
 
 import numpy as np
@@ -255,6 +256,20 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
     triangle up to ~1e-4 (relative) farther than the nearest near an edge where two are
     almost as near (its distance is still evaluated in double).
     """
+    drawn = _draw(mesh, count, sigmas=sigmas, uniform_fraction=uniform_fraction, surface_fraction=surface_fraction,
+                  box=box, margin=margin, seed=seed, normalize=normalize, padding=padding, dtype=dtype)
+    result = _sl.query(drawn.mesh, drawn.points.astype(np.float64), backend=backend, method=method, sign=sign,
+                       precision=precision, threads=threads)
+    return _labelled(drawn, result)
+
+
+# sample_near_surface's sampler keywords and their defaults (precision "double": see its doc).
+_SAMPLER_DEFAULTS = {"sign": "auto", "backend": "auto", "method": "bvh", "precision": "double", "threads": 0}
+
+
+def _draw(mesh, count, *, sigmas=DEFAULT_SIGMAS, uniform_fraction=DEFAULT_UNIFORM_FRACTION, surface_fraction=0.0,
+          box=None, margin=0.1, seed=0, normalize=True, padding=0.0, dtype="float64"):
+    """The points of sample_near_surface, before they are queried (the mesh normalised)."""
     mesh = _sl.as_mesh(mesh)
     count, seed = _check_count(count), _check_seed(seed)
     if dtype not in ("float32", "float64", np.float32, np.float64):
@@ -290,18 +305,24 @@ def sample_near_surface(mesh, count=250_000, *, sigmas=DEFAULT_SIGMAS, uniform_f
         parts.append(uniform_box(box[0], box[1], n_uniform, seeds[-1]))
     group = np.concatenate([np.full(len(p), g, dtype=np.int8) for g, p in enumerate(parts)]) if parts else np.zeros(0, np.int8)
     points = np.concatenate(parts).astype(dtype) if parts else np.zeros((0, 3), dtype)
+    return types.SimpleNamespace(mesh=mesh, vertices=vertices, triangles=triangles, points=points, dtype=dtype,
+                                 group=group, groups=tuple(groups), norm=norm, on_surface=on_surface,
+                                 on_surface_tri=on_surface_tri if n_surface else None)
 
-    result = _sl.query(mesh, points.astype(np.float64), backend=backend, method=method, sign=sign,
-                         precision=precision, threads=threads)
+
+def _labelled(drawn, result):
+    """The Samples of drawn points and their query result."""
+    mesh, dtype, on_surface = drawn.mesh, drawn.dtype, drawn.on_surface
     sdf, normals, triangle = result.distance, np.array(result.gradient), np.array(result.triangle)
     if on_surface is not None:   # on their triangle (up to rounding): its normal, not the gradient's
-        t = triangles[on_surface_tri]
+        vertices = drawn.vertices
+        t = drawn.triangles[drawn.on_surface_tri]
         n = np.cross(vertices[t[:, 1]] - vertices[t[:, 0]], vertices[t[:, 2]] - vertices[t[:, 0]])
         normals[:len(on_surface)] = n / np.linalg.norm(n, axis=1, keepdims=True)
-        triangle[:len(on_surface)] = mesh.source_triangle[on_surface_tri]
-    return Samples(points=points, sdf=sdf.astype(dtype), occupancy=sdf < 0, normals=normals.astype(dtype),
-                   triangle=triangle, group=group, groups=tuple(groups), center=np.asarray(norm.center, dtype=np.float64),
-                   scale=np.float64(norm.scale), mesh=mesh)
+        triangle[:len(on_surface)] = mesh.source_triangle[drawn.on_surface_tri]
+    return Samples(points=drawn.points, sdf=sdf.astype(dtype), occupancy=sdf < 0, normals=normals.astype(dtype),
+                   triangle=triangle, group=drawn.group, groups=drawn.groups,
+                   center=np.asarray(drawn.norm.center, dtype=np.float64), scale=np.float64(drawn.norm.scale), mesh=mesh)
 
 
 def sample_batch(meshes, count=250_000, *, seed=0, **options):
@@ -310,6 +331,8 @@ def sample_batch(meshes, count=250_000, *, seed=0, **options):
     sample_near_surface for each mesh of a list, with the same options, stacked: arrays of
     shape (B, count, ...) (center (B, 3), scale (B,)), mesh a list. Mesh i is sampled with
     seed + i, so its points are those of sample_near_surface(meshes[i], count, seed=seed + i).
+    Every mesh's points are queried in one native call (sdf_lattices.query_batch), with the
+    values of sample_near_surface's one query per mesh, bit for bit.
     """
     meshes = list(meshes)
     if not meshes:
@@ -317,6 +340,11 @@ def sample_batch(meshes, count=250_000, *, seed=0, **options):
     seed = _check_seed(seed)
     if seed + len(meshes) > 2 ** 64:
         raise ValueError(f"seed: seed + len(meshes) must stay below 2^64, got {seed}")
-    each = [sample_near_surface(m, count, seed=seed + i, **options) for i, m in enumerate(meshes)]
+    sampler = dict(_SAMPLER_DEFAULTS)
+    sampler.update({k: options.pop(k) for k in _SAMPLER_DEFAULTS if k in options})
+    count = _check_count(count)
+    drawn = [_draw(m, count, seed=seed + i, **options) for i, m in enumerate(meshes)]
+    results = _sl.query_batch([_sl.SDF(d.mesh, **sampler) for d in drawn], [d.points.astype(np.float64) for d in drawn])
+    each = [_labelled(d, r) for d, r in zip(drawn, results)]
     stacked = {name: np.stack([getattr(s, name) for s in each]) for name in Samples.ARRAYS}
     return Samples(**stacked, groups=each[0].groups, mesh=[s.mesh for s in each])

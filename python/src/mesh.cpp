@@ -1,7 +1,11 @@
 // Meshes: sdf_lattices.Mesh (a PreparedMesh: from arrays or from a file, as sdf-query loads
 // and prepares it), load_mesh and cuda_available.
+#include <map>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/prepared_mesh.h"
@@ -13,6 +17,34 @@
 
 namespace sdf {
 namespace {
+
+/// The options each Python mesh was prepared with, which SDF.refit repeats. PreparedMesh
+/// does not keep them (core/mesh/prepared_mesh.h), and every Python mesh is made by
+/// prepare() below; entries expire with their mesh (a weak_ptr checks that an address is
+/// still the mesh it was, not a later one at the same address).
+class PreparationOptionsTable {
+public:
+    void add(const MeshHolder& mesh, const MeshPreparationOptions& options) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (auto it = entries_.begin(); it != entries_.end();) it = it->second.first.expired() ? entries_.erase(it) : std::next(it);
+        entries_[mesh.get()] = {mesh, options};
+    }
+    std::optional<MeshPreparationOptions> find(const PreparedMesh& mesh) const {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const auto it = entries_.find(&mesh);
+        if (it == entries_.end() || it->second.first.lock().get() != &mesh) return std::nullopt;
+        return it->second.second;
+    }
+
+private:
+    mutable std::mutex mutex_;
+    std::map<const PreparedMesh*, std::pair<std::weak_ptr<const PreparedMesh>, MeshPreparationOptions>> entries_;
+};
+
+PreparationOptionsTable& preparation_options() {
+    static PreparationOptionsTable table;
+    return table;
+}
 
 /// Prepares `mesh` as sdf-query does, with the GIL released (Ctrl-C stops the intersection
 /// check of a large mesh); the preparation's warnings are raised as MeshWarning.
@@ -26,6 +58,7 @@ MeshHolder prepare(TriangleMesh mesh, double weld_tolerance, bool check_intersec
     task.total = int64_t(mesh.triangles.size());
     task.label = "preparing '" + mesh.name + "'";
     MeshHolder prepared = run_task([&] { return std::make_shared<PreparedMesh>(prepare_mesh(mesh, o)); }, task);
+    preparation_options().add(prepared, o);
     const std::vector<std::string> warnings = prepared->warnings();
     if (!warnings.empty()) {
         const py::module_ module = py::module_::import("sdf_lattices._warnings");
@@ -43,22 +76,29 @@ MeshHolder load_prepared(const std::string& path, double weld_tolerance, bool ch
     return prepare(std::move(m), weld_tolerance, check_intersections);
 }
 
+/// `vertices_in` as finite (N, 3) coordinates; TypeError or ValueError naming `argument`.
+std::vector<Vec3d> vertices_argument(const py::array& vertices_in, const std::string& argument) {
+    if (std::string("iuf").find(vertices_in.dtype().kind()) == std::string::npos)
+        throw py::type_error(argument + ": expected an array of real numbers of shape (N, 3), got dtype " +
+                             std::string(py::str(vertices_in.dtype())));
+    const DoubleArray vertices = DoubleArray::ensure(vertices_in);
+    if (!vertices) throw py::type_error(argument + " must be a numeric array");
+    return points_from_array(vertices, argument);
+}
+
 MeshHolder mesh_from_arrays(const py::array& vertices_in, const py::array& faces_in, const std::string& name,
                               double weld_tolerance, bool check_intersections) {
     const char kind = faces_in.dtype().kind();
     if (kind != 'i' && kind != 'u')
         throw py::type_error("faces: expected an integer array of shape (M, 3), got dtype " +
                              std::string(py::str(faces_in.dtype())));
-    if (std::string("iuf").find(vertices_in.dtype().kind()) == std::string::npos)
-        throw py::type_error("vertices: expected an array of real numbers of shape (N, 3), got dtype " +
-                             std::string(py::str(vertices_in.dtype())));
-    const DoubleArray vertices = DoubleArray::ensure(vertices_in);
+    std::vector<Vec3d> vertex_positions = vertices_argument(vertices_in, "vertices");
     const auto faces = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(faces_in);
-    if (!vertices || !faces) throw py::type_error("vertices and faces must be numeric arrays");
+    if (!faces) throw py::type_error("faces must be a numeric array");
     TriangleMesh m;
     m.name = name;
     m.source = "arrays";
-    m.vertices = points_from_array(vertices, "vertices");
+    m.vertices = std::move(vertex_positions);
     if (faces.ndim() != 2 || faces.shape(1) != 3)
         throw std::invalid_argument("faces: expected an array of shape (M, 3) of vertex indices");
     const int64_t nv = int64_t(m.vertices.size());
@@ -93,6 +133,35 @@ std::string mesh_repr(const PreparedMesh& m) {
 }
 
 }  // namespace
+
+MeshHolder refit_mesh(const MeshHolder& mesh, const py::array& new_vertices) {
+    const std::optional<MeshPreparationOptions> options = preparation_options().find(*mesh);
+    if (!options) throw std::invalid_argument("refit: mesh '" + mesh->name() + "' was not prepared by this module");
+    const size_t rows = mesh->input_vertices().size();
+    TriangleMesh m;
+    m.name = mesh->name();
+    m.source = "arrays";
+    m.vertices = vertices_argument(new_vertices, "new_vertices");
+    if (m.vertices.size() != rows)
+        throw std::invalid_argument("new_vertices: expected " + std::to_string(rows) +
+                                    " rows (one per input vertex: Mesh.input_vertices, the rows the faces index), got " +
+                                    std::to_string(m.vertices.size()));
+    m.triangles = mesh->input_triangles();
+    m.content_sha256 = geometry_sha256(m);
+    MeshHolder refitted = prepare(std::move(m), options->weld_tolerance, options->detect_intersections);
+    // Welding, dropping and orientation depend on the positions: refit keeps the prepared
+    // connectivity (and so the numbering the caller's gradients and triangles refer to).
+    if (refitted->triangles() != mesh->triangles() || refitted->source_triangle() != mesh->source_triangle()) {
+        const MeshReport &was = mesh->report(), &now = refitted->report();
+        throw std::invalid_argument(
+            "refit of mesh '" + mesh->name() + "': the new vertices change its connectivity after preparation (triangles kept: " +
+            std::to_string(mesh->triangles().size()) + " before, " + std::to_string(refitted->triangles().size()) +
+            " now; welded vertices: " + std::to_string(was.welded_vertices) + " before, " + std::to_string(now.welded_vertices) +
+            " now; flipped outward: " + (was.flipped ? "yes" : "no") + " before, " + (now.flipped ? "yes" : "no") +
+            " now). refit needs the same welded, cleaned and oriented triangles; build a new SDF of the new vertices instead");
+    }
+    return refitted;
+}
 
 MeshHolder mesh_argument(const py::handle& mesh) {
     if (py::isinstance<PreparedMesh>(mesh)) return mesh.cast<MeshHolder>();

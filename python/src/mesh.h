@@ -18,4 +18,11 @@ using MeshHolder = std::shared_ptr<PreparedMesh>;
 /// TypeError naming what is accepted otherwise.
 MeshHolder mesh_argument(const py::handle& mesh);
 
+/// `mesh` with its input vertices replaced by `new_vertices` (as many rows) and its input
+/// faces kept, prepared with the options it was prepared with: what Mesh(new_vertices,
+/// mesh.input_faces, ...) gives, bit for bit. ValueError when the preparation's
+/// connectivity differs (welds, dropped triangles, the outward flip): the numbering of the
+/// caller's results would change.
+MeshHolder refit_mesh(const MeshHolder& mesh, const py::array& new_vertices);
+
 }  // namespace sdf

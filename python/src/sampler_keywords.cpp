@@ -15,11 +15,22 @@
 namespace sdf {
 namespace {
 
-/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str or None; the codec
-/// then checks it against the key's domain.
+/// A keyword's value as JSON: bool, integer (Python or NumPy), float, str, None, or for a key
+/// that takes a list (devices=[0, 1]) a list or tuple of those; the codec then checks it
+/// against the key's domain.
 nlohmann::json keyword_json(const std::string& call, const std::string& key, const py::handle& value) {
     PyObject* v = value.ptr();
     if (value.is_none()) return nullptr;
+    static const nlohmann::json defaults = sampler_options_to_json(SamplerOptions{});
+    if ((PyList_Check(v) || PyTuple_Check(v)) && defaults.contains(key) && defaults.at(key).is_array()) {
+        nlohmann::json items = nlohmann::json::array();
+        for (const py::handle item : value) {
+            if (PyList_Check(item.ptr()) || PyTuple_Check(item.ptr()))
+                throw py::type_error(call + ": key '" + key + "': expected a flat list, got " + std::string(py::repr(value)));
+            items.push_back(keyword_json(call, key, item));
+        }
+        return items;
+    }
     if (PyBool_Check(v)) return v == Py_True;
     if (PyIndex_Check(v)) {
         int overflow = 0;

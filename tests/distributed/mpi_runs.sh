@@ -5,6 +5,9 @@
 #       one process and by 1, 2 and 3 ranks: every field file's bytes must be equal, and the
 #       manifest must record the ranks and that every rank wrote its own slab's bytes of every
 #       channel file (MPI-IO), and nothing more.
+#   mpi_runs.sh gpu RUN_EXPERIMENT MPIEXEC
+#       on two GPUs (skipped, 77, below two): mpirun -np 2 and one process with "devices": "all"
+#       give one GPU's channel files byte for byte, each rank's slab on another GPU.
 #   mpi_runs.sh narrow_band RUN_EXPERIMENT MPIEXEC
 #       a narrow band (sampler band_width) sampled by one process and by 3 ranks: the same
 #       field files byte for byte and the same counters in the field's sampler report (the
@@ -120,6 +123,42 @@ PY
     same_fields "--distribute runs" "$dist"
     grep -q '"mode": "runs"' "$dist/manifest.json" || fail "--distribute runs: the manifest does not say so"
     echo "--distribute runs: the same results tree and channel files"
+    exit 0
+fi
+
+if [ "$case_name" = gpu ]; then
+    # Issue 36: two GPUs, as ranks and as one process's devices, give one GPU's files byte for
+    # byte, each rank on its own device. Skipped (77) below two visible GPUs.
+    gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU' || true)
+    [ "${gpus:-0}" -ge 2 ] || { echo "$gpus GPU(s) visible, this test needs 2: skipped"; exit 77; }
+    sed -e 's/"backend": "cpu"/"backend": "cuda"/' -e 's/\[11, 9, 13\]/[96, 96, 96]/' -e 's/\[8, 7, 18\]/[64, 64, 128]/' \
+        "$work/mpi_fields.json" > "$work/gpu.json"
+    sed 's/"backend": "cuda"/"backend": "cuda", "devices": "all"/' "$work/gpu.json" > "$work/gpu_all.json"
+    sed -i 's/"name": "mpi_fields"/"name": "mpi_fields_all"/' "$work/gpu_all.json"
+    "$tool" "$work/gpu.json" --no-cache --quiet --output-root "$work/one" > "$work/one.log" 2>&1 || { cat "$work/one.log"; fail "one GPU failed"; }
+    one=$(run_dir "$work/one")
+    (cd "$one" && find . -name '*.raw' | sort) > "$work/one.files"
+    [ "$(wc -l < "$work/one.files")" -eq 12 ] || fail "expected 12 channel files"
+    mpi 2 "$tool" "$work/gpu.json" --no-cache --quiet --output-root "$work/np2" > "$work/np2.log" 2>&1 ||
+        { cat "$work/np2.log"; fail "mpirun -np 2 on GPUs failed"; }
+    "$tool" "$work/gpu_all.json" --no-cache --quiet --output-root "$work/all" > "$work/all.log" 2>&1 ||
+        { cat "$work/all.log"; fail "devices all failed"; }
+    np2=$(run_dir "$work/np2") all=$(run_dir_of "$work/all" mpi_fields_all)
+    while read -r f; do
+        cmp "$one/$f" "$np2/$f" || fail "np 2: $f differs from one GPU's"
+        cmp "$one/$f" "$all/$f" || fail "devices all: $f differs from one GPU's"
+    done < "$work/one.files"
+    python3 - "$np2" "$all" <<'PY' || fail "the provenance does not put each slab on its own GPU"
+import json, os, sys
+fields = json.load(open(os.path.join(sys.argv[1], "manifest.json")))["distributed"]["fields"]
+for f in fields:
+    buses = [s["device"]["pci_bus_id"] for s in f["slabs"]]
+    assert len(set(buses)) == 2, f"np 2: slabs on {buses}"
+metrics = open(os.path.join(sys.argv[2], "metrics.json")).read()
+assert '"split": true' in metrics.replace('"split":true', '"split": true'), "devices all: no field was split"
+print("np 2: each rank on its own GPU;", len(fields), "fields")
+PY
+    echo "GPUs: np 2 and devices all give one GPU's $(wc -l < "$work/one.files") channel files byte for byte"
     exit 0
 fi
 

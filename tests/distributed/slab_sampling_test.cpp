@@ -1,4 +1,4 @@
-// Slabs (kernels/lattice/lattice_slab.h) and their plans (harness/distributed/slab_plan.h):
+// Slabs (kernels/lattice/lattice_slab.h) and their plans (harness/sampling/slab_plan.h):
 // the slabs of a plan tile the lattice, and every sampler's samples of a slab are the whole
 // lattice's samples at the slab's storage offsets, bit for bit. This is what makes a
 // distributed run's field files equal a single process's (tests/distributed/mpi_runs.sh
@@ -10,7 +10,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
-#include "harness/distributed/slab_plan.h"
+#include "harness/sampling/slab_plan.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/test_util/shared_mesh.h"
 

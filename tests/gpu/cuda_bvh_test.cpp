@@ -174,6 +174,45 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
     }
 }
 
+// Issue 38's sliver (an angle of 0.5 degrees, inradius 0.54) under a band of 0.05: a brick's
+// centre whose search ranks the sliver by its edges over-estimates its distance by up to the
+// inradius, which the brick skip must allow for (FloatSearchBound::sliver_reach_*), or bricks
+// on the sliver come out "outside the band". Every banded CUDA field equals the CPU double
+// brute force's field banded, to the bit.
+TEST(CudaBvh, NarrowBandNearASliverKeepsItsBricks) {
+    TriangleMesh m;
+    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
+    m.triangles = {{0, 1, 2}, {0, 3, 1}};
+    m.name = "issue_38_sliver";
+    const PreparedMesh mesh = prepare_mesh(m);
+    Lattice lattice;
+    lattice.type = LatticeType::CC;
+    lattice.origin = {40.0, -0.4, -0.3};
+    lattice.spacing = 0.05;
+    lattice.resolution = {400, 17, 13};
+    const double w = lattice.spacing;
+    SamplerOptions cpu;
+    cpu.backend = "cpu";
+    cpu.method = "brute_force";
+    cpu.precision = Precision::Double;
+    cpu.sign = SignMode::Winding;
+    cpu.progress = false;
+    const SampledField expected = banded(make_sampler(cpu)->bind(share(mesh))->sample(lattice), w);
+    for (const char* kernel : {"warp", "candidates"})
+        for (Precision precision : {Precision::Float, Precision::Double}) {
+            SamplerOptions o = cpu;
+            o.backend = "cuda";
+            o.method = "bvh";
+            o.kernel = kernel;
+            o.precision = precision;
+            o.band_width = w;
+            const SampledField band = make_sampler(o)->bind(share(mesh))->sample(lattice);
+            const std::string what = std::string("sliver ") + kernel + " " + precision_name(precision);
+            ASSERT_EQ(band.closest_triangle, expected.closest_triangle) << what;
+            ASSERT_EQ(band.distance, expected.distance) << what;
+        }
+}
+
 TEST(CudaBvh, RepeatedCallsOfABoundSamplerEqualEachOther) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[3].mesh;  // pawn
     const Lattice lattice = fit_lattice(LatticeType::CC, {16, 16, 16}, mesh.bounds(), 0.1);

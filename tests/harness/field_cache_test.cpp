@@ -117,6 +117,7 @@ void change(T& v) {
     if constexpr (std::is_same_v<T, std::string>) v += "_changed";
     else if constexpr (std::is_same_v<T, bool>) v = !v;
     else if constexpr (std::is_enum_v<T>) v = T(int(v) + 1);
+    else if constexpr (std::is_same_v<T, DeviceSelection>) v.all = !v.all;
     else v = T(v + 1);
 }
 
@@ -143,7 +144,7 @@ TEST(FieldCacheKey, EveryResultOptionChangesTheKeyAndNoOtherDoes) {
         if (f.role == OptionRole::Execution) execution.push_back(f.name);
     });
     EXPECT_EQ(visited, kSamplerOptionFields);
-    const std::vector<std::string> must_not_key = {"backend", "threads", "progress", "device", "max_points_per_piece",
+    const std::vector<std::string> must_not_key = {"backend", "threads", "progress", "device", "devices", "max_points_per_piece",
                                                    "max_triangles_per_chunk", "points_per_thread", "bvh_build"};
     EXPECT_EQ(execution, must_not_key);
 }

@@ -324,5 +324,33 @@ TEST(StreamedSampling, ToolEqualsRunExperimentFieldsByteForByte) {
     }
 }
 
+// Issue 35: --sparse samples only the band's blocks; the files it writes (slab by slab from
+// the sparse band) are the dense --band run's, byte for byte; without a band it is refused.
+TEST(StreamedSampling, SparseBandWritesTheDenseBandsBytes) {
+    test::ScratchDir dir("sdf_sample_sparse");
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) + " --backend cpu --margin 0.3 --memory-budget 256MiB --quiet";
+    for (const std::string& mesh : {std::string("shape:torus"), std::string("shape:pawn")})
+        for (const std::string& lattice : {std::string("--resolution 30 29 28"), std::string("--lattice bcc --resolution 21 20 38")}) {
+            const std::string args = " " + mesh + " " + lattice + " --band 0.12 --max-planes-per-slab 7";
+            const test::ShellResult dense = test::run_in(dir.path(), exe + args + " --out d.json --overwrite");
+            const test::ShellResult sparse = test::run_in(dir.path(), exe + args + " --sparse --out s.json --overwrite");
+            ASSERT_EQ(dense.code, 0) << dense.err;
+            ASSERT_EQ(sparse.code, 0) << sparse.err;
+            EXPECT_TRUE(test::Contains(sparse.out, "sparse band: ")) << sparse.out;
+            for (const char* channel : {"distance", "gradient", "closest_triangle"}) {
+                const std::string c = std::string(".") + channel + ".raw";
+                EXPECT_TRUE(bytes_of(dir.at("d" + c)) == bytes_of(dir.at("s" + c))) << mesh << " " << lattice << " " << channel;
+            }
+            const SampledField d = read_field(dir.at("d.json")), f = read_field(dir.at("s.json"));
+            ASSERT_TRUE(d.sampler.band && f.sampler.band);
+            EXPECT_EQ(d.sampler.band->points_in_band, f.sampler.band->points_in_band);
+            EXPECT_EQ(d.sampler.band->points_outside, f.sampler.band->points_outside);
+            EXPECT_TRUE(test::Contains(f.sampler.band->how, "sparse")) << f.sampler.band->how;
+        }
+    const test::ShellResult no_band = test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --sparse --out n.json");
+    EXPECT_EQ(no_band.code, 2) << no_band.err;
+    EXPECT_TRUE(test::Contains(no_band.err, "--sparse: expected a narrow band")) << no_band.err;
+}
+
 }  // namespace
 }  // namespace sdf

@@ -194,6 +194,15 @@ def test_sampler_keywords_are_the_config_codecs(box):
         sl.SDF(box, progress=True)
     with pytest.raises(TypeError, match=r"sample\(\): key 'backend': expected a str, a number or a bool, got list"):
         sl.sample(box, resolution=5, backend=["cpu"])
+    # devices (issue 36): "all" or a list of GPUs; the CPU backend refuses a list, takes "all".
+    with pytest.raises(ValueError, match=r"sampler.devices: a list of CUDA devices needs the backend cuda"):
+        sl.SDF(box, backend="cpu", devices=[0, 1])
+    with pytest.raises(ValueError, match=r"SDF\(\): key 'devices': expected \"all\" or a list of distinct CUDA device ordinals"):
+        sl.SDF(box, backend="cpu", devices=[0, 0])
+    with pytest.raises(ValueError, match=r"sample\(\): key 'devices': expected \"all\" or a list"):
+        sl.sample(box, resolution=5, backend="cpu", devices="every")
+    assert same_bits(sl.sample(box, resolution=6, backend="cpu", devices="all").values,
+                     sl.sample(box, resolution=6, backend="cpu").values)
     # The codec's keys all work from Python: a narrow band equals the full field clamped to +-W.
     full = sl.sample(box, resolution=6, backend="cpu")
     band = sl.sample(box, resolution=6, backend="cpu", band_width=np.float32(0.25))

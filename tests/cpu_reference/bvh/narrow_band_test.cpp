@@ -122,6 +122,35 @@ TEST(NarrowBand, FewPointsAreComputedWhenMostOfTheLatticeIsOutsideTheBand) {
     EXPECT_EQ(computed + band.points_skipped, lattice.num_points());
 }
 
+// A probe whose nearest triangle is a sliver: the float search ranks a sliver by its edges,
+// which over-estimate its distance by up to its inradius (0.54 here, issue 38's triangles),
+// so the probe's distance may exceed the true one by that much; the brick skip must allow for
+// it or a brick on the sliver is called outside a band of 0.05.
+TEST(NarrowBand, ProbesNearSliversDoNotSkipBricksInTheBand) {
+    TriangleMesh m;
+    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
+    m.triangles = {{0, 1, 2}, {0, 3, 1}};
+    m.name = "issue_38_sliver";
+    const PreparedMesh mesh = prepare_mesh(m);
+    Lattice lattice;
+    lattice.type = LatticeType::CC;
+    lattice.origin = {40.0, -0.4, -0.3};
+    lattice.spacing = 0.05;
+    lattice.resolution = {400, 17, 13};  // x 40..60, across the sliver, 0.3 above and below it
+    const double w = lattice.spacing;
+    for (Precision precision : {Precision::Float, Precision::Double}) {
+        const std::string what = std::string("sliver ") + precision_name(precision);
+        const SampledField full = make_cpu_bvh_sampler(options(precision, 0, SignMode::Winding))->bind(share(mesh))->sample(lattice);
+        const SampledField banded = make_cpu_bvh_sampler(options(precision, w, SignMode::Winding))->bind(share(mesh))->sample(lattice);
+        expect_banded(full, banded, w, what);
+        const SampledField brute = make_cpu_brute_force_sampler(options(Precision::Double, 0, SignMode::Winding))->bind(share(mesh))->sample(lattice);
+        for (size_t i = 0; i < brute.distance.size(); ++i)
+            if (std::abs(brute.distance[i]) <= 0.5 * w) {
+                ASSERT_NE(banded.closest_triangle[i], kOutsideBandTriangle) << what << " point " << i << " at " << brute.distance[i];
+            }
+    }
+}
+
 TEST(NarrowBand, RefusesBadWidthsByName) {
     const PreparedMesh mesh = prepare_mesh(make_icosphere(1, 1.0));
     const Lattice lattice = fit_lattice(LatticeType::CC, {4, 4, 4}, mesh.bounds(), 0.1);

@@ -1,10 +1,11 @@
-#include "harness/distributed/slab_plan.h"
+#include "harness/sampling/slab_plan.h"
 
 #include <algorithm>
 #include <chrono>
 #include <numeric>
 
 #include "core/bvh/triangle_bvh.h"
+#include "core/parallel/parallel_for.h"
 #include "harness/sampling/sampler_table.h"
 #include "kernels/bvh/closest_triangle_bvh.h"
 
@@ -28,16 +29,21 @@ double probe_plane(const BvhView<T>& view, const Lattice& lattice, const Int3& r
 }
 
 template <typename T>
-std::vector<double> bvh_plane_costs(const PreparedMesh& mesh, const Lattice& lattice) {
+std::vector<double> bvh_plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const LatticeSlab& planes) {
     const std::shared_ptr<const TriangleBvh> bvh = mesh.bvh();  // the samplers' tree, built once
     const BvhView<T> view = bvh->view<T>();
     const Int3 r = lattice.resolution, s = lattice.secondary_resolution();
     const bool secondary = lattice.secondary_count() > 0;
     std::vector<double> cost(size_t(r.z), 0.0);
-    for (int k = 0; k < r.z; ++k) {
-        cost[size_t(k)] = probe_plane(view, lattice, r, 0, k) * double(r.x) * double(r.y);
-        if (secondary && k < s.z) cost[size_t(k)] += probe_plane(view, lattice, s, 1, k) * double(s.x) * double(s.y);
-    }
+    // Each plane's probes are independent integers: the planes go to every core (a 1024^3
+    // plan is 65,536 searches), and the result is the same on any number of threads.
+    parallel_for(planes.z_end - planes.z_begin, 8, 0, [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) {
+            const int k = planes.z_begin + int(i);
+            cost[size_t(k)] = probe_plane(view, lattice, r, 0, k) * double(r.x) * double(r.y);
+            if (secondary && k < s.z) cost[size_t(k)] += probe_plane(view, lattice, s, 1, k) * double(s.x) * double(s.y);
+        }
+    });
     return cost;
 }
 
@@ -59,14 +65,19 @@ double SlabPlan::estimated_max_over_mean() const {
 
 std::vector<double> plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const SamplerOptions& options,
                                 std::string& estimate) {
+    return plane_costs(mesh, lattice, options, estimate, whole_lattice_slab(lattice));
+}
+
+std::vector<double> plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const SamplerOptions& options,
+                                std::string& estimate, const LatticeSlab& planes) {
     if (sampler_kind(options).cost == CostModel::BvhVisits && !mesh.triangles().empty()) {
         estimate = "bvh_visits";
-        return options.precision == Precision::Float ? bvh_plane_costs<float>(mesh, lattice)
-                                                     : bvh_plane_costs<double>(mesh, lattice);
+        return options.precision == Precision::Float ? bvh_plane_costs<float>(mesh, lattice, planes)
+                                                     : bvh_plane_costs<double>(mesh, lattice, planes);
     }
     estimate = "points";
-    std::vector<double> cost(size_t(lattice.resolution.z));
-    for (int k = 0; k < lattice.resolution.z; ++k) cost[size_t(k)] = double(slab_point_count(lattice, {k, k + 1}));
+    std::vector<double> cost(size_t(lattice.resolution.z), 0.0);
+    for (int k = planes.z_begin; k < planes.z_end; ++k) cost[size_t(k)] = double(slab_point_count(lattice, {k, k + 1}));
     return cost;
 }
 

@@ -1,5 +1,6 @@
 /// @file slab_plan.h
-/// @brief How a distributed run cuts a lattice into one slab per rank
+/// @brief How a distributed run cuts a lattice into one slab per rank, and a process its
+/// slabs over its GPUs (multi_device_sampler.h),
 /// (kernels/lattice/lattice_slab.h), balanced by an estimate of each z-plane's cost.
 ///
 /// Brute force costs the same at every point (every triangle is tested), so a plane costs
@@ -37,6 +38,10 @@ struct SlabPlan {
 /// Estimated cost of each primary z-plane of `lattice` for a sampler with `options`.
 std::vector<double> plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const SamplerOptions& options,
                                 std::string& estimate);
+
+/// The same for the planes of `planes` only (the others cost 0): a slab cut over devices.
+std::vector<double> plane_costs(const PreparedMesh& mesh, const Lattice& lattice, const SamplerOptions& options,
+                                std::string& estimate, const LatticeSlab& planes);
 
 /// Cuts planes [0, costs.size()) into `parts` contiguous slabs of about equal cost: slab r
 /// ends where the running cost first reaches (r + 1) / parts of the total. Slabs are empty

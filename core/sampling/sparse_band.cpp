@@ -1,0 +1,241 @@
+#include "core/sampling/sparse_band.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "core/parallel/parallel_for.h"
+
+namespace sdf {
+namespace {
+
+int blocks_for(int points) { return points > 0 ? (points + kBandBlockDim - 1) / kBandBlockDim : 0; }
+
+int64_t find_sorted(const std::vector<int64_t>& ids, int64_t id) {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    return it != ids.end() && *it == id ? int64_t(it - ids.begin()) : -1;
+}
+
+bool mask_bit(const BandSignMask& m, int local) { return (m[size_t(local >> 6)] >> (local & 63)) & 1; }
+
+}  // namespace
+
+BandLayout::BandLayout(const Lattice& lattice) : lattice_(lattice) {
+    cosets_ = lattice.secondary_count() > 0 ? 2 : 1;
+    int64_t storage = 0;
+    for (int c = 0; c < cosets_; ++c) {
+        BandCoset& s = coset_[size_t(c)];
+        s.first = c == 0 ? Int3{0, 0, 0} : Int3{1, 1, 1};
+        s.points = c == 0 ? lattice.resolution : lattice.secondary_resolution();
+        s.blocks = {blocks_for(s.points.x), blocks_for(s.points.y), blocks_for(s.points.z)};
+        s.first_block = block_count_;
+        s.storage_offset = storage;
+        block_count_ += s.block_count();
+        storage += int64_t(s.points.x) * s.points.y * s.points.z;
+    }
+}
+
+BandBlockCoords BandLayout::block_coords(int64_t id) const {
+    int c = 0;
+    while (c + 1 < cosets_ && id >= coset_[size_t(c + 1)].first_block) ++c;
+    const BandCoset& s = coset_[size_t(c)];
+    const int64_t local = id - s.first_block;
+    return {c, {int(local % s.blocks.x), int((local / s.blocks.x) % s.blocks.y), int(local / (int64_t(s.blocks.x) * s.blocks.y))}};
+}
+
+Int3 BandLayout::coset_point(int64_t id, int local) const {
+    const BandBlockCoords b = block_coords(id);
+    const Int3 o = local_offset(local);
+    return {b.block.x * kBandBlockDim + o.x, b.block.y * kBandBlockDim + o.y, b.block.z * kBandBlockDim + o.z};
+}
+
+Int3 BandLayout::point_coords(int64_t id, int local) const {
+    const BandBlockCoords b = block_coords(id);
+    const Int3 p = coset_point(id, local);
+    const Int3 f = coset_[size_t(b.coset)].first;
+    return {f.x + 2 * p.x, f.y + 2 * p.y, f.z + 2 * p.z};
+}
+
+int64_t BandLayout::storage_index(int64_t id, int local) const {
+    const BandBlockCoords b = block_coords(id);
+    const BandCoset& s = coset_[size_t(b.coset)];
+    const Int3 p = coset_point(id, local);
+    if (p.x >= s.points.x || p.y >= s.points.y || p.z >= s.points.z) return -1;
+    return s.storage_offset + p.x + int64_t(s.points.x) * (p.y + int64_t(s.points.y) * p.z);
+}
+
+void BandLayout::cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const {
+    const Int3 c = point_coords(id, 0);
+    const int span = 2 * kBandBlockDim;  // 8 spacings, in units of h/2
+    lo = lattice_.position_of_coords(c);
+    hi = lattice_.position_of_coords({c.x + span, c.y + span, c.z + span});
+}
+
+SparseBandField::SparseBandField(const Lattice& lattice_in, double width_in, Precision precision_in)
+    : lattice(lattice_in), width(width_in), precision(precision_in), layout_(lattice_in) {
+    require_band_width(width, "sparse band width");
+    if (!(width > 0)) throw std::invalid_argument("sparse band width: expected a band width > 0, got 0");
+    inside_tiles.assign(size_t((layout_.block_count() + 63) / 64), 0);
+}
+
+int64_t SparseBandField::find_active(int64_t id) const { return find_sorted(active, id); }
+int64_t SparseBandField::find_mixed(int64_t id) const { return find_sorted(mixed, id); }
+
+void SparseBandField::set_tile_inside(int64_t id, bool inside) {
+    const uint64_t bit = uint64_t(1) << (id & 63);
+    if (inside) inside_tiles[size_t(id >> 6)] |= bit;
+    else inside_tiles[size_t(id >> 6)] &= ~bit;
+}
+
+int64_t SparseBandField::add_active(int64_t id) {
+    if (!active.empty() && !(id > active.back()))
+        throw std::logic_error("SparseBandField::add_active: block ids must ascend");
+    active.push_back(id);
+    distance.resize(active.size() * kBandBlockPoints, width);
+    gradient.resize(active.size() * kBandBlockPoints, Vec3d(0.0));
+    closest_triangle.resize(active.size() * kBandBlockPoints, kOutsideBandTriangle);
+    return int64_t(active.size()) - 1;
+}
+
+int64_t SparseBandField::add_mixed(int64_t id) {
+    if (!mixed.empty() && !(id > mixed.back())) throw std::logic_error("SparseBandField::add_mixed: block ids must ascend");
+    mixed.push_back(id);
+    mixed_inside.push_back(BandSignMask{});
+    return int64_t(mixed.size()) - 1;
+}
+
+SparseBandCounts SparseBandField::counts() const {
+    SparseBandCounts c;
+    c.blocks = layout_.block_count();
+    c.active_blocks = int64_t(active.size());
+    c.mixed_blocks = int64_t(mixed.size());
+    c.tiles = c.blocks - c.active_blocks - c.mixed_blocks;
+    for (uint64_t word : inside_tiles) c.inside_tiles += __builtin_popcountll(word);
+    for (const std::vector<int64_t>* ids : {&active, &mixed})  // their tile bits mean nothing
+        for (int64_t id : *ids) c.inside_tiles -= tile_inside(id) ? 1 : 0;
+    for (size_t a = 0; a < active.size(); ++a)
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (layout_.storage_index(active[a], local) < 0) continue;
+            ++c.active_points;
+            if (closest_triangle[a * kBandBlockPoints + size_t(local)] != kOutsideBandTriangle) ++c.band_points;
+        }
+    return c;
+}
+
+size_t SparseBandField::memory_bytes() const {
+    return active.capacity() * sizeof(int64_t) + distance.capacity() * sizeof(double) + gradient.capacity() * sizeof(Vec3d) +
+           closest_triangle.capacity() * sizeof(int32_t) + inside_tiles.capacity() * sizeof(uint64_t) +
+           mixed.capacity() * sizeof(int64_t) + mixed_inside.capacity() * sizeof(BandSignMask);
+}
+
+int64_t SparseBandField::dense_bytes(const Lattice& lattice) {
+    return lattice.num_points() * int64_t(sizeof(double) + sizeof(Vec3d) + sizeof(int32_t));
+}
+
+SampledField SparseBandField::densify(int64_t max_points) const {
+    const int64_t n = lattice.num_points();
+    if (n > max_points)
+        throw std::length_error("densifying a sparse band of " + std::to_string(n) + " lattice points (" +
+                                std::to_string(dense_bytes(lattice)) + " bytes) exceeds the limit of " +
+                                std::to_string(max_points) + " points");
+    SampledField field = densify_slab(whole_lattice_slab(lattice));
+    field.timings = timings;
+    field.sampler = sampler;
+    field.mesh = mesh;
+    return field;
+}
+
+SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
+    if (slab.z_begin < 0 || slab.z_end > lattice.resolution.z || slab.z_begin >= slab.z_end)
+        throw std::invalid_argument("densify_slab: planes [" + std::to_string(slab.z_begin) + ", " +
+                                    std::to_string(slab.z_end) + ") are not a slab of a lattice of " +
+                                    std::to_string(lattice.resolution.z) + " planes");
+    SampledField field;
+    field.lattice = lattice;
+    field.precision = precision;
+    field.resize(slab_point_count(lattice, slab));
+    // Each coset's planes of the slab are one contiguous range of storage (its part), and of
+    // the slab's compact order.
+    int64_t part_base = 0;
+    for (int c = 0; c < layout_.cosets(); ++c) {
+        const BandCoset& s = layout_.coset(c);
+        const StorageRange range = slab_storage(lattice, slab, c);
+        const int planes = c == 0 ? slab.z_end - slab.z_begin : slab_secondary_planes(lattice, slab);
+        if (planes > 0) {
+            const int k0 = slab.z_begin, k1 = slab.z_begin + planes;  // the coset's planes [k0, k1)
+            const int bz0 = k0 / kBandBlockDim, bz1 = (k1 - 1) / kBandBlockDim;
+            const int64_t row_blocks = int64_t(s.blocks.x) * s.blocks.y;
+            parallel_for(int64_t(bz1 - bz0 + 1) * row_blocks, 64, 0, [&](int64_t begin, int64_t end) {
+                const int64_t first_id = s.first_block + int64_t(bz0) * row_blocks + begin;
+                int64_t a = std::lower_bound(active.begin(), active.end(), first_id) - active.begin();
+                int64_t m = std::lower_bound(mixed.begin(), mixed.end(), first_id) - mixed.begin();
+                for (int64_t id = first_id; id < first_id + (end - begin); ++id) {
+                    const bool is_active = a < int64_t(active.size()) && active[size_t(a)] == id;
+                    const bool is_mixed = !is_active && m < int64_t(mixed.size()) && mixed[size_t(m)] == id;
+                    for (int local = 0; local < kBandBlockPoints; ++local) {
+                        const int64_t storage = layout_.storage_index(id, local);
+                        if (storage < range.offset || storage >= range.offset + range.count) continue;  // padding, other planes
+                        const int64_t out = part_base + (storage - range.offset);
+                        if (is_active) {
+                            const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
+                            field.distance[size_t(out)] = distance[v];
+                            field.gradient[size_t(out)] = gradient[v];
+                            field.closest_triangle[size_t(out)] = closest_triangle[v];
+                        } else {
+                            store_outside_band(field, out, is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id),
+                                               width);
+                        }
+                    }
+                    if (is_active) ++a;
+                    if (is_mixed) ++m;
+                }
+            });
+        }
+        part_base += range.count;
+    }
+    return field;
+}
+
+SparseBandField SparseBandField::sparsify(const SampledField& dense, double w) {
+    SparseBandField out(dense.lattice, w, dense.precision);
+    if (dense.size() != dense.lattice.num_points())
+        throw std::invalid_argument("sparsify: the field holds " + std::to_string(dense.size()) + " points, its lattice " +
+                                    std::to_string(dense.lattice.num_points()));
+    out.timings = dense.timings;
+    out.sampler = dense.sampler;
+    out.mesh = dense.mesh;
+    const BandLayout& layout = out.layout();
+    for (int64_t id = 0; id < layout.block_count(); ++id) {
+        bool in_band = false, any_inside = false, any_outside = false;
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            const int64_t i = layout.storage_index(id, local);
+            if (i < 0) continue;
+            const double d = dense.distance[size_t(i)];
+            if (dense.closest_triangle[size_t(i)] != kOutsideBandTriangle && !outside_band(d, w)) in_band = true;
+            (std::signbit(d) ? any_inside : any_outside) = true;
+        }
+        if (in_band) {
+            const size_t base = size_t(out.add_active(id)) * kBandBlockPoints;
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                const int64_t i = layout.storage_index(id, local);
+                if (i < 0) continue;
+                const double d = dense.distance[size_t(i)];
+                const bool flagged = dense.closest_triangle[size_t(i)] == kOutsideBandTriangle || outside_band(d, w);
+                out.distance[base + size_t(local)] = flagged ? (std::signbit(d) ? -w : w) : d;
+                out.gradient[base + size_t(local)] = flagged ? Vec3d(0.0) : dense.gradient[size_t(i)];
+                out.closest_triangle[base + size_t(local)] = flagged ? kOutsideBandTriangle : dense.closest_triangle[size_t(i)];
+            }
+        } else if (any_inside && any_outside) {
+            BandSignMask& mask = out.mixed_inside[size_t(out.add_mixed(id))];
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                const int64_t i = layout.storage_index(id, local);
+                if (i >= 0 && std::signbit(dense.distance[size_t(i)])) mask[size_t(local >> 6)] |= uint64_t(1) << (local & 63);
+            }
+        } else {
+            out.set_tile_inside(id, any_inside);
+        }
+    }
+    return out;
+}
+
+}  // namespace sdf

@@ -1,0 +1,173 @@
+/// @file sparse_band.h
+/// @brief A narrow band stored sparsely (issue 35): the lattice in blocks of 8^3 points (as
+/// OpenVDB's leaves), the exact values of the active blocks only, and the outside as signs.
+///
+/// Layout. A lattice is its cosets (kernels/lattice/lattice_kinds.h: CC one grid, BCC its
+/// primary grid and its secondary grid shifted by h/2), each a CC grid cut into blocks of
+/// 8 x 8 x 8 points: coset point (i, j, k) lies in block (i, j, k) / 8 at local index
+/// (i % 8) + 8 (j % 8) + 64 (k % 8) (x fastest, as OpenVDB's leaf offsets run z fastest: a
+/// writer transposes). Blocks are numbered coset by coset, x fastest then y then z, and a
+/// block's id is that number (BandLayout::block_id); ids sort as the lattice's storage does.
+/// A block's cell is the box from its first point to 8 spacings beyond it on every axis: the
+/// cells of a coset tile space, so a cell that meets no triangle holds one side of the surface.
+///
+/// Values. Every point of an active block (sorted in `active`) holds what the dense banded
+/// field holds there (narrow_band.h): exact distance, gradient and closest triangle where
+/// |d| <= W, else +-W, gradient 0 and kOutsideBandTriangle. Points of a block beyond the
+/// coset's resolution (the last blocks of each axis) are padding: +W, gradient 0,
+/// kOutsideBandTriangle, and no lattice point (BandLayout::storage_index is -1).
+/// Every other block is outside the band: a tile of one sign (bit `inside_tiles`: -W, else
+/// +W), or, where its points' signs differ (the winding sign across a hole, far from any
+/// triangle), a "mixed" block whose signs are stored per point (512 bits).
+///
+/// As a level set: coset c is an OpenVDB/NanoVDB grid of index-space voxels (i, j, k) with
+/// the transform world = lattice.origin + (h/2) first(c) + h (i, j, k) (first: (0,0,0), BCC
+/// secondary (1,1,1)); active blocks are leaves (active voxels: the points with
+/// closest_triangle != kOutsideBandTriangle), inside tiles are tiles of value -W, everything
+/// else background +W; a mixed block is a leaf with every voxel inactive at +-W.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/sampling/narrow_band.h"
+#include "core/sampling/sampled_field.h"
+#include "kernels/lattice/lattice_slab.h"
+
+namespace sdf {
+
+inline constexpr int kBandBlockLog2 = 3;
+inline constexpr int kBandBlockDim = 1 << kBandBlockLog2;  ///< 8 points per axis
+inline constexpr int kBandBlockPoints = kBandBlockDim * kBandBlockDim * kBandBlockDim;  ///< 512
+
+/// One coset's grid of blocks.
+struct BandCoset {
+    Int3 first{};              ///< integer coordinates (units of h/2) of the coset's point (0, 0, 0)
+    Int3 points{};             ///< the coset's points per axis
+    Int3 blocks{};             ///< blocks per axis: ceil(points / 8)
+    int64_t first_block = 0;   ///< id of the coset's block (0, 0, 0)
+    int64_t storage_offset = 0;  ///< lattice storage index of the coset's point (0, 0, 0)
+    int64_t block_count() const { return int64_t(blocks.x) * blocks.y * blocks.z; }
+};
+
+/// A block's coset and block coordinates.
+struct BandBlockCoords {
+    int coset = 0;
+    Int3 block{};
+};
+
+/// The blocks of a lattice (see the file's comment).
+class BandLayout {
+public:
+    BandLayout() = default;
+    explicit BandLayout(const Lattice& lattice);
+
+    const Lattice& lattice() const { return lattice_; }
+    int cosets() const { return cosets_; }
+    const BandCoset& coset(int c) const { return coset_[size_t(c)]; }
+    /// Blocks of every coset together.
+    int64_t block_count() const { return block_count_; }
+
+    int64_t block_id(int coset, const Int3& block) const {
+        const BandCoset& s = coset_[size_t(coset)];
+        return s.first_block + block.x + int64_t(s.blocks.x) * (block.y + int64_t(s.blocks.y) * block.z);
+    }
+    BandBlockCoords block_coords(int64_t id) const;
+    /// Coset point (i, j, k) of block-local index `local` (0 .. 511, x fastest).
+    static Int3 local_offset(int local) {
+        return {local & (kBandBlockDim - 1), (local >> kBandBlockLog2) & (kBandBlockDim - 1), local >> (2 * kBandBlockLog2)};
+    }
+    /// The coset's point indices (i, j, k) of point `local` of block `id`.
+    Int3 coset_point(int64_t id, int local) const;
+    /// Integer coordinates (units of h/2, Lattice::position_of_coords) of that point.
+    Int3 point_coords(int64_t id, int local) const;
+    /// Its lattice storage index, or -1 for padding (beyond the coset's resolution).
+    int64_t storage_index(int64_t id, int local) const;
+    /// The block's cell (see the file's comment), in world units.
+    void cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const;
+
+private:
+    Lattice lattice_{};
+    int cosets_ = 0;
+    std::array<BandCoset, kMaxLatticeCosets> coset_{};
+    int64_t block_count_ = 0;
+};
+
+/// One bit per point of a block: the sides of a mixed block (bit set: inside, -W).
+using BandSignMask = std::array<uint64_t, kBandBlockPoints / 64>;
+
+/// What a sparse band holds, counted.
+struct SparseBandCounts {
+    int64_t blocks = 0;          ///< every block of the lattice
+    int64_t active_blocks = 0;   ///< with values
+    int64_t mixed_blocks = 0;    ///< outside the band, signs per point
+    int64_t tiles = 0;           ///< outside the band, one sign (blocks - active - mixed)
+    int64_t inside_tiles = 0;    ///< of them, inside (-W)
+    int64_t active_points = 0;   ///< lattice points of the active blocks (padding not counted)
+    int64_t band_points = 0;     ///< of them, |d| <= W (closest_triangle != kOutsideBandTriangle)
+};
+
+struct SparseBandField {
+    SparseBandField() = default;
+    /// An empty band of `lattice` (no active block, every block an outside tile).
+    SparseBandField(const Lattice& lattice, double width, Precision precision);
+
+    Lattice lattice;
+    double width = 0;            ///< W > 0, mesh units
+    Precision precision = Precision::Float;
+
+    /// Active block ids, ascending; block a's values are [a * 512, (a + 1) * 512) of each channel.
+    std::vector<int64_t> active;
+    std::vector<double> distance;
+    std::vector<Vec3d> gradient;
+    std::vector<int32_t> closest_triangle;  ///< in the mesh file's face order; kOutsideBandTriangle outside the band
+
+    /// One bit per block id: the tile's side (set: inside, -W); meaningful for tiles only.
+    std::vector<uint64_t> inside_tiles;
+    /// Mixed block ids, ascending, and their per-point sides.
+    std::vector<int64_t> mixed;
+    std::vector<BandSignMask> mixed_inside;
+
+    SamplingTimings timings;
+    SamplerReport sampler;   ///< how it was sampled; `band` holds the band's counts
+    MeshProvenance mesh;
+
+    const BandLayout& layout() const { return layout_; }
+    /// Index of block `id` in `active` (-1: not active), and in `mixed`.
+    int64_t find_active(int64_t id) const;
+    int64_t find_mixed(int64_t id) const;
+    bool tile_inside(int64_t id) const { return (inside_tiles[size_t(id >> 6)] >> (id & 63)) & 1; }
+    void set_tile_inside(int64_t id, bool inside);
+
+    /// Appends an active block (ids must come in ascending order) with every point padding;
+    /// returns its index in `active`.
+    int64_t add_active(int64_t id);
+    /// Appends a mixed block (ascending ids), every point outside.
+    int64_t add_mixed(int64_t id);
+
+    SparseBandCounts counts() const;
+    /// Bytes held by the arrays (capacity, not size).
+    size_t memory_bytes() const;
+
+    /// The dense banded field this band stands for: every lattice point, in storage order,
+    /// as a dense sampler with SamplerOptions::band_width = W stores it (provenance copied).
+    /// Throws std::length_error naming the size when the lattice has more than `max_points`.
+    SampledField densify(int64_t max_points = INT64_MAX) const;
+    /// The same for one slab of the lattice (kernels/lattice/lattice_slab.h), in the slab's
+    /// compact order (sample_slab()'s): a dense field file written slab by slab under a
+    /// memory budget, without the whole lattice in memory. Provenance not copied.
+    SampledField densify_slab(const LatticeSlab& slab) const;
+    /// Bytes densify() allocates for a lattice (distance, gradient, closest triangle).
+    static int64_t dense_bytes(const Lattice& lattice);
+
+    /// The sparse form of a dense banded field (SamplerOptions::band_width = W, or exact
+    /// values, banded here): a block is active when one of its points is within the band,
+    /// else a tile or a mixed block. The fallback of samplers without a sparse path.
+    static SparseBandField sparsify(const SampledField& field, double width);
+
+private:
+    BandLayout layout_;
+};
+
+}  // namespace sdf

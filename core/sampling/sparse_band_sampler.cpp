@@ -1,0 +1,418 @@
+#include "core/sampling/sparse_band_sampler.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/parallel/parallel_for.h"
+#include "core/sampling/sampler.h"
+#include "core/sampling/sampler_sign.h"
+#include "core/sampling/search_range.h"
+#include "core/winding/winding_sign.h"
+
+namespace sdf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// A bit per block.
+class BlockBits {
+public:
+    explicit BlockBits(int64_t n) : bits_(size_t((n + 63) / 64), 0) {}
+    bool get(int64_t i) const { return (bits_[size_t(i >> 6)] >> (i & 63)) & 1; }
+    void set(int64_t i) { bits_[size_t(i >> 6)] |= uint64_t(1) << (i & 63); }
+
+private:
+    std::vector<uint64_t> bits_;
+};
+
+/// Step 1: the blocks whose cells meet a triangle's box dilated by W.
+BlockBits active_blocks(const PreparedMesh& mesh, const BandLayout& layout, double width) {
+    BlockBits bits(layout.block_count());
+    const Lattice& lattice = layout.lattice();
+    const double h = lattice.spacing;
+    const double dilation = width * (1 + 1e-9) + 1e-4 * h;
+    const double eps = 1e-4;  // in spacings: the rounding of u below
+    const std::vector<Vec3d>& v = mesh.vertices();
+    for (int c = 0; c < layout.cosets(); ++c) {
+        const BandCoset& s = layout.coset(c);
+        const Vec3d o = lattice.position_of_coords(s.first);
+        for (const Int3& t : mesh.triangles()) {
+            int lo[3], hi[3];
+            bool empty = false;
+            for (int a = 0; a < 3; ++a) {
+                const double tlo = std::min({v[size_t(t.x)][a], v[size_t(t.y)][a], v[size_t(t.z)][a]}) - dilation;
+                const double thi = std::max({v[size_t(t.x)][a], v[size_t(t.y)][a], v[size_t(t.z)][a]}) + dilation;
+                // Coset index u = (x - o) / h; block b's cell covers u in [8b, 8b + 8].
+                const double ulo = (tlo - o[a]) / h - eps, uhi = (thi - o[a]) / h + eps;
+                const double blo = std::ceil(ulo / kBandBlockDim - 1), bhi = std::floor(uhi / kBandBlockDim);
+                const int n = s.blocks[a];
+                lo[a] = int(std::max(0.0, std::min(blo, double(n))));
+                hi[a] = int(std::max(-1.0, std::min(bhi, double(n - 1))));
+                empty = empty || lo[a] > hi[a];
+            }
+            if (empty) continue;
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) bits.set(layout.block_id(c, {x, y, z}));
+        }
+    }
+    return bits;
+}
+
+/// The mesh's boundary edges with their net oriented uses (non-zero): the sources of the
+/// winding number's gradient.
+struct BoundaryEdge {
+    Vec3d a, b;
+    double weight;  ///< |net uses| x length
+};
+
+std::vector<BoundaryEdge> boundary_edges(const PreparedMesh& mesh) {
+    std::vector<std::pair<uint64_t, int>> uses;
+    uses.reserve(mesh.triangles().size() * 3);
+    for (const Int3& t : mesh.triangles())
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t a = uint32_t(t[e]), b = uint32_t(t[(e + 1) % 3]);
+            uses.push_back({a < b ? (uint64_t(a) << 32 | b) : (uint64_t(b) << 32 | a), a < b ? 1 : -1});
+        }
+    std::sort(uses.begin(), uses.end());
+    std::vector<BoundaryEdge> out;
+    for (size_t i = 0; i < uses.size();) {
+        size_t j = i;
+        int net = 0;
+        for (; j < uses.size() && uses[j].first == uses[i].first; ++j) net += uses[j].second;
+        if (net != 0) {
+            const Vec3d a = mesh.vertices()[size_t(uses[i].first >> 32)], b = mesh.vertices()[size_t(uses[i].first & 0xffffffffu)];
+            out.push_back({a, b, std::abs(net) * length(b - a)});
+        }
+        i = j;
+    }
+    return out;
+}
+
+double point_segment_distance(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
+    const Vec3d ab = b - a;
+    const double l2 = dot(ab, ab);
+    const double t = l2 > 0 ? std::clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return length(p - (a + ab * t));
+}
+
+/// How the side of a cell without surface is decided (see the header).
+enum class OutsideRule { Uniform, WindingBound, PerPoint };
+
+struct Cell {
+    int coset;
+    Int3 lo, hi;  ///< block range [lo, hi)
+};
+
+class OutsideClassifier {
+public:
+    OutsideClassifier(const BandLayout& layout, const BlockBits& active, OutsideRule rule, const WindingSign* winding,
+                      std::vector<BoundaryEdge> edges)
+        : layout_(layout), active_(active), rule_(rule), winding_(winding), edges_(std::move(edges)) {}
+
+    std::vector<Cell> uniform;      ///< cells of inactive blocks with one side
+    std::vector<int64_t> per_point; ///< inactive blocks queried at every point
+    mutable int64_t refused_by_evaluation = 0;  ///< cells whose |w~ - 1/2| is within the evaluation's bound
+    mutable int64_t refused_by_gradient = 0;    ///< cells where w may cross 1/2 by the Biot-Savart bound
+
+    void run() {
+        const int top = 16;  // blocks per axis of the first cells
+        for (int c = 0; c < layout_.cosets(); ++c) {
+            const Int3 n = layout_.coset(c).blocks;
+            for (int z = 0; z < n.z; z += top)
+                for (int y = 0; y < n.y; y += top)
+                    for (int x = 0; x < n.x; x += top)
+                        visit({c, {x, y, z}, {std::min(x + top, n.x), std::min(y + top, n.y), std::min(z + top, n.z)}});
+        }
+        std::sort(per_point.begin(), per_point.end());
+    }
+
+private:
+    void visit(const Cell& cell) {
+        int64_t count = 0, active = 0;
+        for (int z = cell.lo.z; z < cell.hi.z; ++z)
+            for (int y = cell.lo.y; y < cell.hi.y; ++y)
+                for (int x = cell.lo.x; x < cell.hi.x; ++x) {
+                    ++count;
+                    active += active_.get(layout_.block_id(cell.coset, {x, y, z})) ? 1 : 0;
+                }
+        if (active == count) return;
+        if (active == 0 && proven_uniform(cell)) {
+            uniform.push_back(cell);
+            return;
+        }
+        if (count == 1) {
+            per_point.push_back(layout_.block_id(cell.coset, cell.lo));
+            return;
+        }
+        const Int3 mid{(cell.lo.x + cell.hi.x + 1) / 2, (cell.lo.y + cell.hi.y + 1) / 2, (cell.lo.z + cell.hi.z + 1) / 2};
+        for (int k = 0; k < 8; ++k) {
+            Cell child{cell.coset, cell.lo, cell.hi};
+            for (int a = 0; a < 3; ++a) {
+                if (mid[a] >= cell.hi[a]) {  // an extent of one block is not split
+                    if (k >> a & 1) child.hi[a] = child.lo[a];
+                    continue;
+                }
+                if (k >> a & 1) child.lo[a] = mid[a];
+                else child.hi[a] = mid[a];
+            }
+            if (child.lo.x < child.hi.x && child.lo.y < child.hi.y && child.lo.z < child.hi.z) visit(child);
+        }
+    }
+
+    bool proven_uniform(const Cell& cell) const {
+        switch (rule_) {
+            case OutsideRule::Uniform: return true;
+            case OutsideRule::PerPoint: return false;
+            case OutsideRule::WindingBound: break;
+        }
+        Vec3d lo, hi, unused;
+        layout_.cell_box(layout_.block_id(cell.coset, cell.lo), lo, unused);
+        layout_.cell_box(layout_.block_id(cell.coset, {cell.hi.x - 1, cell.hi.y - 1, cell.hi.z - 1}), unused, hi);
+        const Vec3d centre = (lo + hi) * 0.5;
+        const double delta = 0.5 * length(hi - lo);
+        // The fast evaluation's bound is pessimistic (worst cases summed): a larger beta where
+        // it does not decide, as WindingSign's certification does.
+        WindingAccuracy<double> accuracy = winding_->options().accuracy;
+        WindingEstimate<double> w = winding_->estimate(centre, accuracy);
+        for (int k = 0; k < 3 && !(std::abs(w.value - 0.5) > w.error_bound + 0.05); ++k) {
+            accuracy.beta *= 3;
+            w = winding_->estimate(centre, accuracy);
+        }
+        const double room = std::abs(w.value - 0.5) - w.error_bound - 1e-9;  // what w may change by in the cell
+        if (!(room > 0)) {
+            ++refused_by_evaluation;
+            return false;
+        }
+        const double limit = room * 4 * 3.14159265358979323846 / delta;  // on 4 pi |grad w| (Biot-Savart)
+        double g = 0;
+        for (const BoundaryEdge& e : edges_) {
+            const double d = point_segment_distance(centre, e.a, e.b) - delta;
+            g += d > 0 ? e.weight / (d * d) : limit;
+            if (!(g < limit)) {
+                ++refused_by_gradient;
+                return false;
+            }
+        }
+        return true;
+    }
+
+    const BandLayout& layout_;
+    const BlockBits& active_;
+    OutsideRule rule_;
+    const WindingSign* winding_;
+    std::vector<BoundaryEdge> edges_;
+};
+
+/// Queries `points` (lattice positions) in batches; f(first, results) per batch.
+template <typename F>
+void query_in_batches(const BoundSampler& sampler, const std::vector<Vec3d>& points, int64_t batch, SamplingTimings& total,
+                      F&& f) {
+    for (size_t first = 0; first < points.size(); first += size_t(batch)) {
+        const size_t last = std::min(points.size(), first + size_t(batch));
+        const std::vector<Vec3d> part(points.begin() + long(first), points.begin() + long(last));
+        SamplingTimings t;
+        const std::vector<PointSample> r = sampler.query(part, &t);
+        total.kernel += t.kernel;
+        total.upload += t.upload;
+        total.download += t.download;
+        total.certified_points += t.certified_points;
+        total.reranked_points += t.reranked_points;
+        total.full_double_points += t.full_double_points;
+        f(first, r);
+    }
+}
+
+}  // namespace
+
+SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& lattice, double width,
+                                   const SparseBandPlan& plan, const BandBlockKernel& blocks) {
+    const Clock::time_point start = Clock::now();
+    const PreparedMesh& mesh = sampler.mesh();
+    require_search_range(mesh, lattice, plan.precision);
+    if (plan.batch_points < kBandBlockPoints)
+        throw std::invalid_argument("sparse band: batch_points must be at least " + std::to_string(kBandBlockPoints));
+    SparseBandField out(lattice, width, plan.precision);
+    const BandLayout& layout = out.layout();
+    nlohmann::json steps = nlohmann::json::object();
+
+    // 1. Active blocks.
+    Clock::time_point t = Clock::now();
+    const BlockBits active = active_blocks(mesh, layout, width);
+    for (int64_t id = 0; id < layout.block_count(); ++id)
+        if (active.get(id)) out.active.push_back(id);
+    steps["find_blocks_seconds"] = seconds_since(t);
+
+    // 2. Their points, batch by batch (batches of whole blocks).
+    t = Clock::now();
+    out.distance.assign(out.active.size() * kBandBlockPoints, width);
+    out.gradient.assign(out.active.size() * kBandBlockPoints, Vec3d(0.0));
+    out.closest_triangle.assign(out.active.size() * kBandBlockPoints, kOutsideBandTriangle);
+    const int64_t blocks_per_batch = plan.batch_points / kBandBlockPoints;
+    int64_t points_computed = 0;
+    for (size_t first = 0; first < out.active.size(); first += size_t(blocks_per_batch)) {
+        const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
+        if (blocks) {
+            for (size_t a = first; a < last; ++a)
+                for (int local = 0; local < kBandBlockPoints; ++local) points_computed += layout.storage_index(out.active[a], local) >= 0;
+            blocks(out, first, last);
+            continue;
+        }
+        std::vector<Vec3d> points;
+        std::vector<size_t> slot;  // value index of each point
+        points.reserve((last - first) * kBandBlockPoints);
+        slot.reserve((last - first) * kBandBlockPoints);
+        for (size_t a = first; a < last; ++a)
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                if (layout.storage_index(out.active[a], local) < 0) continue;
+                points.push_back(lattice.position_of_coords(layout.point_coords(out.active[a], local)));
+                slot.push_back(a * kBandBlockPoints + size_t(local));
+            }
+        points_computed += int64_t(points.size());
+        query_in_batches(sampler, points, int64_t(points.size()) + 1, out.timings, [&](size_t, const std::vector<PointSample>& r) {
+            for (size_t i = 0; i < r.size(); ++i) {
+                const size_t v = slot[i];
+                if (outside_band(r[i].distance, width)) {
+                    out.distance[v] = std::signbit(r[i].distance) ? -width : width;  // store_outside_band's values
+                } else {
+                    out.distance[v] = r[i].distance;
+                    out.gradient[v] = r[i].gradient;
+                    out.closest_triangle[v] = r[i].triangle;
+                }
+            }
+        });
+    }
+    steps["active_points_seconds"] = seconds_since(t);
+    steps["active_points_by"] = blocks ? "the backend's block kernel" : "point queries";
+
+    // 3. The outside.
+    t = Clock::now();
+    const SignModeChoice& sign = sampler.sign();
+    const bool solid = choose_sign_mode(mesh.report(), SignMode::Auto).mode == SignMode::Pseudonormal;
+    std::vector<BoundaryEdge> edges;
+    std::unique_ptr<WindingSign> winding;
+    OutsideRule rule = OutsideRule::Uniform;
+    if (sign.mode == SignMode::Winding) {
+        edges = boundary_edges(mesh);
+        if (!edges.empty()) {
+            rule = OutsideRule::WindingBound;
+            winding = std::make_unique<WindingSign>(mesh, mesh.bvh(), SamplerSign::winding_options());
+        }
+    } else if (!solid) {
+        rule = OutsideRule::PerPoint;
+    }
+    const size_t boundary_edge_count = edges.size();
+    OutsideClassifier classify(layout, active, rule, winding.get(), std::move(edges));
+    classify.run();
+    // One query per uniform cell, at its first block's first point.
+    std::vector<Vec3d> reps;
+    reps.reserve(classify.uniform.size());
+    for (const Cell& c : classify.uniform)
+        reps.push_back(lattice.position_of_coords(layout.point_coords(layout.block_id(c.coset, c.lo), 0)));
+    query_in_batches(sampler, reps, plan.batch_points, out.timings, [&](size_t first, const std::vector<PointSample>& r) {
+        for (size_t i = 0; i < r.size(); ++i) {
+            const Cell& c = classify.uniform[first + i];
+            if (!std::signbit(r[i].distance)) continue;  // tiles start outside
+            for (int z = c.lo.z; z < c.hi.z; ++z)
+                for (int y = c.lo.y; y < c.hi.y; ++y)
+                    for (int x = c.lo.x; x < c.hi.x; ++x) out.set_tile_inside(layout.block_id(c.coset, {x, y, z}), true);
+        }
+    });
+    // Blocks not proven uniform: every point's side, batch by batch; a block whose sides all
+    // agree becomes a tile.
+    int64_t per_point_points = 0;
+    for (size_t first = 0; first < classify.per_point.size(); first += size_t(blocks_per_batch)) {
+        const size_t last = std::min(classify.per_point.size(), first + size_t(blocks_per_batch));
+        std::vector<Vec3d> points;
+        std::vector<std::pair<size_t, int>> where;
+        for (size_t b = first; b < last; ++b)
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                if (layout.storage_index(classify.per_point[b], local) < 0) continue;
+                points.push_back(lattice.position_of_coords(layout.point_coords(classify.per_point[b], local)));
+                where.push_back({b, local});
+            }
+        per_point_points += int64_t(points.size());
+        std::vector<BandSignMask> masks(last - first, BandSignMask{});
+        std::vector<int> inside(last - first, 0), total(last - first, 0);
+        query_in_batches(sampler, points, int64_t(points.size()) + 1, out.timings, [&](size_t, const std::vector<PointSample>& r) {
+            for (size_t i = 0; i < r.size(); ++i) {
+                const size_t b = where[i].first - first;
+                const int local = where[i].second;
+                ++total[b];
+                if (!std::signbit(r[i].distance)) continue;
+                ++inside[b];
+                masks[b][size_t(local >> 6)] |= uint64_t(1) << (local & 63);
+            }
+        });
+        for (size_t b = first; b < last; ++b) {
+            const int64_t id = classify.per_point[b];
+            if (inside[b - first] == 0 || inside[b - first] == total[b - first]) {
+                out.set_tile_inside(id, inside[b - first] > 0);
+            } else {
+                out.mixed_inside[size_t(out.add_mixed(id))] = masks[b - first];
+            }
+        }
+    }
+    steps["outside_seconds"] = seconds_since(t);
+
+    // The report: the dense band's keys, and the sparse steps' counts.
+    const SparseBandCounts counts = out.counts();
+    BandReport band;
+    band.width = width;
+    band.points_in_band = counts.band_points;
+    band.points_outside = lattice.num_points() - counts.band_points;
+    band.how = "sparse: active blocks sampled, the outside signed per cell";
+    out.sampler.backend = sampler.name();
+    out.sampler.precision = precision_name(plan.precision);
+    out.sampler.points_computed = points_computed + int64_t(reps.size()) + per_point_points;
+    out.sampler.band = band;
+    out.sampler.details["sign"] = {{"mode", sign_mode_name(sign.mode)}, {"reason", sign.reason}};
+    const char* rule_name = rule == OutsideRule::Uniform ? "uniform off the surface"
+                            : rule == OutsideRule::WindingBound ? "winding number bound (Biot-Savart)"
+                                                                : "every point";
+    out.sampler.details["sparse_band"] = {{"block", kBandBlockDim},
+                                          {"blocks", counts.blocks},
+                                          {"active_blocks", counts.active_blocks},
+                                          {"active_points", counts.active_points},
+                                          {"mixed_blocks", counts.mixed_blocks},
+                                          {"tiles", counts.tiles},
+                                          {"inside_tiles", counts.inside_tiles},
+                                          {"uniform_cells", int64_t(classify.uniform.size())},
+                                          {"cells_refused_by_evaluation", classify.refused_by_evaluation},
+                                          {"cells_refused_by_gradient", classify.refused_by_gradient},
+                                          {"points_signed_per_point", per_point_points},
+                                          {"outside_rule", rule_name},
+                                          {"boundary_edges", int64_t(boundary_edge_count)},
+                                          {"steps", steps},
+                                          {"memory_bytes", int64_t(out.memory_bytes())}};
+    out.timings.total = seconds_since(start);
+    if (out.timings.kernel <= 0) out.timings.kernel = out.timings.total;  // a host backend: its wall time, as BackendSampler's slabs
+    out.timings.point_triangle_pairs = double(out.sampler.points_computed) * double(mesh.triangles().size());
+    return out;
+}
+
+}  // namespace sdf
+
+namespace sdf {
+
+SparseBandField BoundSampler::sample_band_sparse(const Lattice& lattice, double width) const {
+    require_band_width(width, "sparse band width");
+    SampledField field = sample(lattice);
+    if (field.sampler.band && field.sampler.band->width < width)
+        throw std::invalid_argument("sparse band of width " + std::to_string(width) + ": sampler " + name() +
+                                    " bands its fields at " + std::to_string(field.sampler.band->width) +
+                                    ", narrower; sample with band_width 0 or >= the band's");
+    apply_narrow_band(field, width);
+    SparseBandField band = SparseBandField::sparsify(field, width);
+    if (band.sampler.band) band.sampler.band->how = "post-processed: the whole lattice sampled, then sparsified";
+    return band;
+}
+
+}  // namespace sdf

@@ -1,0 +1,58 @@
+/// @file sparse_band_sampler.h
+/// @brief The sparse narrow band (issue 35): a SparseBandField sampled with work that grows
+/// with the band, not with the lattice, by any bound sampler's certified point kernel.
+///
+/// 1. Active blocks: every triangle's box, dilated by W (and a margin of 1e-4 spacings that
+///    covers the rounding of the cells' bounds and of the band test's distance), rasterised
+///    into the blocks whose cells it meets (a bit per block). A point with |d| <= W lies in
+///    such a block; a block outside it has no triangle in its cell.
+/// 2. Their lattice points, in batches: through the backend's block kernel where it has one
+///    (the CPU BVH: its dense brick kernel with the band's brick skip, block by block), else
+///    through BoundSampler::query: the certified search, the sign rule and the evaluation of
+///    the dense path at the same positions (Lattice::position_of_coords), then the band's
+///    rule of narrow_band.h.
+/// 3. The outside, cell by cell of an octree over the inactive blocks: a cell that meets no
+///    triangle and whose side is proven uniform is one sign, queried at one lattice point of
+///    the cell with the dense rule; a single block that is not proven uniform is queried at
+///    every point (a mixed block, or a tile when its sides agree). Uniform means:
+///    - pseudonormal sign of a solid (choose_sign_mode's conditions): always (a cell without
+///      surface lies on one side);
+///    - winding sign, no boundary edges (every edge's oriented uses cancel): always (w is an
+///      integer off the surface);
+///    - winding sign with boundary edges: |w~(c) - 1/2| > e(c) + G delta at the cell's centre c
+///      (w~ the fast winding number, e its error bound, delta the half diagonal) with the
+///      Biot-Savart bound G = (1/4 pi) sum_e m_e len_e / (dist(c, e) - delta)^2 over the
+///      boundary edges e (net oriented uses m_e) of |grad w| in the cell;
+///    - pseudonormal sign of any other mesh: never (every inactive point is queried: the
+///      dense path's cost, sparse memory).
+///    The dense path decides a winding side by the fast value at each point; a uniform cell
+///    takes that of one point, so the two agree where the fast value's error at a point off
+///    the band is below its |w - 1/2| (the evaluation's bound; the tests check every point).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "core/sampling/sampled_field.h"
+#include "core/sampling/sparse_band.h"
+
+namespace sdf {
+
+class BoundSampler;
+
+struct SparseBandPlan {
+    Precision precision = Precision::Float;  ///< recorded in the field (the sampler's own)
+    int threads = 0;                         ///< for the host steps (0: every core)
+    int64_t batch_points = int64_t(1) << 20; ///< lattice points per query call
+};
+
+/// A backend's block kernel: fills the values of the active blocks [first, last) of `band`
+/// (band.active) as its dense lattice kernel with the band of band.width fills those points.
+using BandBlockKernel = std::function<void(SparseBandField& band, size_t first, size_t last)>;
+
+/// Samples the band of width `width` > 0 of `lattice`: the active blocks with `blocks`, or,
+/// when it is empty, with `sampler`'s point queries; the outside with its point queries.
+SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& lattice, double width,
+                                   const SparseBandPlan& plan = {}, const BandBlockKernel& blocks = {});
+
+}  // namespace sdf

@@ -1,0 +1,202 @@
+// The sparse narrow band (core/sampling/sparse_band.h, issue 35): densified, it equals the
+// dense sampler's banded field (SamplerOptions::band_width) byte for byte, on meshes with
+// holes (the winding sign changes across them, away from any triangle: mixed blocks),
+// several shells, self-intersections, a solid (pseudonormal sign, one side per cell) and a
+// pseudonormal sign forced on an open mesh (every outside point queried); CC and BCC, float
+// and double, the CPU BVH and brute force. The layout's indexing covers every lattice point
+// once, and sparsify() of a dense band densifies back to it.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <set>
+
+#include "core/lattice/lattice_fitting.h"
+#include "core/mesh/load_mesh.h"
+#include "core/mesh/shapes/procedural_shapes.h"
+#include "core/sampling/sparse_band.h"
+#include "cpu_reference/bvh/bvh_cpu.h"
+#include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
+#include "tests/test_util/shared_mesh.h"
+
+namespace sdf {
+namespace {
+
+SamplerOptions options(Precision precision, double band, SignMode sign) {
+    SamplerOptions o;
+    o.precision = precision;
+    o.band_width = band;
+    o.sign = sign;
+    o.progress = false;
+    return o;
+}
+
+template <typename V>
+bool same_bytes(const std::vector<V>& a, const std::vector<V>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
+}
+
+/// The first differing point, for the message.
+std::string first_difference(const SampledField& a, const SampledField& b) {
+    for (int64_t i = 0; i < a.size() && i < b.size(); ++i)
+        if (a.distance[size_t(i)] != b.distance[size_t(i)] || a.closest_triangle[size_t(i)] != b.closest_triangle[size_t(i)] ||
+            std::memcmp(&a.gradient[size_t(i)], &b.gradient[size_t(i)], sizeof(Vec3d)) != 0)
+            return "point " + std::to_string(i) + ": " + std::to_string(a.distance[size_t(i)]) + " (triangle " +
+                   std::to_string(a.closest_triangle[size_t(i)]) + ") vs " + std::to_string(b.distance[size_t(i)]) +
+                   " (triangle " + std::to_string(b.closest_triangle[size_t(i)]) + ")";
+    return "sizes " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
+}
+
+void expect_same_field(const SampledField& dense, const SampledField& densified, const std::string& what) {
+    const bool same = same_bytes(dense.distance, densified.distance) && same_bytes(dense.gradient, densified.gradient) &&
+                      same_bytes(dense.closest_triangle, densified.closest_triangle);
+    EXPECT_TRUE(same) << what << ": " << (same ? "" : first_difference(dense, densified));
+}
+
+TriangleMesh joined(const std::vector<TriangleMesh>& parts, const std::string& name) {
+    TriangleMesh m;
+    m.name = name;
+    m.source = "shape:" + name;
+    for (const TriangleMesh& p : parts) {
+        const int base = int(m.vertices.size());
+        m.vertices.insert(m.vertices.end(), p.vertices.begin(), p.vertices.end());
+        for (const Int3& t : p.triangles) m.triangles.push_back({t.x + base, t.y + base, t.z + base});
+    }
+    return m;
+}
+
+struct Case {
+    std::string name;
+    PreparedMesh mesh;
+    SignMode sign;
+};
+
+std::vector<Case> cases() {
+    std::vector<Case> out;
+    out.push_back({"torus (solid, pseudonormal)", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), SignMode::Pseudonormal});
+    out.push_back({"open bowl (winding)", test::open_bowl(), SignMode::Winding});
+    out.push_back({"open bowl (pseudonormal forced)", test::open_bowl(), SignMode::Pseudonormal});
+    out.push_back({"nested and separate shells (winding)",
+                   prepare_mesh(joined({make_icosphere(2, 1.0), make_icosphere(2, 0.45, {0.1, 0.0, 0.0}),
+                                        make_icosphere(2, 0.4, {1.9, 0.3, 0.2})},
+                                       "shells")),
+                   SignMode::Winding});
+    out.push_back({"overlapping spheres (self-intersecting, winding)",
+                   prepare_mesh(joined({make_icosphere(2, 1.0), make_icosphere(2, 0.8, {0.7, 0.2, 0.1})}, "overlap")),
+                   SignMode::Winding});
+    out.push_back({"disjoint shells (pseudonormal forced)",
+                   prepare_mesh(joined({make_icosphere(2, 1.0), make_icosphere(2, 0.4, {1.9, 0.3, 0.2})}, "two")),
+                   SignMode::Pseudonormal});
+    const std::string bunny = test::find_data_file("bunny-open.obj");
+    if (!bunny.empty()) out.push_back({"bunny-open (winding)", prepare_mesh(load_mesh_file(bunny)), SignMode::Winding});
+    return out;
+}
+
+TEST(SparseBandLayout, EveryLatticePointOnceAndCellsTile) {
+    for (LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        Lattice lattice;
+        lattice.type = type;
+        lattice.origin = {-1.0, 0.5, 2.0};
+        lattice.spacing = 0.25;
+        lattice.resolution = {17, 9, 24};
+        const BandLayout layout(lattice);
+        std::vector<int> seen(size_t(lattice.num_points()), 0);
+        for (int64_t id = 0; id < layout.block_count(); ++id)
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                const int64_t i = layout.storage_index(id, local);
+                if (i < 0) continue;
+                ++seen[size_t(i)];
+                EXPECT_EQ(lattice.index_of_coords(layout.point_coords(id, local)), i);
+            }
+        for (int s : seen) ASSERT_EQ(s, 1) << lattice_type_name(type);
+        EXPECT_EQ(layout.cosets(), type == LatticeType::BCC ? 2 : 1);
+        EXPECT_EQ(layout.block_count(), type == LatticeType::BCC ? 3 * 2 * 3 + 2 * 1 * 3 : 3 * 2 * 3);
+        Vec3d lo, hi;
+        layout.cell_box(layout.block_id(0, {1, 0, 0}), lo, hi);
+        EXPECT_EQ(lo.x, -1.0 + 8 * 0.25);
+        EXPECT_EQ(hi.x, -1.0 + 16 * 0.25);
+    }
+}
+
+TEST(SparseBand, DensifiedEqualsTheDenseBandByteForByte) {
+    for (const Case& c : cases()) {
+        const Lattice cc = fit_lattice(LatticeType::CC, {41, 38, 36}, c.mesh.bounds(), 0.4);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, {29, 27, 26}, c.mesh.bounds(), 0.4);
+        for (Precision precision : {Precision::Float, Precision::Double})
+            for (const Lattice& lattice : {cc, bcc})
+                for (double spacings : {0.6, 3.0}) {
+                    const double w = spacings * lattice.spacing;
+                    const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
+                                             " w = " + std::to_string(spacings) + " h";
+                    const SampledField dense =
+                        make_cpu_bvh_sampler(options(precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
+                    const SparseBandField sparse =
+                        make_cpu_bvh_sampler(options(precision, 0, c.sign))->bind(share(c.mesh))->sample_band_sparse(lattice, w);
+                    expect_same_field(dense, sparse.densify(), what + " cpu/bvh");
+                    const SparseBandCounts counts = sparse.counts();
+                    ASSERT_TRUE(sparse.sampler.band.has_value());
+                    EXPECT_EQ(sparse.sampler.band->points_in_band, dense.sampler.band->points_in_band) << what;
+                    EXPECT_EQ(counts.band_points, dense.sampler.band->points_in_band) << what;
+                    EXPECT_GT(counts.tiles, 0) << what;
+                    EXPECT_LT(counts.active_blocks, counts.blocks) << what;
+                    EXPECT_EQ(sparse.sampler.backend, "cpu") << what;
+                    // The dense band, sparsified, densifies back to itself.
+                    expect_same_field(dense, SparseBandField::sparsify(dense, w).densify(), what + " sparsify");
+                    if (precision == Precision::Float && spacings == 3.0) {
+                        const SparseBandField brute = make_cpu_brute_force_sampler(options(precision, 0, c.sign))
+                                                          ->bind(share(c.mesh))
+                                                          ->sample_band_sparse(lattice, w);
+                        expect_same_field(dense, brute.densify(), what + " cpu/brute_force");
+                    }
+                    if (HasFailure()) return;
+                }
+    }
+}
+
+// Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
+// sides are stored per point, and they are the dense path's.
+TEST(SparseBand, HolesGiveMixedBlocksWithTheDenseSides) {
+    const PreparedMesh bowl = test::open_bowl();
+    const Lattice lattice = fit_lattice(LatticeType::CC, {96, 96, 96}, bowl.bounds(), 0.6);
+    const double w = 1.0 * lattice.spacing;
+    const SampledField dense = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding))->bind(share(bowl))->sample(lattice);
+    const SparseBandField sparse =
+        make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding))->bind(share(bowl))->sample_band_sparse(lattice, w);
+    expect_same_field(dense, sparse.densify(), "bowl 96^3");
+    const SparseBandCounts counts = sparse.counts();
+    EXPECT_GT(counts.mixed_blocks, 0);
+    EXPECT_GT(counts.inside_tiles, 0);
+    EXPECT_EQ(sparse.sampler.details["sparse_band"]["outside_rule"], "winding number bound (Biot-Savart)");
+    EXPECT_LT(sparse.memory_bytes(), size_t(SparseBandField::dense_bytes(lattice)));
+}
+
+// Slabs of the sparse band (sdf-sample writes the field file slab by slab from it) equal the
+// dense sampler's slabs, in their compact order.
+TEST(SparseBand, SlabsEqualTheDenseSlabs) {
+    const PreparedMesh bowl = test::open_bowl();
+    for (LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        const Lattice lattice = fit_lattice(type, {37, 35, 33}, bowl.bounds(), 0.5);
+        const double w = 1.5 * lattice.spacing;
+        const auto dense = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding))->bind(share(bowl));
+        const SparseBandField sparse =
+            make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding))->bind(share(bowl))->sample_band_sparse(lattice, w);
+        for (const LatticeSlab slab : {LatticeSlab{0, 5}, LatticeSlab{5, 17}, LatticeSlab{17, 32}, LatticeSlab{32, 33}})
+            expect_same_field(dense->sample_slab(lattice, slab), sparse.densify_slab(slab),
+                              std::string(lattice_type_name(type)) + " slab " + std::to_string(slab.z_begin));
+        EXPECT_THROW(sparse.densify_slab({3, 3}), std::invalid_argument);
+        EXPECT_THROW(sparse.densify_slab({0, 34}), std::invalid_argument);
+    }
+}
+
+TEST(SparseBand, RefusesToDensifyPastTheLimitAndBadWidths) {
+    const PreparedMesh torus = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {20, 20, 20}, torus.bounds(), 0.3);
+    const auto bound = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(torus));
+    const SparseBandField sparse = bound->sample_band_sparse(lattice, 2 * lattice.spacing);
+    EXPECT_THROW(sparse.densify(1000), std::length_error);
+    EXPECT_THROW(bound->sample_band_sparse(lattice, 0.0), std::invalid_argument);
+    EXPECT_THROW(bound->sample_band_sparse(lattice, -1.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sdf
