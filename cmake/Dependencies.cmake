@@ -8,7 +8,7 @@ function(sdf_require found what debian)
   if(NOT ${found})
     message(FATAL_ERROR "sdf: ${what} was not found. Install the Debian/Ubuntu package ${debian} "
                         "(scripts/install-deps installs every package of scripts/debian-packages.txt; "
-                        "README.md, \"Building\"), or point CMAKE_PREFIX_PATH at a prefix that has it.")
+                        "README.md, \"Quick start\"), or point CMAKE_PREFIX_PATH at a prefix that has it.")
   endif()
 endfunction()
 
