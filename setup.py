@@ -128,6 +128,8 @@ class CMakeBuild(build_ext):
         if not tools:
             raise SystemExit(f"setup.py: `cmake --install {build_dir}` installed no tools")
         self.distribution.data_files = [("bin", tools)]
+        # (A portable build's bundled libraries, left in setuptools' build folder, are no part of another wheel.)
+        shutil.rmtree(Path(self.build_lib).resolve() / wheel_libs.LIBS_DIR, ignore_errors=True)
         if cmake_cache_value(build_dir, "SDF_WHEEL") in ("ON", "TRUE", "1"):
             self.bundle_libraries(target, [Path(t) for t in tools])
 
@@ -136,7 +138,6 @@ class CMakeBuild(build_ext):
         sdf_lattices.libs/ beside the package (the run paths CMake set point there); then every
         ELF file is checked."""
         libs = Path(self.build_lib).resolve() / wheel_libs.LIBS_DIR
-        shutil.rmtree(libs, ignore_errors=True)
         copied = wheel_libs.bundle([module, *tools], libs)
         print(f"setup.py: bundled into {wheel_libs.LIBS_DIR}/: {' '.join(copied) or 'nothing'}", flush=True)
         files = {f"sdf_lattices/{module.name}": module.read_bytes()}
