@@ -27,14 +27,10 @@ if(SDF_WHEEL)
   target_compile_definitions(sdf_tinyobjloader PUBLIC TINYOBJLOADER_USE_DOUBLE)
   set_target_properties(sdf_tinyobjloader PROPERTIES POSITION_INDEPENDENT_CODE ON)
   add_library(tinyobjloader::tinyobjloader_double ALIAS sdf_tinyobjloader)
-  # Static archives where Debian ships them compiled position-independent (libcrypto.a,
-  # libgmp.a); libz.a is not (it cannot go into a shared object), so zlib is bundled.
+  # Static archives where Debian ships them compiled position-independent: libcrypto.a. GMP's
+  # libgmp.a is not wholly (assert.o) and libz.a not at all, so they cannot go into the module:
+  # setup.py bundles libgmp.so.10 and libz.so.1.
   set(OPENSSL_USE_STATIC_LIBS TRUE)
-  find_library(SDF_GMP_STATIC NAMES libgmp.a)
-  if(SDF_GMP_STATIC)
-    set(GMP_LIBRARY_RELEASE ${SDF_GMP_STATIC} CACHE FILEPATH "GMP (static, for the portable wheel)")
-    set(GMP_LIBRARY_DEBUG ${SDF_GMP_STATIC} CACHE FILEPATH "GMP (static, for the portable wheel)")
-  endif()
   set(CMAKE_CUDA_RUNTIME_LIBRARY Static)
   # MPFR (no position-independent libmpfr.a) stays a shared library that CGAL lists but this
   # code never calls: --as-needed drops it (a call would fail the check of setup.py loudly).
