@@ -19,6 +19,13 @@ Environment:
                           suite's wheel test passes its own build/, so that nothing is compiled
                           twice. Its Python module must be built for this interpreter's ABI.
     SDF_CMAKE_ARGS        extra configure options, e.g. "-DSDF_ENABLE_CUDA=OFF".
+    SDF_WHEEL=1           the portable wheel (docs/python.md, "The portable wheel"): configures
+                          with -DSDF_WHEEL=ON (under build/pip/.../cmake-wheel): no MPI, OpenVDB,
+                          OpenImageIO or peers; libcrypto, GMP and the CUDA runtime static. The
+                          libraries still shared (zlib) are copied into sdf_lattices.libs/, and
+                          every ELF file is checked to need nothing else beyond glibc, libstdc++
+                          and libgcc (python/wheel_libs.py). A build tree configured with
+                          SDF_WHEEL=ON (SDF_CMAKE_BUILD_DIR) is packed the same way.
     CMAKE_BUILD_PARALLEL_LEVEL   build jobs (default: every core).
 """
 import json
@@ -35,6 +42,8 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = Path(__file__).resolve().parent
+sys.path.insert(0, str(ROOT / "python"))
+import wheel_libs  # noqa: E402  (python/wheel_libs.py: the portable wheel's libraries)
 PIP_BUILD = "build/pip"   # setuptools' build folder (relative: setuptools wants it so)
 
 
@@ -119,6 +128,24 @@ class CMakeBuild(build_ext):
         if not tools:
             raise SystemExit(f"setup.py: `cmake --install {build_dir}` installed no tools")
         self.distribution.data_files = [("bin", tools)]
+        # (A portable build's bundled libraries, left in setuptools' build folder, are no part of another wheel.)
+        shutil.rmtree(Path(self.build_lib).resolve() / wheel_libs.LIBS_DIR, ignore_errors=True)
+        if cmake_cache_value(build_dir, "SDF_WHEEL") in ("ON", "TRUE", "1"):
+            self.bundle_libraries(target, [Path(t) for t in tools])
+
+    def bundle_libraries(self, module, tools):
+        """The portable wheel: the shared libraries beyond glibc and the C++ runtime go into
+        sdf_lattices.libs/ beside the package (the run paths CMake set point there); then every
+        ELF file is checked."""
+        libs = Path(self.build_lib).resolve() / wheel_libs.LIBS_DIR
+        copied = wheel_libs.bundle([module, *tools], libs)
+        print(f"setup.py: bundled into {wheel_libs.LIBS_DIR}/: {' '.join(copied) or 'nothing'}", flush=True)
+        files = {f"sdf_lattices/{module.name}": module.read_bytes()}
+        files.update({f"bin/{t.name}": t.read_bytes() for t in tools})
+        files.update({f"{wheel_libs.LIBS_DIR}/{p.name}": p.read_bytes() for p in libs.glob("*")})
+        found = wheel_libs.problems(files)
+        if found:
+            raise SystemExit("setup.py: the portable wheel would need libraries of this machine:\n  " + "\n  ".join(found))
 
     def cmake_tree(self, env):
         """SDF_CMAKE_BUILD_DIR as it is, or build/pip/.../cmake configured for this interpreter."""
@@ -134,9 +161,12 @@ class CMakeBuild(build_ext):
             raise SystemExit(f"setup.py: {sys.executable} cannot build the module: {problem}. On Debian 12, "
                              "install python3-dev python3-numpy pybind11-dev (scripts/install-deps) and build in a "
                              "virtual environment of /usr/bin/python3 made with --system-site-packages (README.md, \"Python\")")
-        build_dir = Path(self.build_temp).resolve() / "cmake"
+        portable = os.environ.get("SDF_WHEEL", "") not in ("", "0")
+        build_dir = Path(self.build_temp).resolve() / ("cmake-wheel" if portable else "cmake")
         options = ["-DCMAKE_BUILD_TYPE=Release", "-DSDF_BUILD_TESTS=OFF", "-DSDF_BUILD_BENCHMARKS=OFF",
                    "-DSDF_BUILD_PYTHON=ON", f"-DPython3_EXECUTABLE={sys.executable}"]
+        if portable:
+            options += ["-DSDF_WHEEL=ON", "-DSDF_BUILD_PEERS=OFF"]
         options += shlex.split(os.environ.get("SDF_CMAKE_ARGS", ""))
         generator = ["-G", "Ninja"] if shutil.which("ninja") and not (build_dir / "CMakeCache.txt").exists() else []
         run(["cmake", "-S", ROOT, "-B", build_dir, *generator, *options], env=env)

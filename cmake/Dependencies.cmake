@@ -1,24 +1,65 @@
 # Finds every dependency in one place. All come from Debian packages listed in
 # scripts/debian-packages.txt; nothing is downloaded at configure or build time.
 
-find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-find_package(nlohmann_json 3.10 REQUIRED)
-find_package(tinyobjloader REQUIRED)
-find_package(OpenSSL REQUIRED)            # SHA-256 of inputs for provenance
-find_package(ZLIB REQUIRED)               # gzip-compressed mesh files
+# A required package that is missing stops the configure step with the Debian package that has
+# it and how to install it, instead of CMake's "X not found" (a stock Ubuntu + CUDA image has
+# none of them; scripts/device/make-gpu-prefix carries them to the lent GPU machines).
+function(sdf_require found what debian)
+  if(NOT ${found})
+    message(FATAL_ERROR "sdf: ${what} was not found. Install the Debian/Ubuntu package ${debian} "
+                        "(scripts/install-deps installs every package of scripts/debian-packages.txt; "
+                        "README.md, \"Quick start\"), or point CMAKE_PREFIX_PATH at a prefix that has it.")
+  endif()
+endfunction()
+
+find_package(Eigen3 3.3 NO_MODULE QUIET)
+sdf_require(Eigen3_FOUND "Eigen 3.3" libeigen3-dev)
+find_package(nlohmann_json 3.10 QUIET)
+sdf_require(nlohmann_json_FOUND "nlohmann_json 3.10" nlohmann-json3-dev)
+if(SDF_WHEEL)
+  # tinyobjloader: Debian ships no static archive, so the wheel compiles the header's
+  # implementation (the double-precision variant the shared libtinyobjloader_double is).
+  find_path(SDF_TINYOBJLOADER_INCLUDE tiny_obj_loader.h)
+  sdf_require(SDF_TINYOBJLOADER_INCLUDE "tinyobjloader's header tiny_obj_loader.h" libtinyobjloader-dev)
+  file(WRITE ${CMAKE_BINARY_DIR}/sdf_tinyobjloader.cpp "#define TINYOBJLOADER_IMPLEMENTATION\n#include <tiny_obj_loader.h>\n")
+  add_library(sdf_tinyobjloader STATIC ${CMAKE_BINARY_DIR}/sdf_tinyobjloader.cpp)
+  target_include_directories(sdf_tinyobjloader SYSTEM PUBLIC ${SDF_TINYOBJLOADER_INCLUDE})
+  target_compile_definitions(sdf_tinyobjloader PUBLIC TINYOBJLOADER_USE_DOUBLE)
+  set_target_properties(sdf_tinyobjloader PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  add_library(tinyobjloader::tinyobjloader_double ALIAS sdf_tinyobjloader)
+  # Static archives where Debian ships them compiled position-independent: libcrypto.a. GMP's
+  # libgmp.a is not wholly (assert.o) and libz.a not at all, so they cannot go into the module:
+  # setup.py bundles libgmp.so.10 and libz.so.1.
+  set(OPENSSL_USE_STATIC_LIBS TRUE)
+  set(CMAKE_CUDA_RUNTIME_LIBRARY Static)
+  # MPFR (no position-independent libmpfr.a) stays a shared library that CGAL lists but this
+  # code never calls: --as-needed drops it (a call would fail the check of setup.py loudly).
+  add_link_options(LINKER:--as-needed)
+  # Without the run paths of the build machine's libraries: what is not static is bundled.
+  set(CMAKE_INSTALL_RPATH_USE_LINK_PATH OFF)
+else()
+  find_package(tinyobjloader QUIET)
+  sdf_require(tinyobjloader_FOUND "tinyobjloader" libtinyobjloader-dev)
+endif()
+find_package(OpenSSL QUIET)               # SHA-256 of inputs for provenance
+sdf_require(OPENSSL_FOUND "OpenSSL's libcrypto" libssl-dev)
+find_package(ZLIB QUIET)                  # gzip-compressed mesh files
+sdf_require(ZLIB_FOUND "zlib" zlib1g-dev)
 find_package(Threads REQUIRED)
 # Exact predicates of the mesh report (core/mesh/exact_predicates.h): CGAL 5 is header-only;
 # its kernel brings GMP and MPFR for the exact fallback.
 find_package(CGAL 5 QUIET)
-if(NOT CGAL_FOUND)
-  message(FATAL_ERROR "CGAL 5 was not found: the mesh report's exact predicates need it; install Debian's "
-                      "libcgal-dev (scripts/install-deps)")
-endif()
-
+sdf_require(CGAL_FOUND "CGAL 5 (the mesh report's exact predicates; it brings GMP and MPFR)"
+            "libcgal-dev (with libgmp-dev and libmpfr-dev)")
+find_package(CLI11 QUIET)                 # the tools' command lines (apps/)
+sdf_require(CLI11_FOUND "CLI11" libcli11-dev)
 # OpenImageIO writes PNG/EXR images; it is optional so that GPU machines without it can
 # still build and run the samplers (images are then written as PFM/PPM).
-find_package(OpenImageIO CONFIG QUIET)
-set(SDF_HAVE_OIIO ${OpenImageIO_FOUND})
+set(SDF_HAVE_OIIO 0)
+if(NOT SDF_WHEEL)
+  find_package(OpenImageIO CONFIG QUIET)
+  set(SDF_HAVE_OIIO ${OpenImageIO_FOUND})
+endif()
 # Debian 12's OpenImageIO target lists /usr/include/opencv4 even without libopencv-dev, and
 # CMake refuses a target with a missing include directory: keep only the existing ones.
 if(SDF_HAVE_OIIO)
@@ -47,7 +88,7 @@ find_path(SDF_OPENVDB_INCLUDE openvdb/openvdb.h)
 find_library(SDF_OPENVDB_LIBRARY openvdb)
 find_package(TBB QUIET)
 find_package(Imath CONFIG QUIET)
-if(SDF_OPENVDB_INCLUDE AND SDF_OPENVDB_LIBRARY AND TBB_FOUND AND Imath_FOUND)
+if(NOT SDF_WHEEL AND SDF_OPENVDB_INCLUDE AND SDF_OPENVDB_LIBRARY AND TBB_FOUND AND Imath_FOUND)
   set(SDF_HAVE_OPENVDB 1)
   add_library(sdf_openvdb INTERFACE)
   target_include_directories(sdf_openvdb SYSTEM INTERFACE ${SDF_OPENVDB_INCLUDE})
@@ -57,7 +98,7 @@ message(STATUS "sdf: OpenVDB ${SDF_HAVE_OPENVDB} (.vdb export and the OpenVDB pe
 
 # MPI (Open MPI from Debian) is optional: distributed runs (harness/distributed).
 set(SDF_HAVE_MPI OFF)
-if(NOT SDF_ENABLE_MPI STREQUAL "OFF")
+if(NOT SDF_ENABLE_MPI STREQUAL "OFF" AND NOT SDF_WHEEL)
   find_package(MPI COMPONENTS CXX QUIET)
   if(MPI_CXX_FOUND)
     set(SDF_HAVE_MPI ON)
