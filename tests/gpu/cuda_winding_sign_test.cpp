@@ -118,8 +118,11 @@ TEST(CudaWindingSign, QueriedPointsEqualTheCpu) {
         for (int j = 0; j <= 8; ++j) points.push_back({-1.3 + 2.6 * i / 80.0, -0.4 + 0.8 * j / 8.0, 0.05});
     const WindingSign reference(mesh, SamplerSign::winding_options());
     const auto cpu = make_sampler(options("cpu", "bvh", "", SignMode::Winding))->bind(share(mesh))->query(points);
-    for (size_t i = 0; i < points.size(); ++i)
-        if (cpu[i].distance != 0) ASSERT_EQ(cpu[i].distance < 0, reference.inside(points[i])) << "point " << i;
+    for (size_t i = 0; i < points.size(); ++i) {
+        if (cpu[i].distance != 0) {
+            ASSERT_EQ(cpu[i].distance < 0, reference.inside(points[i])) << "point " << i;
+        }
+    }
     for (const BvhBuildSite build : {BvhBuildSite::Host, BvhBuildSite::Device})
         for (const char* method : {"brute_force", "bvh"}) {
             SamplerOptions o = options("cuda", method, "", SignMode::Winding);
