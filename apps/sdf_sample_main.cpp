@@ -203,7 +203,10 @@ int main(int argc, char** argv) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision);
             if (band > 0) std::cout << ", band " << band << (sparse ? " (sparse: the band's memory is added when sampled)" : "");
             std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
-            if (!vdb_path.empty())
+            if (!vdb_path.empty() && sparse)
+                std::cout << "vdb: " << vdb_path << ", a level set from the sparse band's blocks, points with |d| <= "
+                          << band << " active (outside the budget)\n";
+            else if (!vdb_path.empty())
                 std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
                           << " active (its grids hold the band's points, outside the budget)\n";
             try {
