@@ -170,3 +170,11 @@ def test_the_spheres_have_inside_tiles(case, request):
     if "sphere" not in request.node.callspec.id:
         pytest.skip("the torus's tube and the open box's inside are thin")
     assert int(stdout.split(" tiles (")[1].split(" inside")[0]) > 0
+
+
+def test_the_open_box_under_the_winding_sign_has_mixed_blocks(case, request):
+    """So that the value test above reads mixed leaves (per-point sides outside the band)."""
+    _, _, _, stdout = case
+    if "open_box" not in request.node.callspec.id:
+        pytest.skip("closed meshes have no mixed blocks")
+    assert int(stdout.split(" mixed;")[0].rsplit(" ", 1)[1]) > 0
