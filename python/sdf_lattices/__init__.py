@@ -32,6 +32,9 @@ query, sdf, query_batch = _gpu.install(_core)
 # Wrong keywords and types named in words, not as pybind11's signature dumps (_arguments.py).
 from . import _arguments  # noqa: E402
 render = _arguments.install(_core)
+# band=W: a sparse narrow band, sdf_lattices.SparseField (_sparse.py); installed after _arguments.
+from . import _sparse  # noqa: E402
+sample = _sparse.install(_core)
 
 from . import data  # noqa: E402,F401  (ML training data: sdf_lattices.data.sample_near_surface, ...)
 from ._build_info import build_info  # noqa: E402,F401  (what the build found: CUDA, MPI, OpenVDB, OpenImageIO)

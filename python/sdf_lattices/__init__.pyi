@@ -3,7 +3,7 @@
 # every public name and member is here.
 import os
 import types
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union, Unpack
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union, Unpack, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -108,6 +108,29 @@ class Field:
     def reconstruct(self, points: npt.ArrayLike, interpolator: str = "", derivatives: str = "", sigma2: float = 0.5,
                     sigma_units: str = "lattice", threads: int = 0, outside: str = "nan") -> Tuple[ArrayF, ArrayF]: ...
 
+class SparseField:
+    distance: ArrayF
+    gradient: Optional[ArrayF]
+    triangle: ArrayI
+    points: ArrayF
+    indices: npt.NDArray[np.int64]
+    subgrid: npt.NDArray[np.int8]
+    width: float
+    lattice: str
+    resolution: Tuple[int, int, int]
+    origin: Vec3
+    spacing: float
+    num_points: int
+    active_blocks: int
+    counts: Dict[str, int]
+    nbytes: int
+    precision: str
+    mesh: Dict[str, Any]
+    def to_dense(self) -> Field: ...
+    def write(self, path: str, overwrite: bool = False) -> List[str]: ...
+    def to_openvdb(self) -> Dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
 class SDF:
     def __init__(self, mesh: MeshLike, **sampler: Unpack[SamplerKeywords]) -> None: ...
     mesh: Mesh
@@ -121,10 +144,16 @@ class SDF:
     def query(self, points: Any, winding: Union[bool, str] = False, progress: Progress = None,
               differentiable: bool = False, dtype: DType = "float64") -> Union[QueryResult, DeviceQueryResult]: ...
     def refit(self, new_vertices: Any) -> "SDF": ...
+    @overload
     def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
                margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
                spacing: Optional[float] = None, origin: Optional[Sequence[float]] = None,
                progress: Progress = None) -> Field: ...
+    @overload
+    def sample(self, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None, samples: Optional[int] = None,
+               margin: Optional[float] = None, bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+               spacing: Optional[float] = None, origin: Optional[Sequence[float]] = None,
+               progress: Progress = None, *, band: float) -> SparseField: ...
 
 def as_mesh(mesh: MeshLike) -> Mesh: ...
 def cuda_available() -> bool: ...
@@ -136,11 +165,18 @@ def sdf(mesh: MeshLike, points: Any, progress: Progress = None, differentiable: 
         **sampler: Unpack[SamplerKeywords]) -> Any: ...
 def query_batch(sdfs: Sequence[SDF], points: Sequence[Any], progress: Progress = None, dtype: DType = "float64",
                 differentiable: bool = False) -> List[Union[QueryResult, DeviceQueryResult]]: ...
+@overload
 def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
            samples: Optional[int] = None, margin: Optional[float] = None,
            bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,
            origin: Optional[Sequence[float]] = None, progress: Progress = None, distributed: bool = True,
            **sampler: Unpack[SamplerKeywords]) -> Field: ...
+@overload
+def sample(mesh: MeshLike, lattice: str = "cc", resolution: Union[None, int, Sequence[int]] = None,
+           samples: Optional[int] = None, margin: Optional[float] = None,
+           bounds: Optional[Tuple[Sequence[float], Sequence[float]]] = None, spacing: Optional[float] = None,
+           origin: Optional[Sequence[float]] = None, progress: Progress = None, distributed: bool = True, *,
+           band: float, **sampler: Unpack[SamplerKeywords]) -> SparseField: ...
 def read_field(path: Union[str, os.PathLike]) -> Field: ...
 def read_field_file(path: str) -> Field: ...
 def render(field: Field, view: str = "three_quarter", size: Union[int, Tuple[int, int]] = 512, interpolator: str = "",

@@ -12,11 +12,15 @@
 // code is called per point. C++ errors arrive as Python exceptions with the tools' messages:
 // std::invalid_argument and ConfigError (sample()'s arguments, read by the config parser) as
 // ValueError, every other std::exception (a file that cannot be read, a backend this machine
-// lacks) as RuntimeError. One file per job: mesh.cpp, query.cpp, field.cpp, render.cpp,
+// lacks) as RuntimeError. One file per job: mesh.cpp, query.cpp, field.cpp, sparse_field.cpp, render.cpp,
 // distributed.cpp.
 #include "harness/config/json_reader.h"
 #include "harness/provenance/version.h"
 #include "python/src/common.h"
+
+namespace sdf {
+void bind_sparse_field(py::module_& m);  // sparse_field.cpp
+}
 
 PYBIND11_MODULE(_core, m) {
     using namespace sdf;
@@ -43,5 +47,6 @@ with the tools' messages.)";
     bind_mesh(m);
     bind_query(m);
     bind_field(m);
+    bind_sparse_field(m);
     bind_render(m);
 }

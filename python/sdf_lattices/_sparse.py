@@ -1,0 +1,61 @@
+"""band=W: a narrow band sampled sparsely (sdf_lattices.SparseField, python/src/sparse_field.cpp).
+
+sample(mesh, ..., band=W) and SDF.sample(..., band=W) sample only the blocks of 8^3 lattice
+points within W of a triangle and return a SparseField; without band= they return the dense
+Field as before (band_width=W, a sampler keyword, keeps its dense meaning)."""
+import functools
+import os
+import tempfile
+
+# sample()'s lattice arguments, passed on to the native _sample_band (as SDF.sample takes them).
+_LATTICE = ("lattice", "resolution", "samples", "margin", "bounds", "spacing", "origin", "progress")
+
+
+def install(core):
+    """Wraps core.sample and core.SDF.sample with band=; adds SparseField.to_openvdb; returns the new sample."""
+    core_sample, sdf_sample = core.sample, core.SDF.sample
+
+    @functools.wraps(core_sample)
+    def sample(mesh, *args, band=None, **kwargs):
+        if band is None:
+            return core_sample(mesh, *args, **kwargs)
+        if kwargs.get("band_width"):
+            raise ValueError("sample(): band=W samples a sparse band; band_width=W (the dense band) is not given with it")
+        kwargs.pop("band_width", None)
+        kwargs.pop("distributed", None)  # a sparse band is sampled on this process
+        if len(args) > len(_LATTICE) - 1:
+            raise TypeError(f"sample(): at most {len(_LATTICE) - 1} positional arguments after mesh")
+        lattice = dict(zip(_LATTICE, args))
+        for key in _LATTICE:
+            if key in kwargs:
+                lattice[key] = kwargs.pop(key)
+        return core._sample_band(core.SDF(mesh, **kwargs), band, **lattice)
+
+    @functools.wraps(sdf_sample)
+    def sdf_sample_band(self, *args, band=None, **kwargs):
+        if band is None:
+            return sdf_sample(self, *args, **kwargs)
+        for key in kwargs:
+            if key not in _LATTICE:
+                return sdf_sample(self, *args, **kwargs)  # raises its TypeError naming the keyword
+        return core._sample_band(self, band, *args, **kwargs)
+
+    def to_openvdb(self):
+        """The band as pyopenvdb grids, {name: grid} (as write(path) writes them: "distance", "gradient",
+        "closest_triangle", with "_primary" / "_secondary" for BCC); needs pyopenvdb (Debian python3-openvdb)."""
+        try:
+            import pyopenvdb
+        except ImportError as e:
+            raise ImportError(f"SparseField.to_openvdb(): {e} (install the Debian package python3-openvdb)") from e
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "band.vdb")
+            self.write(path)
+            grids, _ = pyopenvdb.readAll(path)
+        return {grid.name: grid for grid in grids}
+
+    core.SDF.sample = sdf_sample_band
+    core.SparseField.to_openvdb = to_openvdb
+    return sample
+
+
+__all__ = ["install"]

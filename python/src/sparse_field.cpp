@@ -1,0 +1,210 @@
+// sdf_lattices.SparseField: a narrow band sampled sparsely (core/sampling/sparse_band.h), as
+// sample(mesh, ..., band=W) and SDF.sample(..., band=W) return it (the package routes band=
+// here, python/sdf_lattices/_sparse.py). No dense array is made unless to_dense() is asked.
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "core/mesh/mesh_provenance.h"
+#include "core/sampling/sparse_band.h"
+#include "harness/io/sparse_vdb_file.h"
+#include "harness/resources/memory_budget.h"
+#include "python/src/field.h"
+#include "python/src/task.h"
+
+namespace sdf {
+
+namespace {
+
+class SparseField {
+public:
+    explicit SparseField(SparseBandField band) : band_(std::make_shared<const SparseBandField>(std::move(band))) {
+        // The band's points: channel positions a * 512 + local of the active blocks' points
+        // within the band (closest triangle set), in block order.
+        const SparseBandField& b = *band_;
+        for (size_t a = 0; a < b.active.size(); ++a)
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                const size_t at = a * kBandBlockPoints + size_t(local);
+                if (b.closest_triangle[at] != kOutsideBandTriangle && b.layout().storage_index(b.active[a], local) >= 0)
+                    at_.push_back(int64_t(at));
+            }
+    }
+
+    const SparseBandField& band() const { return *band_; }
+    const Lattice& lattice() const { return band_->lattice; }
+    py::ssize_t size() const { return py::ssize_t(at_.size()); }
+
+    py::array_t<double> distance() const {
+        return new_array<double>({size()}, [&](double* d) {
+            for (size_t i = 0; i < at_.size(); ++i) d[i] = band_->distance[size_t(at_[i])];
+        });
+    }
+    py::object gradient() const {
+        if (band_->gradient.size() != band_->distance.size()) return py::none();
+        return new_array<double>({size(), 3}, [&](double* g) {
+            for (size_t i = 0; i < at_.size(); ++i) {
+                const Vec3d& v = band_->gradient[size_t(at_[i])];
+                g[3 * i] = v.x, g[3 * i + 1] = v.y, g[3 * i + 2] = v.z;
+            }
+        });
+    }
+    py::array_t<int32_t> triangle() const {
+        return new_array<int32_t>({size()}, [&](int32_t* t) {
+            for (size_t i = 0; i < at_.size(); ++i) t[i] = band_->closest_triangle[size_t(at_[i])];
+        });
+    }
+    /// Block id and local index of band point i.
+    std::pair<int64_t, int> block_of(size_t i) const {
+        return {band_->active[size_t(at_[i] / kBandBlockPoints)], int(at_[i] % kBandBlockPoints)};
+    }
+    py::array_t<double> points() const {
+        return new_array<double>({size(), 3}, [&](double* p) {
+            for (size_t i = 0; i < at_.size(); ++i) {
+                const auto [id, local] = block_of(i);
+                const Vec3d x = lattice().position_of_coords(band_->layout().point_coords(id, local));
+                p[3 * i] = x.x, p[3 * i + 1] = x.y, p[3 * i + 2] = x.z;
+            }
+        });
+    }
+    py::array_t<int64_t> indices() const {
+        return new_array<int64_t>({size(), 3}, [&](int64_t* q) {
+            for (size_t i = 0; i < at_.size(); ++i) {
+                const auto [id, local] = block_of(i);
+                const Int3 c = band_->layout().coset_point(id, local);
+                q[3 * i] = c.x, q[3 * i + 1] = c.y, q[3 * i + 2] = c.z;
+            }
+        });
+    }
+    py::array_t<int8_t> subgrid() const {
+        return new_array<int8_t>({size()}, [&](int8_t* s) {
+            for (size_t i = 0; i < at_.size(); ++i) s[i] = int8_t(band_->layout().block_coords(block_of(i).first).coset);
+        });
+    }
+    size_t nbytes() const { return band_->memory_bytes() + at_.capacity() * sizeof(int64_t); }
+
+    Field to_dense() const {
+        const uint64_t bytes = uint64_t(SparseBandField::dense_bytes(lattice()));
+        require_host_memory({bytes, "densifying the band of " + lattice_notation(lattice()) + " (" +
+                                        std::to_string(lattice().num_points()) + " points)"},
+                            "SparseField.to_dense()");
+        std::shared_ptr<const SparseBandField> b = band_;
+        TaskOptions task;
+        task.total = kBackgroundItems;
+        task.label = "densifying the band";
+        return run_task([&] { return Field(b->densify()); }, task);
+    }
+
+    py::list write(const std::string& path, bool overwrite, bool closest_triangle) const {
+        if (path.size() < 5 || path.compare(path.size() - 4, 4, ".vdb") != 0)
+            throw std::invalid_argument(path + ": a SparseField writes .vdb (an OpenVDB level set) only so far; "
+                                        "to_dense().write(path) writes the dense formats (field file, vti, npy, npz)");
+        SparseVdbOptions options;
+        options.gradient = true;
+        options.closest_triangle = closest_triangle;
+        options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
+        std::shared_ptr<const SparseBandField> b = band_;
+        TaskOptions task;
+        task.total = kBackgroundItems;
+        task.label = "writing " + path;
+        run_task([&] { return write_sparse_band_vdb(*b, path, options); }, task);
+        py::list files;
+        files.append(path);
+        return files;
+    }
+
+private:
+    std::shared_ptr<const SparseBandField> band_;
+    std::vector<int64_t> at_;
+};
+
+SparseField sample_band(const MeshSdf& sdf, double band, const std::string& lattice, const py::object& resolution,
+                        const py::object& samples, const py::object& margin, const py::object& bounds,
+                        const py::object& spacing, const py::object& origin, const py::object& progress) {
+    if (!(band > 0) || !std::isfinite(band))
+        throw std::invalid_argument("band: expected a positive width in mesh units, got " + std::to_string(band));
+    if (!(float(band) > 0) || !std::isfinite(float(band)))
+        throw std::invalid_argument("band: " + std::to_string(band) + " is not representable in float32 (a .vdb's values)");
+    const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, sdf.mesh().bounds());
+    TaskOptions task;
+    task.total = kBackgroundItems;
+    task.label = "sampling the band of '" + sdf.mesh().name() + "'";
+    task.progress = progress;
+    SparseBandField field = run_task([&] {
+        try {
+            return sdf.sample_band(l, band);
+        } catch (const std::bad_alloc&) {
+            throw std::runtime_error(out_of_memory_message("sample(band=) of " + sdf.mesh().name() + " on " + lattice_notation(l), 0));
+        }
+    }, task);
+    field.mesh = describe_prepared_mesh(sdf.mesh());
+    return SparseField(std::move(field));
+}
+
+}  // namespace
+
+void bind_sparse_field(py::module_& m) {
+    py::class_<SparseField>(m, "SparseField", R"(A narrow band of width W sampled sparsely: sample(mesh, ..., band=W) and
+SDF.sample(..., band=W) return it. The lattice is cut into blocks of 8^3 points (OpenVDB's
+leaves); only the blocks within W of a triangle are sampled, so its memory grows with the band,
+not with the lattice. Its arrays hold the band's points (|d| <= W), in block order: distance,
+gradient, triangle, their world positions (points) and lattice indices (indices, subgrid).
+Every other lattice point stands for +W or -W by its side: to_dense() is the dense field of
+sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB level set (.vdb).)")
+        .def_property_readonly("distance", &SparseField::distance, "Exact signed distance of the band's points, float64 (N,).")
+        .def_property_readonly("gradient", &SparseField::gradient, "Exact gradient of the band's points, float64 (N, 3).")
+        .def_property_readonly("triangle", &SparseField::triangle, "Closest triangle of the band's points, int32 (N,), 0-based.")
+        .def_property_readonly("points", &SparseField::points, "World positions of the band's points, float64 (N, 3).")
+        .def_property_readonly("indices", &SparseField::indices,
+                               "Lattice indices (i, j, k) of the band's points, int64 (N, 3), x first, in their sub-grid "
+                               "(subgrid): the point is to_dense().values[k, j, i] (CC) or values[subgrid][k, j, i] (BCC).")
+        .def_property_readonly("subgrid", &SparseField::subgrid,
+                               "Sub-grid of each band point, int8 (N,): 0 (CC, or BCC's primary grid) or 1 (BCC's secondary).")
+        .def_property_readonly("width", [](const SparseField& f) { return f.band().width; }, "The band's width W, mesh units.")
+        .def_property_readonly("lattice", [](const SparseField& f) { return lattice_type_name(f.lattice().type); }, "'cc' or 'bcc'.")
+        .def_property_readonly("resolution", [](const SparseField& f) {
+            const Int3 r = f.lattice().resolution;
+            return py::make_tuple(r.x, r.y, f.lattice().type == LatticeType::BCC ? 2 * r.z : r.z);
+        }, "(nx, ny, nz) for CC; (Rx, Ry, 2Rz) for BCC, as Field.resolution.")
+        .def_property_readonly("origin", [](const SparseField& f) {
+            const Vec3d o = f.lattice().origin;
+            return py::make_tuple(o.x, o.y, o.z);
+        }, "World position (x, y, z) of the first (primary) lattice point.")
+        .def_property_readonly("spacing", [](const SparseField& f) { return f.lattice().spacing; }, "h, as Field.spacing.")
+        .def_property_readonly("num_points", [](const SparseField& f) { return f.lattice().num_points(); },
+                               "Lattice points in all (the dense field's).")
+        .def_property_readonly("active_blocks", [](const SparseField& f) { return f.band().active.size(); },
+                               "Blocks of 8^3 points that were sampled.")
+        .def_property_readonly("counts", [](const SparseField& f) {
+            const SparseBandCounts c = f.band().counts();
+            py::dict d;
+            d["blocks"] = c.blocks, d["active_blocks"] = c.active_blocks, d["mixed_blocks"] = c.mixed_blocks;
+            d["tiles"] = c.tiles, d["inside_tiles"] = c.inside_tiles, d["active_points"] = c.active_points;
+            d["band_points"] = c.band_points;
+            return d;
+        }, "The band's blocks and points counted (dict).")
+        .def_property_readonly("nbytes", &SparseField::nbytes, "Bytes the band holds (its arrays' capacity).")
+        .def_property_readonly("precision", [](const SparseField& f) { return precision_name(f.band().precision); },
+                               "The search precision it was sampled with.")
+        .def_property_readonly("mesh", [](const SparseField& f) { return json_to_python(nlohmann::json(f.band().mesh)); },
+                               "The mesh it was sampled from (dict).")
+        .def("to_dense", &SparseField::to_dense,
+             "to_dense() -> Field: the dense banded field (every lattice point; +-W outside the band), refused (RuntimeError, naming "
+             "the size) when it exceeds the memory available, as sample() is.")
+        .def("write", &SparseField::write, py::arg("path"), py::arg("overwrite") = false, py::arg("closest_triangle") = false,
+             "write(path, overwrite=False, closest_triangle=False) -> list of files: an OpenVDB level set (.vdb; "
+             "harness/io/sparse_vdb_file.h) with its gradient grid, written atomically; closest_triangle=True adds an "
+             "Int32Grid of the closest triangles (which Debian's pyopenvdb 10 cannot read). Other formats are refused "
+             "(to_dense().write(path) writes them).")
+        .def("__len__", &SparseField::size)
+        .def("__repr__", [](const SparseField& f) {
+            return "<sdf_lattices.SparseField " + std::string(lattice_type_name(f.lattice().type)) + " " +
+                   lattice_notation(f.lattice()) + ", band " + std::to_string(f.band().width) + ": " + std::to_string(f.size()) +
+                   " points in " + std::to_string(f.band().active.size()) + " blocks>";
+        });
+    m.def("_sample_band", &sample_band, py::arg("sdf"), py::arg("band"), py::arg("lattice") = lattice_type_name(LatticeType::CC),
+          py::arg("resolution") = py::none(), py::arg("samples") = py::none(), py::arg("margin") = py::none(),
+          py::arg("bounds") = py::none(), py::arg("spacing") = py::none(), py::arg("origin") = py::none(),
+          py::arg("progress") = py::none(), "SDF.sample(band=W)'s native part (sdf_lattices._sparse).");
+}
+
+}  // namespace sdf
