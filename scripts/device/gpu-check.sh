@@ -3,7 +3,7 @@
 # touched kernels: builds with CUDA and warnings as errors, runs every GPU test, every CPU test
 # there too, compute-sanitizer on the GPU tests' split/point-query cases, and the CI smoke study
 # from a portable CPU build (whose field checksums must equal those of any other CPU target).
-#   carry: .gpu-prefix data        steps: build gputest test python sanitize portable bench-filters stream
+#   carry: .gpu-prefix data        steps: build gputest test python sanitize asan portable bench-filters stream
 # Output under $OUT: summary.txt and the logs.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -66,6 +66,21 @@ sanitize)
         compute-sanitizer --tool memcheck --error-exitcode 3 $B/tests/gpu/$t > "$OUT/sanitizer-${t%% *}.txt" 2>&1
         echo "compute-sanitizer ${t%% *}: exit $? $(grep 'ERROR SUMMARY' "$OUT/sanitizer-${t%% *}.txt")" | tee -a "$OUT/summary.txt"
     done ;;
+asan)
+    # scripts/test --sanitize with this machine's cores and the carried prefix: ASan + UBSan
+    # build of the CPU code (no CUDA, benchmarks or Python), then the CPU tests, every report fatal.
+    log "AddressSanitizer + UndefinedBehaviorSanitizer: the CPU tests"
+    flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+    san_common=("${cmake_common[@]}")
+    for i in "${!san_common[@]}"; do case "${san_common[$i]}" in -DCMAKE_BUILD_TYPE=*) san_common[$i]=-DCMAKE_BUILD_TYPE=RelWithDebInfo ;;
+        -DCMAKE_CXX_FLAGS=*) flags="$flags ${san_common[$i]#-DCMAKE_CXX_FLAGS=}"; unset 'san_common[$i]' ;; -DCMAKE_CUDA_FLAGS=*) unset 'san_common[$i]' ;; esac; done
+    cmake -S . -B build-asan "${san_common[@]}" -DSDF_ENABLE_CUDA=OFF -DSDF_BUILD_BENCHMARKS=OFF -DSDF_BUILD_PYTHON=OFF \
+        -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" > "$OUT/configure-asan.log" 2>&1 &&
+        cmake --build build-asan -j "$(nproc)" > "$OUT/build-asan.log" 2>&1 || { grep -E "error|FAILED" "$OUT/build-asan.log" | head -20; exit 1; }
+    (cd build-asan && ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1" \
+        UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" ctest --output-on-failure -L cpu -j "$(nproc)" > "$OUT/ctest-asan.log" 2>&1
+        echo "ctest -L cpu (ASan + UBSan) exit $?") | tee -a "$OUT/summary.txt"
+    grep -E "tests passed|\(Failed\)|\(Subprocess|Not Run|Timeout" "$OUT/ctest-asan.log" | tee -a "$OUT/summary.txt" ;;
 portable)
     log "portable CPU build: CI smoke field checksums"
     cmake -S . -B build-portable "${cmake_common[@]}" -DSDF_ENABLE_CUDA=OFF -DSDF_BUILD_TESTS=OFF -DSDF_BUILD_BENCHMARKS=OFF \
