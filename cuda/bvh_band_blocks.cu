@@ -19,6 +19,7 @@
 #include "cuda/bvh_warp_kernel.cuh"
 #include "cuda/cuda_check.h"
 #include "cuda/cuda_device.h"
+#include "cuda/device_guard.h"
 #include "kernels/lattice/band_blocks.h"
 
 namespace sdf::cuda {
@@ -94,7 +95,7 @@ BandBlockKernel BoundCudaBvh::band_block_kernel(double width) const {
     if (kernel_ != BvhGpuKernel::Warp && kernel_ != BvhGpuKernel::Candidates) return {};
     return [this, width](SparseBandField& band, size_t first, size_t last) {
         const std::lock_guard<std::mutex> lock(mutex_);
-        CUDA_CHECK(cudaSetDevice(options_.device));
+        const DeviceGuard on_device(options_.device);
         with_precision(options_.precision, [&](auto zero) { band_blocks_as<decltype(zero)>(band, first, last, width); });
     };
 }
