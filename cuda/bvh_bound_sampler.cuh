@@ -1,7 +1,8 @@
 /// @file bvh_bound_sampler.cuh
-/// @brief The CUDA BVH sampler bound to its mesh (cuda/bvh_sampler.h), for its three
+/// @brief The CUDA BVH sampler bound to its mesh (cuda/bvh_sampler.h), for its four
 /// translation units: the tree made at binding (bvh_device_tree.cu), the lattice path
-/// (bvh_sampler.cu) and the point-query path (bvh_point_query.cu). Its device scratch
+/// (bvh_sampler.cu), the point-query path (bvh_point_query.cu) and the sparse band's blocks
+/// (bvh_band_blocks.cu). Its device scratch
 /// (candidate counters, pinned buffers, a stored slab's channels, the certificate's
 /// counters) is kept between calls, so calls are serialised inside.
 #pragma once
@@ -56,6 +57,8 @@ private:
     SampledField sample_blocks(SlabRun& run) const override;
     std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings& timings,
                                           CertificateCounters& certificate) const override;
+    /// The sparse band's active blocks in device memory (bvh_band_blocks.cu; warp and candidates).
+    BandBlockKernel band_block_kernel(double width) const override;
 
     // ---- the tree (bvh_device_tree.cu) ------------------------------------------------
     template <typename T>
@@ -91,6 +94,10 @@ private:
     template <typename T>
     void record_run(SlabRun& run, const DeviceBvh<T>& dev, const EventTimer& upload, const EventTimer& compute,
                     const EventTimer& download, int64_t pieces) const;
+
+    // ---- sparse band blocks (bvh_band_blocks.cu) ------------------------------------------
+    template <typename T>
+    void band_blocks_as(SparseBandField& band, size_t first, size_t last, double width) const;
 
     // ---- point lists (bvh_point_query.cu) -----------------------------------------------
     template <typename T>

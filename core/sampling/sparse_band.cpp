@@ -9,8 +9,6 @@
 namespace sdf {
 namespace {
 
-int blocks_for(int points) { return points > 0 ? (points + kBandBlockDim - 1) / kBandBlockDim : 0; }
-
 int64_t find_sorted(const std::vector<int64_t>& ids, int64_t id) {
     const auto it = std::lower_bound(ids.begin(), ids.end(), id);
     return it != ids.end() && *it == id ? int64_t(it - ids.begin()) : -1;
@@ -19,50 +17,6 @@ int64_t find_sorted(const std::vector<int64_t>& ids, int64_t id) {
 bool mask_bit(const BandSignMask& m, int local) { return (m[size_t(local >> 6)] >> (local & 63)) & 1; }
 
 }  // namespace
-
-BandLayout::BandLayout(const Lattice& lattice) : lattice_(lattice) {
-    cosets_ = lattice.secondary_count() > 0 ? 2 : 1;
-    int64_t storage = 0;
-    for (int c = 0; c < cosets_; ++c) {
-        BandCoset& s = coset_[size_t(c)];
-        s.first = c == 0 ? Int3{0, 0, 0} : Int3{1, 1, 1};
-        s.points = c == 0 ? lattice.resolution : lattice.secondary_resolution();
-        s.blocks = {blocks_for(s.points.x), blocks_for(s.points.y), blocks_for(s.points.z)};
-        s.first_block = block_count_;
-        s.storage_offset = storage;
-        block_count_ += s.block_count();
-        storage += int64_t(s.points.x) * s.points.y * s.points.z;
-    }
-}
-
-BandBlockCoords BandLayout::block_coords(int64_t id) const {
-    int c = 0;
-    while (c + 1 < cosets_ && id >= coset_[size_t(c + 1)].first_block) ++c;
-    const BandCoset& s = coset_[size_t(c)];
-    const int64_t local = id - s.first_block;
-    return {c, {int(local % s.blocks.x), int((local / s.blocks.x) % s.blocks.y), int(local / (int64_t(s.blocks.x) * s.blocks.y))}};
-}
-
-Int3 BandLayout::coset_point(int64_t id, int local) const {
-    const BandBlockCoords b = block_coords(id);
-    const Int3 o = local_offset(local);
-    return {b.block.x * kBandBlockDim + o.x, b.block.y * kBandBlockDim + o.y, b.block.z * kBandBlockDim + o.z};
-}
-
-Int3 BandLayout::point_coords(int64_t id, int local) const {
-    const BandBlockCoords b = block_coords(id);
-    const Int3 p = coset_point(id, local);
-    const Int3 f = coset_[size_t(b.coset)].first;
-    return {f.x + 2 * p.x, f.y + 2 * p.y, f.z + 2 * p.z};
-}
-
-int64_t BandLayout::storage_index(int64_t id, int local) const {
-    const BandBlockCoords b = block_coords(id);
-    const BandCoset& s = coset_[size_t(b.coset)];
-    const Int3 p = coset_point(id, local);
-    if (p.x >= s.points.x || p.y >= s.points.y || p.z >= s.points.z) return -1;
-    return s.storage_offset + p.x + int64_t(s.points.x) * (p.y + int64_t(s.points.y) * p.z);
-}
 
 void BandLayout::cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const {
     const Int3 c = point_coords(id, 0);

@@ -33,65 +33,41 @@
 
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampled_field.h"
+#include "kernels/lattice/band_blocks.h"
 #include "kernels/lattice/lattice_slab.h"
 
 namespace sdf {
 
-inline constexpr int kBandBlockLog2 = 3;
-inline constexpr int kBandBlockDim = 1 << kBandBlockLog2;  ///< 8 points per axis
-inline constexpr int kBandBlockPoints = kBandBlockDim * kBandBlockDim * kBandBlockDim;  ///< 512
-
-/// One coset's grid of blocks.
-struct BandCoset {
-    Int3 first{};              ///< integer coordinates (units of h/2) of the coset's point (0, 0, 0)
-    Int3 points{};             ///< the coset's points per axis
-    Int3 blocks{};             ///< blocks per axis: ceil(points / 8)
-    int64_t first_block = 0;   ///< id of the coset's block (0, 0, 0)
-    int64_t storage_offset = 0;  ///< lattice storage index of the coset's point (0, 0, 0)
-    int64_t block_count() const { return int64_t(blocks.x) * blocks.y * blocks.z; }
-};
-
-/// A block's coset and block coordinates.
-struct BandBlockCoords {
-    int coset = 0;
-    Int3 block{};
-};
-
-/// The blocks of a lattice (see the file's comment).
+/// The blocks of a lattice (see the file's comment): the lattice and its BandBlockGrid
+/// (kernels/lattice/band_blocks.h, the mapping the device kernels share).
 class BandLayout {
 public:
     BandLayout() = default;
-    explicit BandLayout(const Lattice& lattice);
+    explicit BandLayout(const Lattice& lattice) : lattice_(lattice), grid_(BandBlockGrid::of(lattice)) {}
 
     const Lattice& lattice() const { return lattice_; }
-    int cosets() const { return cosets_; }
-    const BandCoset& coset(int c) const { return coset_[size_t(c)]; }
+    const BandBlockGrid& grid() const { return grid_; }
+    int cosets() const { return grid_.cosets; }
+    const BandCoset& coset(int c) const { return grid_.coset[c]; }
     /// Blocks of every coset together.
-    int64_t block_count() const { return block_count_; }
+    int64_t block_count() const { return grid_.block_count; }
 
-    int64_t block_id(int coset, const Int3& block) const {
-        const BandCoset& s = coset_[size_t(coset)];
-        return s.first_block + block.x + int64_t(s.blocks.x) * (block.y + int64_t(s.blocks.y) * block.z);
-    }
-    BandBlockCoords block_coords(int64_t id) const;
+    int64_t block_id(int coset, const Int3& block) const { return grid_.block_id(coset, block); }
+    BandBlockCoords block_coords(int64_t id) const { return grid_.block_coords(id); }
     /// Coset point (i, j, k) of block-local index `local` (0 .. 511, x fastest).
-    static Int3 local_offset(int local) {
-        return {local & (kBandBlockDim - 1), (local >> kBandBlockLog2) & (kBandBlockDim - 1), local >> (2 * kBandBlockLog2)};
-    }
+    static Int3 local_offset(int local) { return BandBlockGrid::local_offset(local); }
     /// The coset's point indices (i, j, k) of point `local` of block `id`.
-    Int3 coset_point(int64_t id, int local) const;
+    Int3 coset_point(int64_t id, int local) const { return BandBlockGrid::coset_point(block_coords(id), local); }
     /// Integer coordinates (units of h/2, Lattice::position_of_coords) of that point.
-    Int3 point_coords(int64_t id, int local) const;
+    Int3 point_coords(int64_t id, int local) const { return grid_.point_coords(block_coords(id), local); }
     /// Its lattice storage index, or -1 for padding (beyond the coset's resolution).
-    int64_t storage_index(int64_t id, int local) const;
+    int64_t storage_index(int64_t id, int local) const { return grid_.storage_index(block_coords(id), local); }
     /// The block's cell (see the file's comment), in world units.
     void cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const;
 
 private:
     Lattice lattice_{};
-    int cosets_ = 0;
-    std::array<BandCoset, kMaxLatticeCosets> coset_{};
-    int64_t block_count_ = 0;
+    BandBlockGrid grid_{};
 };
 
 /// One bit per point of a block: the sides of a mixed block (bit set: inside, -W).

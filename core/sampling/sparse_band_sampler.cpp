@@ -27,6 +27,14 @@ public:
     explicit BlockBits(int64_t n) : bits_(size_t((n + 63) / 64), 0) {}
     bool get(int64_t i) const { return (bits_[size_t(i >> 6)] >> (i & 63)) & 1; }
     void set(int64_t i) { bits_[size_t(i >> 6)] |= uint64_t(1) << (i & 63); }
+    /// The set bits, ascending, a word at a time: at 4096^3 (134M blocks, 1.4M set) a bit at a
+    /// time took 0.13-0.16 s of CPU on the dragon, this 0.045 s.
+    std::vector<int64_t> set_bits() const {
+        std::vector<int64_t> out;
+        for (size_t w = 0; w < bits_.size(); ++w)
+            for (uint64_t b = bits_[w]; b != 0; b &= b - 1) out.push_back(int64_t(w) * 64 + __builtin_ctzll(b));
+        return out;
+    }
 
 private:
     std::vector<uint64_t> bits_;
@@ -246,8 +254,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     // 1. Active blocks.
     Clock::time_point t = Clock::now();
     const BlockBits active = active_blocks(mesh, layout, width);
-    for (int64_t id = 0; id < layout.block_count(); ++id)
-        if (active.get(id)) out.active.push_back(id);
+    out.active = active.set_bits();
     steps["find_blocks_seconds"] = seconds_since(t);
 
     // 2. Their points, batch by batch (batches of whole blocks).
@@ -257,14 +264,20 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     out.closest_triangle.assign(out.active.size() * kBandBlockPoints, kOutsideBandTriangle);
     const int64_t blocks_per_batch = plan.batch_points / kBandBlockPoints;
     int64_t points_computed = 0;
-    for (size_t first = 0; first < out.active.size(); first += size_t(blocks_per_batch)) {
-        const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
-        if (blocks) {
-            for (size_t a = first; a < last; ++a)
-                for (int local = 0; local < kBandBlockPoints; ++local) points_computed += layout.storage_index(out.active[a], local) >= 0;
-            blocks(out, first, last);
-            continue;
+    if (blocks) {
+        // One call for every block: the kernel batches as its memory allows (a GPU uploads
+        // the ids once).
+        for (const int64_t id : out.active) {
+            const BandBlockCoords b = layout.block_coords(id);
+            const Int3 n = layout.coset(b.coset).points;
+            int64_t points = 1;
+            for (int a = 0; a < 3; ++a) points *= std::min(kBandBlockDim, n[a] - b.block[a] * kBandBlockDim);
+            points_computed += points;
         }
+        if (!out.active.empty()) blocks(out, 0, out.active.size());
+    }
+    for (size_t first = 0; !blocks && first < out.active.size(); first += size_t(blocks_per_batch)) {
+        const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
         std::vector<Vec3d> points;
         std::vector<size_t> slot;  // value index of each point
         points.reserve((last - first) * kBandBlockPoints);

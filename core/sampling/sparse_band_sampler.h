@@ -6,8 +6,9 @@
 ///    covers the rounding of the cells' bounds and of the band test's distance), rasterised
 ///    into the blocks whose cells it meets (a bit per block). A point with |d| <= W lies in
 ///    such a block; a block outside it has no triangle in its cell.
-/// 2. Their lattice points, in batches: through the backend's block kernel where it has one
-///    (the CPU BVH: its dense brick kernel with the band's brick skip, block by block), else
+/// 2. Their lattice points: through the backend's block kernel where it has one (the CPU
+///    BVH: its dense brick kernel with the band's brick skip, block by block; the CUDA BVH:
+///    its warp or candidates kernel over the blocks in device memory), else, in batches,
 ///    through BoundSampler::query: the certified search, the sign rule and the evaluation of
 ///    the dense path at the same positions (Lattice::position_of_coords), then the band's
 ///    rule of narrow_band.h.
@@ -47,7 +48,9 @@ struct SparseBandPlan {
 };
 
 /// A backend's block kernel: fills the values of the active blocks [first, last) of `band`
-/// (band.active) as its dense lattice kernel with the band of band.width fills those points.
+/// (band.active) as its dense lattice kernel with the band of band.width fills those points
+/// (padding included: +W, gradient 0, kOutsideBandTriangle). Called once with every active
+/// block; a device kernel adds its kernel, upload and download seconds to band.timings.
 using BandBlockKernel = std::function<void(SparseBandField& band, size_t first, size_t last)>;
 
 /// Samples the band of width `width` > 0 of `lattice`: the active blocks with `blocks`, or,

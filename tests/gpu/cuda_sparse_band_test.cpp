@@ -1,11 +1,16 @@
 // The sparse narrow band on the CUDA samplers (issue 35): densified, it equals the CPU BVH's
 // dense banded field byte for byte (and the CUDA BVH's own dense band), on a solid
-// (pseudonormal sign), an open bowl (winding sign: mixed blocks across its opening), shells
+// (pseudonormal sign), an open bowl (winding sign: mixed blocks across its opening; and the
+// pseudonormal sign forced on it: no brick skip), shells
 // and self-intersecting spheres; CC and BCC, float and double; bunny-open where
-// SDF_DATA_PATH has it.
+// SDF_DATA_PATH has it. The CUDA BVH's warp and candidates kernels sample the active blocks
+// in device memory (also in batches of a few blocks); its brick kernel and the brute force
+// through point queries.
 #include <gtest/gtest.h>
 
 #include <cstring>
+
+#include <nlohmann/json.hpp>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_mesh.h"
@@ -67,6 +72,8 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                      SignMode::Winding});
     const std::string bunny = test::find_data_file("bunny-open.obj");
     if (!bunny.empty()) cases.push_back({"bunny-open", prepare_mesh(load_mesh_file(bunny)), SignMode::Winding});
+    // The pseudonormal sign forced on an open mesh: no brick skipped, every point searched.
+    cases.push_back({"open bowl (pseudonormal)", test::open_bowl(), SignMode::Pseudonormal});
     for (const Case& c : cases) {
         const Lattice cc = fit_lattice(LatticeType::CC, {61, 58, 56}, c.mesh.bounds(), 0.4);
         const Lattice bcc = fit_lattice(LatticeType::BCC, {41, 39, 37}, c.mesh.bounds(), 0.4);
@@ -77,12 +84,39 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                 const SampledField cpu_dense = make_sampler(options("cpu", "bvh", precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
                 const SampledField gpu_dense = make_sampler(options("cuda", "bvh", precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
                 EXPECT_TRUE(same_field(cpu_dense, gpu_dense)) << what << ": the dense bands differ";
-                for (const char* method : {"bvh", "brute_force"}) {
-                    if (std::string(method) == "brute_force" && precision == Precision::Double) continue;
-                    const SparseBandField sparse =
-                        make_sampler(options("cuda", method, precision, 0, c.sign))->bind(share(c.mesh))->sample_band_sparse(lattice, w);
-                    EXPECT_EQ(sparse.sampler.backend, "cuda") << what;
-                    EXPECT_TRUE(same_field(cpu_dense, sparse.densify())) << what << " cuda/" << method;
+                // bvh warp and candidates: the active blocks in device memory (bvh_band_blocks.cu),
+                // also in batches of 3 blocks; bvh brick and brute force: point queries.
+                struct Run {
+                    const char* method;
+                    const char* kernel;
+                    int64_t max_points_per_piece;
+                    bool on_device;
+                };
+                for (const Run& run : {Run{"bvh", "warp", 0, true}, Run{"bvh", "candidates", 0, true},
+                                       Run{"bvh", "warp", 3 * 512, true}, Run{"bvh", "candidates", 3 * 512 + 100, true},
+                                       Run{"bvh", "brick", 0, false}, Run{"brute_force", "", 0, false}}) {
+                    if (std::string(run.method) == "brute_force" && precision == Precision::Double) continue;
+                    SamplerOptions o = options("cuda", run.method, precision, 0, c.sign);
+                    o.kernel = run.kernel;
+                    o.max_points_per_piece = run.max_points_per_piece;
+                    const SparseBandField sparse = make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(lattice, w);
+                    const std::string which = what + " cuda/" + run.method + "/" + run.kernel + " piece " +
+                                              std::to_string(run.max_points_per_piece);
+                    EXPECT_EQ(sparse.sampler.backend, "cuda") << which;
+                    EXPECT_EQ(sparse.sampler.details.contains("band_blocks_on_device"), run.on_device) << which;
+                    if (run.on_device) {
+                        const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+                        EXPECT_EQ(d["blocks"].get<int64_t>(), int64_t(sparse.active.size())) << which;
+                        if (run.max_points_per_piece > 0) {
+                            EXPECT_EQ(d["blocks_per_batch"].get<int64_t>(), 3) << which;
+                        }
+                        EXPECT_GT(sparse.timings.kernel, 0.0) << which;
+                        EXPECT_LE(sparse.timings.kernel, sparse.timings.total) << which;
+                        if (precision == Precision::Float) {
+                            EXPECT_GT(sparse.timings.certified_points, 0) << which;
+                        }
+                    }
+                    EXPECT_TRUE(same_field(cpu_dense, sparse.densify())) << which;
                 }
                 if (HasFailure()) return;
             }
