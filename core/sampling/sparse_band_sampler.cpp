@@ -14,6 +14,7 @@
 #include "core/sampling/sampler_sign.h"
 #include "core/sampling/search_range.h"
 #include "core/winding/winding_sign.h"
+#include "kernels/winding/certified_winding.h"
 
 namespace sdf {
 namespace {
@@ -122,8 +123,10 @@ struct Cell {
 class OutsideClassifier {
 public:
     OutsideClassifier(const BandLayout& layout, const BlockBits& active, OutsideRule rule, const WindingSign* winding,
-                      std::vector<BoundaryEdge> edges)
-        : layout_(layout), active_(active), rule_(rule), winding_(winding), edges_(std::move(edges)) {}
+                      const PreparedMesh& mesh, std::vector<BoundaryEdge> edges)
+        : layout_(layout), active_(active), rule_(rule), winding_(winding), edges_(std::move(edges)) {
+        if (winding_) view_ = winding_->winding_bvh().view<double>(mesh);
+    }
 
     std::vector<Cell> uniform;      ///< cells of inactive blocks with one side
     std::vector<int64_t> per_point; ///< inactive blocks queried at every point
@@ -186,13 +189,14 @@ private:
         layout_.cell_box(layout_.block_id(cell.coset, {cell.hi.x - 1, cell.hi.y - 1, cell.hi.z - 1}), unused, hi);
         const Vec3d centre = (lo + hi) * 0.5;
         const double delta = 0.5 * length(hi - lo);
-        // The fast evaluation's bound is pessimistic (worst cases summed): a larger beta where
-        // it does not decide, as WindingSign's certification does.
+        // The certified evaluation (its bound covers truncation and rounding, as the sign's
+        // certification uses it), pessimistic where worst cases sum: a larger beta where it
+        // does not decide, as WindingSign's refinement does.
         WindingAccuracy<double> accuracy = winding_->options().accuracy;
-        WindingEstimate<double> w = winding_->estimate(centre, accuracy);
+        WindingEstimate<double> w = certified_winding_number(view_, centre, accuracy);
         for (int k = 0; k < 3 && !(std::abs(w.value - 0.5) > w.error_bound + 0.05); ++k) {
             accuracy.beta *= 3;
-            w = winding_->estimate(centre, accuracy);
+            w = certified_winding_number(view_, centre, accuracy);
         }
         const double room = std::abs(w.value - 0.5) - w.error_bound - 1e-9;  // what w may change by in the cell
         if (!(room > 0)) {
@@ -216,6 +220,7 @@ private:
     const BlockBits& active_;
     OutsideRule rule_;
     const WindingSign* winding_;
+    WindingView<double> view_{};  ///< the winding data's view, for the certified evaluation
     std::vector<BoundaryEdge> edges_;
 };
 
@@ -322,7 +327,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
         rule = OutsideRule::PerPoint;
     }
     const size_t boundary_edge_count = edges.size();
-    OutsideClassifier classify(layout, active, rule, winding.get(), std::move(edges));
+    OutsideClassifier classify(layout, active, rule, winding.get(), mesh, std::move(edges));
     classify.run();
     // One query per uniform cell, at its first block's first point.
     std::vector<Vec3d> reps;

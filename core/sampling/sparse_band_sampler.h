@@ -21,14 +21,17 @@
 ///    - winding sign, no boundary edges (every edge's oriented uses cancel): always (w is an
 ///      integer off the surface);
 ///    - winding sign with boundary edges: |w~(c) - 1/2| > e(c) + G delta at the cell's centre c
-///      (w~ the fast winding number, e its error bound, delta the half diagonal) with the
+///      (w~ the fast winding number with its certified bound e: truncation and rounding,
+///      certified_winding.h; delta the half diagonal) with the
 ///      Biot-Savart bound G = (1/4 pi) sum_e m_e len_e / (dist(c, e) - delta)^2 over the
 ///      boundary edges e (net oriented uses m_e) of |grad w| in the cell;
 ///    - pseudonormal sign of any other mesh: never (every inactive point is queried: the
 ///      dense path's cost, sparse memory).
-///    The dense path decides a winding side by the fast value at each point; a uniform cell
-///    takes that of one point, so the two agree where the fast value's error at a point off
-///    the band is below its |w - 1/2| (the evaluation's bound; the tests check every point).
+///    The dense path's certified winding sign is the exact side of w at each point, and the
+///    test above proves w stays on one side of 1/2 over the cell, so the cell's one side is
+///    every point's (the tests check every point as well). With certification switched off
+///    the dense sign is the fast value's side, which may differ where |w - 1/2| is within the
+///    fast value's error: only the tests check that case.
 #pragma once
 
 #include <cstdint>
