@@ -131,6 +131,12 @@ if(NOT SDF_ENABLE_CUDA STREQUAL "OFF")
     endif()
     enable_language(CUDA)
     find_package(CUDAToolkit REQUIRED)
+    # Several architectures: nvcc compiles them one after another unless told to use threads,
+    # so the default list would cost its length in wall time on every machine with cores to spare.
+    list(LENGTH CMAKE_CUDA_ARCHITECTURES _sdf_cuda_arch_count)
+    if(_sdf_cuda_arch_count GREATER 1)
+      add_compile_options("$<$<COMPILE_LANGUAGE:CUDA>:SHELL:--threads 0>")
+    endif()
     set(SDF_HAVE_CUDA ON)
   elseif(SDF_ENABLE_CUDA STREQUAL "ON")
     message(FATAL_ERROR "SDF_ENABLE_CUDA=ON but no CUDA compiler (nvcc) was found")
