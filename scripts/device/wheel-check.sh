@@ -81,6 +81,13 @@ if ! "$PY" -m venv --system-site-packages "$V" > "$OUT/venv.log" 2>&1; then
 else
     PIP=("$V/bin/python" -m pip)
 fi
+# --system-site-packages leaves out the user site (~/.local) and any PYTHONPATH folder, where a
+# stock image may keep NumPy and PyTorch: the venv sees every site folder of the stock
+# interpreter through a .pth file, so that the test uses exactly the machine's NumPy and PyTorch.
+purelib=$("$V/bin/python" -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")
+"$PY" -c "import site, sys; print('\n'.join(p for p in sys.path if p.endswith(('site-packages', 'dist-packages'))))" \
+    > "$purelib/_stock_python_site.pth"
+log "stock interpreter: $("$PY" -c 'import numpy, torch; print("numpy", numpy.__version__, "torch", torch.__version__, "from", numpy.__file__.rsplit("/", 2)[0])' 2>&1 | tail -1)"
 PIP_NO_INDEX=1 PIP_DISABLE_PIP_VERSION_CHECK=1 "${PIP[@]}" install --no-deps "$wheel" > "$OUT/pip-install.log" 2>&1 ||
     { tail -20 "$OUT/pip-install.log"; exit 1; }
 cd "$(dirname "$V")"   # away from the checkout's python/ folder
