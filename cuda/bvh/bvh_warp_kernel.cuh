@@ -14,9 +14,9 @@
 
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/bvh/streamed_certificate.h"
-#include "cuda/bvh_kernel.cuh"
-#include "cuda/certify_kernel.cuh"
-#include "cuda/finalize_kernel.cuh"
+#include "cuda/bvh/bvh_kernel.cuh"
+#include "cuda/sampling/certify_kernel.cuh"
+#include "cuda/sampling/finalize_kernel.cuh"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {

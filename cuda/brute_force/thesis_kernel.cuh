@@ -8,8 +8,8 @@
 /// the previous chunk stopped. Sign and gradient are computed afterwards from (s, t).
 #pragma once
 
-#include "cuda/finalize_kernel.cuh"
-#include "cuda/point_pieces.h"
+#include "cuda/sampling/finalize_kernel.cuh"
+#include "cuda/sampling/point_pieces.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 #include "kernels/distance/signed_distance.h"
 

@@ -1,12 +1,12 @@
 // DeviceBuffer's memory: stream-ordered allocation from a memory pool of our own on each
-// device (cuda/device_buffer.h says why).
+// device (cuda/util/device_buffer.h says why).
 #include <cuda_runtime.h>
 
 #include <cstdint>
 #include <mutex>
 #include <vector>
 
-#include "cuda/device_buffer.h"
+#include "cuda/util/device_buffer.h"
 
 namespace sdf::cuda {
 namespace {

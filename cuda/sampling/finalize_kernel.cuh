@@ -10,8 +10,8 @@
 #include <cstdlib>
 
 #include "core/sampling/sampled_field.h"
-#include "cuda/point_pieces.h"
-#include "cuda/winding_sign_kernel.cuh"
+#include "cuda/sampling/point_pieces.h"
+#include "cuda/sampling/winding_sign_kernel.cuh"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {

@@ -1,7 +1,7 @@
 /// @file bvh_sampler.h
 /// @brief The CUDA BVH sampler (method "bvh"): the BVH is built on the CPU
 /// (cpu_reference/bvh), uploaded once per mesh, searched on the GPU in float or double
-/// (cuda/bvh_kernel.cuh, cuda/bvh_warp_kernel.cuh, cuda/bvh_candidates_kernel.cuh: "warp" by
+/// (cuda/bvh/bvh_kernel.cuh, cuda/bvh/bvh_warp_kernel.cuh, cuda/bvh/bvh_candidates_kernel.cuh: "warp" by
 /// default, "candidates" (a brick's shared candidate list; the one that skips the bricks
 /// outside a narrow band), "brick", "seeded", "unseeded"); point lists are sorted into Morton
 /// order on the device and searched 128 at a time by the warp kernels, and the winner

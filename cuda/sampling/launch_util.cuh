@@ -10,9 +10,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "cuda/cuda_check.h"
-#include "cuda/device_buffer.h"
-#include "cuda/finalize_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/sampling/finalize_kernel.cuh"
 
 namespace sdf::cuda {
 

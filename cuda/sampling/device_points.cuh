@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "core/sampling/device_query.h"
-#include "cuda/finalize_kernel.cuh"
+#include "cuda/sampling/finalize_kernel.cuh"
 
 namespace sdf::cuda {
 

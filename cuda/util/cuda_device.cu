@@ -1,5 +1,5 @@
-#include "cuda/cuda_check.h"
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/cuda_device.h"
 
 #include <string>
 

@@ -1,6 +1,6 @@
 // The GPU build of the linear BVH: one kernel per step of kernels/bvh/lbvh_steps.h, with
 // CUB's radix sort and prefix sum between them (docs/bvh.md, "Build on the GPU").
-#include "cuda/device_bvh_build.h"
+#include "cuda/bvh/device_bvh_build.h"
 
 #include <chrono>
 #include <stdexcept>
@@ -9,7 +9,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
-#include "cuda/cuda_check.h"
+#include "cuda/util/cuda_check.h"
 #include "kernels/bvh/lbvh_steps.h"
 #include "kernels/distance/packed_triangle.h"
 

@@ -1,4 +1,4 @@
-// The CUDA BVH sampler's point lists (cuda/bvh_sampler.h): the points sorted into Morton
+// The CUDA BVH sampler's point lists (cuda/bvh/bvh_sampler.h): the points sorted into Morton
 // order on the device, searched 128 at a time by the warp kernels and finalized, every
 // result written back at its input position; from host vectors, from the caller's device
 // arrays (core/sampling/device_query.h) or from its host arrays through pinned buffers
@@ -14,11 +14,11 @@
 #include <cub/device/device_radix_sort.cuh>
 
 #include "core/sampling/search_range.h"
-#include "cuda/bvh_bound_sampler.cuh"
-#include "cuda/bvh_candidates_kernel.cuh"
-#include "cuda/bvh_warp_kernel.cuh"
-#include "cuda/cuda_check.h"
-#include "cuda/device_points.cuh"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/bvh/bvh_candidates_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/sampling/device_points.cuh"
 #include "kernels/core/morton.h"
 
 namespace sdf::cuda {

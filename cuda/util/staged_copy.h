@@ -13,8 +13,8 @@
 #include <memory>
 
 #include "core/parallel/parallel_for.h"
-#include "cuda/cuda_check.h"
-#include "cuda/device_buffer.h"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
 
 namespace sdf::cuda {
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "core/parallel/task_monitor.h"
-#include "cuda/bvh_bound_sampler.cuh"
-#include "cuda/cuda_check.h"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/util/cuda_check.h"
 
 namespace sdf::cuda {
 

@@ -7,8 +7,8 @@
 #pragma once
 
 #include "core/sampling/sampler_sign.h"
-#include "cuda/device_buffer.h"
-#include "cuda/winding_sign_kernel.cuh"
+#include "cuda/util/device_buffer.h"
+#include "cuda/sampling/winding_sign_kernel.cuh"
 
 namespace sdf::cuda {
 
@@ -46,7 +46,7 @@ public:
         finish(sign, mesh, stream);
     }
 
-    /// Uses moments already on the device (the GPU build's, cuda/device_bvh_build.h) when
+    /// Uses moments already on the device (the GPU build's, cuda/bvh/device_bvh_build.h) when
     /// `sign`'s mode is winding: nothing is copied; the arrays must outlive this view.
     void adopt(const SamplerSign& sign, const BvhNode* nodes, const WindingNode<double>* moments,
                const int32_t* triangle_index, int num_nodes, const MeshView<double>& mesh) {

@@ -22,7 +22,7 @@
 /// surface), which finalize_samples() turns into the band's value.
 #pragma once
 
-#include "cuda/bvh_warp_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
 
 namespace sdf::cuda {
 

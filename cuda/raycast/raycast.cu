@@ -1,4 +1,4 @@
-#include "cuda/raycast.h"
+#include "cuda/raycast/raycast.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "core/statistics.h"
-#include "cuda/cuda_device.h"
-#include "cuda/device_buffer.h"
+#include "cuda/util/cuda_device.h"
+#include "cuda/util/device_buffer.h"
 #include "kernels/raycast/cast_pixel.h"
 
 namespace sdf::cuda {

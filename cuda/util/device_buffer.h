@@ -7,8 +7,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "cuda/cuda_check.h"
-#include "cuda/device_guard.h"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_guard.h"
 
 namespace sdf::cuda {
 

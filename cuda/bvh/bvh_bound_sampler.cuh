@@ -1,5 +1,5 @@
 /// @file bvh_bound_sampler.cuh
-/// @brief The CUDA BVH sampler bound to its mesh (cuda/bvh_sampler.h), for its four
+/// @brief The CUDA BVH sampler bound to its mesh (cuda/bvh/bvh_sampler.h), for its four
 /// translation units: the tree made at binding (bvh_device_tree.cu), the lattice path
 /// (bvh_sampler.cu), the point-query path (bvh_point_query.cu) and the sparse band's blocks
 /// (bvh_band_blocks.cu). Its device scratch
@@ -15,14 +15,14 @@
 #include <utility>
 
 #include "core/sampling/backend_sampler.h"
-#include "cuda/bvh_device_tree.cuh"
-#include "cuda/bvh_kernel.cuh"
-#include "cuda/bvh_sampler.h"
-#include "cuda/bvh_warp_kernel.cuh"
-#include "cuda/finalize_kernel.cuh"
-#include "cuda/launch_util.cuh"
-#include "cuda/staged_copy.h"
-#include "cuda/stored_output.cuh"
+#include "cuda/bvh/bvh_device_tree.cuh"
+#include "cuda/bvh/bvh_kernel.cuh"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/sampling/finalize_kernel.cuh"
+#include "cuda/sampling/launch_util.cuh"
+#include "cuda/util/staged_copy.h"
+#include "cuda/sampling/stored_output.cuh"
 
 namespace sdf::cuda {
 

@@ -11,7 +11,7 @@
 
 #include <cuda_runtime.h>
 
-#include "cuda/cuda_check.h"
+#include "cuda/util/cuda_check.h"
 
 namespace sdf::cuda {
 

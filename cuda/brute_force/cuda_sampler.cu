@@ -1,6 +1,6 @@
 // The CUDA brute-force sampler: plans pieces (points) and chunks (triangles) that fit the
 // GPU, runs the thesis or the tuned kernel on them, and scatters the results into a field.
-#include "cuda/cuda_sampler.h"
+#include "cuda/brute_force/cuda_sampler.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,18 +11,18 @@
 #include "core/bvh/triangle_bvh.h"
 #include "core/sampling/backend_sampler.h"
 #include "core/sampling/sampler_results.h"
-#include "cuda/certify_kernel.cuh"
-#include "cuda/cuda_check.h"
-#include "cuda/cuda_device.h"
-#include "cuda/device_buffer.h"
-#include "cuda/device_guard.h"
-#include "cuda/device_mesh.h"
-#include "cuda/device_winding.h"
-#include "cuda/finalize_kernel.cuh"
-#include "cuda/launch_util.cuh"
-#include "cuda/point_pieces.h"
-#include "cuda/thesis_kernel.cuh"
-#include "cuda/tuned_kernel.cuh"
+#include "cuda/sampling/certify_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/cuda_device.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/util/device_guard.h"
+#include "cuda/util/device_mesh.h"
+#include "cuda/sampling/device_winding.h"
+#include "cuda/sampling/finalize_kernel.cuh"
+#include "cuda/sampling/launch_util.cuh"
+#include "cuda/sampling/point_pieces.h"
+#include "cuda/brute_force/thesis_kernel.cuh"
+#include "cuda/brute_force/tuned_kernel.cuh"
 
 namespace sdf::cuda {
 namespace {

@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "core/mesh/prepared_mesh.h"
-#include "cuda/device_buffer.h"
+#include "cuda/util/device_buffer.h"
 
 namespace sdf::cuda {
 

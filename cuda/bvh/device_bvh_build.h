@@ -12,7 +12,7 @@
 
 #include "core/bvh/lbvh.h"
 #include "core/mesh/prepared_mesh.h"
-#include "cuda/device_buffer.h"
+#include "cuda/util/device_buffer.h"
 
 namespace sdf::cuda {
 

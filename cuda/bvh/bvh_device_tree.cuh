@@ -1,7 +1,7 @@
 /// @file bvh_device_tree.cuh
 /// @brief The CUDA BVH sampler's tree on its device, made once when the sampler is bound
-/// (cuda/bvh_sampler.h): a tree built on the host and uploaded, or built on the device
-/// (cuda/device_bvh_build.h), beside the double mesh, the winding moments of the winding
+/// (cuda/bvh/bvh_sampler.h): a tree built on the host and uploaded, or built on the device
+/// (cuda/bvh/device_bvh_build.h), beside the double mesh, the winding moments of the winding
 /// sign and the float search's certificate; and the certificate's steps, which a double
 /// search (the reference) skips.
 #pragma once
@@ -13,12 +13,12 @@
 #include "core/mesh/prepared_mesh.h"
 #include "core/sampling/certified_search.h"
 #include "core/sampling/sampler_sign.h"
-#include "cuda/bvh_sampler.h"
-#include "cuda/certify_kernel.cuh"
-#include "cuda/device_buffer.h"
-#include "cuda/device_bvh_build.h"
-#include "cuda/device_mesh.h"
-#include "cuda/device_winding.h"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/sampling/certify_kernel.cuh"
+#include "cuda/util/device_buffer.h"
+#include "cuda/bvh/device_bvh_build.h"
+#include "cuda/util/device_mesh.h"
+#include "cuda/sampling/device_winding.h"
 
 namespace sdf::cuda {
 
@@ -66,7 +66,7 @@ struct DeviceBvh {
         winding.upload_moments(sign, bvh, nodes.get(), triangle_index.get(), mesh->view());
     }
 
-    /// The BVH built on the device (cuda/device_bvh_build.h), with its winding moments;
+    /// The BVH built on the device (cuda/bvh/device_bvh_build.h), with its winding moments;
     /// `device_mesh` is the double mesh it was built from. Nothing is copied.
     DeviceBvh(std::unique_ptr<DeviceLbvh> built, std::unique_ptr<DeviceMesh<double>> device_mesh,
               const PreparedMesh& prepared, const SamplerSign& sign)

@@ -3,7 +3,7 @@
 // (or, for the streamed writer, stores them on the device in the field file's bytes:
 // stored_output.cuh). Its tree is made at binding (bvh_device_tree.cu), its point lists
 // are bvh_point_query.cu's.
-#include "cuda/bvh_sampler.h"
+#include "cuda/bvh/bvh_sampler.h"
 
 #include <algorithm>
 #include <future>
@@ -11,11 +11,11 @@
 #include <string>
 
 #include "core/sampling/sampler_results.h"
-#include "cuda/bvh_bound_sampler.cuh"
-#include "cuda/bvh_candidates_kernel.cuh"
-#include "cuda/bvh_warp_kernel.cuh"
-#include "cuda/cuda_check.h"
-#include "cuda/cuda_device.h"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/bvh/bvh_candidates_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/cuda_device.h"
 
 namespace sdf::cuda {
 

@@ -15,9 +15,9 @@
 
 #include "core/sampling/sampler.h"
 #include "core/sampling/stored_slab.h"
-#include "cuda/cuda_check.h"
-#include "cuda/device_buffer.h"
-#include "cuda/finalize_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/sampling/finalize_kernel.cuh"
 
 namespace sdf::cuda {
 

@@ -19,9 +19,9 @@
 
 #include "core/bvh/triangle_bvh.h"
 #include "core/sampling/certified_search.h"
-#include "cuda/cuda_check.h"
-#include "cuda/device_buffer.h"
-#include "cuda/launch_util.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/sampling/launch_util.cuh"
 #include "kernels/bvh/closest_triangle_bvh.h"
 
 namespace sdf::cuda {

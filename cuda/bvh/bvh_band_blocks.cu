@@ -14,18 +14,18 @@
 #include "core/sampling/certified_search.h"
 #include "core/sampling/search_range.h"
 #include "core/sampling/sparse_band.h"
-#include "cuda/bvh_bound_sampler.cuh"
-#include "cuda/bvh_candidates_kernel.cuh"
-#include "cuda/bvh_warp_kernel.cuh"
-#include "cuda/cuda_check.h"
-#include "cuda/cuda_device.h"
-#include "cuda/device_guard.h"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/bvh/bvh_candidates_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/cuda_device.h"
+#include "cuda/util/device_guard.h"
 #include "kernels/lattice/band_blocks.h"
 
 namespace sdf::cuda {
 namespace {
 
-/// A batch of active blocks as a piece (cuda/point_pieces.h): piece-local id i is point
+/// A batch of active blocks as a piece (cuda/sampling/point_pieces.h): piece-local id i is point
 /// i % 512 (block-local, x fastest) of block ids[i / 512], and its result goes to slot i of
 /// the batch's block-major arrays, padding included (never discarded).
 struct BandBlocksPiece {

@@ -16,8 +16,8 @@
 
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/closest_triangles_packet.h"
-#include "cuda/bvh_sampler.h"
-#include "cuda/point_pieces.h"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/sampling/point_pieces.h"
 
 namespace sdf::cuda {
 
