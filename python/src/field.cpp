@@ -463,6 +463,14 @@ Field read_field_file(const std::string& path) {
 }  // namespace
 
 void bind_field(py::module_& m) {
+    // "'cc' or 'bcc': ...", from the lattice table.
+    static const std::string lattice_doc = [] {
+        std::string names;
+        const std::vector<std::string> all = lattice_type_names();
+        for (size_t i = 0; i < all.size(); ++i)
+            names += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + ("'" + all[i] + "'");
+        return names + ": the lattice kind's name (lattice_kinds()).";
+    }();
     py::class_<Field>(m, "Field", R"(A sampled field on a CC or BCC lattice: signed distance, exact gradient and
 closest triangle at every lattice point, with the lattice and provenance. values, gradient
 and triangle are read-only views of the field's memory (no copy; each keeps the field alive;
@@ -480,7 +488,7 @@ sampled one.)")
         .def("points", &Field::points,
              "points() -> array or (primary, secondary): the world position of every lattice point, shape (nz, ny, nx, 3) per grid.")
         .def_property_readonly("lattice", [](const Field& f) { return lattice_type_name(f.lattice().type); },
-                               "'cc' or 'bcc'.")
+                               lattice_doc.c_str())
         .def_property_readonly("origin", [](const Field& f) {
             const Vec3d o = f.lattice().origin;
             return py::make_tuple(o.x, o.y, o.z);
