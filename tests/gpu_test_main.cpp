@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_device.h"
 
 int main(int argc, char** argv) {
     if (sdf::cuda::device_count() == 0) {

@@ -52,7 +52,7 @@ int exclusive_sum(const int32_t* flags, int32_t* scan, int m) {
     return total;
 }
 
-/// PLOC, step by step as the device runs it (cuda/device_bvh_build.cu).
+/// PLOC, step by step as the device runs it (cuda/bvh/device_bvh_build.cu).
 void ploc_tree(const LbvhArrays& a, int radius, Elements& elements) {
     const size_t n = size_t(a.n);
     std::vector<int32_t> code(n), count(n), nearest(n), merges(n), keeps(n), code2(n), count2(n), merge_scan(n), keep_scan(n);

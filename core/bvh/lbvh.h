@@ -1,7 +1,7 @@
 /// @file lbvh.h
 /// @brief The BVH of the GPU build (LBVH or PLOC), emulated on the host: the same
 /// per-element steps (kernels/bvh/lbvh_steps.h) run one after another, so this produces
-/// the tree, boxes and winding moments of cuda/device_bvh_build.h bit for bit. The tests
+/// the tree, boxes and winding moments of cuda/bvh/device_bvh_build.h bit for bit. The tests
 /// check the tree and its queries here on the CPU; the GPU test compares the two builds.
 #pragma once
 

@@ -1,7 +1,7 @@
 /// @file render_cpu.h
 /// @brief The CPU ray caster of a Reconstruction: cast_pixel (kernels/raycast/cast_pixel.h)
 /// over 16x16 tiles on all cores, with progress lines. The CUDA ray caster
-/// (cuda/raycast.h) runs the same cast_pixel, one thread per pixel.
+/// (cuda/raycast/raycast.h) runs the same cast_pixel, one thread per pixel.
 ///
 /// The ray caster knows a Reconstruction (its interpolator and Hermite data), not how the
 /// field was sampled. By default it casts in float, as the GPU does, from the float copy of

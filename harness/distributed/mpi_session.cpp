@@ -16,7 +16,7 @@
 #include "harness/distributed/wire_codec.h"
 #include "harness/sampling/device_selection.h"
 #if SDF_HAVE_CUDA
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_device.h"
 #endif
 
 namespace sdf {

@@ -15,7 +15,7 @@
 #include "harness/build_config.h"
 #include "harness/sampling/sampler_table.h"
 #if SDF_HAVE_CUDA
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_device.h"
 #endif
 
 namespace sdf {

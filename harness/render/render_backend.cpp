@@ -9,7 +9,7 @@
 #include "harness/sampling/sampler_table.h"
 
 #if SDF_HAVE_CUDA_RAYCAST
-#include "cuda/raycast.h"
+#include "cuda/raycast/raycast.h"
 #endif
 
 namespace sdf {

@@ -1,6 +1,6 @@
 /// @file render_backend.h
 /// @brief The one table of ray casters (as harness/sampling/sampler_table.h is for samplers):
-/// "cpu" (cpu_reference/raycast/render_cpu.h, all cores) and "cuda" (cuda/raycast.h; this build
+/// "cpu" (cpu_reference/raycast/render_cpu.h, all cores) and "cuda" (cuda/raycast/raycast.h; this build
 /// must have the CUDA backend and the machine a GPU); a request may also say "auto" (cuda when
 /// available, else cpu). Both run cast_pixel. Configs, the tools and the module take their
 /// choices from render_backend_choices().

@@ -6,14 +6,14 @@
 #include "core/sampling/kernel_table.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
-#include "cuda/bvh_sampler.h"
-#include "cuda/cuda_sampler.h"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/brute_force/cuda_sampler.h"
 #include "harness/build_config.h"
 #include "harness/sampling/device_selection.h"
 #include "harness/sampling/multi_device_sampler.h"
 #include "harness/sampling/streamed_sampling.h"
 #if SDF_HAVE_CUDA
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_device.h"
 #endif
 
 namespace sdf {

@@ -1,6 +1,6 @@
 /// @file lbvh_steps.h
 /// @brief The per-element steps of the BVH built on the GPU, written once for the host
-/// emulation (core/bvh/lbvh.cpp) and the CUDA build (cuda/device_bvh_build.cu), so both
+/// emulation (core/bvh/lbvh.cpp) and the CUDA build (cuda/bvh/device_bvh_build.cu), so both
 /// produce the same tree, boxes and winding moments bit for bit.
 ///
 /// Two builders make the same binary tree over the triangles (n leaves, n - 1 internal

@@ -19,7 +19,7 @@
 /// certified without any double work. Extra double evaluations of triangles beyond R (a
 /// streamed one the radius later passed) never change the argmin: t* is in the set.
 ///
-/// Compared with the separate certify pass (cuda/certify_kernel.cuh): no second traversal,
+/// Compared with the separate certify pass (cuda/sampling/certify_kernel.cuh): no second traversal,
 /// no candidate array (a fan of any size streams), and double work only where a lane has
 /// more than one candidate at once.
 #pragma once

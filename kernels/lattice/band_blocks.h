@@ -2,7 +2,7 @@
 /// @brief The blocks of 8^3 points of a sparse narrow band (core/sampling/sparse_band.h), written
 /// once for host and device: block ids, a block's coset and coordinates, and a block-local
 /// point's lattice coordinates and storage index. BandLayout (host) and the CUDA band kernel
-/// (cuda/bvh_band_blocks.cu) both map through this, so they agree on every point.
+/// (cuda/bvh/bvh_band_blocks.cu) both map through this, so they agree on every point.
 ///
 /// Coset point (i, j, k) lies in block (i, j, k) / 8 at local index (i % 8) + 8 (j % 8) +
 /// 64 (k % 8); blocks are numbered coset by coset, x fastest then y then z.

@@ -2,7 +2,7 @@
 /// @brief One pixel of a ray-cast reconstruction: primary ray (camera.h), march to the zero
 /// level set (march.h), Blinn-Phong shading with the reconstructed gradient as the normal
 /// (shading.h). The CPU driver (cpu_reference/raycast/render_cpu.h) and the CUDA kernel
-/// (cuda/raycast.cu) both call cast_pixel, so the two backends share every line of
+/// (cuda/raycast/raycast.cu) both call cast_pixel, so the two backends share every line of
 /// the per-pixel work.
 #pragma once
 

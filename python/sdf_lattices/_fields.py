@@ -24,21 +24,45 @@ def _named(path, read):
         raise ValueError(f"{path}: {str(e).strip(chr(39)) or type(e).__name__}") from e
 
 
+def _lattice_kinds():
+    """{name: kind} of the lattice table (kernels/lattice/lattice_kinds.h), in its order; each
+    kind's "parts" are the CC grids its files hold, as the writers name them ("" for CC's one
+    grid, "primary" and "secondary" for BCC's)."""
+    from . import _core
+
+    return {k["name"]: k for k in _core.lattice_kinds()}
+
+
+def _suffixed(key, part, separator):
+    """An array's name for one part: "distance", "distance_primary", ..."""
+    return key + separator + part if part else key
+
+
+def _one_or_tuple(arrays):
+    """What Field takes per lattice: one array for a kind of one grid, a tuple otherwise."""
+    return arrays[0] if len(arrays) == 1 else tuple(arrays)
+
+
 def _read_npz(path):
     from . import _core
 
     if os.path.getsize(path) == 0 or not zipfile.is_zipfile(path):
         raise ValueError(f"{path}: not a .npz file (no zip archive; truncated or not written by Field.write?)")
+    kinds = _lattice_kinds()
     with np.load(path, allow_pickle=False) as z:
         lattice = str(z["lattice"]) if "lattice" in z else None
-        if lattice == "cc":
-            gradient = z["gradient"] if "gradient" in z else None
-            return _core.Field(z["distance"], tuple(z["origin"]), float(z["spacing"]), "cc", gradient)
-        if lattice == "bcc":
-            values = (z["distance_primary"], z["distance_secondary"])
-            gradient = (z["gradient_primary"], z["gradient_secondary"]) if "gradient_primary" in z else None
-            return _core.Field(values, tuple(z["origin_primary"]), float(z["spacing"]), "bcc", gradient)
-    raise ValueError(f"{path}: not an sdf_lattices .npz field (its 'lattice' entry is missing or neither 'cc' nor 'bcc')")
+        kind = kinds.get(lattice)
+        if kind is not None:
+            parts = kind["parts"]
+            values = _one_or_tuple([z[_suffixed("distance", part, "_")] for part in parts])
+            gradient = None
+            if _suffixed("gradient", parts[0], "_") in z:  # then every part's (a missing one is an error)
+                gradient = _one_or_tuple([z[_suffixed("gradient", part, "_")] for part in parts])
+            origin = tuple(z[_suffixed("origin", parts[0], "_")])
+            return _core.Field(values, origin, float(z["spacing"]), lattice, gradient)
+    names = [f"'{name}'" for name in kinds]
+    known = f"neither {names[0]} nor {names[1]}" if len(names) == 2 else "none of " + ", ".join(names)
+    raise ValueError(f"{path}: not an sdf_lattices .npz field (its 'lattice' entry is missing or {known})")
 
 
 def _check_vti_sizes(path):
@@ -134,18 +158,21 @@ def _read_vti_grid(path):
 
 
 def _read_vti(path):
+    """A field's .vti files: NAME.vti for a kind of one grid, NAME.<part>.vti for each of a
+    kind's parts (BCC: NAME.primary.vti and NAME.secondary.vti), the first kind whose files
+    are all there."""
     from . import _core
 
     stem = path[:-len(".vti")]
-    primary, secondary = stem + ".primary.vti", stem + ".secondary.vti"
-    if os.path.exists(path):
-        d, g, origin, h = _read_vti_grid(path)
-        return _core.Field(d, origin, h, "cc", g)
-    if os.path.exists(primary) and os.path.exists(secondary):  # a BCC field: its two CC sub-grids
-        d0, g0, origin, h = _read_vti_grid(primary)
-        d1, g1, _, _ = _read_vti_grid(secondary)
-        gradient = (g0, g1) if g0 is not None and g1 is not None else None
-        return _core.Field((d0, d1), origin, h, "bcc", gradient)
+    for name, kind in _lattice_kinds().items():
+        files = [_suffixed(stem, part, ".") + ".vti" for part in kind["parts"]]
+        if all(os.path.exists(f) for f in files):
+            grids = [_read_vti_grid(f) for f in files]
+            values = _one_or_tuple([distance for distance, _, _, _ in grids])
+            gradients = [gradient for _, gradient, _, _ in grids]
+            gradient = None if any(g is None for g in gradients) else _one_or_tuple(gradients)
+            _, _, origin, spacing = grids[0]
+            return _core.Field(values, origin, spacing, name, gradient)
     raise _missing(path)
 
 

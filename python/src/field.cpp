@@ -463,6 +463,14 @@ Field read_field_file(const std::string& path) {
 }  // namespace
 
 void bind_field(py::module_& m) {
+    // "'cc' or 'bcc': ...", from the lattice table.
+    static const std::string lattice_doc = [] {
+        std::string names;
+        const std::vector<std::string> all = lattice_type_names();
+        for (size_t i = 0; i < all.size(); ++i)
+            names += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + ("'" + all[i] + "'");
+        return names + ": the lattice kind's name (lattice_kinds()).";
+    }();
     py::class_<Field>(m, "Field", R"(A sampled field on a CC or BCC lattice: signed distance, exact gradient and
 closest triangle at every lattice point, with the lattice and provenance. values, gradient
 and triangle are read-only views of the field's memory (no copy; each keeps the field alive;
@@ -480,7 +488,7 @@ sampled one.)")
         .def("points", &Field::points,
              "points() -> array or (primary, secondary): the world position of every lattice point, shape (nz, ny, nx, 3) per grid.")
         .def_property_readonly("lattice", [](const Field& f) { return lattice_type_name(f.lattice().type); },
-                               "'cc' or 'bcc'.")
+                               lattice_doc.c_str())
         .def_property_readonly("origin", [](const Field& f) {
             const Vec3d o = f.lattice().origin;
             return py::make_tuple(o.x, o.y, o.z);
@@ -563,6 +571,31 @@ this rank alone (no other rank takes part).)" "\n\n" + sampler_keywords_doc();
           py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
           py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
           py::arg("distributed") = true, sample_doc.c_str());
+
+    m.def("lattice_kinds", [] {
+        py::list kinds;
+        for (const LatticeKind& k : kLatticeKinds) {
+            Lattice lattice;
+            lattice.type = k.type;
+            lattice.resolution = {2, 2, 2};
+            py::list parts;
+            for (const VolumeGrid& g : volume_grids(lattice)) parts.append(g.part);
+            py::dict kind;
+            kind["name"] = k.name;
+            kind["label"] = k.label;
+            kind["cosets"] = k.cosets;
+            kind["description"] = k.description;
+            kind["parts"] = parts;
+            kinds.append(kind);
+        }
+        return kinds;
+    }, R"(lattice_kinds() -> list of dict
+
+The lattice kinds, the rows of the one lattice table (kernels/lattice/lattice_kinds.h) in its
+order: "name" (what lattice= takes), "label", "cosets" (the CC grids the lattice is made of),
+"description", and "parts": the names of those grids in the files Field.write writes (""
+for a kind of one grid; "primary" and "secondary" for BCC, whose .npz arrays are
+distance_primary, ... and whose .vti files are NAME.primary.vti and NAME.secondary.vti).)");
 
     m.def("read_field_file", &read_field_file, py::arg("path"),
           R"(read_field_file(path) -> Field

@@ -11,6 +11,7 @@
 #include "core/reconstruction/reconstruction.h"
 #include "core/reconstruction/reconstruction_spec.h"
 #include "harness/io/field_output.h"
+#include "harness/io/volume_grids.h"
 #include "core/sampling/sampled_field.h"
 #include "harness/sampling/mesh_sdf.h"
 #include "python/src/common.h"
@@ -31,8 +32,8 @@ public:
         int64_t first;
     };
     std::vector<Grid> grids() const {
-        std::vector<Grid> g = {{lattice().resolution, 0}};
-        if (lattice().type == LatticeType::BCC) g.push_back({lattice().secondary_resolution(), lattice().primary_count()});
+        std::vector<Grid> g;
+        for (const VolumeGrid& v : volume_grids(lattice())) g.push_back({v.resolution, v.first});
         return g;
     }
 
@@ -42,7 +43,9 @@ public:
         std::vector<py::object> arrays;
         for (const Grid& g : grids()) arrays.push_back(make(g, std::vector<py::ssize_t>{g.resolution.z, g.resolution.y, g.resolution.x}));
         if (arrays.size() == 1) return arrays[0];
-        return py::make_tuple(arrays[0], arrays[1]);
+        py::tuple all(arrays.size());
+        for (size_t i = 0; i < arrays.size(); ++i) all[i] = arrays[i];
+        return all;
     }
 
     // The arrays are read-only NumPy views of the field's own memory, each holding the field

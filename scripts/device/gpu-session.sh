@@ -47,8 +47,8 @@ run_step() {
         cpubench) log "bench_cpu_sampler"; "$BUILD/tests/benchmarks/bench_cpu_sampler" --benchmark_counters_tabular=true 2>&1 | tail -8 ;;
         sanitize) log "compute-sanitizer"; compute-sanitizer --tool memcheck --error-exitcode 3 "$BUILD/tests/gpu/cuda_sampler_test" \
                       --gtest_filter='*Splitting*:*PointQueries*' 2>&1 | tee "$OUT/compute-sanitizer.txt" | tail -15 ;;
-        sass) log "SASS of the CUDA sampler"; cuobjdump -sass "$BUILD/cuda/CMakeFiles/sdf_cuda.dir/cuda_sampler.cu.o" > "$OUT/sampler.sass" 2>&1;
-              cuobjdump -res-usage "$BUILD/cuda/CMakeFiles/sdf_cuda.dir/cuda_sampler.cu.o" 2>&1 | grep -A1 tuned | head -20 ;;
+        sass) log "SASS of the CUDA sampler"; cuobjdump -sass "$BUILD/cuda/CMakeFiles/sdf_cuda.dir/brute_force/cuda_sampler.cu.o" > "$OUT/sampler.sass" 2>&1;
+              cuobjdump -res-usage "$BUILD/cuda/CMakeFiles/sdf_cuda.dir/brute_force/cuda_sampler.cu.o" 2>&1 | grep -A1 tuned | head -20 ;;
         profile) log "ncu: tuned kernel on the dragon 64^3";
                  ncu --clock-control none -k regex:nearest_triangle_tuned -c 2 --section SchedulerStats --section WarpStateStats \
                      --section InstructionStats --section Occupancy --section ComputeWorkloadAnalysis \

@@ -5,6 +5,7 @@ figures come from the metrics (experiments/common/thesis_tables.h writes them)."
 import os
 
 from . import plots
+from .schema import lattice_types
 from .tables import Table, count, distinct_functions, number, reconstruction_label, split_curve_id
 
 
@@ -37,8 +38,9 @@ def convergence_table(c):
 
 def convergence_plot(doc, point, c):
     by_key = {split_curve_id(curve["id"]): curve for curve in c["curves"]}
+    cartesian = lattice_types()[0]  # solid; every other kind dashed
     curves = [plots.Curve(label, [p["lattice_points"] for p in by_key[key]["points"]],
-                          [p["rms"] for p in by_key[key]["points"]], dashed=by_key[key]["lattice_type"] == "bcc")
+                          [p["rms"] for p in by_key[key]["points"]], dashed=by_key[key]["lattice_type"] != cartesian)
               for key, label in distinct_functions(by_key)]
     filename = "%s_error_vs_samples.png" % point.name
     plots.log_log(os.path.join(doc.out_dir, filename), "%s: error vs samples (solid CC, dashed BCC)" % c["function"],

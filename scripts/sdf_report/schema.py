@@ -49,6 +49,13 @@ def load_schema(path=SCHEMA_PATH):
     return schema
 
 
+def lattice_types(schema=None):
+    """The lattice kinds' names, as the schema's $defs.lattice_type lists them: the names of
+    the lattice table kLatticeKinds (kernels/lattice/lattice_kinds.h) in its order, the
+    Cartesian kind first (tests/python_module/test_lattice_kinds.py checks they match)."""
+    return list((schema or load_schema())["$defs"]["lattice_type"]["enum"])
+
+
 def metrics_schema(schema, kind):
     """The schema of metrics.json of one experiment kind (its single-run or sweep form)."""
     return schema["metrics"].get(kind)

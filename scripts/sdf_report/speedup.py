@@ -4,6 +4,7 @@ thesis's figures come from the metrics (experiments/common/thesis_tables.h write
 import os
 
 from . import plots
+from .schema import lattice_types
 from .overview import machine
 from .tables import Table, count, number, rate
 
@@ -76,13 +77,14 @@ def reference_is_one_cpu_thread(metrics):
 def speedup_plot(doc, run):
     metrics = run.metrics
     reference = metrics["reference"]
+    cartesian = lattice_types()[0]  # the thesis's speedup figures are of CC lattices
     curves = []
     for mesh in sorted({row["mesh"] for row in metrics["rows"]}):
         for name in backend_names(metrics):
             if name == reference:
                 continue
             pts = [(row["points"], b["speedup_vs_reference"]) for row in metrics["rows"]
-                   if row["mesh"] == mesh and row["lattice"] == "cc" for b in row["backends"]
+                   if row["mesh"] == mesh and row["lattice"] == cartesian for b in row["backends"]
                    if b["name"] == name and "speedup_vs_reference" in b]
             if pts:
                 curves.append(plots.Curve("%s %s" % (mesh, name), [p[0] for p in pts], [p[1] for p in pts]))

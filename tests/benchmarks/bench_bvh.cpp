@@ -34,8 +34,8 @@
 #include "harness/build_config.h"
 #include "harness/sampling/sampler_table.h"
 #if SDF_HAVE_CUDA
-#include "cuda/device_bvh_build.h"
-#include "cuda/device_mesh.h"
+#include "cuda/bvh/device_bvh_build.h"
+#include "cuda/util/device_mesh.h"
 #endif
 
 namespace sdf {
@@ -330,7 +330,7 @@ void BM_CudaBvhBand(benchmark::State& state, const std::string& file) {
 
 /// The GPU sampler's BVH build (issue 23): arg 0 = on the host (binned SAH, the winding
 /// moments, and the upload of nodes, packed constants in BVH order, slots and moments, as
-/// the sampler does), 1 = on the device (cuda/device_bvh_build.h: PLOC with its moments, the
+/// the sampler does), 1 = on the device (cuda/bvh/device_bvh_build.h: PLOC with its moments, the
 /// packed constants made there); arg 2: GpuBvhBuildOptions::ploc_tail_clusters. Wall time;
 /// the double mesh, which both need on the device, is uploaded before the clock starts.
 void BM_CudaBvhBuild(benchmark::State& state, const std::string& file) {

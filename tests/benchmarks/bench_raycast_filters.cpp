@@ -4,7 +4,7 @@
 // (262,144 vs 257,651 points), the camera "three_quarter" at 512x512. The ray caster
 // evaluates the reconstruction (value + gradient, float) at every march step of every pixel.
 //   /cuda: manual time = the median CUDA-event time of one launch over 10 launches after a
-//          warm-up (cuda/raycast.h); skipped without the CUDA backend or a GPU.
+//          warm-up (cuda/raycast/raycast.h); skipped without the CUDA backend or a GPU.
 //   /cpu:  wall time of one render on all cores (float, as the GPU).
 // Counters: "evals" = march steps summed over the pixels (the evaluations while stepping;
 // the root refinement adds a few per hit pixel), "evals/s" = evals / time, "hits".

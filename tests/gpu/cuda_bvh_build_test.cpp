@@ -1,4 +1,4 @@
-// The BVH built on the GPU (cuda/device_bvh_build.h) against its host emulation
+// The BVH built on the GPU (cuda/bvh/device_bvh_build.h) against its host emulation
 // (core/bvh/lbvh.h): nodes, moments, slots and packed constants bit for bit (PLOC's last
 // iterations in one block or not); and the CUDA BVH sampler's fields and point queries on
 // the device-built tree against the host-built (SAH) tree: triangle, distance and gradient
@@ -11,9 +11,9 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/sampling/adversarial_cases.h"
-#include "cuda/bvh_sampler.h"
-#include "cuda/device_bvh_build.h"
-#include "cuda/device_mesh.h"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/bvh/device_bvh_build.h"
+#include "cuda/util/device_mesh.h"
 #include "core/winding/winding_sign.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"

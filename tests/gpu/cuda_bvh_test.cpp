@@ -15,7 +15,7 @@
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
-#include "cuda/bvh_sampler.h"
+#include "cuda/bvh/bvh_sampler.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"

@@ -1,4 +1,4 @@
-// DeviceBuffer's memory (cuda/device_memory.cu): allocations come from a pool of our own, not
+// DeviceBuffer's memory (cuda/util/device_memory.cu): allocations come from a pool of our own, not
 // the device's default pool, whose settings belong to the whole process (PyTorch, CuPy and
 // cuBQL use and set it); memory our pool keeps after a free still counts as free to
 // free_device_memory(), which sizes the samplers' slabs; a sampler still answers exactly
@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "cuda/device_buffer.h"
+#include "cuda/util/device_buffer.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"

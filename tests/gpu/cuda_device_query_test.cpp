@@ -116,7 +116,7 @@ TEST(CudaDeviceQuery, EqualsTheHostQueryBitForBit) {
 // Host arrays in and out (core/sampling/host_query.h), as a NumPy caller passes them:
 // float32 rows go to the device as they are, strided float64 rows are gathered first, and
 // the columns come back through the pinned buffers. More points than one staging chunk
-// (cuda/staged_copy.h: 32 MiB), so both buffers alternate.
+// (cuda/util/staged_copy.h: 32 MiB), so both buffers alternate.
 TEST(CudaDeviceQuery, HostArraysEqualTheHostQueryBitForBit) {
     const PreparedMesh& mesh = test::bvh_test_meshes()[4].mesh;  // soccer ball
     const size_t n = (size_t(3) << 20) + 17;  // 3M points: 72 MiB of gradients, three chunks

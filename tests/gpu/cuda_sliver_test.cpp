@@ -11,8 +11,8 @@
 #include <cstring>
 
 #include "core/sampling/adversarial_cases.h"
-#include "cuda/bvh_sampler.h"
-#include "cuda/cuda_sampler.h"
+#include "cuda/bvh/bvh_sampler.h"
+#include "cuda/brute_force/cuda_sampler.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/test_util/exact_distance.h"
 #include "tests/test_util/shared_mesh.h"

@@ -1,4 +1,4 @@
-// The CUDA samplers' certified winding sign (sign mode "winding", cuda/winding_sign_kernel.cuh,
+// The CUDA samplers' certified winding sign (sign mode "winding", cuda/sampling/winding_sign_kernel.cuh,
 // kernels/winding/certified_winding.h) against the CPU's (WindingSign) on a mesh of
 // overlapping closed parts (two spheres and a box through them) and on dragon-legacy.obj
 // (self-intersecting; when the data path has it): with sign "auto" both resolve to winding,

@@ -1,4 +1,4 @@
-// The warp's winding traversal (cuda/winding_sign_kernel.cuh, warp_fast_winding_value) against
+// The warp's winding traversal (cuda/sampling/winding_sign_kernel.cuh, warp_fast_winding_value) against
 // each thread's own (fast_winding_number), bit for bit, on the device: lattice rows,
 // Morton-sorted points near the surface, scattered points, and lanes without a point in
 // between (which must neither stall the warp nor change their neighbours' sums). Also the
@@ -15,10 +15,10 @@
 
 #include "core/sampling/sampler_sign.h"
 #include "core/winding/winding_sign.h"
-#include "cuda/cuda_check.h"
-#include "cuda/device_buffer.h"
-#include "cuda/device_mesh.h"
-#include "cuda/device_winding.h"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/util/device_mesh.h"
+#include "cuda/sampling/device_winding.h"
 #include "kernels/core/morton.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 

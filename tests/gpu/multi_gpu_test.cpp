@@ -13,7 +13,7 @@
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/sampling/point_sets.h"
-#include "cuda/cuda_device.h"
+#include "cuda/util/cuda_device.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/test_util/shared_mesh.h"
 

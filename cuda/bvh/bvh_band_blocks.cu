@@ -1,0 +1,185 @@
+// The CUDA BVH sampler's sparse narrow band (issue 35): the active blocks of 8^3 points
+// (core/sampling/sparse_band.h) sampled in device memory. Their sorted ids go up once; each
+// batch of blocks (as many as 80% of free device memory holds) runs the dense lattice path's
+// kernels on them: the warp or candidates search with the band's brick skip (a warp's brick
+// is 8 x 4 x 4 points of one block, as a lattice slab's), the certificate, and the same
+// finalize_samples() with the band's width, written straight into block-major arrays; then
+// one copy per channel into the band's host arrays. Padding (points of a block beyond the
+// coset's resolution) is marked "outside, positive side" before the search, so finalize
+// writes it +W, gradient 0, kOutsideBandTriangle: the host's values for padding.
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "core/sampling/certified_search.h"
+#include "core/sampling/search_range.h"
+#include "core/sampling/sparse_band.h"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/bvh/bvh_candidates_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/cuda_device.h"
+#include "cuda/util/device_guard.h"
+#include "kernels/lattice/band_blocks.h"
+
+namespace sdf::cuda {
+namespace {
+
+/// A batch of active blocks as a piece (cuda/sampling/point_pieces.h): piece-local id i is point
+/// i % 512 (block-local, x fastest) of block ids[i / 512], and its result goes to slot i of
+/// the batch's block-major arrays, padding included (never discarded).
+struct BandBlocksPiece {
+    Lattice lattice;
+    BandBlockGrid grid;
+    const int64_t* ids = nullptr;  ///< the batch's block ids, on the device
+    int64_t blocks = 0;
+
+    SDF_CPU_GPU int64_t size() const { return blocks * kBandBlockPoints; }
+    SDF_CPU_GPU int64_t block_local(int64_t i) const { return i; }
+    SDF_CPU_GPU Vec3d position(int64_t i) const {
+        const BandBlockCoords b = grid.block_coords(ids[i / kBandBlockPoints]);
+        return lattice.position_of_coords(grid.point_coords(b, int(i % kBandBlockPoints)));
+    }
+    SDF_CPU_GPU int64_t output_index(int64_t i) const { return i; }
+};
+
+/// The warp kernels' layout over the blocks (bvh_warp_kernel.cuh's SlabLayout for a band):
+/// 128 threads per block, each a run of kRunPoints consecutive points along x; the 4 warps
+/// of a block are its bricks of 8 x 4 x 4 points (lane: 2 runs x 4 rows x 4 layers).
+struct BandBlocksLayout {
+    static constexpr int kPoints = kRunPoints;
+    static constexpr int kThreadsPerBlock = kBandBlockPoints / kRunPoints;
+    static_assert(kBandBlockDim == 2 * kRunPoints && kThreadsPerBlock == 4 * 32, "a block is 4 warps of 8 x 4 x 4 points");
+    BandBlocksPiece piece;
+
+    SDF_CPU_GPU int64_t threads() const { return piece.blocks * kThreadsPerBlock; }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = 0;
+        if (t >= threads()) return 0;
+        const int64_t a = t / kThreadsPerBlock;
+        const int u = int(t % kThreadsPerBlock), w = u / 32, lane = u % 32;
+        const int x = (lane & 1) * kRunPoints, y = (w & 1) * 4 + ((lane >> 1) & 3), z = (w >> 1) * 4 + (lane >> 3);
+        const BandBlockCoords b = piece.grid.block_coords(piece.ids[a]);
+        const Int3 n = piece.grid.coset[b.coset].points;
+        const Int3 p{b.block.x * kBandBlockDim + x, b.block.y * kBandBlockDim + y, b.block.z * kBandBlockDim + z};
+        if (p.x >= n.x || p.y >= n.y || p.z >= n.z) return 0;  // padding: never searched
+        first = a * kBandBlockPoints + x + kBandBlockDim * (y + kBandBlockDim * z);
+        return min(kRunPoints, n.x - p.x);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+
+__global__ void fill_nearest(int* nearest, int64_t n, int code) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) nearest[i] = code;
+}
+
+/// Prepared-mesh triangle indices to the mesh file's face order, in place.
+__global__ void to_source_order(int* triangle, int64_t n, const int32_t* source_triangle) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    const int t = triangle[i];
+    if (t >= 0) triangle[i] = source_triangle[t];
+}
+
+size_t device_bytes_in_use() {
+    size_t free_bytes = 0, total = 0;
+    CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
+    return total - free_bytes;
+}
+
+}  // namespace
+
+BandBlockKernel BoundCudaBvh::band_block_kernel(double width) const {
+    // The kernels whose layout is a warp's brick; the others answer the band's point lists.
+    if (kernel_ != BvhGpuKernel::Warp && kernel_ != BvhGpuKernel::Candidates) return {};
+    return [this, width](SparseBandField& band, size_t first, size_t last) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        const DeviceGuard on_device(options_.device);
+        with_precision(options_.precision, [&](auto zero) { band_blocks_as<decltype(zero)>(band, first, last, width); });
+    };
+}
+
+template <typename T>
+void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t last, double width) const {
+    const DeviceBvh<T>& dev = tree<T>();
+    const Lattice& lattice = band.lattice;
+    require_search_range(mesh(), lattice, options_.precision);
+    const int64_t blocks = int64_t(last - first);
+    EventTimer upload, compute, download;
+    DeviceBuffer<int64_t> ids{size_t(blocks)};
+    upload.begin();
+    ids.upload(band.active.data() + first, size_t(blocks));
+    upload.end();
+
+    // Blocks per batch: 80% of free device memory (max_points_per_piece caps it, as a slab's pieces).
+    const size_t free_bytes = free_device_memory();
+    const int64_t block_bytes = int64_t(PieceResults::bytes_per_point()) * kBandBlockPoints;
+    int64_t batch = int64_t(0.8 * double(free_bytes)) / block_bytes;
+    if (batch < 1 && options_.max_points_per_piece <= 0)
+        throw std::runtime_error("CUDA BVH sampler: " + std::to_string(free_bytes >> 20) +
+                                 " MiB of free GPU memory cannot hold one block of the sparse band (" +
+                                 std::to_string(block_bytes) + " bytes)");
+    if (options_.max_points_per_piece > 0) batch = std::min(batch, options_.max_points_per_piece / kBandBlockPoints);
+    batch = std::clamp<int64_t>(batch, 1, blocks);
+    PieceResults r(batch * kBandBlockPoints);
+    const size_t in_use = device_bytes_in_use();
+
+    // As the dense lattice path (run_slab): the same certificate slack, band and finalize.
+    const double coordinate = largest_lattice_coordinate(lattice);
+    const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
+    const bool winding = dev.winding.view().enabled();
+    const FloatSearchBound& bound = mesh().search_bound();
+    const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
+    const BandSearch search{width, dev.mesh->view(), winding, winding || solid(), reach};
+    reset_certificate(dev);
+    int64_t batches = 0;
+    for (int64_t b0 = 0; b0 < blocks; b0 += batch, ++batches) {
+        const int64_t nb = std::min(batch, blocks - b0), n = nb * kBandBlockPoints;
+        const BandBlocksPiece piece{lattice, band.layout().grid(), ids.get() + b0, nb};
+        const BandBlocksLayout layout{piece};
+        compute.begin();
+        fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
+        CUDA_CHECK_LAUNCH("fill_nearest");
+        const int grid = blocks_for(layout.threads(), kBvhThreads);
+        if (kernel_ == BvhGpuKernel::Warp) {
+            launch_bvh_warp(grid, dev.view, layout, search, fused, r.nearest.get());
+        } else {
+            nearest_triangle_bvh_candidates<T><<<grid, kBvhThreads>>>(dev.view, layout, search, r.nearest.get(), nullptr);
+        }
+        CUDA_CHECK_LAUNCH("nearest_triangle_bvh (band blocks)");
+        if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
+        launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, r.outputs());
+        CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
+        to_source_order<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, dev.source_triangle.get());
+        CUDA_CHECK_LAUNCH("to_source_order");
+        compute.end();
+        download.begin();
+        const size_t v = (first + size_t(b0)) * kBandBlockPoints;
+        staged_.to_host(r.samples.distance.get(), band.distance.data() + v, size_t(n) * sizeof(double));
+        staged_.to_host(r.samples.gradient.get(), band.gradient.data() + v, size_t(n) * sizeof(Vec3d));
+        staged_.to_host(r.samples.triangle.get(), band.closest_triangle.data() + v, size_t(n) * sizeof(int32_t));
+        download.end();
+    }
+    CertificateCounters certificate;
+    read_certificate(dev, certificate);
+    band.timings.upload += upload.seconds();
+    band.timings.kernel += compute.seconds();
+    band.timings.download += download.seconds();
+    band.timings.certified_points += certificate.points.load();
+    band.timings.reranked_points += certificate.reranked.load();
+    band.timings.full_double_points += certificate.full_double.load();
+    band.sampler.details["band_blocks_on_device"] = {
+        {"kernel", kernel_ == BvhGpuKernel::Warp ? "warp" : "candidates"},
+        {"blocks", blocks},
+        {"blocks_per_batch", batch},
+        {"batches", batches},
+        {"brick_skip", search.skip_bricks},
+        {"kernel_seconds", compute.seconds()},
+        {"upload_seconds", upload.seconds()},
+        {"download_seconds", download.seconds()},
+        {"device_bytes_in_use", int64_t(in_use)},  // after the batch's buffers: the conversion's peak (pool included)
+        {"device", describe_device(options_.device)}};
+}
+
+}  // namespace sdf::cuda

@@ -1,0 +1,318 @@
+// The CUDA BVH sampler's point lists (cuda/bvh/bvh_sampler.h): the points sorted into Morton
+// order on the device, searched 128 at a time by the warp kernels and finalized, every
+// result written back at its input position; from host vectors, from the caller's device
+// arrays (core/sampling/device_query.h) or from its host arrays through pinned buffers
+// (core/sampling/host_query.h).
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <future>
+#include <stdexcept>
+#include <string>
+
+#include <cub/device/device_radix_sort.cuh>
+
+#include "core/sampling/search_range.h"
+#include "cuda/bvh/bvh_bound_sampler.cuh"
+#include "cuda/bvh/bvh_candidates_kernel.cuh"
+#include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "cuda/util/cuda_check.h"
+#include "cuda/sampling/device_points.cuh"
+#include "kernels/core/morton.h"
+
+namespace sdf::cuda {
+namespace {
+
+__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, uint64_t* keys, int64_t* identity) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    const Vec3d p = points[i];
+    keys[i] = morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side);
+    identity[i] = i;
+}
+
+__global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t n, Vec3d* sorted) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) sorted[i] = points[order[i]];
+}
+/// Points per thread of the warp search over `n` listed points on a GPU of `sms`
+/// multiprocessors: 4, the lattice's, where the list fills the GPU's resident warps many
+/// times over; fewer for sparser lists, whose 128-point warps leave the GPU to a few long,
+/// divergent traversals. Measured on an H200 (docs/gpu-notes.md): 1M points 6.1 -> 5.6 ms
+/// uniform, 6.9 -> 6.1 ms near the surface at 2; 16.8M points fastest at 4.
+/// SDF_LIST_RUN (1, 2 or 4) overrides the rule, for measurement.
+int list_points_per_thread(int64_t n, int sms) {
+    static const int forced = [] {
+        const char* e = std::getenv("SDF_LIST_RUN");
+        const int v = e ? std::atoi(e) : 0;
+        return v == 1 || v == 2 || v == 4 ? v : 0;
+    }();
+    if (forced) return forced;
+    const int64_t resident_warps = int64_t(sms) * kFusedMinBlocks * (kBvhThreads / 32);
+    if (n / (32 * 4) >= 16 * resident_warps) return 4;
+    if (n / (32 * 2) >= 2 * resident_warps) return 2;
+    return 1;
+}
+
+/// The current device's multiprocessors.
+int multiprocessors() {
+    int device = 0, sms = 1;
+    CUDA_CHECK(cudaGetDevice(&device));
+    CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+    return sms;
+}
+
+/// Sorts points by their Morton keys in the mesh's (cubic) box; the buffers (keys, CUB's
+/// temporary storage) are allocated by the constructor.
+struct MortonSort {
+    int64_t n;
+    DeviceBuffer<uint64_t> keys, keys_sorted;
+    DeviceBuffer<int64_t> identity;
+    DeviceBuffer<unsigned char> temp;
+    size_t temp_bytes = 0;
+
+    explicit MortonSort(int64_t count) : n(count), keys{size_t(count)}, keys_sorted{size_t(count)}, identity{size_t(count)} {
+        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.get(), keys_sorted.get(), identity.get(),
+                                                   identity.get(), n, 0, 63));
+        temp.allocate(temp_bytes);
+    }
+    /// `sorted` receives the points in key order, `order` their input positions.
+    void run(const PreparedMesh& mesh, const Vec3d* points, Vec3d* sorted, int64_t* order) {
+        const Bounds3& box = mesh.bounds();
+        const Vec3d extent = box.extent();
+        const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
+        morton_keys<<<blocks_for(n, 256), 256>>>(points, n, box.min, 1.0 / side, keys.get(), identity.get());
+        CUDA_CHECK_LAUNCH("morton_keys");
+        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
+                                                   n, 0, 63));
+        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted);
+        CUDA_CHECK_LAUNCH("gather_points");
+    }
+};
+
+/// `buffer` with room for `count` elements (kept between queries: a bound SDF queried many
+/// times allocates once).
+template <typename E>
+E* grow(DeviceBuffer<E>& buffer, size_t count) {
+    if (buffer.size() < count) buffer.allocate(count);
+    return buffer.get();
+}
+
+}  // namespace
+
+std::vector<PointSample> BoundCudaBvh::query_points(const std::vector<Vec3d>& points, SamplingTimings& timings,
+                                                    CertificateCounters& certificate) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const DeviceGuard on_device(options_.device);
+    return with_precision(options_.precision,
+                          [&](auto zero) { return query_as<decltype(zero)>(points, timings, certificate); });
+}
+
+bool BoundCudaBvh::query_device(const DevicePoints& points, const DeviceQueryResults& results, SamplingTimings* timings) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    SamplingTimings t;
+    query_device_locked(points, results, t);
+    if (timings) *timings = t;
+    return true;
+}
+
+void BoundCudaBvh::query_device_locked(const DevicePoints& points, const DeviceQueryResults& results,
+                                       SamplingTimings& timings) const {
+    if (points.device != options_.device)
+        throw std::invalid_argument("CUDA BVH sampler: the points are on CUDA device " + std::to_string(points.device) +
+                                    ", the sampler on device " + std::to_string(options_.device));
+    if (points.count < 0 || (points.count > 0 && points.xyz == nullptr))
+        throw std::invalid_argument("CUDA BVH sampler: no device points (count " + std::to_string(points.count) + ")");
+    if (points.count == 0) return;
+    const DeviceGuard on_device(options_.device);
+    with_precision(options_.precision, [&](auto zero) { query_device_as<decltype(zero)>(points, results, timings); });
+}
+
+void BoundCudaBvh::query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings) const {
+    if (points.count <= 0) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    require_finite_points(points, "points", options_.threads);
+    const DeviceGuard current(options_.device);
+    std::vector<Vec3d> gathered;  // only for rows that are not one block of bytes
+    const void* source = points.xyz;
+    size_t bytes = points.bytes();
+    DevicePoints on_device{nullptr, points.float32, points.count, 3, 1, options_.device, nullptr};
+    if (!points.contiguous()) {
+        gathered = gather_points(points, "points", options_.threads);
+        source = gathered.data();
+        bytes = gathered.size() * sizeof(Vec3d);
+        on_device.float32 = false;
+    }
+    grow(host_query_points_, bytes);
+    staged_.to_device(source, host_query_points_.get(), bytes);
+    on_device.xyz = host_query_points_.get();
+    const auto uploaded = std::chrono::steady_clock::now();
+    const size_t n = size_t(points.count);
+    DeviceQueryResults columns;
+    if (results.distance) columns.distance = grow(host_query_distance_, n);
+    if (results.gradient) columns.gradient = grow(host_query_gradient_, 3 * n);
+    if (results.triangle) columns.triangle = grow(host_query_triangle_, n);
+    SamplingTimings t;
+    {
+        // The caller's result arrays are mapped on other threads while the device searches.
+        std::future<void> mapped = std::async(std::launch::async, [&] {
+            if (results.distance) StagedCopy::map_pages(results.distance, n * sizeof(double));
+            if (results.gradient) StagedCopy::map_pages(results.gradient, 3 * n * sizeof(double));
+            if (results.triangle) StagedCopy::map_pages(results.triangle, n * sizeof(int32_t));
+        });
+        query_device_locked(on_device, columns, t);
+        mapped.get();
+    }
+    const auto searched = std::chrono::steady_clock::now();
+    if (results.distance) staged_.to_host(columns.distance, results.distance, n * sizeof(double));
+    if (results.gradient) staged_.to_host(columns.gradient, results.gradient, 3 * n * sizeof(double));
+    if (results.triangle) staged_.to_host(columns.triangle, results.triangle, n * sizeof(int32_t));
+    const auto end = std::chrono::steady_clock::now();
+    using seconds = std::chrono::duration<double>;
+    t.upload += seconds(uploaded - start).count();
+    t.download = seconds(end - searched).count();
+    t.total = seconds(end - start).count();
+    if (timings) *timings = t;
+}
+
+/// Point lists: Morton keys in the mesh's box, a device radix sort, then the warp search
+/// over 128 consecutive sorted points (neighbours in space) and the finalize, whose
+/// output_index sends every result back to its input position.
+template <typename T>
+std::vector<PointSample> BoundCudaBvh::query_as(const std::vector<Vec3d>& points, SamplingTimings& timings,
+                                                CertificateCounters& certificate) const {
+    // The vector first, pageable copies: making it on another thread while the device
+    // works measured 2.5-3x slower (16.8M points, H200: 0.30-0.39 against 0.11-0.13 s),
+    // with staged (pinned) copies too (0.37 against 0.17 s), and a new sampler's pinned
+    // buffers cost a one-point query 15 ms (docs/gpu-notes.md).
+    std::vector<PointSample> out(points.size());
+    const DeviceBvh<T>& dev = tree<T>();
+    EventTimer upload, compute, download;
+    const auto start = std::chrono::steady_clock::now();
+    const int64_t n = int64_t(points.size());
+    DeviceBuffer<Vec3d> device_points{size_t(n)};
+    upload.begin();
+    device_points.upload(points);
+    upload.end();
+    DeviceBuffer<PointSample> device_out{size_t(n)};
+    const double coordinate = largest_coordinate(points);
+    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
+        store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(), device_out.get());
+        CUDA_CHECK_LAUNCH("store_point_samples");
+    });
+    // The results are in input order on the device already: one copy, no host scatter.
+    download.begin();
+    device_out.download(out.data(), out.size());
+    download.end();
+    timings.upload = upload.seconds();
+    timings.kernel = compute.seconds();
+    timings.download = download.seconds();
+    timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+/// query_as() for points already on the device, results written to the caller's device
+/// arrays (core/sampling/device_query.h); no host copy of either.
+template <typename T>
+void BoundCudaBvh::query_device_as(const DevicePoints& points, const DeviceQueryResults& results,
+                                   SamplingTimings& timings) const {
+    require_search_range(mesh(), options_.precision);
+    const DeviceBvh<T>& dev = tree<T>();
+    EventTimer compute;
+    const auto start = std::chrono::steady_clock::now();
+    const int64_t n = points.count;
+    // Work already queued on the caller's stream (that made the points) comes first.
+    CUDA_CHECK(cudaStreamSynchronize(static_cast<cudaStream_t>(points.stream)));
+    DeviceBuffer<Vec3d> device_points{size_t(n)};
+    const double coordinate = read_points(points, device_points.get());
+    CertificateCounters certificate;
+    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
+        store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(), results);
+        CUDA_CHECK_LAUNCH("store_point_columns");
+    });
+    CUDA_CHECK(cudaStreamSynchronize(0));
+    timings = {};
+    timings.kernel = compute.seconds();
+    timings.point_triangle_pairs = double(n) * double(mesh().triangles().size());
+    timings.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record_certificate(timings, certificate);
+}
+
+/// The caller's points as doubles in `out`, refused (naming the first) where a point is
+/// not finite or beyond the search's range: only that point is copied to the host.
+/// Returns their largest |coordinate| (the certified search's bound needs it).
+double BoundCudaBvh::read_points(const DevicePoints& points, Vec3d* out) const {
+    DeviceBuffer<unsigned long long> first_bad{2};  // [0]: first bad index, [1]: largest |coordinate|'s bits
+    const unsigned long long init[2] = {~0ull, 0ull};
+    const unsigned long long none = init[0];
+    CUDA_CHECK(cudaMemcpy(first_bad.get(), init, sizeof init, cudaMemcpyHostToDevice));
+    const double limit = largest_search_coordinate(options_.precision);
+    const int blocks = blocks_for(points.count, 256);
+    if (points.float32)
+        read_device_points<<<blocks, 256>>>(static_cast<const float*>(points.xyz), points.count, points.row_stride,
+                                            points.column_stride, limit, out, first_bad.get());
+    else
+        read_device_points<<<blocks, 256>>>(static_cast<const double*>(points.xyz), points.count, points.row_stride,
+                                            points.column_stride, limit, out, first_bad.get());
+    CUDA_CHECK_LAUNCH("read_device_points");
+    unsigned long long result[2] = {none, 0};
+    CUDA_CHECK(cudaMemcpy(result, first_bad.get(), sizeof result, cudaMemcpyDeviceToHost));
+    if (result[0] != none) {
+        Vec3d p;
+        CUDA_CHECK(cudaMemcpy(&p, out + result[0], sizeof p, cudaMemcpyDeviceToHost));
+        require_query_point_in_range(p, int64_t(result[0]), options_.precision);
+    }
+    double largest = 0;
+    std::memcpy(&largest, &result[1], sizeof largest);
+    return largest;
+}
+
+/// Morton sort, warp (or candidates) search and finalize of n device points, piece by
+/// piece; `store(results, count)` takes each piece's results to their input positions, and
+/// `certificate` the float search's certificate counters.
+template <typename T, typename Store>
+void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n, double coordinate,
+                                 EventTimer& compute, CertificateCounters& certificate, Store store) const {
+    reset_certificate(dev);
+    // Every device buffer is allocated before the timed work (allocation is not search).
+    DeviceBuffer<Vec3d> sorted_points{size_t(n)};
+    DeviceBuffer<int64_t> order{size_t(n)};
+    MortonSort sort(n);
+    int64_t step = n;
+    if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
+    PieceResults r(step);  // reused by every piece
+    const int run = list_points_per_thread(step, multiprocessors());
+    for (int64_t begin = 0; begin < n; begin += step) {
+        compute.begin();
+        if (begin == 0) sort.run(mesh(), device_points, sorted_points.get(), order.get());
+        const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
+        const PointListPiece list{sorted_points.get(), begin, piece.count};
+        const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
+        const auto warp = [&](auto layout) {
+            launch_bvh_warp(blocks_for(layout.threads(), kBvhThreads), dev.view, layout, BandSearch{}, fused, r.nearest.get());
+        };
+        if (kernel_ == BvhGpuKernel::Candidates) {
+            const ListLayout layout{list};
+            nearest_triangle_bvh_candidates<T><<<blocks_for(layout.threads(), kBvhThreads), kBvhThreads>>>(
+                dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
+        } else if (run == 1) {
+            warp(ListRuns<1>{list});
+        } else if (run == 2) {
+            warp(ListRuns<2>{list});
+        } else {
+            warp(ListLayout{list});
+        }
+        CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
+        if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
+        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), options_.band_width,
+                                r.outputs());
+        CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
+        store(r, piece.count);
+        compute.end();
+    }
+    read_certificate(dev, certificate);
+}
+
+}  // namespace sdf::cuda

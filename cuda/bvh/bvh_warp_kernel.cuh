@@ -1,0 +1,289 @@
+/// @file bvh_warp_kernel.cuh
+/// @brief BVH search with one traversal per warp: the 32 threads of a warp (a compact 8 x 4 x
+/// 4 brick of lattice points, 4 points per thread, as in bvh_kernel.cuh) walk the tree
+/// together, so node loads are broadcasts and the warp never diverges in the traversal.
+///
+/// The same exactness argument as closest_triangles_packet.h, over 128 points instead of 4:
+/// a child is entered when its box is nearer to at least one point than that point's best
+/// squared distance (a warp vote), and a subtree on the stack is dropped only when its
+/// nearest point is no nearer than the largest best of the warp. Every point therefore gets
+/// its own exact minimum (up to ties). Leaves are scanned by every thread for its 4 points.
+#pragma once
+
+#include <type_traits>
+
+#include "kernels/bvh/closest_triangles_packet.h"
+#include "kernels/bvh/streamed_certificate.h"
+#include "cuda/bvh/bvh_kernel.cuh"
+#include "cuda/sampling/certify_kernel.cuh"
+#include "cuda/sampling/finalize_kernel.cuh"
+#include "kernels/distance/signed_distance.h"
+
+namespace sdf::cuda {
+
+constexpr unsigned kFullWarp = 0xffffffffu;
+
+template <typename T>
+__device__ SDF_INLINE T warp_min(T v) {
+    for (int o = 16; o > 0; o >>= 1) v = min(v, __shfl_xor_sync(kFullWarp, v, o));
+    return v;
+}
+
+template <typename T>
+__device__ SDF_INLINE T warp_max(T v) {
+    for (int o = 16; o > 0; o >>= 1) v = max(v, __shfl_xor_sync(kFullWarp, v, o));
+    return v;
+}
+
+/// Where a warp's points come from: thread t owns `count` consecutive piece-local ids from
+/// `first` (count 0: none). A lattice slab gives every warp an 8 x 4 x 4 brick (SlabGeometry);
+/// a point list sorted into Morton order gives it 128 consecutive points, which are then
+/// neighbours in space as well (kernels/core/morton.h).
+struct SlabLayout {
+    static constexpr int kPoints = kRunPoints;  ///< points per thread
+    GridRangePiece piece;
+    SlabGeometry slab;
+    SDF_CPU_GPU int64_t threads() const { return slab.threads(); }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = 0;
+        if (t >= slab.threads()) return 0;
+        const Int3 s = slab.run_start(t);
+        if (s.x >= slab.resolution.x || s.y >= slab.resolution.y || s.z >= slab.nz) return 0;
+        first = s.x + int64_t(slab.resolution.x) * (s.y + int64_t(slab.resolution.y) * s.z);
+        return min(kRunPoints, slab.resolution.x - s.x);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+
+/// A sorted point list, K consecutive points per thread (32 K per warp).
+template <int K>
+struct ListRuns {
+    static constexpr int kPoints = K;
+    PointListPiece piece;
+    SDF_CPU_GPU int64_t threads() const { return (piece.size() + K - 1) / K; }
+    SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
+        first = t * K;
+        const int64_t left = piece.size() - first;
+        if (left <= 0) first = 0;
+        return left <= 0 ? 0 : int(left < K ? left : K);
+    }
+    SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
+};
+using ListLayout = ListRuns<kRunPoints>;
+
+/// Loads thread t's points into a packet; lanes without points get best = -1, so they never
+/// want a box or a triangle and never hold the warp back.
+template <typename T, typename Layout>
+__device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& first, BvhPacket<T, Layout::kPoints>& pk) {
+    const int count = layout.points_of(t, first);
+    for (int k = 0; k < Layout::kPoints; ++k) {
+        const Vec3<T> p(layout.position(first + (k < count ? k : 0)));
+        pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
+        pk.best_q[k] = count > 0 ? T(INFINITY) : T(-1);
+        pk.radius[k] = pk.best_q[k];
+        pk.best_slot[k] = -1;
+        pk.best_triangle[k] = -1;
+    }
+    return count;
+}
+
+/// The warp's shared traversal: completes the nearest triangle of every lane's points,
+/// pruning with each lane's radius (`policy`: plain, or the streamed certificate's widened
+/// one). `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
+template <typename T, int K, typename Near>
+__device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, K>& pk, bool valid, int32_t* stack_node,
+                                       T* stack_d2, Near& policy) {
+    T worst = warp_max(valid ? T(INFINITY) : T(-1));
+    int top = 0;  // warp-uniform
+    int32_t node = 0;
+    while (node >= 0) {
+        const BvhNode n = bvh.nodes[node];  // one address for the whole warp
+        T d0, d1;
+        const bool w0 = detail::child_wanted(n, 0, pk, d0), w1 = detail::child_wanted(n, 1, pk, d1);
+        const bool want0 = __any_sync(kFullWarp, w0), want1 = __any_sync(kFullWarp, w1);
+        const T m0 = warp_min(valid ? d0 : T(INFINITY)), m1 = warp_min(valid ? d1 : T(INFINITY));
+        const int near = m1 < m0 ? 1 : 0;
+        const bool want_near = near ? want1 : want0, want_far = near ? want0 : want1;
+        int32_t next = -1;
+        bool scanned = false;
+        T mine = T(-1);  // the thread's largest radius after a scan
+        if (want_near) {
+            if (bvh_child_is_leaf(n, near)) {
+                mine = detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk, policy);
+                scanned = true;
+            } else {
+                next = n.ref[near];
+            }
+        }
+        if (want_far) {
+            const int far = 1 - near;
+            if (bvh_child_is_leaf(n, far)) {
+                mine = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk, policy);
+                scanned = true;
+            } else if (next < 0) {
+                next = n.ref[far];
+            } else {
+                if (threadIdx.x % 32 == 0) {
+                    stack_node[top] = n.ref[far];
+                    stack_d2[top] = near ? m0 : m1;  // the nearest point's distance: a bound for all
+                }
+                ++top;
+            }
+        }
+        if (scanned) worst = warp_max(mine);
+        __syncwarp();
+        while (next < 0 && top > 0) {
+            --top;
+            if (may_hold_nearer(stack_d2[top], worst)) next = stack_node[top];
+        }
+        __syncwarp();
+        node = next;
+    }
+}
+
+/// The narrow band as the search sees it; width 0 = no band, skip_bricks false = every brick
+/// searched (the finalize then applies the band).
+struct BandSearch {
+    double width = 0;
+    MeshView<double> mesh{};  ///< for the side of a brick's centre (pseudonormal sign)
+    bool winding_sign = false;
+    /// The winding sign (each point's own), or the pseudonormal sign on a mesh that auto
+    /// would sign that way (a solid: one side per ball that does not meet the surface). A
+    /// pseudonormal sign forced on an open mesh can change sides away from the surface
+    /// (beyond a rim), so there no brick is skipped.
+    bool skip_bricks = false;
+    /// How much farther than the true nearest the search's nearest may be, through slivers
+    /// ranked by their edges (FloatSearchBound::sliver_reach_*): lowers the centre's bound.
+    double sliver_reach = 0;
+};
+
+/// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
+template <typename T, int K>
+__device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, K>& pk, int count, Vec3<T>& lo, Vec3<T>& hi) {
+    const T inf = T(INFINITY);
+    lo = Vec3<T>(inf, inf, inf);
+    hi = Vec3<T>(-inf, -inf, -inf);
+    for (int k = 0; k < count; ++k) {
+        lo = Vec3<T>(min(lo.x, pk.x[k]), min(lo.y, pk.y[k]), min(lo.z, pk.z[k]));
+        hi = Vec3<T>(max(hi.x, pk.x[k]), max(hi.y, pk.y[k]), max(hi.z, pk.z[k]));
+    }
+    lo = Vec3<T>(warp_min(lo.x), warp_min(lo.y), warp_min(lo.z));
+    hi = Vec3<T>(warp_max(hi.x), warp_max(hi.y), warp_max(hi.z));
+}
+
+/// Narrow band: by 1-Lipschitz continuity every point p of the brick has |d(p)| >= |d(c)| -
+/// |p - c| for the box's centre c; when that bound (less a rounding allowance relative to the
+/// coordinates: the float search is exact relative to them) exceeds the band's width, the
+/// whole brick lies outside the band. Returns its NearestOutsideBand code (the side of c
+/// with the pseudonormal sign, as the brick does not cross the surface; "per point" with the
+/// winding sign, whose side may change away from the surface), or 0 when the brick must be
+/// searched. `seed` receives c's nearest triangle.
+template <typename T, int K>
+__device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, int count, const Vec3<T>& c,
+                                          const BvhHit<T>& seed, const BandSearch& band) {
+    T r2 = T(0);
+    for (int k = 0; k < count; ++k) {
+        const T dx = pk.x[k] - c.x, dy = pk.y[k] - c.y, dz = pk.z[k] - c.z;
+        r2 = max(r2, dx * dx + dy * dy + dz * dz);
+    }
+    r2 = warp_max(r2);
+    const double scale = fmax(fmax(fabs(double(c.x)), fabs(double(c.y))), fabs(double(c.z)));
+    const double dc = sqrt(double(seed.distance_squared)), r = sqrt(double(r2));
+    const double slack = 64.0 * double(std::numeric_limits<T>::epsilon()) * (scale + dc + r) + 1e-300;
+    if (!(dc - r - slack - band.sliver_reach > band.width)) return 0;
+    if (band.winding_sign) return kOutsideBandSignPerPoint;
+    const SignedDistanceSample<double> s = signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[seed.slot]);
+    return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
+}
+
+/// Blocks per SM the fused warp kernel is compiled for: 4 caps it at 128 registers (146-154
+/// uncapped), which measured 7-11% faster on an H100 (docs/gpu-notes.md).
+constexpr int kFusedMinBlocks = 4;
+
+/// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
+/// load_packet), for the streamed certificate's double evaluations.
+template <typename Layout>
+struct RunPoint {
+    Layout layout;
+    int64_t first = 0;
+    int count = 0;
+    SDF_CPU_GPU SDF_INLINE Vec3d operator()(int k) const { return layout.position(first + (k < count ? k : 0)); }
+};
+
+template <typename Layout>
+using StreamedRun = StreamedCertifiedNear<float, Layout::kPoints, RunPoint<Layout>>;
+
+/// Writes the nearest triangle of the thread's `count` points: the plain search's, or with
+/// the certificate fused (kCertified, float only) the double search's, counting the points
+/// and those that needed double evaluations (every lane of the warp must call this).
+template <bool kCertified, typename T, int K, typename Near>
+__device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, Near& policy, int64_t first,
+                                         int count, const StreamedCertify& cert, int* nearest) {
+    if constexpr (kCertified) {
+        unsigned reranked = 0;
+#pragma unroll
+        for (int k = 0; k < K; ++k) {
+            if (k >= count) continue;
+            bool r = false;
+            nearest[first + k] = policy.finish(bvh, k, pk, r);
+            reranked += unsigned(r);
+        }
+        warp_add(cert.counters + 0, unsigned(count));
+        warp_add(cert.counters + 1, reranked);
+    } else {
+        for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
+    }
+}
+
+/// The warp search of a lattice slab or a sorted point list; kCertified (float only) fuses
+/// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
+/// the double search's triangles without the separate certify pass.
+template <typename T, typename Layout, bool kCertified>
+__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
+    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest) {
+    constexpr int kWarps = kBvhThreads / 32;
+    __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
+    __shared__ T stack_d2[kWarps][kBvhMaxDepth];
+    const int w = threadIdx.x / 32;
+
+    // Every thread stays to the end: the votes and shuffles need the whole warp.
+    const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    int64_t first = 0;
+    BvhPacket<T, Layout::kPoints> pk;
+    const int count = load_packet<T>(layout, t, first, pk);
+    if (band.width > 0 && band.skip_bricks) {
+        Vec3<T> lo, hi;
+        warp_brick_box(pk, count, lo, hi);
+        if (!(lo.x <= hi.x)) return;  // no point in this warp
+        const Vec3<T> c((lo.x + hi.x) / T(2), (lo.y + hi.y) / T(2), (lo.z + hi.z) / T(2));
+        const int code = brick_band_code(bvh, pk, count, c, closest_triangle_bvh(bvh, c), band);
+        if (code != 0) {
+            for (int k = 0; k < count; ++k) nearest[first + k] = code;
+            return;
+        }
+    }
+    if constexpr (kCertified) {
+        StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
+        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
+    } else {
+        PacketPlainNear policy;
+        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
+    }
+}
+
+/// Launches the warp search, with the certificate fused when `cert` holds one (float).
+template <typename T, typename Layout>
+void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
+                     const StreamedCertify& cert, int* nearest) {
+    if constexpr (std::is_same_v<T, float>) {
+        if (cert.exact) {
+            nearest_triangle_bvh_warp<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
+            return;
+        }
+    }
+    nearest_triangle_bvh_warp<T, Layout, false><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
+}
+
+}  // namespace sdf::cuda

@@ -1,0 +1,438 @@
+// The GPU build of the linear BVH: one kernel per step of kernels/bvh/lbvh_steps.h, with
+// CUB's radix sort and prefix sum between them (docs/bvh.md, "Build on the GPU").
+#include "cuda/bvh/device_bvh_build.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include <cub/block/block_scan.cuh>
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include "cuda/util/cuda_check.h"
+#include "kernels/bvh/lbvh_steps.h"
+#include "kernels/distance/packed_triangle.h"
+
+namespace sdf::cuda {
+namespace {
+
+constexpr int kThreads = 256;
+
+unsigned blocks_for(int64_t n) { return unsigned((n + kThreads - 1) / kThreads); }
+
+__global__ void lbvh_keys(const Vec3d* vertices, const Int3* triangles, int n, Vec3d lo, double inv_extent,
+                          uint64_t* keys, int32_t* identity) {
+    const int t = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (t >= n) return;
+    keys[t] = lbvh_triangle_key(vertices, triangles, t, lo, inv_extent);
+    identity[t] = t;
+}
+
+__global__ void lbvh_internal(LbvhArrays a) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n - 1) lbvh_internal_node(a, i);
+}
+
+__global__ void lbvh_leaves_in_place(LbvhArrays a) {
+    const int pos = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (pos < a.n) lbvh_leaf_in_place(a, pos);
+}
+
+__global__ void ploc_init(LbvhArrays a, PlocArrays p) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n) ploc_leaf_cluster(a, p, i);
+}
+
+__global__ void ploc_nearest_kernel(PlocArrays p) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m) ploc_nearest(p, i);
+}
+
+__global__ void ploc_flags_kernel(PlocArrays p) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m) ploc_flags(p, i);
+}
+
+__global__ void ploc_merge_kernel(LbvhArrays a, PlocArrays p, const int32_t* merge_scan, int next_id) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < p.m && p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
+}
+
+/// Copies the survivors; the last thread also writes the iteration's totals (merges, survivors).
+__global__ void ploc_compact_kernel(PlocArrays p, PlocArrays q, const int32_t* merge_scan, const int32_t* keep_scan,
+                                    int32_t* totals) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= p.m) return;
+    if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+    if (i == p.m - 1) {
+        totals[0] = merge_scan[i] + p.merges[i];
+        totals[1] = keep_scan[i] + p.keeps[i];
+    }
+}
+
+/// PLOC's last iterations, once at most GpuBvhBuildOptions::ploc_tail_clusters are left: one
+/// block runs them all, the steps of the launches above in the same order (so the same tree),
+/// where the launches and a read-back per iteration would cost some 40 us each for little work.
+constexpr int kPlocTailThreads = 1024;
+constexpr int kPlocTailMaxClusters = 1 << 15;  ///< the scan packs two counts of at most this in an int
+
+/// p: this iteration's clusters (p.m of them), q: the other cluster arrays; `status` becomes 1
+/// where an iteration merged nothing (lbvh_steps.h rules it out; checked, not assumed).
+__global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays a, PlocArrays p, PlocArrays q,
+                                                                       int32_t* merge_scan, int32_t* keep_scan, int next_id,
+                                                                       int32_t* status) {
+    using Scan = cub::BlockScan<int, kPlocTailThreads>;
+    __shared__ typename Scan::TempStorage scan_storage;
+    for (int m = p.m; m > 1;) {
+        p.m = m;
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_nearest(p, i);
+        __syncthreads();
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_flags(p, i);
+        __syncthreads();
+        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m <= 2^15) low.
+        int merges = 0, keeps = 0;
+        for (int base = 0; base < m; base += kPlocTailThreads) {
+            const int i = base + int(threadIdx.x);
+            const int both = i < m ? (p.merges[i] << 16) | p.keeps[i] : 0;
+            int before = 0, chunk = 0;
+            Scan(scan_storage).ExclusiveSum(both, before, chunk);
+            if (i < m) {
+                merge_scan[i] = merges + (before >> 16);
+                keep_scan[i] = keeps + (before & 0xffff);
+            }
+            merges += chunk >> 16;
+            keeps += chunk & 0xffff;
+            __syncthreads();  // scan_storage is reused
+        }
+        if (merges < 1) {  // the same in every thread: the block leaves together
+            if (threadIdx.x == 0) *status = 1;
+            return;
+        }
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
+            if (p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
+        __syncthreads();
+        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
+            if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+        __syncthreads();
+        next_id += merges;
+        m = keeps;
+        // The survivors are in q's cluster arrays now (nearest, merges and keeps are shared).
+        const PlocArrays was = p;
+        p.code = q.code, p.box = q.box, p.count = q.count;
+        q.code = was.code, q.box = was.box, q.count = was.count;
+    }
+}
+
+__global__ void ploc_root(LbvhArrays a) { a.parent[0] = -1; }
+
+__global__ void ploc_leaf_slots(LbvhArrays a) {
+    const int pos = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (pos < a.n) ploc_leaf_slot(a, pos);
+}
+
+__global__ void ploc_first_slots(LbvhArrays a) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n - 1) ploc_first_slot(a, i);
+}
+
+__global__ void lbvh_kept_flags(LbvhArrays a, int32_t* flags, uint64_t* preorder, int32_t* identity) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= a.n - 1) return;
+    flags[i] = lbvh_kept(a, i) ? 1 : 0;
+    preorder[i] = lbvh_preorder_key(a, i);
+    identity[i] = i;
+}
+
+/// kept_index[node] = its rank in pre-order (the first `kept` of the sorted nodes).
+__global__ void lbvh_number_kept(LbvhArrays a, const int32_t* by_key, int kept) {
+    const int r = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (r < kept) a.kept_index[by_key[r]] = r;
+}
+
+__global__ void lbvh_link(LbvhArrays a) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n - 1 && lbvh_kept(a, i)) lbvh_link_node(a, i);
+}
+
+__global__ void lbvh_refit(LbvhArrays a) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < a.n - 1 && lbvh_kept(a, i)) lbvh_refit_from(a, i);
+}
+
+/// counters: [0] depth, [1] leaves, [2] largest leaf.
+__global__ void lbvh_radius(LbvhArrays a, int* counters) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= a.n - 1 || !lbvh_kept(a, i)) return;
+    atomicMax(&counters[0], lbvh_radius_from(a, i));
+    for (int c = 0; c < 2; ++c) {
+        const int count = lbvh_child_count(a, i, c);
+        if (count > a.max_leaf) continue;
+        atomicAdd(&counters[1], 1);
+        atomicMax(&counters[2], count);
+    }
+}
+
+/// The SAH cost figure (BvhBuildStats::sah_cost, as bvh_sah_cost() sums it on the host;
+/// here in another order, so equal to rounding).
+__global__ void lbvh_sah(const BvhNode* nodes, int num_nodes, double node_cost, double* sum) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= num_nodes) return;
+    auto area = [](const BvhNode& n, int c) {
+        const double ex = double(n.max_x[c]) - n.min_x[c], ey = double(n.max_y[c]) - n.min_y[c],
+                     ez = double(n.max_z[c]) - n.min_z[c];
+        return ex < 0 ? 0.0 : 2.0 * (ex * ey + ey * ez + ez * ex);
+    };
+    const BvhNode& root = nodes[0];
+    double lo[3] = {fmin(root.min_x[0], root.min_x[1]), fmin(root.min_y[0], root.min_y[1]), fmin(root.min_z[0], root.min_z[1])};
+    double hi[3] = {fmax(root.max_x[0], root.max_x[1]), fmax(root.max_y[0], root.max_y[1]), fmax(root.max_z[0], root.max_z[1])};
+    const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
+    const double root_area = fmax(2.0 * (ex * ey + ey * ez + ez * ex), 1e-300);
+    const BvhNode& n = nodes[i];
+    double cost = i == 0 ? node_cost : 0.0;
+    for (int c = 0; c < 2; ++c)
+        cost += area(n, c) / root_area * (n.count[c] > 0 ? double(n.count[c]) : (n.ref[c] > 0 ? node_cost : 0.0));
+    atomicAdd(sum, cost);
+}
+
+/// The packed constants of the triangle in slot s, made here (pack_triangle() computes them
+/// bit for bit as the host's mesh buffers hold them): cheaper than uploading the host's.
+/// `out_f` and `slot_of` may be null (a double search without the float certificate).
+__global__ void lbvh_pack(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
+                          PackedTriangle<float>* out_f, PackedTriangle<double>* out_d, int32_t* slot_of) {
+    const int s = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (s >= n) return;
+    const int32_t t = order[s];
+    const Int3 tri = triangles[t];
+    const Vec3d v0 = vertices[tri.x], v1 = vertices[tri.y], v2 = vertices[tri.z];
+    if (out_f) out_f[s] = pack_triangle<float>(v0, v1, v2);
+    out_d[s] = pack_triangle<double>(v0, v1, v2);
+    if (slot_of) slot_of[t] = s;
+}
+
+void check_launch(const char* what) {
+    const cudaError_t e = cudaGetLastError();
+    if (e != cudaSuccess) throw std::runtime_error(std::string("CUDA BVH build: ") + what + ": " + cudaGetErrorString(e));
+}
+
+}  // namespace
+
+/// PLOC's iterations (lbvh_steps.h): one launch per step, CUB scans between them, the
+/// iteration's totals read back to know how many clusters are left; the last iterations in
+/// one block (ploc_tail_kernel).
+static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, DeviceBuffer<unsigned char>& temp) {
+    const size_t n = size_t(a.n);
+    DeviceBuffer<int32_t> code[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
+    DeviceBuffer<int32_t> count[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
+    DeviceBuffer<float> box[2] = {DeviceBuffer<float>(6 * n), DeviceBuffer<float>(6 * n)};
+    DeviceBuffer<int32_t> nearest(n), merges(n), keeps(n), merge_scan(n), keep_scan(n), totals(2);
+    size_t scan_bytes = 0;
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, merges.get(), merge_scan.get(), a.n));
+    if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
+    int cur = 0, m = a.n, next_id = 0;
+    auto arrays = [&](int k, int clusters) {
+        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), merges.get(), keeps.get()};
+    };
+    ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
+    check_launch("ploc init");
+    while (m > 1 && m > tail_clusters) {
+        const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
+        ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
+        ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p);
+        check_launch("ploc nearest");
+        size_t bytes = temp.size();
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, merges.get(), merge_scan.get(), m));
+        bytes = temp.size();
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, keeps.get(), keep_scan.get(), m));
+        ploc_merge_kernel<<<blocks_for(m), kThreads>>>(a, p, merge_scan.get(), next_id);
+        ploc_compact_kernel<<<blocks_for(m), kThreads>>>(p, q, merge_scan.get(), keep_scan.get(), totals.get());
+        check_launch("ploc merge");
+        int32_t t[2] = {0, 0};
+        CUDA_CHECK(cudaMemcpy(t, totals.get(), sizeof(t), cudaMemcpyDeviceToHost));
+        if (t[0] < 1) throw std::logic_error("CUDA BVH build: a PLOC iteration merged nothing");
+        next_id += t[0];
+        m = t[1];
+        cur = 1 - cur;
+    }
+    if (m > 1) {
+        CUDA_CHECK(cudaMemsetAsync(totals.get(), 0, sizeof(int32_t)));
+        ploc_tail_kernel<<<1, kPlocTailThreads>>>(a, arrays(cur, m), arrays(1 - cur, 0), merge_scan.get(), keep_scan.get(),
+                                                  next_id, totals.get());
+        check_launch("ploc tail");
+        int32_t status = 0;
+        CUDA_CHECK(cudaMemcpy(&status, totals.get(), sizeof(status), cudaMemcpyDeviceToHost));
+        if (status != 0) throw std::logic_error("CUDA BVH build: a PLOC iteration merged nothing");
+    }
+    ploc_root<<<1, 1>>>(a);
+    ploc_leaf_slots<<<blocks_for(a.n), kThreads>>>(a);
+    check_launch("ploc slots");
+    ploc_first_slots<<<blocks_for(a.n - 1), kThreads>>>(a);
+    check_launch("ploc first slots");
+}
+
+template <>
+BvhView<float> DeviceLbvh::view<float>() const {
+    return {nodes.get(), packed_float.get(), triangle_index.get(), num_nodes, num_triangles};
+}
+
+template <>
+BvhView<double> DeviceLbvh::view<double>() const {
+    BvhView<double> v{nodes.get(), packed_double.get(), triangle_index.get(), num_nodes, num_triangles};
+    v.margin = double_prune_margin(bound);  // as TriangleBvh::view<double>(): the double search is the brute force's
+    return v;
+}
+
+LbvhBuild DeviceLbvh::download() const {
+    LbvhBuild b;
+    b.bvh.nodes.resize(size_t(num_nodes));
+    b.moments.resize(size_t(num_nodes));
+    b.bvh.triangle_index.resize(size_t(num_triangles));
+    b.bvh.packed_float.resize(size_t(num_triangles));
+    b.bvh.packed_double.resize(size_t(num_triangles));
+    nodes.download(b.bvh.nodes.data(), size_t(num_nodes));
+    moments.download(b.moments.data(), size_t(num_nodes));
+    triangle_index.download(b.bvh.triangle_index.data(), size_t(num_triangles));
+    packed_float.download(b.bvh.packed_float.data(), size_t(num_triangles));
+    packed_double.download(b.bvh.packed_double.data(), size_t(num_triangles));
+    CUDA_CHECK(cudaStreamSynchronize(0));
+    b.bvh.stats = stats;
+    b.bvh.float_bound = bound;
+    b.within_depth = within_depth;
+    return b;
+}
+
+std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const Vec3d* vertices, const Int3* triangles,
+                                                 const GpuBvhBuildOptions& options) {
+    const int n = int(mesh.triangles().size());
+    if (options.max_leaf < 1 || options.ploc_radius < 1)
+        throw std::invalid_argument("CUDA BVH build: max_leaf and ploc_radius must be >= 1");
+    if (options.ploc_tail_clusters < 0 || options.ploc_tail_clusters > kPlocTailMaxClusters)
+        throw std::invalid_argument("CUDA BVH build: ploc_tail_clusters must be in 0.." + std::to_string(kPlocTailMaxClusters) +
+                                    ", got " + std::to_string(options.ploc_tail_clusters));
+    if (n <= options.max_leaf) return nullptr;
+    const auto start = std::chrono::steady_clock::now();
+    EventTimer timer;
+    timer.begin();
+    auto out = std::make_unique<DeviceLbvh>();
+    DeviceLbvh& d = *out;
+    d.num_triangles = n;
+
+    const LbvhKeyFrame frame = lbvh_key_frame(mesh.bounds());
+    const size_t count = mesh.triangles().size();
+    DeviceBuffer<uint64_t> keys_in(count), keys(count);
+    DeviceBuffer<int32_t> identity(count), identity_sorted(count);
+    d.triangle_index.allocate(count);
+    lbvh_keys<<<blocks_for(n), kThreads>>>(vertices, triangles, n, frame.lo, frame.inv_extent, keys_in.get(), identity.get());
+    check_launch("keys");
+    size_t temp_bytes = 0;
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys_in.get(), keys.get(), identity.get(),
+                                               identity_sorted.get(), n, 0, 63));
+    DeviceBuffer<unsigned char> temp(temp_bytes);
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys_in.get(), keys.get(), identity.get(),
+                                               identity_sorted.get(), n, 0, 63));
+
+    const size_t internal = size_t(n - 1);
+    DeviceBuffer<int32_t> left(internal), right(internal), parent(internal), leaf_parent(count), node_count(internal),
+        first(internal), leaf_slot(count), kept_index(internal), flags(internal), by_key(internal);
+    DeviceBuffer<uint32_t> arrivals(internal);
+    CUDA_CHECK(cudaMemsetAsync(arrivals.get(), 0, internal * sizeof(uint32_t)));
+    LbvhArrays a;
+    a.n = n;
+    a.max_leaf = options.max_leaf;
+    a.vertices = vertices;
+    a.triangles = triangles;
+    a.keys = keys.get();
+    a.sorted = identity_sorted.get();
+    a.left = left.get();
+    a.right = right.get();
+    a.parent = parent.get();
+    a.leaf_parent = leaf_parent.get();
+    a.count = node_count.get();
+    a.first = first.get();
+    a.leaf_slot = leaf_slot.get();
+    a.order = d.triangle_index.get();
+    a.kept_index = kept_index.get();
+    a.arrivals = arrivals.get();
+    if (options.builder == GpuBvhBuilder::Lbvh) {
+        lbvh_internal<<<blocks_for(n - 1), kThreads>>>(a);
+        check_launch("radix tree");
+        lbvh_leaves_in_place<<<blocks_for(n), kThreads>>>(a);
+        check_launch("leaves");
+    } else {
+        ploc_on_device(a, options.ploc_radius, options.ploc_tail_clusters, temp);
+    }
+
+    // Kept nodes, numbered in pre-order (lbvh_preorder_key).
+    DeviceBuffer<uint64_t> preorder(internal), preorder_sorted(internal);
+    DeviceBuffer<int32_t> node_ids(internal);
+    lbvh_kept_flags<<<blocks_for(n - 1), kThreads>>>(a, flags.get(), preorder.get(), node_ids.get());
+    check_launch("kept flags");
+    size_t scan_bytes = 0;
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags.get(), kept_index.get(), int(internal)));
+    if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), scan_bytes, flags.get(), kept_index.get(), int(internal)));
+    int32_t tail[2] = {0, 0};
+    CUDA_CHECK(cudaMemcpy(&tail[0], kept_index.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
+    CUDA_CHECK(cudaMemcpy(&tail[1], flags.get() + internal - 1, sizeof(int32_t), cudaMemcpyDeviceToHost));
+    d.num_nodes = tail[0] + tail[1];
+    if (d.num_nodes < 1 || int64_t(d.num_nodes) > int64_t(internal))  // read back from the device: checked before it sizes anything
+        throw std::runtime_error("GPU BVH build of mesh '" + mesh.name() + "': " + std::to_string(d.num_nodes) +
+                                 " nodes kept, expected 1.." + std::to_string(internal));
+    size_t sort_bytes = 0;
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, preorder.get(), preorder_sorted.get(), node_ids.get(),
+                                               by_key.get(), int(internal)));
+    if (sort_bytes > temp.size()) temp.allocate(sort_bytes);
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), sort_bytes, preorder.get(), preorder_sorted.get(), node_ids.get(),
+                                               by_key.get(), int(internal)));
+    lbvh_number_kept<<<blocks_for(d.num_nodes), kThreads>>>(a, by_key.get(), d.num_nodes);
+    check_launch("pre-order");
+
+    d.nodes.allocate(size_t(d.num_nodes));
+    d.moments.allocate(size_t(d.num_nodes));
+    DeviceBuffer<Vec3d> weighted(2 * size_t(d.num_nodes));
+    a.nodes = d.nodes.get();
+    a.moments = d.moments.get();
+    a.weighted = weighted.get();
+    lbvh_link<<<blocks_for(n - 1), kThreads>>>(a);
+    check_launch("link");
+    lbvh_refit<<<blocks_for(n - 1), kThreads>>>(a);
+    check_launch("refit");
+    DeviceBuffer<int> counters(3);
+    CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, 3 * sizeof(int)));
+    lbvh_radius<<<blocks_for(n - 1), kThreads>>>(a, counters.get());
+    check_launch("radius");
+    DeviceBuffer<double> sah(1);
+    CUDA_CHECK(cudaMemsetAsync(sah.get(), 0, sizeof(double)));
+    lbvh_sah<<<blocks_for(d.num_nodes), kThreads>>>(d.nodes.get(), d.num_nodes, 1.0, sah.get());
+    check_launch("sah");
+
+    d.packed_float.allocate(count);
+    d.packed_double.allocate(count);
+    d.slot_of.allocate(count);
+    lbvh_pack<<<blocks_for(n), kThreads>>>(vertices, triangles, d.triangle_index.get(), n, d.packed_float.get(),
+                                           d.packed_double.get(), d.slot_of.get());
+    check_launch("pack");
+    int h[3] = {0, 0, 0};
+    double sah_cost = 0;
+    counters.download(h, 3);
+    sah.download(&sah_cost, 1);
+    timer.end();  // synchronises
+    d.device_seconds = timer.seconds();
+    d.stats.nodes = d.num_nodes;
+    d.stats.depth = h[0];
+    d.stats.leaves = h[1];
+    d.stats.largest_leaf = h[2];
+    d.stats.sah_cost = sah_cost;
+    d.within_depth = h[0] <= kBvhMaxDepth;
+    d.bound = mesh.search_bound();  // made with the mesh (a host pass of 1-3 ms at 100k triangles)
+    d.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+void pack_in_slot_order(const Vec3d* vertices, const Int3* triangles, const int32_t* order, int n,
+                        PackedTriangle<float>* packed_float, PackedTriangle<double>* packed_double, int32_t* slot_of) {
+    if (n <= 0) return;
+    lbvh_pack<<<blocks_for(n), kThreads>>>(vertices, triangles, order, n, packed_float, packed_double, slot_of);
+    check_launch("pack");
+}
+
+}  // namespace sdf::cuda

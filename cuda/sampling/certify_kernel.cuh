@@ -1,0 +1,185 @@
+/// @file certify_kernel.cuh
+/// @brief The certified float search on the GPU (kernels/distance/search_certificate.h).
+/// The warp kernel fuses it into its traversal (StreamedCertify below,
+/// kernels/bvh/streamed_certificate.h). The other float searches (candidates and per-thread
+/// BVH kernels, tuned brute force) run the separate pass here, between the float search and
+/// finalize_samples(): every point's float winner seeds a
+/// certified BVH search (pruning radius widened by the float error bound, candidates kept),
+/// and the candidates are re-ranked in double, so `nearest` ends up holding the double
+/// search's triangle. One seeded traversal per point: the radius is already the winner's, so
+/// it visits only the leaves around the point.
+///
+/// More than kNearCandidates candidates: the search runs again keeping
+/// kWideCandidates; more than that (a fan of that many triangles within the bound), the
+/// double BVH search seeded with the winner decides (closest_triangle_bvh.h), which is the
+/// double brute force up to the rounding of its box distances (8 ulps in double).
+#pragma once
+
+#include <vector>
+
+#include "core/bvh/triangle_bvh.h"
+#include "core/sampling/certified_search.h"
+#include "cuda/util/cuda_check.h"
+#include "cuda/util/device_buffer.h"
+#include "cuda/sampling/launch_util.cuh"
+#include "kernels/bvh/closest_triangle_bvh.h"
+
+namespace sdf::cuda {
+
+constexpr int kWideCandidates = 64;
+
+/// The float and double BVH (same nodes, same slots), the slot of each prepared-mesh
+/// triangle, the bound and three counters: points, re-ranked, full double search.
+struct CertifyView {
+    BvhView<float> bvh;
+    BvhView<double> exact;
+    const int32_t* slot_of = nullptr;
+    SearchSlack<float> slack;
+    unsigned long long* counters = nullptr;
+};
+
+/// The certificate fused into a warp search (kernels/bvh/streamed_certificate.h): the double
+/// triangles in BVH order, the slack at the launch's points and the counters (points,
+/// re-ranked, full double) of the DeviceCertifier. exact == nullptr: not fused (a double
+/// search, or a bound too loose to certify: the separate pass below runs instead).
+struct StreamedCertify {
+    const PackedTriangle<double>* exact = nullptr;
+    SearchSlack<float> slack;
+    unsigned long long* counters = nullptr;
+};
+
+/// Adds `value` over the whole warp (every lane must take part) with one atomic.
+__device__ inline void warp_add(unsigned long long* counter, unsigned value) {
+    for (int o = 16; o > 0; o >>= 1) value += __shfl_xor_sync(0xffffffffu, value, o);
+    if ((threadIdx.x % 32) == 0 && value != 0) atomicAdd(counter, (unsigned long long)value);
+}
+
+/// Adds `flag` over the active threads of the warp with one atomic.
+__device__ inline void warp_count(unsigned long long* counter, bool flag) {
+    const unsigned active = __activemask();
+    const unsigned votes = __ballot_sync(active, flag);
+    if ((threadIdx.x % 32) == unsigned(__ffs(active) - 1) && votes != 0) atomicAdd(counter, (unsigned long long)__popc(votes));
+}
+
+template <typename Piece>
+__global__ void certify_nearest(CertifyView v, Piece piece, int* nearest) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= piece.size()) return;
+    const int n = nearest[i];
+    if (n < 0) return;  // outside the band: no triangle
+    const Vec3d p = piece.position(i);
+    const Vec3f pt(p);
+    NoBvhStats none;
+    CertifiedNear<float> near{v.slack, {}};
+    const BvhHit<float> hit = closest_triangle_bvh(v.bvh, pt, seed_hit(v.bvh, v.slot_of[n], pt), none, near);
+    auto index_of = [&](int32_t s) { return v.bvh.triangle_index[s]; };
+    Rerank r = rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, hit.slot, v.slack.radius(hit.distance_squared),
+                                near.near);
+    const bool full = r.overflow;
+    if (r.overflow) {
+        CertifiedNear<float, kWideCandidates> wide{v.slack, {}};
+        const BvhHit<float> again = closest_triangle_bvh(v.bvh, pt, hit, none, wide);
+        r = rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, again.slot, v.slack.radius(again.distance_squared),
+                             wide.near);
+        if (r.overflow) r.slot = closest_triangle_bvh(v.exact, p, seed_hit(v.exact, hit.slot, p)).slot;
+        r.reranked = true;
+    }
+    nearest[i] = v.bvh.triangle_index[r.slot];
+    warp_count(v.counters + 0, true);
+    warp_count(v.counters + 1, r.reranked);
+    warp_count(v.counters + 2, full);
+}
+
+/// Host side: the float BVH, the double constants in BVH order, the slot of every triangle
+/// and the counters on the device, for certify_nearest() after a float search (the BVH
+/// sampler's and the tuned brute force's).
+class DeviceCertifier {
+public:
+    DeviceCertifier(const TriangleBvh& bvh, const PreparedMesh& mesh) : bound_(float_search_bound(mesh)) {
+        nodes_.upload(bvh.nodes);
+        packed_.upload(bvh.packed_float);
+        exact_.upload(bvh.packed_double);
+        triangle_index_.upload(bvh.triangle_index);
+        std::vector<int32_t> slots(bvh.triangle_index.size());
+        for (size_t s = 0; s < slots.size(); ++s) slots[size_t(bvh.triangle_index[s])] = int32_t(s);
+        slot_of_.upload(slots);
+        counters_.allocate(3);
+        reset();
+        arrays_ = {nodes_.get(), packed_.get(), exact_.get(), triangle_index_.get(), slot_of_.get()};
+        num_nodes_ = int(bvh.nodes.size());
+        num_triangles_ = int(bvh.triangle_index.size());
+    }
+
+    /// Over a BVH already on the device (the GPU build's, with its bound): nothing is
+    /// copied; the arrays must outlive the certifier.
+    DeviceCertifier(const BvhView<float>& bvh, const PackedTriangle<double>* exact, const int32_t* slot_of,
+                    const FloatSearchBound& bound)
+        : bound_(bound) {
+        counters_.allocate(3);
+        reset();
+        arrays_ = {bvh.nodes, bvh.packed, exact, bvh.triangle_index, slot_of};
+        num_nodes_ = bvh.num_nodes;
+        num_triangles_ = bvh.num_triangles;
+    }
+
+    /// Replaces `nearest` (prepared-mesh triangles of the float search, or band codes) with
+    /// the double search's triangles, for points of largest |coordinate| `point_coordinate`.
+    template <typename Piece>
+    void certify(const Piece& piece, double point_coordinate, int* nearest) const {
+        CertifyView v;
+        v.bvh = {arrays_.nodes, arrays_.packed, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact = {arrays_.nodes, arrays_.exact, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact.margin = double_prune_margin(bound_);  // the full double search equals the brute force
+        v.slot_of = arrays_.slot_of;
+        v.slack = make_search_slack(bound_, point_coordinate);
+        v.counters = counters_.get();
+        const int64_t n = piece.size();
+        if (n == 0) return;
+        certify_nearest<<<blocks_for(n, 128), 128>>>(v, piece, nearest);
+        CUDA_CHECK_LAUNCH("certify_nearest");
+    }
+
+    /// The fused certificate for points of largest |coordinate| `point_coordinate`; not
+    /// fused (exact == nullptr) when the bound cannot certify there.
+    StreamedCertify streamed(double point_coordinate) const {
+        StreamedCertify c;
+        c.slack = make_search_slack(bound_, point_coordinate);
+        if (!c.slack.certify) return c;
+        c.exact = arrays_.exact;  // this certifier's upload, or the GPU build's arrays
+        c.counters = counters_.get();
+        return c;
+    }
+
+    void reset() { CUDA_CHECK(cudaMemset(counters_.get(), 0, 3 * sizeof(unsigned long long))); }
+
+    /// The counts since reset().
+    void read(CertificateCounters& c) const {
+        unsigned long long h[3] = {0, 0, 0};
+        counters_.download(h, 3);
+        CUDA_CHECK(cudaStreamSynchronize(0));
+        c.points = int64_t(h[0]);
+        c.reranked = int64_t(h[1]);
+        c.full_double = int64_t(h[2]);
+    }
+
+private:
+    /// The arrays the kernel reads: the buffers below, or another owner's.
+    struct Arrays {
+        const BvhNode* nodes = nullptr;
+        const PackedTriangle<float>* packed = nullptr;
+        const PackedTriangle<double>* exact = nullptr;
+        const int32_t* triangle_index = nullptr;
+        const int32_t* slot_of = nullptr;
+    };
+
+    FloatSearchBound bound_;
+    Arrays arrays_;
+    DeviceBuffer<BvhNode> nodes_;
+    DeviceBuffer<PackedTriangle<float>> packed_;
+    DeviceBuffer<PackedTriangle<double>> exact_;
+    DeviceBuffer<int32_t> triangle_index_, slot_of_;
+    DeviceBuffer<unsigned long long> counters_;
+    int num_nodes_ = 0, num_triangles_ = 0;
+};
+
+}  // namespace sdf::cuda
