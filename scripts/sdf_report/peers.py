@@ -64,7 +64,7 @@ def rows_table(metrics):
     return table
 
 
-BAND_HEADER = ["mesh, lattice, band", "method", "by", "threads", "sign", "build (s)", "band (s)", "total (s)",
+BAND_HEADER = ["mesh, lattice, band", "method", "by", "threads", "sign", "build (s)", "band (s)", "total (s)", "CPU (s)",
                "end to end (s)", "active voxels", "max |d error| (active voxels)", "wrong signs", "notes"]
 
 
@@ -83,11 +83,12 @@ def band_table(metrics):
         where = "%s %s" % (row["mesh"], row["resolution"])
         method = row["method"] + (" " + row["version"] if "version" in row else "")
         if "status" in row:
-            table.add([where, method, row["by"]] + ["-"] * 9 + [row["status"]])
+            table.add([where, method, row["by"]] + ["-"] * 10 + [row["status"]])
             continue
         signed = row.get("signed", True)
         table.add([where, method, row["by"], str(row["threads"]), sign_label(row), number(row["build_seconds"]),
                    number(row["query_seconds"]), number(row["total_seconds"]),
+                   number(row["cpu_seconds"]) if "cpu_seconds" in row else "-",
                    number(row["end_to_end_seconds"]) if "end_to_end_seconds" in row else "-",
                    count(row["active_voxels"]), number(row["max_abs_error"]),
                    str(row["sign_disagreements"]) if signed else "n/a (unsigned)",
