@@ -12,7 +12,8 @@
 // size) and exits. --sparse (with --band W) samples only the blocks of 8^3 points within W of a
 // triangle and signs the rest per block (core/sampling/sparse_band_sampler.h); the field file,
 // the same bytes, is then written slab by slab from the sparse band, and --vdb straight from
-// its blocks (harness/io/sparse_vdb_file.h: a level set, never densified).
+// its blocks (harness/io/sparse_vdb_file.h: a level set, never densified), and --nvdb a NanoVDB
+// level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only).
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
@@ -35,6 +36,7 @@
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/io/atomic_file.h"
+#include "harness/io/sparse_nvdb_file.h"
 #include "harness/io/sparse_vdb_file.h"
 #include "harness/resources/memory_budget.h"
 #include "harness/sampling/sampler_table.h"
@@ -119,6 +121,11 @@ int main(int argc, char** argv) {
                    "else 3 spacings), built as the slabs arrive; with --sparse, straight from the band's blocks: a level set "
                    "with its points with |d| <= W active, inside blocks -W tiles, plus the gradient grid when --channels "
                    "names it");
+    std::string nvdb_path;
+    app.add_option("--nvdb", nvdb_path,
+                   "with --band W --sparse: also write a NanoVDB level set here (FILE.nvdb), straight from the band's "
+                   "blocks: the .vdb's distance grids (points with |d| <= W active, inside blocks -W tiles, BCC as its "
+                   "two named grids); only in builds with NanoVDB");
     app.add_option("--max-planes-per-slab", max_planes, "at most this many z-planes per slab (0: from the budget)")
         ->check(sdf::kNonNegativeNumber);
     app.add_flag("--overwrite", overwrite, "replace an existing field of that name");
@@ -149,6 +156,11 @@ int main(int argc, char** argv) {
         if (!has_distance) throw std::invalid_argument("--channels: the distance channel is always written; name it");
         if (!vdb_path.empty() && (vdb_path.size() < 5 || vdb_path.compare(vdb_path.size() - 4, 4, ".vdb") != 0))
             throw std::invalid_argument("--vdb " + vdb_path + ": expected a file name ending in .vdb");
+        if (!nvdb_path.empty() && (nvdb_path.size() < 6 || nvdb_path.compare(nvdb_path.size() - 5, 5, ".nvdb") != 0))
+            throw std::invalid_argument("--nvdb " + nvdb_path + ": expected a file name ending in .nvdb");
+        if (!nvdb_path.empty() && !sdf::nanovdb_available())
+            throw std::invalid_argument("--nvdb " + nvdb_path + ": this build has no NanoVDB (its headers were not found at "
+                                        "configure time; set SDF_NANOVDB_DIR to the folder holding nanovdb/NanoVDB.h)");
         // The lattice and the sampler as the config parser reads them: its checks and messages.
         nlohmann::json lattice_json = {{"type", lattice_type}};
         if (resolution.size() == 1) {
@@ -167,6 +179,9 @@ int main(int argc, char** argv) {
                                         "--band");
         if (!vdb_path.empty()) sdf::require_representable_band(band, sdf::FieldDtype::Float32, "--band (the .vdb stores float32)");
         if (sparse && !(band > 0)) throw std::invalid_argument("--sparse: expected a narrow band, --band W with W > 0");
+        if (!nvdb_path.empty() && !sparse)
+            throw std::invalid_argument("--nvdb " + nvdb_path + ": the .nvdb is written from the sparse band; add --band W --sparse");
+        if (!nvdb_path.empty()) sdf::require_representable_band(band, sdf::FieldDtype::Float32, "--band (the .nvdb stores float32)");
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return sdf::kExitCommandLineError;
@@ -186,6 +201,7 @@ int main(int argc, char** argv) {
         if (!dry_run) {
             sdf::require_writable_target(out_path, stream.write.overwrite);
             if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
+            if (!nvdb_path.empty()) sdf::require_writable_target(nvdb_path, stream.write.overwrite);
         }
         const auto shared_mesh = std::make_shared<const sdf::PreparedMesh>(
             sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), ".")));
@@ -213,9 +229,13 @@ int main(int argc, char** argv) {
             else if (!vdb_path.empty())
                 std::cout << "vdb: " << vdb_path << ", points with |d| < " << stream.vdb_band
                           << " active (its grids hold the band's points, outside the budget)\n";
+            if (!nvdb_path.empty())
+                std::cout << "nvdb: " << nvdb_path << ", a NanoVDB level set from the sparse band's blocks, points with |d| <= "
+                          << band << " active (outside the budget)\n";
             try {
                 sdf::require_writable_target(out_path, stream.write.overwrite);
                 if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
+                if (!nvdb_path.empty()) sdf::require_writable_target(nvdb_path, stream.write.overwrite);
                 require_runnable();
             } catch (const std::exception& e) {
                 std::cerr << "sdf-sample: error: the run would be refused: " << e.what() << "\n";
@@ -257,6 +277,11 @@ int main(int argc, char** argv) {
             vdb_options.overwrite = stream.write.overwrite;
             vdb_active = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
         }
+        int64_t nvdb_active = 0;
+        if (sparse_slabs && !nvdb_path.empty()) {
+            doing = "writing " + nvdb_path + " from the sparse band";
+            nvdb_active = sdf::write_sparse_band_nvdb(sparse_slabs->band(), nvdb_path, stream.write.overwrite).active_voxels;
+        }
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("
                   << r.header.timings.kernel << " s sampler kernels, " << r.write_wait_seconds
@@ -265,6 +290,8 @@ int main(int argc, char** argv) {
         if (!vdb_path.empty())
             std::cout << "wrote " << vdb_path << ": " << vdb_active << " active points (|d| " << (sparse ? "<=" : "<") << " "
                       << stream.vdb_band << ")\n";
+        if (!nvdb_path.empty())
+            std::cout << "wrote " << nvdb_path << ": " << nvdb_active << " active points (|d| <= " << band << ")\n";
         if (band > 0)
             std::cout << "band " << band << ": " << r.band.in_band << " points in the band, " << r.band.outside << " outside\n";
         return 0;

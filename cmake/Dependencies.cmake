@@ -96,6 +96,50 @@ if(NOT SDF_WHEEL AND SDF_OPENVDB_INCLUDE AND SDF_OPENVDB_LIBRARY AND TBB_FOUND A
 endif()
 message(STATUS "sdf: OpenVDB ${SDF_HAVE_OPENVDB} (.vdb export and the OpenVDB peer)")
 
+# NanoVDB is optional and header-only: with it, a sparse band is also written as .nvdb
+# (harness/io/sparse_nvdb_file.cpp) and, with CUDA, the peers experiment times its GPU
+# MeshToGrid. Not a Debian package (Debian's OpenVDB 10 ships no NanoVDB headers): the folder
+# holding nanovdb/NanoVDB.h comes from SDF_NANOVDB_DIR (cache variable; default: the
+# environment's SDF_NANOVDB_DIR, else nanovdb/ of $SDF_PEERS_DIR, data/peers or ../shared/peers,
+# else an installed OpenVDB 12 or later's include folder). The layout with tools/GridBuilder.h,
+# tools/CreateNanoGrid.h and io/IO.h (NanoVDB 32.7, OpenVDB 12, and later) is required.
+set(SDF_HAVE_NANOVDB 0)
+set(_sdf_nanovdb_default "")
+foreach(_dir "$ENV{SDF_NANOVDB_DIR}" "$ENV{SDF_PEERS_DIR}/nanovdb" "${CMAKE_SOURCE_DIR}/data/peers/nanovdb"
+             "${CMAKE_SOURCE_DIR}/../shared/peers/nanovdb")
+  if(NOT _sdf_nanovdb_default AND NOT _dir STREQUAL "/nanovdb" AND _dir AND EXISTS "${_dir}/nanovdb/NanoVDB.h")
+    get_filename_component(_sdf_nanovdb_default "${_dir}" ABSOLUTE)
+  endif()
+endforeach()
+if(NOT _sdf_nanovdb_default)
+  find_path(_sdf_nanovdb_installed nanovdb/tools/CreateNanoGrid.h)
+  if(_sdf_nanovdb_installed)
+    set(_sdf_nanovdb_default "${_sdf_nanovdb_installed}")
+  endif()
+endif()
+set(SDF_NANOVDB_DIR "${_sdf_nanovdb_default}" CACHE PATH
+    "Folder holding nanovdb/NanoVDB.h (default: $SDF_NANOVDB_DIR, nanovdb/ of the peers' snapshots, or an installed OpenVDB 12+)")
+set(SDF_NANOVDB_WHY_NOT "no nanovdb/NanoVDB.h in SDF_NANOVDB_DIR ('${SDF_NANOVDB_DIR}')")
+if(NOT SDF_WHEEL AND SDF_NANOVDB_DIR AND EXISTS "${SDF_NANOVDB_DIR}/nanovdb/NanoVDB.h")
+  if(EXISTS "${SDF_NANOVDB_DIR}/nanovdb/tools/GridBuilder.h" AND EXISTS "${SDF_NANOVDB_DIR}/nanovdb/tools/CreateNanoGrid.h"
+     AND EXISTS "${SDF_NANOVDB_DIR}/nanovdb/io/IO.h")
+    set(SDF_HAVE_NANOVDB 1)
+    set(SDF_NANOVDB_WHY_NOT "")
+    add_library(sdf_nanovdb INTERFACE)
+    target_include_directories(sdf_nanovdb SYSTEM INTERFACE ${SDF_NANOVDB_DIR})
+    target_link_libraries(sdf_nanovdb INTERFACE Threads::Threads)
+  else()
+    set(SDF_NANOVDB_WHY_NOT "${SDF_NANOVDB_DIR} has nanovdb/NanoVDB.h but not tools/GridBuilder.h, tools/CreateNanoGrid.h "
+                            "and io/IO.h (NanoVDB 32.7 / OpenVDB 12 or later)")
+  endif()
+endif()
+if(SDF_HAVE_NANOVDB)
+  message(STATUS "sdf: NanoVDB 1 (.nvdb export; the NanoVDB MeshToGrid peer with CUDA; test sparse_nvdb_test) "
+                 "headers in ${SDF_NANOVDB_DIR}")
+else()
+  message(STATUS "sdf: NanoVDB 0 (no .nvdb export, no NanoVDB peer, test sparse_nvdb_test not built): ${SDF_NANOVDB_WHY_NOT}")
+endif()
+
 # MPI (Open MPI from Debian) is optional: distributed runs (harness/distributed).
 set(SDF_HAVE_MPI OFF)
 if(NOT SDF_ENABLE_MPI STREQUAL "OFF" AND NOT SDF_WHEEL)

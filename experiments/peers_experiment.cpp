@@ -9,7 +9,8 @@
 ///   "openvdb_band_voxels": 3, "python": "", "repetitions": 1, "sign": "auto",
 ///   "point_sets": [{"kind": "uniform_box", "count": 1048576},
 ///                  {"kind": "gaussian_surface", "count": 1048576, "sigma": 0.01}], "seed": 1,
-///   "point_set_meshes": ["dragon"], "point_set_sign": "pseudonormal", "gpu_bvh_build": "auto"
+///   "point_set_meshes": ["dragon"], "point_set_sign": "pseudonormal", "gpu_bvh_build": "auto",
+///   "band_resolutions": [512], "band_voxels": 3
 ///
 /// Every method, ours and the peers', is a row of one table (experiments/peers/peer.h,
 /// peer_registry.cpp) and runs through one timing loop (time_method): at each of its thread
@@ -30,9 +31,17 @@
 /// the cube whose point count is nearest to each sample count. Point sets (issue 14) are
 /// arbitrary points around the mesh (core/sampling/point_sets.h). GPU rows without a GPU say
 /// "unavailable", peers whose package is missing "not built".
+/// Narrow bands (issue 35; "band_resolutions", each case's CC lattice of N^3 points fitted as
+/// above): the methods of Inputs::Bands (our sparse band, CPU and GPU; OpenVDB's
+/// meshToLevelSet; NanoVDB's GPU MeshToGrid) each make the level set of half-width
+/// "band_voxels" spacings on that lattice's transform and return their own active voxels; a
+/// row's time is its build and band (total_seconds), its accuracy the max |error| over its
+/// active voxels against the exact field there (our CPU BVH query with "sign", untimed) and
+/// its wrong signs (none for unsigned rows: NanoVDB's distances are unsigned).
 #include <algorithm>
 #include <cstdio>
 #include <ostream>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/bvh/triangle_bvh.h"
@@ -48,6 +57,7 @@
 #include "experiments/peers/peer_rows.h"
 #include "harness/config/lattice_spec.h"
 #include "harness/experiment/experiment.h"
+#include "harness/sampling/mesh_sdf.h"
 #include "harness/sampling/sampler_table.h"
 
 namespace sdf {
@@ -59,6 +69,13 @@ using peers::MethodKind;
 /// The point sets' reference where point_set_sign differs from sign; not chosen in "ours".
 constexpr const char* kExactSignReference = "bvh_cpu_exact_sign";
 constexpr const char* kReference = "bvh_cpu";
+
+/// A number as the shortest text that reads back as it (3, 2.5).
+std::string shortest(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
 
 std::vector<std::string> configurable_ours() {
     std::vector<std::string> names = peers::method_names(By::Ours);
@@ -72,6 +89,8 @@ struct QuerySet {
     const Lattice* lattice = nullptr;    ///< null for point sets
     const PointSetSpec* point_set = nullptr;
     int64_t count = 0;
+    double band_width = 0;               ///< > 0: a narrow-band case on `lattice` (mesh units)
+    double band_voxels = 0;              ///< the same in spacings
 };
 
 /// One method of the run: its table row and its adapter (null: why_not).
@@ -110,6 +129,12 @@ public:
             for (const NamedBvhBuildSite& b : kBvhBuildSites)
                 if (site == b.name) peer_options_.gpu_bvh_build = b.value;
         }
+        band_resolutions_ = config.optional<std::vector<int>>("band_resolutions", {}, "CC lattice resolutions N (N^3 points)");
+        for (int r : band_resolutions_)
+            if (r < 2 || r > 65536) config.fail("band_resolutions", "expected resolutions from 2 to 65536, got " + std::to_string(r));
+        peer_options_.band_voxels = config.optional<double>("band_voxels", 3.0, "a band half-width in spacings");
+        if (!(peer_options_.band_voxels >= 1.0) || !(peer_options_.band_voxels <= 64.0))
+            config.fail("band_voxels", "expected 1 to 64 spacings, got " + std::to_string(peer_options_.band_voxels));
         repetitions_ = config.optional<int>("repetitions", 1, "a positive count");
         if (repetitions_ < 1) config.fail("repetitions", "expected at least 1, got " + std::to_string(repetitions_));
         const int64_t seed = config.optional<int64_t>("seed", 1, "a non-negative seed for the point sets");
@@ -143,10 +168,10 @@ public:
 
     std::vector<std::string> plan(const RunContext&) const override {
         std::vector<std::string> lines;
-        auto methods = [&](const PointSetSpec* point_set) {
+        auto methods = [&](const PointSetSpec* point_set, bool band = false) {
             std::string line;
             for (const MethodKind& m : peers::method_table())
-                if (selected(m, point_set)) line += " " + std::string(m.name) + gpu_note(m);
+                if (selected(m, point_set, band)) line += " " + std::string(m.name) + gpu_note(m);
             return line + "; threads " + thread_list() + "; errors against our exact field (CPU BVH)";
         };
         for (const MeshCase& c : cases_) {
@@ -154,6 +179,9 @@ public:
                 const int r = cubic_resolution_for_samples(LatticeType::CC, n);
                 lines.push_back(c.label + " (" + c.mesh.label() + ") CC " + std::to_string(r) + "^3:" + methods(nullptr));
             }
+            for (int r : band_resolutions_)
+                lines.push_back(c.label + " (" + c.mesh.label() + ") CC " + std::to_string(r) + "^3, band " +
+                                shortest(peer_options_.band_voxels) + " spacings:" + methods(nullptr, true));
             for (const PointSetSpec& ps : point_sets_)
                 if (point_sets_for(c)) lines.push_back(c.label + " (" + c.mesh.label() + ") " + point_set_label(ps) + ":" + methods(&ps));
         }
@@ -193,6 +221,15 @@ public:
                 run_case(ctx, c.label, mesh, {lattice_notation(lattice), &lattice, nullptr, lattice.num_points()},
                          lattice_points(lattice), 1.5);
             }
+            for (int r : band_resolutions_) {
+                const Lattice lattice = fit_lattice(LatticeType::CC, {r, r, r}, mesh->bounds(), margin_);
+                QuerySet set{lattice_notation(lattice) + " band " + shortest(peer_options_.band_voxels) + "h", &lattice, nullptr,
+                             0, peer_options_.band_voxels * lattice.spacing, peer_options_.band_voxels};
+                *ctx.log << c.label << " CC " << lattice_notation(lattice) << ", narrow band of half-width " << set.band_voxels
+                         << " spacings (" << set.band_width << ") x " << with_commas(int64_t(mesh->triangles().size()))
+                         << " triangles\n";
+                run_case(ctx, c.label, mesh, set, {}, 1.0);
+            }
             for (const PointSetSpec& ps : point_sets_) {
                 if (!point_sets_for(c)) continue;
                 const QuerySet set{point_set_label(ps), nullptr, &ps, ps.count};
@@ -224,9 +261,15 @@ private:
         return point_set && point_set_sign_ != lattice_sign_ ? kExactSignReference : kReference;
     }
 
-    /// Whether `m` runs on this case's points (a point set, or a lattice where null).
-    bool selected(const MethodKind& m, const PointSetSpec* point_set) const {
+    /// Whether `m` runs on this case's points (a point set, or a lattice where null; `band`: a
+    /// narrow-band case, where only the band methods run).
+    bool selected(const MethodKind& m, const PointSetSpec* point_set, bool band = false) const {
         const std::string name = m.name;
+        if (band || m.inputs == peers::Inputs::Bands) {
+            if (!band || m.inputs != peers::Inputs::Bands) return false;
+            const std::vector<std::string>& chosen = m.by == By::Ours ? ours_ : peer_names_;
+            return std::count(chosen.begin(), chosen.end(), name) > 0;
+        }
         if (name == reference_of(point_set)) return true;
         if (name == kExactSignReference) return false;
         if (m.by == By::Ours) {  // ours only where they apply; the peers' n/a is a row
@@ -263,8 +306,19 @@ private:
     void run_case(RunContext& ctx, const std::string& label, const std::shared_ptr<const PreparedMesh>& mesh, const QuerySet& set,
                   const std::vector<Vec3d>& points, double goal) {
         std::vector<double> reference;
+        std::unique_ptr<MeshSdf> exact;  // band cases: the exact field at each row's own active voxels
+        if (set.band_width > 0) {
+            SamplerOptions o;
+            o.backend = "cpu";
+            o.method = "bvh";
+            o.threads = 0;
+            o.sign = lattice_sign_;
+            o.progress = false;
+            exact = std::make_unique<MeshSdf>(mesh, o);
+        }
         for (Method& m : methods_)
-            if (selected(*m.kind, set.point_set)) time_method(ctx, label, mesh, set, points, m, reference);
+            if (selected(*m.kind, set.point_set, set.band_width > 0))
+                time_method(ctx, label, mesh, set, points, m, reference, exact.get());
         std::vector<nlohmann::json> thread_keys;
         for (int t : threads_) thread_keys.push_back(resolve_thread_count(t));
         // All cores too: the exact-sign reference runs there whatever "threads" says.
@@ -285,7 +339,7 @@ private:
     /// `repetitions_` runs (the medians of their times), the errors against the reference
     /// (the reference method's first run makes it) and the check.
     void time_method(RunContext& ctx, const std::string& label, const std::shared_ptr<const PreparedMesh>& mesh, const QuerySet& set,
-                     const std::vector<Vec3d>& points, Method& m, std::vector<double>& reference) {
+                     const std::vector<Vec3d>& points, Method& m, std::vector<double>& reference, const MeshSdf* exact) {
         const MethodKind& kind = *m.kind;
         nlohmann::json row = base_row(label, set, *mesh, kind);
         if (!m.adapter) return emit(ctx, row, m.why_not);
@@ -306,7 +360,8 @@ private:
         peers::PeerInput input;
         input.mesh = mesh;
         input.lattice = kind.strided ? nullptr : set.lattice;
-        input.points = kind.strided ? &subset : &points;
+        input.points = set.band_width > 0 ? nullptr : kind.strided ? &subset : &points;
+        input.band_width = set.band_width;
         input.our_sign = set.point_set ? point_set_sign_ : lattice_sign_;
         const double scale = kind.strided ? double(n) / double(subset.size()) : 1.0;
         const double tolerance = peers::kCheckTolerance * mesh->bounds().diagonal();
@@ -334,7 +389,8 @@ private:
             row_t["build_seconds"] = median_of(build);
             row_t["query_seconds"] = median_of(query) * scale;
             row_t["total_seconds"] = row_t["build_seconds"].get<double>() + row_t["query_seconds"].get<double>();
-            row_t["points_per_second"] = median_of(query) > 0 ? double(input.points->size()) / median_of(query) : 0.0;
+            const size_t computed = input.points ? input.points->size() : r.band_points.size();
+            row_t["points_per_second"] = median_of(query) > 0 ? double(computed) / median_of(query) : 0.0;
             if (gpu) {
                 row_t["threads"] = "GPU";
                 if (r.end_to_end_seconds >= 0) row_t["end_to_end_seconds"] = median_of(end_to_end) * scale;
@@ -350,7 +406,18 @@ private:
             row_t["sign"] = peers::sign_kind_name(r.sign);
             const std::string sign_method = r.sign_method.empty() ? kind.sign_method : r.sign_method;
             if (!sign_method.empty()) row_t["sign_method"] = sign_method;
-            const peers::Errors e = peers::compare(r.distance, reference, index, r.is_signed(), tolerance);
+            std::vector<double> band_reference;
+            if (exact) {  // a band case: the exact field at this row's active voxels
+                for (const PointSample& p : exact->query(r.band_points)) band_reference.push_back(p.distance);
+                row_t["points"] = int64_t(r.band_points.size());
+                row_t["active_voxels"] = int64_t(r.band_points.size());
+                row_t["level_set"] = {{"width", set.band_width}, {"width_voxels", set.band_voxels},
+                                 {"active_voxels", int64_t(r.band_points.size())},
+                                 {"lattice_points", set.lattice->num_points()},
+                                 {"accuracy", r.is_signed() ? "max |d - exact| over the active voxels; wrong signs there"
+                                                            : "unsigned: max ||d| - |exact|| over the active voxels; no sign"}};
+            }
+            const peers::Errors e = peers::compare(r.distance, exact ? band_reference : reference, index, r.is_signed(), tolerance);
             peers::set_errors(row_t, e, r.is_signed());
             peers::set_check(row_t, e, r.is_signed(), kind.exact, tolerance);
             if (!r.in_band.empty()) {
@@ -392,6 +459,7 @@ private:
     std::vector<MeshCase> cases_;
     std::vector<PointSetSpec> point_sets_;
     std::vector<int> threads_;
+    std::vector<int> band_resolutions_;
     std::vector<std::string> ours_, peer_names_;
     int64_t brute_max_points_ = 4096;
     peers::PeerOptions peer_options_;

@@ -7,7 +7,10 @@
 //           user without a built tree waits for it;
 //   query = the lattice's sampling (its kernel time: the sign data are built) or the point
 //           query (CPU: wall time; GPU: the device time of the Morton sort, search and
-//           finalize, CUDA events, with the transfers as end_to_end_seconds).
+//           finalize, CUDA events, with the transfers as end_to_end_seconds); in a band
+//           case, the sparse band's sampling (MeshSdf::sample_band: CPU its wall time, GPU
+//           its kernel time with the whole call as end_to_end_seconds), its band points the
+//           row's active voxels.
 // GPU rows: a MeshSdf is made and dropped first (the process's first CUDA sampler loads the
 // kernels' modules and fills the device's memory pool), then three are made and timed and
 // the medians kept, as the cuBQL peer times three builds after a first one. Where the GPU
@@ -20,6 +23,7 @@
 
 #include "core/bvh/triangle_bvh.h"
 #include "core/lattice/lattice_fitting.h"
+#include "core/sampling/sparse_band.h"
 #include "core/statistics.h"
 #include "harness/sampling/mesh_sdf.h"
 #include "harness/sampling/sampler_table.h"
@@ -88,14 +92,33 @@ public:
         r.build_seconds = median_of(builds);
         r.sign = sdf->sign_mode() == sign_mode_name(SignMode::Winding) ? SignKind::Winding : SignKind::Pseudonormal;
         r.sign_method = sdf->sign_mode() + ": " + sdf->sign_reason();
-        const std::vector<Vec3d>& points = *in.points;
         const double cpu0 = process_cpu_seconds();
-        if (in.lattice) {
+        if (in.band_width > 0) {
+            // The sparse band (core/sampling/sparse_band.h): its band points are the active voxels.
+            const auto start = std::chrono::steady_clock::now();
+            const SparseBandField band = sdf->sample_band(*in.lattice, in.band_width);
+            const double wall = seconds_since(start);
+            r.query_seconds = gpu ? band.timings.kernel : wall;
+            if (gpu) r.end_to_end_seconds = wall;
+            const BandLayout& layout = band.layout();
+            for (size_t a = 0; a < band.active.size(); ++a)
+                for (int local = 0; local < kBandBlockPoints; ++local) {
+                    const size_t at = a * kBandBlockPoints + size_t(local);
+                    if (band.closest_triangle[at] == kOutsideBandTriangle) continue;  // padding too
+                    r.band_points.push_back(in.lattice->position(layout.storage_index(band.active[a], local)));
+                    r.distance.push_back(band.distance[at]);
+                }
+            const SparseBandCounts c = band.counts();
+            r.details["band_blocks"] = {{"active", c.active_blocks}, {"mixed", c.mixed_blocks}, {"tiles", c.tiles},
+                                        {"inside_tiles", c.inside_tiles}, {"points_searched", c.active_points},
+                                        {"bytes", band.memory_bytes()}, {"wall_seconds", wall}};
+        } else if (in.lattice) {
             const SampledField f = sdf->sample(*in.lattice);
             r.distance = f.distance;
             r.query_seconds = f.timings.kernel;
             if (gpu) r.end_to_end_seconds = f.timings.total;
         } else if (!gpu) {
+            const std::vector<Vec3d>& points = *in.points;
             const auto start = std::chrono::steady_clock::now();
             const std::vector<PointSample> samples = sdf->query(points);
             r.query_seconds = seconds_since(start);
@@ -103,6 +126,7 @@ public:
             for (size_t i = 0; i < samples.size(); ++i) r.distance[i] = samples[i].distance;
         } else {
             // Every column query() gives, written by the device path into our arrays.
+            const std::vector<Vec3d>& points = *in.points;
             const int64_t n = int64_t(points.size());
             r.distance.resize(points.size());
             std::vector<double> gradient(3 * points.size());
@@ -120,9 +144,9 @@ public:
         r.cpu_seconds = cpu + process_cpu_seconds() - cpu0;
         r.notes = std::string(sampler_.about) + "; sign " + sdf->sign_mode() + "; build: the construction of MeshSdf" +
                   (host_tree ? " + the mesh's host BVH build" : "");
-        r.details = {{"sampler", sdf->sampler_name()},
-                     {"sign", {{"mode", sdf->sign_mode()}, {"reason", sdf->sign_reason()}}},
-                     {"host_tree_seconds", host_tree ? host_tree_seconds : 0.0}};
+        r.details["sampler"] = sdf->sampler_name();
+        r.details["sign"] = {{"mode", sdf->sign_mode()}, {"reason", sdf->sign_reason()}};
+        r.details["host_tree_seconds"] = host_tree ? host_tree_seconds : 0.0;
         if (details.contains("bvh")) r.details["bvh"] = details["bvh"];
         if (gpu) {
             r.details["first_call_seconds"] = median_of(first_calls);

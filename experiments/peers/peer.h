@@ -46,6 +46,9 @@ struct PeerInput {
     /// OpenVDB need it; our samplers then sample the lattice); null for point sets and subsets.
     const Lattice* lattice = nullptr;
     const std::vector<Vec3d>* points = nullptr;
+    /// > 0: a narrow-band case (Inputs::Bands): the level set of half-width `band_width` (mesh
+    /// units) on `lattice` (CC), the method's own active voxels out; `points` is null.
+    double band_width = 0;
     int threads = 1;          ///< resolved (>= 1); GPU methods ignore it
     SignMode our_sign = SignMode::Auto;  ///< our samplers' sign in this case (peers ignore it)
 };
@@ -56,6 +59,9 @@ struct PeerResult {
     SignKind sign = SignKind::None; ///< never Mode: ours say which the mode resolved to
     std::string sign_method;        ///< ours: the mode's reason; peers: empty (their table row says it)
     std::vector<uint8_t> in_band;   ///< narrow-band peers: 1 where the value was computed; empty = everywhere
+    /// Band cases: the world position of every active voxel (`distance` holds their values);
+    /// the loop checks them against the exact field there.
+    std::vector<Vec3d> band_points;
     double build_seconds = 0;       ///< acceleration structure (BVH, tree, grid set-up, our build-once object)
     double query_seconds = 0;       ///< the distance queries (and signs) themselves
     double end_to_end_seconds = -1; ///< GPU methods: the query with the points' and results' transfers; < 0: none
@@ -79,14 +85,16 @@ public:
 /// Options the experiment passes to the factories that take them.
 struct PeerOptions {
     double openvdb_band_voxels = 3.0;  ///< OpenVDB narrow band half-width, in voxels (each side)
+    double band_voxels = 3.0;          ///< band cases: every method's half-width W, in voxels
     std::string python;                ///< interpreter with open3d; empty = look for one
     SignMode exact_sign = SignMode::Auto;  ///< our exact sign ("sign"): the reference's and the brute force's
     BvhBuildSite gpu_bvh_build = BvhBuildSite::Auto;  ///< where our GPU rows build their BVH
 };
 
 enum class By { Ours, Peer };
-/// On which points a method runs.
-enum class Inputs { LatticesAndPointSets, Lattices, PointSets };
+/// On which points a method runs: Bands, a narrow band (level set) on a CC lattice, the
+/// method choosing its own active voxels (a case of "band_resolutions").
+enum class Inputs { LatticesAndPointSets, Lattices, PointSets, Bands };
 /// At which thread counts: each of the run's, all cores only, or once on the GPU (rows say "GPU").
 enum class Threads { Each, AllCores, Gpu };
 

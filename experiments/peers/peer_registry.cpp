@@ -2,8 +2,8 @@
 // libraries this build has. Each peer's file is compiled only when its package was found
 // (SDF_HAVE_<PEER>, set in experiments/peers/CMakeLists.txt); its factory here otherwise says
 // why not. Open3D is looked for at run time (a Python module). FCPW and cuBQL are source
-// snapshots (SDF_PEERS_DIR): their "not built" reason comes from CMake (snapshot not found,
-// or no CUDA backend).
+// snapshots (SDF_PEERS_DIR), NanoVDB headers (SDF_NANOVDB_DIR): their "not built" reason
+// comes from CMake (snapshot or headers not found, or no CUDA backend).
 #include <time.h>
 
 #include <stdexcept>
@@ -20,12 +20,16 @@ std::unique_ptr<PeerAdapter> make_embree_peer();
 #endif
 #if SDF_HAVE_OPENVDB
 std::unique_ptr<PeerAdapter> make_openvdb_peer(double band_voxels);
+std::unique_ptr<PeerAdapter> make_openvdb_band_peer();
 #endif
 #if SDF_HAVE_FCPW
 std::unique_ptr<PeerAdapter> make_fcpw_peer();
 #endif
 #if SDF_HAVE_CUBQL
 std::unique_ptr<PeerAdapter> make_cubql_peer(std::string& reason);
+#endif
+#if SDF_HAVE_NANOVDB_PEER
+std::unique_ptr<PeerAdapter> make_nanovdb_peer(std::string& reason);
 #endif
 std::unique_ptr<PeerAdapter> make_open3d_peer(const std::string& python, std::string& reason);
 
@@ -54,6 +58,12 @@ constexpr OurSampler kBruteGpu{"cuda", "brute_force", "", false, "CUDA-event tim
 constexpr OurSampler kBvhGpu{"cuda", "bvh", "", false,
                              "CUDA-event time of the (Morton sort,) search and double finalize, with the exact sign; "
                              "end_to_end_seconds: the whole call (uploads, downloads, scatter into input order)"};
+constexpr OurSampler kBandCpu{"cpu", "bvh", "", false,
+                              "the sparse band (MeshSdf::sample_band), wall time, with the exact sign; its band points "
+                              "(|d| <= W) are the active voxels"};
+constexpr OurSampler kBandGpu{"cuda", "bvh", "", false,
+                              "the sparse band (MeshSdf::sample_band), CUDA-event time of its kernels, with the exact sign; "
+                              "end_to_end_seconds: the whole call (uploads, downloads); its band points are the active voxels"};
 
 template <const OurSampler* Sampler>
 std::unique_ptr<PeerAdapter> ours(const PeerOptions& o, std::string& why_not) {
@@ -87,6 +97,23 @@ std::unique_ptr<PeerAdapter> openvdb(const PeerOptions& o, std::string& why_not)
 #else
     (void)o;
     return not_built(package_missing("libopenvdb-dev"), why_not);
+#endif
+}
+
+std::unique_ptr<PeerAdapter> openvdb_band(const PeerOptions&, std::string& why_not) {
+#if SDF_HAVE_OPENVDB
+    (void)why_not;
+    return make_openvdb_band_peer();
+#else
+    return not_built(package_missing("libopenvdb-dev"), why_not);
+#endif
+}
+
+std::unique_ptr<PeerAdapter> nanovdb(const PeerOptions&, std::string& why_not) {
+#if SDF_HAVE_NANOVDB_PEER
+    return make_nanovdb_peer(why_not);
+#else
+    return not_built(SDF_PEERS_WHY_NOT_NANOVDB, why_not);
 #endif
 }
 
@@ -126,6 +153,8 @@ const std::vector<MethodKind>& method_table() {
         {"brute_cpu",             By::Ours, true,  I::LatticesAndPointSets,   T::Each,      true,   SignKind::Mode, "", ours<&kBruteCpu>},
         {"brute_gpu",             By::Ours, true,  I::Lattices,               T::Gpu,       false,  SignKind::Mode, "", ours<&kBruteGpu>},
         {"bvh_gpu",               By::Ours, true,  I::LatticesAndPointSets,   T::Gpu,       false,  SignKind::Mode, "", ours<&kBvhGpu>},
+        {"band_cpu",              By::Ours, true,  I::Bands,                  T::Each,      false,  SignKind::Mode, "", ours<&kBandCpu>},
+        {"band_gpu",              By::Ours, true,  I::Bands,                  T::Gpu,       false,  SignKind::Mode, "", ours<&kBandGpu>},
         {"cgal",                By::Peer, true,  I::LatticesAndPointSets,   T::Each,      false,
          SignKind::Own, "Side_of_triangle_mesh (ray casting)", cgal},
         {"embree",              By::Peer, true,  I::LatticesAndPointSets,   T::Each,      false,  SignKind::None, "", embree},
@@ -135,6 +164,9 @@ const std::vector<MethodKind>& method_table() {
          SignKind::Own, "flood fill of the narrow band", openvdb},
         {"fcpw",                By::Peer, true,  I::LatticesAndPointSets,   T::Each,      false,  SignKind::None, "", fcpw},
         {"cubql",               By::Peer, true,  I::LatticesAndPointSets,   T::Gpu,       false,  SignKind::None, "", cubql},
+        {"openvdb_band",        By::Peer, false, I::Bands,                  T::Each,      false,
+         SignKind::Own, "flood fill of the narrow band (meshToLevelSet)", openvdb_band},
+        {"nanovdb",             By::Peer, false, I::Bands,                  T::Gpu,       false,  SignKind::None, "", nanovdb},
     };
     return table;
 }

@@ -7,6 +7,7 @@
 
 #include "core/mesh/mesh_provenance.h"
 #include "core/sampling/sparse_band.h"
+#include "harness/io/sparse_nvdb_file.h"
 #include "harness/io/sparse_vdb_file.h"
 #include "harness/resources/memory_budget.h"
 #include "python/src/field.h"
@@ -95,6 +96,7 @@ public:
     }
 
     py::list write(const std::string& path, bool overwrite, bool closest_triangle) const {
+        if (path.size() > 5 && path.compare(path.size() - 5, 5, ".nvdb") == 0) return write_nvdb(path, overwrite, closest_triangle);
         if (path.size() < 5 || path.compare(path.size() - 4, 4, ".vdb") != 0)
             throw std::invalid_argument(path + ": a SparseField writes .vdb (an OpenVDB level set) only so far; "
                                         "to_dense().write(path) writes the dense formats (field file, vti, npy, npz)");
@@ -113,6 +115,20 @@ public:
     }
 
 private:
+    /// The NanoVDB level set (harness/io/sparse_nvdb_file.h): distance grids only.
+    py::list write_nvdb(const std::string& path, bool overwrite, bool closest_triangle) const {
+        if (closest_triangle)
+            throw std::invalid_argument(path + ": a .nvdb holds the distance grids only; closest_triangle=True needs a .vdb");
+        std::shared_ptr<const SparseBandField> b = band_;
+        TaskOptions task;
+        task.total = kBackgroundItems;
+        task.label = "writing " + path;
+        run_task([&] { return write_sparse_band_nvdb(*b, path, overwrite ? Overwrite::Allow : Overwrite::Forbid); }, task);
+        py::list files;
+        files.append(path);
+        return files;
+    }
+
     std::shared_ptr<const SparseBandField> band_;
     std::vector<int64_t> at_;
 };
@@ -193,7 +209,8 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
         .def("write", &SparseField::write, py::arg("path"), py::arg("overwrite") = false, py::arg("closest_triangle") = false,
              "write(path, overwrite=False, closest_triangle=False) -> list of files: an OpenVDB level set (.vdb; "
              "harness/io/sparse_vdb_file.h) with its gradient grid, written atomically; closest_triangle=True adds an "
-             "Int32Grid of the closest triangles (which Debian's pyopenvdb 10 cannot read). Other formats are refused "
+             "Int32Grid of the closest triangles (which Debian's pyopenvdb 10 cannot read). A .nvdb is the NanoVDB level "
+             "set of the distance (harness/io/sparse_nvdb_file.h; builds with NanoVDB only). Other formats are refused "
              "(to_dense().write(path) writes them).")
         .def("__len__", &SparseField::size)
         .def("__repr__", [](const SparseField& f) {

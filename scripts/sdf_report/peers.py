@@ -1,6 +1,7 @@
 """Our samplers (brute force and BVH, CPU and GPU) against the peer libraries (CGAL, Embree,
 Open3D, OpenVDB, FCPW, cuBQL), on lattices and on arbitrary point sets, from "peers" runs
-(configs/peers.json, configs/peers_gpu.json, docs/bvh.md)."""
+(configs/peers.json, configs/peers_gpu.json, docs/bvh.md); and narrow bands (level sets): our
+sparse band against OpenVDB's meshToLevelSet and NanoVDB's MeshToGrid (configs/peers_band.json)."""
 
 from .overview import machine
 from .tables import Table, count, number, rate
@@ -49,6 +50,8 @@ def _notes(row):
 def rows_table(metrics):
     table = Table(HEADER)
     for row in metrics["rows"]:
+        if _is_band_row(row):
+            continue
         where = "%s %s" % (row["mesh"], row["resolution"])
         method = row["method"] + (" " + row["version"] if "version" in row else "")
         if "status" in row:
@@ -58,6 +61,38 @@ def rows_table(metrics):
                    number(row["query_seconds"]), number(row["cpu_seconds"]) if "cpu_seconds" in row else "-",
                    rate(row["points_per_second"]), number(row["max_abs_error"]), str(row["sign_disagreements"]),
                    _check(row), _notes(row)])
+    return table
+
+
+BAND_HEADER = ["mesh, lattice, band", "method", "by", "threads", "sign", "build (s)", "band (s)", "total (s)", "CPU (s)",
+               "end to end (s)", "active voxels", "max |d error| (active voxels)", "wrong signs", "notes"]
+
+
+def _is_band_row(row):
+    """A narrow-band row (band_resolutions): its level set, or a band method's status row."""
+    return "level_set" in row or " band " in row["resolution"]
+
+
+def band_table(metrics):
+    """Every method's own narrow band on the same lattice: time (build included), its active
+    voxels, and its accuracy there against the exact field; unsigned rows have no wrong signs."""
+    table = Table(BAND_HEADER)
+    for row in metrics["rows"]:
+        if not _is_band_row(row):
+            continue
+        where = "%s %s" % (row["mesh"], row["resolution"])
+        method = row["method"] + (" " + row["version"] if "version" in row else "")
+        if "status" in row:
+            table.add([where, method, row["by"]] + ["-"] * 10 + [row["status"]])
+            continue
+        signed = row.get("signed", True)
+        table.add([where, method, row["by"], str(row["threads"]), sign_label(row), number(row["build_seconds"]),
+                   number(row["query_seconds"]), number(row["total_seconds"]),
+                   number(row["cpu_seconds"]) if "cpu_seconds" in row else "-",
+                   number(row["end_to_end_seconds"]) if "end_to_end_seconds" in row else "-",
+                   count(row["active_voxels"]), number(row["max_abs_error"]),
+                   str(row["sign_disagreements"]) if signed else "n/a (unsigned)",
+                   "" if signed else "unsigned: the error is ||d| - |exact||"])
     return table
 
 
@@ -129,6 +164,12 @@ def section(doc, runs):
             cpu, gpu = machine(run)
             doc.heading(3, "%s, run %s: %s, GPU %s" % (point.name, run.run_id, cpu, gpu))
             doc.table(rows_table(point.metrics))
+            bands = band_table(point.metrics)
+            if bands:
+                doc.paragraph("Narrow bands (level sets) on the same lattice and band, on this machine (%s, GPU %s): each "
+                              "method's own active voxels, its time with its build, and its accuracy there against the "
+                              "exact field." % (cpu, gpu))
+                doc.table(bands)
             summary = summary_table(point.metrics)
             if summary:
                 doc.table(summary)

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <set>
+#include <tuple>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -190,6 +192,59 @@ TEST(MethodTable, NamesAreUniqueAndOurCpuSamplersRunAsAdapters) {
     o.sign = SignMode::Pseudonormal;
     o.progress = false;
     EXPECT_EQ(r.distance, MeshSdf(mesh, o).sample(lattice).distance);
+}
+
+// Band cases (issue 35): our sparse band's active voxels are the dense banded field's band
+// points (|d| <= W), with its values; OpenVDB's level set, where built, has its voxels on the
+// lattice's points.
+TEST(MethodTable, BandMethodsReturnTheirOwnActiveVoxels) {
+    const auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(make_torus(1.0, 0.35, 32, 16)));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {30, 28, 26}, mesh->bounds(), 0.1);
+    PeerOptions options;
+    options.exact_sign = SignMode::Pseudonormal;
+    PeerInput in;
+    in.mesh = mesh;
+    in.lattice = &lattice;
+    in.threads = 2;
+    in.band_width = 2.5 * lattice.spacing;
+    std::string why_not;
+    const MethodKind& ours = method_kind("band_cpu");
+    EXPECT_EQ(ours.inputs, Inputs::Bands);
+    const PeerResult r = ours.make(options, why_not)->run(in);
+    SamplerOptions o;
+    o.backend = "cpu";
+    o.method = "bvh";
+    o.threads = 2;
+    o.sign = SignMode::Pseudonormal;
+    o.band_width = in.band_width;
+    o.progress = false;
+    const SampledField dense = MeshSdf(mesh, o).sample(lattice);
+    std::map<std::tuple<double, double, double>, double> band;
+    for (int64_t i = 0; i < lattice.num_points(); ++i)
+        if (dense.closest_triangle[size_t(i)] != kOutsideBandTriangle) {
+            const Vec3d p = lattice.position(i);
+            band[{p.x, p.y, p.z}] = dense.distance[size_t(i)];
+        }
+    ASSERT_GT(band.size(), 0u);
+    ASSERT_EQ(r.band_points.size(), band.size());
+    ASSERT_EQ(r.distance.size(), band.size());
+    for (size_t k = 0; k < r.band_points.size(); ++k) {
+        const Vec3d& p = r.band_points[k];
+        const auto it = band.find({p.x, p.y, p.z});
+        ASSERT_NE(it, band.end()) << "not a band point: " << p.x << " " << p.y << " " << p.z;
+        EXPECT_EQ(r.distance[k], it->second);
+    }
+    EXPECT_EQ(r.sign, SignKind::Pseudonormal);
+
+    const std::unique_ptr<PeerAdapter> openvdb = method_kind("openvdb_band").make(options, why_not);
+    if (!openvdb) return;  // "not built": no libopenvdb-dev
+    const PeerResult v = openvdb->run(in);
+    ASSERT_GT(v.band_points.size(), 0u);
+    EXPECT_EQ(v.sign, SignKind::Own);
+    for (const Vec3d& p : v.band_points)
+        for (double c : {(p.x - lattice.origin.x) / lattice.spacing, (p.y - lattice.origin.y) / lattice.spacing,
+                         (p.z - lattice.origin.z) / lattice.spacing})
+            ASSERT_NEAR(c, std::round(c), 1e-9) << "a voxel off the lattice's points";
 }
 
 }  // namespace

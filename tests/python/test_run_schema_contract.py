@@ -69,3 +69,33 @@ def test_a_checked_run_records_its_check(results):
     assert manifest["check"]["passed"] is True
     assert manifest["check"]["failed"] == 0 and manifest["check"]["ok"] > 0
     assert manifest["check"]["baseline"].endswith("results/baselines/ci_smoke.json")
+
+
+def test_narrow_band_rows_are_measured_against_the_exact_field(results, schema):
+    """The peers run's narrow-band rows (band_resolutions): our sparse band's active voxels are
+    its band points, every value exact (the exact field's own query at those points) with no
+    wrong sign; OpenVDB's and NanoVDB's rows, where built, are measured at their own voxels."""
+    paths = [p for p in runs.candidate_paths(str(results)) if "contract_peers" in p]
+    assert len(paths) == 1
+    run = runs.load_run_dir(paths[0], schema, strict=True)
+    rows = [r for point in run.points for r in point.metrics["rows"] if " band " in r["resolution"]]
+    assert {r["method"] for r in rows} == {"band_cpu", "band_gpu", "openvdb_band", "nanovdb"}
+    ours = [r for r in rows if r["method"] == "band_cpu"]
+    assert len(ours) == 1
+    band = ours[0]
+    width = band["level_set"]["width"]
+    assert band["level_set"]["width_voxels"] == 3
+    assert band["level_set"]["lattice_points"] == 24 ** 3
+    assert 0 < band["active_voxels"] < 24 ** 3
+    assert band["compared_points"] == band["active_voxels"]
+    assert band["max_abs_error"] <= 1e-12 * width, band["max_abs_error"]
+    assert band["sign_disagreements"] == 0
+    assert band["passes_check"] is True
+    for row in rows:
+        if "status" in row:
+            continue
+        assert row["active_voxels"] > 0 and row["compared_points"] == row["active_voxels"], row["method"]
+        if row["method"] == "openvdb_band":  # float values, its own band: within a spacing of the exact field
+            assert row["max_abs_error"] < width / 3, row["max_abs_error"]
+        if row["method"] == "nanovdb":
+            assert row["sign_disagreements"] == "n/a (unsigned)"

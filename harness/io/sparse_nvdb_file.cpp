@@ -1,0 +1,151 @@
+/// @file sparse_nvdb_file.cpp
+/// @brief The sparse band's NanoVDB writer (sparse_nvdb_file.h): NanoVDB's host grid builder
+/// fed the blocks directly, converted to a NanoGrid<float>, written to a temporary and renamed.
+#include "harness/io/sparse_nvdb_file.h"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "harness/io/volume_grids.h"
+
+#if SDF_HAVE_NANOVDB
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/io/IO.h>
+#include <nanovdb/tools/CreateNanoGrid.h>
+#include <nanovdb/tools/GridBuilder.h>
+#endif
+
+namespace sdf {
+
+#if SDF_HAVE_NANOVDB
+namespace {
+
+using BuildGrid = nanovdb::tools::build::Grid<float>;
+using BuildLeaf = BuildGrid::Node0;
+static_assert(BuildLeaf::DIM == uint32_t(kBandBlockDim), "a band block is a NanoVDB leaf");
+
+/// NanoVDB's leaf offset of the block-local point `local` (ours runs x fastest, NanoVDB's z).
+uint32_t leaf_offset(int local) {
+    const Int3 o = BandLayout::local_offset(local);
+    return uint32_t((o.x << (2 * kBandBlockLog2)) | (o.y << kBandBlockLog2) | o.z);
+}
+
+nanovdb::Coord block_origin(const BandBlockCoords& b) {
+    return nanovdb::Coord(b.block.x * kBandBlockDim, b.block.y * kBandBlockDim, b.block.z * kBandBlockDim);
+}
+
+/// The leaf of the block at `origin`, created (every voxel inactive at the background +W).
+BuildLeaf& touch_leaf(nanovdb::tools::build::ValueAccessor<float>& acc, const nanovdb::Coord& origin, float w) {
+    BuildLeaf* leaf = acc.setValue(origin, w);  // creates the leaf and turns voxel 0 on
+    leaf->mValueMask.setOff(0);
+    return *leaf;
+}
+
+void set_inactive(BuildLeaf& leaf, uint32_t offset, float value) {
+    leaf.mValues[offset] = value;
+    leaf.mValueMask.setOff(offset);
+}
+
+void write_grids(const SparseBandField& band, const std::string& path, SparseNvdbCounts& counts) {
+    const BandLayout& layout = band.layout();
+    const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
+    if (int(parts.size()) != layout.cosets()) throw std::logic_error(path + ": the band's cosets are not the lattice's grids");
+    const float w = float(band.width);
+    std::vector<std::unique_ptr<BuildGrid>> grids;
+    std::vector<nanovdb::tools::build::ValueAccessor<float>> accessors;
+    for (int c = 0; c < layout.cosets(); ++c) {
+        const VolumeGrid& g = parts[size_t(c)];
+        grids.push_back(std::make_unique<BuildGrid>(w, g.part.empty() ? "distance" : "distance_" + g.part,
+                                                    nanovdb::GridClass::LevelSet));
+        grids.back()->setTransform(g.spacing, nanovdb::Vec3d(g.origin.x, g.origin.y, g.origin.z));
+        accessors.push_back(grids.back()->getAccessor());
+    }
+    // Active blocks: leaves whose band points are active voxels.
+    for (size_t a = 0; a < band.active.size(); ++a) {
+        const BandBlockCoords b = layout.block_coords(band.active[a]);
+        BuildLeaf& leaf = touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (layout.storage_index(band.active[a], local) < 0) continue;  // padding: background +W
+            const size_t at = a * kBandBlockPoints + size_t(local);
+            const uint32_t offset = leaf_offset(local);
+            const float d = float(band.distance[at]);
+            if (band.closest_triangle[at] == kOutsideBandTriangle) {
+                set_inactive(leaf, offset, d);  // +-W, its side
+                continue;
+            }
+            leaf.setValue(offset, d);  // on
+            ++counts.active_voxels;
+        }
+        ++counts.leaves;
+    }
+    // Mixed blocks: leaves of inactive voxels, each on its side.
+    for (size_t m = 0; m < band.mixed.size(); ++m) {
+        const BandBlockCoords b = layout.block_coords(band.mixed[m]);
+        BuildLeaf& leaf = touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
+        const BandSignMask& inside = band.mixed_inside[m];
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (layout.storage_index(band.mixed[m], local) < 0) continue;
+            if ((inside[size_t(local >> 6)] >> (local & 63)) & 1) set_inactive(leaf, leaf_offset(local), -w);
+        }
+        ++counts.leaves;
+    }
+    // Inside tiles: -W tiles of one leaf's extent (level 1). The builder makes a missing lower
+    // node with the tile's value for all its 4096 tiles, so the node is first made with a +W
+    // (background) tile, then that tile set to -W.
+    for (size_t word = 0; word < band.inside_tiles.size(); ++word) {
+        for (uint64_t bits = band.inside_tiles[word]; bits; bits &= bits - 1) {
+            const int64_t id = int64_t(word) * 64 + __builtin_ctzll(bits);
+            if (id >= layout.block_count() || band.find_active(id) >= 0 || band.find_mixed(id) >= 0) continue;
+            const BandBlockCoords b = layout.block_coords(id);
+            BuildGrid& grid = *grids[size_t(b.coset)];
+            grid.tree().root().addTile<1>(block_origin(b), w, false);
+            grid.tree().root().addTile<1>(block_origin(b), -w, false);
+            ++counts.inside_tiles;
+        }
+    }
+    std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+    accessors.clear();
+    for (const std::unique_ptr<BuildGrid>& grid : grids) {
+        handles.push_back(nanovdb::tools::createNanoGrid(*grid));
+        counts.bytes += int64_t(handles.back().bufferSize());
+    }
+    nanovdb::io::writeGrids(path, handles);
+}
+
+}  // namespace
+
+bool nanovdb_available() { return true; }
+
+SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::string& path, Overwrite overwrite) {
+    namespace fs = std::filesystem;
+    if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
+    if (overwrite == Overwrite::Forbid && fs::exists(path))
+        throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
+    SparseNvdbCounts counts;
+    const std::string temporary = unique_sibling_name(path, "tmp");
+    try {
+        write_grids(band, temporary, counts);
+        if (overwrite == Overwrite::Allow)
+            fs::rename(temporary, path);
+        else if (!rename_no_replace(temporary, path))
+            throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
+    } catch (...) {
+        std::error_code ec;
+        fs::remove(temporary, ec);
+        throw;
+    }
+    return counts;
+}
+
+#else
+
+bool nanovdb_available() { return false; }
+
+SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField&, const std::string& path, Overwrite) {
+    throw std::runtime_error(path + ": this build has no NanoVDB support (its headers were not found at configure time: "
+                                    "set SDF_NANOVDB_DIR to the folder holding nanovdb/NanoVDB.h)");
+}
+
+#endif
+
+}  // namespace sdf
