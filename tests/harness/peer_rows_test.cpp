@@ -208,7 +208,8 @@ TEST(MethodTable, BandMethodsReturnTheirOwnActiveVoxels) {
     in.threads = 2;
     in.band_width = 2.5 * lattice.spacing;
     std::string why_not;
-    const MethodKind& ours = method_kind("band_cpu");
+    const std::string band_cpu = "band_cpu";  // named: a temporary argument would look dangling to GCC 13
+    const MethodKind& ours = method_kind(band_cpu);
     EXPECT_EQ(ours.inputs, Inputs::Bands);
     const PeerResult r = ours.make(options, why_not)->run(in);
     SamplerOptions o;

@@ -72,7 +72,9 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
         const SparseNvdbCounts counts = write_sparse_band_nvdb(band, path);
         ASSERT_TRUE(fs::exists(path));
         EXPECT_EQ(counts.active_voxels, band.counts().band_points);
-        if (c.name.find("mixed") != std::string::npos) EXPECT_GT(band.counts().mixed_blocks, 0);
+        if (c.name.find("mixed") != std::string::npos) {
+            EXPECT_GT(band.counts().mixed_blocks, 0);
+        }
         EXPECT_GT(band.counts().inside_tiles, 0) << "the test should cover inside tiles";
 
         const std::vector<std::string> names =
