@@ -365,11 +365,15 @@ The SDF of the same mesh with its vertices moved (a deforming mesh of the same t
 new_vertices has one row per input vertex (Mesh.input_vertices: the rows the faces index),
 the faces stay. The result is a new SDF with this one's sampler options, equal bit for bit
 to SDF(Mesh(new_vertices, mesh.input_faces, weld_tolerance=..., check_intersections=...),
-same options): the positions' data are made again (welding, degenerate triangles,
-orientation, pseudonormals, the self-intersection check and the sign's choice, the BVH, the
-winding data and the GPU upload). The prepared connectivity must stay the same (the same
-welds, no triangle newly degenerate, the same outward flip), so that triangle numbers and
-vertex gradients keep referring to the same faces; ValueError otherwise (build a new SDF).
+same options). What the faces alone decide is kept from the first preparation and not
+derived again (the welds, the degenerate triangles dropped, the edge adjacency, boundary,
+non-manifold and orientation counts, the shells); what the positions decide is made again
+(the signed volume and the outward flip, normals and pseudonormals, bounds, the
+self-intersection check and so the sign's choice, the BVH, the winding data and the GPU
+upload). ValueError, naming the vertex or triangle, where the new positions would weld or
+drop otherwise than the first preparation (two vertices welded or no longer welded, a
+triangle newly degenerate or no longer degenerate): build a new SDF then. Triangle numbers
+and vertex gradients keep referring to the same input faces.
 This SDF is unchanged, and results already returned stay valid.)")
         .def("sample", &sample_bound, py::arg("lattice") = lattice_type_name(LatticeType::CC), py::arg("resolution") = py::none(),
              py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),
