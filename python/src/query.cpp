@@ -14,6 +14,8 @@
 
 #include "core/parallel/parallel_for.h"
 #include "harness/sampling/mesh_sdf.h"
+#include "harness/sampling/multi_device_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
 #include "python/src/mesh.h"
@@ -313,6 +315,12 @@ void bind_query(py::module_& m) {
             return d;
         }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
            "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (the CPU's, CUDA brute force).")
+        .def_property_readonly("devices", [](const QueryResult& r) {
+            const SamplerOptions& o = r.sdf->options();
+            return json_to_python(plan_device_split(r.points.points.count, -1, sampler_device_count(o), o.min_points_per_device).to_json());
+        }, "How the points went over the SDF's devices (SDF(..., devices=...)): {'count': devices requested, 'used', "
+           "'split', 'min_points_per_device' (the split threshold), 'why_not' or 'why_fewer'}; a query of fewer than "
+           "2 x min_points_per_device points runs on the first device.")
         .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
         .def("__repr__", &query_repr);
 
