@@ -78,6 +78,9 @@ int main(int argc, char** argv) {
     sampler.add(app, "--devices", "devices",
                 "several GPUs of this machine: all, or a list such as 0,1 (the work split over them, the results "
                 "one GPU's bit for bit)");
+    sampler.add(app, "--min-points-per-device", "min_points_per_device",
+                "with --devices, the fewest points a GPU is given before a job is split over several (smaller jobs "
+                "run on the first; docs/distributed.md)");
     sampler.add(app, "--precision", "precision", "float or double");
     sampler.add(app, "--sign", "sign",
                 "sign mode: pseudonormal, winding (generalized winding number > 1/2), or auto (pseudonormal where "

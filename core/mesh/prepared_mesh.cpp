@@ -6,12 +6,12 @@
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "core/bvh/search_bound.h"
 #include "core/bvh/triangle_bvh.h"
 #include "core/mesh/exact_predicates.h"
 #include "core/mesh/self_intersections.h"
+#include "core/mesh/vertex_welding.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/task_monitor.h"
 
@@ -19,50 +19,6 @@ namespace sdf {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-struct PositionKey {
-    double x, y, z;
-    bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-struct PositionHash {
-    size_t operator()(const PositionKey& k) const {
-        std::hash<double> h;
-        return h(k.x) ^ (h(k.y) * 0x9e3779b97f4a7c15ull) ^ (h(k.z) * 0xc2b2ae3d27d4eb4full);
-    }
-};
-
-/// Maps every input vertex to a welded vertex id. With tolerance 0 only bit-identical
-/// positions merge; otherwise a vertex merges into the first kept vertex within `tolerance`
-/// (searched in the 27 grid cells of size `tolerance` around it), so closeness and not
-/// grid alignment decides.
-std::vector<int> weld_vertices(const std::vector<Vec3d>& in, double tolerance, std::vector<Vec3d>& out) {
-    std::vector<int> remap(in.size());
-    std::unordered_map<PositionKey, std::vector<int>, PositionHash> cells;
-    auto cell_of = [&](const Vec3d& p) {
-        return tolerance > 0 ? PositionKey{std::floor(p.x / tolerance), std::floor(p.y / tolerance), std::floor(p.z / tolerance)}
-                             : PositionKey{p.x, p.y, p.z};
-    };
-    for (size_t i = 0; i < in.size(); ++i) {
-        const PositionKey c = cell_of(in[i]);
-        int found = -1;
-        const int reach = tolerance > 0 ? 1 : 0;
-        for (int dz = -reach; dz <= reach && found < 0; ++dz)
-            for (int dy = -reach; dy <= reach && found < 0; ++dy)
-                for (int dx = -reach; dx <= reach && found < 0; ++dx) {
-                    auto it = cells.find({c.x + dx, c.y + dy, c.z + dz});
-                    if (it == cells.end()) continue;
-                    for (int id : it->second)
-                        if (tolerance > 0 ? length(out[size_t(id)] - in[i]) <= tolerance : true) { found = id; break; }
-                }
-        if (found < 0) {
-            found = int(out.size());
-            out.push_back(in[i]);
-            cells[c].push_back(found);
-        }
-        remap[i] = found;
-    }
-    return remap;
-}
 
 double corner_angle(const Vec3d& at, const Vec3d& a, const Vec3d& b) {
     const Vec3d u = normalize_or_zero(a - at), v = normalize_or_zero(b - at);
@@ -190,99 +146,67 @@ std::shared_ptr<MeshBuffers<T>> make_buffers(const PreparedMesh& m, int threads)
 }
 }  // namespace
 
-PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options) {
-    PreparedMesh out;
-    out.name_ = mesh.name;
-    out.source_ = mesh.source;
-    out.content_sha256_ = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;
-    MeshReport& rep = out.report_;
-    rep.input_vertices = int(mesh.vertices.size());
-    rep.input_triangles = int(mesh.triangles.size());
-    rep.polygons = mesh.polygon_stats;
-    if (options.keep_input) out.input_ = std::make_shared<const PreparedMesh::InputArrays>(PreparedMesh::InputArrays{mesh.vertices, mesh.triangles});
+/// What preparation derives from the faces alone, kept with keep_topology and shared by a
+/// mesh's refits: refit_prepared_mesh() checks the welds and dropped triangles against it and
+/// reuses the edge adjacency. Its static members are preparation's passes that both
+/// prepare_mesh() and refit_prepared_mesh() run (a nested class sees the mesh's own fields).
+struct PreparedMesh::Topology {
+    MeshPreparationOptions options;
+    std::vector<Int3> input_triangles;  ///< as given to prepare_mesh()
+    std::vector<int> weld;              ///< input vertex -> welded vertex (weld_vertices' remap)
+    std::vector<uint8_t> degenerate;    ///< per input triangle: dropped
+    std::vector<int> welded_of;         ///< prepared vertex -> its welded vertex
+    EdgeUses edges;                     ///< of the triangles as oriented (PreparedMesh::triangles())
 
-    // Weld, then drop triangles with a repeated vertex or exactly zero area.
-    std::vector<Vec3d> welded;
-    const std::vector<int> remap = weld_vertices(mesh.vertices, options.weld_tolerance, welded);
-    rep.welded_vertices = int(mesh.vertices.size() - welded.size());
-    const int threads = resolve_thread_count(options.threads);
-    const int64_t input_triangles = int64_t(mesh.triangles.size());
-    std::vector<Int3> welded_triangles(static_cast<size_t>(input_triangles));
-    std::vector<uint8_t> degenerate(static_cast<size_t>(input_triangles));
-    parallel_for(input_triangles, 8192, threads, [&](int64_t i0, int64_t i1) {
+    /// The signed volume of the triangles (summed in triangle order) and, where the mesh is
+    /// closed and consistent, the outward flip; true when the triangles were flipped.
+    static bool orient(PreparedMesh& out, const MeshPreparationOptions& options);
+    /// Everything the positions decide, given the triangles and their edges: pseudonormals,
+    /// bounds, buffers, the float search's bound, the BVH and the self-intersection check.
+    static void make_geometry(PreparedMesh& out, const EdgeUses& edges, const MeshPreparationOptions& options, int threads);
+};
+
+namespace {
+
+Int3 welded_triangle(const std::vector<int>& weld, const Int3& t) {
+    return {weld[size_t(t.x)], weld[size_t(t.y)], weld[size_t(t.z)]};
+}
+
+/// Per input triangle: dropped, for a repeated vertex or exactly collinear corners (decided in
+/// exact arithmetic: a rounded cross product of collinear points need not be 0; the
+/// intersection predicates need a plane per triangle).
+std::vector<uint8_t> degenerate_triangles(const std::vector<Int3>& triangles, const std::vector<int>& weld,
+                                          const std::vector<Vec3d>& welded, int threads) {
+    std::vector<uint8_t> degenerate(triangles.size());
+    parallel_for(int64_t(triangles.size()), 8192, threads, [&](int64_t i0, int64_t i1) {
         for (int64_t i = i0; i < i1; ++i) {
-            const Int3 t = mesh.triangles[size_t(i)];
-            const Int3 w{remap[size_t(t.x)], remap[size_t(t.y)], remap[size_t(t.z)]};
-            const bool repeated = w.x == w.y || w.y == w.z || w.z == w.x;
-            // Exactly collinear, decided in exact arithmetic (a rounded cross product of
-            // collinear points need not be 0): the intersection predicates need a plane per
-            // triangle.
-            degenerate[size_t(i)] = repeated || exact::collinear(welded[size_t(w.x)], welded[size_t(w.y)], welded[size_t(w.z)]);
-            welded_triangles[size_t(i)] = w;
+            const Int3 w = welded_triangle(weld, triangles[size_t(i)]);
+            degenerate[size_t(i)] = w.x == w.y || w.y == w.z || w.z == w.x ||
+                                    exact::collinear(welded[size_t(w.x)], welded[size_t(w.y)], welded[size_t(w.z)]);
         }
     });
-    std::vector<Int3> tris;
-    tris.reserve(size_t(input_triangles));
-    out.source_triangle_.reserve(size_t(input_triangles));
-    for (int64_t i = 0; i < input_triangles; ++i) {
-        if (degenerate[size_t(i)]) {
-            ++rep.degenerate_triangles;
-            continue;
-        }
-        tris.push_back(welded_triangles[size_t(i)]);
-        out.source_triangle_.push_back(int(i));
-    }
+    return degenerate;
+}
 
-    // Nothing left to measure distance to: every sampler, BVH and lattice fit downstream
-    // assumes at least one triangle, so refuse here, where the file can still be named.
-    if (tris.empty())
-        throw std::runtime_error((mesh.source.empty() ? mesh.name : mesh.source) + ": no triangle left: all " +
-                                 std::to_string(mesh.triangles.size()) +
-                                 " triangles are degenerate (repeated vertex or zero area); expected at least one "
-                                 "triangle with three distinct, non-collinear vertices");
+}  // namespace
 
-    // Compact away unreferenced vertices.
-    std::vector<int> used(welded.size(), -1);
-    for (Int3& t : tris)
-        for (int k = 0; k < 3; ++k) {
-            int& id = used[size_t(t[k])];
-            if (id < 0) { id = int(out.vertices_.size()); out.vertices_.push_back(welded[size_t(t[k])]); }
-            t[k] = id;
-        }
-    rep.unreferenced_vertices = int(welded.size() - out.vertices_.size());
-    out.triangles_ = std::move(tris);
-
-    // Edge adjacency: boundary, non-manifold and orientation checks; components.
-    EdgeUses edges(out.triangles_, int(out.vertices_.size()), threads);
-    std::vector<int> parent(out.triangles_.size());
-    std::iota(parent.begin(), parent.end(), 0);
-    edges.for_each([&](const EdgeUse* uses, size_t count) {
-        if (count == 1) ++rep.boundary_edges;
-        if (count > 2) ++rep.nonmanifold_edges;
-        if (count == 2 && uses[0].forward == uses[1].forward) ++rep.inconsistent_edges;
-        for (size_t u = 1; u < count; ++u)
-            parent[size_t(find_root(parent, uses[u].triangle))] = find_root(parent, uses[0].triangle);
-    });
-    out.shell_of_.assign(parent.size(), -1);
-    std::vector<int> shell_of_root(parent.size(), -1);
-    for (size_t i = 0; i < parent.size(); ++i) {
-        int& shell = shell_of_root[size_t(find_root(parent, int(i)))];
-        if (shell < 0) shell = rep.components++;
-        out.shell_of_[i] = shell;
-    }
-
-    // Orientation: make a closed, consistent mesh point outward.
+bool PreparedMesh::Topology::orient(PreparedMesh& out, const MeshPreparationOptions& options) {
+    MeshReport& rep = out.report_;
+    rep.signed_volume = 0;
     for (const Int3& t : out.triangles_)
         rep.signed_volume += dot(out.vertices_[size_t(t.x)],
                                  cross(out.vertices_[size_t(t.y)], out.vertices_[size_t(t.z)])) / 6.0;
-    if (options.orient_outward && rep.closed() && rep.consistently_oriented() && rep.signed_volume < 0) {
+    rep.flipped = options.orient_outward && rep.closed() && rep.consistently_oriented() && rep.signed_volume < 0;
+    if (rep.flipped) {
         for (Int3& t : out.triangles_) std::swap(t.y, t.z);
         rep.signed_volume = -rep.signed_volume;
-        rep.flipped = true;
-        // Edge e of a flipped triangle is a different edge; rebuild the adjacency lookups below.
-        edges = EdgeUses(out.triangles_, int(out.vertices_.size()), threads);
     }
+    return rep.flipped;
+}
 
+void PreparedMesh::Topology::make_geometry(PreparedMesh& out, const EdgeUses& edges, const MeshPreparationOptions& options,
+                                           int threads) {
+    MeshReport& rep = out.report_;
     // Angle-weighted pseudonormals.
     const size_t nt = out.triangles_.size();
     out.face_normals_.resize(nt);
@@ -336,6 +260,8 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
     out.search_bound_ =
         float_search_bound(out.vertices_, out.triangles_, out.double_buffers_->packed, out.float_buffers_->packed, threads);
 
+    rep.intersections_checked = false;
+    rep.self_intersecting_pairs = rep.shell_intersecting_pairs = rep.overlapping_shells = 0;
     if (options.detect_intersections && !out.triangles_.empty()) {
         // The samplers' tree (the same build): kept, so that the mesh's BVH is built once.
         BvhBuildOptions tree;
@@ -348,6 +274,167 @@ PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions
         rep.shell_intersecting_pairs = found.between_shells;
         rep.overlapping_shells = found.overlapping_shell_pairs;
     }
+}
+
+PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options) {
+    PreparedMesh out;
+    out.name_ = mesh.name;
+    out.source_ = mesh.source;
+    out.content_sha256_ = mesh.content_sha256.empty() ? geometry_sha256(mesh) : mesh.content_sha256;
+    MeshReport& rep = out.report_;
+    rep.input_vertices = int(mesh.vertices.size());
+    rep.input_triangles = int(mesh.triangles.size());
+    rep.polygons = mesh.polygon_stats;
+    if (options.keep_input) out.input_ = std::make_shared<const PreparedMesh::InputArrays>(PreparedMesh::InputArrays{mesh.vertices, mesh.triangles});
+
+    // Weld, then drop triangles with a repeated vertex or exactly zero area.
+    std::vector<Vec3d> welded;
+    const std::vector<int> remap = weld_vertices(mesh.vertices, options.weld_tolerance, welded);
+    rep.welded_vertices = int(mesh.vertices.size() - welded.size());
+    const int threads = resolve_thread_count(options.threads);
+    const int64_t input_triangles = int64_t(mesh.triangles.size());
+    const std::vector<uint8_t> degenerate = degenerate_triangles(mesh.triangles, remap, welded, threads);
+    std::vector<Int3> tris;
+    tris.reserve(size_t(input_triangles));
+    out.source_triangle_.reserve(size_t(input_triangles));
+    for (int64_t i = 0; i < input_triangles; ++i) {
+        if (degenerate[size_t(i)]) {
+            ++rep.degenerate_triangles;
+            continue;
+        }
+        tris.push_back(welded_triangle(remap, mesh.triangles[size_t(i)]));
+        out.source_triangle_.push_back(int(i));
+    }
+
+    // Nothing left to measure distance to: every sampler, BVH and lattice fit downstream
+    // assumes at least one triangle, so refuse here, where the file can still be named.
+    if (tris.empty())
+        throw std::runtime_error((mesh.source.empty() ? mesh.name : mesh.source) + ": no triangle left: all " +
+                                 std::to_string(mesh.triangles.size()) +
+                                 " triangles are degenerate (repeated vertex or zero area); expected at least one "
+                                 "triangle with three distinct, non-collinear vertices");
+
+    // Compact away unreferenced vertices.
+    std::vector<int> used(welded.size(), -1), welded_of;
+    for (Int3& t : tris)
+        for (int k = 0; k < 3; ++k) {
+            int& id = used[size_t(t[k])];
+            if (id < 0) {
+                id = int(out.vertices_.size());
+                out.vertices_.push_back(welded[size_t(t[k])]);
+                welded_of.push_back(t[k]);
+            }
+            t[k] = id;
+        }
+    rep.unreferenced_vertices = int(welded.size() - out.vertices_.size());
+    out.triangles_ = std::move(tris);
+
+    // Edge adjacency: boundary, non-manifold and orientation checks; components.
+    EdgeUses edges(out.triangles_, int(out.vertices_.size()), threads);
+    std::vector<int> parent(out.triangles_.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    edges.for_each([&](const EdgeUse* uses, size_t count) {
+        if (count == 1) ++rep.boundary_edges;
+        if (count > 2) ++rep.nonmanifold_edges;
+        if (count == 2 && uses[0].forward == uses[1].forward) ++rep.inconsistent_edges;
+        for (size_t u = 1; u < count; ++u)
+            parent[size_t(find_root(parent, uses[u].triangle))] = find_root(parent, uses[0].triangle);
+    });
+    out.shell_of_.assign(parent.size(), -1);
+    std::vector<int> shell_of_root(parent.size(), -1);
+    for (size_t i = 0; i < parent.size(); ++i) {
+        int& shell = shell_of_root[size_t(find_root(parent, int(i)))];
+        if (shell < 0) shell = rep.components++;
+        out.shell_of_[i] = shell;
+    }
+
+    // Orientation: make a closed, consistent mesh point outward. Edge e of a flipped triangle
+    // is a different edge: the adjacency lookups are made again.
+    using Topology = PreparedMesh::Topology;
+    if (Topology::orient(out, options)) edges = EdgeUses(out.triangles_, int(out.vertices_.size()), threads);
+    Topology::make_geometry(out, edges, options, threads);
+    if (options.keep_topology)
+        out.topology_ = std::make_shared<const Topology>(
+            Topology{options, mesh.triangles, remap, degenerate, std::move(welded_of), std::move(edges)});
+    return out;
+}
+
+namespace {
+
+[[noreturn]] void refuse_refit(const PreparedMesh& mesh, const std::string& why) {
+    throw std::invalid_argument("refit of mesh '" + mesh.name() + "': " + why +
+                                "; refit keeps the topology of the mesh's first preparation: prepare the moved mesh anew");
+}
+
+/// What welding did with input vertex i, for messages.
+std::string weld_fate(const std::vector<int>& weld, size_t i) {
+    size_t first = 0;
+    while (weld[first] != weld[i]) ++first;
+    return first == i ? "a vertex of its own" : "welded to input vertex " + std::to_string(first);
+}
+
+}  // namespace
+
+PreparedMesh refit_prepared_mesh(const PreparedMesh& mesh, const TriangleMesh& moved) {
+    if (!mesh.topology_) refuse_refit(mesh, "it was prepared without keep_topology");
+    const PreparedMesh::Topology& topo = *mesh.topology_;
+    const MeshPreparationOptions& options = topo.options;
+    if (moved.vertices.size() != topo.weld.size())
+        refuse_refit(mesh, "expected " + std::to_string(topo.weld.size()) + " vertices (one per input vertex), got " +
+                               std::to_string(moved.vertices.size()));
+    if (moved.triangles != topo.input_triangles) refuse_refit(mesh, "the triangles differ from the input's");
+    const int threads = resolve_thread_count(options.threads);
+
+    // The welds and the dropped triangles must be the ones a preparation of the new
+    // positions makes. With tolerance 0 that is checked without the welding's map of lists
+    // (welds_like); else, and to say how they differ, the welding runs and is compared.
+    std::vector<Vec3d> welded;
+    std::vector<int> remap;
+    if (options.weld_tolerance == 0 && welds_like(moved.vertices, topo.weld, welded, threads))
+        remap = topo.weld;
+    else
+        remap = weld_vertices(moved.vertices, options.weld_tolerance, welded = {});
+    const auto differs = std::mismatch(remap.begin(), remap.end(), topo.weld.begin());
+    if (differs.first != remap.end()) {
+        const size_t i = size_t(differs.first - remap.begin());
+        std::ostringstream tolerance;
+        tolerance << options.weld_tolerance;
+        refuse_refit(mesh, "input vertex " + std::to_string(i) + " was " + weld_fate(topo.weld, i) +
+                               " when the mesh was prepared and is " + weld_fate(remap, i) +
+                               " at the new positions (weld_tolerance " + tolerance.str() + ")");
+    }
+    const std::vector<uint8_t> degenerate = degenerate_triangles(moved.triangles, remap, welded, threads);
+    const auto changed = std::mismatch(degenerate.begin(), degenerate.end(), topo.degenerate.begin());
+    if (changed.first != degenerate.end()) {
+        const size_t t = size_t(changed.first - degenerate.begin());
+        refuse_refit(mesh, "input triangle " + std::to_string(t) + (*changed.first ? " is" : " is not") +
+                               " degenerate (collinear corners) at the new positions and" +
+                               (*changed.first ? " was not" : " was") + " when the mesh was prepared");
+    }
+
+    PreparedMesh out;
+    out.name_ = moved.name;
+    out.source_ = moved.source;
+    out.content_sha256_ = moved.content_sha256.empty() ? geometry_sha256(moved) : moved.content_sha256;
+    if (options.keep_input) out.input_ = std::make_shared<const PreparedMesh::InputArrays>(PreparedMesh::InputArrays{moved.vertices, moved.triangles});
+    // The face-derived counts are the first preparation's; the positions' are made below.
+    out.report_ = mesh.report_;
+    out.report_.polygons = moved.polygon_stats;
+    out.source_triangle_ = mesh.source_triangle_;
+    out.shell_of_ = mesh.shell_of_;
+    out.vertices_.resize(topo.welded_of.size());
+    for (size_t v = 0; v < topo.welded_of.size(); ++v) out.vertices_[v] = welded[size_t(topo.welded_of[v])];
+    out.triangles_ = mesh.triangles_;
+    if (mesh.report_.flipped)  // back to the input's orientation, which preparation orients
+        for (Int3& t : out.triangles_) std::swap(t.y, t.z);
+    if (PreparedMesh::Topology::orient(out, options) == mesh.report_.flipped) {
+        out.topology_ = mesh.topology_;
+    } else {  // turned inside out: the flip differs, and so the triangles' edges
+        PreparedMesh::Topology flipped{options, topo.input_triangles, topo.weld, topo.degenerate, topo.welded_of,
+                                       EdgeUses(out.triangles_, int(out.vertices_.size()), threads)};
+        out.topology_ = std::make_shared<const PreparedMesh::Topology>(std::move(flipped));
+    }
+    PreparedMesh::Topology::make_geometry(out, out.topology_->edges, options, threads);
     return out;
 }
 

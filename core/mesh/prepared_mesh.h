@@ -35,6 +35,10 @@ struct MeshPreparationOptions {
     /// numbering of query results, for callers that have no other copy (the Python module's
     /// meshes read from files).
     bool keep_input = false;
+    /// Keep what preparation derives from the faces alone (the welds, the dropped triangles,
+    /// the edge adjacency, about 60 bytes a triangle), so that refit_prepared_mesh() can move
+    /// the vertices without deriving it again (the Python module's SDF.refit).
+    bool keep_topology = false;
 };
 
 /// What preparation found; printed in summaries and stored in field headers.
@@ -125,9 +129,15 @@ public:
     /// is its build time either way. Throws what build_triangle_bvh throws.
     std::shared_ptr<const TriangleBvh> bvh(bool* built_by_this_call = nullptr) const;
 
+    /// Whether refit_prepared_mesh() can move its vertices (prepared with keep_topology).
+    bool refittable() const { return topology_ != nullptr; }
+
 private:
     friend PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options);
+    friend PreparedMesh refit_prepared_mesh(const PreparedMesh& mesh, const TriangleMesh& moved);
     PreparedMesh() = default;
+    struct Topology;  // prepared_mesh.cpp: the face-derived part, shared by a mesh's refits
+    std::shared_ptr<const Topology> topology_;
 
     std::string name_, source_, content_sha256_;
     std::vector<Vec3d> vertices_;
@@ -157,6 +167,19 @@ private:
 };
 
 PreparedMesh prepare_mesh(const TriangleMesh& mesh, const MeshPreparationOptions& options = {});
+
+/// A deforming mesh of the same topology: prepare_mesh(moved, the options `mesh` was prepared
+/// with), bit for bit, where `moved` has `mesh`'s input triangles and new positions for its
+/// input vertices, without deriving again what the faces alone decide (the welds, the
+/// triangles dropped, the edge adjacency, boundary, non-manifold and orientation counts, the
+/// shells). The geometry is made again: positions, signed volume, normals and pseudonormals,
+/// bounds, buffers, the BVH and the self-intersection check. The outward flip follows the
+/// new signed volume, as preparation's. Throws std::invalid_argument, naming the first input
+/// vertex or triangle, where the new positions would change that topology (two vertices
+/// welded or no longer welded, a triangle newly degenerate or no longer degenerate), or when
+/// `mesh` was not prepared with keep_topology or `moved` has other triangles: prepare the
+/// moved mesh anew then.
+PreparedMesh refit_prepared_mesh(const PreparedMesh& mesh, const TriangleMesh& moved);
 
 
 }  // namespace sdf

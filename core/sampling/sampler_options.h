@@ -39,6 +39,12 @@ struct DeviceSelection {
     bool operator==(const DeviceSelection& o) const { return all == o.all && list == o.list; }
 };
 
+/// SamplerOptions::min_points_per_device's default, 2^23. Measured on two H200s (docs/
+/// distributed.md): 4.19M query points (2.1M a device) took longer on two GPUs than on one
+/// (0.078 s against 0.058 s), a CC 512^3 lattice (67M points a device) half the kernel time
+/// (0.117 s against 0.216 s); 2^23 lies between, with a factor 4 of margin on the loss.
+inline constexpr int64_t kDefaultMinPointsPerDevice = int64_t(1) << 23;
+
 struct SamplerOptions {
     std::string backend = "auto";  ///< "auto", or a backend of the sampler table ("cpu", "cuda")
     std::string method = "bvh";    ///< a method of the sampler table ("bvh", "brute_force")
@@ -65,6 +71,11 @@ struct SamplerOptions {
     /// on the device where that gives the same field as the host build (pseudonormal sign),
     /// else on the host; host and device force one. The CPU samplers always build on the host.
     BvhBuildSite bvh_build = BvhBuildSite::Auto;
+    /// Several devices (`devices`): the fewest points each device must get before a lattice
+    /// or point list is split over them; a smaller job runs on the first device and the
+    /// report says why (harness/sampling/multi_device_sampler.h; docs/distributed.md, "When a
+    /// job is split"). 0 or 1 splits whatever can be split (tests).
+    int64_t min_points_per_device = kDefaultMinPointsPerDevice;
 };
 
 /// Whether a field decides the sampled values.
@@ -94,7 +105,7 @@ struct OptionField {
 };
 
 /// The number of rows below; the codec checks it against the struct's field count.
-inline constexpr std::size_t kSamplerOptionFields = 15;
+inline constexpr std::size_t kSamplerOptionFields = 16;
 
 /// Calls f(OptionField, member) for every field of `o`, in the order above. `O` is
 /// SamplerOptions or const SamplerOptions.
@@ -121,6 +132,9 @@ void for_each_sampler_option(O& o, F&& f) {
       o.points_per_thread);
     f(OptionField{"band_width", R::Result, D::Width, "a band width in mesh units (0 = no band)"}, o.band_width);
     f(OptionField{"bvh_build", R::Execution, D::Named, "where the GPU BVH is built"}, o.bvh_build);
+    f(OptionField{"min_points_per_device", R::Execution, D::Count,
+                  "a point count: the fewest points a device gets before a job is split over several"},
+      o.min_points_per_device);
 }
 
 /// Names of the enums a sampler option takes (the first is the default of a new struct).

@@ -5,7 +5,8 @@
 ///    "precision": "float" | "double", "sign": "auto" | "pseudonormal" | "winding",
 ///    "threads": 0, "bcc_strategy": "two_grids" | "double_resolution", "progress": true,
 ///    "device": 0, "devices": "all" | [0, 1] | [], "max_points_per_piece": 0, "max_triangles_per_chunk": 0,
-///    "points_per_thread": 0, "band_width": 0, "bvh_build": "auto" | "host" | "device"}
+///    "points_per_thread": 0, "band_width": 0, "bvh_build": "auto" | "host" | "device",
+///    "min_points_per_device": 8388608}
 /// and every other place options travel as JSON: the tools' command lines, the Python
 /// module's keywords, the MPI wire, the run's manifest, the field cache's key. Every absent
 /// key takes the struct's default (docs/harness.md, "Defaults").

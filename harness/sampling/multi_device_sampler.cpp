@@ -16,19 +16,36 @@
 
 namespace sdf {
 
-int device_parts(int64_t points, int devices, int64_t min_points, std::string& why_not) {
-    why_not.clear();
-    if (devices <= 1) {
-        why_not = "one device";
-        return 1;
-    }
-    const int64_t by_size = min_points > 0 ? points / min_points : points;
+DeviceSplit plan_device_split(int64_t points, int planes, int devices, int64_t min_points_per_device) {
+    DeviceSplit d;
+    d.requested = std::max(devices, 1);
+    d.points = points;
+    d.min_points_per_device = min_points_per_device;
+    const int64_t least = std::max<int64_t>(min_points_per_device, 1);
+    const std::string requested = std::to_string(d.requested) + " devices requested, ";
+    if (d.requested == 1) return d;
+    const int64_t by_size = points / least;
     if (by_size < 2) {
-        why_not = std::to_string(points) + " points: too few to split (at least " + std::to_string(min_points) +
-                  " points a device)";
-        return 1;
+        d.why = requested + "1 used: " + std::to_string(points) + " points, fewer than 2 x " + std::to_string(least) +
+                " (min_points_per_device: the fewest points a device is given)";
+        return d;
     }
-    return int(std::min<int64_t>(devices, by_size));
+    d.used = int(std::min<int64_t>(d.requested, by_size));
+    if (d.used < d.requested)
+        d.why = requested + std::to_string(d.used) + " used: " + std::to_string(points) + " points, " +
+                std::to_string(least) + " or more a device (min_points_per_device)";
+    if (planes >= 0 && planes < d.used) {
+        d.used = std::max(planes, 1);
+        d.why = requested + std::to_string(d.used) + " used: " + std::to_string(planes) + " z-plane" +
+                (planes == 1 ? "" : "s") + ", one or more a device";
+    }
+    return d;
+}
+
+nlohmann::json DeviceSplit::to_json() const {
+    nlohmann::json j = {{"count", requested}, {"used", used}, {"split", split()}, {"min_points_per_device", min_points_per_device}};
+    if (!why.empty()) j[split() ? "why_fewer" : "why_not"] = why;
+    return j;
 }
 
 std::vector<LatticeSlab> split_slab(const std::vector<double>& plane_cost, const LatticeSlab& slab, int parts) {
@@ -117,9 +134,9 @@ nlohmann::json part_record(const nlohmann::json& device, const SamplingTimings& 
 class BoundMultiDevice final : public BoundSampler {
 public:
     BoundMultiDevice(std::shared_ptr<const PreparedMesh> mesh, const std::vector<std::unique_ptr<Sampler>>& samplers,
-                     std::vector<int> devices, SamplerOptions options, DeviceDescriber describe, int64_t min_points)
+                     std::vector<int> devices, SamplerOptions options, DeviceDescriber describe)
         : BoundSampler(mesh), devices_(std::move(devices)), options_(std::move(options)), describe_(std::move(describe)),
-          min_points_(min_points), bound_(samplers.size()) {
+          bound_(samplers.size()) {
         // Each device's tree and uploads are made on its own thread, at once.
         on_each_device(devices_, samplers.size(), [&](size_t i) { bound_[i] = samplers[i]->bind(mesh); });
     }
@@ -129,19 +146,16 @@ public:
 
     SampledField sample_slab(const Lattice& lattice, const LatticeSlab& slab) const override {
         const auto t0 = std::chrono::steady_clock::now();
-        std::string why_not;
-        const int parts = device_parts(slab_point_count(lattice, slab), int(bound_.size()), min_points_, why_not);
-        if (parts == 1 || slab.z_end - slab.z_begin < 2) {
-            if (why_not.empty()) why_not = "one z-plane";
+        const DeviceSplit split = lattice_split(lattice, slab);
+        if (!split.split()) {
             SampledField field = bound_[0]->sample_slab(lattice, slab);
-            field.sampler.details["devices"] = {
-                {"count", bound_.size()}, {"split", false}, {"why_not", why_not},
-                {"parts", {with_planes(part_record(describe_(devices_[0]), field.timings, seconds_since(t0), field.size()), slab)}}};
+            field.sampler.details["devices"] = record(
+                split, {with_planes(part_record(describe_(devices_[0]), field.timings, seconds_since(t0), field.size()), slab)});
             return field;
         }
         std::string estimate;
         const std::vector<double> cost = plane_costs(mesh(), lattice, options_, estimate, slab);
-        const std::vector<LatticeSlab> subs = split_slab(cost, slab, parts);
+        const std::vector<LatticeSlab> subs = split_slab(cost, slab, split.used);
         // The field's arrays (36 bytes a point, each page mapped at its first write) are made
         // on another thread while the devices compute, as one device's sampler does.
         require_search_range(mesh(), lattice, options_.precision);
@@ -173,7 +187,7 @@ public:
         made.get();  // rethrows a failed allocation (also when every device failed first)
         SamplerReport merged;
         for (const SamplerReport& r : reports) merged.merge(r);  // in slab order: the details are the first part's
-        merged.details["devices"] = {{"count", bound_.size()}, {"split", true}, {"cost_estimate", estimate}, {"parts", records}};
+        merged.details["devices"] = record(split, records, estimate);
         field.sampler = std::move(merged);
         field.mesh = provenance;
         for (const SamplingTimings& t : timings) add_part_timings(field.timings, t);
@@ -186,20 +200,17 @@ public:
     std::optional<StoredSlab> sample_slab_stored(const Lattice& lattice, const LatticeSlab& slab,
                                                  const StoredLayout& layout) const override {
         const auto t0 = std::chrono::steady_clock::now();
-        std::string why_not;
-        const int parts = device_parts(slab_point_count(lattice, slab), int(bound_.size()), min_points_, why_not);
-        if (parts == 1 || slab.z_end - slab.z_begin < 2) {
-            if (why_not.empty()) why_not = "one z-plane";
+        const DeviceSplit split = lattice_split(lattice, slab);
+        if (!split.split()) {
             std::optional<StoredSlab> one = bound_[0]->sample_slab_stored(lattice, slab, layout);
             if (one)
-                one->info.sampler.details["devices"] = {
-                    {"count", bound_.size()}, {"split", false}, {"why_not", why_not},
-                    {"parts", {with_planes(part_record(describe_(devices_[0]), one->info.timings, seconds_since(t0), one->points), slab)}}};
+                one->info.sampler.details["devices"] = record(
+                    split, {with_planes(part_record(describe_(devices_[0]), one->info.timings, seconds_since(t0), one->points), slab)});
             return one;
         }
         std::string estimate;
         const std::vector<double> cost = plane_costs(mesh(), lattice, options_, estimate, slab);
-        const std::vector<LatticeSlab> subs = split_slab(cost, slab, parts);
+        const std::vector<LatticeSlab> subs = split_slab(cost, slab, split.used);
         const int64_t points = slab_point_count(lattice, slab);
         const size_t vb = layout.value_bytes();
         auto bytes = std::make_shared<std::vector<char>>(size_t(points) * layout.bytes_per_point());
@@ -239,7 +250,7 @@ public:
         out.info = std::move(got[0]->info);  // lattice, precision, mesh
         out.info.sampler = std::move(merged);
         out.info.timings = timings;
-        out.info.sampler.details["devices"] = {{"count", bound_.size()}, {"split", true}, {"cost_estimate", estimate}, {"parts", records}};
+        out.info.sampler.details["devices"] = record(split, records, estimate);
         out.info.timings.total = seconds_since(t0);
         out.points = points;
         out.distance = distance;
@@ -250,11 +261,10 @@ public:
     }
 
     std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings) const override {
-        std::string why_not;
-        const int parts = device_parts(int64_t(points.size()), int(bound_.size()), min_points_, why_not);
-        if (parts == 1) return bound_[0]->query(points, timings);
+        const DeviceSplit split = points_split(int64_t(points.size()));
+        if (!split.split()) return bound_[0]->query(points, timings);
         const auto t0 = std::chrono::steady_clock::now();
-        const std::vector<PointRange> ranges = split_points(int64_t(points.size()), parts);
+        const std::vector<PointRange> ranges = split_points(int64_t(points.size()), split.used);
         std::vector<PointSample> out(points.size());
         std::vector<SamplingTimings> t(ranges.size());
         on_each_device(devices_, ranges.size(), [&](size_t i) {
@@ -272,11 +282,10 @@ public:
     }
 
     void query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings) const override {
-        std::string why_not;
-        const int parts = device_parts(points.count, int(bound_.size()), min_points_, why_not);
-        if (parts == 1) return bound_[0]->query_host(points, results, timings);
+        const DeviceSplit split = points_split(points.count);
+        if (!split.split()) return bound_[0]->query_host(points, results, timings);
         const auto t0 = std::chrono::steady_clock::now();
-        const std::vector<PointRange> ranges = split_points(points.count, parts);
+        const std::vector<PointRange> ranges = split_points(points.count, split.used);
         std::vector<SamplingTimings> t(ranges.size());
         on_each_device(devices_, ranges.size(), [&](size_t i) {
             const PointRange r = ranges[i];
@@ -313,18 +322,33 @@ private:
         return record;
     }
 
+    DeviceSplit lattice_split(const Lattice& lattice, const LatticeSlab& slab) const {
+        return plan_device_split(slab_point_count(lattice, slab), slab.z_end - slab.z_begin, int(bound_.size()),
+                                 options_.min_points_per_device);
+    }
+    DeviceSplit points_split(int64_t points) const {
+        return plan_device_split(points, -1, int(bound_.size()), options_.min_points_per_device);
+    }
+
+    /// The report's "devices": the decision, the parts, and how the planes were costed.
+    static nlohmann::json record(const DeviceSplit& split, nlohmann::json parts, const std::string& estimate = "") {
+        nlohmann::json j = split.to_json();
+        if (!estimate.empty()) j["cost_estimate"] = estimate;
+        j["parts"] = std::move(parts);
+        return j;
+    }
+
     std::vector<int> devices_;
     SamplerOptions options_;
     DeviceDescriber describe_;
-    int64_t min_points_;
     std::vector<std::unique_ptr<BoundSampler>> bound_;  ///< one per device, in devices_' order
 };
 
 class MultiDeviceSampler final : public Sampler {
 public:
     MultiDeviceSampler(const SamplerOptions& options, std::vector<int> devices, const DeviceSamplerFactory& make_one,
-                       DeviceDescriber describe, int64_t min_points)
-        : options_(options), devices_(std::move(devices)), describe_(std::move(describe)), min_points_(min_points) {
+                       DeviceDescriber describe)
+        : options_(options), devices_(std::move(devices)), describe_(std::move(describe)) {
         if (devices_.empty()) throw std::invalid_argument("sampler.devices: no device to sample on");
         for (int d : devices_) {
             SamplerOptions one = options;
@@ -339,22 +363,21 @@ public:
 
     std::unique_ptr<BoundSampler> bind(std::shared_ptr<const PreparedMesh> mesh) const override {
         if (!mesh) throw std::invalid_argument("bind: no mesh");
-        return std::make_unique<BoundMultiDevice>(std::move(mesh), samplers_, devices_, options_, describe_, min_points_);
+        return std::make_unique<BoundMultiDevice>(std::move(mesh), samplers_, devices_, options_, describe_);
     }
 
 private:
     SamplerOptions options_;
     std::vector<int> devices_;
     DeviceDescriber describe_;
-    int64_t min_points_;
     std::vector<std::unique_ptr<Sampler>> samplers_;
 };
 
 }  // namespace
 
 std::unique_ptr<Sampler> make_multi_device_sampler(const SamplerOptions& options, std::vector<int> devices,
-                                                   DeviceSamplerFactory make_one, DeviceDescriber describe, int64_t min_points) {
-    return std::make_unique<MultiDeviceSampler>(options, std::move(devices), make_one, std::move(describe), min_points);
+                                                   DeviceSamplerFactory make_one, DeviceDescriber describe) {
+    return std::make_unique<MultiDeviceSampler>(options, std::move(devices), make_one, std::move(describe));
 }
 
 }  // namespace sdf

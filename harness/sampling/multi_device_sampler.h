@@ -5,11 +5,15 @@
 /// plan MPI uses) and a point list into contiguous pieces; every point is computed by one
 /// device exactly as one device computes it alone (kernels/lattice/lattice_slab.h: a slab's
 /// blocks start at the lattice's own integer coordinates), so the field is one device's bit
-/// for bit. A job too small to split (fewer than kMinPointsPerDevice points a device, or one
-/// z-plane) runs on the first device, and the report says why.
+/// for bit. A job is split only where splitting can pay: each device used gets at least
+/// SamplerOptions::min_points_per_device points (the split threshold; its default and why
+/// in core/sampling/sampler_options.h and docs/distributed.md), and a lattice at least one
+/// z-plane; a smaller job runs on the first device, or on fewer devices, and the report says
+/// why (plan_device_split).
 ///
 /// Report: the parts' SamplerReports merged (SamplerReport::merge) plus details "devices":
-///   {"count", "split", "why_not" (unsplit only), "cost_estimate" (lattices),
+///   {"count" (requested), "used", "split", "min_points_per_device",
+///    "why_not" (unsplit) | "why_fewer" (split over fewer than requested), "cost_estimate" (lattices),
 ///    "parts": [{"device": {index, name, pci_bus_id, ...}, "z_planes" | "rows", "points",
 ///               "seconds", "kernel_seconds", "upload_seconds", "download_seconds"}]}
 /// Timings: kernel, upload and download are the largest part's (the devices run at once),
@@ -28,19 +32,31 @@
 
 namespace sdf {
 
-/// Fewest points a device is given: below this, a GPU's launch, transfer and thread start
-/// cost more than the share of work it takes off the others (a 64^3 lattice is 262,144).
-inline constexpr int64_t kMinPointsPerDevice = int64_t(1) << 18;
-
 /// Rows [begin, begin + count) of a point list.
 struct PointRange {
     int64_t begin = 0;
     int64_t count = 0;
 };
 
-/// How many parts `points` points go into over `devices` devices: at most one a device, each
-/// at least `min_points`; 1 with `why_not` set when the job is not split.
-int device_parts(int64_t points, int devices, int64_t min_points, std::string& why_not);
+/// How a job goes over the devices of a multi-device sampler: the decision and its reason.
+struct DeviceSplit {
+    int requested = 1;                 ///< devices the sampler drives
+    int used = 1;                      ///< devices this job runs on: the first `used`
+    int64_t points = 0;
+    int64_t min_points_per_device = 0; ///< the split threshold it was decided with
+    std::string why;                   ///< why fewer than requested are used ("" when all are)
+    bool split() const { return used > 1; }
+    /// {"count", "used", "split", "min_points_per_device", "why_not" | "why_fewer"}.
+    nlohmann::json to_json() const;
+};
+
+/// The split of a job of `points` points over `devices` devices: at most one part a device,
+/// each of at least `min_points_per_device` points (0 counts as 1) and, for a lattice
+/// (`planes` >= 0 z-planes; -1 for a point list), at least one z-plane. A job below the
+/// threshold runs on one device, with `why` saying so: "2 devices requested, 1 used:
+/// 4194304 points, fewer than 2 x 8388608 (min_points_per_device: the fewest points a device
+/// is given)".
+DeviceSplit plan_device_split(int64_t points, int planes, int devices, int64_t min_points_per_device);
 
 /// Cuts planes [slab.z_begin, slab.z_end) into `parts` contiguous slabs of about equal
 /// `plane_cost` (indexed by the lattice's planes), each at least one plane; fewer parts when
@@ -60,9 +76,8 @@ using DeviceSamplerFactory = std::function<std::unique_ptr<Sampler>(const Sample
 using DeviceDescriber = std::function<nlohmann::json(int device)>;
 
 /// The sampler over `devices` (at least one): `make_one` is called once per device with
-/// `options` naming that device. `min_points` is kMinPointsPerDevice but for tests.
+/// `options` naming that device; jobs are split by options.min_points_per_device.
 std::unique_ptr<Sampler> make_multi_device_sampler(const SamplerOptions& options, std::vector<int> devices,
-                                                   DeviceSamplerFactory make_one, DeviceDescriber describe,
-                                                   int64_t min_points = kMinPointsPerDevice);
+                                                   DeviceSamplerFactory make_one, DeviceDescriber describe);
 
 }  // namespace sdf

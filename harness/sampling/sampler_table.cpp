@@ -135,4 +135,13 @@ std::unique_ptr<Sampler> make_sampler(const SamplerOptions& options) {
 #endif
 }
 
+int sampler_device_count(const SamplerOptions& options) {
+    if (!sampler_kind(options).on_gpu || options.devices.is_default()) return 1;
+#if SDF_HAVE_CUDA
+    return int(resolve_devices(options, cuda::device_count()).size());
+#else
+    return 1;
+#endif
+}
+
 }  // namespace sdf

@@ -64,4 +64,9 @@ std::unique_ptr<Sampler> make_sampler(const SamplerOptions& options);
 /// True when this build has the CUDA backend and a GPU is present.
 bool cuda_backend_available();
 
+/// How many devices the sampler make_sampler(options) makes drives: 1 on the CPU or with the
+/// default `devices`, else the selection's visible devices (resolve_devices); what a point
+/// query's split is decided over (plan_device_split, multi_device_sampler.h).
+int sampler_device_count(const SamplerOptions& options);
+
 }  // namespace sdf

@@ -38,6 +38,7 @@ class SamplerKeywords(TypedDict, total=False):
     max_triangles_per_chunk: int  # 0 = automatic
     points_per_thread: int        # 0, 1, 2, 4, 8
     band_width: float             # 0 = no band (lattices only)
+    min_points_per_device: int    # with devices: fewest points a GPU gets before a job is split (default 2**23)
 
 class SdfWarning(UserWarning): ...
 class MeshWarning(SdfWarning): ...
@@ -73,6 +74,7 @@ class QueryResult:
     sign: str
     sampler: str
     timings_seconds: Dict[str, float]
+    devices: Dict[str, Any]       # count, used, split, min_points_per_device, why_not | why_fewer
     def __len__(self) -> int: ...
 
 class DeviceQueryResult:

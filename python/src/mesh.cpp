@@ -1,8 +1,6 @@
 // Meshes: sdf_lattices.Mesh (a PreparedMesh: from arrays or from a file, as sdf-query loads
 // and prepares it), load_mesh and cuda_available.
-#include <map>
-#include <mutex>
-#include <optional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -18,32 +16,13 @@
 namespace sdf {
 namespace {
 
-/// The options each Python mesh was prepared with, which SDF.refit repeats. PreparedMesh
-/// does not keep them (core/mesh/prepared_mesh.h), and every Python mesh is made by
-/// prepare() below; entries expire with their mesh (a weak_ptr checks that an address is
-/// still the mesh it was, not a later one at the same address).
-class PreparationOptionsTable {
-public:
-    void add(const MeshHolder& mesh, const MeshPreparationOptions& options) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (auto it = entries_.begin(); it != entries_.end();) it = it->second.first.expired() ? entries_.erase(it) : std::next(it);
-        entries_[mesh.get()] = {mesh, options};
-    }
-    std::optional<MeshPreparationOptions> find(const PreparedMesh& mesh) const {
-        std::lock_guard<std::mutex> lock(mutex_);
-        const auto it = entries_.find(&mesh);
-        if (it == entries_.end() || it->second.first.lock().get() != &mesh) return std::nullopt;
-        return it->second.second;
-    }
-
-private:
-    mutable std::mutex mutex_;
-    std::map<const PreparedMesh*, std::pair<std::weak_ptr<const PreparedMesh>, MeshPreparationOptions>> entries_;
-};
-
-PreparationOptionsTable& preparation_options() {
-    static PreparationOptionsTable table;
-    return table;
+/// The preparation's warnings, raised as MeshWarning at the caller's line.
+void warn_about(const PreparedMesh& prepared) {
+    const std::vector<std::string> warnings = prepared.warnings();
+    if (warnings.empty()) return;
+    const py::module_ module = py::module_::import("sdf_lattices._warnings");
+    const py::object category = module.attr("MeshWarning"), warn = module.attr("warn_at_caller");
+    for (const std::string& w : warnings) warn(w, category);
 }
 
 /// Prepares `mesh` as sdf-query does, with the GIL released (Ctrl-C stops the intersection
@@ -52,19 +31,14 @@ MeshHolder prepare(TriangleMesh mesh, double weld_tolerance, bool check_intersec
     MeshPreparationOptions o;
     o.weld_tolerance = weld_tolerance;
     o.detect_intersections = check_intersections;
-    o.keep_input = true;  // Mesh.input_vertices and input_faces: the numbering of query results
+    o.keep_input = true;     // Mesh.input_vertices and input_faces: the numbering of query results
+    o.keep_topology = true;  // SDF.refit
     if (!(weld_tolerance >= 0)) throw std::invalid_argument("weld_tolerance: expected a distance >= 0");
     TaskOptions task;
     task.total = int64_t(mesh.triangles.size());
     task.label = "preparing '" + mesh.name + "'";
     MeshHolder prepared = run_task([&] { return std::make_shared<PreparedMesh>(prepare_mesh(mesh, o)); }, task);
-    preparation_options().add(prepared, o);
-    const std::vector<std::string> warnings = prepared->warnings();
-    if (!warnings.empty()) {
-        const py::module_ module = py::module_::import("sdf_lattices._warnings");
-        const py::object category = module.attr("MeshWarning"), warn = module.attr("warn_at_caller");
-        for (const std::string& w : warnings) warn(w, category);  // at the caller's line
-    }
+    warn_about(*prepared);
     return prepared;
 }
 
@@ -135,8 +109,7 @@ std::string mesh_repr(const PreparedMesh& m) {
 }  // namespace
 
 MeshHolder refit_mesh(const MeshHolder& mesh, const py::array& new_vertices) {
-    const std::optional<MeshPreparationOptions> options = preparation_options().find(*mesh);
-    if (!options) throw std::invalid_argument("refit: mesh '" + mesh->name() + "' was not prepared by this module");
+    if (!mesh->refittable()) throw std::invalid_argument("refit: mesh '" + mesh->name() + "' was not prepared by this module");
     const size_t rows = mesh->input_vertices().size();
     TriangleMesh m;
     m.name = mesh->name();
@@ -148,18 +121,13 @@ MeshHolder refit_mesh(const MeshHolder& mesh, const py::array& new_vertices) {
                                     std::to_string(m.vertices.size()));
     m.triangles = mesh->input_triangles();
     m.content_sha256 = geometry_sha256(m);
-    MeshHolder refitted = prepare(std::move(m), options->weld_tolerance, options->detect_intersections);
-    // Welding, dropping and orientation depend on the positions: refit keeps the prepared
-    // connectivity (and so the numbering the caller's gradients and triangles refer to).
-    if (refitted->triangles() != mesh->triangles() || refitted->source_triangle() != mesh->source_triangle()) {
-        const MeshReport &was = mesh->report(), &now = refitted->report();
-        throw std::invalid_argument(
-            "refit of mesh '" + mesh->name() + "': the new vertices change its connectivity after preparation (triangles kept: " +
-            std::to_string(mesh->triangles().size()) + " before, " + std::to_string(refitted->triangles().size()) +
-            " now; welded vertices: " + std::to_string(was.welded_vertices) + " before, " + std::to_string(now.welded_vertices) +
-            " now; flipped outward: " + (was.flipped ? "yes" : "no") + " before, " + (now.flipped ? "yes" : "no") +
-            " now). refit needs the same welded, cleaned and oriented triangles; build a new SDF of the new vertices instead");
-    }
+    TaskOptions task;
+    task.total = int64_t(m.triangles.size());
+    task.label = "refitting '" + m.name + "'";
+    // The topology of the first preparation is kept (core/mesh/prepared_mesh.h): ValueError
+    // where the new positions would weld or drop otherwise.
+    MeshHolder refitted = run_task([&] { return std::make_shared<PreparedMesh>(refit_prepared_mesh(*mesh, m)); }, task);
+    warn_about(*refitted);
     return refitted;
 }
 

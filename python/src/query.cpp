@@ -14,6 +14,8 @@
 
 #include "core/parallel/parallel_for.h"
 #include "harness/sampling/mesh_sdf.h"
+#include "harness/sampling/multi_device_sampler.h"
+#include "harness/sampling/sampler_table.h"
 #include "python/src/common.h"
 #include "python/src/field.h"
 #include "python/src/mesh.h"
@@ -313,6 +315,12 @@ void bind_query(py::module_& m) {
             return d;
         }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
            "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (the CPU's, CUDA brute force).")
+        .def_property_readonly("devices", [](const QueryResult& r) {
+            const SamplerOptions& o = r.sdf->options();
+            return json_to_python(plan_device_split(r.points.points.count, -1, sampler_device_count(o), o.min_points_per_device).to_json());
+        }, "How the points went over the SDF's devices (SDF(..., devices=...)): {'count': devices requested, 'used', "
+           "'split', 'min_points_per_device' (the split threshold), 'why_not' or 'why_fewer'}; a query of fewer than "
+           "2 x min_points_per_device points runs on the first device.")
         .def("__len__", [](const QueryResult& r) { return r.distance.size(); })
         .def("__repr__", &query_repr);
 
@@ -365,11 +373,15 @@ The SDF of the same mesh with its vertices moved (a deforming mesh of the same t
 new_vertices has one row per input vertex (Mesh.input_vertices: the rows the faces index),
 the faces stay. The result is a new SDF with this one's sampler options, equal bit for bit
 to SDF(Mesh(new_vertices, mesh.input_faces, weld_tolerance=..., check_intersections=...),
-same options): the positions' data are made again (welding, degenerate triangles,
-orientation, pseudonormals, the self-intersection check and the sign's choice, the BVH, the
-winding data and the GPU upload). The prepared connectivity must stay the same (the same
-welds, no triangle newly degenerate, the same outward flip), so that triangle numbers and
-vertex gradients keep referring to the same faces; ValueError otherwise (build a new SDF).
+same options). What the faces alone decide is kept from the first preparation and not
+derived again (the welds, the degenerate triangles dropped, the edge adjacency, boundary,
+non-manifold and orientation counts, the shells); what the positions decide is made again
+(the signed volume and the outward flip, normals and pseudonormals, bounds, the
+self-intersection check and so the sign's choice, the BVH, the winding data and the GPU
+upload). ValueError, naming the vertex or triangle, where the new positions would weld or
+drop otherwise than the first preparation (two vertices welded or no longer welded, a
+triangle newly degenerate or no longer degenerate): build a new SDF then. Triangle numbers
+and vertex gradients keep referring to the same input faces.
 This SDF is unchanged, and results already returned stay valid.)")
         .def("sample", &sample_bound, py::arg("lattice") = lattice_type_name(LatticeType::CC), py::arg("resolution") = py::none(),
              py::arg("samples") = py::none(), py::arg("margin") = py::none(), py::arg("bounds") = py::none(),

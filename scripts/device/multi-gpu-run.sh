@@ -105,7 +105,8 @@ for k in (1, 2, 4):
     if reference is None:
         reference = r.distance
     same = "same bytes" if np.array_equal(r.distance.view(np.uint64), reference.view(np.uint64)) else "DIFFERENT"
-    print(f"| {n} points ({same}) | {k} | {t['kernel']:.3f} | {t['upload']:.3f} | {t['download']:.3f} | {t['total']:.3f} |")
+    used = f"{k}" if r.devices["used"] == k else f"{k} ({r.devices['used']} used: below the split threshold)"
+    print(f"| {n} points ({same}) | {used} | {t['kernel']:.3f} | {t['upload']:.3f} | {t['download']:.3f} | {t['total']:.3f} |")
 PY
 cat "$OUT/rows.txt" > "$OUT/scaling.md"
 cat "$OUT/scaling.md"

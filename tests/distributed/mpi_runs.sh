@@ -133,7 +133,8 @@ if [ "$case_name" = gpu ]; then
     [ "${gpus:-0}" -ge 2 ] || { echo "$gpus GPU(s) visible, this test needs 2: skipped"; exit 77; }
     sed -e 's/"backend": "cpu"/"backend": "cuda"/' -e 's/\[11, 9, 13\]/[96, 96, 96]/' -e 's/\[8, 7, 18\]/[64, 64, 128]/' \
         "$work/mpi_fields.json" > "$work/gpu.json"
-    sed 's/"backend": "cuda"/"backend": "cuda", "devices": "all"/' "$work/gpu.json" > "$work/gpu_all.json"
+    # min_points_per_device 1: these lattices are below the default split threshold.
+    sed 's/"backend": "cuda"/"backend": "cuda", "devices": "all", "min_points_per_device": 1/' "$work/gpu.json" > "$work/gpu_all.json"
     sed -i 's/"name": "mpi_fields"/"name": "mpi_fields_all"/' "$work/gpu_all.json"
     "$tool" "$work/gpu.json" --no-cache --quiet --output-root "$work/one" > "$work/one.log" 2>&1 || { cat "$work/one.log"; fail "one GPU failed"; }
     one=$(run_dir "$work/one")

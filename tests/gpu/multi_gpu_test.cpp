@@ -81,6 +81,7 @@ TEST(MultiGpu, TwoDevicesInOneProcessGiveOneDevicesBytes) {
                 one.band_width = band;
                 SamplerOptions two = one;
                 two.devices.list = {0, 1};
+                two.min_points_per_device = 1;  // split these small lattices (the default keeps them on one GPU)
                 const std::string what = method + " " + lattice_type_name(lattice.type) + " band " + std::to_string(band);
                 const SampledField a = make_sampler(one)->bind(torus())->sample(lattice);
                 const SampledField b = make_sampler(two)->bind(torus())->sample(lattice);
@@ -96,6 +97,21 @@ TEST(MultiGpu, TwoDevicesInOneProcessGiveOneDevicesBytes) {
             }
 }
 
+// The split threshold's default: a lattice too small to pay for a split runs on device 0,
+// and the report says why (SamplerOptions::min_points_per_device).
+TEST(MultiGpu, ASmallJobStaysOnOneDeviceAndSaysWhy) {
+    const Lattice lattice = lattices()[0];  // 96^3: 884,736 points, below 2 x 2^23
+    SamplerOptions two = on("bvh", 0);
+    two.devices.list = {0, 1};
+    const SampledField a = make_sampler(on("bvh", 0))->bind(torus())->sample(lattice);
+    const SampledField b = make_sampler(two)->bind(torus())->sample(lattice);
+    expect_same_bytes(a, b, "unsplit");
+    const nlohmann::json& d = b.sampler.details.at("devices");
+    EXPECT_FALSE(d.at("split").get<bool>()) << d;
+    EXPECT_EQ(d.at("used"), 1);
+    EXPECT_NE(d.at("why_not").get<std::string>().find("884736 points, fewer than 2 x 8388608"), std::string::npos) << d;
+}
+
 // sdf-sample's path: the slab's bytes as the field file stores them, made on each device.
 TEST(MultiGpu, TwoDevicesStoreOneDevicesFileBytes) {
     for (const Lattice& lattice : lattices())
@@ -103,6 +119,7 @@ TEST(MultiGpu, TwoDevicesStoreOneDevicesFileBytes) {
             const StoredLayout layout{float32, true, true};
             SamplerOptions two = on("bvh", 0);
             two.devices.list = {0, 1};
+            two.min_points_per_device = 1;
             const LatticeSlab slab{5, lattice.resolution.z - 3};
             const auto a = make_sampler(on("bvh", 0))->bind(torus())->sample_slab_stored(lattice, slab, layout);
             const auto b = make_sampler(two)->bind(torus())->sample_slab_stored(lattice, slab, layout);
@@ -121,6 +138,7 @@ TEST(MultiGpu, TwoDevicesAnswerPointQueriesAsOne) {
         make_point_set(*torus(), PointSetSpec{PointSetKind::GaussianSurface, 1'000'003, 0.02, 0.1, 11});
     SamplerOptions two = on("bvh", 0);
     two.devices.all = true;
+    two.min_points_per_device = 1;
     const auto one_bound = make_sampler(on("bvh", 0))->bind(torus());
     const auto two_bound = make_sampler(two)->bind(torus());
     const std::vector<PointSample> a = one_bound->query(points);

@@ -265,6 +265,7 @@ TEST(SamplerSpec, Defaults) {
     EXPECT_EQ(o.max_triangles_per_chunk, 0);
     EXPECT_EQ(o.points_per_thread, 0);
     EXPECT_EQ(o.bvh_build, BvhBuildSite::Auto);
+    EXPECT_EQ(o.min_points_per_device, kDefaultMinPointsPerDevice);
 }
 
 TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
@@ -272,7 +273,7 @@ TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
                     {"threads", 3},             {"precision", "double"},    {"bcc_strategy", "double_resolution"},
                     {"progress", false},        {"device", 1},              {"max_points_per_piece", 5000000000LL},
                     {"max_triangles_per_chunk", 4096}, {"points_per_thread", 4}, {"band_width", 0.125},
-                    {"bvh_build", "host"}};
+                    {"bvh_build", "host"}, {"min_points_per_device", 1}};
     const SamplerOptions o = sampler(j);
     EXPECT_EQ(o.backend, "cuda");
     EXPECT_EQ(o.kernel, "tuned");
@@ -295,6 +296,7 @@ TEST(SamplerSpec, EveryKeyReadAndWrittenBack) {
     EXPECT_EQ(back.at("band_width"), 0.125);
     EXPECT_EQ(back.at("progress"), false);
     EXPECT_EQ(back.at("bvh_build"), "host");
+    EXPECT_EQ(back.at("min_points_per_device"), 1);
     // The codec reads back what it writes: every field of the table, nothing lost.
     JsonReader again(back, "wire", "sampler");
     EXPECT_EQ(sampler_options_to_json(parse_sampler_options(again)), back);

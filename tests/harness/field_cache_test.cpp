@@ -145,7 +145,8 @@ TEST(FieldCacheKey, EveryResultOptionChangesTheKeyAndNoOtherDoes) {
     });
     EXPECT_EQ(visited, kSamplerOptionFields);
     const std::vector<std::string> must_not_key = {"backend", "threads", "progress", "device", "devices", "max_points_per_piece",
-                                                   "max_triangles_per_chunk", "points_per_thread", "bvh_build"};
+                                                   "max_triangles_per_chunk", "points_per_thread", "bvh_build",
+                                                   "min_points_per_device"};
     EXPECT_EQ(execution, must_not_key);
 }
 

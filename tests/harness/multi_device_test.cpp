@@ -114,14 +114,52 @@ TEST(DeviceSelection, RanksTakeTheGpusOfTheirHostByLocalRank) {
 }
 
 TEST(DeviceSplit, SmallJobsAreNotSplitAndSayWhy) {
-    std::string why;
-    EXPECT_EQ(device_parts(1000, 2, kMinPointsPerDevice, why), 1);
-    EXPECT_NE(why.find("too few to split"), std::string::npos) << why;
-    EXPECT_EQ(device_parts(int64_t(1) << 30, 1, kMinPointsPerDevice, why), 1);
-    EXPECT_EQ(why, "one device");
-    EXPECT_EQ(device_parts(3 * kMinPointsPerDevice, 4, kMinPointsPerDevice, why), 3);
-    EXPECT_TRUE(why.empty());
-    EXPECT_EQ(device_parts(int64_t(1) << 30, 4, kMinPointsPerDevice, why), 4);
+    // The measured losing case (docs/distributed.md): 4,194,304 query points on 2 H200s.
+    DeviceSplit d = plan_device_split(4194304, -1, 2, kDefaultMinPointsPerDevice);
+    EXPECT_EQ(d.used, 1);
+    EXPECT_FALSE(d.split());
+    EXPECT_EQ(d.why, "2 devices requested, 1 used: 4194304 points, fewer than 2 x 8388608 (min_points_per_device: the "
+                     "fewest points a device is given)");
+    json j = d.to_json();
+    EXPECT_EQ(j.at("count"), 2);
+    EXPECT_EQ(j.at("used"), 1);
+    EXPECT_EQ(j.at("split"), false);
+    EXPECT_EQ(j.at("min_points_per_device"), kDefaultMinPointsPerDevice);
+    EXPECT_EQ(j.at("why_not"), d.why);
+    EXPECT_FALSE(j.contains("why_fewer"));
+    // The measured paying case: CC 512^3 (512 z-planes) on 2 devices, and on 4.
+    EXPECT_EQ(plan_device_split(int64_t(512) * 512 * 512, 512, 2, kDefaultMinPointsPerDevice).used, 2);
+    EXPECT_EQ(plan_device_split(int64_t(512) * 512 * 512, 512, 4, kDefaultMinPointsPerDevice).used, 4);
+    // The threshold exactly: 2 x M points split in two, one fewer does not.
+    EXPECT_EQ(plan_device_split(2 * kDefaultMinPointsPerDevice, -1, 2, kDefaultMinPointsPerDevice).used, 2);
+    EXPECT_EQ(plan_device_split(2 * kDefaultMinPointsPerDevice - 1, -1, 2, kDefaultMinPointsPerDevice).used, 1);
+    // Fewer devices than requested: as many as get M points each, and the report says why.
+    d = plan_device_split(3 * kDefaultMinPointsPerDevice, -1, 4, kDefaultMinPointsPerDevice);
+    EXPECT_EQ(d.used, 3);
+    EXPECT_EQ(d.why, "4 devices requested, 3 used: 25165824 points, 8388608 or more a device (min_points_per_device)");
+    j = d.to_json();
+    EXPECT_EQ(j.at("why_fewer"), d.why);
+    EXPECT_FALSE(j.contains("why_not"));
+    // A lattice's planes: one z-plane is not split; two planes go to at most two devices.
+    d = plan_device_split(1000, 1, 2, 1);
+    EXPECT_EQ(d.used, 1);
+    EXPECT_EQ(d.why, "2 devices requested, 1 used: 1 z-plane, one or more a device");
+    EXPECT_EQ(plan_device_split(1000, 2, 4, 1).used, 2);
+    // One device: nothing to say. A threshold of 0 or 1 splits whatever can be (tests).
+    d = plan_device_split(int64_t(1) << 30, 7, 1, kDefaultMinPointsPerDevice);
+    EXPECT_EQ(d.used, 1);
+    EXPECT_TRUE(d.why.empty());
+    EXPECT_EQ(plan_device_split(2, -1, 2, 0).used, 2);
+    EXPECT_EQ(plan_device_split(3, -1, 4, 1).used, 3);
+}
+
+TEST(DeviceSplit, TheThresholdIsATypedOptionWithItsDefault) {
+    EXPECT_EQ(SamplerOptions{}.min_points_per_device, int64_t(1) << 23);
+    EXPECT_EQ(read(json::object()).min_points_per_device, kDefaultMinPointsPerDevice);
+    EXPECT_EQ(read({{"min_points_per_device", 1}}).min_points_per_device, 1);
+    EXPECT_EQ(sampler_options_to_json(read({{"min_points_per_device", 4096}})).at("min_points_per_device"), 4096);
+    const std::string e = error_of({{"min_points_per_device", -1}});
+    EXPECT_NE(e.find("sampler.min_points_per_device"), std::string::npos) << e;
 }
 
 TEST(DeviceSplit, PiecesTileThePointsAndSlabsTheirSlab) {
@@ -167,6 +205,13 @@ SamplerOptions cpu_bvh() {
     o.method = "bvh";
     o.threads = 1;
     o.progress = false;
+    o.min_points_per_device = 64;  // small lattices split (the default would run them on one device)
+    return o;
+}
+
+SamplerOptions cpu_bvh_default_threshold() {
+    SamplerOptions o = cpu_bvh();
+    o.min_points_per_device = SamplerOptions{}.min_points_per_device;
     return o;
 }
 
@@ -178,7 +223,7 @@ std::unique_ptr<Sampler> fake_devices(const SamplerOptions& o, std::vector<int> 
             if (made) made->push_back(one.device);
             return make_sampler(one);
         },
-        [](int d) { return json{{"index", d}, {"name", "fake " + std::to_string(d)}}; }, 64);
+        [](int d) { return json{{"index", d}, {"name", "fake " + std::to_string(d)}}; });
 }
 
 void expect_same_bytes(const SampledField& a, const SampledField& b, const std::string& what) {
@@ -229,6 +274,8 @@ TEST(MultiDeviceSampler, FieldsEqualOneDevicesByteForByte) {
                 }
                 const json& d = many.sampler.details.at("devices");
                 EXPECT_TRUE(d.at("split").get<bool>()) << what;
+                EXPECT_EQ(d.at("used"), devices) << what;
+                EXPECT_EQ(d.at("min_points_per_device"), 64) << what;
                 ASSERT_EQ(d.at("parts").size(), size_t(devices)) << what;
                 int next = 0;
                 for (size_t i = 0; i < d.at("parts").size(); ++i) {
@@ -254,8 +301,32 @@ TEST(MultiDeviceSampler, ASmallJobRunsOnTheFirstDeviceAndSaysWhy) {
     expect_same_bytes(one, many, "small");
     const json& d = many.sampler.details.at("devices");
     EXPECT_FALSE(d.at("split").get<bool>());
-    EXPECT_NE(d.at("why_not").get<std::string>().find("too few to split"), std::string::npos) << d;
+    EXPECT_EQ(d.at("used"), 1);
+    EXPECT_EQ(d.at("why_not"), "2 devices requested, 1 used: 48 points, fewer than 2 x 64 (min_points_per_device: the "
+                               "fewest points a device is given)")
+        << d;
     EXPECT_EQ(d.at("parts")[0].at("device").at("index"), 1);
+}
+
+TEST(MultiDeviceSampler, AJobSplitsOverAsManyDevicesAsItsThresholdAllows) {
+    const auto mesh = share(prepare_mesh(make_torus(1.0, 0.35, 24, 12)));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {13, 11, 17}, mesh->bounds(), 0.1);  // 2431 points
+    SamplerOptions o = cpu_bvh();
+    o.min_points_per_device = 1000;  // two devices' worth
+    const SampledField one = make_sampler(o)->bind(mesh)->sample(lattice);
+    const SampledField many = fake_devices(o, {0, 1, 2, 3, 4})->bind(mesh)->sample(lattice);
+    expect_same_bytes(one, many, "threshold 1000");
+    const json& d = many.sampler.details.at("devices");
+    EXPECT_TRUE(d.at("split").get<bool>());
+    EXPECT_EQ(d.at("count"), 5);
+    EXPECT_EQ(d.at("used"), 2);
+    EXPECT_EQ(d.at("parts").size(), 2u);
+    EXPECT_EQ(d.at("why_fewer"), "5 devices requested, 2 used: 2431 points, 1000 or more a device (min_points_per_device)");
+    // The default threshold keeps this lattice, and a point list, on the first device.
+    const SampledField unsplit = fake_devices(cpu_bvh_default_threshold(), {0, 1})->bind(mesh)->sample(lattice);
+    expect_same_bytes(one, unsplit, "default threshold");
+    EXPECT_FALSE(unsplit.sampler.details.at("devices").at("split").get<bool>());
+    EXPECT_EQ(unsplit.sampler.details.at("devices").at("min_points_per_device"), kDefaultMinPointsPerDevice);
 }
 
 TEST(MultiDeviceSampler, PointQueriesEqualOneDevicesByteForByte) {

@@ -437,3 +437,12 @@ def test_the_notebook_example_in_the_docs_runs(tmp_path, monkeypatch):
     for block in blocks:
         exec(compile(block, "docs/python.md", "exec"), scope)
     assert os.path.exists(tmp_path / "torus_slice_and_isosurface.png")
+
+
+def test_a_query_says_how_it_went_over_the_devices():
+    # Issue 36: a job below the split threshold (min_points_per_device) runs on one device, and says so.
+    v, f = box_arrays()
+    d = sl.SDF((v, f), backend="cpu").query(np.zeros((10, 3))).devices
+    assert d == {"count": 1, "used": 1, "split": False, "min_points_per_device": 2 ** 23}
+    d = sl.SDF((v, f), backend="cpu", min_points_per_device=5).query(np.zeros((10, 3))).devices
+    assert d["min_points_per_device"] == 5 and d["used"] == 1

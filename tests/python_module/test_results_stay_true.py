@@ -5,6 +5,7 @@ messages that name the problem (MemoryError with the size, warnings at the calle
 unsigned face indices, one name for one bad row)."""
 import inspect
 import os
+import re
 import warnings
 
 import numpy as np
@@ -240,3 +241,17 @@ def test_wrong_arguments_are_named_not_dumped(tmp_path):
     f = s.sample(resolution=8)  # the wrapped calls still work, with their own keywords
     assert sl.render(f, size=16).shape[:2] == (16, 16)
     assert s.sample.__doc__ == sl._core.SDF.sample.__doc__
+
+
+def test_build_info_lists_the_cuda_architectures():
+    # Issue 39 item 3: build_info() says which GPUs the build's code runs on, the list CMake
+    # compiled for (read back from the build's CMakeCache.txt where the build is at hand).
+    cuda = sl.build_info()["optional"]["cuda"]
+    if not cuda["found"]:
+        pytest.skip("built without the CUDA backend")
+    archs = cuda["architectures"]
+    assert archs and all(re.fullmatch(r"\d+(-real|-virtual)?", a) for a in archs), archs
+    cache = os.path.join(os.environ.get("SDF_BUILD_DIR", ""), "CMakeCache.txt")
+    if os.path.exists(cache):
+        line = next(l for l in open(cache) if l.startswith("CMAKE_CUDA_ARCHITECTURES:"))
+        assert archs == line.split("=", 1)[1].strip().split(";")

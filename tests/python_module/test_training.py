@@ -1,5 +1,5 @@
 """Training-loop features (issue 39 item 4): torch autograd on the CPU (and CUDA where present)
-with respect to the points and the mesh's vertices, SDF.refit of a deforming mesh, a batch
+with respect to the points and the mesh's vertices, SDF.refit's vertex gradients, a batch
 of meshes in one call, and float32 outputs.
 
 Truth is independent of the code under test: central finite differences of the distance in
@@ -219,39 +219,7 @@ def _deformed(v, t):
     return v * (1.0 + 0.1 * t) + 0.05 * np.sin(3.0 * v[:, [1, 2, 0]] + t)
 
 
-@pytest.mark.parametrize("sampler", [{}, {"sign": "winding"}, {"precision": "float"}, {"sign": "none"}])
-def test_refit_equals_a_fresh_sdf_bit_for_bit(torus_arrays, sampler):
-    v, f = torus_arrays
-    p = np.random.default_rng(9).uniform(-1.7, 1.7, (3000, 3))
-    bound = sl.SDF((v, f), backend="cpu", **sampler)
-    before = bound.query(p)
-    for t in (0.5, 1.0):
-        moved = _deformed(v, t)
-        refitted = bound.refit(moved)
-        fresh = sl.SDF(sl.Mesh(moved, f), backend="cpu", **sampler)
-        a, b = refitted.query(p, winding=True), fresh.query(p, winding=True)
-        for name in ("distance", "gradient", "triangle", "closest_point", "barycentric", "winding"):
-            assert same_bits(getattr(a, name), getattr(b, name)), name
-        assert refitted.sign == fresh.sign and refitted.sampler == fresh.sampler
-        assert np.array_equal(refitted.mesh.vertices, fresh.mesh.vertices)
-        bound = refitted
-    # the first SDF and its results are untouched
-    assert same_bits(sl.SDF((v, f), backend="cpu", **sampler).query(p).distance, before.distance)
-
-
-def test_refit_keeps_weld_tolerance_and_refuses_new_connectivity():
-    v, f = box_arrays()
-    bound = sl.SDF(sl.Mesh(v, f, weld_tolerance=1e-3))
-    assert same_bits(bound.refit(v * 2).query([[3.0, 0, 0]]).distance, np.array([1.0]))
-    collapsed = v.copy()
-    collapsed[7] = collapsed[5]  # welds two corners: two triangles degenerate
-    with pytest.raises(ValueError, match="connectivity after preparation"), pytest.warns(sl.MeshWarning, match="degenerate"):
-        bound.refit(collapsed)
-    with pytest.raises(ValueError, match="expected 8 rows"):
-        bound.refit(v[:7])
-    inward = v * np.array([-1.0, 1.0, 1.0])  # mirrored: inward orientation, flipped by the preparation
-    with pytest.raises(ValueError, match="flipped outward: no before, yes now"), pytest.warns(sl.MeshWarning, match="flipped"):
-        bound.refit(inward)
+# (refit against a fresh SDF, and its refusals: test_refit.py, which needs no torch)
 
 
 def test_refit_with_torch_vertices_gives_vertex_gradients(torus_arrays):
