@@ -23,6 +23,7 @@
 
 #include "core/reconstruction/reconstruction.h"
 #include "core/sampling/sparse_band_cells.h"
+#include "harness/config/json_reader.h"
 #include "harness/io/field_file.h"
 #include "harness/io/sparse_field_file.h"
 #include "harness/io/points_file.h"
@@ -57,8 +58,14 @@ int main(int argc, char** argv) {
     try {
         // A sparse band's file: its band (for the band's cells) and its densified field.
         std::unique_ptr<sdf::SparseBandField> band;
-        if (sdf::is_sparse_field_file(field_path)) band = std::make_unique<sdf::SparseBandField>(sdf::read_sparse_field(field_path));
-        const sdf::SampledField field = sdf::read_field_densified(field_path, "sdf-eval");
+        sdf::SampledField field;
+        if (sdf::is_sparse_field_file(field_path)) {
+            band = std::make_unique<sdf::SparseBandField>(sdf::read_sparse_field(field_path));
+            const bool gradient = sdf::read_json_file(field_path, "field header").contains("gradient_channel");
+            field = sdf::densify_within_memory(*band, gradient, field_path, "sdf-eval");
+        } else {
+            field = sdf::read_field(field_path);
+        }
         doing = "reconstructing " + field_path + " (" + std::to_string(field.size()) + " lattice points) at " + points_path;
         bytes = uint64_t(field.size()) * sdf::kReconstructionBytesPerPoint;
         spec.interpolator = sdf::parse_interpolator(interpolator);

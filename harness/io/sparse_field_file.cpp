@@ -362,18 +362,22 @@ SparseBandField read_sparse_field(const std::string& header_path) {
     return band;
 }
 
-SampledField read_field_densified(const std::string& header_path, const std::string& where) {
-    if (!is_sparse_field_file(header_path)) return read_field(header_path);
-    const bool has_gradient = read_json_file(header_path, "field header").contains("gradient_channel");
-    const SparseBandField band = read_sparse_field(header_path);
+SampledField densify_within_memory(const SparseBandField& band, bool gradient, const std::string& what,
+                                   const std::string& where) {
     const Lattice& l = band.lattice;
     require_host_memory({uint64_t(SparseBandField::dense_bytes(l)),
-                         "densifying the sparse band of " + header_path + " (" + lattice_notation(l) + ", " +
+                         "densifying the sparse band of " + what + " (" + lattice_notation(l) + ", " +
                              std::to_string(l.num_points()) + " points)"},
                         where);
     SampledField field = band.densify();
-    if (!has_gradient) field.gradient.clear();  // no gradient channel: none to reconstruct with, as read_field
+    if (!gradient) field.gradient.clear();  // no gradient channel: none to reconstruct with, as read_field
     return field;
+}
+
+SampledField read_field_densified(const std::string& header_path, const std::string& where) {
+    if (!is_sparse_field_file(header_path)) return read_field(header_path);
+    const bool has_gradient = read_json_file(header_path, "field header").contains("gradient_channel");
+    return densify_within_memory(read_sparse_field(header_path), has_gradient, header_path, where);
 }
 
 }  // namespace sdf

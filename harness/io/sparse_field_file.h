@@ -56,4 +56,10 @@ bool is_sparse_field_file(const std::string& header_path);
 /// sdf-render) read every field file this way.
 SampledField read_field_densified(const std::string& header_path, const std::string& where);
 
+/// `band` densified (the dense `--band W` field), refused past the host memory check
+/// (naming `what`, its size and `where`); without `gradient` the field has none (a file read
+/// without its gradient channel).
+SampledField densify_within_memory(const SparseBandField& band, bool gradient, const std::string& what,
+                                   const std::string& where);
+
 }  // namespace sdf
