@@ -12,13 +12,16 @@
 #include <fstream>
 #include <map>
 #include <random>
+#include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/reconstruction/reconstruction.h"
 #include "core/sampling/sparse_band_cells.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
+#include "harness/cache/field_cache.h"
 #include "harness/io/sparse_field_file.h"
+#include "harness/study/field_source.h"
 #include "harness_test_util.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
@@ -218,6 +221,39 @@ TEST_F(SparseFieldFile, BandCellsFollowTheBandsPoints) {
                 const Vec3d p = lattice.origin + Vec3d(i + 0.5, j + 0.5, k + 0.5) * lattice.spacing;
                 ASSERT_EQ(in_band_cells(band, p), all) << i << " " << j << " " << k;
             }
+}
+
+// run-experiment's fields (FieldSource, a config's band_width): a band is sampled sparsely,
+// equal to the dense sampler's banded field byte for byte, and cached as the sparse file,
+// which loads back as the same field.
+TEST_F(SparseFieldFile, FieldSourceSamplesTheBandSparselyAndCachesItsFile) {
+    const PreparedMesh bowl = test::open_bowl();
+    for (LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        const Lattice lattice = fit_lattice(type, type == LatticeType::CC ? Int3{33, 31, 30} : Int3{24, 23, 44}, bowl.bounds(), 0.5);
+        SamplerOptions o = options(1.5 * lattice.spacing, SignMode::Winding);
+        o.backend = "cpu";
+        o.threads = 2;
+        const SampledField dense = make_cpu_bvh_sampler(o)->bind(share(bowl))->sample(lattice);
+        const FieldCache cache(at(std::string("cache-") + lattice_type_name(type)));
+        const auto mesh = share(bowl);
+        std::ostringstream log;
+        FieldSource source(&cache, o, "test");
+        const ObtainedField fresh = source.get(mesh, lattice, "bowl", log);
+        const ObtainedField cached = FieldSource(&cache, o, "test").get(mesh, lattice, "bowl", log);
+        EXPECT_FALSE(fresh.from_cache);
+        EXPECT_TRUE(cached.from_cache);
+        for (const SampledField* f : {&fresh.field, &cached.field}) {
+            EXPECT_TRUE(same_bytes(f->distance, dense.distance)) << lattice_notation(lattice);
+            EXPECT_TRUE(same_bytes(f->gradient, dense.gradient)) << lattice_notation(lattice);
+            EXPECT_TRUE(same_bytes(f->closest_triangle, dense.closest_triangle)) << lattice_notation(lattice);
+            ASSERT_TRUE(f->sampler.band.has_value());
+            EXPECT_TRUE(test::Contains(f->sampler.band->how, "sparse"));
+            EXPECT_EQ(f->sampler.band->points_in_band, dense.sampler.band->points_in_band);
+        }
+        const nlohmann::json key = field_cache_key(bowl.content_sha256(), lattice, o);
+        EXPECT_TRUE(is_sparse_field_file(cache.entry_path(key) + "/field.json"));
+        EXPECT_TRUE(test::Contains(log.str(), "sampling the sparse band"));
+    }
 }
 
 class HostileSparseFile : public SparseFieldFile {
