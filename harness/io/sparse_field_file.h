@@ -47,7 +47,7 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
 SparseBandField read_sparse_field(const std::string& header_path);
 
 /// Whether the field header at `header_path` is a sparse band's ("layout": "sparse_band").
-/// Throws, naming the file, when it is not a readable JSON object.
+/// Throws, naming the file, when it is not readable JSON (read_field's first check).
 bool is_sparse_field_file(const std::string& header_path);
 
 /// read_field() of a dense field file; of a sparse band's, its densified field (every
