@@ -285,13 +285,12 @@ SparseBandField read_sparse_field(const std::string& header_path) {
         const std::string p = r.choice("precision", {"float", "double"}, "float");
         precision = p == "double" ? Precision::Double : Precision::Float;
     }
-    SparseBandField band;
     try {
-        band = SparseBandField(lattice, width, precision);
+        require_band_width(width, "sparse band width");
     } catch (const std::invalid_argument& e) {
         b.fail("width", e.what());
     }
-    const int64_t blocks = band.layout().block_count();
+    const int64_t blocks = BandLayout(lattice).block_count();  // nothing allocated before the files are checked
     const int64_t stated = b.required<int64_t>("blocks", "the lattice's number of blocks");
     if (stated != blocks)
         b.fail("blocks", "expected " + std::to_string(blocks) + " (blocks of 8^3 points of " + lattice_notation(lattice) +
@@ -324,6 +323,7 @@ SparseBandField read_sparse_field(const std::string& header_path) {
     OpenChannel mixed_ids = open_channel(header, channels, "mixed_blocks", mixed, 1, {"int64"});
     OpenChannel signs = open_channel(header, channels, "mixed_signs", mixed, kSignWords, {"uint64"});
 
+    SparseBandField band(lattice, width, precision);
     band.active.resize(size_t(active));
     read_values(ids, band.active.data(), active, header);
     require_block_ids(band.active, blocks, header, "active_blocks");
