@@ -6,7 +6,11 @@
 // point, in input order: "f gx gy gz" (value and world-space gradient, %.9g). POINTS has
 // "x y z" per line in world units ('-' = stdin; blank lines and '#' comments are skipped), or
 // is a .npy file of shape (N, 3); at least one point (none is an error naming the input).
-// Points outside the interpolator's domain are clamped into it (a warning counts them).
+// Points outside the interpolator's domain are clamped into it (a warning counts them). A
+// sparse band's file (sdf-sample --layout sparse) is densified past the memory check into the
+// dense `--band W` field; points outside the band's cells (core/sampling/sparse_band_cells.h)
+// print that field's reconstruction (built from +-W there), and a warning counts them, as the
+// lattice's edge.
 // docs/reconstruction.md describes the interpolators and derivative sources.
 #include <CLI/CLI.hpp>
 
@@ -15,9 +19,13 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "core/reconstruction/reconstruction.h"
+#include "core/sampling/sparse_band_cells.h"
+#include "harness/config/json_reader.h"
 #include "harness/io/field_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/io/points_file.h"
 #include "harness/resources/memory_budget.h"
 
@@ -48,7 +56,16 @@ int main(int argc, char** argv) {
     std::string doing = "reading the field " + field_path;  // for an out-of-memory message
     uint64_t bytes = 0;
     try {
-        const sdf::SampledField field = sdf::read_field(field_path);
+        // A sparse band's file: its band (for the band's cells) and its densified field.
+        std::unique_ptr<sdf::SparseBandField> band;
+        sdf::SampledField field;
+        if (sdf::is_sparse_field_file(field_path)) {
+            band = std::make_unique<sdf::SparseBandField>(sdf::read_sparse_field(field_path));
+            const bool gradient = sdf::read_json_file(field_path, "field header").contains("gradient_channel");
+            field = sdf::densify_within_memory(*band, gradient, field_path, "sdf-eval");
+        } else {
+            field = sdf::read_field(field_path);
+        }
         doing = "reconstructing " + field_path + " (" + std::to_string(field.size()) + " lattice points) at " + points_path;
         bytes = uint64_t(field.size()) * sdf::kReconstructionBytesPerPoint;
         spec.interpolator = sdf::parse_interpolator(interpolator);
@@ -60,11 +77,18 @@ int main(int argc, char** argv) {
         const sdf::Reconstruction recon(field, spec);
         const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
         const auto samples = recon.evaluate(points, threads);
-        int64_t outside = 0;
-        for (const auto& s : samples) {
+        int64_t outside = 0, off_band = 0;
+        for (size_t i = 0; i < samples.size(); ++i) {
+            const auto& s = samples[i];
             std::printf("%.9g %.9g %.9g %.9g\n", s.value, s.gradient.x, s.gradient.y, s.gradient.z);
             outside += s.inside ? 0 : 1;
+            off_band += band && s.inside && !sdf::in_band_cells(*band, points[i]) ? 1 : 0;
         }
+        if (off_band > 0)
+            std::fprintf(stderr,
+                         "sdf-eval: warning: %lld of %zu points lie outside the sparse band's cells (|d| <= %.9g at every "
+                         "corner); their values are the dense band field's, built from +-W there\n",
+                         static_cast<long long>(off_band), samples.size(), band->width);
         if (outside > 0) {
             const sdf::DomainBox<double> box = recon.domain();
             std::fprintf(stderr,

@@ -3,7 +3,9 @@
 //
 // INPUT is a field file (NAME.json, docs/field-format.md) or a mesh (an OBJ file found on
 // the data search path, or shape:NAME). A mesh is sampled on --lattice/--resolution (fields
-// are kept in the field cache shared with run-experiment); a field file is used as it is.
+// are kept in the field cache shared with run-experiment); a field file is used as it is (a
+// sparse band's file densified, past the memory check: the dense `--band W` field, whose +-W
+// off the band the ray marcher steps through).
 //
 //   one image per view:  sdf-render dragon.obj --lattice bcc --resolution 64,64,128
 //                          --interpolator bcc_cubic --derivatives true --view dragon_side
@@ -35,6 +37,7 @@
 #include "harness/cache/field_cache.h"
 #include "harness/config/mesh_spec.h"
 #include "harness/io/field_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/provenance/provenance.h"
 #include "harness/render/image_io.h"
 #include "harness/render/render_backend.h"
@@ -212,7 +215,7 @@ int run_single(const Options& o, const RenderSpec& spec, const nlohmann::json& r
     std::shared_ptr<const PreparedMesh> mesh;
     SampledField field;
     if (is_field_file(o.input)) {
-        field = read_field(o.input);
+        field = read_field_densified(o.input, "sdf-render");  // a sparse band's file: densified (the dense --band field)
         if (!o.mesh_file.empty())
             mesh = std::make_shared<const PreparedMesh>(
                 prepare_mesh(load_mesh(mesh_spec_from_argument(o.mesh_file), data_search_path(), ".")));

@@ -1,6 +1,6 @@
 // sdf-sample MESH --resolution N|NX NY NZ --out NAME.json [--lattice cc|bcc] [--margin F]
 //            [--method bvh|brute_force] [--backend auto|cpu|cuda] [--precision float|double]
-//            [--sign auto|pseudonormal|winding] [--band W [--sparse]] [--memory-budget SIZE]
+//            [--sign auto|pseudonormal|winding] [--band W [--sparse [--layout sparse]]] [--memory-budget SIZE]
 //            [--channels distance,gradient,closest_triangle] [--dtype float32|float64]
 //            [--overwrite] [--dry-run] [--quiet]
 //
@@ -12,8 +12,11 @@
 // size) and exits. --sparse (with --band W) samples only the blocks of 8^3 points within W of a
 // triangle and signs the rest per block (core/sampling/sparse_band_sampler.h); the field file,
 // the same bytes, is then written slab by slab from the sparse band, and --vdb straight from
-// its blocks (harness/io/sparse_vdb_file.h: a level set, never densified), and --nvdb a NanoVDB
-// level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only).
+// its blocks (harness/io/sparse_vdb_file.h: a level set, never densified), --nvdb a NanoVDB
+// level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only), and
+// --layout sparse the field file's sparse variant instead of the dense one
+// (harness/io/sparse_field_file.h: the band's blocks, never densified; sdf-eval, sdf-render and
+// Python's read_field read it).
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
@@ -36,6 +39,7 @@
 #include "harness/config/mesh_spec.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/io/atomic_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/io/sparse_nvdb_file.h"
 #include "harness/io/sparse_vdb_file.h"
 #include "harness/resources/memory_budget.h"
@@ -80,6 +84,7 @@ int main(int argc, char** argv) {
     int max_planes = 0;
     sdf::SamplerCli sampler;  // the options codec's flags, defaults and checks (apps/sampler_cli.h)
     bool overwrite = false, dry_run = false, quiet = false, sparse = false;
+    std::string layout = "dense";
     app.add_option("mesh", mesh_arg, "mesh file (" + sdf::mesh_formats_help() + ") or shape:NAME")->required();
     app.add_option("--lattice", lattice_type, "lattice type: " + sdf::quoted_alternatives(sdf::lattice_type_names()))
         ->check(CLI::IsMember(sdf::lattice_type_names()))->capture_default_str();
@@ -110,6 +115,12 @@ int main(int argc, char** argv) {
     app.add_flag("--sparse", sparse,
                  "with --band W: sample only the blocks of 8^3 points within W of a triangle and sign the rest per "
                  "block (work and memory grow with the band); the outputs are the same bytes");
+    app.add_option("--layout", layout,
+                   "the field file at --out: dense (every lattice point) or sparse (with --sparse: the band's blocks, tiles "
+                   "and per-point signs, docs/field-format.md; its closest_triangle channel is always written, as it marks "
+                   "the band's points)")
+        ->check(CLI::IsMember({"dense", "sparse"}))
+        ->capture_default_str();
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
     app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
@@ -185,6 +196,8 @@ int main(int argc, char** argv) {
         if (!nvdb_path.empty() && !sparse)
             throw std::invalid_argument("--nvdb " + nvdb_path + ": the .nvdb is written from the sparse band; add --band W --sparse");
         if (!nvdb_path.empty()) sdf::require_representable_band(band, sdf::FieldDtype::Float32, "--band (the .nvdb stores float32)");
+        if (layout == "sparse" && !sparse)
+            throw std::invalid_argument("--layout sparse: the sparse field file is written from a sparse band; add --sparse");
     } catch (const std::exception& e) {
         std::cerr << "sdf-sample: error: " << e.what() << "\n";
         return sdf::kExitCommandLineError;
@@ -220,12 +233,15 @@ int main(int argc, char** argv) {
         // What the run checks before sampling; the dry run checks it too and says so.
         const auto require_runnable = [&] {
             sdf::require_plan_fits_machine(plan.peak_estimate, stream.memory_budget, "--memory-budget");
-            require_output_space(plan, out_path);
+            if (layout == "dense") require_output_space(plan, out_path);  // sparse: known once sampled
         };
         if (dry_run) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision);
             if (band > 0) std::cout << ", band " << band << (sparse ? " (sparse: the band's memory is added when sampled)" : "");
-            std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
+            if (layout == "sparse")
+                std::cout << "\nout: " << out_path << ", the sparse band's field file (its size grows with the band)\n";
+            else
+                std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
             if (!vdb_path.empty() && sparse)
                 std::cout << "vdb: " << vdb_path << ", a level set from the sparse band's blocks, points with |d| <= "
                           << band << " active (outside the budget)\n";
@@ -268,6 +284,26 @@ int main(int argc, char** argv) {
                       << " tiles (" << c.inside_tiles << " inside), " << c.mixed_blocks << " mixed; "
                       << sdf::format_bytes(sparse_slabs->band().memory_bytes()) << ", " << sparse_slabs->band().timings.total
                       << " s\n";
+        }
+        if (layout == "sparse") {
+            doing = "writing the sparse field file " + out_path;
+            sdf::SparseFieldWriteOptions file;
+            file.dtype = stream.write.dtype;
+            file.gradient = stream.gradient;
+            file.overwrite = stream.write.overwrite;
+            sdf::write_sparse_field(out_path, sparse_slabs->band(), file);
+            if (!vdb_path.empty()) {
+                doing = "writing " + vdb_path + " from the sparse band";
+                sdf::SparseVdbOptions vdb_options;
+                vdb_options.gradient = stream.gradient;
+                vdb_options.closest_triangle = false;
+                vdb_options.overwrite = stream.write.overwrite;
+                const int64_t active = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
+                std::cout << "wrote " << vdb_path << ": " << active << " active points (|d| <= " << band << ")\n";
+            }
+            std::cout << "wrote " << out_path << ": the sparse band's field file, " << sparse_slabs->band().active.size()
+                      << " active blocks\n";
+            return 0;
         }
         const sdf::StreamResult r = sdf::sample_streamed(sparse_slabs ? *sparse_slabs : bound, options, lattice, stream, mesh_provenance);
         int64_t vdb_active = r.vdb_active_points;

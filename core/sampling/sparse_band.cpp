@@ -133,7 +133,7 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
                         if (is_active) {
                             const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
                             field.distance[size_t(out)] = distance[v];
-                            field.gradient[size_t(out)] = gradient[v];
+                            if (!gradient.empty()) field.gradient[size_t(out)] = gradient[v];  // else 0: read without it
                             field.closest_triangle[size_t(out)] = closest_triangle[v];
                         } else {
                             store_outside_band(field, out, is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id),

@@ -6,6 +6,7 @@
 #include "harness/config/json_reader.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/io/field_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/provenance/provenance.h"
 
 namespace sdf {
@@ -40,7 +41,8 @@ std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {
     if (!found) return std::nullopt;
     const std::string dir = *found;
     try {
-        SampledField field = read_field(dir + "/field.json");
+        const std::string header = dir + "/field.json";
+        SampledField field = is_sparse_field_file(header) ? read_sparse_field(header).densify() : read_field(header);
         const nlohmann::json info = read_json_file(dir + "/entry.json").at("info");
         const nlohmann::json& t = info.at("timings_seconds");
         field.timings.total = t.at("total");
@@ -54,6 +56,29 @@ std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {
         throw std::runtime_error("field cache entry " + dir + " is damaged (" + e.what() +
                                  "); remove that directory or run with --no-cache");
     }
+}
+
+namespace {
+
+nlohmann::json entry_info(const SamplerReport& sampler, const SamplingTimings& timings) {
+    return {{"filled_by", sampler},
+            {"host_cpu", cpu_model()},
+            {"timings_seconds", {{"total", timings.total},
+                                 {"kernel", timings.kernel},
+                                 {"upload", timings.upload},
+                                 {"download", timings.download}}},
+            {"point_triangle_pairs", timings.point_triangle_pairs},
+            {"git_commit", git_state().commit}};
+}
+
+}  // namespace
+
+bool FieldCache::store_band(const nlohmann::json& key, const SparseBandField& band) const {
+    return store_.store("fields", key, entry_info(band.sampler, band.timings), [&](const std::string& dir) {
+        SparseFieldWriteOptions o;
+        o.dtype = FieldDtype::Float64;
+        write_sparse_field(dir + "/field.json", band, o);
+    });
 }
 
 bool FieldCache::store(const nlohmann::json& key, const SampledField& field) const {

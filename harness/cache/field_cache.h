@@ -10,7 +10,8 @@
 /// option is keyed once it has its row), and kFieldCodeVersion. The Execution options
 /// (backend, threads, device, progress, GPU piece sizes) are not part of it: every backend
 /// computes the same field up to float ties; the entry records which one filled it. Fields
-/// are stored as float64, so a cached field equals the fresh one.
+/// are stored as float64, so a cached field equals the fresh one; a narrow band as the sparse
+/// band's field file (store_band), densified on loading.
 #pragma once
 
 #include <optional>
@@ -41,6 +42,10 @@ public:
     std::optional<SampledField> load(const nlohmann::json& key) const;
     /// Stores `field` unless the key is present; returns whether it was stored.
     bool store(const nlohmann::json& key, const SampledField& field) const;
+    /// Stores a narrow band sampled sparsely (SamplerOptions::band_width > 0) as the sparse
+    /// band's field file (harness/io/sparse_field_file.h, float64), unless the key is present:
+    /// the entry grows with the band; load() gives it back densified, the dense band field.
+    bool store_band(const nlohmann::json& key, const SparseBandField& band) const;
 
 private:
     ContentCache store_;

@@ -254,6 +254,9 @@ SampledField read_field(const std::string& header_path) {
     if (format != "sdf-lattice-field") r.fail("format", "expected \"sdf-lattice-field\", got \"" + format + "\"");
     const int version = r.required<int>("version", "the format version 1");
     if (version != 1) r.fail("version", "only version 1 is known, got " + std::to_string(version));
+    if (r.has("layout") && r.choice("layout", {"dense", "sparse_band"}, "dense") != "dense")
+        r.fail("layout", "this is a sparse band's file (\"sparse_band\", docs/field-format.md): read_sparse_field "
+                         "(harness/io/sparse_field_file.h) reads it; sdf-eval, sdf-render and Python's read_field read both");
     SampledField field;
     field.lattice = lattice_from_json(r.raw("lattice"), header_path);
     const int64_t points = field.lattice.num_points();

@@ -19,8 +19,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The channels a field file of the project may have (field_channel_files' names).
-constexpr const char* kChannelNames[] = {"distance", "gradient", "closest_triangle"};
+/// The channels a field file of the project may have (field_channel_files' names, then the
+/// sparse band's own: sparse_field_file.h).
+constexpr const char* kChannelNames[] = {"distance",     "gradient",   "closest_triangle", "active_blocks",
+                                         "mixed_blocks", "tile_signs", "mixed_signs"};
 
 /// NAME of NAME.json (the file name, without the folder).
 std::string field_name(const std::string& header_path) {
@@ -124,13 +126,17 @@ void FieldReplacement::place(size_t i, const std::string& staged) {
 void FieldReplacement::placed(size_t i) { placed_.at(i) = true; }
 
 void FieldReplacement::commit(const SampledField& field) {
+    commit_with([&](const std::vector<FieldChannelFile>& channels) { write_field_header(header_, field, channels, overwrite_); });
+}
+
+void FieldReplacement::commit_with(const std::function<void(const std::vector<FieldChannelFile>&)>& write_header) {
     if (committed_) throw std::logic_error(header_ + ": FieldReplacement committed twice");
     for (size_t i = 0; i < channels_.size(); ++i)
         if (!placed_[i]) throw std::logic_error(channels_[i].path + ": committed before it was written");
     const fs::path dir = fs::absolute(header_).parent_path();
     sync_folder(dir);  // the channels' names are durable before the header names them
     const std::vector<std::string> old = files_named_by(header_);  // the field being replaced
-    write_field_header(header_, field, channels_, overwrite_);  // the commit point
+    write_header(channels_);  // the commit point
     committed_ = true;
     if (overwrite_ == Overwrite::Forbid) return;  // nothing was there to replace
     // The old field's channel files, and those of interrupted writers of this name (their

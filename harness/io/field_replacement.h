@@ -19,6 +19,7 @@
 /// Destroyed without commit(), it removes the channel files it placed: the old field stays.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,10 @@ public:
     /// Writes the header of `field` over the old one in one atomic step, then removes the old
     /// field's channel files that the new header does not name. Every channel must be placed.
     void commit(const SampledField& field);
+    /// The same for a header written by `write_header` (atomically, at the header's path,
+    /// naming the final channel paths it is given): the sparse band's file
+    /// (sparse_field_file.h) commits this way.
+    void commit_with(const std::function<void(const std::vector<FieldChannelFile>&)>& write_header);
 
 private:
     std::string header_;

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <ostream>
 
 #include "core/lattice/lattice_fitting.h"
@@ -75,9 +76,20 @@ ObtainedField FieldSource::get(const std::shared_ptr<const PreparedMesh>& shared
         }
     }
     const BoundSampler& sampler = bound(shared_mesh);
-    log << "  " << what << ": sampling with " << sampler.name() << " ..." << std::endl;
+    // A narrow band is sampled sparsely (issue 35: only the blocks within W of a triangle; its
+    // densified field is the dense band's byte for byte) and cached as the sparse file.
+    // Over the ranks of a distributed run the lattice's slabs are sampled densely, as before.
+    const double band_width = reach_ == SamplerReach::ThisProcess || !distributed_active() ? options_.band_width : 0.0;
+    std::optional<SparseBandField> band;
+    log << "  " << what << ": sampling " << (band_width > 0 ? "the sparse band " : "") << "with " << sampler.name()
+        << " ..." << std::endl;
     try {
-        out.field = sampler.sample(lattice);
+        if (band_width > 0) {
+            band = sampler.sample_band_sparse(lattice, band_width);
+            out.field = band->densify();
+        } else {
+            out.field = sampler.sample(lattice);
+        }
     } catch (const std::bad_alloc&) {  // a limit the memory plan could not see: name what and how much
         const MemoryNeed need = whole_lattice_sampling_need(lattice, mesh.name());
         throw std::runtime_error(out_of_memory_message(need.what + " for " + label, need.host_bytes));
@@ -88,7 +100,8 @@ ObtainedField FieldSource::get(const std::shared_ptr<const PreparedMesh>& shared
     log << line;
     if (cache_) {
         out.field.mesh = describe_prepared_mesh(mesh);
-        const bool stored = cache_->store(key, out.field);
+        if (band) band->mesh = out.field.mesh;
+        const bool stored = band ? cache_->store_band(key, *band) : cache_->store(key, out.field);
         log << (stored ? "; cached as " : "; already cached as ") << out.cache_key.substr(0, 12);
     }
     log << "\n";

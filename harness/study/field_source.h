@@ -5,7 +5,11 @@
 /// when it holds it, else it is sampled (the sampler is made and bound to the mesh on first
 /// use, and kept while the same mesh is asked for) and stored in the
 /// cache at once, so an interrupted run resumes without sampling again; an allocation that
-/// fails while sampling names the mesh, the lattice and the bytes.
+/// fails while sampling names the mesh, the lattice and the bytes. A narrow band (the
+/// sampler's band_width > 0, a config's "band_width") is sampled sparsely
+/// (BoundSampler::sample_band_sparse, only the blocks within W of a triangle; over the ranks
+/// of a distributed run, densely as before) and densified:
+/// the dense band's field byte for byte; the cache keeps its sparse file (FieldCache::store_band).
 #pragma once
 
 #include <iosfwd>

@@ -183,9 +183,11 @@ def read_field(path):
     field file, docs/field-format.md: every point at the dtype it was written with, float32
     by default, float64 with write(..., dtype="float64"), with closest triangles and provenance),
     ".npz" and ".vti" (values and gradients on their lattice; BCC .vti as NAME.primary.vti
-    and NAME.secondary.vti beside the NAME.vti given). ".npy" holds values without their
-    lattice and ".vdb" only a narrow band of them: both raise ValueError saying how to read
-    them instead. A missing file raises FileNotFoundError.
+    and NAME.secondary.vti beside the NAME.vti given). A sparse band's field file (".json"
+    with "layout": "sparse_band", SparseField.write) comes back as the SparseField. ".vdb"
+    holds a narrow band: where pyopenvdb is importable it comes back as its grids, {name: grid}
+    (as SparseField.to_openvdb() gives them), else (or missing) ValueError says how to read it. ".npy" holds
+    values without their lattice: ValueError. A missing file raises FileNotFoundError.
     """
     from . import _core
 
@@ -194,6 +196,8 @@ def read_field(path):
     if ext == ".json":
         if not os.path.exists(path):
             raise _missing(path)
+        if _core._is_sparse_field_file(path):  # "layout": "sparse_band": the band back, never densified
+            return _core._read_sparse_field_file(path)
         return _core.read_field_file(path)
     if ext == ".npz":
         if not os.path.exists(path):
@@ -206,6 +210,12 @@ def read_field(path):
                          "be read back as a Field: use numpy.load and sdf_lattices.Field(values, origin, spacing), or "
                          "write .npz or .json, which keep the lattice")
     if ext == ".vdb":
+        try:
+            import pyopenvdb
+        except ImportError:
+            pyopenvdb = None
+        if pyopenvdb is not None and os.path.exists(path):  # its grids, as SparseField.to_openvdb() gives them
+            return _named(path, lambda: {grid.name: grid for grid in pyopenvdb.readAll(path)[0]})
         raise ValueError(f"{path}: a .vdb file holds the field only in a narrow band (every other voxel is the "
                          "background value), so it cannot be read back as the sampled Field: open it with pyopenvdb, "
                          "or write .json or .npz, which keep every point of the lattice (float32 by default; "

@@ -2,11 +2,16 @@
 // sample(mesh, ..., band=W) and SDF.sample(..., band=W) return it (the package routes band=
 // here, python/sdf_lattices/_sparse.py). No dense array is made unless to_dense() is asked.
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
 #include "core/mesh/mesh_provenance.h"
 #include "core/sampling/sparse_band.h"
+#include "core/sampling/sparse_band_cells.h"
+#include "harness/config/json_reader.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/io/sparse_nvdb_file.h"
 #include "harness/io/sparse_vdb_file.h"
 #include "harness/resources/memory_budget.h"
@@ -16,6 +21,12 @@
 namespace sdf {
 
 namespace {
+
+std::string text_of(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", v);
+    return text;
+}
 
 class SparseField {
 public:
@@ -83,6 +94,42 @@ public:
     }
     size_t nbytes() const { return band_->memory_bytes() + at_.capacity() * sizeof(int64_t); }
 
+    /// The dense field, made once (to_dense()) for reconstruct().
+    const Field& dense() const {
+        if (!dense_) dense_ = std::make_shared<Field>(to_dense());
+        return *dense_;
+    }
+
+    /// The dense band field's reconstruction (to_dense(), past the memory check), with the
+    /// band's rule: a point outside the band's cells (sparse_band_cells.h) is treated as a
+    /// point outside the lattice's domain (outside= "nan", "clamp": the dense band field's
+    /// value there, built from +-W, or "error").
+    py::tuple reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
+                          double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
+        choose("outside", outside, {"nan", "clamp", "error"});
+        const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
+        py::tuple out = const_cast<Field&>(dense()).reconstruct(points_in, interpolator, derivatives, sigma2, sigma_units,
+                                                                threads, outside);
+        if (outside == "clamp") return out;
+        auto values = out[0].cast<py::array_t<double>>();
+        auto gradients = out[1].cast<py::array_t<double>>();
+        auto v = values.mutable_unchecked<1>();
+        auto g = gradients.mutable_unchecked<2>();
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        for (size_t i = 0; i < points.size(); ++i) {
+            if (std::isnan(v(py::ssize_t(i))) || in_band_cells(*band_, points[i])) continue;
+            if (outside == "error")
+                throw std::invalid_argument("points: row " + std::to_string(i) + " (" + text_of(points[i].x) + ", " +
+                                            text_of(points[i].y) + ", " + text_of(points[i].z) +
+                                            ") lies outside the band's cells (a corner of its cell holds |d| > W = " +
+                                            text_of(band_->width) + "; outside=\"nan\" gives NaN there, \"clamp\" the "
+                                            "dense band field's value, built from +-W)");
+            v(py::ssize_t(i)) = nan;
+            for (int a = 0; a < 3; ++a) g(py::ssize_t(i), a) = nan;
+        }
+        return py::make_tuple(values, gradients);
+    }
+
     Field to_dense() const {
         const uint64_t bytes = uint64_t(SparseBandField::dense_bytes(lattice()));
         require_host_memory({bytes, "densifying the band of " + lattice_notation(lattice()) + " (" +
@@ -95,16 +142,32 @@ public:
         return run_task([&] { return Field(b->densify()); }, task);
     }
 
-    py::list write(const std::string& path, bool overwrite, bool closest_triangle) const {
+    py::list write(const std::string& path, bool overwrite, bool closest_triangle, const std::string& dtype) const {
         if (path.size() > 5 && path.compare(path.size() - 5, 5, ".nvdb") == 0) return write_nvdb(path, overwrite, closest_triangle);
+        choose("dtype", dtype, {"float32", "float64"});
+        std::shared_ptr<const SparseBandField> b = band_;
+        if (path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0) {
+            SparseFieldWriteOptions options;
+            options.dtype = dtype == "float32" ? FieldDtype::Float32 : FieldDtype::Float64;
+            options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
+            TaskOptions task;
+            task.total = kBackgroundItems;
+            task.label = "writing " + path;
+            run_task([&] { write_sparse_field(path, *b, options); return 0; }, task);
+            py::list files;
+            files.append(path);
+            const nlohmann::json header = read_json_file(path, "field header");
+            for (const auto& [name, channel] : header["channels"].items())
+                files.append((std::filesystem::path(path).parent_path() / channel["file"].get<std::string>()).string());
+            return files;
+        }
         if (path.size() < 5 || path.compare(path.size() - 4, 4, ".vdb") != 0)
-            throw std::invalid_argument(path + ": a SparseField writes .vdb (an OpenVDB level set) only so far; "
-                                        "to_dense().write(path) writes the dense formats (field file, vti, npy, npz)");
+            throw std::invalid_argument(path + ": a SparseField writes .json (the sparse band's field file), .vdb (an "
+                                        "OpenVDB level set) and .nvdb (a NanoVDB level set); to_dense().write(path) writes the dense formats (vti, npy, npz)");
         SparseVdbOptions options;
         options.gradient = true;
         options.closest_triangle = closest_triangle;
         options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
-        std::shared_ptr<const SparseBandField> b = band_;
         TaskOptions task;
         task.total = kBackgroundItems;
         task.label = "writing " + path;
@@ -131,7 +194,16 @@ private:
 
     std::shared_ptr<const SparseBandField> band_;
     std::vector<int64_t> at_;
+    mutable std::shared_ptr<Field> dense_;
 };
+
+/// read_field of a sparse band's field file (sdf_lattices._fields routes .json files here).
+SparseField read_sparse_field_file(const std::string& path) {
+    TaskOptions task;
+    task.total = kBackgroundItems;
+    task.label = "reading " + path;
+    return SparseField(run_task([&] { return read_sparse_field(path); }, task));
+}
 
 SparseField sample_band(const MeshSdf& sdf, double band, const std::string& lattice, const py::object& resolution,
                         const py::object& samples, const py::object& margin, const py::object& bounds,
@@ -207,17 +279,32 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
              "to_dense() -> Field: the dense banded field (every lattice point; +-W outside the band), refused (RuntimeError, naming "
              "the size) when it exceeds the memory available, as sample() is.")
         .def("write", &SparseField::write, py::arg("path"), py::arg("overwrite") = false, py::arg("closest_triangle") = false,
-             "write(path, overwrite=False, closest_triangle=False) -> list of files: an OpenVDB level set (.vdb; "
-             "harness/io/sparse_vdb_file.h) with its gradient grid, written atomically; closest_triangle=True adds an "
-             "Int32Grid of the closest triangles (which Debian's pyopenvdb 10 cannot read). A .nvdb is the NanoVDB level "
-             "set of the distance (harness/io/sparse_nvdb_file.h; builds with NanoVDB only). Other formats are refused "
+             py::arg("dtype") = "float32",
+             "write(path, overwrite=False, closest_triangle=False, dtype=\"float32\") -> list of files: by the extension, "
+             ".json: the sparse band's field file (docs/field-format.md; its blocks, tiles and signs, values as dtype, "
+             "closest triangles always), read back by read_field, sdf-eval and sdf-render; .vdb: an OpenVDB level set "
+             "(harness/io/sparse_vdb_file.h) with its gradient grid, closest_triangle=True adding an Int32Grid of the "
+             "closest triangles (which Debian's pyopenvdb 10 cannot read); .nvdb: the NanoVDB level set of the distance "
+             "(harness/io/sparse_nvdb_file.h; builds with NanoVDB only). Written atomically. Other formats are refused "
              "(to_dense().write(path) writes them).")
+        .def("reconstruct", &SparseField::reconstruct, py::arg("points"), py::arg("interpolator") = "",
+             py::arg("derivatives") = "", py::arg("sigma2") = 0.5, py::arg("sigma_units") = "lattice", py::arg("threads") = 0,
+             py::arg("outside") = "nan",
+             "reconstruct(points, interpolator=\"\", derivatives=\"\", sigma2=0.5, sigma_units=\"lattice\", threads=0, "
+             "outside=\"nan\") -> (values, gradients): Field.reconstruct of to_dense() (made once, refused past the "
+             "memory check), the band's values inside it. A point outside the band's cells (a corner of its lattice "
+             "cell, in either BCC sub-grid, holds |d| > W) is treated as a point outside the lattice: outside=\"nan\" "
+             "gives NaN, \"clamp\" the dense band field's reconstruction there (built from +-W), \"error\" raises.")
         .def("__len__", &SparseField::size)
         .def("__repr__", [](const SparseField& f) {
             return "<sdf_lattices.SparseField " + std::string(lattice_type_name(f.lattice().type)) + " " +
                    lattice_notation(f.lattice()) + ", band " + std::to_string(f.band().width) + ": " + std::to_string(f.size()) +
                    " points in " + std::to_string(f.band().active.size()) + " blocks>";
         });
+    m.def("_read_sparse_field_file", &read_sparse_field_file, py::arg("path"),
+          "read_field's native part for a sparse band's field file (sdf_lattices._fields).");
+    m.def("_is_sparse_field_file", &is_sparse_field_file, py::arg("path"),
+          "Whether the field header at path is a sparse band's (\"layout\": \"sparse_band\").");
     m.def("_sample_band", &sample_band, py::arg("sdf"), py::arg("band"), py::arg("lattice") = lattice_type_name(LatticeType::CC),
           py::arg("resolution") = py::none(), py::arg("samples") = py::none(), py::arg("margin") = py::none(),
           py::arg("bounds") = py::none(), py::arg("spacing") = py::none(), py::arg("origin") = py::none(),

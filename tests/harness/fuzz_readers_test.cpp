@@ -2,7 +2,7 @@
 // every format (OBJ, ASCII and binary PLY and STL, OFF, gzip; polygon faces, ASCII STL in
 // capitals and on one line, classic Mac line ends, gzip members: issue 26; polygons of
 // 256+ corners in every format: issue 38), points files (text and .npy),
-// field headers and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
+// field headers (dense, and the sparse band's header and block ids: issue 35) and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
 // are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
 // huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
 // Every input must either parse or throw one of the project's error types (std::runtime_error
@@ -32,6 +32,7 @@
 #include "harness/sampling/sampler_table.h"
 #include "experiments/experiment_registry.h"
 #include "harness/io/field_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/io/npy_file.h"
 #include "harness/io/points_file.h"
 #include "harness/runner/runner.h"
@@ -405,6 +406,63 @@ TEST_F(FuzzReaders, FieldHeaders) {
     });
     EXPECT_GT(parsed, 0);
     EXPECT_GT(refused, 0);
+}
+
+// The sparse band's field file (sparse_field_file.h): its header, and its active block ids
+// (binary: truncated, flipped, reordered), each read back and densified when it parses.
+TEST_F(FuzzReaders, SparseFieldHeadersAndBlockIds) {
+    Lattice l;
+    l.type = LatticeType::BCC;
+    l.spacing = 0.5;
+    l.resolution = {20, 10, 9};
+    SparseBandField band(l, 0.75, Precision::Float);
+    for (int64_t id : {1, 4, 9}) {
+        const size_t base = size_t(band.add_active(id)) * kBandBlockPoints;
+        for (int local = 0; local < kBandBlockPoints; local += 3) {
+            band.distance[base + size_t(local)] = 0.01 * local - 0.7;
+            band.gradient[base + size_t(local)] = {0, 0, 1};
+            band.closest_triangle[base + size_t(local)] = local % 5;
+        }
+    }
+    band.mixed_inside[size_t(band.add_mixed(6))][2] = 0xF0F0;
+    band.set_tile_inside(7, true);
+    band.set_tile_inside(int(band.layout().block_count()) - 1, true);
+    band.sampler.backend = "cpu";
+    band.sampler.band = BandReport{0.75, 20, 7, "bricks", true, 3, 1, 7};
+    band.mesh.name = "fuzz";
+    write_sparse_field(at("s.json"), band);
+    const auto read_back = [](const std::string& path) {
+        const SparseBandField b = read_sparse_field(path);
+        b.densify();
+        b.counts();
+    };
+    const std::string seed = test::read_text(at("s.json"));
+    const auto [parsed, refused] = fuzz(at("s.json"), seed, kPerSeed, 4100, [&](const std::string& path, const std::string& bytes) {
+        test::write_file(path, bytes);
+        read_back(path);
+    });
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+    test::write_file(at("s.json"), seed);
+    const std::string ids_path = at("s.active_blocks.raw"), ids = test::read_text(ids_path);
+    int id_refused = 0;
+    Mutator m(4200);
+    for (int i = 0; i < kPerSeed; ++i) {
+        test::write_file(ids_path, m.mutate(ids));
+        try {
+            read_back(at("s.json"));
+        } catch (const std::runtime_error& e) {
+            ++id_refused;
+            EXPECT_NE(std::string(e.what()).find("s.json"), std::string::npos) << e.what();
+        } catch (const std::invalid_argument& e) {
+            ++id_refused;
+            EXPECT_NE(std::string(e.what()).find("s.json"), std::string::npos) << e.what();
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "block ids mutation " << i << " threw a foreign exception (" << typeid(e).name() << "): " << e.what();
+        }
+    }
+    std::cout << "s.active_blocks.raw: " << kPerSeed << " mutations, " << id_refused << " refused\n";
+    EXPECT_GT(id_refused, 0);
 }
 
 TEST_F(FuzzReaders, ConfigsReadValidatedAndPlanned) {

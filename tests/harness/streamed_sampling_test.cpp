@@ -6,6 +6,7 @@
 // outputs are kept, and the tool's command line refuses bad budget strings with exit 2.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -14,6 +15,7 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "harness/io/field_file.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness/resources/memory_budget.h"
 #include "harness/sampling/streamed_sampling.h"
 #include "harness_test_util.h"
@@ -350,6 +352,45 @@ TEST(StreamedSampling, SparseBandWritesTheDenseBandsBytes) {
     const test::ShellResult no_band = test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --sparse --out n.json");
     EXPECT_EQ(no_band.code, 2) << no_band.err;
     EXPECT_TRUE(test::Contains(no_band.err, "--sparse: expected a narrow band")) << no_band.err;
+}
+
+// Issue 35: --layout sparse writes the field file's sparse variant (sparse_field_file.h):
+// densified it is the dense --band run's field; sdf-eval reads it and prints what it prints
+// for the dense file, warning about the points off the band's cells.
+TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
+    test::ScratchDir dir("sdf_sample_sparse_layout");
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) + " --backend cpu --margin 0.3 --quiet";
+    for (const std::string& lattice : {std::string("--resolution 30 29 28"), std::string("--lattice bcc --resolution 21 20 38")}) {
+        const std::string args = " shape:torus " + lattice + " --band 0.12";
+        const test::ShellResult dense = test::run_in(dir.path(), exe + args + " --out d.json --overwrite");
+        const test::ShellResult sparse =
+            test::run_in(dir.path(), exe + args + " --sparse --layout sparse --out s.json --overwrite");
+        ASSERT_EQ(dense.code, 0) << dense.err;
+        ASSERT_EQ(sparse.code, 0) << sparse.err;
+        EXPECT_TRUE(test::Contains(sparse.out, "the sparse band's field file")) << sparse.out;
+        EXPECT_TRUE(is_sparse_field_file(dir.at("s.json")));
+        const SampledField d = read_field(dir.at("d.json")), f = read_sparse_field(dir.at("s.json")).densify();
+        EXPECT_TRUE(d.distance == f.distance) << lattice;
+        EXPECT_TRUE(d.closest_triangle == f.closest_triangle) << lattice;
+        ASSERT_EQ(d.gradient.size(), f.gradient.size());
+        EXPECT_EQ(std::memcmp(d.gradient.data(), f.gradient.data(), d.gradient.size() * sizeof(Vec3d)), 0) << lattice;
+        // sdf-eval: the same lines for both files, on and off the band.
+        std::string points;
+        for (int i = 0; i < 60; ++i) points += std::to_string(-1.2 + 0.04 * i) + " " + std::to_string(0.02 * i - 0.3) + " 0.05\n";
+        test::write_file(dir.at("p.txt"), points);
+        const std::string interp = lattice.find("bcc") != std::string::npos ? "bcc_cubic" : "tricubic_lm";
+        const std::string eval = test::quote(SDF_EVAL_EXE) + " --interpolator " + interp + " --threads 1 ";
+        const test::ShellResult from_dense = test::run_in(dir.path(), eval + "d.json p.txt");
+        const test::ShellResult from_sparse = test::run_in(dir.path(), eval + "s.json p.txt");
+        ASSERT_EQ(from_dense.code, 0) << from_dense.err;
+        ASSERT_EQ(from_sparse.code, 0) << from_sparse.err;
+        EXPECT_EQ(from_dense.out, from_sparse.out);
+        EXPECT_TRUE(test::Contains(from_sparse.err, "outside the sparse band's cells")) << from_sparse.err;
+    }
+    const test::ShellResult refused =
+        test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --band 0.1 --layout sparse --out n.json");
+    EXPECT_EQ(refused.code, 2) << refused.err;
+    EXPECT_TRUE(test::Contains(refused.err, "--layout sparse")) << refused.err;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 against the dense field of band_width=W (the existing path, sampled independently): to_dense()
 equal to it bit for bit, the band's points holding its values at its points, write() read back
 by pyopenvdb (Debian python3-openvdb), and the refusals."""
+import json
 import warnings
 
 import numpy as np
@@ -112,6 +113,9 @@ def test_write_vdb_read_by_pyopenvdb(pair, tmp_path):
             value, active = acc.probeValue((int(i), int(j), int(k)))
             assert active and value == np.float32(d)
     assert set(sparse.to_openvdb()) == set(grids_read)
+    read_back = sl.read_field(path)  # the grids, through pyopenvdb
+    assert set(read_back) == set(grids_read)
+    assert read_back["distance" + parts[0]].activeVoxelCount() == grids_read["distance" + parts[0]].activeVoxelCount()
     # closest_triangle=True adds Int32Grids, which Debian's pyopenvdb 10 cannot read: the other grids still read
     # by name, and the file names the new ones.
     with_triangles = str(tmp_path / "triangles.vdb")
@@ -159,3 +163,63 @@ def test_memory_grows_with_the_band():
     sparse = sl.sample(mesh, resolution=96, band=0.03, backend="cpu", threads=2)
     dense_bytes = sparse.num_points * (8 + 24 + 4)
     assert sparse.nbytes < dense_bytes / 4, (sparse.nbytes, dense_bytes)
+
+
+def test_sparse_field_file_round_trip_and_densified_equals_the_dense_field(pair, tmp_path):
+    """write(.json) and read_field: the band back, array for array (float64), and densified, the dense
+    band_width=W field (float64 bit for bit; float32: the dense field written and read as float32)."""
+    *_, sparse, dense = pair
+    path = str(tmp_path / "band.json")
+    files = sparse.write(path, dtype="float64")
+    assert files[0] == path and len(files) == 8  # header, 7 channels (gradient included)
+    back = sl.read_field(path)
+    assert isinstance(back, sl.SparseField) and len(back) == len(sparse)
+    for name in ("distance", "gradient", "triangle", "points", "indices", "subgrid"):
+        assert same_bits(getattr(back, name), getattr(sparse, name)), name
+    assert back.counts == sparse.counts and back.width == sparse.width and back.mesh == sparse.mesh
+    d = back.to_dense()
+    for a, b in zip(grids(d.values), grids(dense.values)):
+        assert same_bits(a, b)
+    sparse.write(str(tmp_path / "b32.json"))
+    dense.write(str(tmp_path / "dense32.json"))
+    d32, dense32 = sl.read_field(str(tmp_path / "b32.json")).to_dense(), sl.read_field(str(tmp_path / "dense32.json"))
+    for a, b in zip(grids(d32.values) + grids(d32.gradient), grids(dense32.values) + grids(dense32.gradient)):
+        assert same_bits(a, b)
+    with pytest.raises(RuntimeError, match="already exists"):
+        sparse.write(path)
+
+
+def test_reconstruct_inside_the_band_is_the_dense_fields(pair):
+    _, lattice, *_, sparse, dense = pair
+    interpolator = "tricubic_lm" if lattice == "cc" else "bcc_cubic"
+    rng = np.random.default_rng(35)
+    points = sparse.points[rng.choice(len(sparse), 400)] + rng.uniform(-0.4, 0.4, (400, 3)) * sparse.spacing
+    values, gradients = sparse.reconstruct(points, interpolator, "true")
+    dense_values, dense_gradients = dense.reconstruct(points, interpolator, "true")
+    inside = ~np.isnan(values)
+    assert 0 < inside.sum() < len(points)  # some near the band's edge are outside its cells
+    assert same_bits(values[inside], dense_values[inside])
+    assert same_bits(gradients[inside], dense_gradients[inside])
+    clamped, _ = sparse.reconstruct(points, interpolator, "true", outside="clamp")
+    dense_clamped, _ = dense.reconstruct(points, interpolator, "true", outside="clamp")
+    assert same_bits(clamped, dense_clamped)  # the dense band field's reconstruction, from +-W off the band
+    on_lattice = points[~np.isnan(dense_values)]  # off the lattice, the lattice's message comes first
+    with pytest.raises(ValueError, match="outside the band's cells"):
+        sparse.reconstruct(on_lattice, interpolator, "true", outside="error")
+    far, _ = sparse.reconstruct(np.array([[1e3, 0.0, 0.0]]), interpolator, "true")
+    assert np.isnan(far[0])  # outside the lattice, as the dense field
+
+
+def test_hostile_sparse_field_files_are_refused_naming_the_file(pair, tmp_path):
+    *_, sparse, _ = pair
+    path = tmp_path / "band.json"
+    sparse.write(str(path))
+    distance = tmp_path / "band.distance.raw"
+    distance.write_bytes(distance.read_bytes()[:-4])
+    with pytest.raises(RuntimeError, match=r"band\.json.*channel 'distance'.*holds"):
+        sl.read_field(str(path))
+    header = json.loads(path.read_text())
+    header["band"]["active_blocks"] = 10**12  # past the lattice's blocks: refused before anything is allocated
+    path.write_text(json.dumps(header))
+    with pytest.raises(ValueError, match=r"band\.json: key 'band\.active_blocks': expected 0 to"):
+        sl.read_field(str(path))
