@@ -572,31 +572,6 @@ this rank alone (no other rank takes part).)" "\n\n" + sampler_keywords_doc();
           py::arg("spacing") = py::none(), py::arg("origin") = py::none(), py::arg("progress") = py::none(),
           py::arg("distributed") = true, sample_doc.c_str());
 
-    m.def("lattice_kinds", [] {
-        py::list kinds;
-        for (const LatticeKind& k : kLatticeKinds) {
-            Lattice lattice;
-            lattice.type = k.type;
-            lattice.resolution = {2, 2, 2};
-            py::list parts;
-            for (const VolumeGrid& g : volume_grids(lattice)) parts.append(g.part);
-            py::dict kind;
-            kind["name"] = k.name;
-            kind["label"] = k.label;
-            kind["cosets"] = k.cosets;
-            kind["description"] = k.description;
-            kind["parts"] = parts;
-            kinds.append(kind);
-        }
-        return kinds;
-    }, R"(lattice_kinds() -> list of dict
-
-The lattice kinds, the rows of the one lattice table (kernels/lattice/lattice_kinds.h) in its
-order: "name" (what lattice= takes), "label", "cosets" (the CC grids the lattice is made of),
-"description", and "parts": the names of those grids in the files Field.write writes (""
-for a kind of one grid; "primary" and "secondary" for BCC, whose .npz arrays are
-distance_primary, ... and whose .vti files are NAME.primary.vti and NAME.secondary.vti).)");
-
     m.def("read_field_file", &read_field_file, py::arg("path"),
           R"(read_field_file(path) -> Field
 

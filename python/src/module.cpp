@@ -12,14 +12,15 @@
 // code is called per point. C++ errors arrive as Python exceptions with the tools' messages:
 // std::invalid_argument and ConfigError (sample()'s arguments, read by the config parser) as
 // ValueError, every other std::exception (a file that cannot be read, a backend this machine
-// lacks) as RuntimeError. One file per job: mesh.cpp, query.cpp, field.cpp, sparse_field.cpp, render.cpp,
-// distributed.cpp.
+// lacks) as RuntimeError. One file per job: mesh.cpp, query.cpp, field.cpp, sparse_field.cpp, lattice_kinds.cpp,
+// render.cpp, distributed.cpp.
 #include "harness/config/json_reader.h"
 #include "harness/provenance/version.h"
 #include "python/src/common.h"
 
 namespace sdf {
 void bind_sparse_field(py::module_& m);  // sparse_field.cpp
+void bind_lattice_kinds(py::module_& m);  // lattice_kinds.cpp
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -48,5 +49,6 @@ with the tools' messages.)";
     bind_query(m);
     bind_field(m);
     bind_sparse_field(m);
+    bind_lattice_kinds(m);
     bind_render(m);
 }
