@@ -100,6 +100,15 @@ public:
         JsonReader out = config.optional_object("output");
         write_fields_ = out.optional<bool>("fields", true, "true or false");
         out.finish();
+        // The run's field files are float32: a band they cannot store is refused in the plan,
+        // not after sampling (and caching) every lattice.
+        if (write_fields_) {
+            try {
+                require_representable_band(inputs_.sampler.band_width, FieldDtype::Float32, "band_width");
+            } catch (const std::invalid_argument& e) {
+                config.fail("sampler", std::string(e.what()) + " (the run's fields/ files; or \"output\": {\"fields\": false})");
+            }
+        }
     }
 
     MemoryNeed memory_need(const RunContext&) const override {

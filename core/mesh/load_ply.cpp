@@ -359,7 +359,10 @@ struct Reader {
 
     void skip_list(const PlyElement& e, const PlyProperty& p) {
         const double n = values.value(p.count_type);
-        if (n < 0 || n > double(values.bytes_left())) fail(e, "list '" + p.name + "' has " + std::to_string(int64_t(n)) + " items");
+        if (n < 0) fail(e, "list '" + p.name + "' has a negative item count (" + std::to_string(int64_t(n)) + ")");
+        if (n > double(values.bytes_left()))
+            fail(e, "list '" + p.name + "' declares " + std::to_string(int64_t(n)) + " items, more than the file's remaining " +
+                        std::to_string(values.bytes_left()) + " bytes hold (truncated, or a wrong count?)");
         for (int64_t j = 0; j < int64_t(n); ++j) values.value(p.type);
     }
 

@@ -59,55 +59,41 @@ struct Projection {
     }
 };
 
-/// The corners that are not strictly convex (the set S of the ear test), in a k-d tree of
-/// tight boxes built over those of the start, so that an ear test visits only the boxes
-/// its triangle may reach: a box is skipped when one of the triangle's edges has every
-/// corner of the box outside it by more than that edge's rounding error, so every corner
-/// the plain scan's computed test could accept is still tested (the same answers). A
-/// corner that leaves S is unmarked (the counts of live corners let empty boxes be
-/// skipped); one that joins S later (only in a polygon that is not simple) goes to a list
-/// of its own, scanned first.
-class ReflexCorners {
+/// The three edges of an ear's triangle, each as the half-plane orient(e0, e1, q) >= 0 that
+/// the ear test asks, as the projection computes it.
+struct CornerEdges {
+    struct Edge {
+        double au, av, du, dv, sign, magnitude;
+    } edge[3];
+};
+
+/// A k-d tree of tight boxes over a fixed list of corners (in the projection's plane), each
+/// node counting the corners below it that are in the set S of the ear test, so that a
+/// search skips boxes without one. An ear test visits only the boxes its triangle may reach:
+/// a box is skipped when one of the triangle's edges has every corner of the box outside it
+/// by more than that edge's rounding error, so every corner the plain scan's computed test
+/// could accept is still tested (the same answers).
+class CornerTree {
 public:
-    ReflexCorners(const std::vector<Vec3d>& p, const Projection& proj, std::vector<int> initial)
-        : p_(p), proj_(proj), member_(p.size(), 0), slot_(p.size(), -1), extra_position_(p.size(), -1),
-          items_(std::move(initial)), leaf_of_(items_.size(), -1) {
-        for (const int i : items_) member_[size_t(i)] = 1;
+    /// Over `corners`, every one of them in S.
+    CornerTree(const std::vector<Vec3d>& p, const Projection& proj, std::vector<int> corners)
+        : p_(p), proj_(proj), items_(std::move(corners)), leaf_of_(items_.size(), -1) {
         if (!items_.empty()) build(0, int(items_.size()), -1);
-        for (size_t s = 0; s < items_.size(); ++s) slot_[size_t(items_[s])] = int(s);
     }
 
-    bool contains(int i) const { return member_[size_t(i)] != 0; }
-
-    void insert(int i) {
-        if (contains(i)) return;
-        member_[size_t(i)] = 1;
-        if (slot_[size_t(i)] >= 0) return count(i, +1);
-        extra_position_[size_t(i)] = int(extra_.size());
-        extra_.push_back(i);
+    size_t size() const { return items_.size(); }
+    /// The corners, each at its slot.
+    const std::vector<int>& corners() const { return items_; }
+    /// The corner at `slot` joins (+1) or leaves (-1) S.
+    void count(int slot, int change) {
+        for (int n = leaf_of_[size_t(slot)]; n >= 0; n = nodes_[size_t(n)].parent) nodes_[size_t(n)].alive += change;
     }
 
-    void erase(int i) {
-        if (!contains(i)) return;
-        member_[size_t(i)] = 0;
-        if (slot_[size_t(i)] >= 0) return count(i, -1);
-        const int last = extra_.back();
-        extra_[size_t(extra_position_[size_t(i)])] = last;
-        extra_position_[size_t(last)] = extra_position_[size_t(i)];
-        extra_.pop_back();
-        extra_position_[size_t(i)] = -1;
-    }
-
-    /// The first corner j of S (in no particular order) that the triangle (a, b, c) may hold
-    /// and for which stop(j) is true, or -1; every corner of S that it may hold is offered.
-    template <typename Stop>
-    int find(const Vec3d& a, const Vec3d& b, const Vec3d& c, Stop stop) const {
-        for (const int j : extra_)
-            if (stop(j)) return j;
+    /// The first corner j of S (in no particular order) that the triangle with `edges` may
+    /// hold and for which stop(j) is true, or -1.
+    template <typename InS, typename Stop>
+    int find(const CornerEdges& edges, InS in_s, Stop stop) const {
         if (nodes_.empty() || nodes_[0].alive == 0) return -1;
-        const Vec3d* corners[3] = {&a, &b, &c};
-        Edge edges[3];
-        for (int k = 0; k < 3; ++k) edges[k] = edge(*corners[k], *corners[(k + 1) % 3]);
         int stack[64 * 2];
         int top = 0;
         stack[top++] = 0;
@@ -117,7 +103,7 @@ public:
             if (n.child[0] < 0) {
                 for (int s = n.begin; s < n.end; ++s) {
                     const int j = items_[size_t(s)];
-                    if (member_[size_t(j)] && stop(j)) return j;
+                    if (in_s(j) && stop(j)) return j;
                 }
                 continue;
             }
@@ -135,24 +121,15 @@ private:
         int parent;
         int alive;            ///< corners of S among them
     };
-    /// The half-plane orient(e0, e1, q) >= 0 that the ear test asks, as the projection computes it.
-    struct Edge {
-        double au, av, du, dv, sign, magnitude;
-    };
 
     double u(const Vec3d& q) const { return q[proj_.u]; }
     double v(const Vec3d& q) const { return q[proj_.v]; }
 
-    Edge edge(const Vec3d& e0, const Vec3d& e1) const {
-        const double du = u(e1) - u(e0), dv = v(e1) - v(e0);
-        return {u(e0), v(e0), du, dv, proj_.sign, std::abs(du) + std::abs(dv)};
-    }
-
     /// True when every point of the box is outside one of the edges by more than the
     /// rounding of the ear test's orient() (a few units of 2^-52 of the products: 16 used).
-    bool outside(const Node& n, const Edge (&edges)[3]) const {
+    static bool outside(const Node& n, const CornerEdges& edges) {
         constexpr double kRounding = 16 * std::numeric_limits<double>::epsilon();
-        for (const Edge& e : edges) {
+        for (const CornerEdges::Edge& e : edges.edge) {
             double most = -std::numeric_limits<double>::infinity(), reach = 0;
             for (int k = 0; k < 4; ++k) {
                 const double qu = (k & 1 ? n.hi[0] : n.lo[0]) - e.au, qv = (k & 2 ? n.hi[1] : n.lo[1]) - e.av;
@@ -162,10 +139,6 @@ private:
             if (most < -2 * kRounding * e.magnitude * reach) return true;
         }
         return false;
-    }
-
-    void count(int i, int change) {
-        for (int n = leaf_of_[size_t(slot_[size_t(i)])]; n >= 0; n = nodes_[size_t(n)].parent) nodes_[size_t(n)].alive += change;
     }
 
     int build(int begin, int end, int parent) {
@@ -201,13 +174,86 @@ private:
     static constexpr int kLeafSize = 8;
     const std::vector<Vec3d>& p_;
     Projection proj_;
-    std::vector<char> member_;       ///< in S
-    std::vector<int> slot_;          ///< place in items_, -1 for corners not in the tree
-    std::vector<int> extra_position_;
-    std::vector<int> items_;         ///< the tree's corners, each node's a range
-    std::vector<int> leaf_of_;       ///< the leaf of each slot of items_
+    std::vector<int> items_;    ///< the corners, each node's a range
+    std::vector<int> leaf_of_;  ///< the leaf of each slot of items_
     std::vector<Node> nodes_;
-    std::vector<int> extra_;         ///< corners of S not in the tree (joined later)
+};
+
+/// The set S of the ear test: the live corners that are not strictly convex. Those of the
+/// start sit in one CornerTree. A corner joins S later only in a polygon that crosses itself
+/// (in a simple one, clipping an ear makes its neighbours more convex, never less); such
+/// corners go to trees of their own, kept as Bentley and Saxe's logarithmic method keeps a
+/// static structure dynamic: a new corner and every tree no larger than what it gathered are
+/// rebuilt as one (the trees' sizes halve from one to the next, so a search visits O(log n)
+/// trees and each corner is rebuilt O(log n) times). A list of late corners scanned by every
+/// ear test made such polygons quadratic.
+class ReflexCorners {
+public:
+    ReflexCorners(const std::vector<Vec3d>& p, const Projection& proj, std::vector<int> initial)
+        : p_(p), proj_(proj), member_(p.size(), 0), tree_of_(p.size(), -1), slot_(p.size(), -1) {
+        for (const int i : initial) member_[size_t(i)] = 1;
+        add_tree(std::move(initial));
+    }
+
+    bool contains(int i) const { return member_[size_t(i)] != 0; }
+
+    void insert(int i) {
+        if (contains(i)) return;
+        member_[size_t(i)] = 1;
+        if (tree_of_[size_t(i)] >= 0) return trees_[size_t(tree_of_[size_t(i)])].count(slot_[size_t(i)], +1);
+        // Gather the late trees no larger than what is gathered (their corners still in S).
+        std::vector<int> corners = {i};
+        while (trees_.size() > 1 && trees_.back().size() <= corners.size()) {
+            for (const int j : trees_.back().corners()) {
+                tree_of_[size_t(j)] = -1;
+                if (contains(j)) corners.push_back(j);
+            }
+            trees_.pop_back();
+        }
+        add_tree(std::move(corners));
+    }
+
+    void erase(int i) {
+        if (!contains(i)) return;
+        member_[size_t(i)] = 0;
+        trees_[size_t(tree_of_[size_t(i)])].count(slot_[size_t(i)], -1);
+    }
+
+    /// The first corner j of S (in no particular order) that the triangle (a, b, c) may hold
+    /// and for which stop(j) is true, or -1; every corner of S that it may hold is offered.
+    template <typename Stop>
+    int find(const Vec3d& a, const Vec3d& b, const Vec3d& c, Stop stop) const {
+        const Vec3d* corners[3] = {&a, &b, &c};
+        CornerEdges edges;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3d &e0 = *corners[k], &e1 = *corners[(k + 1) % 3];
+            const double du = e1[proj_.u] - e0[proj_.u], dv = e1[proj_.v] - e0[proj_.v];
+            edges.edge[k] = {e0[proj_.u], e0[proj_.v], du, dv, proj_.sign, std::abs(du) + std::abs(dv)};
+        }
+        const auto in_s = [&](int j) { return contains(j); };
+        for (const CornerTree& tree : trees_) {
+            const int j = tree.find(edges, in_s, stop);
+            if (j >= 0) return j;
+        }
+        return -1;
+    }
+
+private:
+    void add_tree(std::vector<int> corners) {
+        trees_.emplace_back(p_, proj_, std::move(corners));
+        const std::vector<int>& placed = trees_.back().corners();
+        for (size_t s = 0; s < placed.size(); ++s) {
+            tree_of_[size_t(placed[s])] = int(trees_.size()) - 1;
+            slot_[size_t(placed[s])] = int(s);
+        }
+    }
+
+    const std::vector<Vec3d>& p_;
+    Projection proj_;
+    std::vector<char> member_;       ///< in S
+    std::vector<int> tree_of_;       ///< the tree holding each corner, -1 for none
+    std::vector<int> slot_;          ///< its slot there
+    std::vector<CornerTree> trees_;  ///< the start's corners, then late ones in trees of decreasing size
 };
 
 /// Ear clipping of one polygon (corners without consecutive repeats), as described in the header.
@@ -221,6 +267,10 @@ private:
 /// `recheck_` finds exactly the ears that testing every corner would find, and the clipping
 /// order, hence every triangle, is that of the plain algorithm, in O(n log n) for polygons
 /// whose corners are spread evenly (one 40,000-corner polygon: milliseconds, not 30 s).
+/// A polygon that crosses itself runs out of ears now and then; its fallback corner, the
+/// most convex one, comes from an ordered set of every live corner's turn, built at the
+/// first fallback and kept up to date from then on (a scan of every corner per fallback
+/// made such polygons quadratic).
 class EarClipper {
 public:
     EarClipper(const std::vector<Vec3d>& p, const std::vector<int>& ids, Projection proj, std::vector<Int3>& out)
@@ -242,7 +292,8 @@ public:
                 tip = ears_.begin()->second % int(p_.size());
             } else {
                 simple = false;
-                tip = most_convex();
+                if (!tracking_turns_) track_turns();
+                tip = turns_.begin()->second;
             }
             clip(tip);
         }
@@ -269,6 +320,7 @@ private:
         const int a = prev_[size_t(tip)], c = next_[size_t(tip)];
         emit(a, tip, c);
         forget(tip);
+        untrack_turn(tip);
         alive_[size_t(tip)] = false;
         leave_reflex(tip);
         next_[size_t(a)] = c;
@@ -281,6 +333,8 @@ private:
         }
         update(a);
         update(c);
+        if (tracking_turns_)
+            for (const int corner : {a, c}) { untrack_turn(corner); track_turn(corner); }
     }
 
     /// `j` leaves S: the corners it blocked are tested again when ears run out.
@@ -354,17 +408,28 @@ private:
             if (alive_[size_t(i)] && key_[size_t(i)] < 0) update(i);
     }
 
-    /// The corner that turns the polygon's way the most, the first of equals (a fallback:
-    /// it may hold other corners).
-    int most_convex() const {
-        int best = -1;
-        double best_turn = 0;
-        for (int i = 0; i < int(p_.size()); ++i) {
-            if (!alive_[size_t(i)]) continue;
-            const double turn = proj_.orient(p_[size_t(prev_[size_t(i)])], p_[size_t(i)], p_[size_t(next_[size_t(i)])]);
-            if (best < 0 || turn > best_turn) { best = i; best_turn = turn; }
-        }
-        return best;
+    /// How much corner i turns the polygon's way; the fallback clips the corner that turns
+    /// the most, the first of equals (it may hold other corners). A turn that overflowed to
+    /// NaN counts as the least.
+    double turn(int i) const {
+        const double t = proj_.orient(p_[size_t(prev_[size_t(i)])], p_[size_t(i)], p_[size_t(next_[size_t(i)])]);
+        return std::isnan(t) ? -std::numeric_limits<double>::infinity() : t;
+    }
+
+    void track_turns() {
+        tracking_turns_ = true;
+        turn_key_.assign(p_.size(), 0.0);
+        for (int i = 0; i < int(p_.size()); ++i)
+            if (alive_[size_t(i)]) track_turn(i);
+    }
+
+    void track_turn(int i) {
+        turn_key_[size_t(i)] = -turn(i);
+        turns_.insert({turn_key_[size_t(i)], i});
+    }
+
+    void untrack_turn(int i) {
+        if (tracking_turns_) turns_.erase({turn_key_[size_t(i)], i});
     }
 
     const std::vector<Vec3d>& p_;
@@ -377,6 +442,9 @@ private:
     std::set<std::pair<double, int>> ears_;  ///< (squared cut length, rank): shortest cut first
     std::vector<std::vector<int>> blocked_;   ///< the corners each corner of S blocked when last tested
     std::vector<int> recheck_;                ///< corners whose blocker left S
+    std::set<std::pair<double, int>> turns_;  ///< (-turn, corner) of every live corner, once a fallback was needed
+    std::vector<double> turn_key_;            ///< each corner's key in turns_
+    bool tracking_turns_ = false;
     ReflexCorners reflex_;                    ///< S: live corners not strictly convex
     TaskMonitor* monitor_;
     int left_ = 0;

@@ -25,11 +25,14 @@
 /// Ear clipping (Meisters 1975) is a few dozen lines here and needs no dependency: no C++
 /// earcut or polygon triangulator is packaged in Debian 12 apart from CGAL, whose
 /// constrained Delaunay triangulation would bring Boost, GMP and MPFR for faces that
-/// are mostly quads. Cost: the corners that are not convex sit in a k-d tree, so an ear
+/// are mostly quads. Cost: the corners that are not convex sit in k-d trees, so an ear
 /// test looks only at those its triangle may reach, and a corner is tested again only when
 /// a neighbour is clipped or the corner that blocked it leaves (issue 38): O(n log n) in
 /// practice (a 40,000-corner star or comb: a fraction of a second; the plain O(n r) scan
-/// took 29 s), the same triangles as the plain scan. A long clipping
+/// took 29 s), the same triangles as the plain scan. A polygon that crosses itself (corners
+/// turning reflex as others are clipped, fallbacks when no ear is left) keeps that cost:
+/// late reflex corners join trees of their own and the fallback's corner comes from an
+/// ordered set (40,000 random corners: 0.23 s, 3.5 s before). A long clipping
 /// stops on the calling thread's stop request (task_monitor.h: Ctrl-C in Python).
 #pragma once
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -141,6 +142,11 @@ struct FieldReader {
             case OptionDomain::Width:
                 if (!(v >= 0) || !std::isfinite(double(v)))
                     r.fail(f.name, "expected " + std::string(f.expected) + ": a finite number >= 0" + got());
+                // Below double's least normal value no field (the cache's float64 included) can
+                // hold +-w: refused here, before any sampling.
+                if (v > 0 && double(v) < std::numeric_limits<double>::min())
+                    r.fail(f.name, "expected " + std::string(f.expected) + ": 0 or at least " +
+                                       "2.2250738585072014e-308 (a normal double)" + got());
                 break;
             default: break;
         }

@@ -148,14 +148,41 @@ bool rename_no_replace(const std::string& from, const std::string& to) {
     throw std::runtime_error("cannot rename " + from + " to " + to + ": " + errno_text(e));
 }
 
-void write_file_atomically(const std::string& path, const void* data, size_t size, Overwrite overwrite) {
-    auto refuse = [&] {
-        return std::runtime_error(path + ": already exists; refusing to overwrite it (choose another output or "
-                                         "remove the file)");
-    };
-    if (overwrite == Overwrite::Forbid && fs::exists(path)) throw refuse();
+namespace {
+
+std::runtime_error refusal(const std::string& path) {
+    return std::runtime_error(path + ": already exists; refusing to overwrite it (choose another output or "
+                                     "remove the file)");
+}
+
+/// Renames the complete, synced temporary `tmp` to `path` (never over an existing file unless
+/// overwriting is allowed) and syncs the folder; removes `tmp` when it cannot be placed.
+void place(const std::string& tmp, const std::string& path, Overwrite overwrite) {
+    try {
+        fault_point("rename " + path + " into place");
+        if (overwrite == Overwrite::Forbid) {
+            if (!rename_no_replace(tmp, path)) throw refusal(path);
+        } else if (::rename(tmp.c_str(), path.c_str()) != 0) {
+            throw std::runtime_error(path + ": cannot move the written file into place: " + errno_text(errno));
+        }
+    } catch (...) {
+        ::unlink(tmp.c_str());
+        throw;
+    }
+    sync_parent_directory(path);
+}
+
+/// The checks before writing `path`: not there unless it may be replaced; its folder made.
+void prepare_target(const std::string& path, Overwrite overwrite) {
+    if (overwrite == Overwrite::Forbid && fs::exists(path)) throw refusal(path);
     const fs::path target(path);
     if (target.has_parent_path()) fs::create_directories(target.parent_path());
+}
+
+}  // namespace
+
+void write_file_atomically(const std::string& path, const void* data, size_t size, Overwrite overwrite) {
+    prepare_target(path, overwrite);
     const std::string tmp = unique_sibling_name(path, "tmp");
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) throw std::runtime_error(tmp + ": cannot open for writing: " + errno_text(errno));
@@ -166,18 +193,21 @@ void write_file_atomically(const std::string& path, const void* data, size_t siz
         ::unlink(tmp.c_str());
         throw std::runtime_error(path + ": write failed: " + errno_text(e));
     }
+    place(tmp, path, overwrite);
+}
+
+void write_through_temporary(const std::string& path, Overwrite overwrite,
+                             const std::function<void(const std::string& temporary)>& write) {
+    prepare_target(path, overwrite);
+    const std::string tmp = unique_sibling_name(path, "tmp");
     try {
-        fault_point("rename " + path + " into place");
-        if (overwrite == Overwrite::Forbid) {
-            if (!rename_no_replace(tmp, path)) throw refuse();
-        } else if (::rename(tmp.c_str(), path.c_str()) != 0) {
-            throw std::runtime_error(path + ": cannot move the written file into place: " + errno_text(errno));
-        }
+        write(tmp);
+        sync_file(tmp);
     } catch (...) {
         ::unlink(tmp.c_str());
         throw;
     }
-    sync_parent_directory(path);
+    place(tmp, path, overwrite);
 }
 
 void write_text_atomically(const std::string& path, const std::string& text, Overwrite overwrite) {

@@ -9,6 +9,7 @@
 /// temporary is removed on every failure.
 #pragma once
 
+#include <functional>
 #include <string>
 
 namespace sdf {
@@ -21,6 +22,14 @@ void write_file_atomically(const std::string& path, const void* data, size_t siz
                            Overwrite overwrite = Overwrite::Forbid);
 void write_text_atomically(const std::string& path, const std::string& text,
                            Overwrite overwrite = Overwrite::Forbid);
+
+/// Writes `path` atomically through `write`, a writer that takes a file name (a library's:
+/// OpenVDB's io::File), which is given a temporary name beside `path`; the temporary is then
+/// flushed to disk (fsync) and placed as write_file_atomically() places its own. Refuses an
+/// existing `path` before calling `write` unless overwriting is allowed. The temporary is
+/// removed on every failure, `write`'s own included.
+void write_through_temporary(const std::string& path, Overwrite overwrite,
+                             const std::function<void(const std::string& temporary)>& write);
 
 /// Renames `from` to `to` unless `to` exists (file or directory, empty or not): returns false
 /// then and leaves both alone. Other failures throw, naming both paths.

@@ -1,6 +1,6 @@
 /// @file sparse_vdb_file.cpp
 /// @brief The sparse band's OpenVDB writer (sparse_vdb_file.h): leaves and tiles built from
-/// the blocks directly, then written to a temporary and renamed into place.
+/// the blocks directly, then written to a temporary, synced and placed (write_through_temporary).
 #include "harness/io/sparse_vdb_file.h"
 
 #include <filesystem>
@@ -155,18 +155,8 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
         throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     openvdb::initialize();
     SparseVdbCounts counts;
-    const std::string temporary = unique_sibling_name(path, "tmp");
-    try {
-        write_grids(band, temporary, options, counts);
-        if (options.overwrite == Overwrite::Allow)
-            fs::rename(temporary, path);
-        else if (!rename_no_replace(temporary, path))
-            throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
-    } catch (...) {
-        std::error_code ec;
-        fs::remove(temporary, ec);
-        throw;
-    }
+    write_through_temporary(path, options.overwrite,
+                            [&](const std::string& temporary) { write_grids(band, temporary, options, counts); });
     return counts;
 }
 

@@ -258,18 +258,8 @@ void write_vdb_atomically(const SampledField& field, const std::string& path, co
     if (!(options.vdb_band > 0) || !std::isfinite(options.vdb_band))
         throw std::invalid_argument(path + ": the OpenVDB band must be a positive number of spacings, got " +
                                     number_text(options.vdb_band));
-    const std::string temporary = unique_sibling_name(path, "tmp");
-    try {
-        write_vdb_file(field, temporary, options.vdb_band);
-        if (options.overwrite == Overwrite::Allow)
-            fs::rename(temporary, path);
-        else if (!rename_no_replace(temporary, path))
-            throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
-    } catch (...) {
-        std::error_code ec;
-        fs::remove(temporary, ec);
-        throw;
-    }
+    write_through_temporary(path, options.overwrite,
+                            [&](const std::string& temporary) { write_vdb_file(field, temporary, options.vdb_band); });
 }
 
 }  // namespace

@@ -180,11 +180,7 @@ TEST(CudaBvh, NarrowBandIsTheFullFieldBandedBitForBit) {
 // on the sliver come out "outside the band". Every banded CUDA field equals the CPU double
 // brute force's field banded, to the bit.
 TEST(CudaBvh, NarrowBandNearASliverKeepsItsBricks) {
-    TriangleMesh m;
-    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
-    m.triangles = {{0, 1, 2}, {0, 3, 1}};
-    m.name = "issue_38_sliver";
-    const PreparedMesh mesh = prepare_mesh(m);
+    const PreparedMesh mesh = prepare_mesh(test::make_issue38_slivers());
     Lattice lattice;
     lattice.type = LatticeType::CC;
     lattice.origin = {40.0, -0.4, -0.3};

@@ -14,6 +14,7 @@
 #include "cuda/bvh/bvh_sampler.h"
 #include "cuda/brute_force/cuda_sampler.h"
 #include "harness/sampling/sampler_table.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/exact_distance.h"
 #include "tests/test_util/shared_mesh.h"
 
@@ -53,11 +54,7 @@ SamplerOptions options_of(const std::string& backend, const std::string& method,
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(CudaSliver, TheTwoTrianglesOfTheIssue) {
-    TriangleMesh m;
-    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
-    m.triangles = {{0, 1, 2}, {0, 3, 1}};
-    m.name = "issue_38_sliver";
-    const PreparedMesh mesh = prepare_mesh(m);
+    const PreparedMesh mesh = prepare_mesh(test::make_issue38_slivers());
     const std::vector<Vec3d> points = {{66, 0, 0}, {50, 0.1, 0}, {66, 0, -1}};
     const double want[] = {0, 0, 1};
     Lattice lattice;

@@ -5,7 +5,8 @@
 // reference run of either, never the old header over the new channels. Both on the same
 // lattice (where a mix would read back without error) and on another one. A failed run leaves
 // no file behind; a killed run's leftovers are removed by the next run. Also: every target is
-// checked before sampling (a missing --vdb folder), values float32 cannot hold are refused
+// checked before sampling (a missing --vdb folder), the sparse band's .vdb is old or new whole
+// at every step too (write_through_temporary), values float32 cannot hold are refused
 // (--band 1e-300), and budgets beyond the machine are refused with both figures.
 #include <gtest/gtest.h>
 
@@ -181,6 +182,58 @@ TEST_F(AtomicReplacement, SigkillAtRandomInstantsLeavesAWholeField) {
     ASSERT_EQ(sample(work, "", new_args + " --out f.json --overwrite --max-planes-per-slab 2").code, 0);
     EXPECT_EQ(fingerprint((work / "f.json").string()), new_fp);
     EXPECT_EQ(entries(work).size(), 4u) << "header and 3 channels; leftovers of the killed runs removed";
+}
+
+// The sparse band's .vdb (write_sparse_band_vdb) is written through a temporary, synced and
+// placed by write_through_temporary (atomic_file.h), whose rename is a fault point: failed or
+// killed at every step of a replacing run, the .vdb is the old file byte for byte or a whole
+// new one (as large as the reference run's: OpenVDB's bytes differ only in the file's UUID),
+// the field is old or new whole, and a failed run leaves no temporary behind.
+TEST_F(AtomicReplacement, SparseBandVdbIsOldOrNewWholeAtEveryStep) {
+    const std::string old_args = "shape:sphere --resolution 12 --band 0.3 --sparse" + kFourPlanes,
+                      new_args = "shape:torus --resolution 12 --band 0.3 --sparse" + kFourPlanes;
+    const std::string old_fp = reference("sparse_old", old_args), new_fp = reference("sparse_new", new_args);
+    const fs::path seed = dir_ / "sparse_seed", fresh = dir_ / "sparse_fresh";
+    fs::create_directories(seed);
+    fs::create_directories(fresh);
+    ASSERT_EQ(sample(seed, "", old_args + " --out f.json --vdb f.vdb").code, 0);
+    ASSERT_EQ(sample(fresh, "", new_args + " --out f.json --vdb f.vdb").code, 0);
+    const std::string old_vdb = test::read_text(seed / "f.vdb");
+    const size_t new_vdb_size = fs::file_size(fresh / "f.vdb");
+    ASSERT_NE(old_vdb.size(), new_vdb_size);
+    const std::set<std::string> old_files = entries(seed);
+    for (const char* mode : {"fail", "kill"}) {
+        int completed_at = 0, vdb_kept_at_last_step = 0;
+        for (int k = 1; k <= 40 && completed_at == 0; ++k) {
+            const std::string what = std::string(mode) + " at step " + std::to_string(k);
+            const fs::path work = dir_ / "sparse_work";
+            copy_folder(seed, work);
+            const std::string env = "SDF_FAULT_AT=" + std::to_string(k) + (std::string(mode) == "kill" ? " SDF_FAULT_MODE=kill" : "");
+            const test::ShellResult r = sample(work, env, new_args + " --out f.json --vdb f.vdb --overwrite");
+            const std::string now = fingerprint((work / "f.json").string());
+            const std::string vdb = test::read_text(work / "f.vdb");
+            EXPECT_TRUE(vdb == old_vdb || vdb.size() == new_vdb_size) << what << ": a .vdb of " << vdb.size() << " bytes";
+            if (r.code == 0) {
+                completed_at = k;
+                EXPECT_EQ(now, new_fp) << what;
+                EXPECT_EQ(vdb.size(), new_vdb_size) << what;
+                continue;
+            }
+            EXPECT_TRUE(now == old_fp || now == new_fp) << what << ": " << now << "\n" << r.err;
+            if (now == new_fp && vdb == old_vdb) vdb_kept_at_last_step = k;  // the field committed, the .vdb not yet
+            if (std::string(mode) == "fail") {
+                EXPECT_TRUE(test::Contains(r.err, "injected failure at step " + std::to_string(k))) << what;
+                if (now == old_fp) {
+                    EXPECT_EQ(entries(work), old_files) << what;
+                }
+                for (const std::string& name : entries(work))
+                    EXPECT_EQ(name.find(".tmp."), std::string::npos) << what << ": " << name << " left behind";
+            }
+        }
+        EXPECT_GE(completed_at, 8) << mode;
+        // The last step before completion is the .vdb's rename: the field is new, the .vdb still old.
+        EXPECT_EQ(vdb_kept_at_last_step, completed_at - 1) << mode;
+    }
 }
 
 // The case: a missing --vdb folder was found after the sampling, with the new channels

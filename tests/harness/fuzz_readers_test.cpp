@@ -1,7 +1,7 @@
 // A deterministic fuzz battery for every reader of outside input (issue 11): mesh files of
 // every format (OBJ, ASCII and binary PLY and STL, OFF, gzip; polygon faces, ASCII STL in
 // capitals and on one line, classic Mac line ends, gzip members: issue 26; polygons of
-// 256+ corners in every format: issue 38), points files (text and .npy),
+// 256+ corners and slivers of every size in every format: issue 38), points files (text and .npy),
 // field headers (dense, and the sparse band's header and block ids: issue 35) and configs (read, validated and planned as by run-experiment --dry-run). Valid seed files
 // are mutated with a fixed seed: bit flips, truncation, swapped and deleted tokens and lines,
 // huge, negative, fractional and non-finite numbers, byte-order marks, CRLF, NUL bytes.
@@ -10,7 +10,9 @@
 // crash (the test would die), never another exception type (a library's own, bad_alloc,
 // length_error), never a nameless message. Meshes that load are prepared too. And the certified
 // float search (issue 22) on fresh adversarial points (core/sampling/adversarial_cases.h,
-// another fixed seed): bit for bit the double brute force.
+// another fixed seed): bit for bit the double brute force. A hostile input per reader
+// (truncated, or a count far beyond the file) gets a message naming the file, the place and
+// what was expected.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -335,6 +337,179 @@ TEST_F(FuzzReaders, PolygonsOfMoreThan255CornersInEveryFormat) {
             const auto [parsed, refused] = fuzz(path, seed, kPerSeed / 3, 9000 + 10 * k + size_t(n), load_and_prepare);
             EXPECT_GT(refused, 0) << path;
         }
+}
+
+/// Slivers of every size (make_sliver_zoo: needles and caps of 1e-2 .. 1e-8 degrees beside
+/// their neighbours) and issue 38's sliver beside a wide triangle, with points on and around
+/// them.
+AdversarialCase sliver_seed_mesh() {
+    AdversarialCase c = make_sliver_zoo(1.0, 38, 20);
+    const int base = int(c.mesh.vertices.size());
+    const Vec3d o{0, 10, 0};
+    for (const Vec3d& v : std::vector<Vec3d>{{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}}) c.mesh.vertices.push_back(o + v);
+    c.mesh.triangles.push_back({base, base + 1, base + 2});
+    c.mesh.triangles.push_back({base, base + 3, base + 1});
+    for (const Vec3d& p : std::vector<Vec3d>{{66, 0, 0}, {50, 0.1, 0}, {66, 0, -1}, {99, 0, 0.01}}) c.points.push_back(o + p);
+    return c;
+}
+
+// Issue 38: slivers in every format. Each seed reads back as written (the text and double
+// formats bit for bit; STL's float32 corners to their triangle count), every search of the
+// mesh read (brute force and BVH, double and the certified float) finds the double brute
+// force's triangle and distance at every point on and around the slivers, and mutations of
+// each seed parse or are refused naming the file.
+TEST_F(FuzzReaders, SliversInEveryFormat) {
+    const AdversarialCase c = sliver_seed_mesh();
+    const std::vector<std::pair<std::string, std::string>> seeds = {
+        {"s.obj", test::obj_text(c.mesh)},
+        {"s.off", test::off_text(c.mesh)},
+        {"a_s.ply", test::ply_text(c.mesh, test::PlyEncoding::Ascii)},
+        {"le_s.ply", test::ply_text(c.mesh, test::PlyEncoding::BinaryLittleEndian)},
+        {"be_s.ply", test::ply_text(c.mesh, test::PlyEncoding::BinaryBigEndian)},
+        {"a_s.stl", test::stl_ascii_text(c.mesh)},
+        {"b_s.stl", test::stl_binary_text(c.mesh)},
+    };
+    for (size_t k = 0; k < seeds.size(); ++k) {
+        const std::string path = at(seeds[k].first);
+        test::write_file(path, seeds[k].second);
+        const TriangleMesh read = load_mesh_file(path);
+        ASSERT_EQ(read.triangles.size(), c.mesh.triangles.size()) << path;
+        if (path.find(".stl") == std::string::npos) {
+            ASSERT_EQ(read.vertices.size(), c.mesh.vertices.size()) << path;
+            for (size_t i = 0; i < read.vertices.size(); ++i)
+                ASSERT_TRUE(read.vertices[i] == c.mesh.vertices[i]) << path << ": vertex " << i;
+            for (size_t i = 0; i < read.triangles.size(); ++i) ASSERT_EQ(read.triangles[i], c.mesh.triangles[i]) << path;
+        }
+        MeshPreparationOptions prep;
+        prep.detect_intersections = false;
+        const PreparedMesh mesh = prepare_mesh(read, prep);
+        SamplerOptions o;
+        o.backend = "cpu";
+        o.method = "brute_force";
+        o.precision = Precision::Double;
+        o.progress = false;
+        const std::vector<PointSample> want = make_sampler(o)->bind(share(mesh))->query(c.points);
+        for (const Precision precision : {Precision::Double, Precision::Float})
+            for (const char* method : {"brute_force", "bvh"}) {
+                o.precision = precision;
+                o.method = method;
+                const std::vector<PointSample> got = make_sampler(o)->bind(share(mesh))->query(c.points);
+                for (size_t i = 0; i < got.size(); ++i)
+                    ASSERT_TRUE(got[i].triangle == want[i].triangle && got[i].distance == want[i].distance)
+                        << path << " " << method << (precision == Precision::Float ? " float" : " double") << " point " << i
+                        << ": " << got[i].distance << " (triangle " << got[i].triangle << "), want " << want[i].distance
+                        << " (triangle " << want[i].triangle << ")";
+            }
+        const auto [parsed, refused] = fuzz(path, seeds[k].second, kPerSeed / 3, 9500 + k, load_and_prepare);
+        EXPECT_GT(refused, 0) << path;
+    }
+}
+
+/// What `read` throws for `bytes` written to `path` (a project error), or "" with a failure.
+template <typename Read>
+std::string refusal_of(const std::string& path, const std::string& bytes, Read read) {
+    test::write_file(path, bytes);
+    try {
+        read(path);
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << path << ": a foreign exception (" << typeid(e).name() << "): " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << path << ": read without a word";
+    return "";
+}
+
+/// A .npy header of `shape_text` ("(4, 3)") over `data_bytes` zero bytes of float64.
+std::string npy_with_shape(const std::string& shape_text, size_t data_bytes) {
+    std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': " + shape_text + ", }";
+    while ((10 + dict.size() + 1) % 64 != 0) dict += ' ';
+    dict += '\n';
+    std::string s = "\x93NUMPY\x01";
+    s += '\0';
+    s += char(dict.size() & 0xff);
+    s += char(dict.size() >> 8);
+    return s + dict + std::string(data_bytes, '\0');
+}
+
+// A hostile input per reader, truncated or with a count far beyond the file: each is refused
+// before anything of that size is allocated (the sanitizer build would fail on the
+// allocation), with a message naming the file, the place (line, element or key) and what was
+// expected or found.
+TEST_F(FuzzReaders, HostileInputsGetAClearMessage) {
+    const TriangleMesh box = make_box({1.0, 0.5, 0.25});
+    const auto mesh = [](const std::string& path) { load_mesh_file(path); };
+    struct Hostile {
+        std::string name, bytes;
+        std::vector<std::string> says;  ///< phrases the message must hold (besides the file's name)
+    };
+    std::string obj = test::obj_text(box);
+    std::string off = test::off_text(box);
+    std::string stl = test::stl_ascii_text(box);
+    std::string stl_binary = test::stl_binary_text(box);
+    std::string ply_binary = test::ply_text(box, test::PlyEncoding::BinaryLittleEndian);
+    std::string stl_count = stl_binary;
+    for (int k = 0; k < 4; ++k) stl_count[size_t(80 + k)] = '\xff';  // 4,294,967,295 triangles
+    std::string ply_count = test::ply_text(box, test::PlyEncoding::Ascii);
+    ply_count.replace(ply_count.find("element vertex 8"), 16, "element vertex 2000000000");
+    const std::vector<Hostile> meshes = {
+        {"cut.obj", obj.substr(0, obj.find("\nv ", obj.find("\nv ") + 1) + 6), {"cut.obj:3:", "expected three finite numbers after 'v'"}},
+        {"index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967297\n", {"index.obj:4:", "refers to vertex 4294967297, but the file has 3 vertices"}},
+        {"cut.off", off.substr(0, off.rfind('\n', off.rfind('\n', off.size() - 2) - 1) + 1), {"OFF line 21", "file ends after 10 of 12 faces", "truncated?"}},
+        {"count.off", "OFF\n2000000000 2000000000 0\n0 0 0\n1 0 0\n", {"OFF line 2", "declares 2000000000 vertices and 2000000000 faces, more than the file's remaining 12 bytes hold"}},
+        {"polygon.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n", {"OFF line 6", "face 0 declares 2000000000 vertices, more than its line holds"}},
+        {"cut.ply", ply_binary.substr(0, ply_binary.size() - 7), {"PLY element 'face' 11", "list 'texcoord' declares 2 items", "truncated"}},
+        {"count.ply", ply_count, {"PLY header", "need at least 16000000052 bytes", "only 349 follow"}},
+        {"cut.stl", stl.substr(0, stl.size() / 2), {"ASCII STL line 43", "expected 'endfacet', found 'endfac'"}},
+        {"end.stl", stl.substr(0, stl.rfind("endsolid")), {"ASCII STL", "without 'endsolid' (truncated?)"}},
+        {"count.stl", stl_count, {"binary STL header", "declares 4294967295 triangles, which take 214748364834 bytes, but the file has 684"}},
+    };
+    for (const Hostile& h : meshes) {
+        const std::string msg = refusal_of(at(h.name), h.bytes, mesh);
+        std::cout << h.name << ": " << msg << "\n";
+        EXPECT_TRUE(test::Contains(msg, h.name)) << msg;
+        for (const std::string& phrase : h.says) EXPECT_TRUE(test::Contains(msg, phrase)) << h.name << ": " << msg << "\nlacks: " << phrase;
+    }
+    const auto points = [](const std::string& path) { read_points_file(path); };
+    const std::vector<Hostile> point_files = {
+        {"cut.txt", "0 0 0\n1 2 3\n4 5", {"cut.txt:3:", "expected three finite numbers", "'4 5'"}},
+        {"cut.npy", npy_with_shape("(4, 3)", 40), {"needs 96 bytes of data; the file has 40"}},
+        {"count.npy", npy_with_shape("(4000000000000, 3)", 96), {"shape (4000000000000, 3)", "needs 96000000000000 bytes"}},
+    };
+    for (const Hostile& h : point_files) {
+        const std::string msg = refusal_of(at(h.name), h.bytes, points);
+        std::cout << h.name << ": " << msg << "\n";
+        EXPECT_TRUE(test::Contains(msg, h.name)) << msg;
+        for (const std::string& phrase : h.says) EXPECT_TRUE(test::Contains(msg, phrase)) << h.name << ": " << msg << "\nlacks: " << phrase;
+    }
+    // A field header whose lattice is far larger than its channels, and a channel cut short.
+    SampledField f;
+    f.lattice.type = LatticeType::CC;
+    f.lattice.spacing = 0.5;
+    f.lattice.resolution = {3, 3, 3};
+    for (int64_t i = 0; i < f.lattice.num_points(); ++i) f.distance.push_back(double(i));
+    write_field(at("big.json"), f);
+    std::string header = test::read_text(at("big.json"));
+    const size_t resolution = header.find("\"resolution\"");
+    ASSERT_NE(resolution, std::string::npos) << header;
+    header.replace(resolution, header.find(']', resolution) + 1 - resolution, "\"resolution\": [100000, 100000, 100000]");
+    const auto field = [](const std::string& path) { read_field(path); };
+    std::string msg = refusal_of(at("big.json"), header, field);
+    std::cout << "big.json: " << msg << "\n";
+    EXPECT_TRUE(test::Contains(msg, "big.json")) << msg;
+    EXPECT_TRUE(test::Contains(msg, "lattice.resolution")) << msg;
+    EXPECT_TRUE(test::Contains(msg, "1000000000000000 points")) << msg;
+    write_field(at("cut.json"), f);
+    const std::string channel = test::read_text(at("cut.distance.raw"));
+    test::write_file(at("cut.distance.raw"), channel.substr(0, channel.size() / 2));
+    msg = refusal_of(at("cut.json"), test::read_text(at("cut.json")), field);
+    std::cout << "cut.json: " << msg << "\n";
+    EXPECT_TRUE(test::Contains(msg, "cut.distance.raw")) << msg;
+    EXPECT_TRUE(test::Contains(msg, "holds " + std::to_string(channel.size() / 2) + " bytes")) << msg;
+    EXPECT_TRUE(test::Contains(msg, "need " + std::to_string(channel.size()))) << msg;
 }
 
 TEST_F(FuzzReaders, PointsFiles) {

@@ -692,6 +692,29 @@ TEST_F(Trust, RunExperimentRefusesABandItsFieldFilesCannotStoreInThePlan) {
         EXPECT_FALSE(Contains(r.out, "sampling with")) << dry << ": " << r.out;
         EXPECT_FALSE(fs::exists(at("cache"))) << dry << ": a field was cached";
     }
+    // The reconstruction study writes its fields (float32) too: the same refusal in its plan
+    // (it sampled, cached and then failed); a band below double's normal range, which not even
+    // the float64 cache can store, is refused by the sampler options in every kind.
+    write("recon.json", R"({"name": "recon", "kind": "reconstruction", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [4, 4, 4]}],
+        "reconstructions": [{"lattice": "cc", "interpolator": "trilinear"}],
+        "sampler": {"threads": 1, "progress": false, "band_width": 1e-300}})");
+    write("subnormal.json", R"({"name": "subnormal", "mesh": {"shape": "box"},
+        "lattices": [{"type": "cc", "resolution": [4, 4, 4]}], "output": {"dtype": "float64"},
+        "sampler": {"threads": 1, "progress": false, "band_width": 1e-310}})");
+    for (const std::string dry : {" --dry-run", ""}) {
+        const ShellResult r = experiment("recon.json --output-root out" + dry);
+        EXPECT_NE(r.code, 0) << dry;
+        EXPECT_TRUE(Contains(r.err, "band_width: 1e-300 cannot be stored in float32")) << dry << ": " << r.err;
+        EXPECT_TRUE(Contains(r.err, "fields")) << dry << ": " << r.err;
+        EXPECT_FALSE(Contains(r.out, "sampling with")) << dry << ": " << r.out;
+        const ShellResult sub = experiment("subnormal.json --output-root out" + dry);
+        EXPECT_NE(sub.code, 0) << dry;
+        EXPECT_TRUE(Contains(sub.err, "band_width")) << dry << ": " << sub.err;
+        EXPECT_TRUE(Contains(sub.err, "a normal double")) << dry << ": " << sub.err;
+        EXPECT_FALSE(Contains(sub.out, "sampling with")) << dry << ": " << sub.out;
+        EXPECT_FALSE(fs::exists(at("cache"))) << dry << ": a field was cached";
+    }
 }
 
 TEST_F(Trust, RunExperimentRefusesACacheDirThatIsAFileInThePlan) {

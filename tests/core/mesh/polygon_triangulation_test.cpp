@@ -11,13 +11,18 @@
 //  - Issue 38: the grid clipper gives the triangles of the quadratic one it replaced
 //    (reference_ear_clipping.h) on random simple, comb, keyhole, collinear and
 //    self-crossing polygons; a 40,000-corner star and comb are triangulated (29 s before) and stop
-//    on request; a cylinder with 300-corner caps reads alike in every format, its centre
+//    on request; polygons of 10,000..40,000 corners that cross themselves (random corners,
+//    a circle wound three times, a star polygon, a figure of eight) triangulate as chains
+//    whose winding numbers are the polygon's at random points (crossing counts) and stop on
+//    request; a cylinder with 300-corner caps reads alike in every format, its centre
 //    inside (OBJ corners beyond 255: tinyobjloader's unsigned char count), and an OFF
 //    polygon on the last line is not taken for a truncated file.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <random>
 #include <string>
@@ -274,6 +279,132 @@ TEST(TriangulatePolygon, FortyThousandCornersAndAStopRequest) {
     const std::vector<Vec3d> v = star(40000);
     std::vector<int> corners(v.size());
     for (size_t i = 0; i < v.size(); ++i) corners[i] = int(i);
+    TaskMonitor monitor;
+    monitor.request_stop();
+    ScopedTaskMonitor scope(&monitor);
+    std::vector<Int3> tris;
+    PolygonStats stats;
+    EXPECT_THROW(triangulate_polygon(v, corners, tris, stats), TaskStopped);
+}
+
+/// Winding number of the closed polygon `uv` around q (Sunday's crossing rule: upward edges
+/// with q strictly left count +1, downward edges with q strictly right -1).
+int polygon_winding(const std::pair<double, double>* uv, size_t n, std::pair<double, double> q) {
+    int w = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const auto& a = uv[i];
+        const auto& b = uv[(i + 1) % n];
+        const double side = (b.first - a.first) * (q.second - a.second) - (q.first - a.first) * (b.second - a.second);
+        if (a.second <= q.second && b.second > q.second && side > 0) ++w;
+        if (a.second > q.second && b.second <= q.second && side < 0) --w;
+    }
+    return w;
+}
+
+/// Checks the triangles of a polygon that crosses itself, as chains: n - 2 triangles of the
+/// polygon's own corners, their signed areas summing to the polygon's shoelace area, every
+/// polygon edge used once in its own direction and every cut once in each direction (so the
+/// triangles' boundary is the polygon), and at `probes` random points of the polygon's box
+/// the sum of the triangles' windings equal to the polygon's winding number, computed
+/// independently by crossing counts. Returns the seconds the triangulation took (printed,
+/// never asserted).
+double expect_chain_triangulation(const std::vector<std::pair<double, double>>& uv, const std::string& what,
+                                  int probes = 300) {
+    const PlanarPolygon p = place(uv, {0.5, -2, 7}, {0, 0, 1}, {1, 0, 0});
+    std::vector<Int3> tris;
+    PolygonStats stats;
+    const auto start = std::chrono::steady_clock::now();
+    triangulate_polygon(p.vertices, p.corners, tris, stats);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const size_t n = uv.size();
+    EXPECT_EQ(tris.size(), n - 2) << what;
+    EXPECT_EQ(stats.not_simple, 1) << what;
+    // Signed areas in the (u, v) of `uv` (the placement maps u to z and v to x: a proper rotation).
+    const auto orient = [&](int a, int b, int c) {
+        const auto &pa = uv[size_t(a)], &pb = uv[size_t(b)], &pc = uv[size_t(c)];
+        return (pb.first - pa.first) * (pc.second - pa.second) - (pb.second - pa.second) * (pc.first - pa.first);
+    };
+    double area = 0, magnitude = 0;
+    std::map<std::pair<int, int>, int> directed;
+    for (const Int3& t : tris) {
+        EXPECT_TRUE(t.x >= 0 && t.y >= 0 && t.z >= 0 && size_t(std::max({t.x, t.y, t.z})) < n) << what;
+        area += 0.5 * orient(t.x, t.y, t.z);
+        magnitude += 0.5 * std::abs(orient(t.x, t.y, t.z));
+        for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+    }
+    EXPECT_NEAR(area, p.area, 1e-9 * magnitude) << what;
+    for (size_t i = 0; i < n; ++i) {
+        const std::pair<int, int> e{int(i), int((i + 1) % n)};
+        const std::pair<int, int> reversed{e.second, e.first};
+        EXPECT_EQ(directed[e] - directed[reversed], 1) << what << ": polygon edge " << e.first;
+    }
+    for (const auto& [e, count] : directed) {
+        if (e.second == (e.first + 1) % int(n) || e.first == (e.second + 1) % int(n)) continue;
+        const std::pair<int, int> reversed{e.second, e.first};
+        EXPECT_EQ(count, directed[reversed]) << what << ": cut " << e.first << "-" << e.second;
+    }
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const auto& q : uv) {
+        lo[0] = std::min(lo[0], q.first); hi[0] = std::max(hi[0], q.first);
+        lo[1] = std::min(lo[1], q.second); hi[1] = std::max(hi[1], q.second);
+    }
+    std::mt19937_64 rng(n);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int nonzero = 0;
+    for (int k = 0; k < probes; ++k) {
+        const std::pair<double, double> q{lo[0] + (hi[0] - lo[0]) * u(rng), lo[1] + (hi[1] - lo[1]) * u(rng)};
+        int sum = 0;
+        for (const Int3& t : tris) {
+            const std::pair<double, double> tri[3] = {uv[size_t(t.x)], uv[size_t(t.y)], uv[size_t(t.z)]};
+            sum += polygon_winding(tri, 3, q);
+        }
+        const int want = polygon_winding(uv.data(), uv.size(), q);
+        nonzero += want != 0;
+        EXPECT_EQ(sum, want) << what << ": probe " << k << " at (" << q.first << ", " << q.second << ")";
+    }
+    EXPECT_GT(nonzero, 0) << what;
+    std::cout << what << ": " << n << " corners, " << tris.size() << " triangles in " << seconds << " s\n";
+    return seconds;
+}
+
+// Issue 38: polygons that cross themselves ran out of ears again and again, and each time the
+// fallback scanned every corner (and corners turned reflex went to a list scanned by every ear
+// test): quadratic. Now their triangles are checked as chains whose winding is the polygon's
+// everywhere, on 10,000..40,001 corners: random corners, a circle wound three times, a star
+// polygon {n/k} and a figure of eight. A small one still gets the quadratic clipper's triangles.
+TEST(TriangulatePolygon, LargePolygonsThatCrossThemselves) {
+    std::mt19937_64 rng(3838);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<std::pair<double, double>> uv;
+    for (int i = 0; i < 10000; ++i) uv.push_back({u(rng), u(rng)});
+    expect_chain_triangulation(uv, "10,000 random corners", 100);
+    uv.clear();
+    for (int i = 0; i < 20000; ++i) {  // three turns, radius wobbling so that the turns cross
+        const double angle = 3 * 2 * kPi * i / 20000, r = 1 + 0.2 * std::sin(7.3 * angle) + 0.01 * u(rng);
+        uv.push_back({r * std::cos(angle), r * std::sin(angle)});
+    }
+    expect_chain_triangulation(uv, "a circle wound three times");
+    uv.clear();
+    for (int i = 0; i < 40001; ++i) {  // {40001/137}: each edge crosses many others
+        const double angle = 2 * kPi * double((int64_t(i) * 137) % 40001) / 40001;
+        uv.push_back({std::cos(angle) * (1 + 1e-3 * u(rng)), std::sin(angle)});
+    }
+    expect_chain_triangulation(uv, "a star polygon {40001/137}", 40);
+    uv.clear();
+    for (int i = 0; i < 20000; ++i) {  // a figure of eight: winding +1 in one lobe, -1 in the other
+        const double t = 2 * kPi * i / 20000;
+        uv.push_back({std::sin(t), std::sin(t) * std::cos(t) + 1e-4 * u(rng)});
+    }
+    expect_chain_triangulation(uv, "a figure of eight");
+    // The quadratic clipper's triangles on a self-crossing polygon larger than those of
+    // SameTrianglesAsTheQuadraticClipper.
+    std::vector<Vec3d> v;
+    for (int i = 0; i < 1500; ++i) v.push_back({u(rng), 0.25, u(rng)});
+    expect_reference_triangles(v, "1,500 random corners");
+    // A stop request ends a self-crossing polygon's clipping too.
+    std::vector<int> corners(v.size());
+    for (size_t i = 0; i < v.size(); ++i) corners[i] = int(i);
+    for (int i = 0; i < 8192; ++i) { v.push_back({u(rng), 0.25, u(rng)}); corners.push_back(int(v.size()) - 1); }
     TaskMonitor monitor;
     monitor.request_stop();
     ScopedTaskMonitor scope(&monitor);

@@ -1,7 +1,7 @@
 /// @file bvh_test_meshes.h
 /// @brief The meshes the BVH is checked on (CPU and GPU tests) and the comparison of a BVH
 /// field with the brute-force field: the procedural shapes, a sphere full of tiny and
-/// sliver triangles, a slab with large flat faces, and bunny/dragon when SDF_DATA_PATH has
+/// sliver triangles, issue 38's sliver beside a wide triangle, a slab with large flat faces, and bunny/dragon when SDF_DATA_PATH has
 /// them.
 #pragma once
 
@@ -47,6 +47,18 @@ inline TriangleMesh make_sliver_sphere(int subdivisions = 3) {
     }
     m.triangles = out;
     m.name = "sliver_sphere";
+    return m;
+}
+
+/// Issue 38's two triangles: a wide one (triangle 0) and, sharing its long edge, a sliver
+/// of 100 x 0.872 (triangle 1: an angle of 0.5 degrees at the origin, inradius 0.54) that the
+/// searches ranked by its edges only. (66,0,0) and (50,0.1,0) lie on the sliver, (66,0,-1)
+/// is 1 below it.
+inline TriangleMesh make_issue38_slivers() {
+    TriangleMesh m;
+    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
+    m.triangles = {{0, 1, 2}, {0, 3, 1}};
+    m.name = "issue_38_sliver";
     return m;
 }
 

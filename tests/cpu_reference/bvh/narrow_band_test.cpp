@@ -127,11 +127,7 @@ TEST(NarrowBand, FewPointsAreComputedWhenMostOfTheLatticeIsOutsideTheBand) {
 // so the probe's distance may exceed the true one by that much; the brick skip must allow for
 // it or a brick on the sliver is called outside a band of 0.05.
 TEST(NarrowBand, ProbesNearSliversDoNotSkipBricksInTheBand) {
-    TriangleMesh m;
-    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
-    m.triangles = {{0, 1, 2}, {0, 3, 1}};
-    m.name = "issue_38_sliver";
-    const PreparedMesh mesh = prepare_mesh(m);
+    const PreparedMesh mesh = prepare_mesh(test::make_issue38_slivers());
     Lattice lattice;
     lattice.type = LatticeType::CC;
     lattice.origin = {40.0, -0.4, -0.3};

@@ -53,19 +53,11 @@ std::unique_ptr<Sampler> sampler_of(const Search& s, SignMode sign = SignMode::A
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-TriangleMesh issue_mesh() {
-    TriangleMesh m;
-    m.vertices = {{0, 0, 0}, {100, 0.436, 0}, {0, 5, 0}, {100, -0.436, 0}};
-    m.triangles = {{0, 1, 2}, {0, 3, 1}};
-    m.name = "issue_38_sliver";
-    return m;
-}
-
 // The reproduction of issue 38: (66,0,0) and (50,0.1,0) lie on the sliver (triangle 1, an
 // angle of 0.5 degrees), (66,0,-1) is 1 below it; every search used to answer 0.288, 0.118
 // and 1.041 from triangle 0. Point queries with both signs, and a lattice (fields).
 TEST(SliverSearch, TheTwoTrianglesOfTheIssue) {
-    const PreparedMesh mesh = prepare_mesh(issue_mesh());
+    const PreparedMesh mesh = prepare_mesh(test::make_issue38_slivers());
     const std::vector<Vec3d> points = {{66, 0, 0}, {50, 0.1, 0}, {66, 0, -1}};
     const double want[] = {0, 0, 1};
     Lattice lattice;
