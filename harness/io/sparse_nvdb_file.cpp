@@ -1,6 +1,7 @@
 /// @file sparse_nvdb_file.cpp
 /// @brief The sparse band's NanoVDB writer (sparse_nvdb_file.h): NanoVDB's host grid builder
-/// fed the blocks directly, converted to a NanoGrid<float>, written to a temporary and renamed.
+/// fed the blocks directly, converted to a NanoGrid<float>, written to a temporary, synced and
+/// placed (write_through_temporary).
 #include "harness/io/sparse_nvdb_file.h"
 
 #include <filesystem>
@@ -117,23 +118,9 @@ void write_grids(const SparseBandField& band, const std::string& path, SparseNvd
 bool nanovdb_available() { return true; }
 
 SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::string& path, Overwrite overwrite) {
-    namespace fs = std::filesystem;
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
-    if (overwrite == Overwrite::Forbid && fs::exists(path))
-        throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     SparseNvdbCounts counts;
-    const std::string temporary = unique_sibling_name(path, "tmp");
-    try {
-        write_grids(band, temporary, counts);
-        if (overwrite == Overwrite::Allow)
-            fs::rename(temporary, path);
-        else if (!rename_no_replace(temporary, path))
-            throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
-    } catch (...) {
-        std::error_code ec;
-        fs::remove(temporary, ec);
-        throw;
-    }
+    write_through_temporary(path, overwrite, [&](const std::string& temporary) { write_grids(band, temporary, counts); });
     return counts;
 }
 
