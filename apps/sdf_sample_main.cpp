@@ -285,6 +285,24 @@ int main(int argc, char** argv) {
                       << sdf::format_bytes(sparse_slabs->band().memory_bytes()) << ", " << sparse_slabs->band().timings.total
                       << " s\n";
         }
+        // The level sets written straight from the sparse band's blocks, after either field file.
+        const auto write_level_sets = [&]() -> std::pair<int64_t, int64_t> {
+            std::pair<int64_t, int64_t> active{0, 0};
+            if (!vdb_path.empty()) {
+                doing = "writing " + vdb_path + " from the sparse band";
+                sdf::SparseVdbOptions vdb_options;
+                vdb_options.gradient = stream.gradient;
+                // As the dense .vdb: no closest-triangle grid (Debian's pyopenvdb 10 cannot read an Int32Grid).
+                vdb_options.closest_triangle = false;
+                vdb_options.overwrite = stream.write.overwrite;
+                active.first = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
+            }
+            if (!nvdb_path.empty()) {
+                doing = "writing " + nvdb_path + " from the sparse band";
+                active.second = sdf::write_sparse_band_nvdb(sparse_slabs->band(), nvdb_path, stream.write.overwrite).active_voxels;
+            }
+            return active;
+        };
         if (layout == "sparse") {
             doing = "writing the sparse field file " + out_path;
             sdf::SparseFieldWriteOptions file;
@@ -292,34 +310,20 @@ int main(int argc, char** argv) {
             file.gradient = stream.gradient;
             file.overwrite = stream.write.overwrite;
             sdf::write_sparse_field(out_path, sparse_slabs->band(), file);
-            if (!vdb_path.empty()) {
-                doing = "writing " + vdb_path + " from the sparse band";
-                sdf::SparseVdbOptions vdb_options;
-                vdb_options.gradient = stream.gradient;
-                vdb_options.closest_triangle = false;
-                vdb_options.overwrite = stream.write.overwrite;
-                const int64_t active = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
-                std::cout << "wrote " << vdb_path << ": " << active << " active points (|d| <= " << band << ")\n";
-            }
+            const auto [vdb_active, nvdb_active] = write_level_sets();
             std::cout << "wrote " << out_path << ": the sparse band's field file, " << sparse_slabs->band().active.size()
                       << " active blocks\n";
+            if (!vdb_path.empty()) std::cout << "wrote " << vdb_path << ": " << vdb_active << " active points (|d| <= " << band << ")\n";
+            if (!nvdb_path.empty())
+                std::cout << "wrote " << nvdb_path << ": " << nvdb_active << " active points (|d| <= " << band << ")\n";
             return 0;
         }
         const sdf::StreamResult r = sdf::sample_streamed(sparse_slabs ? *sparse_slabs : bound, options, lattice, stream, mesh_provenance);
-        int64_t vdb_active = r.vdb_active_points;
-        if (sparse_slabs && !vdb_path.empty()) {
-            doing = "writing " + vdb_path + " from the sparse band";
-            sdf::SparseVdbOptions vdb_options;
-            vdb_options.gradient = stream.gradient;
-            // As the dense .vdb: no closest-triangle grid (Debian's pyopenvdb 10 cannot read an Int32Grid).
-            vdb_options.closest_triangle = false;
-            vdb_options.overwrite = stream.write.overwrite;
-            vdb_active = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
-        }
-        int64_t nvdb_active = 0;
-        if (sparse_slabs && !nvdb_path.empty()) {
-            doing = "writing " + nvdb_path + " from the sparse band";
-            nvdb_active = sdf::write_sparse_band_nvdb(sparse_slabs->band(), nvdb_path, stream.write.overwrite).active_voxels;
+        int64_t vdb_active = r.vdb_active_points, nvdb_active = 0;
+        if (sparse_slabs) {
+            const std::pair<int64_t, int64_t> active = write_level_sets();
+            if (!vdb_path.empty()) vdb_active = active.first;
+            nvdb_active = active.second;
         }
         std::cout << "wrote " << out_path << ": " << r.plan.points << " points in " << r.plan.slabs << " slabs, "
                   << sdf::format_bytes(r.plan.output_bytes) << "; " << r.seconds << " s end to end ("

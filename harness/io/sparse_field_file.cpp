@@ -212,8 +212,9 @@ OpenChannel open_channel(const std::string& header, JsonReader& channels, const 
     if (!fs::exists(st)) throw std::runtime_error(header + ": channel '" + name + "': file " + c.path + " not found");
     if (!fs::is_regular_file(st)) throw std::runtime_error(header + ": channel '" + name + "': " + c.path + " is not a regular file");
     const uint64_t size = fs::file_size(c.path, ec);
+    if (ec) throw std::runtime_error(header + ": channel '" + name + "': cannot read the size of " + c.path + ": " + ec.message());
     const std::optional<int64_t> expected = checked_mul(count, int64_t(components), int64_t(dtype_bytes(c.dtype)));
-    if (ec || !expected || size != uint64_t(*expected))
+    if (!expected || size != uint64_t(*expected))
         throw std::runtime_error(header + ": channel '" + name + "': " + c.path + " holds " + std::to_string(size) +
                                  " bytes; the header's band needs " + std::to_string(count) + " x " + std::to_string(components) +
                                  " " + c.dtype + " = " + (expected ? std::to_string(*expected) : "too many") + " bytes");
@@ -232,14 +233,19 @@ void read_values(OpenChannel& c, Held* out, int64_t n, const std::string& header
         bytes.resize(size_t(m) * width);
         c.in.read(bytes.data(), std::streamsize(bytes.size()));
         if (!c.in) throw std::runtime_error(header + ": " + c.path + ": read failed");
-        for (int64_t i = 0; i < m; ++i) {
-            const char* at = bytes.data() + size_t(i) * width;
-            if (c.dtype == "float32") { float v; std::memcpy(&v, at, 4); out[first + i] = Held(v); }
-            else if (c.dtype == "float64") { double v; std::memcpy(&v, at, 8); out[first + i] = Held(v); }
-            else if (c.dtype == "int32") { int32_t v; std::memcpy(&v, at, 4); out[first + i] = Held(v); }
-            else if (c.dtype == "int64") { int64_t v; std::memcpy(&v, at, 8); out[first + i] = Held(v); }
-            else { uint64_t v; std::memcpy(&v, at, 8); out[first + i] = Held(v); }
-        }
+        // The dtype is decided once per chunk, not per value (a 2048^3 band holds 10^8 values).
+        const auto convert = [&](auto stored) {
+            using Stored = decltype(stored);
+            for (int64_t i = 0; i < m; ++i) {
+                std::memcpy(&stored, bytes.data() + size_t(i) * sizeof(Stored), sizeof(Stored));
+                out[first + i] = Held(stored);
+            }
+        };
+        if (c.dtype == "float32") convert(float{});
+        else if (c.dtype == "float64") convert(double{});
+        else if (c.dtype == "int32") convert(int32_t{});
+        else if (c.dtype == "int64") convert(int64_t{});
+        else convert(uint64_t{});
     }
 }
 
@@ -316,6 +322,8 @@ SparseBandField read_sparse_field(const std::string& header_path) {
     // Every channel's size is checked before any is read.
     OpenChannel ids = open_channel(header, channels, "active_blocks", active, 1, {"int64"});
     OpenChannel dist = open_channel(header, channels, "distance", points, 1, {"float32", "float64"});
+    // A float32 file's +-W must be a float32 W (neither 0 nor infinite), as its writers required.
+    if (dist.dtype == "float32") require_representable_band(width, FieldDtype::Float32, header + ": key 'band.width'");
     std::optional<OpenChannel> grad;
     if (has_gradient) grad = open_channel(header, channels, "gradient", points, 3, {"float32", "float64"});
     OpenChannel tri = open_channel(header, channels, "closest_triangle", points, 1, {"int32"});

@@ -5,8 +5,10 @@
 #include "harness/io/sparse_nvdb_file.h"
 
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
+#include "harness/io/field_file.h"
 #include "harness/io/volume_grids.h"
 
 #if SDF_HAVE_NANOVDB
@@ -47,7 +49,8 @@ void set_inactive(BuildLeaf& leaf, uint32_t offset, float value) {
     leaf.mValueMask.setOff(offset);
 }
 
-void write_grids(const SparseBandField& band, const std::string& path, SparseNvdbCounts& counts) {
+// path: the temporary written; target: the name the messages give.
+void write_grids(const SparseBandField& band, const std::string& path, const std::string& target, SparseNvdbCounts& counts) {
     const BandLayout& layout = band.layout();
     const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
     if (int(parts.size()) != layout.cosets()) throw std::logic_error(path + ": the band's cosets are not the lattice's grids");
@@ -110,7 +113,13 @@ void write_grids(const SparseBandField& band, const std::string& path, SparseNvd
         handles.push_back(nanovdb::tools::createNanoGrid(*grid));
         counts.bytes += int64_t(handles.back().bufferSize());
     }
-    nanovdb::io::writeGrids(path, handles);
+    // NanoVDB's file-name overload neither checks its stream nor reports a short write: a full
+    // disk would be placed as a whole file. Our own stream, checked after closing, does not.
+    std::ofstream os(path, std::ios::binary | std::ios::trunc);
+    if (!os) throw std::runtime_error(target + ": cannot open a file beside it for writing");
+    nanovdb::io::writeGrids(os, handles);
+    os.close();
+    if (!os) throw std::runtime_error(target + ": writing the NanoVDB grids failed (disk full?)");
 }
 
 }  // namespace
@@ -119,8 +128,10 @@ bool nanovdb_available() { return true; }
 
 SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::string& path, Overwrite overwrite) {
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
+    require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .nvdb stores float32)");
     SparseNvdbCounts counts;
-    write_through_temporary(path, overwrite, [&](const std::string& temporary) { write_grids(band, temporary, counts); });
+    write_through_temporary(path, overwrite,
+                            [&](const std::string& temporary) { write_grids(band, temporary, path, counts); });
     return counts;
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "harness/io/field_file.h"
 #include "harness/io/volume_grids.h"
 
 #if SDF_HAVE_OPENVDB
@@ -151,6 +152,7 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
                                       const SparseVdbOptions& options) {
     namespace fs = std::filesystem;
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
+    require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .vdb stores float32)");
     if (options.overwrite == Overwrite::Forbid && fs::exists(path))
         throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     openvdb::initialize();

@@ -5,8 +5,8 @@
 /// plan MPI uses) and a point list into contiguous pieces; every point is computed by one
 /// device exactly as one device computes it alone (kernels/lattice/lattice_slab.h: a slab's
 /// blocks start at the lattice's own integer coordinates), so the field is one device's bit
-/// for bit. A job is split only where splitting can pay: each device used gets at least
-/// SamplerOptions::min_points_per_device points (the split threshold; its default and why
+/// for bit. A job is split only where splitting can pay: the devices used get on average at
+/// least SamplerOptions::min_points_per_device points (the split threshold; its default and why
 /// in core/sampling/sampler_options.h and docs/distributed.md), and a lattice at least one
 /// z-plane; a smaller job runs on the first device, or on fewer devices, and the report says
 /// why (plan_device_split).

@@ -94,10 +94,15 @@ public:
     }
     size_t nbytes() const { return band_->memory_bytes() + at_.capacity() * sizeof(int64_t); }
 
-    /// The dense field, made once (to_dense()) for reconstruct().
-    const Field& dense() const {
-        if (!dense_) dense_ = std::make_shared<Field>(to_dense());
-        return *dense_;
+    /// The dense field, made once (to_dense()) for reconstruct(). to_dense() releases the GIL,
+    /// so another thread may have made it meanwhile: the first one made is kept, and each caller
+    /// holds its own reference, so that no field is freed while a reconstruction reads it.
+    std::shared_ptr<Field> dense() const {
+        if (!dense_) {
+            std::shared_ptr<Field> made = std::make_shared<Field>(to_dense());
+            if (!dense_) dense_ = std::move(made);
+        }
+        return dense_;
     }
 
     /// The dense band field's reconstruction (to_dense(), past the memory check), with the
@@ -108,8 +113,8 @@ public:
                           double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
         choose("outside", outside, {"nan", "clamp", "error"});
         const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
-        py::tuple out = const_cast<Field&>(dense()).reconstruct(points_in, interpolator, derivatives, sigma2, sigma_units,
-                                                                threads, outside);
+        const std::shared_ptr<Field> field = dense();
+        py::tuple out = field->reconstruct(points_in, interpolator, derivatives, sigma2, sigma_units, threads, outside);
         if (outside == "clamp") return out;
         auto values = out[0].cast<py::array_t<double>>();
         auto gradients = out[1].cast<py::array_t<double>>();
@@ -143,10 +148,14 @@ public:
     }
 
     py::list write(const std::string& path, bool overwrite, bool closest_triangle, const std::string& dtype) const {
-        if (path.size() > 5 && path.compare(path.size() - 5, 5, ".nvdb") == 0) return write_nvdb(path, overwrite, closest_triangle);
         choose("dtype", dtype, {"float32", "float64"});
+        const bool json = path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0;
+        if (!json && dtype != "float32")
+            throw std::invalid_argument(path + ": dtype=\"" + dtype + "\": a level set (.vdb, .nvdb) stores float32; "
+                                        "float64 is for the sparse band's field file (.json)");
+        if (path.size() > 5 && path.compare(path.size() - 5, 5, ".nvdb") == 0) return write_nvdb(path, overwrite, closest_triangle);
         std::shared_ptr<const SparseBandField> b = band_;
-        if (path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0) {
+        if (json) {
             SparseFieldWriteOptions options;
             options.dtype = dtype == "float32" ? FieldDtype::Float32 : FieldDtype::Float64;
             options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;

@@ -393,5 +393,23 @@ TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
     EXPECT_TRUE(test::Contains(refused.err, "--layout sparse")) << refused.err;
 }
 
+#if SDF_TEST_HAVE_NANOVDB
+// --nvdb beside either field file: the streamed dense file and the sparse layout write the
+// same NanoVDB level set, byte for byte (the sparse layout once returned before writing it).
+TEST(StreamedSampling, NvdbIsWrittenBesideEitherFieldFile) {
+    test::ScratchDir dir("sdf_sample_nvdb");
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) +
+                            " --backend cpu --margin 0.3 --quiet shape:torus --resolution 30 29 28 --band 0.12 --sparse";
+    const test::ShellResult streamed = test::run_in(dir.path(), exe + " --out d.json --nvdb d.nvdb");
+    const test::ShellResult sparse = test::run_in(dir.path(), exe + " --layout sparse --out s.json --nvdb s.nvdb");
+    ASSERT_EQ(streamed.code, 0) << streamed.err;
+    ASSERT_EQ(sparse.code, 0) << sparse.err;
+    EXPECT_TRUE(test::Contains(sparse.out, "wrote s.nvdb")) << sparse.out;
+    const std::string a = test::read_text(dir.at("d.nvdb")), b = test::read_text(dir.at("s.nvdb"));
+    EXPECT_EQ(a.substr(0, 8), "NanoVDB2");
+    EXPECT_TRUE(a == b) << a.size() << " and " << b.size() << " bytes";
+}
+#endif
+
 }  // namespace
 }  // namespace sdf

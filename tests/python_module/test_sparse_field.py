@@ -223,3 +223,26 @@ def test_hostile_sparse_field_files_are_refused_naming_the_file(pair, tmp_path):
     path.write_text(json.dumps(header))
     with pytest.raises(ValueError, match=r"band\.json: key 'band\.active_blocks': expected 0 to"):
         sl.read_field(str(path))
+
+
+def test_a_float32_files_band_width_must_be_a_float32(pair, tmp_path):
+    """A float32 file's +-W are float32 values: a header whose width rounds to 0 or overflows
+    float32 is refused before anything is read (densified it would hold +-0 or +-inf)."""
+    *_, sparse, _ = pair
+    path = tmp_path / "band.json"
+    sparse.write(str(path))  # dtype float32
+    header = json.loads(path.read_text())
+    for width in (1e-50, 1e300):
+        header["band"]["width"] = width
+        path.write_text(json.dumps(header))
+        with pytest.raises(ValueError, match=r"band\.json: key 'band\.width': .* cannot be stored in float32"):
+            sl.read_field(str(path))
+
+
+def test_level_sets_refuse_float64(pair, tmp_path):
+    """.vdb and .nvdb store float32: dtype="float64" is refused, not silently narrowed."""
+    *_, sparse, _ = pair
+    for name in ("band.vdb", "band.nvdb"):
+        with pytest.raises(ValueError, match=r"stores float32"):
+            sparse.write(str(tmp_path / name), dtype="float64")
+        assert not (tmp_path / name).exists()
