@@ -316,6 +316,8 @@ void bind_query(py::module_& m) {
         }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
            "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (the CPU's, CUDA brute force).")
         .def_property_readonly("devices", [](const QueryResult& r) {
+            // plan_device_split depends only on the count, the devices and the threshold, all
+            // fixed when the SDF was made: this is the plan the query's sampler followed.
             const SamplerOptions& o = r.sdf->options();
             return json_to_python(plan_device_split(r.points.points.count, -1, sampler_device_count(o), o.min_points_per_device).to_json());
         }, "How the points went over the SDF's devices (SDF(..., devices=...)): {'count': devices requested, 'used', "
