@@ -4,7 +4,10 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/sampling/backend_sampler.h"
 #include "core/sampling/sampler_results.h"
@@ -65,9 +68,9 @@ private:
                 if (outside_band(s.distance, w)) store_outside_band(field, out, std::signbit(s.distance), w);
                 else store_sample(field, out, mesh(), s.distance, s.gradient, s.triangle);
             };
-            auto emit_outside = [&](int64_t i, bool negative) {
+            auto emit_outside = [&](int64_t i, BandSide side) {  // band_.bound_squared is 0: a side always
                 const int64_t out = block.output_index(lattice, i);
-                if (out >= 0) store_outside_band(field, out, negative, w);
+                if (out >= 0) store_outside_band(field, out, side == kBandSideInside, w);
             };
             with_precision(options_.precision, [&](auto zero) {
                 using T = decltype(zero);
@@ -101,17 +104,26 @@ private:
 
     /// A sparse band's active blocks through the dense path's brick kernel (with its brick
     /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's.
+    /// On a solid with a band at least a spacing wide the search is bounded by the band, and
+    /// the points beyond it take their sides from their neighbours (band_sides.h).
     BandBlockKernel band_block_kernel(double width) const override {
         if (kernel_ != BvhKernel::Brick) return {};
-        const BandSkip band = band_skip(width);
-        if (!band.enabled()) return {};  // a pseudonormal sign off a solid: every point searched by the queries
-        return [this, band](SparseBandField& out, size_t first, size_t last) {
+        const BandSkip skip = band_skip(width);
+        if (!skip.enabled()) return {};  // a pseudonormal sign off a solid: every point searched by the queries
+        return [this, skip](SparseBandField& out, size_t first, size_t last) {
             const BandLayout& layout = out.layout();
             const Lattice& lattice = out.lattice;
+            BandSkip band = skip;
+            if (band.probe_sign && band.winding == nullptr && band.width >= lattice.spacing) {
+                const double scale = band.coordinate_scale + largest_lattice_coordinate(lattice);
+                band.bound_squared = float_search() ? band_search_bound_squared<float>(band.width, scale, band.sliver_reach)
+                                                    : band_search_bound_squared<double>(band.width, scale, band.sliver_reach);
+            }
             CertificateCounters certificate;
             SharedWindingCounts winding;  // a sparse band's report has no winding counters (as queries)
             QueryCounters counters(certificate, winding);
             BandCounters band_counters;
+            std::atomic<int64_t> searched_blocks{0};
             parallel_for(int64_t(last - first), 8, options_.threads, [&](int64_t begin, int64_t end) {
                 for (size_t a = first + size_t(begin); a < first + size_t(end); ++a) {
                     const BandBlockCoords b = layout.block_coords(out.active[a]);
@@ -125,8 +137,14 @@ private:
                         const int x = int(i % r.x), y = int((i / r.x) % r.y), z = int(i / (int64_t(r.x) * r.y));
                         return base + size_t(x + kBandBlockDim * (y + kBandBlockDim * z));
                     };
+                    // Each point's side for the flood: padding stays kBandSidePadding.
+                    std::array<signed char, kBandBlockPoints> side;
+                    side.fill(kBandSidePadding);
+                    std::array<bool, kBandBlockPoints> flooded{};  // the points whose side the flood gives
+                    bool flood = false;
                     auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const size_t v = slot(i);
+                        side[v - base] = std::signbit(s.distance) ? kBandSideInside : kBandSideOutside;
                         if (outside_band(s.distance, band.width)) {
                             out.distance[v] = std::signbit(s.distance) ? -band.width : band.width;
                             return;
@@ -135,15 +153,55 @@ private:
                         out.gradient[v] = s.gradient;
                         out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
                     };
-                    auto emit_outside = [&](int64_t i, bool negative) { out.distance[slot(i)] = negative ? -band.width : band.width; };
+                    auto emit_outside = [&](int64_t i, BandSide s) {
+                        const size_t v = slot(i);
+                        side[v - base] = s;
+                        flooded[v - base] = s == kBandSideNone;
+                        flood = flood || s == kBandSideNone;
+                        out.distance[v] = s == kBandSideInside ? -band.width : band.width;
+                    };
                     with_precision(options_.precision, [&](auto zero) {
                         using T = decltype(zero);
                         evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters, emit,
                                            emit_outside);
                     });
+                    if (!flood) continue;
+                    if (std::none_of(side.begin(), side.end(), band_side_known)) {  // its point 0 by a plain search
+                        side[0] = plain_search_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside;
+                        ++searched_blocks;
+                    }
+                    for (bool changed = true; changed;) {
+                        changed = false;
+                        for (int local = 0; local < kBandBlockPoints; ++local) {
+                            if (side[size_t(local)] != kBandSideNone) continue;
+                            side[size_t(local)] = neighbour_side([&](int j) { return side[size_t(j)]; }, local);
+                            changed = changed || side[size_t(local)] != kBandSideNone;
+                        }
+                    }
+                    for (int local = 0; local < kBandBlockPoints; ++local) {
+                        if (side[size_t(local)] == kBandSideNone)
+                            throw std::logic_error("CPU BVH sparse band: a point beyond the band was left without a side");
+                        if (flooded[size_t(local)] && side[size_t(local)] == kBandSideInside) out.distance[base + size_t(local)] = -band.width;
+                    }
                 }
             });
+            out.sampler.details["band_blocks_on_host"] = {{"bounded_search", band.bound_squared > 0},
+                                                          {"points_flooded", band_counters.points_beyond_bound.load()},
+                                                          {"blocks_signed_by_a_search", searched_blocks.load()}};
         };
+    }
+
+    /// Whether p is inside by the pseudonormal sign at a plain search's nearest triangle (the
+    /// band probes' sign: p lies beyond the band of a solid).
+    bool plain_search_inside(const Vec3d& p) const {
+        BvhStats stats;
+        return with_precision(options_.precision, [&](auto zero) {
+            using T = decltype(zero);
+            const BvhView<T> view = bvh_->view<T>();
+            const Vec3<T> pt(p);
+            const BvhHit<T> hit = cpu_kernels<T>().closest_triangle(view, pt, seed_hit(view, -1, pt), stats);
+            return signed_distance_to_triangle(mesh().buffers<double>().view(), p, view.triangle_index[hit.slot]).distance < 0;
+        });
     }
 
     /// The brick skip of the band: with the winding sign (each point's own), or with the

@@ -217,8 +217,9 @@ void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const 
         near.slack = certifier.slack;
         certifier.kernels.closest_triangles_packet(view, pk, stats, near);
         for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
-        for (int k = 0; k < count; ++k)
-            slot[k] = certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
+        for (int k = 0; k < count; ++k)  // a lane of a bounded search may have found nothing (-1)
+            slot[k] = pk.best_slot[k] < 0 ? -1
+                                          : certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
     } else {
         cpu_kernels<T>().closest_triangles_packet(view, pk, stats);
         for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];

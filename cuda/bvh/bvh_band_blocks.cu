@@ -7,6 +7,8 @@
 // one copy per channel into the band's host arrays. Padding (points of a block beyond the
 // coset's resolution) is marked "outside, positive side" before the search, so finalize
 // writes it +W, gradient 0, kOutsideBandTriangle: the host's values for padding.
+// On a solid, the search is bounded by the band (BandSearch::bound_squared): a point beyond
+// it finds no triangle and takes its side from its neighbours (flood_band_sides).
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -21,6 +23,7 @@
 #include "cuda/util/cuda_device.h"
 #include "cuda/util/device_guard.h"
 #include "kernels/lattice/band_blocks.h"
+#include "kernels/lattice/band_sides.h"
 
 namespace sdf::cuda {
 namespace {
@@ -82,6 +85,52 @@ __global__ void to_source_order(int* triangle, int64_t n, const int32_t* source_
     if (t >= 0) triangle[i] = source_triangle[t];
 }
 
+/// The sides of the points a bounded search left without a triangle (kOutsideBandFlood): one
+/// CUDA block of 512 threads per band block, each point taking a neighbour's side
+/// (kernels/lattice/band_sides.h) until none changes. A block of such points only takes the
+/// side of its point 0 from a plain search, as brick_band_code takes its centre's (that
+/// point too lies beyond the band). counters: points flooded, blocks signed by a search,
+/// points left without a side (never: the host checks).
+template <typename T>
+__global__ void __launch_bounds__(kBandBlockPoints)
+    flood_band_sides(BvhView<T> bvh, MeshView<double> mesh, BandBlocksPiece piece, const int* nearest, double width,
+                     double* distance, unsigned long long* counters) {
+    __shared__ volatile signed char side[kBandBlockPoints];
+    const int local = threadIdx.x;
+    const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + local;
+    const BandBlockCoords b = piece.grid.block_coords(piece.ids[blockIdx.x]);
+    const bool padding = piece.grid.padding(b, local);
+    const bool flood = !padding && nearest[i] == kOutsideBandFlood;
+    side[local] = padding ? kBandSidePadding : flood ? kBandSideNone : signbit(distance[i]) ? kBandSideInside : kBandSideOutside;
+    const int flooded = __syncthreads_count(flood);
+    if (flooded == 0) return;  // uniform over the block
+    if (!__syncthreads_or(!flood && !padding)) {
+        if (local == 0) {  // point 0 of a block is never padding
+            const Vec3d p = piece.position(i);
+            const BvhHit<T> hit = closest_triangle_bvh(bvh, Vec3<T>(p));
+            const bool inside = signed_distance_to_triangle(mesh, p, bvh.triangle_index[hit.slot]).distance < 0;
+            side[0] = inside ? kBandSideInside : kBandSideOutside;
+            atomicAdd(counters + 1, 1ull);
+        }
+        __syncthreads();
+    }
+    const auto side_of = [&](int j) { return static_cast<signed char>(side[j]); };
+    for (;;) {
+        bool changed = false;
+        if (side[local] == kBandSideNone) {
+            const signed char s = neighbour_side(side_of, local);
+            if (s != kBandSideNone) {
+                side[local] = s;
+                changed = true;
+            }
+        }
+        if (!__syncthreads_or(changed)) break;
+    }
+    if (flood) distance[i] = side[local] == kBandSideInside ? -width : width;
+    if (local == 0) atomicAdd(counters + 0, (unsigned long long)flooded);
+    if (flood && side[local] == kBandSideNone) atomicAdd(counters + 2, 1ull);
+}
+
 size_t device_bytes_in_use() {
     size_t free_bytes = 0, total = 0;
     CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
@@ -131,7 +180,17 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     const bool winding = dev.winding.view().enabled();
     const FloatSearchBound& bound = mesh().search_bound();
     const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
-    const BandSearch search{width, dev.mesh->view(), winding, winding || solid(), reach};
+    BandSearch search{width, dev.mesh->view(), winding, winding || solid(), reach};
+    // The bounded search and the flood where the sides of points beyond W can be taken from
+    // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
+    // (flood_band_sides), the warp kernel (the candidates kernel searches every point).
+    const bool bounded = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
+    if (bounded) {
+        const double scale = coordinate + bound.coordinate;
+        search.bound_squared = band_search_bound_squared<T>(width, scale, reach);
+    }
+    DeviceBuffer<unsigned long long> flood_counters{3};
+    CUDA_CHECK(cudaMemset(flood_counters.get(), 0, 3 * sizeof(unsigned long long)));
     reset_certificate(dev);
     int64_t batches = 0;
     for (int64_t b0 = 0; b0 < blocks; b0 += batch, ++batches) {
@@ -151,6 +210,11 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, r.outputs());
         CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
+        if (bounded) {
+            flood_band_sides<T><<<int(nb), kBandBlockPoints>>>(dev.view, dev.mesh->view(), piece, r.nearest.get(), width,
+                                                               r.samples.distance.get(), flood_counters.get());
+            CUDA_CHECK_LAUNCH("flood_band_sides");
+        }
         to_source_order<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, dev.source_triangle.get());
         CUDA_CHECK_LAUNCH("to_source_order");
         compute.end();
@@ -161,6 +225,11 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         staged_.to_host(r.samples.triangle.get(), band.closest_triangle.data() + v, size_t(n) * sizeof(int32_t));
         download.end();
     }
+    unsigned long long flood[3] = {0, 0, 0};
+    CUDA_CHECK(cudaMemcpy(flood, flood_counters.get(), sizeof(flood), cudaMemcpyDeviceToHost));
+    if (flood[2] != 0)
+        throw std::logic_error("CUDA BVH sparse band: " + std::to_string(flood[2]) +
+                               " points beyond the band were left without a side by the flood");
     CertificateCounters certificate;
     read_certificate(dev, certificate);
     band.timings.upload += upload.seconds();
@@ -175,6 +244,9 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"blocks_per_batch", batch},
         {"batches", batches},
         {"brick_skip", search.skip_bricks},
+        {"bounded_search", bounded},
+        {"points_flooded", int64_t(flood[0])},
+        {"blocks_signed_by_a_search", int64_t(flood[1])},
         {"kernel_seconds", compute.seconds()},
         {"upload_seconds", upload.seconds()},
         {"download_seconds", download.seconds()},

@@ -93,7 +93,9 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
 template <typename T, int K, typename Near>
 __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, K>& pk, bool valid, int32_t* stack_node,
                                        T* stack_d2, Near& policy) {
-    T worst = warp_max(valid ? T(INFINITY) : T(-1));
+    T worst = T(-1);  // the lanes' radii: +inf, or a bounded search's bound
+    for (int k = 0; k < K; ++k) worst = max(worst, pk.radius[k]);
+    worst = warp_max(valid ? worst : T(-1));
     int top = 0;  // warp-uniform
     int32_t node = 0;
     while (node >= 0) {
@@ -155,7 +157,31 @@ struct BandSearch {
     /// How much farther than the true nearest the search's nearest may be, through slivers
     /// ranked by their edges (FloatSearchBound::sliver_reach_*): lowers the centre's bound.
     double sliver_reach = 0;
+    /// A bounded search (0: none): each point starts with this squared radius instead of
+    /// +inf, so a point farther than the band from every triangle ends with no triangle
+    /// (kOutsideBandFlood) after visiting only the nodes within the bound. The bound exceeds
+    /// (W + the float error + sliver_reach)^2, so every point within W still finds its
+    /// nearest: the same one, as a search started at +inf keeps every triangle within the
+    /// bound (streamed_certificate.h: the double winner stays within the radius). Set only
+    /// where the sides of such points can be taken from their neighbours (band_sides.h:
+    /// band_search_bound_squared).
+    double bound_squared = 0;
 };
+
+/// Starts every real lane of a bounded search (band.bound_squared > 0) at the bound: no
+/// triangle yet, and the radius a best of the bound would have (the certificate's widening,
+/// or the plain search's margin, as refresh_radii sets it), so that every triangle the
+/// unbounded search could rank below the bound is still reached.
+template <typename T, int K, typename Near>
+__device__ SDF_INLINE void bound_lanes(const BvhView<T>& bvh, BvhPacket<T, K>& pk, int count, const BandSearch& band,
+                                       const Near& policy) {
+    if (!(band.bound_squared > 0) || count == 0) return;
+    const T b = T(band.bound_squared);
+    for (int k = 0; k < K; ++k) {
+        pk.best_q[k] = b;
+        pk.radius[k] = Near::kStreams ? policy.radius(b) : bvh.margin.widen(policy.radius(b));
+    }
+}
 
 /// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
 template <typename T, int K>
@@ -220,18 +246,24 @@ template <bool kCertified, typename T, int K, typename Near>
 __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, Near& policy, int64_t first,
                                          int count, const StreamedCertify& cert, int* nearest) {
     if constexpr (kCertified) {
-        unsigned reranked = 0;
+        unsigned reranked = 0, found = 0;
 #pragma unroll
         for (int k = 0; k < K; ++k) {
             if (k >= count) continue;
+            if (pk.best_slot[k] < 0) {  // a bounded search found nothing within its bound
+                nearest[first + k] = kOutsideBandFlood;
+                continue;
+            }
             bool r = false;
             nearest[first + k] = policy.finish(bvh, k, pk, r);
             reranked += unsigned(r);
+            ++found;
         }
-        warp_add(cert.counters + 0, unsigned(count));
+        warp_add(cert.counters + 0, found);
         warp_add(cert.counters + 1, reranked);
     } else {
-        for (int k = 0; k < count; ++k) nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
+        for (int k = 0; k < count; ++k)
+            nearest[first + k] = pk.best_slot[k] < 0 ? int(kOutsideBandFlood) : bvh.triangle_index[pk.best_slot[k]];
     }
 }
 
@@ -264,10 +296,12 @@ __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
     }
     if constexpr (kCertified) {
         StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
+        bound_lanes(bvh, pk, count, band, policy);
         warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
         write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
     } else {
         PacketPlainNear policy;
+        bound_lanes(bvh, pk, count, band, policy);
         warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
         write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
     }

@@ -22,6 +22,10 @@ enum NearestOutsideBand : int {
     kOutsideBandOutside = -2,        ///< positive side
     kOutsideBandInside = -3,         ///< negative side
     kOutsideBandSignPerPoint = -4,   ///< the winding number decides, point by point
+    /// No triangle within the bounded search's radius: outside the band, its side taken
+    /// from a neighbour after finalize (the sparse band's flood, cuda/bvh/bvh_band_blocks.cu);
+    /// finalize writes +W meanwhile.
+    kOutsideBandFlood = -5,
 };
 
 /// Per-piece results, downloaded and scattered into the field by the host.

@@ -5,7 +5,10 @@
 // and self-intersecting spheres; CC and BCC, float and double; bunny-open where
 // SDF_DATA_PATH has it. The CUDA BVH's warp and candidates kernels sample the active blocks
 // in device memory (also in batches of a few blocks); its brick kernel and the brute force
-// through point queries.
+// through point queries. On solids the warp kernel's search is bounded by the band and the
+// points beyond it take their sides from their neighbours (the flood): checked on solids
+// whose triangles' boxes reach far from them (an icosahedron: whole blocks without a band
+// point), the torus and the dragon, at widths from one spacing up, and off below one.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -16,6 +19,7 @@
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/sampling/sparse_band.h"
+#include "core/winding/winding_sign.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
@@ -121,6 +125,74 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                 if (HasFailure()) return;
             }
     }
+}
+
+TEST(CudaSparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
+    struct Case {
+        std::string name;
+        PreparedMesh mesh;
+        Int3 cc, bcc;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"icosahedron", prepare_mesh(make_icosphere(0, 1.0)), {48, 48, 48}, {33, 33, 33}});
+    cases.push_back({"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), {61, 58, 56}, {41, 39, 37}});
+    const std::string dragon = test::find_data_file("dragon.obj");
+    if (!dragon.empty()) cases.push_back({"dragon", prepare_mesh(load_mesh_file(dragon)), {96, 80, 72}, {64, 54, 48}});
+    int64_t flooded = 0, searched_blocks = 0;
+    for (const Case& c : cases) {
+        ASSERT_EQ(choose_sign_mode(c.mesh.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << c.name << " is a solid";
+        const Lattice cc = fit_lattice(LatticeType::CC, c.cc, c.mesh.bounds(), 0.4);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, c.bcc, c.mesh.bounds(), 0.4);
+        for (Precision precision : {Precision::Float, Precision::Double})
+            for (const Lattice& lattice : {cc, bcc})
+                for (double spacings : {0.9, 1.0, 1.7, 3.0}) {
+                    const double w = spacings * lattice.spacing;
+                    const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision) +
+                                             " W = " + std::to_string(spacings) + " h";
+                    const SampledField dense =
+                        make_sampler(options("cpu", "bvh", precision, w, SignMode::Auto))->bind(share(c.mesh))->sample(lattice);
+                    for (int64_t piece : {int64_t(0), int64_t(5 * 512)}) {
+                        SamplerOptions o = options("cuda", "bvh", precision, 0, SignMode::Auto);
+                        o.kernel = "warp";
+                        o.max_points_per_piece = piece;
+                        const SparseBandField sparse = make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(lattice, w);
+                        const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+                        EXPECT_EQ(d["bounded_search"].get<bool>(), spacings >= 1.0) << what;
+                        if (spacings >= 1.0) {
+                            EXPECT_GT(d["points_flooded"].get<int64_t>(), 0) << what;
+                        }
+                        flooded += d["points_flooded"].get<int64_t>();
+                        searched_blocks += d["blocks_signed_by_a_search"].get<int64_t>();
+                        EXPECT_TRUE(same_field(dense, sparse.densify())) << what << " piece " << piece;
+                    }
+                    if (HasFailure()) return;
+                }
+    }
+    // A box cut by the lattice: the last plane of points (a block of one plane in x, the rest
+    // padding) lies inside, 3.3 spacings below the +x face whose triangles make the block
+    // active. Its middle blocks hold no point within W = 3 spacings and no point a probe or
+    // brick skip signs: their sides come from the search at their point 0.
+    const PreparedMesh box = prepare_mesh(make_box({1.0, 1.0, 1.0}));
+    for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
+        for (Precision precision : {Precision::Float, Precision::Double}) {
+            Lattice lattice;
+            lattice.type = type;
+            lattice.spacing = 0.05;
+            lattice.resolution = {33, 49, 49};
+            lattice.origin = {1.0 - 35.3 * lattice.spacing, -1.2, -1.2};
+            const double w = 3 * lattice.spacing;
+            const std::string what = "box cut by " + lattice_notation(lattice) + " " + precision_name(precision);
+                const SampledField dense =
+                    make_sampler(options("cpu", "bvh", precision, w, SignMode::Auto))->bind(share(box))->sample(lattice);
+                SamplerOptions o = options("cuda", "bvh", precision, 0, SignMode::Auto);
+                o.kernel = "warp";
+                const SparseBandField sparse = make_sampler(o)->bind(share(box))->sample_band_sparse(lattice, w);
+                const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+                searched_blocks += d["blocks_signed_by_a_search"].get<int64_t>();
+                EXPECT_TRUE(same_field(dense, sparse.densify())) << what;
+        }
+    EXPECT_GT(flooded, 0);
+    EXPECT_GT(searched_blocks, 0) << "no block was all beyond the band: the search for its side went untested";
 }
 
 }  // namespace
