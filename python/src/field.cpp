@@ -222,12 +222,27 @@ Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::obj
     return field_for_mesh(std::move(field), sdf.mesh());
 }
 
-py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
-                             double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
-    choose("outside", outside, {"nan", "clamp", "error"});
+ReconstructionSpec reconstruction_spec(LatticeType lattice, bool has_gradient, const std::string& interpolator_in,
+                                       const std::string& derivatives, double sigma2, const std::string& sigma_units,
+                                       int threads) {
     if (!(sigma2 > 0 && std::isfinite(sigma2)))
         throw std::invalid_argument("sigma2: expected a finite variance > 0, got " + number_text(sigma2));
-    const DoubleArray array = points_argument(points_in);
+    const std::string interpolator =
+        interpolator_in.empty() ? (lattice == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm") : interpolator_in;
+    ReconstructionSpec spec;
+    spec.interpolator = parse_interpolator(interpolator);
+    spec.derivatives = derivatives.empty() ? default_derivative_source(spec.interpolator, has_gradient)
+                                           : parse_derivative_source(derivatives);
+    spec.sigma2 = sigma2;
+    spec.sigma_units = choose("sigma_units", sigma_units, {"lattice", "spacing"}) == "lattice" ? SigmaUnits::LatticeUnits
+                                                                                                : SigmaUnits::Spacing;
+    if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
+    spec.threads = threads;
+    return spec;
+}
+
+std::pair<std::vector<Vec3d>, std::vector<ReconstructedSample<double>>> reconstruct_points(
+    const DoubleArray& array, const std::function<std::vector<ReconstructedSample<double>>(const std::vector<Vec3d>&)>& evaluate) {
     // What a call holds per point: the points, the samples and the two result arrays.
     const auto out_of_memory = [&] {
         const uint64_t n = array.ndim() == 2 ? uint64_t(array.shape(0)) : uint64_t(array.size());
@@ -237,24 +252,28 @@ py::tuple Field::reconstruct(const py::object& points_in, const std::string& int
     };
     std::vector<Vec3d> points;
     std::vector<ReconstructedSample<double>> samples;
-    const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
     try {
         points = points_from_array(array, "points");
         TaskOptions task;
         task.total = int64_t(points.size());
         task.label = "reconstructing";
-        samples = run_task([&] { return r->evaluate(points, threads); }, task);
+        samples = run_task([&] { return evaluate(points); }, task);
     } catch (const std::bad_alloc&) {
         out_of_memory();
     } catch (py::error_already_set& e) {
         if (e.matches(PyExc_MemoryError)) out_of_memory();
         throw;
     }
+    return {std::move(points), std::move(samples)};
+}
+
+py::tuple reconstruction_arrays(const std::vector<Vec3d>& points, const std::vector<ReconstructedSample<double>>& samples,
+                                const DomainBox<double>& d, const std::string& outside) {
+    choose("outside", outside, {"nan", "clamp", "error"});
     const size_t n = samples.size();
     if (outside == "error")
         for (size_t i = 0; i < n; ++i)
             if (!samples[i].inside) {
-                const DomainBox<double> d = r->domain();
                 std::ostringstream m;
                 m << "points: row " << i << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z
                   << ") lies outside the field's domain [" << d.lo.x << ", " << d.hi.x << "] x [" << d.lo.y << ", " << d.hi.y
@@ -275,6 +294,15 @@ py::tuple Field::reconstruct(const py::object& points_in, const std::string& int
         }
     });
     return py::make_tuple(values, gradients);
+}
+
+py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
+                             double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
+    choose("outside", outside, {"nan", "clamp", "error"});
+    const DoubleArray array = points_argument(points_in);  // bad points are named before anything is built
+    const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
+    const auto [points, samples] = reconstruct_points(array, [&](const std::vector<Vec3d>& p) { return r->evaluate(p, threads); });
+    return reconstruction_arrays(points, samples, r->domain(), outside);
 }
 
 py::object Field::points() const {

@@ -3,7 +3,9 @@
 /// for, kept for repeated calls (reconstruct, render).
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,23 @@
 #include "python/src/common.h"
 
 namespace sdf {
+
+/// The spec of reconstruct()'s keywords: an empty `interpolator` is bcc_cubic on BCC,
+/// tricubic_lm on CC; an empty `derivatives` sdf-eval's default (default_derivative_source).
+ReconstructionSpec reconstruction_spec(LatticeType lattice, bool has_gradient, const std::string& interpolator,
+                                       const std::string& derivatives, double sigma2, const std::string& sigma_units,
+                                       int threads);
+
+/// reconstruct()'s arrays (values (N,), gradients (N, 3)) of `samples` at `points`: a sample
+/// outside `domain` is NaN (outside="nan"), as reconstructed (clamped into it: "clamp") or
+/// raises ValueError naming the first such row ("error").
+py::tuple reconstruction_arrays(const std::vector<Vec3d>& points, const std::vector<ReconstructedSample<double>>& samples,
+                                const DomainBox<double>& domain, const std::string& outside);
+
+/// Runs `evaluate()` (the reconstruction of the points of `array`, points_argument()'s) as a task,
+/// turning an allocation failure into a MemoryError that names the points' size.
+std::pair<std::vector<Vec3d>, std::vector<ReconstructedSample<double>>> reconstruct_points(
+    const DoubleArray& array, const std::function<std::vector<ReconstructedSample<double>>(const std::vector<Vec3d>&)>& evaluate);
 
 class Field {
 public:
@@ -90,19 +109,10 @@ public:
     }
 
     /// The reconstruction of these names (sdf-eval's defaults for an empty `derivatives`).
-    std::shared_ptr<const Reconstruction> reconstruction(const std::string& interpolator_in, const std::string& derivatives,
+    std::shared_ptr<const Reconstruction> reconstruction(const std::string& interpolator, const std::string& derivatives,
                                                          double sigma2, const std::string& sigma_units, int threads) {
-        const std::string interpolator =
-            interpolator_in.empty() ? (lattice().type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm") : interpolator_in;
-        ReconstructionSpec spec;
-        spec.interpolator = parse_interpolator(interpolator);
-        spec.derivatives = derivatives.empty() ? default_derivative_source(spec.interpolator, !field_->gradient.empty())
-                                               : parse_derivative_source(derivatives);
-        spec.sigma2 = sigma2;
-        spec.sigma_units = choose("sigma_units", sigma_units, {"lattice", "spacing"}) == "lattice" ? SigmaUnits::LatticeUnits
-                                                                                                    : SigmaUnits::Spacing;
-        if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
-        spec.threads = threads;
+        const ReconstructionSpec spec = reconstruction_spec(lattice().type, !field_->gradient.empty(), interpolator, derivatives,
+                                                            sigma2, sigma_units, threads);
         const std::string key = describe(spec);
         if (!recon_ || recon_key_ != key) {
             std::shared_ptr<const SampledField> f = field_;
