@@ -3,9 +3,7 @@
 /// for, kept for repeated calls (reconstruct, render).
 #pragma once
 
-#include <functional>
 #include <memory>
-#include <utility>
 #include <string>
 #include <vector>
 
@@ -17,25 +15,9 @@
 #include "core/sampling/sampled_field.h"
 #include "harness/sampling/mesh_sdf.h"
 #include "python/src/common.h"
+#include "python/src/reconstruct.h"
 
 namespace sdf {
-
-/// The spec of reconstruct()'s keywords: an empty `interpolator` is bcc_cubic on BCC,
-/// tricubic_lm on CC; an empty `derivatives` sdf-eval's default (default_derivative_source).
-ReconstructionSpec reconstruction_spec(LatticeType lattice, bool has_gradient, const std::string& interpolator,
-                                       const std::string& derivatives, double sigma2, const std::string& sigma_units,
-                                       int threads);
-
-/// reconstruct()'s arrays (values (N,), gradients (N, 3)) of `samples` at `points`: a sample
-/// outside `domain` is NaN (outside="nan"), as reconstructed (clamped into it: "clamp") or
-/// raises ValueError naming the first such row ("error").
-py::tuple reconstruction_arrays(const std::vector<Vec3d>& points, const std::vector<ReconstructedSample<double>>& samples,
-                                const DomainBox<double>& domain, const std::string& outside);
-
-/// Runs `evaluate()` (the reconstruction of the points of `array`, points_argument()'s) as a task,
-/// turning an allocation failure into a MemoryError that names the points' size.
-std::pair<std::vector<Vec3d>, std::vector<ReconstructedSample<double>>> reconstruct_points(
-    const DoubleArray& array, const std::function<std::vector<ReconstructedSample<double>>(const std::vector<Vec3d>&)>& evaluate);
 
 class Field {
 public:
