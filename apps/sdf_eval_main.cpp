@@ -7,9 +7,12 @@
 // "x y z" per line in world units ('-' = stdin; blank lines and '#' comments are skipped), or
 // is a .npy file of shape (N, 3); at least one point (none is an error naming the input).
 // Points outside the interpolator's domain are clamped into it (a warning counts them). A
-// sparse band's file (sdf-sample --layout sparse) is densified past the memory check into the
-// dense `--band W` field; points outside the band's cells (core/sampling/sparse_band_cells.h)
-// print that field's reconstruction (built from +-W there), and a warning counts them, as the
+// sparse band's file (sdf-sample --layout sparse) is reconstructed straight from its blocks
+// (core/reconstruction/sparse_reconstruction.h): bit for bit the dense `--band W` field's
+// reconstruction, in memory that grows with the band, not the lattice; only the interpolating
+// splines (cc_bspline3, bcc_box_quintic), whose prefilter spans the lattice, densify it, past
+// the memory check. Points outside the band's cells (core/sampling/sparse_band_cells.h) print
+// that field's reconstruction (built from +-W there), and a warning counts them, as the
 // lattice's edge.
 // docs/reconstruction.md describes the interpolators and derivative sources.
 #include <CLI/CLI.hpp>
@@ -20,8 +23,10 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "core/reconstruction/reconstruction.h"
+#include "core/reconstruction/sparse_reconstruction.h"
 #include "core/sampling/sparse_band_cells.h"
 #include "harness/config/json_reader.h"
 #include "harness/io/field_file.h"
@@ -56,27 +61,39 @@ int main(int argc, char** argv) {
     std::string doing = "reading the field " + field_path;  // for an out-of-memory message
     uint64_t bytes = 0;
     try {
-        // A sparse band's file: its band (for the band's cells) and its densified field.
+        // The header is parsed once; a sparse band's file is read as its blocks.
+        const nlohmann::json header = sdf::read_json_file(field_path, "field header");
         std::unique_ptr<sdf::SparseBandField> band;
         sdf::SampledField field;
-        if (sdf::is_sparse_field_file(field_path)) {
-            band = std::make_unique<sdf::SparseBandField>(sdf::read_sparse_field(field_path));
-            const bool gradient = sdf::read_json_file(field_path, "field header").contains("gradient_channel");
-            field = sdf::densify_within_memory(*band, gradient, field_path, "sdf-eval");
+        bool gradient = false;
+        if (sdf::is_sparse_field_header(header)) {
+            band = std::make_unique<sdf::SparseBandField>(sdf::read_sparse_field(field_path, header));
+            gradient = header.contains("gradient_channel");
         } else {
             field = sdf::read_field(field_path);
+            gradient = !field.gradient.empty();
         }
-        doing = "reconstructing " + field_path + " (" + std::to_string(field.size()) + " lattice points) at " + points_path;
-        bytes = uint64_t(field.size()) * sdf::kReconstructionBytesPerPoint;
         spec.interpolator = sdf::parse_interpolator(interpolator);
-        spec.derivatives = derivatives.empty()
-                               ? sdf::default_derivative_source(spec.interpolator, !field.gradient.empty())
-                               : sdf::parse_derivative_source(derivatives);
+        spec.derivatives = derivatives.empty() ? sdf::default_derivative_source(spec.interpolator, gradient)
+                                               : sdf::parse_derivative_source(derivatives);
         spec.sigma_units = sigma_units == "lattice" ? sdf::SigmaUnits::LatticeUnits : sdf::SigmaUnits::Spacing;
         spec.threads = threads;
-        const sdf::Reconstruction recon(field, spec);
+        // One of the two: the band's own reconstruction, or the dense field's.
+        std::optional<sdf::SparseReconstruction> sparse;
+        std::optional<sdf::Reconstruction> dense;
+        if (band && sdf::reconstructs_locally(spec.interpolator)) {
+            doing = "reconstructing the sparse band of " + field_path + " (" + std::to_string(band->active.size()) +
+                    " active blocks) at " + points_path;
+            bytes = uint64_t(band->memory_bytes());
+            sparse.emplace(*band, spec, gradient);
+        } else {
+            if (band) field = sdf::densify_within_memory(*band, gradient, field_path, "sdf-eval");
+            doing = "reconstructing " + field_path + " (" + std::to_string(field.size()) + " lattice points) at " + points_path;
+            bytes = uint64_t(field.size()) * sdf::kReconstructionBytesPerPoint;
+            dense.emplace(field, spec);
+        }
         const std::vector<sdf::Vec3d> points = sdf::read_points_file(points_path);
-        const auto samples = recon.evaluate(points, threads);
+        const auto samples = sparse ? sparse->evaluate(points, threads) : dense->evaluate(points, threads);
         int64_t outside = 0, off_band = 0;
         for (size_t i = 0; i < samples.size(); ++i) {
             const auto& s = samples[i];
@@ -90,11 +107,11 @@ int main(int argc, char** argv) {
                          "corner); their values are the dense band field's, built from +-W there\n",
                          static_cast<long long>(off_band), samples.size(), band->width);
         if (outside > 0) {
-            const sdf::DomainBox<double> box = recon.domain();
+            const sdf::DomainBox<double> box = sparse ? sparse->domain() : dense->domain();
             std::fprintf(stderr,
                          "sdf-eval: warning: %lld of %zu points lie outside the %s domain [%.9g %.9g %.9g] - "
                          "[%.9g %.9g %.9g] and were clamped into it\n",
-                         static_cast<long long>(outside), samples.size(), recon.description().c_str(), box.lo.x,
+                         static_cast<long long>(outside), samples.size(), sdf::describe(spec).c_str(), box.lo.x,
                          box.lo.y, box.lo.z, box.hi.x, box.hi.y, box.hi.z);
         }
         return 0;

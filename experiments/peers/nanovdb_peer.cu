@@ -21,6 +21,7 @@
 
 #include <cuda_runtime.h>
 
+#include "cuda/util/device_buffer.h"
 #include "experiments/peers/peer.h"
 
 namespace sdf::peers {
@@ -82,18 +83,11 @@ public:
         };
         { auto warm_up = convert(); }  // module load and the memory pool's first allocations
         check(cudaDeviceSynchronize(), "warm-up conversion");
-        cudaEvent_t begin, end;
-        check(cudaEventCreate(&begin), "cudaEventCreate");
-        check(cudaEventCreate(&end), "cudaEventCreate");
+        cuda::EventTimer conversion;  // its events are destroyed whatever throws (cuda/util/device_buffer.h)
         const auto wall = std::chrono::steady_clock::now();
-        cudaEventRecord(begin);
+        conversion.begin();
         auto [handle, sidecar] = convert();
-        cudaEventRecord(end);
-        check(cudaEventSynchronize(end), "conversion");
-        float ms = 0;
-        cudaEventElapsedTime(&ms, begin, end);
-        cudaEventDestroy(begin);
-        cudaEventDestroy(end);
+        conversion.end();  // synchronises: a fault of the conversion throws here
         const double conversion_wall = seconds_since(wall);
         start = std::chrono::steady_clock::now();
         std::vector<char> grid_bytes(handle.bufferSize());
@@ -101,7 +95,7 @@ public:
         check(cudaMemcpy(grid_bytes.data(), handle.deviceData(), grid_bytes.size(), cudaMemcpyDeviceToHost), "grid download");
         check(cudaMemcpy(udf.data(), sidecar.deviceData(), udf.size() * sizeof(float), cudaMemcpyDeviceToHost), "sidecar download");
         const double download = seconds_since(start);
-        r.query_seconds = 1e-3 * double(ms);
+        r.query_seconds = conversion.seconds();
         r.end_to_end_seconds = r.build_seconds + conversion_wall + download;
 
         const IndexGrid* grid = reinterpret_cast<const IndexGrid*>(grid_bytes.data());

@@ -263,14 +263,20 @@ void require_block_ids(const std::vector<int64_t>& ids, int64_t blocks, const st
 
 }  // namespace
 
-bool is_sparse_field_file(const std::string& header_path) {
-    const nlohmann::json j = read_json_file(header_path, "field header");
+bool is_sparse_field_header(const nlohmann::json& j) {
     return j.is_object() && j.contains("layout") && j["layout"] == kSparseBandLayout;  // else read_field's messages
 }
 
+bool is_sparse_field_file(const std::string& header_path) {
+    return is_sparse_field_header(read_json_file(header_path, "field header"));
+}
+
 SparseBandField read_sparse_field(const std::string& header_path) {
+    return read_sparse_field(header_path, read_json_file(header_path, "field header"));
+}
+
+SparseBandField read_sparse_field(const std::string& header_path, const nlohmann::json& j) {
     const std::string& header = header_path;
-    const nlohmann::json j = read_json_file(header, "field header");
     JsonReader r(j, header);
     const std::string format = r.required<std::string>("format", "\"sdf-lattice-field\"");
     if (format != "sdf-lattice-field") r.fail("format", "expected \"sdf-lattice-field\", got \"" + format + "\"");
@@ -382,9 +388,9 @@ SampledField densify_within_memory(const SparseBandField& band, bool gradient, c
 }
 
 SampledField read_field_densified(const std::string& header_path, const std::string& where) {
-    if (!is_sparse_field_file(header_path)) return read_field(header_path);
-    const bool has_gradient = read_json_file(header_path, "field header").contains("gradient_channel");
-    return densify_within_memory(read_sparse_field(header_path), has_gradient, header_path, where);
+    const nlohmann::json header = read_json_file(header_path, "field header");
+    if (!is_sparse_field_header(header)) return read_field(header_path);
+    return densify_within_memory(read_sparse_field(header_path, header), header.contains("gradient_channel"), header_path, where);
 }
 
 }  // namespace sdf

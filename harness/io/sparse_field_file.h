@@ -45,10 +45,15 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
 /// own +-W values are): densified, it is read_field() of the dense float32 file. Errors (std::runtime_error, std::invalid_argument) name the file,
 /// the key or channel, and what was expected.
 SparseBandField read_sparse_field(const std::string& header_path);
+/// The same from the header's JSON, already read from `header_path` (read_json_file): a tool
+/// that looks at the header first (is_sparse_field_header, "gradient_channel") parses it once.
+SparseBandField read_sparse_field(const std::string& header_path, const nlohmann::json& header);
 
 /// Whether the field header at `header_path` is a sparse band's ("layout": "sparse_band").
 /// Throws, naming the file, when it is not readable JSON (read_field's first check).
 bool is_sparse_field_file(const std::string& header_path);
+/// The same for a header already parsed.
+bool is_sparse_field_header(const nlohmann::json& header);
 
 /// read_field() of a dense field file; of a sparse band's, its densified field (every
 /// lattice point: the dense `--band W` field), refused past the host memory check

@@ -1,6 +1,7 @@
 #include "python/src/common.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
@@ -111,6 +112,12 @@ py::array_t<double> vec3_array(const Vec3d* v, size_t n, std::vector<py::ssize_t
 
 py::object json_to_python(const nlohmann::json& j) {
     return py::module_::import("json").attr("loads")(j.dump());
+}
+
+std::string number_text(double v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    return std::string(text, end);
 }
 
 }  // namespace sdf

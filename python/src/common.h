@@ -21,6 +21,10 @@ namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+/// The shortest text that reads back as `v`, for messages (std::to_string writes 1e-300 as
+/// 0.000000).
+std::string number_text(double v);
+
 /// `value` when it is one of `choices`, else ValueError naming the argument and the choices
 /// (as the config reader words it: core/quoted_alternatives.h).
 const std::string& choose(const std::string& argument, const std::string& value, const std::vector<std::string>& choices);

@@ -1,6 +1,5 @@
 // Fields: sdf_lattices.Field, sample (as run-experiment samples a lattice) and read_field.
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -48,14 +47,6 @@ double number_argument(const py::object& value, const std::string& what) {
     const double v = PyFloat_AsDouble(value.ptr());
     if (v == -1.0 && PyErr_Occurred()) throw py::error_already_set();
     return v;
-}
-
-/// The shortest text that reads back as `v`, for messages (std::to_string writes 1e-300 as
-/// 0.000000).
-std::string number_text(double v) {
-    char text[32];
-    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
-    return std::string(text, end);
 }
 
 /// The "lattice" object of a config, from sample()'s arguments, parsed by the config's own
@@ -225,56 +216,10 @@ Field sample_bound(const MeshSdf& sdf, const std::string& lattice, const py::obj
 py::tuple Field::reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
                              double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
     choose("outside", outside, {"nan", "clamp", "error"});
-    if (!(sigma2 > 0 && std::isfinite(sigma2)))
-        throw std::invalid_argument("sigma2: expected a finite variance > 0, got " + number_text(sigma2));
-    const DoubleArray array = points_argument(points_in);
-    // What a call holds per point: the points, the samples and the two result arrays.
-    const auto out_of_memory = [&] {
-        const uint64_t n = array.ndim() == 2 ? uint64_t(array.shape(0)) : uint64_t(array.size());
-        raise_memory_error("reconstruct(): out of memory for " + std::to_string(n) + " points (about " +
-                           format_bytes(n * (sizeof(Vec3d) + sizeof(ReconstructedSample<double>) + 4 * sizeof(double))) +
-                           "); reconstruct fewer points per call");
-    };
-    std::vector<Vec3d> points;
-    std::vector<ReconstructedSample<double>> samples;
+    const DoubleArray array = points_argument(points_in);  // bad points are named before anything is built
     const std::shared_ptr<const Reconstruction> r = reconstruction(interpolator, derivatives, sigma2, sigma_units, threads);
-    try {
-        points = points_from_array(array, "points");
-        TaskOptions task;
-        task.total = int64_t(points.size());
-        task.label = "reconstructing";
-        samples = run_task([&] { return r->evaluate(points, threads); }, task);
-    } catch (const std::bad_alloc&) {
-        out_of_memory();
-    } catch (py::error_already_set& e) {
-        if (e.matches(PyExc_MemoryError)) out_of_memory();
-        throw;
-    }
-    const size_t n = samples.size();
-    if (outside == "error")
-        for (size_t i = 0; i < n; ++i)
-            if (!samples[i].inside) {
-                const DomainBox<double> d = r->domain();
-                std::ostringstream m;
-                m << "points: row " << i << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z
-                  << ") lies outside the field's domain [" << d.lo.x << ", " << d.hi.x << "] x [" << d.lo.y << ", " << d.hi.y
-                  << "] x [" << d.lo.z << ", " << d.hi.z << "] (outside=\"nan\" gives NaN there, \"clamp\" the nearest value inside)";
-                throw std::invalid_argument(m.str());
-            }
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    const bool to_nan = outside == "nan";
-    auto values = new_array<double>({py::ssize_t(n)}, [&](double* v) {
-        for (size_t i = 0; i < n; ++i) v[i] = to_nan && !samples[i].inside ? nan : samples[i].value;
-    });
-    auto gradients = new_array<double>({py::ssize_t(n), 3}, [&](double* g) {
-        for (size_t i = 0; i < n; ++i) {
-            const bool blank = to_nan && !samples[i].inside;
-            g[3 * i] = blank ? nan : samples[i].gradient.x;
-            g[3 * i + 1] = blank ? nan : samples[i].gradient.y;
-            g[3 * i + 2] = blank ? nan : samples[i].gradient.z;
-        }
-    });
-    return py::make_tuple(values, gradients);
+    const auto [points, samples] = reconstruct_points(array, [&](const std::vector<Vec3d>& p) { return r->evaluate(p, threads); });
+    return reconstruction_arrays(points, samples, r->domain(), outside);
 }
 
 py::object Field::points() const {

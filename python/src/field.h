@@ -15,6 +15,7 @@
 #include "core/sampling/sampled_field.h"
 #include "harness/sampling/mesh_sdf.h"
 #include "python/src/common.h"
+#include "python/src/reconstruct.h"
 
 namespace sdf {
 
@@ -90,19 +91,10 @@ public:
     }
 
     /// The reconstruction of these names (sdf-eval's defaults for an empty `derivatives`).
-    std::shared_ptr<const Reconstruction> reconstruction(const std::string& interpolator_in, const std::string& derivatives,
+    std::shared_ptr<const Reconstruction> reconstruction(const std::string& interpolator, const std::string& derivatives,
                                                          double sigma2, const std::string& sigma_units, int threads) {
-        const std::string interpolator =
-            interpolator_in.empty() ? (lattice().type == LatticeType::BCC ? "bcc_cubic" : "tricubic_lm") : interpolator_in;
-        ReconstructionSpec spec;
-        spec.interpolator = parse_interpolator(interpolator);
-        spec.derivatives = derivatives.empty() ? default_derivative_source(spec.interpolator, !field_->gradient.empty())
-                                               : parse_derivative_source(derivatives);
-        spec.sigma2 = sigma2;
-        spec.sigma_units = choose("sigma_units", sigma_units, {"lattice", "spacing"}) == "lattice" ? SigmaUnits::LatticeUnits
-                                                                                                    : SigmaUnits::Spacing;
-        if (threads < 0) throw std::invalid_argument("threads: expected 0 (all cores) or a positive count");
-        spec.threads = threads;
+        const ReconstructionSpec spec = reconstruction_spec(lattice().type, !field_->gradient.empty(), interpolator, derivatives,
+                                                            sigma2, sigma_units, threads);
         const std::string key = describe(spec);
         if (!recon_ || recon_key_ != key) {
             std::shared_ptr<const SampledField> f = field_;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "core/mesh/mesh_provenance.h"
+#include "core/reconstruction/sparse_reconstruction.h"
 #include "core/sampling/sparse_band.h"
 #include "core/sampling/sparse_band_cells.h"
 #include "harness/config/json_reader.h"
@@ -93,6 +94,20 @@ public:
         });
     }
     size_t nbytes() const { return band_->memory_bytes() + at_.capacity() * sizeof(int64_t); }
+    /// Whether the band holds gradients (a file read without its gradient channel does not).
+    bool has_gradient() const { return band_->gradient.size() == band_->distance.size(); }
+
+    /// The band's reconstruction of `spec`, the last one kept for the next call. Each caller
+    /// holds its own reference (the GIL is released while it evaluates); it reads band_,
+    /// which lives as long as this object.
+    std::shared_ptr<const SparseReconstruction> reconstruction(const ReconstructionSpec& spec) const {
+        const std::string key = describe(spec);
+        if (!recon_ || recon_key_ != key) {
+            recon_ = std::make_shared<const SparseReconstruction>(*band_, spec, has_gradient());
+            recon_key_ = key;
+        }
+        return recon_;
+    }
 
     /// The dense field, made once (to_dense()) for reconstruct(). to_dense() releases the GIL,
     /// so another thread may have made it meanwhile: the first one made is kept, and each caller
@@ -105,16 +120,30 @@ public:
         return dense_;
     }
 
-    /// The dense band field's reconstruction (to_dense(), past the memory check), with the
-    /// band's rule: a point outside the band's cells (sparse_band_cells.h) is treated as a
-    /// point outside the lattice's domain (outside= "nan", "clamp": the dense band field's
-    /// value there, built from +-W, or "error").
+    /// The band's reconstruction with the band's rule: a point outside the band's cells
+    /// (sparse_band_cells.h) is treated as a point outside the lattice's domain (outside=
+    /// "nan", "clamp": the dense band field's value there, built from +-W, or "error"). From
+    /// the blocks (SparseReconstruction: the dense band field's reconstruction bit for bit,
+    /// without it); the interpolating splines, whose prefilter spans the lattice, from
+    /// to_dense() (made once, past the memory check).
     py::tuple reconstruct(const py::object& points_in, const std::string& interpolator, const std::string& derivatives,
                           double sigma2, const std::string& sigma_units, int threads, const std::string& outside) {
         choose("outside", outside, {"nan", "clamp", "error"});
-        const std::vector<Vec3d> points = points_from_array(points_argument(points_in), "points");
-        const std::shared_ptr<Field> field = dense();
-        py::tuple out = field->reconstruct(points_in, interpolator, derivatives, sigma2, sigma_units, threads, outside);
+        const DoubleArray array = points_argument(points_in);
+        const ReconstructionSpec spec =
+            reconstruction_spec(lattice().type, has_gradient(), interpolator, derivatives, sigma2, sigma_units, threads);
+        py::tuple out;
+        std::vector<Vec3d> points;
+        if (reconstructs_locally(spec.interpolator)) {
+            const std::shared_ptr<const SparseReconstruction> r = reconstruction(spec);
+            auto [p, samples] = reconstruct_points(array, [&](const std::vector<Vec3d>& q) { return r->evaluate(q, threads); });
+            out = reconstruction_arrays(p, samples, r->domain(), outside);
+            points = std::move(p);
+        } else {
+            const std::shared_ptr<Field> field = dense();
+            out = field->reconstruct(points_in, interpolator, derivatives, sigma2, sigma_units, threads, outside);
+            points = points_from_array(array, "points");
+        }
         if (outside == "clamp") return out;
         auto values = out[0].cast<py::array_t<double>>();
         auto gradients = out[1].cast<py::array_t<double>>();
@@ -144,7 +173,12 @@ public:
         TaskOptions task;
         task.total = kBackgroundItems;
         task.label = "densifying the band";
-        return run_task([&] { return Field(b->densify()); }, task);
+        const bool gradient = has_gradient();
+        return run_task([&] {
+            SampledField f = b->densify();
+            if (!gradient) f.gradient.clear();  // read without its gradient channel: none, as read_field of the dense file
+            return Field(std::move(f));
+        }, task);
     }
 
     py::list write(const std::string& path, bool overwrite, bool closest_triangle, const std::string& dtype) const {
@@ -204,6 +238,8 @@ private:
     std::shared_ptr<const SparseBandField> band_;
     std::vector<int64_t> at_;
     mutable std::shared_ptr<Field> dense_;
+    mutable std::shared_ptr<const SparseReconstruction> recon_;
+    mutable std::string recon_key_;
 };
 
 /// read_field of a sparse band's field file (sdf_lattices._fields routes .json files here).
@@ -300,8 +336,9 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
              py::arg("derivatives") = "", py::arg("sigma2") = 0.5, py::arg("sigma_units") = "lattice", py::arg("threads") = 0,
              py::arg("outside") = "nan",
              "reconstruct(points, interpolator=\"\", derivatives=\"\", sigma2=0.5, sigma_units=\"lattice\", threads=0, "
-             "outside=\"nan\") -> (values, gradients): Field.reconstruct of to_dense() (made once, refused past the "
-             "memory check), the band's values inside it. A point outside the band's cells (a corner of its lattice "
+             "outside=\"nan\") -> (values, gradients): to_dense().reconstruct(...) bit for bit, computed from the band's "
+             "blocks without the dense field (its memory grows with the band; cc_bspline3 and bcc_box_quintic, whose "
+             "prefilter spans the lattice, use to_dense(), made once and refused past the memory check). A point outside the band's cells (a corner of its lattice "
              "cell, in either BCC sub-grid, holds |d| > W) is treated as a point outside the lattice: outside=\"nan\" "
              "gives NaN, \"clamp\" the dense band field's reconstruction there (built from +-W), \"error\" raises.")
         .def("__len__", &SparseField::size)

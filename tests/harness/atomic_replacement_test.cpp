@@ -7,7 +7,8 @@
 // no file behind; a killed run's leftovers are removed by the next run. Also: every target is
 // checked before sampling (a missing --vdb folder), the sparse band's .vdb is old or new whole
 // at every step too (write_through_temporary), values float32 cannot hold are refused
-// (--band 1e-300), and budgets beyond the machine are refused with both figures.
+// (--band 1e-300), and budgets beyond the machine are refused with both figures. The sparse
+// band's field file (--layout sparse) is old or new whole at every step as well.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -23,6 +24,7 @@
 #include "core/mesh/sha256.h"
 #include "harness/io/field_file.h"
 #include "harness/io/field_replacement.h"
+#include "harness/io/sparse_field_file.h"
 #include "harness_test_util.h"
 
 #if !defined(SDF_SAMPLE_EXE) || !defined(RUN_EXPERIMENT_EXE)
@@ -233,6 +235,76 @@ TEST_F(AtomicReplacement, SparseBandVdbIsOldOrNewWholeAtEveryStep) {
         EXPECT_GE(completed_at, 8) << mode;
         // The last step before completion is the .vdb's rename: the field is new, the .vdb still old.
         EXPECT_EQ(vdb_kept_at_last_step, completed_at - 1) << mode;
+    }
+}
+
+/// What a sparse band's field file holds: its mesh, lattice, band and every array, or
+/// "unreadable: why".
+std::string sparse_fingerprint(const std::string& header) {
+    try {
+        const SparseBandField b = read_sparse_field(header);
+        std::string bytes = nlohmann::json(b.mesh).dump() + lattice_to_json(b.lattice).dump() + std::to_string(b.width);
+        const auto add = [&](const auto& v) {
+            bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0]));
+        };
+        add(b.active), add(b.distance), add(b.gradient), add(b.closest_triangle), add(b.inside_tiles), add(b.mixed),
+            add(b.mixed_inside);
+        return sha256_hex(bytes.data(), bytes.size());
+    } catch (const std::exception& e) {
+        return std::string("unreadable: ") + e.what();
+    }
+}
+
+// The sparse band's field file (write_sparse_field: its channels placed by FieldReplacement,
+// the header last) replaced by `sdf-sample --layout sparse --overwrite` that fails or is
+// killed at every step: it reads back as the old band whole or the new one whole; a failed
+// run leaves the old files and no temporary; the next run after a kill replaces it cleanly.
+TEST_F(AtomicReplacement, SparseFieldFileIsOldOrNewWholeAtEveryStep) {
+    const std::string old_args = "shape:sphere --resolution 12 --band 0.3 --sparse --layout sparse",
+                      new_args = "shape:torus --resolution 14 --band 0.3 --sparse --layout sparse";
+    const fs::path seed = dir_ / "sparse_file_seed", fresh = dir_ / "sparse_file_fresh";
+    fs::create_directories(seed);
+    fs::create_directories(fresh);
+    ASSERT_EQ(sample(seed, "", old_args + " --out f.json").code, 0);
+    ASSERT_EQ(sample(fresh, "", new_args + " --out f.json").code, 0);
+    const std::string old_fp = sparse_fingerprint((seed / "f.json").string()), new_fp = sparse_fingerprint((fresh / "f.json").string());
+    ASSERT_EQ(old_fp.rfind("unreadable", 0), std::string::npos) << old_fp;
+    ASSERT_NE(old_fp, new_fp);
+    const std::set<std::string> old_files = entries(seed), new_files = entries(fresh);
+    ASSERT_EQ(old_files.size(), 8u) << "header and 7 channels";
+    for (const char* mode : {"fail", "kill"}) {
+        int completed_at = 0;
+        for (int k = 1; k <= 40 && completed_at == 0; ++k) {
+            const std::string what = std::string(mode) + " at step " + std::to_string(k);
+            const fs::path work = dir_ / "sparse_file_work";
+            copy_folder(seed, work);
+            const std::string env = "SDF_FAULT_AT=" + std::to_string(k) + (std::string(mode) == "kill" ? " SDF_FAULT_MODE=kill" : "");
+            const test::ShellResult r = sample(work, env, new_args + " --out f.json --overwrite");
+            const std::string now = sparse_fingerprint((work / "f.json").string());
+            if (r.code == 0) {
+                completed_at = k;
+                EXPECT_EQ(now, new_fp) << what;
+                EXPECT_EQ(entries(work).size(), 8u) << what;
+                continue;
+            }
+            EXPECT_TRUE(now == old_fp || now == new_fp) << what << ": " << now << "\n" << r.err;
+            if (std::string(mode) == "fail") {
+                EXPECT_EQ(r.code, 1) << what;
+                EXPECT_TRUE(test::Contains(r.err, "injected failure at step " + std::to_string(k))) << what;
+                if (now == old_fp) {
+                    EXPECT_EQ(entries(work), old_files) << what;
+                }
+                for (const std::string& name : entries(work))
+                    EXPECT_EQ(name.find(".tmp"), std::string::npos) << what << ": " << name << " left behind";
+            } else {
+                EXPECT_TRUE(r.code == -1 || r.code == 128 + SIGKILL) << what << ": not killed (" << r.code << ")\n" << r.err;
+                ASSERT_EQ(sample(work, "", new_args + " --out f.json --overwrite").code, 0) << what;
+                EXPECT_EQ(sparse_fingerprint((work / "f.json").string()), new_fp) << what;
+                EXPECT_EQ(entries(work).size(), 8u) << what << ": header and 7 channels";
+            }
+        }
+        // Every step was tried: the 7 channels' renames, the header, the old files' removal.
+        EXPECT_GE(completed_at, 9) << mode;
     }
 }
 

@@ -356,7 +356,8 @@ TEST(StreamedSampling, SparseBandWritesTheDenseBandsBytes) {
 
 // Issue 35: --layout sparse writes the field file's sparse variant (sparse_field_file.h):
 // densified it is the dense --band run's field; sdf-eval reads it and prints what it prints
-// for the dense file, warning about the points off the band's cells.
+// for the dense file, warning about the points off the band's cells, from the band's blocks
+// (with less memory than the dense field needs).
 TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
     test::ScratchDir dir("sdf_sample_sparse_layout");
     const std::string exe = test::quote(SDF_SAMPLE_EXE) + " --backend cpu --margin 0.3 --quiet";
@@ -386,6 +387,17 @@ TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
         ASSERT_EQ(from_sparse.code, 0) << from_sparse.err;
         EXPECT_EQ(from_dense.out, from_sparse.out);
         EXPECT_TRUE(test::Contains(from_sparse.err, "outside the sparse band's cells")) << from_sparse.err;
+        // The band is reconstructed from its blocks: with less memory than its dense field
+        // needs (36 bytes a point), the same lines; a filter that only densifies is refused.
+        const std::string small = "SDF_MEMORY_AVAILABLE=" + std::to_string(d.size() * 36 / 2) + " ";
+        const test::ShellResult from_blocks = test::run_in(dir.path(), small + eval + "s.json p.txt");
+        ASSERT_EQ(from_blocks.code, 0) << from_blocks.err;
+        EXPECT_EQ(from_blocks.out, from_dense.out);
+        const std::string global = lattice.find("bcc") != std::string::npos ? "bcc_box_quintic" : "cc_bspline3";
+        const test::ShellResult refused_dense = test::run_in(
+            dir.path(), small + test::quote(SDF_EVAL_EXE) + " --interpolator " + global + " --threads 1 s.json p.txt");
+        EXPECT_EQ(refused_dense.code, 1) << refused_dense.out;
+        EXPECT_TRUE(test::Contains(refused_dense.err, "densifying the sparse band of s.json")) << refused_dense.err;
     }
     const test::ShellResult refused =
         test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --band 0.1 --layout sparse --out n.json");

@@ -210,6 +210,47 @@ def test_reconstruct_inside_the_band_is_the_dense_fields(pair):
     assert np.isnan(far[0])  # outside the lattice, as the dense field
 
 
+def test_reconstruct_is_the_dense_fields_for_each_filter_and_derivative_source(pair):
+    _, lattice, *_, sparse, dense = pair
+    filters = [("trilinear", "fd"), ("tricubic_lm", "fd"), ("catmull_rom", "fd"), ("cc_bspline3", "fd")] if lattice == "cc" else [
+        ("bcc_linear", "fd"), ("bcc_cubic", "fd"), ("bcc_cubic", "fd_weighted"), ("bcc_box_quintic_qi", "fd"),
+        ("bcc_box_quintic", "fd")]
+    rng = np.random.default_rng(36)
+    lo, hi = np.min(sparse.points, axis=0) - 2 * sparse.spacing, np.max(sparse.points, axis=0) + 2 * sparse.spacing
+    points = np.concatenate([sparse.points[rng.choice(len(sparse), 300)] + rng.uniform(-1.5, 1.5, (300, 3)) * sparse.spacing,
+                             rng.uniform(lo, hi, (200, 3))])
+    for interpolator, derivatives in filters:
+        for outside in ("nan", "clamp"):
+            values, gradients = sparse.reconstruct(points, interpolator, derivatives, outside=outside)
+            dense_values, dense_gradients = dense.reconstruct(points, interpolator, derivatives, outside=outside)
+            kept = ~np.isnan(values)
+            assert kept.sum() > 0, interpolator
+            assert same_bits(values[kept], dense_values[kept]), (interpolator, derivatives, outside)
+            assert same_bits(gradients[kept], dense_gradients[kept]), (interpolator, derivatives, outside)
+            if outside == "clamp":
+                assert kept.all() and same_bits(values, dense_values)
+    with pytest.raises(ValueError, match="outside the field's domain"):  # the lattice's edge first, as the dense field
+        sparse.reconstruct(np.array([[1e3, 0.0, 0.0]]), filters[0][0], outside="error")
+
+
+def test_reconstruct_needs_no_dense_field(pair, monkeypatch, tmp_path):
+    _, lattice, *_, sparse, dense = pair
+    interpolator = "tricubic_lm" if lattice == "cc" else "bcc_cubic"
+    points = sparse.points[:200] + 0.1 * sparse.spacing
+    want, want_gradients = dense.reconstruct(points, interpolator, "true")
+    sparse.write(str(tmp_path / "band.json"), dtype="float64")
+    band = sl.read_field(str(tmp_path / "band.json"))  # a fresh SparseField: nothing densified
+    monkeypatch.setenv("SDF_MEMORY_AVAILABLE", "1000")  # below the dense field's size
+    got, gradients = band.reconstruct(points, interpolator, "true")
+    kept = ~np.isnan(got)
+    assert kept.sum() > 0 and same_bits(got[kept], want[kept]) and same_bits(gradients[kept], want_gradients[kept])
+    with pytest.raises(RuntimeError, match="densifying"):
+        band.to_dense()
+    spline = "cc_bspline3" if lattice == "cc" else "bcc_box_quintic"  # its prefilter spans the lattice: densified
+    with pytest.raises(RuntimeError, match="densifying"):
+        band.reconstruct(points, spline)
+
+
 def test_hostile_sparse_field_files_are_refused_naming_the_file(pair, tmp_path):
     *_, sparse, _ = pair
     path = tmp_path / "band.json"
