@@ -100,7 +100,9 @@ private:
     }
 
     /// A sparse band's active blocks through the dense path's brick kernel (with its brick
-    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's.
+    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's,
+    /// every lattice point's channels written (the arrays come unwritten; padding is the
+    /// sampler's), the gradient only when the band holds it.
     BandBlockKernel band_block_kernel(double width) const override {
         if (kernel_ != BvhKernel::Brick) return {};
         const BandSkip band = band_skip(width);
@@ -125,17 +127,23 @@ private:
                         const int x = int(i % r.x), y = int((i / r.x) % r.y), z = int(i / (int64_t(r.x) * r.y));
                         return base + size_t(x + kBandBlockDim * (y + kBandBlockDim * z));
                     };
+                    const bool gradient = out.channels.gradient;
+                    const auto store_outside = [&](size_t v, bool negative) {
+                        out.distance[v] = negative ? -band.width : band.width;
+                        if (gradient) out.gradient[v] = Vec3d(0.0);
+                        out.closest_triangle[v] = kOutsideBandTriangle;
+                    };
                     auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const size_t v = slot(i);
                         if (outside_band(s.distance, band.width)) {
-                            out.distance[v] = std::signbit(s.distance) ? -band.width : band.width;
+                            store_outside(v, std::signbit(s.distance));
                             return;
                         }
                         out.distance[v] = s.distance;
-                        out.gradient[v] = s.gradient;
+                        if (gradient) out.gradient[v] = s.gradient;
                         out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
                     };
-                    auto emit_outside = [&](int64_t i, bool negative) { out.distance[slot(i)] = negative ? -band.width : band.width; };
+                    auto emit_outside = [&](int64_t i, bool negative) { store_outside(slot(i), negative); };
                     with_precision(options_.precision, [&](auto zero) {
                         using T = decltype(zero);
                         evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters, emit,
