@@ -199,7 +199,7 @@ def test_channels_without_gradient_keep_none_and_the_same_bytes(tmp_path):
     assert "gradient" in headers["full"]["channels"]
     for name in ("slim", "slim-sparse"):
         assert "gradient" not in headers[name]["channels"] and "gradient_channel" not in headers[name]
-        assert headers[name]["sampler"]["details"]["sparse_band"]["channels"] == ["distance", "closest_triangle"]
+        assert headers[name]["sampler"]["sparse_band"]["channels"] == ["distance", "closest_triangle"]
     for channel in ("distance", "closest_triangle"):
         full = _channel(str(tmp_path / "full.json"), headers["full"], channel)
         slim = _channel(str(tmp_path / "slim.json"), headers["slim"], channel)
