@@ -16,7 +16,8 @@
 // level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only), and
 // --layout sparse the field file's sparse variant instead of the dense one
 // (harness/io/sparse_field_file.h: the band's blocks, never densified; sdf-eval, sdf-render and
-// Python's read_field read it).
+// Python's read_field read it). A sparse band holds the gradient only when --channels names
+// it: without it, it is neither kept nor downloaded from a GPU (12 bytes a point, not 36).
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
@@ -123,7 +124,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
-    app.add_option("--channels", channels_text, "comma-separated channels to write: distance (always), gradient, closest_triangle")
+    app.add_option("--channels", channels_text,
+                   "comma-separated channels to write: distance (always), gradient, closest_triangle (with --sparse, a "
+                   "band without gradient never keeps one)")
         ->capture_default_str();
     app.add_option("--dtype", dtype, "float32 or float64 for distance and gradient")
         ->check(CLI::IsMember({"float32", "float64"}))
@@ -274,7 +277,9 @@ int main(int argc, char** argv) {
         std::unique_ptr<sdf::SparseBandSlabs> sparse_slabs;
         if (sparse) {
             doing = "sampling the sparse band of " + mesh_arg + " on " + sdf::lattice_notation(lattice);
-            sdf::SparseBandField sparse_band = bound.sample_band_sparse(lattice, band);
+            sdf::BandChannels channels;
+            channels.gradient = stream.gradient;  // the closest triangle is always held: it marks the band's points
+            sdf::SparseBandField sparse_band = bound.sample_band_sparse(lattice, band, channels);
             sparse_band.mesh = mesh_provenance;
             stream.fixed_bytes += sparse_band.memory_bytes();  // held while the slabs are written
             sparse_slabs = std::make_unique<sdf::SparseBandSlabs>(bound, std::move(sparse_band));

@@ -68,11 +68,12 @@ void BackendSampler::finish_slab(SampledField& field, SlabRun& run, std::optiona
     }
 }
 
-SparseBandField BackendSampler::sample_band_sparse(const Lattice& lattice, double width) const {
+SparseBandField BackendSampler::sample_band_sparse(const Lattice& lattice, double width, BandChannels channels) const {
     require_band_width(width, "sparse band width");
     SparseBandPlan plan;
     plan.precision = options_.precision;
     plan.threads = options_.threads;
+    plan.channels = channels;
     SparseBandField band = sample_sparse_band(*this, lattice, width, plan, band_block_kernel(width));
     band.sampler.backend = backend_;
     band.sampler.method = method_;

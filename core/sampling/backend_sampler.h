@@ -70,7 +70,7 @@ public:
     /// timings, the provenance, the certificate and the band.
     SampledField sample_slab(const Lattice& lattice, const LatticeSlab& slab) const final;
     /// Only the band's blocks, through query_points() (sparse_band_sampler.h).
-    SparseBandField sample_band_sparse(const Lattice& lattice, double width) const override;
+    SparseBandField sample_band_sparse(const Lattice& lattice, double width, BandChannels channels = {}) const override;
     /// The range checks around query_points(), and the call's timings.
     std::vector<PointSample> query(const std::vector<Vec3d>& points, SamplingTimings* timings = nullptr) const final;
 

@@ -69,8 +69,10 @@ public:
     /// issue 35): densified, it is sample()'s field with SamplerOptions::band_width = width,
     /// byte for byte. The backends (BackendSampler) sample only the band's blocks with their
     /// point kernels (core/sampling/sparse_band_sampler.h); this default samples the whole
-    /// lattice and sparsifies it (refused when the sampler's own band is narrower).
-    virtual SparseBandField sample_band_sparse(const Lattice& lattice, double width) const;
+    /// lattice and sparsifies it (refused when the sampler's own band is narrower). The band
+    /// holds `channels` (without the gradient: neither kept nor, on a GPU, downloaded); its
+    /// distances and closest triangles are the same bytes either way.
+    virtual SparseBandField sample_band_sparse(const Lattice& lattice, double width, BandChannels channels = {}) const;
     /// Samples arbitrary points, returned in input order. `timings` (may be null) receives
     /// this call's timings where the sampler measures them (GPU: `kernel` = the device's
     /// sort, search and finalize, `upload`/`download` the transfers; every sampler: the

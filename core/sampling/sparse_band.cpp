@@ -25,8 +25,8 @@ void BandLayout::cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const {
     hi = lattice_.position_of_coords({c.x + span, c.y + span, c.z + span});
 }
 
-SparseBandField::SparseBandField(const Lattice& lattice_in, double width_in, Precision precision_in)
-    : lattice(lattice_in), width(width_in), precision(precision_in), layout_(lattice_in) {
+SparseBandField::SparseBandField(const Lattice& lattice_in, double width_in, Precision precision_in, BandChannels channels_in)
+    : lattice(lattice_in), width(width_in), precision(precision_in), channels(channels_in), layout_(lattice_in) {
     require_band_width(width, "sparse band width");
     if (!(width > 0)) throw std::invalid_argument("sparse band width: expected a band width > 0, got 0");
     inside_tiles.assign(size_t((layout_.block_count() + 63) / 64), 0);
@@ -46,7 +46,7 @@ int64_t SparseBandField::add_active(int64_t id) {
         throw std::logic_error("SparseBandField::add_active: block ids must ascend");
     active.push_back(id);
     distance.resize(active.size() * kBandBlockPoints, width);
-    gradient.resize(active.size() * kBandBlockPoints, Vec3d(0.0));
+    if (channels.gradient) gradient.resize(active.size() * kBandBlockPoints, Vec3d(0.0));
     closest_triangle.resize(active.size() * kBandBlockPoints, kOutsideBandTriangle);
     return int64_t(active.size()) - 1;
 }
@@ -56,6 +56,17 @@ int64_t SparseBandField::add_mixed(int64_t id) {
     mixed.push_back(id);
     mixed_inside.push_back(BandSignMask{});
     return int64_t(mixed.size()) - 1;
+}
+
+void SparseBandField::require_channels(BandChannels wanted, const std::string& what) const {
+    if (wanted.gradient && !channels.gradient)
+        throw std::invalid_argument(what + ": the band holds no gradient (sampled without the gradient channel, or read "
+                                           "from a file without one); ask for it when sampling, or write without it");
+    const size_t values = active.size() * kBandBlockPoints;
+    if (distance.size() != values || closest_triangle.size() != values || gradient.size() != (channels.gradient ? values : 0))
+        throw std::invalid_argument(what + ": the band's value arrays (" + std::to_string(distance.size()) + " distances, " +
+                                    std::to_string(gradient.size()) + " gradients, " + std::to_string(closest_triangle.size()) +
+                                    " triangles) do not match its " + std::to_string(active.size()) + " active blocks");
 }
 
 SparseBandCounts SparseBandField::counts() const {
@@ -82,15 +93,15 @@ size_t SparseBandField::memory_bytes() const {
            mixed.capacity() * sizeof(int64_t) + mixed_inside.capacity() * sizeof(BandSignMask);
 }
 
-int64_t SparseBandField::dense_bytes(const Lattice& lattice) {
-    return lattice.num_points() * int64_t(sizeof(double) + sizeof(Vec3d) + sizeof(int32_t));
+int64_t SparseBandField::dense_bytes(const Lattice& lattice, BandChannels channels) {
+    return lattice.num_points() * int64_t(sizeof(double) + (channels.gradient ? sizeof(Vec3d) : 0) + sizeof(int32_t));
 }
 
 SampledField SparseBandField::densify(int64_t max_points) const {
     const int64_t n = lattice.num_points();
     if (n > max_points)
         throw std::length_error("densifying a sparse band of " + std::to_string(n) + " lattice points (" +
-                                std::to_string(dense_bytes(lattice)) + " bytes) exceeds the limit of " +
+                                std::to_string(dense_bytes(lattice, channels)) + " bytes) exceeds the limit of " +
                                 std::to_string(max_points) + " points");
     SampledField field = densify_slab(whole_lattice_slab(lattice));
     field.timings = timings;
@@ -107,7 +118,13 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
     SampledField field;
     field.lattice = lattice;
     field.precision = precision;
-    field.resize(slab_point_count(lattice, slab));
+    const int64_t n = slab_point_count(lattice, slab);
+    if (channels.gradient) {
+        field.resize(n);
+    } else {  // no gradient channel: none in the field either
+        field.distance.assign(size_t(n), 0.0);
+        field.closest_triangle.assign(size_t(n), -1);
+    }
     // Each coset's planes of the slab are one contiguous range of storage (its part), and of
     // the slab's compact order.
     int64_t part_base = 0;
@@ -133,11 +150,16 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
                         if (is_active) {
                             const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
                             field.distance[size_t(out)] = distance[v];
-                            if (!gradient.empty()) field.gradient[size_t(out)] = gradient[v];  // else 0: read without it
+                            if (channels.gradient) field.gradient[size_t(out)] = gradient[v];
                             field.closest_triangle[size_t(out)] = closest_triangle[v];
                         } else {
-                            store_outside_band(field, out, is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id),
-                                               width);
+                            const bool inside = is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id);
+                            if (channels.gradient) {
+                                store_outside_band(field, out, inside, width);
+                            } else {
+                                field.distance[size_t(out)] = inside ? -width : width;
+                                field.closest_triangle[size_t(out)] = kOutsideBandTriangle;
+                            }
                         }
                     }
                     if (is_active) ++a;
@@ -150,11 +172,13 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
     return field;
 }
 
-SparseBandField SparseBandField::sparsify(const SampledField& dense, double w) {
-    SparseBandField out(dense.lattice, w, dense.precision);
+SparseBandField SparseBandField::sparsify(const SampledField& dense, double w, BandChannels channels) {
+    SparseBandField out(dense.lattice, w, dense.precision, channels);
     if (dense.size() != dense.lattice.num_points())
         throw std::invalid_argument("sparsify: the field holds " + std::to_string(dense.size()) + " points, its lattice " +
                                     std::to_string(dense.lattice.num_points()));
+    if (channels.gradient && dense.gradient.size() != dense.distance.size())
+        throw std::invalid_argument("sparsify: the gradient channel was asked for, but the field holds no gradient");
     out.timings = dense.timings;
     out.sampler = dense.sampler;
     out.mesh = dense.mesh;
@@ -176,7 +200,7 @@ SparseBandField SparseBandField::sparsify(const SampledField& dense, double w) {
                 const double d = dense.distance[size_t(i)];
                 const bool flagged = dense.closest_triangle[size_t(i)] == kOutsideBandTriangle || outside_band(d, w);
                 out.distance[base + size_t(local)] = flagged ? (std::signbit(d) ? -w : w) : d;
-                out.gradient[base + size_t(local)] = flagged ? Vec3d(0.0) : dense.gradient[size_t(i)];
+                if (channels.gradient) out.gradient[base + size_t(local)] = flagged ? Vec3d(0.0) : dense.gradient[size_t(i)];
                 out.closest_triangle[base + size_t(local)] = flagged ? kOutsideBandTriangle : dense.closest_triangle[size_t(i)];
             }
         } else if (any_inside && any_outside) {

@@ -16,6 +16,8 @@
 /// |d| <= W, else +-W, gradient 0 and kOutsideBandTriangle. Points of a block beyond the
 /// coset's resolution (the last blocks of each axis) are padding: +W, gradient 0,
 /// kOutsideBandTriangle, and no lattice point (BandLayout::storage_index is -1).
+/// A band holds the gradient channel only when asked (BandChannels): without it `gradient`
+/// is empty and the band costs 12 bytes a point instead of 36.
 /// Every other block is outside the band: a tile of one sign (bit `inside_tiles`: -W, else
 /// +W), or, where its points' signs differ (the winding sign across a hole, far from any
 /// triangle), a "mixed" block whose signs are stored per point (512 bits).
@@ -29,8 +31,10 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
+#include "core/default_init_vector.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampled_field.h"
 #include "kernels/lattice/band_blocks.h"
@@ -84,20 +88,32 @@ struct SparseBandCounts {
     int64_t band_points = 0;     ///< of them, |d| <= W (closest_triangle != kOutsideBandTriangle)
 };
 
+/// The value channels a sparse band holds, as its sampler is asked for them. The distance
+/// and the closest triangle are always held: the triangle marks the band's points
+/// (kOutsideBandTriangle off the band), which the level sets' active voxels and the band's
+/// cells are.
+struct BandChannels {
+    bool gradient = true;  ///< 24 of a point's 36 bytes
+};
+
 struct SparseBandField {
     SparseBandField() = default;
     /// An empty band of `lattice` (no active block, every block an outside tile).
-    SparseBandField(const Lattice& lattice, double width, Precision precision);
+    SparseBandField(const Lattice& lattice, double width, Precision precision, BandChannels channels = {});
 
     Lattice lattice;
     double width = 0;            ///< W > 0, mesh units
     Precision precision = Precision::Float;
+    /// What it holds: `gradient` is empty without the gradient channel (sampled without it,
+    /// or read from a file without it), else as long as `distance`.
+    BandChannels channels;
 
     /// Active block ids, ascending; block a's values are [a * 512, (a + 1) * 512) of each channel.
+    /// The value arrays' resize(n) leaves new values unwritten (a block kernel writes them all).
     std::vector<int64_t> active;
-    std::vector<double> distance;
-    std::vector<Vec3d> gradient;
-    std::vector<int32_t> closest_triangle;  ///< in the mesh file's face order; kOutsideBandTriangle outside the band
+    DefaultInitVector<double> distance;
+    DefaultInitVector<Vec3d> gradient;
+    DefaultInitVector<int32_t> closest_triangle;  ///< in the mesh file's face order; kOutsideBandTriangle outside the band
 
     /// One bit per block id: the tile's side (set: inside, -W); meaningful for tiles only.
     std::vector<uint64_t> inside_tiles;
@@ -116,11 +132,16 @@ struct SparseBandField {
     bool tile_inside(int64_t id) const { return (inside_tiles[size_t(id >> 6)] >> (id & 63)) & 1; }
     void set_tile_inside(int64_t id, bool inside);
 
-    /// Appends an active block (ids must come in ascending order) with every point padding;
+    /// Appends an active block (ids must come in ascending order) with every point padding
+    /// (+W, gradient 0 when held, kOutsideBandTriangle);
     /// returns its index in `active`.
     int64_t add_active(int64_t id);
     /// Appends a mixed block (ascending ids), every point outside.
     int64_t add_mixed(int64_t id);
+
+    /// Throws std::invalid_argument naming `what` when `wanted` asks for a channel the band
+    /// does not hold, or when the arrays of a channel it holds do not match its active blocks.
+    void require_channels(BandChannels wanted, const std::string& what) const;
 
     SparseBandCounts counts() const;
     /// Bytes held by the arrays (capacity, not size).
@@ -128,19 +149,22 @@ struct SparseBandField {
 
     /// The dense banded field this band stands for: every lattice point, in storage order,
     /// as a dense sampler with SamplerOptions::band_width = W stores it (provenance copied).
-    /// Throws std::length_error naming the size when the lattice has more than `max_points`.
+    /// Without the band's gradient channel the field has none (an empty `gradient`, as
+    /// read_field gives a file without one). Throws std::length_error naming the size when
+    /// the lattice has more than `max_points`.
     SampledField densify(int64_t max_points = INT64_MAX) const;
     /// The same for one slab of the lattice (kernels/lattice/lattice_slab.h), in the slab's
     /// compact order (sample_slab()'s): a dense field file written slab by slab under a
     /// memory budget, without the whole lattice in memory. Provenance not copied.
     SampledField densify_slab(const LatticeSlab& slab) const;
-    /// Bytes densify() allocates for a lattice (distance, gradient, closest triangle).
-    static int64_t dense_bytes(const Lattice& lattice);
+    /// Bytes densify() allocates for a lattice (distance, the gradient when held, closest triangle).
+    static int64_t dense_bytes(const Lattice& lattice, BandChannels channels = {});
 
     /// The sparse form of a dense banded field (SamplerOptions::band_width = W, or exact
     /// values, banded here): a block is active when one of its points is within the band,
-    /// else a tile or a mixed block. The fallback of samplers without a sparse path.
-    static SparseBandField sparsify(const SampledField& field, double width);
+    /// else a tile or a mixed block. The fallback of samplers without a sparse path. The
+    /// gradient channel asked of a field without gradients is refused (std::invalid_argument).
+    static SparseBandField sparsify(const SampledField& field, double width, BandChannels channels = {});
 
 private:
     BandLayout layout_;

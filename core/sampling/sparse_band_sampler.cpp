@@ -252,7 +252,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     require_search_range(mesh, lattice, plan.precision);
     if (plan.batch_points < kBandBlockPoints)
         throw std::invalid_argument("sparse band: batch_points must be at least " + std::to_string(kBandBlockPoints));
-    SparseBandField out(lattice, width, plan.precision);
+    SparseBandField out(lattice, width, plan.precision, plan.channels);
     const BandLayout& layout = out.layout();
     nlohmann::json steps = nlohmann::json::object();
 
@@ -264,22 +264,39 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
 
     // 2. Their points, batch by batch (batches of whole blocks).
     t = Clock::now();
-    out.distance.assign(out.active.size() * kBandBlockPoints, width);
-    out.gradient.assign(out.active.size() * kBandBlockPoints, Vec3d(0.0));
-    out.closest_triangle.assign(out.active.size() * kBandBlockPoints, kOutsideBandTriangle);
+    const size_t values = out.active.size() * kBandBlockPoints;
     const int64_t blocks_per_batch = plan.batch_points / kBandBlockPoints;
     int64_t points_computed = 0;
     if (blocks) {
+        // The kernel writes every lattice point's values: allocated, not written (the fill
+        // and the pages' first touch cost what a GPU's kernels do, 36 bytes a point), but
+        // for the padding of the blocks at the lattice's far edges.
+        out.distance.resize(values);
+        if (plan.channels.gradient) out.gradient.resize(values);
+        out.closest_triangle.resize(values);
+        for (size_t a = 0; a < out.active.size(); ++a) {
+            const BandBlockCoords b = layout.block_coords(out.active[a]);
+            const Int3 n = layout.coset(b.coset).points;
+            Int3 r{};
+            for (int k = 0; k < 3; ++k) r[k] = std::min(kBandBlockDim, n[k] - b.block[k] * kBandBlockDim);
+            points_computed += int64_t(r.x) * r.y * r.z;
+            if (r.x == kBandBlockDim && r.y == kBandBlockDim && r.z == kBandBlockDim) continue;
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                const Int3 p = BandLayout::local_offset(local);
+                if (p.x < r.x && p.y < r.y && p.z < r.z) continue;
+                const size_t v = a * kBandBlockPoints + size_t(local);
+                out.distance[v] = width;
+                if (plan.channels.gradient) out.gradient[v] = Vec3d(0.0);
+                out.closest_triangle[v] = kOutsideBandTriangle;
+            }
+        }
         // One call for every block: the kernel batches as its memory allows (a GPU uploads
         // the ids once).
-        for (const int64_t id : out.active) {
-            const BandBlockCoords b = layout.block_coords(id);
-            const Int3 n = layout.coset(b.coset).points;
-            int64_t points = 1;
-            for (int a = 0; a < 3; ++a) points *= std::min(kBandBlockDim, n[a] - b.block[a] * kBandBlockDim);
-            points_computed += points;
-        }
         if (!out.active.empty()) blocks(out, 0, out.active.size());
+    } else {
+        out.distance.assign(values, width);
+        if (plan.channels.gradient) out.gradient.assign(values, Vec3d(0.0));
+        out.closest_triangle.assign(values, kOutsideBandTriangle);
     }
     for (size_t first = 0; !blocks && first < out.active.size(); first += size_t(blocks_per_batch)) {
         const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
@@ -301,7 +318,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                     out.distance[v] = std::signbit(r[i].distance) ? -width : width;  // store_outside_band's values
                 } else {
                     out.distance[v] = r[i].distance;
-                    out.gradient[v] = r[i].gradient;
+                    if (plan.channels.gradient) out.gradient[v] = r[i].gradient;
                     out.closest_triangle[v] = r[i].triangle;
                 }
             }
@@ -407,6 +424,9 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"cells_refused_by_gradient", classify.refused_by_gradient},
                                           {"points_signed_per_point", per_point_points},
                                           {"outside_rule", rule_name},
+                                          {"channels", plan.channels.gradient
+                                                           ? nlohmann::json::array({"distance", "gradient", "closest_triangle"})
+                                                           : nlohmann::json::array({"distance", "closest_triangle"})},
                                           {"boundary_edges", int64_t(boundary_edge_count)},
                                           {"steps", steps},
                                           {"memory_bytes", int64_t(out.memory_bytes())}};
@@ -420,7 +440,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
 
 namespace sdf {
 
-SparseBandField BoundSampler::sample_band_sparse(const Lattice& lattice, double width) const {
+SparseBandField BoundSampler::sample_band_sparse(const Lattice& lattice, double width, BandChannels channels) const {
     require_band_width(width, "sparse band width");
     SampledField field = sample(lattice);
     if (field.sampler.band && field.sampler.band->width < width)
@@ -428,7 +448,7 @@ SparseBandField BoundSampler::sample_band_sparse(const Lattice& lattice, double 
                                     " bands its fields at " + std::to_string(field.sampler.band->width) +
                                     ", narrower; sample with band_width 0 or >= the band's");
     apply_narrow_band(field, width);
-    SparseBandField band = SparseBandField::sparsify(field, width);
+    SparseBandField band = SparseBandField::sparsify(field, width, channels);
     if (band.sampler.band) band.sampler.band->how = "post-processed: the whole lattice sampled, then sparsified";
     return band;
 }

@@ -103,9 +103,11 @@ private:
     }
 
     /// A sparse band's active blocks through the dense path's brick kernel (with its brick
-    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's.
-    /// On a solid with a band at least a spacing wide the search is bounded by the band, and
-    /// the points beyond it take their sides from their neighbours (band_sides.h).
+    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's,
+    /// every lattice point's channels written (the arrays come unwritten; padding is the
+    /// sampler's), the gradient only when the band holds it. On a solid with a band at least
+    /// a spacing wide the search is bounded by the band, and the points beyond it take their
+    /// sides from their neighbours (band_sides.h).
     BandBlockKernel band_block_kernel(double width) const override {
         if (kernel_ != BvhKernel::Brick) return {};
         const BandSkip skip = band_skip(width);
@@ -142,15 +144,21 @@ private:
                     side.fill(kBandSidePadding);
                     std::array<bool, kBandBlockPoints> flooded{};  // the points whose side the flood gives
                     bool flood = false;
+                    const bool gradient = out.channels.gradient;
+                    const auto store_outside = [&](size_t v, bool negative) {
+                        out.distance[v] = negative ? -band.width : band.width;
+                        if (gradient) out.gradient[v] = Vec3d(0.0);
+                        out.closest_triangle[v] = kOutsideBandTriangle;
+                    };
                     auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const size_t v = slot(i);
                         side[v - base] = std::signbit(s.distance) ? kBandSideInside : kBandSideOutside;
                         if (outside_band(s.distance, band.width)) {
-                            out.distance[v] = std::signbit(s.distance) ? -band.width : band.width;
+                            store_outside(v, std::signbit(s.distance));
                             return;
                         }
                         out.distance[v] = s.distance;
-                        out.gradient[v] = s.gradient;
+                        if (gradient) out.gradient[v] = s.gradient;
                         out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
                     };
                     auto emit_outside = [&](int64_t i, BandSide s) {
@@ -158,7 +166,7 @@ private:
                         side[v - base] = s;
                         flooded[v - base] = s == kBandSideNone;
                         flood = flood || s == kBandSideNone;
-                        out.distance[v] = s == kBandSideInside ? -band.width : band.width;
+                        store_outside(v, s == kBandSideInside);
                     };
                     with_precision(options_.precision, [&](auto zero) {
                         using T = decltype(zero);

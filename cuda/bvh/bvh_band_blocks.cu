@@ -4,7 +4,8 @@
 // kernels on them: the warp or candidates search with the band's brick skip (a warp's brick
 // is 8 x 4 x 4 points of one block, as a lattice slab's), the certificate, and the same
 // finalize_samples() with the band's width, written straight into block-major arrays; then
-// one copy per channel into the band's host arrays. Padding (points of a block beyond the
+// one copy per channel the band holds into its host arrays (written there for the first
+// time: the sampler allocates them without a fill). Padding (points of a block beyond the
 // coset's resolution) is marked "outside, positive side" before the search, so finalize
 // writes it +W, gradient 0, kOutsideBandTriangle: the host's values for padding.
 // On a solid, the search is bounded by the band (BandSearch::bound_squared): a point beyond
@@ -221,7 +222,8 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         download.begin();
         const size_t v = (first + size_t(b0)) * kBandBlockPoints;
         staged_.to_host(r.samples.distance.get(), band.distance.data() + v, size_t(n) * sizeof(double));
-        staged_.to_host(r.samples.gradient.get(), band.gradient.data() + v, size_t(n) * sizeof(Vec3d));
+        if (band.channels.gradient)  // else the band holds none: 24 of a point's 36 bytes stay on the device
+            staged_.to_host(r.samples.gradient.get(), band.gradient.data() + v, size_t(n) * sizeof(Vec3d));
         staged_.to_host(r.samples.triangle.get(), band.closest_triangle.data() + v, size_t(n) * sizeof(int32_t));
         download.end();
     }

@@ -95,8 +95,11 @@ public:
         const double cpu0 = process_cpu_seconds();
         if (in.band_width > 0) {
             // The sparse band (core/sampling/sparse_band.h): its band points are the active voxels.
+            // Distances only, as the peers' level sets: no gradient channel kept or downloaded.
+            BandChannels channels;
+            channels.gradient = false;
             const auto start = std::chrono::steady_clock::now();
-            const SparseBandField band = sdf->sample_band(*in.lattice, in.band_width);
+            const SparseBandField band = sdf->sample_band(*in.lattice, in.band_width, channels);
             const double wall = seconds_since(start);
             r.query_seconds = gpu ? band.timings.kernel : wall;
             if (gpu) r.end_to_end_seconds = wall;
@@ -111,7 +114,8 @@ public:
             const SparseBandCounts c = band.counts();
             r.details["band_blocks"] = {{"active", c.active_blocks}, {"mixed", c.mixed_blocks}, {"tiles", c.tiles},
                                         {"inside_tiles", c.inside_tiles}, {"points_searched", c.active_points},
-                                        {"bytes", band.memory_bytes()}, {"wall_seconds", wall}};
+                                        {"bytes", band.memory_bytes()}, {"wall_seconds", wall},
+                                        {"channels", nlohmann::json::array({"distance", "closest_triangle"})}};
         } else if (in.lattice) {
             const SampledField f = sdf->sample(*in.lattice);
             r.distance = f.distance;

@@ -125,9 +125,9 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
     if (!parent.empty()) fs::create_directories(parent);
     require_representable_band(band.width, options.dtype, header + ": the narrow band width");
     const int64_t points = int64_t(band.active.size()) * kBandBlockPoints;
-    const bool gradient = options.gradient && band.gradient.size() == size_t(points);
-    if (band.distance.size() != size_t(points) || band.closest_triangle.size() != size_t(points) ||
-        band.mixed_inside.size() != band.mixed.size() ||
+    const bool gradient = options.gradient;
+    band.require_channels({gradient}, header + ": the gradient channel");
+    if (band.mixed_inside.size() != band.mixed.size() ||
         band.inside_tiles.size() != size_t((band.layout().block_count() + 63) / 64))
         throw std::invalid_argument(header + ": the sparse band's arrays do not match its " + std::to_string(band.active.size()) +
                                     " active and " + std::to_string(band.mixed.size()) + " mixed blocks");
@@ -337,7 +337,9 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
     OpenChannel mixed_ids = open_channel(header, channels, "mixed_blocks", mixed, 1, {"int64"});
     OpenChannel signs = open_channel(header, channels, "mixed_signs", mixed, kSignWords, {"uint64"});
 
-    SparseBandField band(lattice, width, precision);
+    BandChannels held;
+    held.gradient = has_gradient;
+    SparseBandField band(lattice, width, precision, held);
     band.active.resize(size_t(active));
     read_values(ids, band.active.data(), active, header);
     require_block_ids(band.active, blocks, header, "active_blocks");
@@ -378,7 +380,7 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
 SampledField densify_within_memory(const SparseBandField& band, bool gradient, const std::string& what,
                                    const std::string& where) {
     const Lattice& l = band.lattice;
-    require_host_memory({uint64_t(SparseBandField::dense_bytes(l)),
+    require_host_memory({uint64_t(SparseBandField::dense_bytes(l, band.channels)),
                          "densifying the sparse band of " + what + " (" + lattice_notation(l) + ", " +
                              std::to_string(l.num_points()) + " points)"},
                         where);

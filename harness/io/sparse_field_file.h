@@ -31,12 +31,13 @@ inline constexpr const char* kSparseBandLayout = "sparse_band";
 
 struct SparseFieldWriteOptions {
     FieldDtype dtype = FieldDtype::Float32;  ///< of distance and gradient
-    bool gradient = true;                    ///< write the gradient channel (when the band holds gradients)
+    bool gradient = true;                    ///< write the gradient channel: refused of a band without it (BandChannels)
     Overwrite overwrite = Overwrite::Forbid;
 };
 
 /// Writes `band` as NAME.json and its channel files (NAME = header path without ".json").
-/// A band width or a value the dtype cannot hold is refused, naming the file.
+/// A band width or a value the dtype cannot hold is refused, naming the file, and so is
+/// options.gradient of a band without the gradient channel (std::invalid_argument).
 void write_sparse_field(const std::string& header_path, const SparseBandField& band,
                         const SparseFieldWriteOptions& options = {});
 

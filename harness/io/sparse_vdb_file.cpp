@@ -63,7 +63,7 @@ void write_grids(const SparseBandField& band, const std::string& path, const Spa
             throw std::logic_error(path + ": coset " + std::to_string(c) + " is not the lattice's grid " + g.part);
     }
     const float w = float(band.width);
-    const bool gradient = options.gradient && band.gradient.size() == band.distance.size();
+    const bool gradient = options.gradient;  // checked against the band's channels by write_sparse_band_vdb
     std::vector<CosetGrids> grids(size_t(layout.cosets()));
     for (CosetGrids& cg : grids) {
         cg.distance = openvdb::FloatGrid::create(w);
@@ -153,6 +153,7 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
     namespace fs = std::filesystem;
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
     require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .vdb stores float32)");
+    band.require_channels({options.gradient}, path + ": the gradient grids");
     if (options.overwrite == Overwrite::Forbid && fs::exists(path))
         throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     openvdb::initialize();
@@ -164,7 +165,8 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
 
 #else
 
-SparseVdbCounts write_sparse_band_vdb(const SparseBandField&, const std::string& path, const SparseVdbOptions&) {
+SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::string& path, const SparseVdbOptions& options) {
+    band.require_channels({options.gradient}, path + ": the gradient grids");  // as with OpenVDB: the caller's error first
     throw std::runtime_error(path + ": this build has no OpenVDB support (libopenvdb-dev)");
 }
 

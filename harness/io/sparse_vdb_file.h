@@ -23,7 +23,7 @@
 namespace sdf {
 
 struct SparseVdbOptions {
-    bool gradient = true;           ///< write the gradient grids (when the band holds gradients)
+    bool gradient = true;           ///< write the gradient grids: refused of a band without them (BandChannels)
     bool closest_triangle = false;  ///< write the closest triangle grids
     Overwrite overwrite = Overwrite::Forbid;
 };
@@ -35,7 +35,8 @@ struct SparseVdbCounts {
 };
 
 /// Writes `band` to `path` (.vdb) atomically (a temporary beside it, then renamed; an existing
-/// file is refused unless options.overwrite allows it). Without OpenVDB it throws, naming it.
+/// file is refused unless options.overwrite allows it). Without OpenVDB it throws, naming it;
+/// so does options.gradient of a band without the gradient channel (std::invalid_argument).
 SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::string& path,
                                       const SparseVdbOptions& options = {});
 

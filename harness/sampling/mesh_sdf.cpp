@@ -100,12 +100,12 @@ SampledField MeshSdf::sample(const Lattice& lattice) const {
     return field;
 }
 
-SparseBandField MeshSdf::sample_band(const Lattice& lattice, double width) const {
+SparseBandField MeshSdf::sample_band(const Lattice& lattice, double width, BandChannels channels) const {
     if (unsigned_distance_)
         throw std::invalid_argument("band: a sparse band holds signed distances (inside tiles are -W); not with sign=\"none\"");
     if (!(width > 0) || !std::isfinite(width))
         throw std::invalid_argument("band: expected a positive width in mesh units, got " + std::to_string(width));
-    return bound_->sample_band_sparse(lattice, width);
+    return bound_->sample_band_sparse(lattice, width, channels);
 }
 
 ClosestPointOnMesh MeshSdf::closest_point(const Vec3d& p, int32_t triangle) const {

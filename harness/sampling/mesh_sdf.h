@@ -68,8 +68,9 @@ public:
     /// Samples every point of the lattice; with unsigned_distance, |d| everywhere.
     SampledField sample(const Lattice& lattice) const;
     /// The sparse narrow band of width `width` (core/sampling/sparse_band.h) by the bound
-    /// sampler; densified, it is sample()'s field with band_width = width. Signed only.
-    SparseBandField sample_band(const Lattice& lattice, double width) const;
+    /// sampler; densified, it is sample()'s field with band_width = width. Signed only. It
+    /// holds `channels` (BoundSampler::sample_band_sparse).
+    SparseBandField sample_band(const Lattice& lattice, double width, BandChannels channels = {}) const;
 
     /// The closest point of p on input face `triangle` (a query's PointSample::triangle).
     ClosestPointOnMesh closest_point(const Vec3d& p, int32_t triangle) const;

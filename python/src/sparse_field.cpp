@@ -53,7 +53,7 @@ public:
         });
     }
     py::object gradient() const {
-        if (band_->gradient.size() != band_->distance.size()) return py::none();
+        if (!band_->channels.gradient) return py::none();
         return new_array<double>({size(), 3}, [&](double* g) {
             for (size_t i = 0; i < at_.size(); ++i) {
                 const Vec3d& v = band_->gradient[size_t(at_[i])];
@@ -165,7 +165,7 @@ public:
     }
 
     Field to_dense() const {
-        const uint64_t bytes = uint64_t(SparseBandField::dense_bytes(lattice()));
+        const uint64_t bytes = uint64_t(SparseBandField::dense_bytes(lattice(), band_->channels));
         require_host_memory({bytes, "densifying the band of " + lattice_notation(lattice()) + " (" +
                                         std::to_string(lattice().num_points()) + " points)"},
                             "SparseField.to_dense()");
@@ -191,6 +191,7 @@ public:
         std::shared_ptr<const SparseBandField> b = band_;
         if (json) {
             SparseFieldWriteOptions options;
+            options.gradient = b->channels.gradient;
             options.dtype = dtype == "float32" ? FieldDtype::Float32 : FieldDtype::Float64;
             options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
             TaskOptions task;
@@ -208,7 +209,7 @@ public:
             throw std::invalid_argument(path + ": a SparseField writes .json (the sparse band's field file), .vdb (an "
                                         "OpenVDB level set) and .nvdb (a NanoVDB level set); to_dense().write(path) writes the dense formats (vti, npy, npz)");
         SparseVdbOptions options;
-        options.gradient = true;
+        options.gradient = b->channels.gradient;
         options.closest_triangle = closest_triangle;
         options.overwrite = overwrite ? Overwrite::Allow : Overwrite::Forbid;
         TaskOptions task;
@@ -252,7 +253,7 @@ SparseField read_sparse_field_file(const std::string& path) {
 
 SparseField sample_band(const MeshSdf& sdf, double band, const std::string& lattice, const py::object& resolution,
                         const py::object& samples, const py::object& margin, const py::object& bounds,
-                        const py::object& spacing, const py::object& origin, const py::object& progress) {
+                        const py::object& spacing, const py::object& origin, const py::object& progress, bool gradient) {
     if (!(band > 0) || !std::isfinite(band))
         throw std::invalid_argument("band: expected a positive width in mesh units, got " + std::to_string(band));
     if (!(float(band) > 0) || !std::isfinite(float(band)))
@@ -262,9 +263,11 @@ SparseField sample_band(const MeshSdf& sdf, double band, const std::string& latt
     task.total = kBackgroundItems;
     task.label = "sampling the band of '" + sdf.mesh().name() + "'";
     task.progress = progress;
+    BandChannels channels;
+    channels.gradient = gradient;
     SparseBandField field = run_task([&] {
         try {
-            return sdf.sample_band(l, band);
+            return sdf.sample_band(l, band, channels);
         } catch (const std::bad_alloc&) {
             throw std::runtime_error(out_of_memory_message("sample(band=) of " + sdf.mesh().name() + " on " + lattice_notation(l), 0));
         }
@@ -280,11 +283,14 @@ void bind_sparse_field(py::module_& m) {
 SDF.sample(..., band=W) return it. The lattice is cut into blocks of 8^3 points (OpenVDB's
 leaves); only the blocks within W of a triangle are sampled, so its memory grows with the band,
 not with the lattice. Its arrays hold the band's points (|d| <= W), in block order: distance,
-gradient, triangle, their world positions (points) and lattice indices (indices, subgrid).
+gradient (None when sampled with gradient=False or read without one), triangle, their world
+positions (points) and lattice indices (indices, subgrid).
 Every other lattice point stands for +W or -W by its side: to_dense() is the dense field of
 sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB level set (.vdb).)")
         .def_property_readonly("distance", &SparseField::distance, "Exact signed distance of the band's points, float64 (N,).")
-        .def_property_readonly("gradient", &SparseField::gradient, "Exact gradient of the band's points, float64 (N, 3).")
+        .def_property_readonly("gradient", &SparseField::gradient,
+                               "Exact gradient of the band's points, float64 (N, 3); None when the band holds none (sampled "
+                               "with gradient=False, or read from a file without the channel).")
         .def_property_readonly("triangle", &SparseField::triangle, "Closest triangle of the band's points, int32 (N,), 0-based.")
         .def_property_readonly("points", &SparseField::points, "World positions of the band's points, float64 (N, 3).")
         .def_property_readonly("indices", &SparseField::indices,
@@ -328,7 +334,7 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
              "write(path, overwrite=False, closest_triangle=False, dtype=\"float32\") -> list of files: by the extension, "
              ".json: the sparse band's field file (docs/field-format.md; its blocks, tiles and signs, values as dtype, "
              "closest triangles always), read back by read_field, sdf-eval and sdf-render; .vdb: an OpenVDB level set "
-             "(harness/io/sparse_vdb_file.h) with its gradient grid, closest_triangle=True adding an Int32Grid of the "
+             "(harness/io/sparse_vdb_file.h) with its gradient grid where the band holds gradients, closest_triangle=True adding an Int32Grid of the "
              "closest triangles (which Debian's pyopenvdb 10 cannot read); .nvdb: the NanoVDB level set of the distance "
              "(harness/io/sparse_nvdb_file.h; builds with NanoVDB only). Written atomically. Other formats are refused "
              "(to_dense().write(path) writes them).")
@@ -354,7 +360,8 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
     m.def("_sample_band", &sample_band, py::arg("sdf"), py::arg("band"), py::arg("lattice") = lattice_type_name(LatticeType::CC),
           py::arg("resolution") = py::none(), py::arg("samples") = py::none(), py::arg("margin") = py::none(),
           py::arg("bounds") = py::none(), py::arg("spacing") = py::none(), py::arg("origin") = py::none(),
-          py::arg("progress") = py::none(), "SDF.sample(band=W)'s native part (sdf_lattices._sparse).");
+          py::arg("progress") = py::none(), py::arg("gradient") = true,
+          "SDF.sample(band=W)'s native part (sdf_lattices._sparse); gradient=False: a band without the gradient channel.");
 }
 
 }  // namespace sdf

@@ -21,6 +21,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/sparse_field_file.h"
+#include "harness/io/sparse_vdb_file.h"
 #include "harness/study/field_source.h"
 #include "harness_test_util.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
@@ -40,8 +41,8 @@ SamplerOptions options(double band, SignMode sign) {
     return o;
 }
 
-template <typename V>
-bool same_bytes(const std::vector<V>& a, const std::vector<V>& b) {
+template <typename V, typename A>
+bool same_bytes(const std::vector<V, A>& a, const std::vector<V, A>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
 }
 
@@ -254,6 +255,60 @@ TEST_F(SparseFieldFile, FieldSourceSamplesTheBandSparselyAndCachesItsFile) {
         EXPECT_TRUE(is_sparse_field_file(cache.entry_path(key) + "/field.json"));
         EXPECT_TRUE(test::Contains(log.str(), "sampling the sparse band"));
     }
+}
+
+// A band sampled without its gradient channel: its file has no gradient channel, reads back
+// as a band without one (the same distances and triangles as the full band's file), and
+// densifies to the dense band file without the gradient; asking a writer for the gradient
+// of such a band is refused, naming the file.
+TEST_F(SparseFieldFile, BandWithoutGradientWrittenReadAndRefusedWhereAskedFor) {
+    const PreparedMesh bowl = test::open_bowl();
+    const Lattice lattice = fit_lattice(LatticeType::CC, {96, 96, 96}, bowl.bounds(), 0.6);  // mixed blocks, as above
+    const double w = 1.0 * lattice.spacing;
+    const auto bound = make_cpu_bvh_sampler(options(0, SignMode::Winding))->bind(share(bowl));
+    BandChannels slim_channels;
+    slim_channels.gradient = false;
+    const SparseBandField full = bound->sample_band_sparse(lattice, w);
+    const SparseBandField slim = bound->sample_band_sparse(lattice, w, slim_channels);
+    ASSERT_GT(slim.mixed.size(), 0u);
+    // The writers refuse the gradient the band does not hold.
+    const std::string e = test::error_of([&] { write_sparse_field(at("slim.json"), slim); });
+    EXPECT_TRUE(test::Contains(e, "slim.json")) << e;
+    EXPECT_TRUE(test::Contains(e, "the band holds no gradient")) << e;
+    EXPECT_THROW(write_sparse_field(at("slim.json"), slim), std::invalid_argument);
+    EXPECT_FALSE(fs::exists(at("slim.json")));
+    SparseVdbOptions vdb;
+    EXPECT_THROW(write_sparse_band_vdb(slim, at("slim.vdb"), vdb), std::invalid_argument);
+    EXPECT_FALSE(fs::exists(at("slim.vdb")));
+    // Without the gradient asked: written, and read back as it was held.
+    SparseFieldWriteOptions o64;
+    o64.dtype = FieldDtype::Float64;
+    o64.gradient = false;
+    write_sparse_field(at("slim.json"), slim, o64);
+    EXPECT_FALSE(test::read_json(at("slim.json"))["channels"].contains("gradient"));
+    EXPECT_FALSE(test::read_json(at("slim.json")).contains("gradient_channel"));
+    const SparseBandField back = read_sparse_field(at("slim.json"));
+    EXPECT_FALSE(back.channels.gradient);
+    EXPECT_TRUE(back.gradient.empty());
+    expect_same_band(slim, back, "without gradient, float64");
+    // The full band's file without its gradient channel is the same band.
+    write_sparse_field(at("full.json"), full, o64);
+    const SparseBandField full_back = read_sparse_field(at("full.json"));
+    EXPECT_FALSE(full_back.channels.gradient);
+    EXPECT_TRUE(same_bytes(full_back.distance, back.distance));
+    EXPECT_TRUE(same_bytes(full_back.closest_triangle, back.closest_triangle));
+    EXPECT_TRUE(same_bytes(full_back.mixed_inside, back.mixed_inside));
+    // Densified: the dense band file's distances and triangles, no gradient.
+    FieldWriteOptions dense64;
+    dense64.dtype = FieldDtype::Float64;
+    write_field(at("dense.json"), make_cpu_bvh_sampler(options(w, SignMode::Winding))->bind(share(bowl))->sample(lattice),
+                dense64);
+    const SampledField from_dense = read_field(at("dense.json"));
+    const SampledField from_slim = read_field_densified(at("slim.json"), "test");
+    EXPECT_TRUE(from_slim.gradient.empty());
+    EXPECT_TRUE(same_bytes(from_slim.distance, from_dense.distance));
+    EXPECT_TRUE(same_bytes(from_slim.closest_triangle, from_dense.closest_triangle));
+    EXPECT_THROW(write_sparse_field(at("again.json"), back), std::invalid_argument);
 }
 
 class HostileSparseFile : public SparseFieldFile {

@@ -178,3 +178,34 @@ def test_the_open_box_under_the_winding_sign_has_mixed_blocks(case, request):
     if "open_box" not in request.node.callspec.id:
         pytest.skip("closed meshes have no mixed blocks")
     assert int(stdout.split(" mixed;")[0].rsplit(" ", 1)[1]) > 0
+
+
+def test_channels_without_gradient_keep_none_and_the_same_bytes(tmp_path):
+    """--channels distance,closest_triangle --band W --sparse: the band is sampled without its gradient
+    (the sampler's report says so), the dense and the sparse field files and the .vdb have no gradient,
+    and their distances and triangles are the full run's bytes."""
+    if os.environ.get("SDF_HAVE_OPENVDB", "0") != "1":
+        pytest.skip("this build has no OpenVDB")
+    import pyopenvdb
+    common = ["--lattice", "cc", "--resolution", "36", "--band", "0.1", "--dtype", "float64", "--sparse"]
+    slim_channels = ["--channels", "distance,closest_triangle"]
+    _sdf_sample(tmp_path, "shape:torus", common + ["--out", "full.json", "--vdb", "full.vdb"])
+    _sdf_sample(tmp_path, "shape:torus", common + slim_channels + ["--out", "slim.json", "--vdb", "slim.vdb"])
+    _sdf_sample(tmp_path, "shape:torus", common + slim_channels + ["--layout", "sparse", "--out", "slim-sparse.json"])
+    headers = {}
+    for name in ("full", "slim", "slim-sparse"):
+        with open(tmp_path / (name + ".json")) as f:
+            headers[name] = json.load(f)
+    assert "gradient" in headers["full"]["channels"]
+    for name in ("slim", "slim-sparse"):
+        assert "gradient" not in headers[name]["channels"] and "gradient_channel" not in headers[name]
+        assert headers[name]["sampler"]["sparse_band"]["channels"] == ["distance", "closest_triangle"]
+    for channel in ("distance", "closest_triangle"):
+        full = _channel(str(tmp_path / "full.json"), headers["full"], channel)
+        slim = _channel(str(tmp_path / "slim.json"), headers["slim"], channel)
+        assert full.tobytes() == slim.tobytes(), channel
+    assert {g.name for g in pyopenvdb.readAll(str(tmp_path / "full.vdb"))[0]} == {"distance", "gradient"}
+    slim_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "slim.vdb"))[0]}
+    full_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "full.vdb"))[0]}
+    assert set(slim_grids) == {"distance"}
+    assert slim_grids["distance"].activeVoxelCount() == full_grids["distance"].activeVoxelCount() > 0

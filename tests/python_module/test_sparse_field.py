@@ -189,6 +189,43 @@ def test_sparse_field_file_round_trip_and_densified_equals_the_dense_field(pair,
         sparse.write(path)
 
 
+def test_band_without_gradient_has_the_same_distances_and_triangles(pair, tmp_path):
+    """band=W, gradient=False: no gradient held (None), the same distances, triangles and points bit for bit,
+    less memory; to_dense() without gradient; write() without the gradient channel or grid."""
+    mesh, lattice, resolution, keywords, sparse, dense = pair
+    slim = sl.sample(mesh, lattice, resolution, band=W, gradient=False, backend="cpu", threads=2, **keywords)
+    assert slim.gradient is None and sparse.gradient is not None
+    for name in ("distance", "triangle", "points", "indices", "subgrid"):
+        assert same_bits(getattr(slim, name), getattr(sparse, name)), name
+    assert slim.counts == sparse.counts and slim.nbytes < sparse.nbytes
+    same_sdf = sl.SDF(mesh, backend="cpu", threads=2, **keywords).sample(lattice, resolution, band=W, gradient=False)
+    assert same_sdf.gradient is None and same_bits(same_sdf.distance, sparse.distance)
+    d = slim.to_dense()
+    assert d.gradient is None
+    for a, b in zip(grids(d.values) + grids(d.triangle), grids(dense.values) + grids(dense.triangle)):
+        assert same_bits(a, b)
+    path = str(tmp_path / "slim.json")
+    files = slim.write(path, dtype="float64")
+    assert len(files) == 7  # header, 6 channels: no gradient
+    with open(path) as f:
+        assert "gradient" not in json.load(f)["channels"]
+    back = sl.read_field(path)
+    assert back.gradient is None and same_bits(back.distance, sparse.distance) and same_bits(back.triangle, sparse.triangle)
+    try:
+        import pyopenvdb
+    except ImportError:
+        pyopenvdb = None
+    if sl.build_info()["optional"]["openvdb"]["found"] and pyopenvdb is not None:
+        vdb = str(tmp_path / "slim.vdb")
+        assert slim.write(vdb) == [vdb]
+        parts = [""] if slim.lattice == "cc" else ["_primary", "_secondary"]
+        assert {g.name for g in pyopenvdb.readAll(vdb)[0]} == {"distance" + p for p in parts}
+    with pytest.raises(TypeError, match="gradient= goes with band=W"):
+        sl.sample(mesh, lattice, resolution, gradient=False, backend="cpu", **keywords)
+    with pytest.raises(TypeError, match="True or False"):
+        sl.sample(mesh, lattice, resolution, band=W, gradient="no", backend="cpu", **keywords)
+
+
 def test_reconstruct_inside_the_band_is_the_dense_fields(pair):
     _, lattice, *_, sparse, dense = pair
     interpolator = "tricubic_lm" if lattice == "cc" else "bcc_cubic"

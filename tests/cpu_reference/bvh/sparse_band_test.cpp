@@ -13,6 +13,8 @@
 
 #include <cstring>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_mesh.h"
@@ -36,8 +38,8 @@ SamplerOptions options(Precision precision, double band, SignMode sign) {
     return o;
 }
 
-template <typename V>
-bool same_bytes(const std::vector<V>& a, const std::vector<V>& b) {
+template <typename V, typename A>
+bool same_bytes(const std::vector<V, A>& a, const std::vector<V, A>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
 }
 
@@ -156,6 +158,109 @@ TEST(SparseBand, DensifiedEqualsTheDenseBandByteForByte) {
                     if (HasFailure()) return;
                 }
     }
+}
+
+/// Every padding point (beyond the lattice) of the band's active blocks holds +W, gradient 0
+/// (when held) and kOutsideBandTriangle: the block kernels write into unfilled arrays.
+/// Returns the points that do not; adds the padding points checked to `checked`.
+int64_t bad_padding(const SparseBandField& band, int64_t& checked) {
+    int64_t bad = 0;
+    for (size_t a = 0; a < band.active.size(); ++a)
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (band.layout().storage_index(band.active[a], local) >= 0) continue;
+            ++checked;
+            const size_t v = a * kBandBlockPoints + size_t(local);
+            const bool zero = !band.channels.gradient ||
+                              (band.gradient[v].x == 0 && band.gradient[v].y == 0 && band.gradient[v].z == 0);
+            if (!(band.distance[v] == band.width && band.closest_triangle[v] == kOutsideBandTriangle && zero)) ++bad;
+        }
+    return bad;
+}
+
+// A band sampled without its gradient channel: the same distances, closest triangles, tiles
+// and mixed blocks, byte for byte, as with it (through the brick kernel and the point
+// queries); no gradient held, and none densified.
+TEST(SparseBand, WithoutTheGradientTheSameDistancesAndTriangles) {
+    BandChannels slim_channels;
+    slim_channels.gradient = false;
+    int64_t padding = 0;
+    for (const Case& c : cases()) {
+        const Lattice cc = fit_lattice(LatticeType::CC, {41, 38, 36}, c.mesh.bounds(), 0.4);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, {29, 27, 26}, c.mesh.bounds(), 0.4);
+        for (const Lattice& lattice : {cc, bcc}) {
+            const double w = 2.0 * lattice.spacing;
+            const std::string what = c.name + " " + lattice_notation(lattice);
+            const auto bound = make_cpu_bvh_sampler(options(Precision::Float, 0, c.sign))->bind(share(c.mesh));
+            const SparseBandField full = bound->sample_band_sparse(lattice, w);
+            const SparseBandField slim = bound->sample_band_sparse(lattice, w, slim_channels);
+            EXPECT_TRUE(full.channels.gradient) << what;
+            EXPECT_EQ(full.gradient.size(), full.distance.size()) << what;
+            EXPECT_FALSE(slim.channels.gradient) << what;
+            EXPECT_TRUE(slim.gradient.empty()) << what;
+            EXPECT_TRUE(same_bytes(full.active, slim.active)) << what;
+            EXPECT_TRUE(same_bytes(full.distance, slim.distance)) << what;
+            EXPECT_TRUE(same_bytes(full.closest_triangle, slim.closest_triangle)) << what;
+            EXPECT_TRUE(same_bytes(full.mixed, slim.mixed)) << what;
+            EXPECT_TRUE(same_bytes(full.mixed_inside, slim.mixed_inside)) << what;
+            EXPECT_EQ(full.counts().inside_tiles, slim.counts().inside_tiles) << what;
+            EXPECT_EQ(bad_padding(full, padding), 0) << what;
+            EXPECT_EQ(bad_padding(slim, padding), 0) << what;
+            EXPECT_LT(slim.memory_bytes(), full.memory_bytes()) << what;
+            EXPECT_EQ(slim.sampler.details["sparse_band"]["channels"], nlohmann::json::array({"distance", "closest_triangle"}))
+                << what;
+            // Densified: the dense band's distances and triangles, no gradient.
+            const SampledField dense =
+                make_cpu_bvh_sampler(options(Precision::Float, w, c.sign))->bind(share(c.mesh))->sample(lattice);
+            const SampledField densified = slim.densify();
+            EXPECT_TRUE(densified.gradient.empty()) << what;
+            EXPECT_TRUE(same_bytes(dense.distance, densified.distance)) << what;
+            EXPECT_TRUE(same_bytes(dense.closest_triangle, densified.closest_triangle)) << what;
+            EXPECT_TRUE(slim.densify_slab({3, 9}).gradient.empty()) << what;
+            EXPECT_LT(SparseBandField::dense_bytes(lattice, slim_channels), SparseBandField::dense_bytes(lattice)) << what;
+            // The dense band sparsified without its gradient: the same values.
+            const SparseBandField sparsified = SparseBandField::sparsify(dense, w, slim_channels);
+            EXPECT_TRUE(sparsified.gradient.empty()) << what;
+            const SampledField back = sparsified.densify();
+            EXPECT_TRUE(back.gradient.empty() && same_bytes(dense.distance, back.distance) &&
+                        same_bytes(dense.closest_triangle, back.closest_triangle))
+                << what;
+            // Asking a band without gradients for them is refused, naming the caller's what.
+            try {
+                slim.require_channels(BandChannels{}, "the test's writer");
+                ADD_FAILURE() << what << ": require_channels accepted a missing gradient";
+            } catch (const std::invalid_argument& e) {
+                EXPECT_NE(std::string(e.what()).find("the test's writer: the band holds no gradient"), std::string::npos)
+                    << e.what();
+            }
+            EXPECT_NO_THROW(slim.require_channels(slim_channels, "x")) << what;
+            EXPECT_NO_THROW(full.require_channels(BandChannels{}, "x")) << what;
+            if (HasFailure()) return;
+        }
+        // Point queries (brute force has no block kernel): the same bytes too. A lattice
+        // close around the mesh, so that active blocks reach past its far edges (padding).
+        const Lattice lattice = fit_lattice(LatticeType::CC, {27, 26, 25}, c.mesh.bounds(), 0.05);
+        const auto brute = make_cpu_brute_force_sampler(options(Precision::Float, 0, c.sign))->bind(share(c.mesh));
+        const SparseBandField full = brute->sample_band_sparse(lattice, 2 * lattice.spacing);
+        const SparseBandField slim = brute->sample_band_sparse(lattice, 2 * lattice.spacing, slim_channels);
+        EXPECT_TRUE(slim.gradient.empty()) << c.name;
+        EXPECT_TRUE(same_bytes(full.distance, slim.distance) && same_bytes(full.closest_triangle, slim.closest_triangle))
+            << c.name << " brute force";
+        EXPECT_EQ(bad_padding(slim, padding), 0) << c.name << " brute force";
+        const SparseBandField bvh = make_cpu_bvh_sampler(options(Precision::Float, 0, c.sign))
+                                        ->bind(share(c.mesh))
+                                        ->sample_band_sparse(lattice, 2 * lattice.spacing, slim_channels);
+        EXPECT_EQ(bad_padding(bvh, padding), 0) << c.name << " bvh";
+        EXPECT_TRUE(same_bytes(bvh.distance, slim.distance) && same_bytes(bvh.closest_triangle, slim.closest_triangle))
+            << c.name << " bvh against brute force";
+    }
+    EXPECT_GT(padding, 0) << "no active block reached the lattice's far edges";
+    // A dense field without gradients cannot give a band with them.
+    const PreparedMesh torus = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
+    const Lattice lattice = fit_lattice(LatticeType::CC, {20, 20, 20}, torus.bounds(), 0.3);
+    SampledField dense = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(torus))->sample(lattice);
+    dense.gradient.clear();
+    EXPECT_THROW(SparseBandField::sparsify(dense, 2 * lattice.spacing), std::invalid_argument);
+    EXPECT_TRUE(SparseBandField::sparsify(dense, 2 * lattice.spacing, slim_channels).gradient.empty());
 }
 
 // Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
