@@ -157,6 +157,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     require_search_range(mesh(), lattice, options_.precision);
     const int64_t blocks = int64_t(last - first);
     EventTimer upload, compute, download;
+    EventTimer search_stage, finalize_stage, flood_stage;  // compute's parts
     DeviceBuffer<int64_t> ids{size_t(blocks)};
     upload.begin();
     ids.upload(band.active.data() + first, size_t(blocks));
@@ -199,6 +200,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         const BandBlocksPiece piece{lattice, band.layout().grid(), ids.get() + b0, nb};
         const BandBlocksLayout layout{piece};
         compute.begin();
+        search_stage.begin();
         fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
         CUDA_CHECK_LAUNCH("fill_nearest");
         const int grid = blocks_for(layout.threads(), kBvhThreads);
@@ -209,8 +211,14 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh (band blocks)");
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
-        launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, r.outputs());
+        search_stage.end();
+        finalize_stage.begin();
+        PieceOutputs outputs = r.outputs();
+        if (!band.channels.gradient) outputs.gradient = nullptr;  // not written: 24 of a point's 36 bytes
+        launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, outputs);
         CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
+        finalize_stage.end();
+        flood_stage.begin();
         if (bounded) {
             flood_band_sides<T><<<int(nb), kBandBlockPoints>>>(dev.view, dev.mesh->view(), piece, r.nearest.get(), width,
                                                                r.samples.distance.get(), flood_counters.get());
@@ -218,6 +226,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         }
         to_source_order<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, dev.source_triangle.get());
         CUDA_CHECK_LAUNCH("to_source_order");
+        flood_stage.end();
         compute.end();
         download.begin();
         const size_t v = (first + size_t(b0)) * kBandBlockPoints;
@@ -250,6 +259,8 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
         {"kernel_seconds", compute.seconds()},
+        {"stage_seconds", {{"search", search_stage.seconds()}, {"finalize", finalize_stage.seconds()},
+                           {"flood_and_source_order", flood_stage.seconds()}}},
         {"upload_seconds", upload.seconds()},
         {"download_seconds", download.seconds()},
         {"device_bytes_in_use", int64_t(in_use)},  // after the batch's buffers: the conversion's peak (pool included)

@@ -31,7 +31,7 @@ enum NearestOutsideBand : int {
 /// Per-piece results, downloaded and scattered into the field by the host.
 struct PieceOutputs {
     double* distance;
-    Vec3d* gradient;
+    Vec3d* gradient;        ///< null: not wanted (a sparse band without its gradient channel)
     int* triangle;
     int64_t* output_index;  ///< -1: padding or discarded
 };
@@ -40,12 +40,12 @@ struct PieceOutputs {
 __device__ inline void store_sample(const PieceOutputs& out, int64_t i, const SignedDistanceSample<double>& s, double band_width) {
     if (band_width > 0 && fabs(s.distance) > band_width) {
         out.distance[i] = s.distance < 0 ? -band_width : band_width;
-        out.gradient[i] = Vec3d(0.0);
+        if (out.gradient) out.gradient[i] = Vec3d(0.0);
         out.triangle[i] = kOutsideBandTriangle;
         return;
     }
     out.distance[i] = s.distance;
-    out.gradient[i] = s.gradient;
+    if (out.gradient) out.gradient[i] = s.gradient;
     out.triangle[i] = s.triangle;
 }
 
@@ -103,7 +103,7 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
         if (n == kOutsideBandSignPerPoint) inside = winding_inside;
     }
     out.distance[i] = inside ? -band_width : band_width;
-    out.gradient[i] = Vec3d(0.0);
+    if (out.gradient) out.gradient[i] = Vec3d(0.0);
     out.triangle[i] = kOutsideBandTriangle;
 }
 
