@@ -16,8 +16,9 @@
 // level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only), and
 // --layout sparse the field file's sparse variant instead of the dense one
 // (harness/io/sparse_field_file.h: the band's blocks, never densified; sdf-eval, sdf-render and
-// Python's read_field read it). A sparse band holds the gradient only when --channels names
-// it: without it, it is neither kept nor downloaded from a GPU (12 bytes a point, not 36).
+// Python's read_field read it). A sparse band holds the gradient and the closest triangle only
+// when --channels names them: without them, they are neither kept nor downloaded from a GPU
+// (--channels distance: 8.125 bytes a point, not 36.125; the band's points are a bit mask).
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
@@ -118,15 +119,15 @@ int main(int argc, char** argv) {
                  "block (work and memory grow with the band); the outputs are the same bytes");
     app.add_option("--layout", layout,
                    "the field file at --out: dense (every lattice point) or sparse (with --sparse: the band's blocks, tiles "
-                   "and per-point signs, docs/field-format.md; its closest_triangle channel is always written, as it marks "
-                   "the band's points)")
+                   "and per-point signs, docs/field-format.md; its closest_triangle channel marks the band's points, or, "
+                   "without closest_triangle in --channels, its band_points bit mask)")
         ->check(CLI::IsMember({"dense", "sparse"}))
         ->capture_default_str();
     app.add_option("--memory-budget", budget_text,
                    "peak host memory to stay under, e.g. 8GiB or 512MiB (default: half of the available memory)");
     app.add_option("--channels", channels_text,
-                   "comma-separated channels to write: distance (always), gradient, closest_triangle (with --sparse, a "
-                   "band without gradient never keeps one)")
+                   "comma-separated channels to write: distance (always), gradient, closest_triangle (with --sparse, the "
+                   "band keeps only the channels named)")
         ->capture_default_str();
     app.add_option("--dtype", dtype, "float32 or float64 for distance and gradient")
         ->check(CLI::IsMember({"float32", "float64"}))
@@ -278,7 +279,8 @@ int main(int argc, char** argv) {
         if (sparse) {
             doing = "sampling the sparse band of " + mesh_arg + " on " + sdf::lattice_notation(lattice);
             sdf::BandChannels channels;
-            channels.gradient = stream.gradient;  // the closest triangle is always held: it marks the band's points
+            channels.gradient = stream.gradient;
+            channels.closest_triangle = stream.write.closest_triangle;  // the band's points are its mask either way
             sdf::SparseBandField sparse_band = bound.sample_band_sparse(lattice, band, channels);
             sparse_band.mesh = mesh_provenance;
             stream.fixed_bytes += sparse_band.memory_bytes();  // held while the slabs are written

@@ -1,6 +1,7 @@
 #include "core/sampling/sparse_band.h"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -14,9 +15,14 @@ int64_t find_sorted(const std::vector<int64_t>& ids, int64_t id) {
     return it != ids.end() && *it == id ? int64_t(it - ids.begin()) : -1;
 }
 
-bool mask_bit(const BandSignMask& m, int local) { return (m[size_t(local >> 6)] >> (local & 63)) & 1; }
-
 }  // namespace
+
+nlohmann::json channel_names(BandChannels channels) {
+    nlohmann::json names = nlohmann::json::array({"distance"});
+    if (channels.gradient) names.push_back("gradient");
+    if (channels.closest_triangle) names.push_back("closest_triangle");
+    return names;
+}
 
 void BandLayout::cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const {
     const Int3 c = point_coords(id, 0);
@@ -47,8 +53,25 @@ int64_t SparseBandField::add_active(int64_t id) {
     active.push_back(id);
     distance.resize(active.size() * kBandBlockPoints, width);
     if (channels.gradient) gradient.resize(active.size() * kBandBlockPoints, Vec3d(0.0));
-    closest_triangle.resize(active.size() * kBandBlockPoints, kOutsideBandTriangle);
+    if (channels.closest_triangle) closest_triangle.resize(active.size() * kBandBlockPoints, kOutsideBandTriangle);
+    band_mask.resize(active.size(), BandPointMask{});
     return int64_t(active.size()) - 1;
+}
+
+void SparseBandField::mask_from_triangles() {
+    if (!channels.closest_triangle || closest_triangle.size() != active.size() * kBandBlockPoints)
+        throw std::logic_error("SparseBandField::mask_from_triangles: the band holds no closest triangle per active point");
+    band_mask.resize(active.size());
+    parallel_for(int64_t(active.size()), 256, 0, [&](int64_t begin, int64_t end) {
+        for (int64_t a = begin; a < end; ++a) {
+            BandPointMask m{};
+            for (int local = 0; local < kBandBlockPoints; ++local)
+                if (closest_triangle[size_t(a) * kBandBlockPoints + size_t(local)] != kOutsideBandTriangle &&
+                    layout_.storage_index(active[size_t(a)], local) >= 0)
+                    set_mask_bit(m, local);
+            band_mask[size_t(a)] = m;
+        }
+    });
 }
 
 int64_t SparseBandField::add_mixed(int64_t id) {
@@ -62,11 +85,17 @@ void SparseBandField::require_channels(BandChannels wanted, const std::string& w
     if (wanted.gradient && !channels.gradient)
         throw std::invalid_argument(what + ": the band holds no gradient (sampled without the gradient channel, or read "
                                            "from a file without one); ask for it when sampling, or write without it");
+    if (wanted.closest_triangle && !channels.closest_triangle)
+        throw std::invalid_argument(what + ": the band holds no closest triangle (sampled without the closest_triangle "
+                                           "channel, or read from a file without one); ask for it when sampling, or write "
+                                           "without it");
     const size_t values = active.size() * kBandBlockPoints;
-    if (distance.size() != values || closest_triangle.size() != values || gradient.size() != (channels.gradient ? values : 0))
+    if (distance.size() != values || closest_triangle.size() != (channels.closest_triangle ? values : 0) ||
+        gradient.size() != (channels.gradient ? values : 0) || band_mask.size() != active.size())
         throw std::invalid_argument(what + ": the band's value arrays (" + std::to_string(distance.size()) + " distances, " +
                                     std::to_string(gradient.size()) + " gradients, " + std::to_string(closest_triangle.size()) +
-                                    " triangles) do not match its " + std::to_string(active.size()) + " active blocks");
+                                    " triangles, " + std::to_string(band_mask.size()) + " block masks) do not match its " +
+                                    std::to_string(active.size()) + " active blocks");
 }
 
 SparseBandCounts SparseBandField::counts() const {
@@ -78,23 +107,27 @@ SparseBandCounts SparseBandField::counts() const {
     for (uint64_t word : inside_tiles) c.inside_tiles += __builtin_popcountll(word);
     for (const std::vector<int64_t>* ids : {&active, &mixed})  // their tile bits mean nothing
         for (int64_t id : *ids) c.inside_tiles -= tile_inside(id) ? 1 : 0;
-    for (size_t a = 0; a < active.size(); ++a)
-        for (int local = 0; local < kBandBlockPoints; ++local) {
-            if (layout_.storage_index(active[a], local) < 0) continue;
-            ++c.active_points;
-            if (closest_triangle[a * kBandBlockPoints + size_t(local)] != kOutsideBandTriangle) ++c.band_points;
-        }
+    for (size_t a = 0; a < active.size(); ++a) {
+        const BandBlockCoords b = layout_.block_coords(active[a]);
+        const Int3 n = layout_.coset(b.coset).points;
+        int64_t points = 1;
+        for (int k = 0; k < 3; ++k) points *= std::min(kBandBlockDim, n[k] - b.block[k] * kBandBlockDim);
+        c.active_points += points;
+        for (uint64_t word : band_mask[a]) c.band_points += __builtin_popcountll(word);  // padding bits are clear
+    }
     return c;
 }
 
 size_t SparseBandField::memory_bytes() const {
     return active.capacity() * sizeof(int64_t) + distance.capacity() * sizeof(double) + gradient.capacity() * sizeof(Vec3d) +
-           closest_triangle.capacity() * sizeof(int32_t) + inside_tiles.capacity() * sizeof(uint64_t) +
+           closest_triangle.capacity() * sizeof(int32_t) + band_mask.capacity() * sizeof(BandPointMask) +
+           inside_tiles.capacity() * sizeof(uint64_t) +
            mixed.capacity() * sizeof(int64_t) + mixed_inside.capacity() * sizeof(BandSignMask);
 }
 
 int64_t SparseBandField::dense_bytes(const Lattice& lattice, BandChannels channels) {
-    return lattice.num_points() * int64_t(sizeof(double) + (channels.gradient ? sizeof(Vec3d) : 0) + sizeof(int32_t));
+    return lattice.num_points() *
+           int64_t(sizeof(double) + (channels.gradient ? sizeof(Vec3d) : 0) + (channels.closest_triangle ? sizeof(int32_t) : 0));
 }
 
 SampledField SparseBandField::densify(int64_t max_points) const {
@@ -110,7 +143,7 @@ SampledField SparseBandField::densify(int64_t max_points) const {
     return field;
 }
 
-SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
+SampledField SparseBandField::densify_slab(const LatticeSlab& slab, NarrowBandCounts* counts) const {
     if (slab.z_begin < 0 || slab.z_end > lattice.resolution.z || slab.z_begin >= slab.z_end)
         throw std::invalid_argument("densify_slab: planes [" + std::to_string(slab.z_begin) + ", " +
                                     std::to_string(slab.z_end) + ") are not a slab of a lattice of " +
@@ -119,12 +152,14 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
     field.lattice = lattice;
     field.precision = precision;
     const int64_t n = slab_point_count(lattice, slab);
-    if (channels.gradient) {
+    if (channels.gradient && channels.closest_triangle) {
         field.resize(n);
-    } else {  // no gradient channel: none in the field either
+    } else {  // a channel the band does not hold: none in the field either
         field.distance.assign(size_t(n), 0.0);
-        field.closest_triangle.assign(size_t(n), -1);
+        if (channels.gradient) field.gradient.assign(size_t(n), Vec3d(0.0));
+        if (channels.closest_triangle) field.closest_triangle.assign(size_t(n), -1);
     }
+    std::atomic<int64_t> in_band{0};
     // Each coset's planes of the slab are one contiguous range of storage (its part), and of
     // the slab's compact order.
     int64_t part_base = 0;
@@ -140,6 +175,7 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
                 const int64_t first_id = s.first_block + int64_t(bz0) * row_blocks + begin;
                 int64_t a = std::lower_bound(active.begin(), active.end(), first_id) - active.begin();
                 int64_t m = std::lower_bound(mixed.begin(), mixed.end(), first_id) - mixed.begin();
+                int64_t band_points = 0;
                 for (int64_t id = first_id; id < first_id + (end - begin); ++id) {
                     const bool is_active = a < int64_t(active.size()) && active[size_t(a)] == id;
                     const bool is_mixed = !is_active && m < int64_t(mixed.size()) && mixed[size_t(m)] == id;
@@ -151,24 +187,24 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab) const {
                             const size_t v = size_t(a) * kBandBlockPoints + size_t(local);
                             field.distance[size_t(out)] = distance[v];
                             if (channels.gradient) field.gradient[size_t(out)] = gradient[v];
-                            field.closest_triangle[size_t(out)] = closest_triangle[v];
-                        } else {
+                            if (channels.closest_triangle) field.closest_triangle[size_t(out)] = closest_triangle[v];
+                            band_points += mask_bit(band_mask[size_t(a)], local) ? 1 : 0;
+                        } else {  // store_outside_band's values, in the channels held
                             const bool inside = is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id);
-                            if (channels.gradient) {
-                                store_outside_band(field, out, inside, width);
-                            } else {
-                                field.distance[size_t(out)] = inside ? -width : width;
-                                field.closest_triangle[size_t(out)] = kOutsideBandTriangle;
-                            }
+                            field.distance[size_t(out)] = inside ? -width : width;
+                            if (channels.gradient) field.gradient[size_t(out)] = Vec3d(0.0);
+                            if (channels.closest_triangle) field.closest_triangle[size_t(out)] = kOutsideBandTriangle;
                         }
                     }
                     if (is_active) ++a;
                     if (is_mixed) ++m;
                 }
+                in_band += band_points;
             });
         }
         part_base += range.count;
     }
+    if (counts) *counts = {in_band.load(), n - in_band.load()};
     return field;
 }
 
@@ -179,6 +215,8 @@ SparseBandField SparseBandField::sparsify(const SampledField& dense, double w, B
                                     std::to_string(dense.lattice.num_points()));
     if (channels.gradient && dense.gradient.size() != dense.distance.size())
         throw std::invalid_argument("sparsify: the gradient channel was asked for, but the field holds no gradient");
+    if (dense.closest_triangle.size() != dense.distance.size())  // it marks the dense band's points
+        throw std::invalid_argument("sparsify: the field holds no closest triangle, which marks its band's points");
     out.timings = dense.timings;
     out.sampler = dense.sampler;
     out.mesh = dense.mesh;
@@ -193,7 +231,7 @@ SparseBandField SparseBandField::sparsify(const SampledField& dense, double w, B
             (std::signbit(d) ? any_inside : any_outside) = true;
         }
         if (in_band) {
-            const size_t base = size_t(out.add_active(id)) * kBandBlockPoints;
+            const size_t a = size_t(out.add_active(id)), base = a * kBandBlockPoints;
             for (int local = 0; local < kBandBlockPoints; ++local) {
                 const int64_t i = layout.storage_index(id, local);
                 if (i < 0) continue;
@@ -201,13 +239,15 @@ SparseBandField SparseBandField::sparsify(const SampledField& dense, double w, B
                 const bool flagged = dense.closest_triangle[size_t(i)] == kOutsideBandTriangle || outside_band(d, w);
                 out.distance[base + size_t(local)] = flagged ? (std::signbit(d) ? -w : w) : d;
                 if (channels.gradient) out.gradient[base + size_t(local)] = flagged ? Vec3d(0.0) : dense.gradient[size_t(i)];
-                out.closest_triangle[base + size_t(local)] = flagged ? kOutsideBandTriangle : dense.closest_triangle[size_t(i)];
+                if (channels.closest_triangle)
+                    out.closest_triangle[base + size_t(local)] = flagged ? kOutsideBandTriangle : dense.closest_triangle[size_t(i)];
+                if (!flagged) set_mask_bit(out.band_mask[a], local);
             }
         } else if (any_inside && any_outside) {
             BandSignMask& mask = out.mixed_inside[size_t(out.add_mixed(id))];
             for (int local = 0; local < kBandBlockPoints; ++local) {
                 const int64_t i = layout.storage_index(id, local);
-                if (i >= 0 && std::signbit(dense.distance[size_t(i)])) mask[size_t(local >> 6)] |= uint64_t(1) << (local & 63);
+                if (i >= 0 && std::signbit(dense.distance[size_t(i)])) set_mask_bit(mask, local);
             }
         } else {
             out.set_tile_inside(id, any_inside);

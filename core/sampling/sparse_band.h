@@ -16,16 +16,20 @@
 /// |d| <= W, else +-W, gradient 0 and kOutsideBandTriangle. Points of a block beyond the
 /// coset's resolution (the last blocks of each axis) are padding: +W, gradient 0,
 /// kOutsideBandTriangle, and no lattice point (BandLayout::storage_index is -1).
-/// A band holds the gradient channel only when asked (BandChannels): without it `gradient`
-/// is empty and the band costs 12 bytes a point instead of 36.
+/// The band's points (|d| <= W: the dense field's points with exact values) are marked in
+/// `band_mask`, one bit per point of each active block (padding bits clear): every reader of
+/// band membership (counts, level sets' active voxels, the band's cells) reads it there.
+/// The gradient and the closest triangle are held only when asked (BandChannels): a point
+/// costs 8 bytes of distance and 1/8 byte of mask, +24 with the gradient, +4 with the triangle
+/// (36.125 with both, as sampled by default; 8.125 with the distance alone).
 /// Every other block is outside the band: a tile of one sign (bit `inside_tiles`: -W, else
 /// +W), or, where its points' signs differ (the winding sign across a hole, far from any
 /// triangle), a "mixed" block whose signs are stored per point (512 bits).
 ///
 /// As a level set: coset c is an OpenVDB/NanoVDB grid of index-space voxels (i, j, k) with
 /// the transform world = lattice.origin + (h/2) first(c) + h (i, j, k) (first: (0,0,0), BCC
-/// secondary (1,1,1)); active blocks are leaves (active voxels: the points with
-/// closest_triangle != kOutsideBandTriangle), inside tiles are tiles of value -W, everything
+/// secondary (1,1,1)); active blocks are leaves (active voxels: the band's points, set bits
+/// of band_mask), inside tiles are tiles of value -W, everything
 /// else background +W; a mixed block is a leaf with every voxel inactive at +-W.
 #pragma once
 
@@ -74,8 +78,15 @@ private:
     BandBlockGrid grid_{};
 };
 
-/// One bit per point of a block: the sides of a mixed block (bit set: inside, -W).
-using BandSignMask = std::array<uint64_t, kBandBlockPoints / 64>;
+/// One bit per point of a block: bit (local & 63) of word (local >> 6), local the point's
+/// block-local index (x fastest). 64-bit words, so that a device writing it as 32-bit halves
+/// on a little-endian host (bvh_band_blocks.cu) gives the same bytes.
+using BandPointMask = std::array<uint64_t, kBandBlockPoints / 64>;
+/// The sides of a mixed block (bit set: inside, -W).
+using BandSignMask = BandPointMask;
+
+inline bool mask_bit(const BandPointMask& m, int local) { return (m[size_t(local >> 6)] >> (local & 63)) & 1; }
+inline void set_mask_bit(BandPointMask& m, int local) { m[size_t(local >> 6)] |= uint64_t(1) << (local & 63); }
 
 /// What a sparse band holds, counted.
 struct SparseBandCounts {
@@ -85,16 +96,20 @@ struct SparseBandCounts {
     int64_t tiles = 0;           ///< outside the band, one sign (blocks - active - mixed)
     int64_t inside_tiles = 0;    ///< of them, inside (-W)
     int64_t active_points = 0;   ///< lattice points of the active blocks (padding not counted)
-    int64_t band_points = 0;     ///< of them, |d| <= W (closest_triangle != kOutsideBandTriangle)
+    int64_t band_points = 0;     ///< of them, |d| <= W (bits of band_mask)
 };
 
 /// The value channels a sparse band holds, as its sampler is asked for them. The distance
-/// and the closest triangle are always held: the triangle marks the band's points
-/// (kOutsideBandTriangle off the band), which the level sets' active voxels and the band's
-/// cells are.
+/// and the band's points (band_mask) are always held; without the closest triangle the
+/// band's points are still known (the mask), not which triangle is nearest.
 struct BandChannels {
-    bool gradient = true;  ///< 24 of a point's 36 bytes
+    bool gradient = true;          ///< 24 bytes a point
+    bool closest_triangle = true;  ///< 4 bytes a point
 };
+
+/// A band's channels by name, as reports list them: "distance", then "gradient" and
+/// "closest_triangle" where held.
+nlohmann::json channel_names(BandChannels channels);
 
 struct SparseBandField {
     SparseBandField() = default;
@@ -104,8 +119,8 @@ struct SparseBandField {
     Lattice lattice;
     double width = 0;            ///< W > 0, mesh units
     Precision precision = Precision::Float;
-    /// What it holds: `gradient` is empty without the gradient channel (sampled without it,
-    /// or read from a file without it), else as long as `distance`.
+    /// What it holds: `gradient` (`closest_triangle`) is empty without its channel (sampled
+    /// without it, or read from a file without it), else as long as `distance`.
     BandChannels channels;
 
     /// Active block ids, ascending; block a's values are [a * 512, (a + 1) * 512) of each channel.
@@ -114,6 +129,9 @@ struct SparseBandField {
     DefaultInitVector<double> distance;
     DefaultInitVector<Vec3d> gradient;
     DefaultInitVector<int32_t> closest_triangle;  ///< in the mesh file's face order; kOutsideBandTriangle outside the band
+    /// The band's points, one mask per active block (always held): bit set where |d| <= W
+    /// (closest_triangle != kOutsideBandTriangle, where held); padding bits clear.
+    DefaultInitVector<BandPointMask> band_mask;
 
     /// One bit per block id: the tile's side (set: inside, -W); meaningful for tiles only.
     std::vector<uint64_t> inside_tiles;
@@ -130,17 +148,23 @@ struct SparseBandField {
     int64_t find_active(int64_t id) const;
     int64_t find_mixed(int64_t id) const;
     bool tile_inside(int64_t id) const { return (inside_tiles[size_t(id >> 6)] >> (id & 63)) & 1; }
+    /// Whether point `local` of active block a (its index in `active`) is a band point.
+    bool in_band(size_t a, int local) const { return mask_bit(band_mask[a], local); }
     void set_tile_inside(int64_t id, bool inside);
 
     /// Appends an active block (ids must come in ascending order) with every point padding
-    /// (+W, gradient 0 when held, kOutsideBandTriangle);
+    /// (+W, gradient 0 and kOutsideBandTriangle when held, no band point);
     /// returns its index in `active`.
     int64_t add_active(int64_t id);
+    /// Sets band_mask from closest_triangle (held): for code that writes the triangles
+    /// itself (a file's reader, tests). Padding bits stay clear whatever their triangles.
+    void mask_from_triangles();
     /// Appends a mixed block (ascending ids), every point outside.
     int64_t add_mixed(int64_t id);
 
     /// Throws std::invalid_argument naming `what` when `wanted` asks for a channel the band
-    /// does not hold, or when the arrays of a channel it holds do not match its active blocks.
+    /// does not hold, or when the arrays of a channel it holds (or band_mask) do not match
+    /// its active blocks.
     void require_channels(BandChannels wanted, const std::string& what) const;
 
     SparseBandCounts counts() const;
@@ -149,21 +173,23 @@ struct SparseBandField {
 
     /// The dense banded field this band stands for: every lattice point, in storage order,
     /// as a dense sampler with SamplerOptions::band_width = W stores it (provenance copied).
-    /// Without the band's gradient channel the field has none (an empty `gradient`, as
-    /// read_field gives a file without one). Throws std::length_error naming the size when
-    /// the lattice has more than `max_points`.
+    /// Without the band's gradient (closest triangle) channel the field has none (an empty
+    /// `gradient` / `closest_triangle`, as read_field gives a file without one). Throws
+    /// std::length_error naming the size when the lattice has more than `max_points`.
     SampledField densify(int64_t max_points = INT64_MAX) const;
     /// The same for one slab of the lattice (kernels/lattice/lattice_slab.h), in the slab's
     /// compact order (sample_slab()'s): a dense field file written slab by slab under a
-    /// memory budget, without the whole lattice in memory. Provenance not copied.
-    SampledField densify_slab(const LatticeSlab& slab) const;
-    /// Bytes densify() allocates for a lattice (distance, the gradient when held, closest triangle).
+    /// memory budget, without the whole lattice in memory. Provenance not copied. `counts`
+    /// (may be null) receives the slab's points in and outside the band (from band_mask:
+    /// count_narrow_band() of a field without triangles cannot tell).
+    SampledField densify_slab(const LatticeSlab& slab, NarrowBandCounts* counts = nullptr) const;
+    /// Bytes densify() allocates for a lattice (distance, and the channels held).
     static int64_t dense_bytes(const Lattice& lattice, BandChannels channels = {});
 
     /// The sparse form of a dense banded field (SamplerOptions::band_width = W, or exact
     /// values, banded here): a block is active when one of its points is within the band,
-    /// else a tile or a mixed block. The fallback of samplers without a sparse path. The
-    /// gradient channel asked of a field without gradients is refused (std::invalid_argument).
+    /// else a tile or a mixed block. The fallback of samplers without a sparse path. A channel
+    /// asked of a field without it is refused (std::invalid_argument).
     static SparseBandField sparsify(const SampledField& field, double width, BandChannels channels = {});
 
 private:

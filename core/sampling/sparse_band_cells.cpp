@@ -24,7 +24,7 @@ bool in_band_cells(const SparseBandField& band, const Vec3d& p) {
             const Int3 block{point.x / kBandBlockDim, point.y / kBandBlockDim, point.z / kBandBlockDim};
             const int local = point.x % kBandBlockDim + kBandBlockDim * (point.y % kBandBlockDim + kBandBlockDim * (point.z % kBandBlockDim));
             const int64_t a = band.find_active(layout.block_id(c, block));
-            if (a < 0 || band.closest_triangle[size_t(a) * kBandBlockPoints + size_t(local)] == kOutsideBandTriangle) return false;
+            if (a < 0 || !band.in_band(size_t(a), local)) return false;
         }
     }
     return true;

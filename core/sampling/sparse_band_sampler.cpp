@@ -273,7 +273,8 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
         // for the padding of the blocks at the lattice's far edges.
         out.distance.resize(values);
         if (plan.channels.gradient) out.gradient.resize(values);
-        out.closest_triangle.resize(values);
+        if (plan.channels.closest_triangle) out.closest_triangle.resize(values);
+        out.band_mask.resize(out.active.size());  // the kernel writes every block's
         for (size_t a = 0; a < out.active.size(); ++a) {
             const BandBlockCoords b = layout.block_coords(out.active[a]);
             const Int3 n = layout.coset(b.coset).points;
@@ -287,7 +288,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                 const size_t v = a * kBandBlockPoints + size_t(local);
                 out.distance[v] = width;
                 if (plan.channels.gradient) out.gradient[v] = Vec3d(0.0);
-                out.closest_triangle[v] = kOutsideBandTriangle;
+                if (plan.channels.closest_triangle) out.closest_triangle[v] = kOutsideBandTriangle;
             }
         }
         // One call for every block: the kernel batches as its memory allows (a GPU uploads
@@ -296,7 +297,8 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     } else {
         out.distance.assign(values, width);
         if (plan.channels.gradient) out.gradient.assign(values, Vec3d(0.0));
-        out.closest_triangle.assign(values, kOutsideBandTriangle);
+        if (plan.channels.closest_triangle) out.closest_triangle.assign(values, kOutsideBandTriangle);
+        out.band_mask.assign(out.active.size(), BandPointMask{});
     }
     for (size_t first = 0; !blocks && first < out.active.size(); first += size_t(blocks_per_batch)) {
         const size_t last = std::min(out.active.size(), first + size_t(blocks_per_batch));
@@ -319,7 +321,8 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                 } else {
                     out.distance[v] = r[i].distance;
                     if (plan.channels.gradient) out.gradient[v] = r[i].gradient;
-                    out.closest_triangle[v] = r[i].triangle;
+                    if (plan.channels.closest_triangle) out.closest_triangle[v] = r[i].triangle;
+                    set_mask_bit(out.band_mask[v / kBandBlockPoints], int(v % kBandBlockPoints));
                 }
             }
         });
@@ -424,9 +427,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"cells_refused_by_gradient", classify.refused_by_gradient},
                                           {"points_signed_per_point", per_point_points},
                                           {"outside_rule", rule_name},
-                                          {"channels", plan.channels.gradient
-                                                           ? nlohmann::json::array({"distance", "gradient", "closest_triangle"})
-                                                           : nlohmann::json::array({"distance", "closest_triangle"})},
+                                          {"channels", channel_names(plan.channels)},
                                           {"boundary_edges", int64_t(boundary_edge_count)},
                                           {"steps", steps},
                                           {"memory_bytes", int64_t(out.memory_bytes())}};

@@ -48,22 +48,25 @@ struct SparseBandPlan {
     Precision precision = Precision::Float;  ///< recorded in the field (the sampler's own)
     int threads = 0;                         ///< for the host steps (0: every core)
     int64_t batch_points = int64_t(1) << 20; ///< lattice points per query call
-    BandChannels channels;                   ///< what the band holds (sparse_band.h): the gradient when asked
+    BandChannels channels;                   ///< what the band holds (sparse_band.h): gradient, triangle when asked
 };
 
 /// A backend's block kernel: writes the values of the active blocks [first, last) of `band`
 /// (band.active) as its dense lattice kernel with the band of band.width fills those points:
 /// every lattice point's, in every channel the band holds (band.channels; without the
-/// gradient channel `gradient` is empty), into arrays allocated but not written, whose
-/// padding the caller has written (+W, gradient 0, kOutsideBandTriangle; a kernel may write
-/// it again with those values). Called once with every active block; a device kernel adds
-/// its kernel, upload and download seconds to band.timings.
+/// gradient or the closest_triangle channel that array is empty), into arrays allocated but
+/// not written, whose padding the caller has written (+W, gradient 0, kOutsideBandTriangle;
+/// a kernel may write it again with those values); and every block's band_mask (allocated,
+/// not written: the block's points with |d| <= W, padding bits clear). Called once with
+/// every active block; a device kernel adds its kernel, upload and download seconds to
+/// band.timings.
 using BandBlockKernel = std::function<void(SparseBandField& band, size_t first, size_t last)>;
 
 /// Samples the band of width `width` > 0 of `lattice`: the active blocks with `blocks`, or,
 /// when it is empty, with `sampler`'s point queries; the outside with its point queries.
-/// The band holds the channels plan.channels asks for (the gradient is neither kept nor,
-/// by a device kernel, downloaded without it).
+/// The band holds the channels plan.channels asks for (the gradient and the closest
+/// triangle are neither kept nor, by a device kernel, downloaded without them); band_mask
+/// always.
 SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& lattice, double width,
                                    const SparseBandPlan& plan = {}, const BandBlockKernel& blocks = {});
 

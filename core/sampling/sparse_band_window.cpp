@@ -31,7 +31,7 @@ SampledField densify_window(const SparseBandField& band, const LatticeWindow& wi
     field.lattice = window.lattice_in(band.lattice);
     field.precision = band.precision;
     field.resize(field.lattice.num_points());
-    const bool band_gradient = !band.gradient.empty();
+    const bool band_gradient = !band.gradient.empty(), band_triangle = band.channels.closest_triangle;
     // Points are visited x fastest, so consecutive ones mostly share a block: its kind is
     // looked up (a binary search of the active and the mixed ids) once per change of block.
     int64_t block = -1, active = -1, mixed = -1;
@@ -56,15 +56,16 @@ SampledField densify_window(const SparseBandField& band, const LatticeWindow& wi
                         const size_t v = size_t(active) * kBandBlockPoints + size_t(local);
                         field.distance[size_t(out)] = band.distance[v];
                         if (band_gradient) field.gradient[size_t(out)] = band.gradient[v];
-                        field.closest_triangle[size_t(out)] = band.closest_triangle[v];
+                        if (band_triangle) field.closest_triangle[size_t(out)] = band.closest_triangle[v];
                     } else {
                         const bool inside = mixed >= 0 ? (band.mixed_inside[size_t(mixed)][size_t(local >> 6)] >> (local & 63)) & 1
                                                        : band.tile_inside(id);
-                        store_outside_band(field, out, inside, band.width);
+                        store_outside_band(field, out, inside, band.width);  // the triangle channel cleared below if not held
                     }
                 }
     }
     if (!gradient) field.gradient.clear();
+    if (!band_triangle) field.closest_triangle.clear();  // a band without triangles: none (nor -1s) in its windows
     return field;
 }
 

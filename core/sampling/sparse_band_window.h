@@ -26,7 +26,8 @@ struct LatticeWindow {
 /// The window of `band`'s lattice, densified: every point holds the densified band's
 /// distance, gradient and closest triangle (store order of the window's lattice). Without
 /// `gradient` the field has no gradient channel (as densify_within_memory without it); the
-/// gradient of a band read without one is 0, as densify() gives. Throws
+/// gradient of a band read without one is 0, as densify() gives; a band without the closest
+/// triangle gives a field without one (an empty `closest_triangle`). Throws
 /// std::invalid_argument when the window does not fit the lattice.
 SampledField densify_window(const SparseBandField& band, const LatticeWindow& window, bool gradient);
 

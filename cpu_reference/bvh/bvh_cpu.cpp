@@ -144,11 +144,12 @@ private:
                     side.fill(kBandSidePadding);
                     std::array<bool, kBandBlockPoints> flooded{};  // the points whose side the flood gives
                     bool flood = false;
-                    const bool gradient = out.channels.gradient;
+                    const bool gradient = out.channels.gradient, triangle = out.channels.closest_triangle;
+                    BandPointMask in_band{};  // the block's band points
                     const auto store_outside = [&](size_t v, bool negative) {
                         out.distance[v] = negative ? -band.width : band.width;
                         if (gradient) out.gradient[v] = Vec3d(0.0);
-                        out.closest_triangle[v] = kOutsideBandTriangle;
+                        if (triangle) out.closest_triangle[v] = kOutsideBandTriangle;
                     };
                     auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const size_t v = slot(i);
@@ -159,7 +160,8 @@ private:
                         }
                         out.distance[v] = s.distance;
                         if (gradient) out.gradient[v] = s.gradient;
-                        out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
+                        if (triangle) out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
+                        set_mask_bit(in_band, int(v - base));
                     };
                     auto emit_outside = [&](int64_t i, BandSide s) {
                         const size_t v = slot(i);
@@ -173,6 +175,7 @@ private:
                         evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters, emit,
                                            emit_outside);
                     });
+                    out.band_mask[a] = in_band;
                     if (!flood) continue;
                     if (std::none_of(side.begin(), side.end(), band_side_known)) {  // its point 0 by a plain search
                         side[0] = plain_search_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside;

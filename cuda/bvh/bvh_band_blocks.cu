@@ -132,6 +132,18 @@ __global__ void __launch_bounds__(kBandBlockPoints)
     if (flood && side[local] == kBandSideNone) atomicAdd(counters + 2, 1ull);
 }
 
+/// The band's points of a batch's blocks as their masks (SparseBandField::band_mask): bit
+/// `local` of a block set where its point's triangle is not kOutsideBandTriangle (padding's
+/// is). One thread per point, one ballot per warp: the warp's 32 points are 32-bit half
+/// i / 32 of the masks' 64-bit words (little-endian, as the host reads them). n is a whole
+/// number of blocks, so a warp is wholly in or out.
+__global__ void mark_band_points(const int* triangle, int64_t n, uint32_t* mask) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i - (threadIdx.x & 31) >= n) return;
+    const unsigned bits = __ballot_sync(0xffffffffu, i < n && triangle[i] != kOutsideBandTriangle);
+    if ((threadIdx.x & 31) == 0) mask[i >> 5] = bits;
+}
+
 size_t device_bytes_in_use() {
     size_t free_bytes = 0, total = 0;
     CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
@@ -174,6 +186,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     if (options_.max_points_per_piece > 0) batch = std::min(batch, options_.max_points_per_piece / kBandBlockPoints);
     batch = std::clamp<int64_t>(batch, 1, blocks);
     PieceResults r(batch * kBandBlockPoints);
+    DeviceBuffer<uint32_t> band_mask{size_t(batch) * kBandBlockPoints / 32};  // 64 bytes a block: within the 20% left free
     const size_t in_use = device_bytes_in_use();
 
     // As the dense lattice path (run_slab): the same certificate slack, band and finalize.
@@ -226,14 +239,18 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         }
         to_source_order<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, dev.source_triangle.get());
         CUDA_CHECK_LAUNCH("to_source_order");
+        mark_band_points<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, band_mask.get());
+        CUDA_CHECK_LAUNCH("mark_band_points");
         flood_stage.end();
         compute.end();
         download.begin();
         const size_t v = (first + size_t(b0)) * kBandBlockPoints;
         staged_.to_host(r.samples.distance.get(), band.distance.data() + v, size_t(n) * sizeof(double));
-        if (band.channels.gradient)  // else the band holds none: 24 of a point's 36 bytes stay on the device
+        if (band.channels.gradient)  // else the band holds none: 24 bytes a point stay on the device
             staged_.to_host(r.samples.gradient.get(), band.gradient.data() + v, size_t(n) * sizeof(Vec3d));
-        staged_.to_host(r.samples.triangle.get(), band.closest_triangle.data() + v, size_t(n) * sizeof(int32_t));
+        if (band.channels.closest_triangle)  // else 4 bytes a point stay: the mask marks the band's points
+            staged_.to_host(r.samples.triangle.get(), band.closest_triangle.data() + v, size_t(n) * sizeof(int32_t));
+        staged_.to_host(band_mask.get(), band.band_mask.data() + first + size_t(b0), size_t(nb) * sizeof(BandPointMask));
         download.end();
     }
     unsigned long long flood[3] = {0, 0, 0};
@@ -260,7 +277,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"blocks_signed_by_a_search", int64_t(flood[1])},
         {"kernel_seconds", compute.seconds()},
         {"stage_seconds", {{"search", search_stage.seconds()}, {"finalize", finalize_stage.seconds()},
-                           {"flood_and_source_order", flood_stage.seconds()}}},
+                           {"flood_source_order_and_mask", flood_stage.seconds()}}},
         {"upload_seconds", upload.seconds()},
         {"download_seconds", download.seconds()},
         {"device_bytes_in_use", int64_t(in_use)},  // after the batch's buffers: the conversion's peak (pool included)

@@ -95,9 +95,11 @@ public:
         const double cpu0 = process_cpu_seconds();
         if (in.band_width > 0) {
             // The sparse band (core/sampling/sparse_band.h): its band points are the active voxels.
-            // Distances only, as the peers' level sets: no gradient channel kept or downloaded.
+            // Distances only, as the peers' level sets: no gradient or closest triangle kept or
+            // downloaded (the band's points are its mask).
             BandChannels channels;
             channels.gradient = false;
+            channels.closest_triangle = false;
             const auto start = std::chrono::steady_clock::now();
             const SparseBandField band = sdf->sample_band(*in.lattice, in.band_width, channels);
             const double wall = seconds_since(start);
@@ -107,7 +109,7 @@ public:
             for (size_t a = 0; a < band.active.size(); ++a)
                 for (int local = 0; local < kBandBlockPoints; ++local) {
                     const size_t at = a * kBandBlockPoints + size_t(local);
-                    if (band.closest_triangle[at] == kOutsideBandTriangle) continue;  // padding too
+                    if (!band.in_band(a, local)) continue;  // padding too
                     r.band_points.push_back(in.lattice->position(layout.storage_index(band.active[a], local)));
                     r.distance.push_back(band.distance[at]);
                 }
@@ -115,7 +117,7 @@ public:
             r.details["band_blocks"] = {{"active", c.active_blocks}, {"mixed", c.mixed_blocks}, {"tiles", c.tiles},
                                         {"inside_tiles", c.inside_tiles}, {"points_searched", c.active_points},
                                         {"bytes", band.memory_bytes()}, {"wall_seconds", wall},
-                                        {"channels", nlohmann::json::array({"distance", "closest_triangle"})}};
+                                        {"channels", channel_names(channels)}};
         } else if (in.lattice) {
             const SampledField f = sdf->sample(*in.lattice);
             r.distance = f.distance;

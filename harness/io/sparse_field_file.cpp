@@ -126,7 +126,7 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
     require_representable_band(band.width, options.dtype, header + ": the narrow band width");
     const int64_t points = int64_t(band.active.size()) * kBandBlockPoints;
     const bool gradient = options.gradient;
-    band.require_channels({gradient}, header + ": the gradient channel");
+    band.require_channels({gradient, false}, header + ": the gradient channel");
     if (band.mixed_inside.size() != band.mixed.size() ||
         band.inside_tiles.size() != size_t((band.layout().block_count() + 63) / 64))
         throw std::invalid_argument(header + ": the sparse band's arrays do not match its " + std::to_string(band.active.size()) +
@@ -134,7 +134,10 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
     const char* real = options.dtype == FieldDtype::Float32 ? "float32" : "float64";
     std::vector<SparseChannel> layout = {{"active_blocks", "int64", 1}, {"distance", real, 1}};
     if (gradient) layout.push_back({"gradient", real, 3});
-    layout.push_back({"closest_triangle", "int32", 1});
+    // The band's points: its closest triangles where held (kOutsideBandTriangle off the
+    // band), else its mask (sparse_band.h's band_mask).
+    if (band.channels.closest_triangle) layout.push_back({"closest_triangle", "int32", 1});
+    else layout.push_back({"band_points", "uint64", kSignWords});
     layout.push_back({"tile_signs", "uint64", 1});
     layout.push_back({"mixed_blocks", "int64", 1});
     layout.push_back({"mixed_signs", "uint64", kSignWords});
@@ -161,6 +164,10 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
         } else if (name == "closest_triangle") {
             write_channel(replacement, i, c, points, [&](int64_t first, int64_t n, char* out) {
                 std::memcpy(out, band.closest_triangle.data() + first, size_t(n) * sizeof(int32_t));
+            });
+        } else if (name == "band_points") {
+            write_channel(replacement, i, c, int64_t(band.band_mask.size()), [&](int64_t first, int64_t n, char* out) {
+                std::memcpy(out, band.band_mask.data() + first, size_t(n) * sizeof(BandPointMask));
             });
         } else if (name == "tile_signs") {
             // Only tiles' bits mean something (sparse_band.h): active and mixed blocks' are cleared.
@@ -332,13 +339,22 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
     if (dist.dtype == "float32") require_representable_band(width, FieldDtype::Float32, header + ": key 'band.width'");
     std::optional<OpenChannel> grad;
     if (has_gradient) grad = open_channel(header, channels, "gradient", points, 3, {"float32", "float64"});
-    OpenChannel tri = open_channel(header, channels, "closest_triangle", points, 1, {"int32"});
+    // The band's points: by their closest triangles, or by their mask (a band without triangles).
+    const bool has_triangle = channels.has("closest_triangle");
+    if (has_triangle == channels.has("band_points"))
+        throw std::runtime_error(header + ": key 'channels': expected exactly one of the channels 'closest_triangle' (int32, 512 "
+                                          "per active block) and 'band_points' (uint64, 8 per active block), which mark the "
+                                          "band's points; " + (has_triangle ? "both are given" : "neither is given"));
+    std::optional<OpenChannel> tri, marks;
+    if (has_triangle) tri = open_channel(header, channels, "closest_triangle", points, 1, {"int32"});
+    else marks = open_channel(header, channels, "band_points", active, kSignWords, {"uint64"});
     OpenChannel tiles = open_channel(header, channels, "tile_signs", (blocks + 63) / 64, 1, {"uint64"});
     OpenChannel mixed_ids = open_channel(header, channels, "mixed_blocks", mixed, 1, {"int64"});
     OpenChannel signs = open_channel(header, channels, "mixed_signs", mixed, kSignWords, {"uint64"});
 
     BandChannels held;
     held.gradient = has_gradient;
+    held.closest_triangle = has_triangle;
     SparseBandField band(lattice, width, precision, held);
     band.active.resize(size_t(active));
     read_values(ids, band.active.data(), active, header);
@@ -361,8 +377,20 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
     // A float32 file holds +-float(W) where its active blocks leave the band; its tiles and
     // mixed blocks read as the same value, so the band densifies to the dense float32 file.
     if (dist.dtype == "float32") band.width = double(float(width));
-    band.closest_triangle.resize(size_t(points));
-    read_values(tri, band.closest_triangle.data(), points, header);
+    if (tri) {
+        band.closest_triangle.resize(size_t(points));
+        read_values(*tri, band.closest_triangle.data(), points, header);
+        band.mask_from_triangles();
+    } else {
+        band.band_mask.resize(size_t(active));
+        read_values(*marks, band.band_mask.empty() ? nullptr : band.band_mask[0].data(), active * kSignWords, header);
+        for (size_t a = 0; a < band.active.size(); ++a)  // padding is never a band point (counts rely on it)
+            for (int local = 0; local < kBandBlockPoints; ++local)
+                if (band.in_band(a, local) && band.layout().storage_index(band.active[a], local) < 0)
+                    throw std::runtime_error(header + ": channel 'band_points': block " + std::to_string(band.active[a]) +
+                                             " marks its point " + std::to_string(local) +
+                                             " as a band point, but it lies beyond the lattice (padding)");
+    }
     if (grad) {
         band.gradient.resize(size_t(points));
         read_values(*grad, band.gradient.empty() ? nullptr : &band.gradient[0].x, 3 * points, header);

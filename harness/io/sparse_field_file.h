@@ -9,7 +9,9 @@
 ///   active_blocks     int64, one id per active block, ascending
 ///   distance          float32 | float64, 512 per active block (block-local order, x fastest)
 ///   gradient          the same, 3 components (optional)
-///   closest_triangle  int32, 512 per active block (kOutsideBandTriangle off the band)
+///   closest_triangle  int32, 512 per active block (kOutsideBandTriangle off the band), or,
+///                     for a band without the closest triangle channel, instead:
+///   band_points       uint64, 8 words (512 bits) per active block (set: |d| <= W)
 ///   tile_signs        uint64, one bit per block of the lattice (set: an inside tile, -W)
 ///   mixed_blocks      int64, one id per mixed block, ascending
 ///   mixed_signs       uint64, 8 words (512 bits) per mixed block (set: inside, -W)
@@ -35,7 +37,8 @@ struct SparseFieldWriteOptions {
     Overwrite overwrite = Overwrite::Forbid;
 };
 
-/// Writes `band` as NAME.json and its channel files (NAME = header path without ".json").
+/// Writes `band` as NAME.json and its channel files (NAME = header path without ".json"): the
+/// closest triangles where the band holds them, else its band_points mask.
 /// A band width or a value the dtype cannot hold is refused, naming the file, and so is
 /// options.gradient of a band without the gradient channel (std::invalid_argument).
 void write_sparse_field(const std::string& header_path, const SparseBandField& band,

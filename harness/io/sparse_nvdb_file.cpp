@@ -73,7 +73,7 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
             const size_t at = a * kBandBlockPoints + size_t(local);
             const uint32_t offset = leaf_offset(local);
             const float d = float(band.distance[at]);
-            if (band.closest_triangle[at] == kOutsideBandTriangle) {
+            if (!band.in_band(a, local)) {
                 set_inactive(leaf, offset, d);  // +-W, its side
                 continue;
             }
@@ -128,6 +128,7 @@ bool nanovdb_available() { return true; }
 
 SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::string& path, Overwrite overwrite) {
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
+    band.require_channels({false, false}, path + ": the distance grids");  // the arrays match the active blocks
     require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .nvdb stores float32)");
     SparseNvdbCounts counts;
     write_through_temporary(path, overwrite,

@@ -6,7 +6,7 @@
 /// Per coset (CC: one grid; BCC: "distance_primary" and "distance_secondary") a NanoVDB
 /// FloatGrid "distance[_part]" of class level set, background W, whose map is the coset's
 /// exact transform (voxel size h, translated to the coset's first point, as volume_grids.h):
-/// an active block is a leaf whose band points (closest triangle != kOutsideBandTriangle) are
+/// an active block is a leaf whose band points (the band's mask, SparseBandField::band_mask) are
 /// active voxels holding float(d), its other points inactive at +-W and its padding inactive
 /// at +W; a mixed block is a leaf of inactive voxels at +-W; an inside tile is an inactive
 /// tile of one leaf's extent at -W; every other block is the background +W. The grids are

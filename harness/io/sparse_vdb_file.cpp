@@ -84,7 +84,7 @@ void write_grids(const SparseBandField& band, const std::string& path, const Spa
             const openvdb::Index offset = leaf_offset(local);
             if (layout.storage_index(band.active[a], local) < 0) continue;  // padding: background +W
             const float d = float(band.distance[at]);
-            if (band.closest_triangle[at] == kOutsideBandTriangle) {
+            if (!band.in_band(a, local)) {
                 leaf->setValueOff(offset, d);  // +-W, its side
                 continue;
             }
@@ -153,7 +153,7 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
     namespace fs = std::filesystem;
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
     require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .vdb stores float32)");
-    band.require_channels({options.gradient}, path + ": the gradient grids");
+    band.require_channels({options.gradient, options.closest_triangle}, path + ": the gradient and closest triangle grids");
     if (options.overwrite == Overwrite::Forbid && fs::exists(path))
         throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     openvdb::initialize();
@@ -166,7 +166,8 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
 #else
 
 SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::string& path, const SparseVdbOptions& options) {
-    band.require_channels({options.gradient}, path + ": the gradient grids");  // as with OpenVDB: the caller's error first
+    band.require_channels({options.gradient, options.closest_triangle},
+                          path + ": the gradient and closest triangle grids");  // as with OpenVDB: the caller's error first
     throw std::runtime_error(path + ": this build has no OpenVDB support (libopenvdb-dev)");
 }
 

@@ -6,7 +6,7 @@
 /// dense field's sub-grids, volume_grids.h) a FloatGrid "distance[_part]" of class level set,
 /// background W, the coset's transform (voxel size h, translated to the coset's first point):
 /// - an active block is a leaf (8^3 = OpenVDB's LeafNode); its points within the band
-///   (closest triangle != kOutsideBandTriangle) are active voxels holding float(d), its other
+///   (the band's mask, SparseBandField::band_mask) are active voxels holding float(d), its other
 ///   points inactive voxels at +-W, its padding (beyond the lattice) inactive at +W;
 /// - a mixed block is a leaf of inactive voxels at +-W, point by point;
 /// - an inside tile is an inactive level-1 tile (8^3 voxels) at -W, an outside tile is the
@@ -24,7 +24,7 @@ namespace sdf {
 
 struct SparseVdbOptions {
     bool gradient = true;           ///< write the gradient grids: refused of a band without them (BandChannels)
-    bool closest_triangle = false;  ///< write the closest triangle grids
+    bool closest_triangle = false;  ///< write the closest triangle grids: refused of a band without them
     Overwrite overwrite = Overwrite::Forbid;
 };
 
@@ -36,7 +36,8 @@ struct SparseVdbCounts {
 
 /// Writes `band` to `path` (.vdb) atomically (a temporary beside it, then renamed; an existing
 /// file is refused unless options.overwrite allows it). Without OpenVDB it throws, naming it;
-/// so does options.gradient of a band without the gradient channel (std::invalid_argument).
+/// so does options.gradient (closest_triangle) of a band without that channel
+/// (std::invalid_argument).
 SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::string& path,
                                       const SparseVdbOptions& options = {});
 

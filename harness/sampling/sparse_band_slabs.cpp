@@ -15,9 +15,9 @@ SampledField SparseBandSlabs::sample_slab(const Lattice& lattice, const LatticeS
     if (lattice.type != own.type || !(lattice.resolution == own.resolution) || lattice.spacing != own.spacing ||
         lattice.origin.x != own.origin.x || lattice.origin.y != own.origin.y || lattice.origin.z != own.origin.z)
         throw std::invalid_argument("sparse band slabs: asked for a slab of another lattice than the band's");
-    SampledField field = band_.densify_slab(slab);
+    NarrowBandCounts counts;  // from the band's mask: the field may hold no triangles
+    SampledField field = band_.densify_slab(slab, &counts);
     field.sampler = band_.sampler;
-    const NarrowBandCounts counts = count_narrow_band(field);
     if (field.sampler.band) {
         field.sampler.band->points_in_band = counts.in_band;
         field.sampler.band->points_outside = counts.outside;

@@ -33,14 +33,13 @@ class SparseField {
 public:
     explicit SparseField(SparseBandField band) : band_(std::make_shared<const SparseBandField>(std::move(band))) {
         // The band's points: channel positions a * 512 + local of the active blocks' points
-        // within the band (closest triangle set), in block order.
+        // within the band (their mask's bits; padding's are clear), in block order.
         const SparseBandField& b = *band_;
+        b.require_channels({false, false}, "SparseField");
+        at_.reserve(size_t(b.counts().band_points));
         for (size_t a = 0; a < b.active.size(); ++a)
-            for (int local = 0; local < kBandBlockPoints; ++local) {
-                const size_t at = a * kBandBlockPoints + size_t(local);
-                if (b.closest_triangle[at] != kOutsideBandTriangle && b.layout().storage_index(b.active[a], local) >= 0)
-                    at_.push_back(int64_t(at));
-            }
+            for (int local = 0; local < kBandBlockPoints; ++local)
+                if (b.in_band(a, local)) at_.push_back(int64_t(a * kBandBlockPoints + size_t(local)));
     }
 
     const SparseBandField& band() const { return *band_; }
@@ -61,7 +60,8 @@ public:
             }
         });
     }
-    py::array_t<int32_t> triangle() const {
+    py::object triangle() const {
+        if (!band_->channels.closest_triangle) return py::none();
         return new_array<int32_t>({size()}, [&](int32_t* t) {
             for (size_t i = 0; i < at_.size(); ++i) t[i] = band_->closest_triangle[size_t(at_[i])];
         });
@@ -183,6 +183,9 @@ public:
 
     py::list write(const std::string& path, bool overwrite, bool closest_triangle, const std::string& dtype) const {
         choose("dtype", dtype, {"float32", "float64"});
+        if (closest_triangle && !band_->channels.closest_triangle)
+            throw std::invalid_argument(path + ": closest_triangle=True, but the band holds no closest triangle (sampled with "
+                                        "closest_triangle=False, or read from a file without one)");
         const bool json = path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0;
         if (!json && dtype != "float32")
             throw std::invalid_argument(path + ": dtype=\"" + dtype + "\": a level set (.vdb, .nvdb) stores float32; "
@@ -253,7 +256,8 @@ SparseField read_sparse_field_file(const std::string& path) {
 
 SparseField sample_band(const MeshSdf& sdf, double band, const std::string& lattice, const py::object& resolution,
                         const py::object& samples, const py::object& margin, const py::object& bounds,
-                        const py::object& spacing, const py::object& origin, const py::object& progress, bool gradient) {
+                        const py::object& spacing, const py::object& origin, const py::object& progress, bool gradient,
+                        bool closest_triangle) {
     if (!(band > 0) || !std::isfinite(band))
         throw std::invalid_argument("band: expected a positive width in mesh units, got " + std::to_string(band));
     if (!(float(band) > 0) || !std::isfinite(float(band)))
@@ -265,6 +269,7 @@ SparseField sample_band(const MeshSdf& sdf, double band, const std::string& latt
     task.progress = progress;
     BandChannels channels;
     channels.gradient = gradient;
+    channels.closest_triangle = closest_triangle;
     SparseBandField field = run_task([&] {
         try {
             return sdf.sample_band(l, band, channels);
@@ -283,15 +288,18 @@ void bind_sparse_field(py::module_& m) {
 SDF.sample(..., band=W) return it. The lattice is cut into blocks of 8^3 points (OpenVDB's
 leaves); only the blocks within W of a triangle are sampled, so its memory grows with the band,
 not with the lattice. Its arrays hold the band's points (|d| <= W), in block order: distance,
-gradient (None when sampled with gradient=False or read without one), triangle, their world
-positions (points) and lattice indices (indices, subgrid).
+gradient (None when sampled with gradient=False or read without one), triangle (None when
+sampled with closest_triangle=False or read without one), their world positions (points) and
+lattice indices (indices, subgrid).
 Every other lattice point stands for +W or -W by its side: to_dense() is the dense field of
 sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB level set (.vdb).)")
         .def_property_readonly("distance", &SparseField::distance, "Exact signed distance of the band's points, float64 (N,).")
         .def_property_readonly("gradient", &SparseField::gradient,
                                "Exact gradient of the band's points, float64 (N, 3); None when the band holds none (sampled "
                                "with gradient=False, or read from a file without the channel).")
-        .def_property_readonly("triangle", &SparseField::triangle, "Closest triangle of the band's points, int32 (N,), 0-based.")
+        .def_property_readonly("triangle", &SparseField::triangle,
+                               "Closest triangle of the band's points, int32 (N,), 0-based; None when the band holds none "
+                               "(sampled with closest_triangle=False, or read from a file without the channel).")
         .def_property_readonly("points", &SparseField::points, "World positions of the band's points, float64 (N, 3).")
         .def_property_readonly("indices", &SparseField::indices,
                                "Lattice indices (i, j, k) of the band's points, int64 (N, 3), x first, in their sub-grid "
@@ -333,7 +341,7 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
              py::arg("dtype") = "float32",
              "write(path, overwrite=False, closest_triangle=False, dtype=\"float32\") -> list of files: by the extension, "
              ".json: the sparse band's field file (docs/field-format.md; its blocks, tiles and signs, values as dtype, "
-             "closest triangles always), read back by read_field, sdf-eval and sdf-render; .vdb: an OpenVDB level set "
+             "the closest triangles where held, else the band points' bit mask), read back by read_field, sdf-eval and sdf-render; .vdb: an OpenVDB level set "
              "(harness/io/sparse_vdb_file.h) with its gradient grid where the band holds gradients, closest_triangle=True adding an Int32Grid of the "
              "closest triangles (which Debian's pyopenvdb 10 cannot read); .nvdb: the NanoVDB level set of the distance "
              "(harness/io/sparse_nvdb_file.h; builds with NanoVDB only). Written atomically. Other formats are refused "
@@ -360,8 +368,9 @@ sample(mesh, ..., band_width=W), bit for bit. write(path) writes an OpenVDB leve
     m.def("_sample_band", &sample_band, py::arg("sdf"), py::arg("band"), py::arg("lattice") = lattice_type_name(LatticeType::CC),
           py::arg("resolution") = py::none(), py::arg("samples") = py::none(), py::arg("margin") = py::none(),
           py::arg("bounds") = py::none(), py::arg("spacing") = py::none(), py::arg("origin") = py::none(),
-          py::arg("progress") = py::none(), py::arg("gradient") = true,
-          "SDF.sample(band=W)'s native part (sdf_lattices._sparse); gradient=False: a band without the gradient channel.");
+          py::arg("progress") = py::none(), py::arg("gradient") = true, py::arg("closest_triangle") = true,
+          "SDF.sample(band=W)'s native part (sdf_lattices._sparse); gradient=False (closest_triangle=False): a band "
+          "without that channel.");
 }
 
 }  // namespace sdf

@@ -1,7 +1,8 @@
 // The sparse narrow band against the dense one (issue 35), on the CPU BVH or the CUDA BVH:
 // one line of JSON per run, so that each run's peak resident memory is its own process's.
-//   bench_sparse_band sparse|sparse-no-gradient|dense|check MESH RES [BAND_SPACINGS=3] [cc|bcc] [cpu|cuda] [KERNEL]
-// sparse: sample_band_sparse(); sparse-no-gradient: the same without the gradient channel; dense: the whole lattice with band_width, slab by slab (64
+//   bench_sparse_band sparse|sparse-no-gradient|sparse-distance|dense|check MESH RES [BAND_SPACINGS=3] [cc|bcc] [cpu|cuda] [KERNEL]
+// sparse: sample_band_sparse(); sparse-no-gradient: the same without the gradient channel;
+// sparse-distance: with the distance alone (no gradient, no closest triangle); dense: the whole lattice with band_width, slab by slab (64
 // z-planes at a time, each slab dropped once sampled, so that lattices whose dense field does
 // not fit in memory are timed too); check: both, densified and compared byte for byte.
 // Threads: every core (SDF_THREADS overrides). Wall and process CPU seconds are reported; the
@@ -39,7 +40,9 @@ double peak_rss_mib() {
 int main(int argc, char** argv) {
     using namespace sdf;
     if (argc < 4) {
-        std::fprintf(stderr, "usage: %s sparse|sparse-no-gradient|dense|check MESH RES [BAND_SPACINGS=3] [cc|bcc] [cpu|cuda] [KERNEL]\n",
+        std::fprintf(stderr,
+                     "usage: %s sparse|sparse-no-gradient|sparse-distance|dense|check MESH RES [BAND_SPACINGS=3] [cc|bcc] "
+                     "[cpu|cuda] [KERNEL]\n",
                      argv[0]);
         return 2;
     }
@@ -79,9 +82,10 @@ int main(int argc, char** argv) {
     auto t0 = std::chrono::steady_clock::now();
     double c0 = cpu_seconds();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-    if (mode == "sparse" || mode == "sparse-no-gradient" || mode == "check") {
+    if (mode == "sparse" || mode == "sparse-no-gradient" || mode == "sparse-distance" || mode == "check") {
         BandChannels channels;
-        channels.gradient = mode != "sparse-no-gradient";
+        channels.gradient = mode != "sparse-no-gradient" && mode != "sparse-distance";
+        channels.closest_triangle = mode != "sparse-distance";
         const SparseBandField sparse = bound_sparse->sample_band_sparse(lattice, w, channels);
         out["sparse_wall_s"] = elapsed();
         out["sparse_cpu_s"] = cpu_seconds() - c0;

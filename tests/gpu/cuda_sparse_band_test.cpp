@@ -131,6 +131,29 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                         EXPECT_TRUE(slim.gradient.empty()) << which;
                         EXPECT_TRUE(same_bytes(sparse.distance, slim.distance)) << which << ": without the gradient";
                         EXPECT_TRUE(same_bytes(sparse.closest_triangle, slim.closest_triangle)) << which << ": without the gradient";
+                        // The band's points (the device's mask, mark_band_points) are the points
+                        // whose triangle marks them; with the distance alone (neither gradient nor
+                        // triangles downloaded) the same mask and distances.
+                        std::vector<BandPointMask> truth(sparse.active.size(), BandPointMask{});
+                        for (size_t a = 0; a < sparse.active.size(); ++a)
+                            for (int local = 0; local < kBandBlockPoints; ++local)
+                                if (sparse.layout().storage_index(sparse.active[a], local) >= 0 &&
+                                    sparse.closest_triangle[a * kBandBlockPoints + size_t(local)] != kOutsideBandTriangle)
+                                    set_mask_bit(truth[a], local);
+                        const auto same_masks = [&](const SparseBandField& b) {
+                            return b.band_mask.size() == truth.size() &&
+                                   (truth.empty() || std::memcmp(b.band_mask.data(), truth.data(), truth.size() * 64) == 0);
+                        };
+                        EXPECT_TRUE(same_masks(sparse)) << which << ": the band's mask";
+                        BandChannels lean_channels;
+                        lean_channels.gradient = false;
+                        lean_channels.closest_triangle = false;
+                        const SparseBandField lean =
+                            make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(lattice, w, lean_channels);
+                        EXPECT_TRUE(lean.gradient.empty() && lean.closest_triangle.empty()) << which;
+                        EXPECT_TRUE(same_bytes(sparse.distance, lean.distance)) << which << ": the distance alone";
+                        EXPECT_TRUE(same_masks(lean)) << which << ": the distance alone, its mask";
+                        EXPECT_EQ(lean.counts().band_points, sparse.counts().band_points) << which;
                     }
                 }
                 if (HasFailure()) return;

@@ -599,6 +599,7 @@ TEST_F(FuzzReaders, SparseFieldHeadersAndBlockIds) {
             band.closest_triangle[base + size_t(local)] = local % 5;
         }
     }
+    band.mask_from_triangles();
     band.mixed_inside[size_t(band.add_mixed(6))][2] = 0xF0F0;
     band.set_tile_inside(7, true);
     band.set_tile_inside(int(band.layout().block_count()) - 1, true);
@@ -638,6 +639,65 @@ TEST_F(FuzzReaders, SparseFieldHeadersAndBlockIds) {
     }
     std::cout << "s.active_blocks.raw: " << kPerSeed << " mutations, " << id_refused << " refused\n";
     EXPECT_GT(id_refused, 0);
+}
+
+// A sparse band's file without closest triangles: its band points as a mask ("band_points",
+// 8 words per active block). Its header, and the mask's bytes (truncated, flipped: a bit on a
+// padding point is refused), each read back, counted and densified when it parses.
+TEST_F(FuzzReaders, SparseFieldBandPointsMask) {
+    Lattice l;
+    l.type = LatticeType::CC;
+    l.spacing = 0.5;
+    l.resolution = {20, 10, 9};  // blocks beyond x 16, y 8, z 8 hold padding
+    BandChannels channels;
+    channels.gradient = false;
+    channels.closest_triangle = false;
+    SparseBandField band(l, 0.75, Precision::Float, channels);
+    for (int64_t id : {0, 5, 11}) {
+        const size_t a = size_t(band.add_active(id));
+        for (int local = 0; local < kBandBlockPoints; local += 3) {
+            if (band.layout().storage_index(id, local) < 0) continue;
+            band.distance[a * kBandBlockPoints + size_t(local)] = 0.01 * local - 0.7;
+            set_mask_bit(band.band_mask[a], local);
+        }
+    }
+    band.mixed_inside[size_t(band.add_mixed(6))][2] = 0xF0F0;
+    band.set_tile_inside(7, true);
+    SparseFieldWriteOptions o;
+    o.gradient = false;
+    write_sparse_field(at("m.json"), band, o);
+    const auto read_back = [](const std::string& path) {
+        const SparseBandField b = read_sparse_field(path);
+        b.densify();
+        b.counts();
+    };
+    read_back(at("m.json"));
+    const std::string seed = test::read_text(at("m.json"));
+    const auto [parsed, refused] = fuzz(at("m.json"), seed, kPerSeed, 4300, [&](const std::string& path, const std::string& bytes) {
+        test::write_file(path, bytes);
+        read_back(path);
+    });
+    EXPECT_GT(parsed, 0);
+    EXPECT_GT(refused, 0);
+    test::write_file(at("m.json"), seed);
+    const std::string mask_path = at("m.band_points.raw"), mask = test::read_text(mask_path);
+    ASSERT_EQ(mask.size(), 3u * 64u);
+    int mask_refused = 0, mask_parsed = 0;
+    Mutator m(4400);
+    for (int i = 0; i < kPerSeed; ++i) {
+        test::write_file(mask_path, m.mutate(mask));
+        try {
+            read_back(at("m.json"));
+            ++mask_parsed;
+        } catch (const std::runtime_error& e) {
+            ++mask_refused;
+            EXPECT_NE(std::string(e.what()).find("m.json"), std::string::npos) << e.what();
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "band_points mutation " << i << " threw a foreign exception (" << typeid(e).name() << "): " << e.what();
+        }
+    }
+    std::cout << "m.band_points.raw: " << kPerSeed << " mutations, " << mask_parsed << " parsed, " << mask_refused << " refused\n";
+    EXPECT_GT(mask_refused, 0);
 }
 
 TEST_F(FuzzReaders, ConfigsReadValidatedAndPlanned) {

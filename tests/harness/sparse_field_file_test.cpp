@@ -21,6 +21,7 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "harness/cache/field_cache.h"
 #include "harness/io/sparse_field_file.h"
+#include "harness/io/sparse_nvdb_file.h"
 #include "harness/io/sparse_vdb_file.h"
 #include "harness/study/field_source.h"
 #include "harness_test_util.h"
@@ -92,6 +93,7 @@ void expect_same_band(const SparseBandField& a, const SparseBandField& b, const 
     EXPECT_TRUE(same_bytes(a.distance, b.distance)) << what;
     EXPECT_TRUE(same_bytes(a.gradient, b.gradient)) << what;
     EXPECT_TRUE(same_bytes(a.closest_triangle, b.closest_triangle)) << what;
+    EXPECT_TRUE(same_bytes(a.band_mask, b.band_mask)) << what;
     EXPECT_TRUE(same_bytes(a.mixed, b.mixed)) << what;
     EXPECT_TRUE(same_bytes(a.mixed_inside, b.mixed_inside)) << what;
     EXPECT_TRUE(tile_sides(a) == tile_sides(b)) << what;
@@ -309,6 +311,103 @@ TEST_F(SparseFieldFile, BandWithoutGradientWrittenReadAndRefusedWhereAskedFor) {
     EXPECT_TRUE(same_bytes(from_slim.distance, from_dense.distance));
     EXPECT_TRUE(same_bytes(from_slim.closest_triangle, from_dense.closest_triangle));
     EXPECT_THROW(write_sparse_field(at("again.json"), back), std::invalid_argument);
+}
+
+// A band sampled without its closest triangles (the distance alone): its file holds the band
+// points' mask ("band_points") instead of the triangles, reads back as the same band (mask,
+// distances, tiles, signs), densifies to the dense band file without its triangle channel,
+// and writes the same .vdb/.nvdb active voxels as the full band; a file with both or
+// neither marking channel, or a mask bit on padding, is refused naming the file and channel.
+TEST_F(SparseFieldFile, BandWithoutTrianglesWritesItsMaskAndReadsBack) {
+    const PreparedMesh bowl = test::open_bowl();
+    const Lattice lattice = fit_lattice(LatticeType::CC, {96, 96, 96}, bowl.bounds(), 0.6);  // mixed blocks, as above
+    const double w = 1.0 * lattice.spacing;
+    const auto bound = make_cpu_bvh_sampler(options(0, SignMode::Winding))->bind(share(bowl));
+    BandChannels lean_channels;
+    lean_channels.gradient = false;
+    lean_channels.closest_triangle = false;
+    const SparseBandField full = bound->sample_band_sparse(lattice, w);
+    const SparseBandField lean = bound->sample_band_sparse(lattice, w, lean_channels);
+    ASSERT_GT(lean.mixed.size(), 0u);
+    SparseFieldWriteOptions o64;
+    o64.dtype = FieldDtype::Float64;
+    o64.gradient = false;
+    write_sparse_field(at("lean.json"), lean, o64);
+    const nlohmann::json header = test::read_json(at("lean.json"));
+    EXPECT_FALSE(header["channels"].contains("closest_triangle"));
+    EXPECT_EQ(header["channels"]["band_points"]["dtype"], "uint64");
+    EXPECT_EQ(header["channels"]["band_points"]["components"], 8);
+    EXPECT_EQ(header["band"]["band_points"], full.counts().band_points);
+    EXPECT_EQ(fs::file_size(at(header["channels"]["band_points"]["file"].get<std::string>())), lean.active.size() * 64);
+    const SparseBandField back = read_sparse_field(at("lean.json"));
+    EXPECT_FALSE(back.channels.closest_triangle);
+    EXPECT_FALSE(back.channels.gradient);
+    expect_same_band(lean, back, "without triangles, float64");
+    EXPECT_TRUE(same_bytes(full.band_mask, back.band_mask));
+    // The full band's file: its mask comes back from its triangles.
+    write_sparse_field(at("full.json"), full, o64);
+    const SparseBandField full_back = read_sparse_field(at("full.json"));
+    EXPECT_TRUE(same_bytes(full_back.band_mask, back.band_mask));
+    EXPECT_TRUE(same_bytes(full_back.distance, back.distance));
+    // Densified: the dense band file's distances (float64 both), no triangle channel.
+    FieldWriteOptions dense64;
+    dense64.dtype = FieldDtype::Float64;
+    write_field(at("dense.json"), make_cpu_bvh_sampler(options(w, SignMode::Winding))->bind(share(bowl))->sample(lattice),
+                dense64);
+    const SampledField from_dense = read_field(at("dense.json"));
+    const SampledField from_lean = read_field_densified(at("lean.json"), "test");
+    EXPECT_TRUE(from_lean.closest_triangle.empty());
+    EXPECT_TRUE(same_bytes(from_lean.distance, from_dense.distance));
+    // Writers refuse the triangles the band does not hold.
+    SparseVdbOptions vdb;
+    vdb.gradient = false;
+    vdb.closest_triangle = true;
+    const std::string e = test::error_of([&] { write_sparse_band_vdb(lean, at("lean.vdb"), vdb); });
+    EXPECT_TRUE(test::Contains(e, "lean.vdb")) << e;
+    EXPECT_TRUE(test::Contains(e, "the band holds no closest triangle")) << e;
+    EXPECT_FALSE(fs::exists(at("lean.vdb")));
+    if (nanovdb_available()) {  // the same NanoVDB level set, byte for byte
+        write_sparse_band_nvdb(full, at("full.nvdb"));
+        const SparseNvdbCounts counts = write_sparse_band_nvdb(back, at("lean.nvdb"));
+        EXPECT_EQ(counts.active_voxels, full.counts().band_points);
+        EXPECT_EQ(test::read_text(at("full.nvdb")), test::read_text(at("lean.nvdb")));
+    }
+    // Hostile variants of its header and mask.
+    const std::string mask_path = at(header["channels"]["band_points"]["file"].get<std::string>());
+    const std::string mask = test::read_text(mask_path);
+    nlohmann::json h = header;
+    h["channels"].erase("band_points");
+    test::write_file(at("lean.json"), h.dump(2));
+    std::string err = test::error_of([&] { read_sparse_field(at("lean.json")); });
+    EXPECT_TRUE(test::Contains(err, "lean.json") && test::Contains(err, "'band_points'") && test::Contains(err, "neither")) << err;
+    h = header;
+    h["channels"]["closest_triangle"] = {{"file", h["channels"]["band_points"]["file"]}, {"dtype", "int32"}};
+    test::write_file(at("lean.json"), h.dump(2));
+    err = test::error_of([&] { read_sparse_field(at("lean.json")); });
+    EXPECT_TRUE(test::Contains(err, "lean.json") && test::Contains(err, "both")) << err;
+    test::write_file(at("lean.json"), header.dump(2));
+    test::write_file(mask_path, mask.substr(8));
+    err = test::error_of([&] { read_sparse_field(at("lean.json")); });
+    EXPECT_TRUE(test::Contains(err, "channel 'band_points'") && test::Contains(err, "bytes")) << err;
+    // A bit on a padding point, in a lattice close around the bowl (active blocks at its far edges).
+    const Lattice tight = fit_lattice(LatticeType::CC, {27, 26, 25}, bowl.bounds(), 0.05);
+    const SparseBandField edge = bound->sample_band_sparse(tight, 2 * tight.spacing, lean_channels);
+    write_sparse_field(at("edge.json"), edge, o64);
+    read_sparse_field(at("edge.json"));
+    size_t a = 0;
+    int pad = -1;
+    for (; a < edge.active.size() && pad < 0; ++a)
+        for (int local = 0; local < kBandBlockPoints && pad < 0; ++local)
+            if (edge.layout().storage_index(edge.active[a], local) < 0) pad = local;
+    ASSERT_GE(pad, 0) << "no active block with padding";
+    const std::string edge_mask = at(test::read_json(at("edge.json"))["channels"]["band_points"]["file"].get<std::string>());
+    std::string bad = test::read_text(edge_mask);
+    bad[(a - 1) * 64 + size_t(pad / 8)] = char(bad[(a - 1) * 64 + size_t(pad / 8)] | (1 << (pad % 8)));
+    test::write_file(edge_mask, bad);
+    err = test::error_of([&] { read_sparse_field(at("edge.json")); });
+    EXPECT_TRUE(test::Contains(err, "edge.json") && test::Contains(err, "channel 'band_points'") &&
+                test::Contains(err, "padding"))
+        << err;
 }
 
 class HostileSparseFile : public SparseFieldFile {

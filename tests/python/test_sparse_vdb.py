@@ -209,3 +209,34 @@ def test_channels_without_gradient_keep_none_and_the_same_bytes(tmp_path):
     full_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "full.vdb"))[0]}
     assert set(slim_grids) == {"distance"}
     assert slim_grids["distance"].activeVoxelCount() == full_grids["distance"].activeVoxelCount() > 0
+
+
+def test_channels_distance_alone_keeps_neither_gradient_nor_triangles(tmp_path):
+    """--channels distance --band W --sparse: the band holds the distance and its points' mask only (the
+    sampler's report says so); the dense field file's distances are the full run's bytes, the sparse field
+    file marks the band's points with its band_points mask, and the .vdb has the full run's active voxels
+    and values."""
+    if os.environ.get("SDF_HAVE_OPENVDB", "0") != "1":
+        pytest.skip("this build has no OpenVDB")
+    import pyopenvdb
+    common = ["--lattice", "bcc", "--resolution", "30", "--band", "0.1", "--dtype", "float64", "--sparse"]
+    lean = ["--channels", "distance"]
+    _sdf_sample(tmp_path, "shape:torus", common + ["--out", "full.json", "--vdb", "full.vdb"])
+    _sdf_sample(tmp_path, "shape:torus", common + lean + ["--out", "lean.json", "--vdb", "lean.vdb"])
+    _sdf_sample(tmp_path, "shape:torus", common + lean + ["--layout", "sparse", "--out", "lean-sparse.json"])
+    headers = {}
+    for name in ("full", "lean", "lean-sparse"):
+        with open(tmp_path / (name + ".json")) as f:
+            headers[name] = json.load(f)
+    for name in ("lean", "lean-sparse"):
+        assert headers[name]["sampler"]["details"]["sparse_band"]["channels"] == ["distance"]
+        assert "closest_triangle" not in headers[name]["channels"] and "gradient" not in headers[name]["channels"]
+    assert headers["lean-sparse"]["channels"]["band_points"]["dtype"] == "uint64"
+    assert headers["lean-sparse"]["band"]["band_points"] == headers["full"]["sampler"]["band"]["points_in_band"]
+    full = _channel(str(tmp_path / "full.json"), headers["full"], "distance")
+    assert full.tobytes() == _channel(str(tmp_path / "lean.json"), headers["lean"], "distance").tobytes()
+    full_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "full.vdb"))[0]}
+    lean_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "lean.vdb"))[0]}
+    assert set(lean_grids) == {"distance_primary", "distance_secondary"}
+    for name, grid in lean_grids.items():
+        assert _active_voxels(grid) == _active_voxels(full_grids[name]) != {}

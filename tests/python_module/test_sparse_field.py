@@ -226,6 +226,70 @@ def test_band_without_gradient_has_the_same_distances_and_triangles(pair, tmp_pa
         sl.sample(mesh, lattice, resolution, band=W, gradient="no", backend="cpu", **keywords)
 
 
+def test_band_without_triangles_has_the_same_values_points_and_level_sets(pair, tmp_path):
+    """band=W, closest_triangle=False (with and without gradient=False): no triangle held (None), the same
+    distances, gradients, points and counts bit for bit, less memory; to_dense() without triangles but the
+    same values; write() of .json holds the band points' mask, read back as the same band; the .nvdb is the
+    full band's byte for byte and the .vdb holds the same active voxels and values."""
+    mesh, lattice, resolution, keywords, sparse, dense = pair
+    for gradient in (True, False):
+        lean = sl.sample(mesh, lattice, resolution, band=W, gradient=gradient, closest_triangle=False, backend="cpu",
+                         threads=2, **keywords)
+        assert lean.triangle is None and (lean.gradient is None) == (not gradient)
+        names = ("distance", "points", "indices", "subgrid") + (("gradient",) if gradient else ())
+        for name in names:
+            assert same_bits(getattr(lean, name), getattr(sparse, name)), name
+        assert lean.counts == sparse.counts and lean.nbytes < sparse.nbytes
+        d = lean.to_dense()
+        assert d.triangle is None
+        for a, b in zip(grids(d.values), grids(dense.values)):
+            assert same_bits(a, b)
+        if gradient:
+            for a, b in zip(grids(d.gradient), grids(dense.gradient)):
+                assert same_bits(a, b)
+    same_sdf = sl.SDF(mesh, backend="cpu", threads=2, **keywords).sample(lattice, resolution, band=W, gradient=False,
+                                                                          closest_triangle=False)
+    assert same_sdf.triangle is None and same_bits(same_sdf.distance, sparse.distance)
+    path = str(tmp_path / "lean.json")
+    files = lean.write(path, dtype="float64")
+    with open(path) as f:
+        channels = json.load(f)["channels"]
+    assert "closest_triangle" not in channels and channels["band_points"]["dtype"] == "uint64"
+    assert len(files) == 7  # header, 6 channels: no gradient, the mask for the triangles
+    back = sl.read_field(path)
+    assert back.triangle is None and back.gradient is None and back.counts == sparse.counts
+    assert same_bits(back.distance, sparse.distance) and same_bits(back.points, sparse.points)
+    with pytest.raises(ValueError, match="holds no closest triangle"):
+        lean.write(str(tmp_path / "t.vdb"), closest_triangle=True)
+    try:
+        sparse.write(str(tmp_path / "full.nvdb"))
+    except RuntimeError as e:  # a build without NanoVDB
+        assert "NanoVDB" in str(e)
+    else:
+        lean.write(str(tmp_path / "lean.nvdb"))
+        assert (tmp_path / "full.nvdb").read_bytes() == (tmp_path / "lean.nvdb").read_bytes()
+    try:
+        import pyopenvdb
+    except ImportError:
+        pyopenvdb = None
+    if sl.build_info()["optional"]["openvdb"]["found"] and pyopenvdb is not None:
+        sparse.write(str(tmp_path / "full.vdb"))
+        lean.write(str(tmp_path / "lean.vdb"))
+        full_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "full.vdb"))[0]}
+        lean_grids = {g.name: g for g in pyopenvdb.readAll(str(tmp_path / "lean.vdb"))[0]}
+        for name, grid in lean_grids.items():
+            if not name.startswith("distance"):
+                continue
+            def on(g):
+                return sorted((tuple(item["min"]), item["value"]) for item in g.citerOnValues())
+            assert grid.activeVoxelCount() == full_grids[name].activeVoxelCount() > 0
+            assert on(grid) == on(full_grids[name])
+    with pytest.raises(TypeError, match="closest_triangle= goes with band=W"):
+        sl.sample(mesh, lattice, resolution, closest_triangle=False, backend="cpu", **keywords)
+    with pytest.raises(TypeError, match="True or False"):
+        sl.sample(mesh, lattice, resolution, band=W, closest_triangle=0, backend="cpu", **keywords)
+
+
 def test_reconstruct_inside_the_band_is_the_dense_fields(pair):
     _, lattice, *_, sparse, dense = pair
     interpolator = "tricubic_lm" if lattice == "cc" else "bcc_cubic"

@@ -225,6 +225,7 @@ SparseBandField sphere_band(const Lattice& lattice, const Vec3d& c) {
                         band.distance[base + size_t(local)] = length(x) - radius < 0 ? -w : w;
                     }
             }
+    band.mask_from_triangles();  // the band's points, as its triangles mark them
     return band;
 }
 

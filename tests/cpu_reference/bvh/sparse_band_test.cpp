@@ -172,7 +172,9 @@ int64_t bad_padding(const SparseBandField& band, int64_t& checked) {
             const size_t v = a * kBandBlockPoints + size_t(local);
             const bool zero = !band.channels.gradient ||
                               (band.gradient[v].x == 0 && band.gradient[v].y == 0 && band.gradient[v].z == 0);
-            if (!(band.distance[v] == band.width && band.closest_triangle[v] == kOutsideBandTriangle && zero)) ++bad;
+            const bool off_band = !band.in_band(a, local) &&
+                                  (!band.channels.closest_triangle || band.closest_triangle[v] == kOutsideBandTriangle);
+            if (!(band.distance[v] == band.width && off_band && zero)) ++bad;
         }
     return bad;
 }
@@ -261,6 +263,125 @@ TEST(SparseBand, WithoutTheGradientTheSameDistancesAndTriangles) {
     dense.gradient.clear();
     EXPECT_THROW(SparseBandField::sparsify(dense, 2 * lattice.spacing), std::invalid_argument);
     EXPECT_TRUE(SparseBandField::sparsify(dense, 2 * lattice.spacing, slim_channels).gradient.empty());
+}
+
+/// The band's points by the rule of the dense band (narrow_band.h): the points of each active
+/// block whose closest triangle is not kOutsideBandTriangle, padding excluded.
+std::vector<BandPointMask> masks_from_triangles(const SparseBandField& band) {
+    std::vector<BandPointMask> masks(band.active.size(), BandPointMask{});
+    for (size_t a = 0; a < band.active.size(); ++a)
+        for (int local = 0; local < kBandBlockPoints; ++local)
+            if (band.layout().storage_index(band.active[a], local) >= 0 &&
+                band.closest_triangle[a * kBandBlockPoints + size_t(local)] != kOutsideBandTriangle)
+                set_mask_bit(masks[a], local);
+    return masks;
+}
+
+bool same_masks(const std::vector<BandPointMask>& a, const DefaultInitVector<BandPointMask>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(BandPointMask)) == 0);
+}
+
+bool same_counts(const SparseBandCounts& a, const SparseBandCounts& b) {
+    return a.blocks == b.blocks && a.active_blocks == b.active_blocks && a.mixed_blocks == b.mixed_blocks && a.tiles == b.tiles &&
+           a.inside_tiles == b.inside_tiles && a.active_points == b.active_points && a.band_points == b.band_points;
+}
+
+// A band sampled without its closest triangles (with and without the gradient): the same
+// distances (and gradients), tiles and mixed blocks byte for byte as the full band, and its
+// band points, a bit per point, are the full band's points whose triangle marks them
+// (through the brick kernel and the point queries). Densified it is the dense band without
+// the closest-triangle channel; its slabs count the dense slabs' band points.
+TEST(SparseBand, WithoutTheClosestTriangleTheSameValuesAndBandPoints) {
+    BandChannels no_triangle, distance_only;
+    no_triangle.closest_triangle = false;
+    distance_only.gradient = false;
+    distance_only.closest_triangle = false;
+    int64_t padding = 0;
+    for (const Case& c : cases()) {
+        const Lattice cc = fit_lattice(LatticeType::CC, {41, 38, 36}, c.mesh.bounds(), 0.4);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, {29, 27, 26}, c.mesh.bounds(), 0.4);
+        for (const Lattice& lattice : {cc, bcc}) {
+            const double w = 2.0 * lattice.spacing;
+            const auto bound = make_cpu_bvh_sampler(options(Precision::Float, 0, c.sign))->bind(share(c.mesh));
+            const SparseBandField full = bound->sample_band_sparse(lattice, w);
+            const std::vector<BandPointMask> truth = masks_from_triangles(full);
+            EXPECT_TRUE(same_masks(truth, full.band_mask)) << c.name << " " << lattice_notation(lattice) << ": the full band";
+            const SampledField dense =
+                make_cpu_bvh_sampler(options(Precision::Float, w, c.sign))->bind(share(c.mesh))->sample(lattice);
+            for (const BandChannels& channels : {no_triangle, distance_only}) {
+                const std::string what = c.name + " " + lattice_notation(lattice) + (channels.gradient ? " no triangle" : " distance only");
+                const SparseBandField lean = bound->sample_band_sparse(lattice, w, channels);
+                EXPECT_FALSE(lean.channels.closest_triangle) << what;
+                EXPECT_TRUE(lean.closest_triangle.empty()) << what;
+                EXPECT_EQ(lean.gradient.empty(), !channels.gradient) << what;
+                EXPECT_TRUE(same_bytes(full.active, lean.active)) << what;
+                EXPECT_TRUE(same_bytes(full.distance, lean.distance)) << what;
+                if (channels.gradient) {
+                    EXPECT_TRUE(same_bytes(full.gradient, lean.gradient)) << what;
+                }
+                EXPECT_TRUE(same_masks(truth, lean.band_mask)) << what;
+                EXPECT_TRUE(same_bytes(full.mixed, lean.mixed)) << what;
+                EXPECT_TRUE(same_bytes(full.mixed_inside, lean.mixed_inside)) << what;
+                EXPECT_TRUE(same_counts(full.counts(), lean.counts())) << what;
+                EXPECT_EQ(lean.counts().band_points, count_narrow_band(dense).in_band) << what;
+                EXPECT_EQ(bad_padding(lean, padding), 0) << what;
+                EXPECT_LT(lean.memory_bytes(), full.memory_bytes()) << what;
+                EXPECT_EQ(lean.sampler.details["sparse_band"]["channels"], channel_names(channels)) << what;
+                // Densified: the dense band's distances (and gradients), no triangle channel.
+                const SampledField densified = lean.densify();
+                EXPECT_TRUE(densified.closest_triangle.empty()) << what;
+                EXPECT_TRUE(same_bytes(dense.distance, densified.distance)) << what;
+                if (channels.gradient) {
+                    EXPECT_TRUE(same_bytes(dense.gradient, densified.gradient)) << what;
+                } else {
+                    EXPECT_TRUE(densified.gradient.empty()) << what;
+                }
+                // A slab's counts from the mask: the dense slab's (count_narrow_band of its triangles).
+                NarrowBandCounts slab_counts;
+                const SampledField slab = lean.densify_slab({3, 9}, &slab_counts);
+                const NarrowBandCounts dense_slab = count_narrow_band(full.densify_slab({3, 9}));
+                EXPECT_TRUE(slab.closest_triangle.empty()) << what;
+                EXPECT_EQ(slab_counts.in_band, dense_slab.in_band) << what;
+                EXPECT_EQ(slab_counts.outside, dense_slab.outside) << what;
+                EXPECT_LT(SparseBandField::dense_bytes(lattice, channels), SparseBandField::dense_bytes(lattice)) << what;
+                // Sparsified without the channel: the band sparsified with it (whose active
+                // blocks are those holding band points, fewer than the sampler's), less the triangles.
+                const SparseBandField sparsified = SparseBandField::sparsify(dense, w, channels);
+                const SparseBandField sparsified_full = SparseBandField::sparsify(dense, w);
+                EXPECT_TRUE(sparsified.closest_triangle.empty()) << what;
+                EXPECT_TRUE(same_masks(masks_from_triangles(sparsified_full), sparsified.band_mask) &&
+                            same_bytes(sparsified.distance, sparsified_full.distance) &&
+                            same_bytes(sparsified.active, sparsified_full.active))
+                    << what;
+                EXPECT_EQ(sparsified.counts().band_points, lean.counts().band_points) << what;
+                // Asking it for triangles is refused, naming the caller's what.
+                BandChannels wanted = channels;
+                wanted.closest_triangle = true;
+                try {
+                    lean.require_channels(wanted, "the test's writer");
+                    ADD_FAILURE() << what << ": require_channels accepted a missing closest triangle";
+                } catch (const std::invalid_argument& e) {
+                    EXPECT_NE(std::string(e.what()).find("the test's writer: the band holds no closest triangle"),
+                              std::string::npos)
+                        << e.what();
+                }
+                EXPECT_NO_THROW(lean.require_channels(channels, "x")) << what;
+            }
+            if (HasFailure()) return;
+        }
+        // Point queries (brute force has no block kernel): the same band points too, padding
+        // included (a lattice close around the mesh).
+        const Lattice lattice = fit_lattice(LatticeType::CC, {27, 26, 25}, c.mesh.bounds(), 0.05);
+        const auto brute = make_cpu_brute_force_sampler(options(Precision::Float, 0, c.sign))->bind(share(c.mesh));
+        const SparseBandField full = brute->sample_band_sparse(lattice, 2 * lattice.spacing);
+        const SparseBandField lean = brute->sample_band_sparse(lattice, 2 * lattice.spacing, distance_only);
+        EXPECT_TRUE(lean.closest_triangle.empty() && lean.gradient.empty()) << c.name;
+        EXPECT_TRUE(same_masks(masks_from_triangles(full), full.band_mask)) << c.name << " brute force";
+        EXPECT_TRUE(same_masks(masks_from_triangles(full), lean.band_mask) && same_bytes(full.distance, lean.distance))
+            << c.name << " brute force";
+        EXPECT_EQ(bad_padding(lean, padding), 0) << c.name << " brute force";
+    }
+    EXPECT_GT(padding, 0) << "no active block reached the lattice's far edges";
 }
 
 // Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
