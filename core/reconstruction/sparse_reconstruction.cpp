@@ -41,7 +41,7 @@ bool reconstructs_locally(InterpolatorKind kind) {
 
 SparseReconstruction::SparseReconstruction(const SparseBandField& band, const ReconstructionSpec& spec, bool gradient)
     : band_(band), spec_(spec), gradient_(gradient), frame_(frame_of(band.lattice)) {
-    if (gradient && band.gradient.size() != band.distance.size())
+    if (gradient && (!band.channels.gradient || band.gradient.size() != band.distance.size()))
         throw std::invalid_argument("sparse band has " + std::to_string(band.gradient.size()) + " gradients for " +
                                     std::to_string(band.distance.size()) + " values");
     validate_reconstruction(spec_, band.lattice, gradient);
@@ -141,11 +141,17 @@ void SparseReconstruction::evaluate(const Vec3d* points, ReconstructedSample<dou
     parallel_for(int64_t(starts.size()) - 1, 1, threads, [&](int64_t begin, int64_t end) {
         for (int64_t g = begin; g < end; ++g) {
             const int64_t first = starts[size_t(g)], count = starts[size_t(g) + 1] - first;
-            const Int3 c = cell_of(frame_.to_lattice(points[order[size_t(first)]]));
-            const Int3 block{c.x / kCellBlock * kCellBlock, c.y / kCellBlock * kCellBlock, c.z / kCellBlock * kCellBlock};
-            const Int3 last{std::min(block.x + kCellBlock - 1, r.x - 2), std::min(block.y + kCellBlock - 1, r.y - 2),
-                            std::min(block.z + kCellBlock - 1, r.z - 2)};
-            evaluate_group(block, last, points, order.data() + first, count, out);
+            // The window covers the cells the group's points lie in (a few scattered points
+            // need no window of the whole block).
+            Int3 lo = cell_of(frame_.to_lattice(points[order[size_t(first)]])), hi = lo;
+            for (int64_t k = 1; k < count; ++k) {
+                const Int3 c = cell_of(frame_.to_lattice(points[order[size_t(first + k)]]));
+                for (int a = 0; a < 3; ++a) {
+                    lo[a] = std::min(lo[a], c[a]);
+                    hi[a] = std::max(hi[a], c[a]);
+                }
+            }
+            evaluate_group(lo, hi, points, order.data() + first, count, out);
         }
     });
 }

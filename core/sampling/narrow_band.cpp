@@ -1,6 +1,7 @@
 #include "core/sampling/narrow_band.h"
 
 #include <stdexcept>
+#include <string>
 
 namespace sdf {
 
@@ -12,6 +13,10 @@ void require_band_width(double w, const std::string& what) {
 
 NarrowBandCounts apply_narrow_band(SampledField& field, double w) {
     require_band_width(w);
+    if (field.closest_triangle.size() != field.distance.size())  // it marks the band's points
+        throw std::invalid_argument("narrow band: the field holds " + std::to_string(field.closest_triangle.size()) +
+                                    " closest triangles for " + std::to_string(field.distance.size()) +
+                                    " points; banding needs one per point");
     NarrowBandCounts counts;
     for (int64_t i = 0; i < field.size(); ++i) {
         if (field.closest_triangle[size_t(i)] == kOutsideBandTriangle) {

@@ -177,8 +177,8 @@ private:
                     });
                     out.band_mask[a] = in_band;
                     if (!flood) continue;
-                    if (std::none_of(side.begin(), side.end(), band_side_known)) {  // its point 0 by a plain search
-                        side[0] = plain_search_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside;
+                    if (std::none_of(side.begin(), side.end(), band_side_known)) {  // its point 0 by the double search
+                        side[0] = nearest_side_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside;
                         ++searched_blocks;
                     }
                     for (bool changed = true; changed;) {
@@ -202,17 +202,14 @@ private:
         };
     }
 
-    /// Whether p is inside by the pseudonormal sign at a plain search's nearest triangle (the
-    /// band probes' sign: p lies beyond the band of a solid).
-    bool plain_search_inside(const Vec3d& p) const {
+    /// Whether p is inside by the pseudonormal sign at its nearest triangle, found by the
+    /// double search (the reference: exact where a float search may tie across a thin part;
+    /// p lies beyond the band of a solid).
+    bool nearest_side_inside(const Vec3d& p) const {
         BvhStats stats;
-        return with_precision(options_.precision, [&](auto zero) {
-            using T = decltype(zero);
-            const BvhView<T> view = bvh_->view<T>();
-            const Vec3<T> pt(p);
-            const BvhHit<T> hit = cpu_kernels<T>().closest_triangle(view, pt, seed_hit(view, -1, pt), stats);
-            return signed_distance_to_triangle(mesh().buffers<double>().view(), p, view.triangle_index[hit.slot]).distance < 0;
-        });
+        const BvhView<double> view = bvh_->view<double>();
+        const BvhHit<double> hit = cpu_kernels<double>().closest_triangle(view, p, seed_hit(view, -1, p), stats);
+        return signed_distance_to_triangle(mesh().buffers<double>().view(), p, view.triangle_index[hit.slot]).distance < 0;
     }
 
     /// The brick skip of the band: with the winding sign (each point's own), or with the

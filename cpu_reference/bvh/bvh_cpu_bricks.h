@@ -183,7 +183,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             seed_packet(view, seed, pk);
             int32_t* column_below = &below[size_t(b % bricks.x) * kBrick];
             improve_seeds_from_below(view, column_below, pk);
-            if (band.bound_squared > 0) {  // a seed beyond the bound gives way to it
+            if (band.bound_squared > 0) {  // a seed beyond the bound gives way to it (the search widens the radius)
                 const T bound = T(band.bound_squared);
                 for (int k = 0; k < kBrick; ++k)
                     if (!(pk.best_q[k] <= bound)) {

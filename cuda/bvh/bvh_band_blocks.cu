@@ -89,8 +89,8 @@ __global__ void to_source_order(int* triangle, int64_t n, const int32_t* source_
 /// The sides of the points a bounded search left without a triangle (kOutsideBandFlood): one
 /// CUDA block of 512 threads per band block, each point taking a neighbour's side
 /// (kernels/lattice/band_sides.h) until none changes. A block of such points only takes the
-/// side of its point 0 from a plain search, as brick_band_code takes its centre's (that
-/// point too lies beyond the band). counters: points flooded, blocks signed by a search,
+/// side of its point 0, at its nearest triangle in double (that point too lies beyond the
+/// band). counters: points flooded, blocks signed by a search,
 /// points left without a side (never: the host checks).
 template <typename T>
 __global__ void __launch_bounds__(kBandBlockPoints)
@@ -106,11 +106,38 @@ __global__ void __launch_bounds__(kBandBlockPoints)
     const int flooded = __syncthreads_count(flood);
     if (flooded == 0) return;  // uniform over the block
     if (!__syncthreads_or(!flood && !padding)) {
-        if (local == 0) {  // point 0 of a block is never padding
-            const Vec3d p = piece.position(i);
-            const BvhHit<T> hit = closest_triangle_bvh(bvh, Vec3<T>(p));
-            const bool inside = signed_distance_to_triangle(mesh, p, bvh.triangle_index[hit.slot]).distance < 0;
-            side[0] = inside ? kBandSideInside : kBandSideOutside;
+        // Point 0's side (a block's point 0 is never padding) at its nearest triangle in
+        // double over every triangle, the block's threads sharing them (ties: the smaller
+        // index, as closest_triangle_bvh.h's rule): exact where a float search may tie
+        // across a thin part. A block without a point of known side is rare.
+        __shared__ double nearest_d[kBandBlockPoints];
+        __shared__ int nearest_t[kBandBlockPoints];
+        const Vec3d p = piece.position(int64_t(blockIdx.x) * kBandBlockPoints);
+        double best = INFINITY;
+        int best_t = -1;
+        for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
+            const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
+            if (d < best) {
+                best = d;
+                best_t = t;
+            }
+        }
+        nearest_d[local] = best;
+        nearest_t[local] = best_t;
+        __syncthreads();
+        for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
+            if (local < half) {
+                const double d = nearest_d[local + half];
+                const int t = nearest_t[local + half];
+                if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
+                    nearest_d[local] = d;
+                    nearest_t[local] = t;
+                }
+            }
+            __syncthreads();
+        }
+        if (local == 0) {
+            side[0] = signed_distance_to_triangle(mesh, p, nearest_t[0]).distance < 0 ? kBandSideInside : kBandSideOutside;
             atomicAdd(counters + 1, 1ull);
         }
         __syncthreads();

@@ -391,6 +391,20 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
                                              " marks its point " + std::to_string(local) +
                                              " as a band point, but it lies beyond the lattice (padding)");
     }
+    // The values agree with the marks (a writer's invariant, which the level-set writers and
+    // the band's cells rely on): a band point has |d| <= W, any other point +-W (padding +W).
+    for (size_t a = 0; a < band.active.size(); ++a)
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            const double d = band.distance[a * kBandBlockPoints + size_t(local)];
+            const bool padding = band.layout().storage_index(band.active[a], local) < 0;
+            const bool in_band = band.in_band(a, local);
+            const bool fits = in_band ? std::abs(d) <= band.width : padding ? d == band.width : std::abs(d) == band.width;
+            if (!fits)
+                throw std::runtime_error(header + ": channel 'distance': block " + std::to_string(band.active[a]) + " point " +
+                                         std::to_string(local) + " holds " + std::to_string(d) + ", expected " +
+                                         (in_band ? "|d| <= W (a band point)" : padding ? "+W (padding)" : "+-W (outside the band)") +
+                                         " with W = " + std::to_string(band.width));
+        }
     if (grad) {
         band.gradient.resize(size_t(points));
         read_values(*grad, band.gradient.empty() ? nullptr : &band.gradient[0].x, 3 * points, header);

@@ -336,7 +336,12 @@ StreamResult sample_streamed(const BoundSampler& sampler, const SamplerOptions& 
         if (field->size() != slab_point_count(lattice, slab))
             throw std::logic_error("sampler returned " + std::to_string(field->size()) + " points for a slab of " +
                                    std::to_string(slab_point_count(lattice, slab)));
-        if (w > 0) {
+        if (w > 0 && field->closest_triangle.empty() && field->sampler.band) {
+            // A sparse band's slab held without triangles (SparseBandSlabs): banded already,
+            // counted from the band's mask.
+            result.band.in_band += field->sampler.band->points_in_band;
+            result.band.outside += field->sampler.band->points_outside;
+        } else if (w > 0) {
             const NarrowBandCounts c = apply_narrow_band(*field, w);
             result.band.in_band += c.in_band;
             result.band.outside += c.outside;

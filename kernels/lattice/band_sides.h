@@ -46,10 +46,11 @@ SDF_CPU_GPU SDF_INLINE signed char neighbour_side(const SideOf& side, int local)
 /// The squared radius a search bounded by the band starts with (its points find no triangle
 /// when they lie beyond the band, and then take their sides from their neighbours): a
 /// triangle whose T distance from a point is at least its root lies farther than `width`
-/// from it. The allowance is the band skip's (64 epsilon of the magnitudes, here 256; the
-/// float search is exact relative to them) plus the sliver reach (how much farther than the
-/// true nearest a search's nearest may be, FloatSearchBound::sliver_reach_*). `scale` bounds
-/// every |coordinate| of the points and of the mesh.
+/// from it. The allowance is 256 epsilon of the magnitudes (the float search is exact relative
+/// to them; wider than the GPU brick skip's 64 epsilon and, in float, the CPU probes' relative
+/// 1e-5 of W alone) plus the sliver reach (how much farther than the true nearest a search's
+/// nearest may be, FloatSearchBound::sliver_reach_*). `scale` bounds every |coordinate| of the
+/// points and of the mesh.
 template <typename T>
 inline double band_search_bound_squared(double width, double scale, double sliver_reach) {
     const double e = 256.0 * double(std::numeric_limits<T>::epsilon());

@@ -3,6 +3,7 @@
 // here, python/sdf_lattices/_sparse.py). No dense array is made unless to_dense() is asked.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -95,16 +96,21 @@ public:
     }
     size_t nbytes() const { return band_->memory_bytes() + at_.capacity() * sizeof(int64_t); }
     /// Whether the band holds gradients (a file read without its gradient channel does not).
-    bool has_gradient() const { return band_->gradient.size() == band_->distance.size(); }
+    bool has_gradient() const { return band_->channels.gradient; }
 
     /// The band's reconstruction of `spec`, the last one kept for the next call. Each caller
     /// holds its own reference (the GIL is released while it evaluates); it reads band_,
     /// which lives as long as this object.
     std::shared_ptr<const SparseReconstruction> reconstruction(const ReconstructionSpec& spec) const {
-        const std::string key = describe(spec);
-        if (!recon_ || recon_key_ != key) {
+        // Keyed on the exact values (describe() prints sigma2 to 6 digits); threads only
+        // change how the derivative arrays are built, not their values.
+        const auto same = [](const ReconstructionSpec& a, const ReconstructionSpec& b) {
+            return a.interpolator == b.interpolator && a.derivatives == b.derivatives && a.sigma_units == b.sigma_units &&
+                   std::memcmp(&a.sigma2, &b.sigma2, sizeof(double)) == 0;
+        };
+        if (!recon_ || !same(recon_spec_, spec)) {
             recon_ = std::make_shared<const SparseReconstruction>(*band_, spec, has_gradient());
-            recon_key_ = key;
+            recon_spec_ = spec;
         }
         return recon_;
     }
@@ -243,7 +249,7 @@ private:
     std::vector<int64_t> at_;
     mutable std::shared_ptr<Field> dense_;
     mutable std::shared_ptr<const SparseReconstruction> recon_;
-    mutable std::string recon_key_;
+    mutable ReconstructionSpec recon_spec_;
 };
 
 /// read_field of a sparse band's field file (sdf_lattices._fields routes .json files here).

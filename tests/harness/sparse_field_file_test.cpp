@@ -13,6 +13,7 @@
 #include <map>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -492,6 +493,32 @@ TEST_F(HostileSparseFile, RefusedWithTheFileAndWhatWasExpected) {
             EXPECT_TRUE(test::Contains(test::error_of([&] { read_sparse_field(at("h.json")); }), "also active"));
         }
     }
+}
+
+TEST_F(HostileSparseFile, ValuesThatContradictTheMarksAreRefused) {
+    // A band point must hold |d| <= W and any other point +-W: a file that says otherwise
+    // would give level sets with active voxels outside the band.
+    write_sparse_field(at("h.json"), band_, {FieldDtype::Float64, true, Overwrite::Allow});
+    header_ = test::read_json(at("h.json"));
+    const std::string values = test::read_text(channel("distance"));
+    int64_t in = -1, out = -1;
+    for (size_t a = 0; a < band_.active.size(); ++a)
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (band_.layout().storage_index(band_.active[a], local) < 0) continue;
+            (band_.in_band(a, local) ? in : out) = int64_t(a) * kBandBlockPoints + local;
+        }
+    ASSERT_GE(in, 0);
+    ASSERT_GE(out, 0);
+    for (const auto& [at_point, value, expected] : {std::tuple{in, 2 * band_.width, "a band point"},
+                                                    std::tuple{out, 0.5 * band_.width, "outside the band"}}) {
+        std::string bad = values;
+        std::memcpy(bad.data() + 8 * at_point, &value, 8);
+        test::write_file(channel("distance"), bad);
+        const std::string e = test::error_of([&] { read_sparse_field(at("h.json")); });
+        EXPECT_TRUE(test::Contains(e, "h.json") && test::Contains(e, "channel 'distance'") && test::Contains(e, expected)) << e;
+    }
+    test::write_file(channel("distance"), values);
+    read_sparse_field(at("h.json"));
 }
 
 TEST_F(HostileSparseFile, ReplacedWholeAndNeverSilently) {

@@ -229,7 +229,7 @@ def test_channels_distance_alone_keeps_neither_gradient_nor_triangles(tmp_path):
         with open(tmp_path / (name + ".json")) as f:
             headers[name] = json.load(f)
     for name in ("lean", "lean-sparse"):
-        assert headers[name]["sampler"]["details"]["sparse_band"]["channels"] == ["distance"]
+        assert headers[name]["sampler"]["sparse_band"]["channels"] == ["distance"]
         assert "closest_triangle" not in headers[name]["channels"] and "gradient" not in headers[name]["channels"]
     assert headers["lean-sparse"]["channels"]["band_points"]["dtype"] == "uint64"
     assert headers["lean-sparse"]["band"]["band_points"] == headers["full"]["sampler"]["band"]["points_in_band"]
