@@ -19,6 +19,7 @@
 #include <tuple>
 #include <vector>
 
+#include "core/mesh/load_mesh.h"
 #include "core/mesh/load_obj.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -130,6 +131,38 @@ inline PreparedMesh open_bowl() {
         if (m.vertices[size_t(t.x)].z + m.vertices[size_t(t.y)].z + m.vertices[size_t(t.z)].z < 0.6) kept.push_back(t);
     m.triangles = kept;
     return prepare_mesh(m);
+}
+
+/// Solids for the sparse band's search bounded by the band and its sides taken from the
+/// neighbours (kernels/lattice/band_sides.h), with CC and BCC resolutions times `scale`: an
+/// icosahedron (its triangles' boxes reach far from it: blocks without a band point), the
+/// torus, and the dragon where SDF_DATA_PATH has it.
+struct BandSolid {
+    std::string name;
+    PreparedMesh mesh;
+    Int3 cc, bcc;
+};
+inline std::vector<BandSolid> band_solids(double scale) {
+    const auto times = [scale](Int3 r) { return Int3{int(r.x * scale), int(r.y * scale), int(r.z * scale)}; };
+    std::vector<BandSolid> out;
+    out.push_back({"icosahedron", prepare_mesh(make_icosphere(0, 1.0)), times({40, 40, 40}), times({28, 28, 28})});
+    out.push_back({"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), times({49, 46, 44}), times({33, 31, 29})});
+    const std::string dragon = find_data_file("dragon.obj");
+    if (!dragon.empty()) out.push_back({"dragon", prepare_mesh(load_mesh_file(dragon)), times({64, 54, 48}), times({44, 37, 33})});
+    return out;
+}
+
+/// A lattice of `type` cutting the box make_box({1, 1, 1}): its last plane of points (a block
+/// of one plane in x, the rest padding) lies inside, 3.3 spacings below the +x face whose
+/// triangles make the block active. With W = 3 spacings its middle blocks hold no point within
+/// W and no point a probe or brick skip signs: their sides come from the search at point 0.
+inline Lattice lattice_cutting_the_box(LatticeType type) {
+    Lattice lattice;
+    lattice.type = type;
+    lattice.spacing = 0.05;
+    lattice.resolution = {33, 49, 49};
+    lattice.origin = {1.0 - 35.3 * lattice.spacing, -1.2, -1.2};
+    return lattice;
 }
 
 /// Every BVH test mesh, prepared once; bunny and dragon only when the data path has them.

@@ -384,21 +384,10 @@ TEST(SparseBand, WithoutTheClosestTriangleTheSameValuesAndBandPoints) {
     EXPECT_GT(padding, 0) << "no active block reached the lattice's far edges";
 }
 
-// Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
-// sides are stored per point, and they are the dense path's.
 TEST(SparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
-    struct Case {
-        std::string name;
-        PreparedMesh mesh;
-        Int3 cc, bcc;
-    };
-    std::vector<Case> cases;
-    cases.push_back({"icosahedron", prepare_mesh(make_icosphere(0, 1.0)), {40, 40, 40}, {28, 28, 28}});
-    cases.push_back({"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), {49, 46, 44}, {33, 31, 29}});
-    const std::string dragon = test::find_data_file("dragon.obj");
-    if (!dragon.empty()) cases.push_back({"dragon", prepare_mesh(load_mesh_file(dragon)), {64, 54, 48}, {44, 37, 33}});
+    const std::vector<test::BandSolid> cases = test::band_solids(1.0);
     int64_t flooded = 0, searched_blocks = 0;
-    for (const Case& c : cases) {
+    for (const test::BandSolid& c : cases) {
         ASSERT_EQ(choose_sign_mode(c.mesh.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << c.name << " is a solid";
         const Lattice cc = fit_lattice(LatticeType::CC, c.cc, c.mesh.bounds(), 0.4);
         const Lattice bcc = fit_lattice(LatticeType::BCC, c.bcc, c.mesh.bounds(), 0.4);
@@ -423,31 +412,26 @@ TEST(SparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
                     if (HasFailure()) return;
                 }
     }
-    // A box cut by the lattice: the last plane of points (a block of one plane in x, the rest
-    // padding) lies inside, 3.3 spacings below the +x face whose triangles make the block
-    // active. Its middle blocks hold no point within W = 3 spacings and no point a probe or
-    // brick skip signs: their sides come from the search at their point 0.
+    // Whole blocks beyond the band (test::lattice_cutting_the_box).
     const PreparedMesh box = prepare_mesh(make_box({1.0, 1.0, 1.0}));
     for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
         for (Precision precision : {Precision::Float, Precision::Double}) {
-            Lattice lattice;
-            lattice.type = type;
-            lattice.spacing = 0.05;
-            lattice.resolution = {33, 49, 49};
-            lattice.origin = {1.0 - 35.3 * lattice.spacing, -1.2, -1.2};
+            const Lattice lattice = test::lattice_cutting_the_box(type);
             const double w = 3 * lattice.spacing;
             const std::string what = "box cut by " + lattice_notation(lattice) + " " + precision_name(precision);
-                const SampledField dense = make_cpu_bvh_sampler(options(precision, w, SignMode::Auto))->bind(share(box))->sample(lattice);
-                const SparseBandField sparse =
-                    make_cpu_bvh_sampler(options(precision, 0, SignMode::Auto))->bind(share(box))->sample_band_sparse(lattice, w);
-                const nlohmann::json& d = sparse.sampler.details["band_blocks_on_host"];
-                searched_blocks += d["blocks_signed_by_a_search"].get<int64_t>();
-                expect_same_field(dense, sparse.densify(), what);
+            const SampledField dense = make_cpu_bvh_sampler(options(precision, w, SignMode::Auto))->bind(share(box))->sample(lattice);
+            const SparseBandField sparse =
+                make_cpu_bvh_sampler(options(precision, 0, SignMode::Auto))->bind(share(box))->sample_band_sparse(lattice, w);
+            const nlohmann::json& d = sparse.sampler.details["band_blocks_on_host"];
+            searched_blocks += d["blocks_signed_by_a_search"].get<int64_t>();
+            expect_same_field(dense, sparse.densify(), what);
         }
     EXPECT_GT(flooded, 0);
     EXPECT_GT(searched_blocks, 0) << "no block was all beyond the band: the search for its side went untested";
 }
 
+// Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
+// sides are stored per point, and they are the dense path's.
 TEST(SparseBand, HolesGiveMixedBlocksWithTheDenseSides) {
     const PreparedMesh bowl = test::open_bowl();
     const Lattice lattice = fit_lattice(LatticeType::CC, {96, 96, 96}, bowl.bounds(), 0.6);
