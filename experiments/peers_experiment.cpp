@@ -1,7 +1,7 @@
 /// @file peers_experiment.cpp
 /// @brief Kind "peers": our samplers (brute force and BVH, CPU and GPU) side by side with the
 /// libraries users pick for signed distances (CGAL, Embree, Open3D, OpenVDB, FCPW, cuBQL), on
-/// the same meshes, lattices, point sets, machine and thread counts, in one run (docs/bvh.md).
+/// the same meshes, lattices, point sets, machine and thread counts, in one run (docs/bvh-peers.md).
 ///
 ///   "cases": [{"label": "dragon", "mesh": "dragon.obj", "samples": [262144, 2097152]}],
 ///   "threads": [1, 2], "ours": ["brute_cpu", "bvh_cpu", "bvh_cpu_per_point", "brute_gpu", "bvh_gpu"],

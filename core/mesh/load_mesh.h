@@ -39,7 +39,7 @@ struct MeshFormatRow {
 
 /// The one table of mesh formats, in the order their content is tested (detect_mesh_format)
 /// and help texts list them. Adding a format: its MeshFormat, its row and its reader
-/// (docs/architecture.md, "How to add").
+/// (docs/architecture-recipes.md).
 const std::vector<MeshFormatRow>& mesh_formats();
 
 /// The row of `format`.

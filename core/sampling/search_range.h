@@ -13,10 +13,10 @@
 /// double argmin of squared_distance() (ties to the smaller index), and a certified float
 /// search (kernels/distance/search_certificate.h: every sampler but the thesis's CUDA kernel
 /// and the CPU "eberly" kernel) returns that same triangle; the winner is evaluated in double,
-/// so distance, sign and gradient are bit for bit the double run's (docs/architecture.md,
-/// "Precision contract"). The sign of a point outside the mesh's bounding box is "outside"
-/// (MeshView::box_lo), which far from the mesh is where the search cannot tell the nearest
-/// triangle from one on the far side.
+/// so distance, sign and gradient are bit for bit the double run's
+/// (docs/architecture-floating-point.md, "Precision contract"). The sign of a point outside
+/// the mesh's bounding box is "outside" (MeshView::box_lo), which far from the mesh is where
+/// the search cannot tell the nearest triangle from one on the far side.
 #pragma once
 
 #include <string>

@@ -4,7 +4,7 @@
 ///
 /// A portable build runs everywhere at x86-64-v2 but compiles the search loops once per level
 /// (cpu_kernels.h) and runs the widest the CPU supports: the loops vectorise well only with
-/// AVX-512's masked operations (docs/architecture.md, "Build target and floating point").
+/// AVX-512's masked operations (docs/architecture-floating-point.md).
 #pragma once
 
 #include <string>

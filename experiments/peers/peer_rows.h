@@ -1,5 +1,5 @@
 /// @file peer_rows.h
-/// @brief The rows of the peers experiment (metrics.json "rows" and "summary", docs/bvh.md):
+/// @brief The rows of the peers experiment (metrics.json "rows" and "summary", docs/bvh-peers.md):
 /// each method's errors against the reference, its check, and the summary that compares only
 /// rows that pass their own checks. Plain functions of JSON rows, so the summary's rules are
 /// tested without running a method (tests/harness/peer_rows_test.cpp).

@@ -6,7 +6,7 @@
 ///
 /// Adding a kind: its LatticeType, its row, its case in lattice_kind() (no default: a type
 /// without its case is a -Wswitch warning, an error with SDF_WARNINGS_AS_ERRORS), then its
-/// geometry (docs/architecture.md, "How to add").
+/// geometry (docs/architecture-recipes.md).
 #pragma once
 
 #include <stdexcept>

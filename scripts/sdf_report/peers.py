@@ -1,6 +1,6 @@
 """Our samplers (brute force and BVH, CPU and GPU) against the peer libraries (CGAL, Embree,
 Open3D, OpenVDB, FCPW, cuBQL), on lattices and on arbitrary point sets, from "peers" runs
-(configs/peers.json, configs/peers_gpu.json, docs/bvh.md); and narrow bands (level sets): our
+(configs/peers.json, configs/peers_gpu.json, docs/bvh-peers.md); and narrow bands (level sets): our
 sparse band against OpenVDB's meshToLevelSet and NanoVDB's MeshToGrid (configs/peers_band.json)."""
 
 from .overview import machine
@@ -157,7 +157,7 @@ def section(doc, runs):
     peers_runs = [r for r in runs if r.kind == "peers"]
     doc.heading(2, HEADING)
     if not peers_runs:
-        doc.note("No peers run in the results: run `run-experiment configs/peers.json` (docs/bvh.md).")
+        doc.note("No peers run in the results: run `run-experiment configs/peers.json` (docs/bvh-peers.md).")
         return
     for run in peers_runs:
         for point in run.points:
@@ -187,4 +187,4 @@ def section(doc, runs):
                   "(our point-set GPU rows: the device time of the Morton sort, search and finalize; 'end to end' = with "
                   "transfers); 'unavailable' = no GPU on the machine of the run; 'not built' = the peer's package or "
                   "source snapshot (FCPW, cuBQL: SDF_PEERS_DIR) was missing when the harness was built. OpenVDB is a "
-                  "narrow-band method; Embree, FCPW and cuBQL return unsigned distances. See docs/bvh.md.")
+                  "narrow-band method; Embree, FCPW and cuBQL return unsigned distances. See docs/bvh-peers.md.")

@@ -4,7 +4,7 @@
 // adversarial_cases.h: needles and caps of 1e-2 .. 1e-8 degrees beside neighbours), against
 // the CPU double brute force, which tests/cpu_reference/bvh/sliver_search_test.cpp checks
 // against exact rational distances. Certified searches and double equal it bit for bit; the
-// uncertified thesis kernel in float within its near-ties (docs/architecture.md).
+// uncertified thesis kernel in float within its near-ties (docs/architecture-floating-point.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

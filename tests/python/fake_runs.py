@@ -211,7 +211,7 @@ def peers_point_set_metrics():
     cubql = dict(base, method="cubql", by="peer", status="not built: this build has no CUDA backend")
     return {"peers": {"fcpw": {"version": "snapshot abc", "exact": True, "gpu": False}, "cubql": {"status": "not built"}},
             "machine": {"hardware_threads": 2}, "meshes": {"dragon": mesh("dragon", "/x/dragon.obj", 100000, 50000)},
-            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh.md", "our_sign": "auto"},
+            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh-peers.md", "our_sign": "auto"},
             "rows": [bvh, fcpw, open3d, cubql],
             "summary": [{"mesh": "dragon", "resolution": "uniform_box/1000", "threads": 2, "ours": "bvh_cpu",
                          "fastest_exact_peer": "fcpw", "fastest_exact_peer_signed": False, "query_speedup": 3.0,
@@ -262,7 +262,7 @@ def peers_honest_metrics():
                       "cgal": {"version": "5.5.1", "exact": True, "gpu": False, "sign": "own",
                                "sign_method": "Side_of_triangle_mesh (ray casting)"}},
             "machine": {"hardware_threads": 16}, "meshes": {"dragon": mesh("dragon", "/x/dragon.obj", 100000, 50000)},
-            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh.md", "our_sign": "auto",
+            "check": {"tolerance_relative_to_diagonal": 1e-5, "rule": "see docs/bvh-peers.md", "our_sign": "auto",
                       "our_sign_point_sets": "pseudonormal"},
             "rows": rows, "summary": summary,
             "regression": {"dragon/gaussian_surface(0.01)/1000/16/bvh_cpu_exact_sign_vs_fastest_peer":

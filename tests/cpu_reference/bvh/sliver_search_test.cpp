@@ -121,7 +121,7 @@ TEST(SliverSearch, EverySearchIsExactOnSliversOfEverySize) {
                 const double q_min = e.q[size_t(e.triangle)], q_got = e.q[size_t(got[i].triangle)];
                 const double m = std::sqrt(q_min) + 2.0 * longest;
                 // The uncertified float Eberly kernel ranks by its own float distances: near-ties
-                // within about 2^-23 M^2 (docs/architecture.md, "Precision contract").
+                // within about 2^-23 M^2 (docs/architecture-floating-point.md, "Precision contract").
                 const bool uncertified = s.precision == Precision::Float && std::string(s.kernel) == "eberly";
                 const double tolerance = uncertified ? 0x1p-20 * m * m : q_tolerance(q_min, longest);
                 if (!(q_got - q_min <= tolerance) && not_least++ < 3)
