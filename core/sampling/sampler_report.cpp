@@ -23,7 +23,8 @@ void merge_certificate(CertificateReport& into, const CertificateReport& part) {
 }
 
 nlohmann::json winding_sign_to_json(const WindingSignReport& w) {
-    return {{"points", w.points()}, {"fast", w.fast}, {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}};
+    return {{"points", w.points()}, {"surface", w.surface}, {"fast", w.fast},
+            {"refined", w.refined},  {"direct", w.direct},   {"ties", w.ties}};
 }
 
 nlohmann::json band_to_json(const BandReport& b) {
@@ -126,8 +127,9 @@ WindingSignReport winding_sign_from_json(const nlohmann::json& j) {
     w.refined = k.integer("refined");
     w.direct = k.integer("direct");
     w.ties = k.integer("ties");
+    w.surface = k.has("surface") ? k.integer("surface") : 0;  // fields sampled before the surface stage
     if (k.integer("points") != w.points())
-        throw std::runtime_error("sampler.winding_sign.points: expected fast + refined + direct + ties = " +
+        throw std::runtime_error("sampler.winding_sign.points: expected surface + fast + refined + direct + ties = " +
                                  std::to_string(w.points()) + ", got " + j.at("points").dump());
     return w;
 }

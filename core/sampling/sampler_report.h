@@ -15,7 +15,7 @@
 ///            [, "probes", "bricks_skipped", "points_skipped"]},
 ///   "search_certificate": {"certified"[, "note"]
 ///            [, "points", "reranked_in_double", "full_double_search", "reranked_fraction"]},
-///   "winding_sign": {"points", "fast", "refined", "direct", "ties"}
+///   "winding_sign": {"points", "surface", "fast", "refined", "direct", "ties"}
 /// An empty report (a field made from arrays, a default SampledField) is JSON null.
 #pragma once
 
@@ -48,11 +48,12 @@ struct CertificateReport {
 };
 
 /// The certified winding sign (kernels/winding/certified_winding.h): points signed by the
-/// winding number, by how their side was decided: by the fast evaluation's bound, by a
-/// stricter opening rule, by the direct sum, or a tie (outside).
+/// winding number, by how their side was decided: by the closest triangle's side
+/// (surface_side.h), by the fast evaluation's bound, by a stricter opening rule, by the
+/// direct sum, or a tie (outside).
 struct WindingSignReport {
-    int64_t fast = 0, refined = 0, direct = 0, ties = 0;
-    int64_t points() const { return fast + refined + direct + ties; }
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0;
+    int64_t points() const { return fast + refined + direct + ties + surface; }
 };
 
 struct SamplerReport {

@@ -1,5 +1,7 @@
 #include "core/sampling/sampler_sign.h"
 
+#include <cstdlib>
+
 #include "core/parallel/task_monitor.h"
 
 namespace sdf {
@@ -9,15 +11,27 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
     return "sign auto for mesh '" + mesh.name() + "' (" + mesh.source() + "): " + reason;
 }
 
+/// The table of sides from the closest triangle, when the winding sign uses it. The
+/// environment's SDF_WINDING_LADDER_ONLY=1 leaves it out (every point takes the ladder: the
+/// measurement of what it saves; the signs are the same).
+std::shared_ptr<const SurfaceSides> surface_sides_for(const PreparedMesh& mesh) {
+    const WindingSignOptions o = SamplerSign::winding_options();
+    const char* ladder_only = std::getenv("SDF_WINDING_LADDER_ONLY");
+    if (!o.certify || !o.surface_sides || (ladder_only != nullptr && std::string(ladder_only) == "1")) return nullptr;
+    return std::make_shared<const SurfaceSides>(build_surface_sides(mesh));
+}
+
 }  // namespace
 
 const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();
+    surface_.reset();
     external_moments_on_.clear();
     mesh_scale_ = winding_scale(mesh);
-    if (requested_ == SignMode::Auto && choice_.mode == SignMode::Winding)
-        report_warning(auto_sign_text(mesh, choice_.reason));
+    if (choice_.mode != SignMode::Winding) return choice_;
+    if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
+    surface_ = surface_sides_for(mesh);
     return choice_;
 }
 
@@ -25,14 +39,25 @@ const SignModeChoice& SamplerSign::prepare(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     external_moments_on_.clear();
     winding_.reset();
+    surface_.reset();
     mesh_scale_ = winding_scale(mesh);
     if (choice_.mode != SignMode::Winding) return choice_;
     if (requested_ == SignMode::Auto) report_warning(auto_sign_text(mesh, choice_.reason));
     winding_ = std::make_shared<const WindingSign>(mesh, mesh.bvh(), winding_options());
+    surface_ = surface_sides_for(mesh);
     return choice_;
 }
 
 namespace {
+
+nlohmann::json surface_sides_json(const SurfaceSides& s) {
+    if (!s.why_off.empty()) return {{"used", false}, {"why", s.why_off}};
+    return {{"used", true},
+            {"components", s.components},
+            {"components_decided", s.components_decided},
+            {"triangles_known", s.triangles_known},
+            {"seconds", s.seconds}};
+}
 
 nlohmann::json winding_accuracy_json(const WindingSignOptions& o) {
     nlohmann::json j = {{"beta", o.accuracy.beta}, {"order", o.accuracy.order}, {"certified", o.certify}};
@@ -57,6 +82,7 @@ nlohmann::json SamplerSign::provenance() const {
         p["winding"]["moments_seconds"] = external_moments_seconds_;
         p["winding"]["moments_built_on"] = external_moments_on_;
     }
+    if (p.contains("winding") && surface_) p["winding"]["surface_sides"] = surface_sides_json(*surface_);
     return p;
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/mesh/prepared_mesh.h"
+#include "core/winding/surface_sides.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/with_sign.h"
 
@@ -48,10 +49,19 @@ public:
     SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p,
                                        WindingSignCounts& counts) const {
         if (!winding()) return s;
+        bool inside = false;
+        if (surface_side(surface_view(), s.triangle, s.distance, inside)) {
+            counts.add(WindingStage::Surface);
+            return with_sign(s, inside);
+        }
         const WindingSide side = winding_->side(p);
         counts.add(side.stage);
         return with_sign(s, side.inside);
     }
+
+    /// The mesh's table of sides from the closest triangle (surface_sides.h), in winding mode
+    /// when winding_options() asks for it; otherwise off (no table).
+    SurfaceSideView surface_view() const { return surface_ ? surface_->view() : SurfaceSideView{}; }
 
     /// {"requested", "mode", "reason"} and, in winding mode, "winding": {"beta", "order",
     /// "moments_seconds"}: for the field's sampler provenance.
@@ -69,6 +79,7 @@ private:
     SignMode requested_;
     SignModeChoice choice_;
     std::shared_ptr<const WindingSign> winding_;
+    std::shared_ptr<const SurfaceSides> surface_;
     double external_moments_seconds_ = 0;
     std::string external_moments_on_;  ///< empty: the moments are winding_'s
     double mesh_scale_ = 0;

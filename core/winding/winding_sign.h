@@ -32,32 +32,39 @@ struct WindingSignOptions {
     /// outside. Off: the fast value's side (tree-dependent; kept for measurements).
     bool certify = true;
     WindingCertification certification;
+    /// With certify: first read the side of a point of a closed mesh from its closest
+    /// triangle where the table of core/winding/surface_sides.h vouches for it (the same
+    /// exact side, without the far field's refinements near the surface). Off: every point
+    /// takes the ladder (its tests).
+    bool surface_sides = true;
 };
 
 /// Points signed, by how their side was decided (certified_winding.h's ladder).
 struct WindingSignCounts {
-    int64_t fast = 0, refined = 0, direct = 0, ties = 0;
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0;
     void add(WindingStage stage, int64_t n = 1) {
         switch (stage) {
         case WindingStage::Fast: fast += n; break;
         case WindingStage::Refined: refined += n; break;
         case WindingStage::Direct: direct += n; break;
         case WindingStage::Tie: ties += n; break;
+        case WindingStage::Surface: surface += n; break;
         }
     }
-    int64_t points() const { return fast + refined + direct + ties; }
+    int64_t points() const { return fast + refined + direct + ties + surface; }
     WindingSignCounts& operator+=(const WindingSignCounts& o) {
         fast += o.fast;
         refined += o.refined;
         direct += o.direct;
         ties += o.ties;
+        surface += o.surface;
         return *this;
     }
     WindingSignCounts operator-(const WindingSignCounts& o) const {
-        return {fast - o.fast, refined - o.refined, direct - o.direct, ties - o.ties};
+        return {fast - o.fast, refined - o.refined, direct - o.direct, ties - o.ties, surface - o.surface};
     }
     bool operator==(const WindingSignCounts& o) const {
-        return fast == o.fast && refined == o.refined && direct == o.direct && ties == o.ties;
+        return fast == o.fast && refined == o.refined && direct == o.direct && ties == o.ties && surface == o.surface;
     }
 };
 
@@ -70,10 +77,12 @@ struct SharedWindingCounts {
         n[int(WindingStage::Refined)] += c.refined;
         n[int(WindingStage::Direct)] += c.direct;
         n[int(WindingStage::Tie)] += c.ties;
+        n[int(WindingStage::Surface)] += c.surface;
     }
     WindingSignCounts load() const {
         return {n[int(WindingStage::Fast)].load(), n[int(WindingStage::Refined)].load(),
-                n[int(WindingStage::Direct)].load(), n[int(WindingStage::Tie)].load()};
+                n[int(WindingStage::Direct)].load(), n[int(WindingStage::Tie)].load(),
+                n[int(WindingStage::Surface)].load()};
     }
 };
 

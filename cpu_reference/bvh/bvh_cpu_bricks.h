@@ -194,16 +194,17 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
-            packet_sign.prepare(br.position, br.count);
+            SignedDistanceSample<double> sample[kBrick];  // triangle -1 beyond the bound
+            for (int k = 0; k < br.count; ++k)
+                if (slot[k] >= 0) sample[k] = signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]);
+            packet_sign.prepare(br.position, sample, br.count);
             for (int k = 0; k < br.count; ++k) {
                 if (slot[k] < 0) {  // beyond the bound
                     emit_outside(br.local[k], kBandSideNone);
                     ++beyond_bound;
                     continue;
                 }
-                emit(br.local[k], packet_sign.apply(signed_distance_to_triangle(exact, br.position[k],
-                                                                                view.triangle_index[slot[k]]),
-                                                    k, br.position[k]));
+                emit(br.local[k], packet_sign.apply(sample[k], k, br.position[k]));
             }
             // The next brick's lanes start from this brick's last column in x, (1 to 4
             // spacings away rather than 4): a tighter first radius.

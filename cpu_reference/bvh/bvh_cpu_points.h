@@ -58,12 +58,10 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
             search_packet(view, certifier, position, count, pk, stats, certified, slot);
-            packet_sign.prepare(position, count);
-            for (int k = 0; k < count; ++k) {
-                const int64_t i = int64_t(order[size_t(first + k)]);
-                const Vec3d& p = points[size_t(i)];
-                emit(i, packet_sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot[k]]), k, p));
-            }
+            SignedDistanceSample<double> sample[kPointPacket];
+            for (int k = 0; k < count; ++k) sample[k] = signed_distance_to_triangle(exact, position[k], view.triangle_index[slot[k]]);
+            packet_sign.prepare(position, sample, count);
+            for (int k = 0; k < count; ++k) emit(int64_t(order[size_t(first + k)]), packet_sign.apply(sample[k], k, position[k]));
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;
         }

@@ -102,30 +102,46 @@ struct Certifier {
     }
 };
 
-/// The sign of a packet's lanes. With the samplers' winding sign (certified: the exact side,
-/// certified_winding_packet.h) the sides of the packet's lanes come from one traversal per
-/// stage of the certified ladder, each lane's side and stage what WindingSign::side() gives
-/// its point; uncertified (measurements), the fast winding numbers of all kCpuPacketLanes
-/// lanes come from one traversal (fast_winding_packet.h), each lane's value the bits
-/// WindingSign::side() computes; otherwise each point gets SamplerSign::apply(). The points
-/// are counted by stage here, and added to the run's counters by add_to() (once per chunk).
+/// The sign of a packet's lanes. With the samplers' winding sign (certified: the exact side)
+/// a lane whose closest triangle the mesh's table vouches for takes its side from it
+/// (surface_side.h); the sides of the other lanes come from one traversal per stage of the
+/// certified ladder (certified_winding_packet.h), each lane's side and stage what
+/// WindingSign::side() gives its point; uncertified (measurements), the fast winding numbers
+/// of all kCpuPacketLanes lanes come from one traversal (fast_winding_packet.h), each lane's
+/// value the bits WindingSign::side() computes; otherwise each point gets
+/// SamplerSign::apply(). The points are counted by stage here, and added to the run's
+/// counters by add_to() (once per chunk).
 class PacketSign {
 public:
-    explicit PacketSign(const SamplerSign& sign) : sign_(sign) {
+    explicit PacketSign(const SamplerSign& sign) : sign_(sign), surface_(sign.surface_view()) {
         winding_ = sign.winding() ? sign.winding_sign() : nullptr;
     }
 
-    /// Evaluates the sides of the packet's points `position`: the first `count` lanes are
+    /// Evaluates the sides of the packet's points `position`, whose samples (pseudonormal
+    /// sign; triangle -1 where there is none) are `sample`: the first `count` lanes are
     /// points (counted), the others spare.
-    void prepare(const Vec3d* position, int count) {
+    void prepare(const Vec3d* position, const SignedDistanceSample<double>* sample, int count) {
         if (winding_ == nullptr) return;
         const WindingSignOptions& o = winding_->options();
         if (o.certify) {
-            WindingSide side[kCpuPacketLanes];
-            certified_kernel_(winding_->view(), position, count, o.accuracy, o.certification, side);
+            Vec3d ladder_position[kCpuPacketLanes];
+            int ladder_lane[kCpuPacketLanes];
+            int ladder = 0;
             for (int k = 0; k < count; ++k) {
-                inside_[k] = side[k].inside;
-                counts_.add(side[k].stage);
+                if (surface_side(surface_, sample[k].triangle, sample[k].distance, inside_[k])) {
+                    counts_.add(WindingStage::Surface);
+                    continue;
+                }
+                ladder_lane[ladder] = k;
+                ladder_position[ladder++] = position[k];
+            }
+            if (ladder == 0) return;
+            for (int j = ladder; j < kCpuPacketLanes; ++j) ladder_position[j] = ladder_position[0];  // spare lanes
+            WindingSide side[kCpuPacketLanes];
+            certified_kernel_(winding_->view(), ladder_position, ladder, o.accuracy, o.certification, side);
+            for (int j = 0; j < ladder; ++j) {
+                inside_[ladder_lane[j]] = side[j].inside;
+                counts_.add(side[j].stage);
             }
             return;
         }
@@ -160,6 +176,7 @@ public:
 
 private:
     const SamplerSign& sign_;
+    SurfaceSideView surface_;
     const WindingSign* winding_ = nullptr;  ///< non-null: packets of winding numbers
     WindingPacketFn kernel_ = active_cpu_kernels().winding_numbers_packet;
     CertifiedWindingPacketFn certified_kernel_ = active_cpu_kernels().winding_sides_packet;

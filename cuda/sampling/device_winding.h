@@ -1,6 +1,6 @@
 /// @file device_winding.h
-/// @brief A SamplerSign's winding BVH on the GPU: its nodes, per-node moments (double) and
-/// triangle order, next to a DeviceMesh<double> whose vertices and triangles it shares;
+/// @brief A SamplerSign's winding BVH on the GPU: its nodes, per-node moments (double),
+/// triangle order and table of sides from the closest triangle (surface_sides.h), next to a DeviceMesh<double> whose vertices and triangles it shares;
 /// empty (pseudonormal mode) when the sign did not resolve to winding. Also the device's
 /// counters of the certified sign (how each point's side was decided), read into a sampling's
 /// counters (SlabRun::winding) and from there into its report.
@@ -86,6 +86,11 @@ private:
         view_.certification = o.certification;
         view_.view.num_triangles = mesh.num_triangles;
         view_.view.scale = sign.mesh_scale();
+        const SurfaceSideView surface = sign.surface_view();
+        if (surface.front_winding != nullptr) {  // the sides from the closest triangle
+            surface_.upload(surface.front_winding, size_t(mesh.num_triangles), stream);
+            view_.surface = {surface_.get(), surface.min_distance};
+        }
         if (counts_.get() == nullptr) counts_.allocate(kWindingStages);
         CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), stream));
         view_.counts = counts_.get();
@@ -94,6 +99,7 @@ private:
     DeviceBuffer<BvhNode> nodes_;
     DeviceBuffer<WindingNode<double>> moments_;
     DeviceBuffer<int32_t> triangle_index_;
+    DeviceBuffer<int8_t> surface_;  ///< SurfaceSides::front_winding
     DeviceBuffer<unsigned long long> counts_;  ///< kWindingStages: the current sampling's (scratch)
     WindingSignView view_;
 };

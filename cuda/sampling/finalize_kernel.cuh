@@ -78,22 +78,26 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
     if (in_piece) out.output_index[i] = o;
     const Vec3d p = o >= 0 ? piece.position(i) : Vec3d(0.0);
     const int n = o >= 0 ? nearest[i] : -1;
+    SignedDistanceSample<double> s;
+    if (n >= 0) s = signed_distance_to_triangle(mesh, p, n);
     bool winding_inside = false;
     if constexpr (Winding) {
-        const bool wants = o >= 0 && (n >= 0 || n == kOutsideBandSignPerPoint);
+        // The closest triangle's side where the mesh's table vouches for it (surface_side.h).
+        const bool by_surface = n >= 0 && sign.certify && surface_side(sign.surface, n, s.distance, winding_inside);
+        const bool wants = o >= 0 && !by_surface && (n >= 0 || n == kOutsideBandSignPerPoint);
         if constexpr (PerThread) {
+            if (by_surface) count_winding_stage(sign, WindingStage::Surface);
             if (wants) {
                 const WindingSide side = winding_side(sign, p);
                 count_winding_stage(sign, side.stage);
                 winding_inside = side.inside;
             }
         } else {
-            winding_inside = warp_winding_inside(sign, p, wants);
+            winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside);
         }
     }
     if (o < 0) return;
     if (n >= 0) {
-        SignedDistanceSample<double> s = signed_distance_to_triangle(mesh, p, n);
         if constexpr (Winding) s = with_sign(s, winding_inside);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
         return;

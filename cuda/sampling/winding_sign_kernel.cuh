@@ -10,6 +10,7 @@
 
 #include "kernels/winding/certified_winding.h"
 #include "kernels/winding/fast_winding_number.h"
+#include "kernels/winding/surface_side.h"
 #include "kernels/winding/with_sign.h"
 
 namespace sdf::cuda {
@@ -20,6 +21,7 @@ struct WindingSignView {
     WindingAccuracy<double> accuracy{};
     bool certify = true;  ///< false: the fast value's side (WindingSignOptions::certify)
     WindingCertification certification{};
+    SurfaceSideView surface{};  ///< the sides from the closest triangle (device), or off
     unsigned long long* counts = nullptr;  ///< kWindingStages counters (device), or null
     SDF_CPU_GPU bool enabled() const { return view.nodes != nullptr; }
 };
@@ -39,6 +41,11 @@ __device__ inline WindingSide winding_side(const WindingSignView& w, const Vec3d
 __device__ inline SignedDistanceSample<double> apply_winding_sign(const WindingSignView& w, const SignedDistanceSample<double>& s,
                                                                   const Vec3d& p) {
     if (!w.enabled()) return s;
+    bool inside = false;
+    if (w.certify && surface_side(w.surface, s.triangle, s.distance, inside)) {
+        count_winding_stage(w, WindingStage::Surface);
+        return with_sign(s, inside);
+    }
     const WindingSide side = winding_side(w, p);
     count_winding_stage(w, side.stage);
     return with_sign(s, side.inside);
@@ -138,21 +145,26 @@ __device__ inline WindingEstimate<double> warp_certified_winding(const WindingVi
 
 /// The side of every lane's point (WindingSign::side's bits) with the warp's traversal for the
 /// first evaluation; the lanes it does not decide refine alone (certified_winding_refine).
-/// Counts the warp's points by stage, one atomic per stage and warp. Every lane must call it.
-__device__ inline bool warp_winding_inside(const WindingSignView& w, const Vec3d& p, bool wants) {
+/// A lane whose side its closest triangle gave (`by_surface`, surface_side.h) passes it in
+/// `surface_inside` with wants = false. Counts the warp's points by stage, one atomic per
+/// stage and warp. Every lane must call it.
+__device__ inline bool warp_winding_inside(const WindingSignView& w, const Vec3d& p, bool wants, bool by_surface = false,
+                                           bool surface_inside = false) {
     constexpr unsigned kWarp = 0xffffffffu;
-    WindingSide side{false, WindingStage::Fast};
+    WindingSide side{surface_inside, WindingStage::Surface};
+    if (!by_surface) side.stage = WindingStage::Fast;
     if (!w.certify) {
-        side.inside = warp_fast_winding_value(w.view, p, wants, w.accuracy) > 0.5;
+        const double value = warp_fast_winding_value(w.view, p, wants, w.accuracy);
+        if (wants) side.inside = value > 0.5;
     } else {
         const WindingEstimate<double> e = warp_certified_winding(w.view, p, wants, w.accuracy);
-        side.inside = e.value > 0.5;
+        if (wants) side.inside = e.value > 0.5;
         if (wants && !winding_decides(e)) side = certified_winding_refine(w.view, p, w.accuracy, w.certification);
     }
     __syncwarp(kWarp);
     if (w.counts != nullptr)
         for (int s = 0; s < kWindingStages; ++s) {
-            const unsigned lanes = __ballot_sync(kWarp, wants && int(side.stage) == s);
+            const unsigned lanes = __ballot_sync(kWarp, (wants || by_surface) && int(side.stage) == s);
             if (lanes != 0 && (threadIdx.x & 31u) == 0) atomicAdd(&w.counts[s], (unsigned long long)__popc(lanes));
         }
     return side.inside;

@@ -45,9 +45,11 @@ namespace sdf {
 constexpr double kWindingUnitRoundoff = 1.1102230246251565404e-16;
 constexpr double kWindingPi = 3.14159265358979323846;
 
-/// How a certified side was decided (the manifest's counters: sampler_report.h).
-enum class WindingStage : uint8_t { Fast = 0, Refined = 1, Direct = 2, Tie = 3 };
-constexpr int kWindingStages = 4;
+/// How a certified side was decided (the manifest's counters: sampler_report.h). Surface:
+/// by the closest triangle's side and the winding number in front of it (surface_side.h),
+/// before the ladder.
+enum class WindingStage : uint8_t { Fast = 0, Refined = 1, Direct = 2, Tie = 3, Surface = 4 };
+constexpr int kWindingStages = 5;
 
 struct WindingSide {
     bool inside = false;
