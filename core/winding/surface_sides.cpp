@@ -26,39 +26,46 @@ struct UnionFind {
     }
 };
 
-/// The triangles around each vertex, in compressed rows.
-struct VertexTriangles {
-    std::vector<int64_t> first;  ///< vertices + 1
-    std::vector<int> triangle;
-    VertexTriangles(size_t vertices, const std::vector<Int3>& tris) : first(vertices + 1, 0), triangle(3 * tris.size()) {
-        for (const Int3& t : tris)
-            for (int v : {t.x, t.y, t.z}) ++first[size_t(v) + 1];
-        std::partial_sum(first.begin(), first.end(), first.begin());
-        std::vector<int64_t> next(first.begin(), first.end() - 1);
-        for (size_t i = 0; i < tris.size(); ++i)
-            for (int v : {tris[i].x, tris[i].y, tris[i].z}) triangle[size_t(next[size_t(v)]++)] = int(i);
-    }
+/// Every edge with its two triangles and their local edges (edge k of a triangle runs from
+/// its corner k to corner k + 1): each triangle's edges grouped by their smaller vertex (a
+/// closed, edge-manifold mesh has exactly two uses of every edge; an edge with another count,
+/// which such a mesh does not have, is left out).
+struct EdgePair {
+    int t, u;            ///< the two triangles
+    int8_t t_edge, u_edge;
 };
 
-/// True when the triangles around vertex v form one fan (they connect across their edges
-/// through v); a closed mesh's vertex where two fans touch has no single pseudonormal side.
-bool one_fan(const VertexTriangles& around, const std::vector<Int3>& tris, int v) {
-    const int64_t begin = around.first[size_t(v)], end = around.first[size_t(v) + 1];
-    const size_t k = size_t(end - begin);
-    thread_local std::vector<std::pair<int, int>> other;  // (the edge's other vertex, local triangle)
-    other.clear();
-    for (size_t j = 0; j < k; ++j) {
-        const Int3 t = tris[size_t(around.triangle[size_t(begin) + j])];
-        for (int w : {t.x, t.y, t.z})
-            if (w != v) other.emplace_back(w, int(j));
+std::vector<EdgePair> edge_pairs(size_t vertices, const std::vector<Int3>& tris) {
+    std::vector<int64_t> first(vertices + 1, 0);
+    for (const Int3& t : tris) {
+        ++first[size_t(std::min(t.x, t.y)) + 1];
+        ++first[size_t(std::min(t.y, t.z)) + 1];
+        ++first[size_t(std::min(t.z, t.x)) + 1];
     }
-    std::sort(other.begin(), other.end());
-    UnionFind fan(k);
-    for (size_t i = 1; i < other.size(); ++i)
-        if (other[i].first == other[i - 1].first) fan.unite(other[i].second, other[i - 1].second);
-    for (size_t j = 1; j < k; ++j)
-        if (fan.find(int(j)) != 0) return false;
-    return true;
+    std::partial_sum(first.begin(), first.end(), first.begin());
+    std::vector<std::pair<int, int>> use(3 * tris.size());  // (the larger vertex, 4 triangle + edge)
+    std::vector<int64_t> next(first.begin(), first.end() - 1);
+    for (size_t i = 0; i < tris.size(); ++i) {
+        const int c[3] = {tris[i].x, tris[i].y, tris[i].z};
+        for (int e = 0; e < 3; ++e) {
+            const int a = c[e], b = c[(e + 1) % 3];
+            use[size_t(next[size_t(std::min(a, b))]++)] = {std::max(a, b), int(4 * i) + e};
+        }
+    }
+    std::vector<EdgePair> pairs;
+    pairs.reserve(3 * tris.size() / 2);
+    for (size_t v = 0; v < vertices; ++v) {
+        const auto begin = use.begin() + first[v], end = use.begin() + first[v + 1];
+        std::sort(begin, end);
+        for (auto it = begin; it != end;) {
+            auto last = it;
+            while (last != end && last->first == it->first) ++last;
+            if (last - it == 2)
+                pairs.push_back({it->second >> 2, (it + 1)->second >> 2, int8_t(it->second & 3), int8_t((it + 1)->second & 3)});
+            it = last;
+        }
+    }
+    return pairs;
 }
 
 /// The certified winding number in front of triangle t, when the direct sum decides it: the
@@ -118,7 +125,6 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     // pseudonormal side that can be trusted.
     std::vector<uint8_t> crossed(n, 0), tainted(nv, 0);
     for (const auto& [a, b] : mesh.intersecting_triangles()) crossed[size_t(a)] = crossed[size_t(b)] = 1;
-    const VertexTriangles around(nv, tris);
     const std::vector<Vec3d>& x = mesh.vertices();
     std::vector<double> area(n, 0.0);  // twice the area
     for (size_t t = 0; t < n; ++t) {
@@ -130,28 +136,38 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         if (crossed[t] || !(area[t] > std::ldexp(longest, -30)))
             for (int v : {tris[t].x, tris[t].y, tris[t].z}) tainted[size_t(v)] = 1;
     }
-    std::vector<uint8_t> fan_ok(nv, 1);
-    parallel_for(int64_t(nv), 4096, threads, [&](int64_t v0, int64_t v1) {
-        for (int64_t v = v0; v < v1; ++v) fan_ok[size_t(v)] = one_fan(around, tris, int(v));
-    });
-    for (size_t v = 0; v < nv; ++v) tainted[v] |= !fan_ok[v];
-
-    // Components of the uncrossed triangles across their (manifold) edges: the region in
-    // front of one is the region in front of all.
+    // The triangle across each triangle's edge k; the uncrossed triangles joined across
+    // their edges are the components, the region in front of one being in front of all.
+    const std::vector<EdgePair> pairs = edge_pairs(nv, tris);
+    std::vector<int> across(3 * n, -1);
     UnionFind components(n);
-    for (size_t t = 0; t < n; ++t) {
-        if (crossed[t]) continue;
-        const int c[3] = {tris[t].x, tris[t].y, tris[t].z};
-        for (int e = 0; e < 3; ++e) {
-            const int a = c[e], b = c[(e + 1) % 3];
-            for (int64_t j = around.first[size_t(a)]; j < around.first[size_t(a) + 1]; ++j) {
-                const int u = around.triangle[size_t(j)];
-                if (size_t(u) == t || crossed[size_t(u)]) continue;
-                const Int3 o = tris[size_t(u)];
-                if (o.x == b || o.y == b || o.z == b) components.unite(int(t), u);
+    for (const EdgePair& e : pairs) {
+        across[3 * size_t(e.t) + size_t(e.t_edge)] = e.u;
+        across[3 * size_t(e.u) + size_t(e.u_edge)] = e.t;
+        if (!crossed[size_t(e.t)] && !crossed[size_t(e.u)]) components.unite(e.t, e.u);
+    }
+    // The corners around a vertex: from corner k of t (its edge k leaves the vertex) to the
+    // triangle across that edge, whose corner at the vertex leaves it by its other edge; one
+    // cycle through all of them is one fan, more cycles are fans that touch.
+    std::vector<uint8_t> seen(3 * n, 0), cycles(nv, 0);
+    for (size_t t0 = 0; t0 < n; ++t0)
+        for (int k0 = 0; k0 < 3; ++k0) {
+            if (seen[3 * t0 + size_t(k0)]) continue;
+            const int v = tris[t0][k0];
+            if (cycles[size_t(v)] < 2) ++cycles[size_t(v)];
+            size_t t = t0;
+            int k = k0;
+            while (!seen[3 * t + size_t(k)]) {
+                seen[3 * t + size_t(k)] = 1;
+                const int u = across[3 * t + size_t(k)];
+                if (u < 0) break;
+                const Int3 c = tris[size_t(u)];
+                t = size_t(u);
+                k = c.x == v ? 0 : c.y == v ? 1 : 2;
             }
         }
-    }
+    for (size_t v = 0; v < nv; ++v)
+        if (cycles[v] > 1) tainted[v] = 1;
     // Each component's candidates: its safe triangles, largest first (their centroids lie
     // farthest from the other triangles' planes).
     std::vector<int> root(n), size_of(n, 0);
@@ -174,9 +190,9 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         const Int3 tri = tris[t];
         if (tainted[size_t(tri.x)] || tainted[size_t(tri.y)] || tainted[size_t(tri.z)]) continue;
         std::vector<int>& c = candidates[size_t(slot_of[size_t(root[t])])];
-        c.push_back(int(t));
-        std::sort(c.begin(), c.end(), [&](int a, int b) { return area[size_t(a)] > area[size_t(b)] || (area[size_t(a)] == area[size_t(b)] && a < b); });
-        if (c.size() > size_t(kCandidates)) c.pop_back();
+        if (c.size() == size_t(kCandidates) && !(area[t] > area[size_t(c.back())])) continue;
+        if (c.size() == size_t(kCandidates)) c.pop_back();
+        c.insert(std::upper_bound(c.begin(), c.end(), int(t), [&](int a, int b) { return area[size_t(a)] > area[size_t(b)]; }), int(t));
     }
 
     WindingView<double> view;
