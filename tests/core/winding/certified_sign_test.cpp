@@ -25,6 +25,7 @@
 #include "kernels/winding/certified_winding.h"
 #include "kernels/winding/certified_winding_packet.h"
 #include "tests/core/winding/exact_winding_long.h"
+#include "tests/core/winding/mesh_parts.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
@@ -54,17 +55,6 @@ double distance_to_mesh(const PreparedMesh& m, const Vec3d& p) {
     return best;
 }
 
-TriangleMesh concatenated(const std::vector<TriangleMesh>& parts, const char* name) {
-    TriangleMesh all;
-    all.name = name;
-    for (const TriangleMesh& m : parts) {
-        const int first = int(all.vertices.size());
-        all.vertices.insert(all.vertices.end(), m.vertices.begin(), m.vertices.end());
-        for (const Int3& t : m.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
-    }
-    return all;
-}
-
 /// An icosphere with the triangles above `z_cut` removed: a hole whose spanning surface
 /// (w = 1/2) the points below cross.
 TriangleMesh holed_sphere(int subdivisions, double z_cut, Vec3d center, const char* name) {
@@ -88,7 +78,7 @@ std::vector<Case> cases() {
     c.push_back({prepare_mesh(holed_sphere(3, 0.6, {0, 0, 0}, "bowl")), {{0.05, 0.02, 0.3}}});
     c.push_back({prepare_mesh(holed_sphere(2, 0.85, {0, 0, 0}, "small hole")), {{0.01, -0.02, 0.5}}});
     // Overlapping shells: two spheres through each other, one of them open.
-    c.push_back({prepare_mesh(concatenated({make_icosphere(3, 1.0), holed_sphere(2, 0.5, {0.8, 0.1, 0.0}, "")},
+    c.push_back({prepare_mesh(test::concatenated({make_icosphere(3, 1.0), holed_sphere(2, 0.5, {0.8, 0.1, 0.0}, "")},
                                            "overlapping shells")),
                  {{0.83, 0.12, 0.2}}});
     // Self-intersecting: a torus thicker than its hole.

@@ -19,26 +19,16 @@
 #include "core/sampling/sampler_sign.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
+#include "tests/core/winding/mesh_parts.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
 #include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
 
-TriangleMesh concatenated(const std::vector<TriangleMesh>& parts) {
-    TriangleMesh all;
-    all.name = "parts";
-    for (const TriangleMesh& m : parts) {
-        const int first = int(all.vertices.size());
-        all.vertices.insert(all.vertices.end(), m.vertices.begin(), m.vertices.end());
-        for (const Int3& t : m.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
-    }
-    return all;
-}
-
 /// Two spheres and a box through both (as in winding_number_test.cpp), with the analytic union.
 struct Parts {
-    TriangleMesh mesh = concatenated({make_icosphere(3, 0.6, {-0.5, 0, 0}), make_icosphere(3, 0.6, {0.5, 0, 0}),
+    TriangleMesh mesh = test::concatenated({make_icosphere(3, 0.6, {-0.5, 0, 0}), make_icosphere(3, 0.6, {0.5, 0, 0}),
                                       make_box({1.3, 0.2, 0.2}, {0, 0, 0})});
     static bool inside_union(const Vec3d& p) {
         return test::sphere_sdf(p - Vec3d{-0.5, 0, 0}, 0.6) < 0 || test::sphere_sdf(p - Vec3d{0.5, 0, 0}, 0.6) < 0 ||

@@ -22,22 +22,12 @@
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "kernels/distance/signed_distance.h"
 #include "tests/core/winding/exact_winding_long.h"
+#include "tests/core/winding/mesh_parts.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
 namespace {
-
-TriangleMesh concatenated(const std::vector<TriangleMesh>& parts, const char* name) {
-    TriangleMesh all;
-    all.name = name;
-    for (const TriangleMesh& m : parts) {
-        const int first = int(all.vertices.size());
-        all.vertices.insert(all.vertices.end(), m.vertices.begin(), m.vertices.end());
-        for (const Int3& t : m.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
-    }
-    return all;
-}
 
 /// The closest triangle by brute force and its pseudonormal-signed sample.
 SignedDistanceSample<double> closest_sample(const PreparedMesh& m, const Vec3d& p) {
@@ -101,7 +91,7 @@ Checked check_sides(const PreparedMesh& m, const SurfaceSides& sides, const std:
 
 TEST(SurfaceSides, OverlappingSpheresHaveTheExactSideAndFrontWindingOneInsideTheOther) {
     const TriangleMesh a = make_icosphere(3, 1.0), b = make_icosphere(3, 0.7, {0.9, 0.1, 0.05});
-    const PreparedMesh m = prepare_mesh(concatenated({a, b}, "overlapping spheres"));
+    const PreparedMesh m = prepare_mesh(test::concatenated({a, b}, "overlapping spheres"));
     ASSERT_GT(m.report().shell_intersecting_pairs, 0);
     const SurfaceSides sides = build_surface_sides(m, 2);
     ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
@@ -132,7 +122,7 @@ TEST(SurfaceSides, OverlappingSpheresHaveTheExactSideAndFrontWindingOneInsideThe
 TEST(SurfaceSides, ThickTorusAndNestedShellsHaveTheExactSide) {
     TriangleMesh thick = make_torus(0.5, 0.7, 32, 16);
     thick.name = "thick torus";
-    TriangleMesh nested = concatenated({make_icosphere(2, 1.0), make_icosphere(2, 0.5, {0.1, 0.0, 0.0})}, "nested shells");
+    TriangleMesh nested = test::concatenated({make_icosphere(2, 1.0), make_icosphere(2, 0.5, {0.1, 0.0, 0.0})}, "nested shells");
     for (const TriangleMesh& mesh : {thick, nested}) {
         const PreparedMesh m = prepare_mesh(mesh);
         const SurfaceSides sides = build_surface_sides(m, 2);
@@ -173,7 +163,7 @@ TEST(SurfaceSides, OpenMeshesGetNoTable) {
 
 TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
     const TriangleMesh a = make_icosphere(3, 1.0), b = make_icosphere(3, 0.7, {0.9, 0.1, 0.05});
-    const PreparedMesh m = prepare_mesh(concatenated({a, b}, "overlapping spheres"));
+    const PreparedMesh m = prepare_mesh(test::concatenated({a, b}, "overlapping spheres"));
     SamplerOptions o;
     o.sign = SignMode::Winding;
     o.threads = 2;

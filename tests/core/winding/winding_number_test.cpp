@@ -19,6 +19,7 @@
 #include "core/winding/winding_bvh.h"
 #include "core/winding/winding_sign.h"
 #include "kernels/winding/with_sign.h"
+#include "tests/core/winding/mesh_parts.h"
 #include "tests/cpu_reference/sampling/analytic_shapes.h"
 #include "tests/test_util/shared_mesh.h"
 
@@ -34,17 +35,6 @@ std::vector<Vec3d> random_points(int n, Vec3d lo, Vec3d hi, unsigned seed) {
     std::vector<Vec3d> p(size_t(n), Vec3d(0.0));
     for (Vec3d& q : p) q = {lo.x + (hi.x - lo.x) * u(rng), lo.y + (hi.y - lo.y) * u(rng), lo.z + (hi.z - lo.z) * u(rng)};
     return p;
-}
-
-TriangleMesh concatenated(const std::vector<TriangleMesh>& parts) {
-    TriangleMesh all;
-    all.name = "parts";
-    for (const TriangleMesh& m : parts) {
-        const int first = int(all.vertices.size());
-        all.vertices.insert(all.vertices.end(), m.vertices.begin(), m.vertices.end());
-        for (const Int3& t : m.triangles) all.triangles.push_back({t.x + first, t.y + first, t.z + first});
-    }
-    return all;
 }
 
 /// Exact winding number of p over the prepared mesh (double MeshView, every triangle).
@@ -96,7 +86,7 @@ TEST(WindingNumber, AnalyticShapesAreOneInsideAndZeroOutside) {
 // ---- Overlapping closed parts: two spheres and a box through both ---------------------
 
 struct Parts {
-    TriangleMesh mesh = concatenated({make_icosphere(3, 0.6, {-0.5, 0, 0}), make_icosphere(3, 0.6, {0.5, 0, 0}),
+    TriangleMesh mesh = test::concatenated({make_icosphere(3, 0.6, {-0.5, 0, 0}), make_icosphere(3, 0.6, {0.5, 0, 0}),
                                       make_box({1.3, 0.2, 0.2}, {0, 0, 0})});
     /// Number of parts containing p (analytic spheres; the mesh spheres lie within 0.01 of them).
     static int depth(const Vec3d& p) {
