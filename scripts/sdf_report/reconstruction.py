@@ -6,6 +6,7 @@ import os
 
 from . import images, plots
 from .analytic import eval_cost
+from .schema import lattice_types
 from .tables import Table, count, distinct_functions, number, percent, reconstruction_label, same_function_as
 
 ERROR_HEADER = ["reconstruction", "thesis panel", "RMS / h", "max / h", "band mean / h", "band RMS / h",
@@ -38,14 +39,17 @@ def study_summary(metrics):
 
 
 def sweep_plot(doc, run):
-    curves = {}
+    curves, kind_of = {}, {}
     for point in run.points:
         lattices = point.metrics["lattices"]
         mean_points = sum(l["lattice"]["points"] for l in lattices) / len(lattices)
+        type_of_label = {l["label"]: l["lattice"]["type"] for l in lattices}
         for rec in point.metrics["reconstructions"]:
             key = (rec["interpolator"], rec["derivatives"])
             curves.setdefault(key, []).append((mean_points, rec["errors"]["band"]["rms"]))
-    lines = [plots.Curve(label, [v[0] for v in curves[key]], [v[1] for v in curves[key]], dashed=key[0].startswith("bcc"))
+            kind_of[key] = type_of_label.get(rec["lattice"])
+    cartesian = lattice_types()[0]  # solid; every other kind dashed
+    lines = [plots.Curve(label, [v[0] for v in curves[key]], [v[1] for v in curves[key]], dashed=kind_of[key] != cartesian)
              for key, label in distinct_functions(sorted(curves))]
     filename = "%s_error_vs_samples.png" % run.name
     plots.log_log(os.path.join(doc.out_dir, filename), "%s: error vs samples (solid CC, dashed BCC)" % run.name,
