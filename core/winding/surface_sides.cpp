@@ -35,7 +35,7 @@ struct EdgePair {
     int8_t t_edge, u_edge;
 };
 
-std::vector<EdgePair> edge_pairs(size_t vertices, const std::vector<Int3>& tris) {
+std::vector<EdgePair> edge_pairs(size_t vertices, const std::vector<Int3>& tris, int threads) {
     std::vector<int64_t> first(vertices + 1, 0);
     for (const Int3& t : tris) {
         ++first[size_t(std::min(t.x, t.y)) + 1];
@@ -52,19 +52,29 @@ std::vector<EdgePair> edge_pairs(size_t vertices, const std::vector<Int3>& tris)
             use[size_t(next[size_t(std::min(a, b))]++)] = {std::max(a, b), int(4 * i) + e};
         }
     }
+    // Vertex ranges on every thread, each with its own pairs, joined in order.
+    constexpr int64_t kVertexChunk = 8192;
+    const int64_t chunks = (int64_t(vertices) + kVertexChunk - 1) / kVertexChunk;
+    std::vector<std::vector<EdgePair>> found(static_cast<size_t>(chunks));
+    parallel_for(chunks, 1, threads, [&](int64_t c0, int64_t c1) {
+        for (int64_t c = c0; c < c1; ++c) {
+            std::vector<EdgePair>& pairs = found[size_t(c)];
+            for (int64_t v = c * kVertexChunk; v < std::min<int64_t>(int64_t(vertices), (c + 1) * kVertexChunk); ++v) {
+                const auto begin = use.begin() + first[size_t(v)], end = use.begin() + first[size_t(v) + 1];
+                std::sort(begin, end);
+                for (auto it = begin; it != end;) {
+                    auto last = it;
+                    while (last != end && last->first == it->first) ++last;
+                    if (last - it == 2)
+                        pairs.push_back({it->second >> 2, (it + 1)->second >> 2, int8_t(it->second & 3), int8_t((it + 1)->second & 3)});
+                    it = last;
+                }
+            }
+        }
+    });
     std::vector<EdgePair> pairs;
     pairs.reserve(3 * tris.size() / 2);
-    for (size_t v = 0; v < vertices; ++v) {
-        const auto begin = use.begin() + first[v], end = use.begin() + first[v + 1];
-        std::sort(begin, end);
-        for (auto it = begin; it != end;) {
-            auto last = it;
-            while (last != end && last->first == it->first) ++last;
-            if (last - it == 2)
-                pairs.push_back({it->second >> 2, (it + 1)->second >> 2, int8_t(it->second & 3), int8_t((it + 1)->second & 3)});
-            it = last;
-        }
-    }
+    for (const std::vector<EdgePair>& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
     return pairs;
 }
 
@@ -123,22 +133,32 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     // Triangles in an intersecting pair split the regions beside the surface; the corners
     // of such triangles and of slivers, and corners where fans touch, have no single
     // pseudonormal side that can be trusted.
-    std::vector<uint8_t> crossed(n, 0), tainted(nv, 0);
+    std::vector<uint8_t> crossed(n, 0), tainted(nv, 0), doubtful(n, 0);
     for (const auto& [a, b] : mesh.intersecting_triangles()) crossed[size_t(a)] = crossed[size_t(b)] = 1;
     const std::vector<Vec3d>& x = mesh.vertices();
     std::vector<double> area(n, 0.0);  // twice the area
-    for (size_t t = 0; t < n; ++t) {
-        const Vec3d a = x[size_t(tris[t].x)], b = x[size_t(tris[t].y)], c = x[size_t(tris[t].z)];
-        area[t] = length(cross(b - a, c - a));
-        // A sliver's normal is uncertain in direction by about u L^2 / area: its pseudonormals
-        // (face, edges and corners) do not vouch for a side.
-        const double longest = std::max({length_squared(b - a), length_squared(c - b), length_squared(a - c)});
-        if (crossed[t] || !(area[t] > std::ldexp(longest, -30)))
-            for (int v : {tris[t].x, tris[t].y, tris[t].z}) tainted[size_t(v)] = 1;
-    }
+    parallel_for(int64_t(n), 16384, threads, [&](int64_t t0, int64_t t1) {
+        for (int64_t t = t0; t < t1; ++t) {
+            const Int3 tri = tris[size_t(t)];
+            const Vec3d a = x[size_t(tri.x)], b = x[size_t(tri.y)], c = x[size_t(tri.z)];
+            area[size_t(t)] = length(cross(b - a, c - a));
+            // A sliver's normal is uncertain in direction by about u L^2 / area: its
+            // pseudonormals (face, edges and corners) do not vouch for a side.
+            const double longest = std::max({length_squared(b - a), length_squared(c - b), length_squared(a - c)});
+            doubtful[size_t(t)] = crossed[size_t(t)] || !(area[size_t(t)] > std::ldexp(longest, -30));
+        }
+    });
+    // Each vertex's number of corners and one of them, for the walk around it below.
+    std::vector<int> degree(nv, 0), first_corner(nv, -1);
+    for (size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const int v = tris[t][k];
+            if (doubtful[t]) tainted[size_t(v)] = 1;
+            if (degree[size_t(v)]++ == 0) first_corner[size_t(v)] = int(3 * t) + k;
+        }
     // The triangle across each triangle's edge k; the uncrossed triangles joined across
     // their edges are the components, the region in front of one being in front of all.
-    const std::vector<EdgePair> pairs = edge_pairs(nv, tris);
+    const std::vector<EdgePair> pairs = edge_pairs(nv, tris, threads);
     std::vector<int> across(3 * n, -1);
     UnionFind components(n);
     for (const EdgePair& e : pairs) {
@@ -147,27 +167,23 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         if (!crossed[size_t(e.t)] && !crossed[size_t(e.u)]) components.unite(e.t, e.u);
     }
     // The corners around a vertex: from corner k of t (its edge k leaves the vertex) to the
-    // triangle across that edge, whose corner at the vertex leaves it by its other edge; one
-    // cycle through all of them is one fan, more cycles are fans that touch.
-    std::vector<uint8_t> seen(3 * n, 0), cycles(nv, 0);
-    for (size_t t0 = 0; t0 < n; ++t0)
-        for (int k0 = 0; k0 < 3; ++k0) {
-            if (seen[3 * t0 + size_t(k0)]) continue;
-            const int v = tris[t0][k0];
-            if (cycles[size_t(v)] < 2) ++cycles[size_t(v)];
-            size_t t = t0;
-            int k = k0;
-            while (!seen[3 * t + size_t(k)]) {
-                seen[3 * t + size_t(k)] = 1;
-                const int u = across[3 * t + size_t(k)];
-                if (u < 0) break;
+    // triangle across that edge, whose corner at the vertex leaves it by its other edge. One
+    // cycle through all of the vertex's corners is one fan; a shorter one means fans that
+    // touch there.
+    parallel_for(int64_t(nv), 4096, threads, [&](int64_t v0, int64_t v1) {
+        for (int64_t v = v0; v < v1; ++v) {
+            if (first_corner[size_t(v)] < 0) continue;
+            int t = first_corner[size_t(v)] / 3, k = first_corner[size_t(v)] % 3, steps = 0;
+            do {
+                const int u = across[3 * size_t(t) + size_t(k)];
+                if (u < 0 || ++steps > degree[size_t(v)]) break;
                 const Int3 c = tris[size_t(u)];
-                t = size_t(u);
-                k = c.x == v ? 0 : c.y == v ? 1 : 2;
-            }
+                t = u;
+                k = c.x == int(v) ? 0 : c.y == int(v) ? 1 : 2;
+            } while (3 * t + k != first_corner[size_t(v)]);
+            if (steps != degree[size_t(v)]) tainted[size_t(v)] = 1;
         }
-    for (size_t v = 0; v < nv; ++v)
-        if (cycles[v] > 1) tainted[v] = 1;
+    });
     // Each component's candidates: its safe triangles, largest first (their centroids lie
     // farthest from the other triangles' planes).
     std::vector<int> root(n), size_of(n, 0);

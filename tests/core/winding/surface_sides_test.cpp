@@ -151,6 +151,28 @@ TEST(SurfaceSides, TheDragonsSidesAreExactAwayFromItsIntersections) {
     EXPECT_GT(c.decided, 50);
 }
 
+TEST(SurfaceSides, FansThatTouchAtAVertexAreNotVouchedFor) {
+    // Two tetrahedra with one vertex in common (closed, no edge shared by more than two
+    // triangles, no intersection): the common vertex has two fans, so its six triangles are
+    // left to the ladder; the others have the outside in front of them.
+    TriangleMesh m;
+    m.name = "two tetrahedra touching at a vertex";
+    m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+    m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},   // outward
+                   {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};  // the point reflection, outward
+    const PreparedMesh pm = prepare_mesh(m);
+    ASSERT_TRUE(pm.report().closed());
+    ASSERT_EQ(pm.report().self_intersecting_pairs + pm.report().shell_intersecting_pairs, 0);
+    const SurfaceSides sides = build_surface_sides(pm, 2);
+    ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
+    for (size_t t = 0; t < pm.triangles().size(); ++t) {
+        const Int3 tri = pm.triangles()[t];
+        const bool at_common = tri.x == 0 || tri.y == 0 || tri.z == 0;
+        EXPECT_EQ(sides.front_winding[t], at_common ? kSurfaceSideUnknown : int8_t(0)) << t;
+    }
+    EXPECT_EQ(sides.triangles_known, 2);
+}
+
 TEST(SurfaceSides, OpenMeshesGetNoTable) {
     TriangleMesh bowl = make_icosphere(2, 1.0);
     bowl.triangles.resize(bowl.triangles.size() - 10);
