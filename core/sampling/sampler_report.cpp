@@ -152,6 +152,7 @@ void SamplerReport::merge(const SamplerReport& part) {
         winding_sign->refined += part.winding_sign->refined;
         winding_sign->direct += part.winding_sign->direct;
         winding_sign->ties += part.winding_sign->ties;
+        winding_sign->surface += part.winding_sign->surface;
     } else if (part.winding_sign) {
         winding_sign = part.winding_sign;
     }

@@ -125,12 +125,33 @@ TEST(MeshProvenance, OneRecordReadBackWholeAndTheEarlierShortOneIntoItsReport) {
     EXPECT_THROW((void)nlohmann::json({{"name", "x"}, {"vertices", "many"}}).get<MeshProvenance>(), std::runtime_error);
 }
 
+/// The surface stage's counter (kernels/winding/surface_side.h) is summed over slabs and ranks
+/// like the others, and a field written before it (no "surface") reads as 0.
+TEST(SamplerReport, WindingSurfaceCounterMergesAndReadsBack) {
+    SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
+    a.winding_sign = WindingSignReport{2, 1, 0, 0, 97};
+    b.winding_sign = WindingSignReport{0, 0, 0, 1, 49};
+    SamplerReport whole;
+    whole.merge(a);
+    whole.merge(b);
+    ASSERT_TRUE(whole.winding_sign.has_value());
+    EXPECT_EQ(whole.winding_sign->surface, 146);
+    EXPECT_EQ(whole.winding_sign->points(), 150);
+    const nlohmann::json j = whole;
+    EXPECT_EQ(j.at("winding_sign").at("surface"), 146);
+    EXPECT_EQ(j.get<SamplerReport>().winding_sign->surface, 146);
+    nlohmann::json before = j;
+    before["winding_sign"].erase("surface");
+    before["winding_sign"]["points"] = 4;
+    EXPECT_EQ(before.get<SamplerReport>().winding_sign->surface, 0);
+}
+
 /// The certified winding sign's counters (kernels/winding/certified_winding.h): summed by
 /// merge, written with their total, read back, and a total that does not add up is refused.
 TEST(SamplerReport, WindingSignCountersMergeAndRoundTrip) {
     SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
-    a.winding_sign = WindingSignReport{90, 8, 1, 1};
-    b.winding_sign = WindingSignReport{45, 5, 0, 0};
+    a.winding_sign = WindingSignReport{90, 8, 1, 1, 0};
+    b.winding_sign = WindingSignReport{45, 5, 0, 0, 0};
     SamplerReport whole;
     whole.merge(a);
     whole.merge(SamplerReport());
@@ -140,6 +161,7 @@ TEST(SamplerReport, WindingSignCountersMergeAndRoundTrip) {
     EXPECT_EQ(whole.winding_sign->refined, 13);
     EXPECT_EQ(whole.winding_sign->direct, 1);
     EXPECT_EQ(whole.winding_sign->ties, 1);
+    EXPECT_EQ(whole.winding_sign->surface, 0);
     const nlohmann::json j = whole;
     EXPECT_EQ(j.at("winding_sign").at("points"), 150);
     const SamplerReport back = j.get<SamplerReport>();
