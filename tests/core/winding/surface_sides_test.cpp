@@ -173,6 +173,29 @@ TEST(SurfaceSides, FansThatTouchAtAVertexAreNotVouchedFor) {
     EXPECT_EQ(sides.triangles_known, 2);
 }
 
+TEST(SurfaceSides, SliversAreNotVouchedFor) {
+    // A tetrahedron whose face a-b-c is split at a point `offset` from the midpoint of edge
+    // a-b: at 1e-13 the triangle a-b-m is a sliver whose normal's direction rounding cannot
+    // fix, and every triangle (each has a corner at a, b or m) is left to the ladder; at 0.2
+    // the same mesh has no sliver and every triangle is vouched for.
+    const Vec3d a{1, 0, 0}, b{0, 1, 0}, c{0, 0, 1};
+    const Vec3d mid = (a + b) * 0.5;
+    for (double offset : {1e-13, 0.2}) {
+        TriangleMesh m;
+        m.name = "tetrahedron with a split face";
+        m.vertices = {{0, 0, 0}, a, b, c, mid + (c - mid) * (offset / length(c - mid))};
+        m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 4}, {2, 3, 4}, {3, 1, 4}};
+        const PreparedMesh pm = prepare_mesh(m);
+        ASSERT_EQ(pm.triangles().size(), 6u) << offset;  // the sliver has an area: it is kept
+        ASSERT_TRUE(pm.report().closed()) << offset;
+        const SurfaceSides sides = build_surface_sides(pm, 1);
+        ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
+        EXPECT_EQ(sides.triangles_known, offset < 1e-6 ? 0 : 6) << offset;
+        const Checked checked = check_sides(pm, sides, points_around(pm, 200, 23));
+        EXPECT_EQ(checked.decided, offset < 1e-6 ? 0 : 200) << offset;
+    }
+}
+
 TEST(SurfaceSides, OpenMeshesGetNoTable) {
     TriangleMesh bowl = make_icosphere(2, 1.0);
     bowl.triangles.resize(bowl.triangles.size() - 10);
