@@ -131,8 +131,8 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     }
     const size_t n = tris.size(), nv = mesh.vertices().size();
     // Triangles in an intersecting pair split the regions beside the surface; the corners
-    // of such triangles and of slivers, and corners where fans touch, have no single
-    // pseudonormal side that can be trusted.
+    // of such triangles, of slivers and of edges folded flat, and corners where fans touch,
+    // have no single pseudonormal side that can be trusted.
     std::vector<uint8_t> crossed(n, 0), tainted(nv, 0), doubtful(n, 0);
     for (const auto& [a, b] : mesh.intersecting_triangles()) crossed[size_t(a)] = crossed[size_t(b)] = 1;
     const std::vector<Vec3d>& x = mesh.vertices();
@@ -161,10 +161,17 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     const std::vector<EdgePair> pairs = edge_pairs(nv, tris, threads);
     std::vector<int> across(3 * n, -1);
     UnionFind components(n);
+    const std::vector<Vec3d>& normal = mesh.face_normals();
     for (const EdgePair& e : pairs) {
         across[3 * size_t(e.t) + size_t(e.t_edge)] = e.u;
         across[3 * size_t(e.u) + size_t(e.u_edge)] = e.t;
         if (!crossed[size_t(e.t)] && !crossed[size_t(e.u)]) components.unite(e.t, e.u);
+        // An edge folded flat (opposite normals to within 1e-12) has an edge pseudonormal of
+        // uncertain direction, as a sliver's face normal is.
+        if (dot(normal[size_t(e.t)], normal[size_t(e.u)]) < -1.0 + 1e-12) {
+            tainted[size_t(tris[size_t(e.t)][e.t_edge])] = 1;
+            tainted[size_t(tris[size_t(e.t)][(e.t_edge + 1) % 3])] = 1;
+        }
     }
     // The corners around a vertex: from corner k of t (its edge k leaves the vertex) to the
     // triangle across that edge, whose corner at the vertex leaves it by its other edge. One

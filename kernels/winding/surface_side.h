@@ -9,7 +9,8 @@
 /// closest point c lies on triangle T at distance d > 0 sees no surface in the open ball of
 /// radius d about it, so w(p) is the winding number of the region beside c on p's side. Where
 /// no other triangle touches T or the triangles around its corners (none is in an
-/// intersecting pair), none of them is a sliver and those corners are manifold, that side is
+/// intersecting pair), none of them is a sliver or folded flat against its neighbour and
+/// those corners are manifold, that side is
 /// the pseudonormal's
 /// (Baerentzen & Aanaes 2005: the sign of the sample's distance), and the region in front of T
 /// is the one in front of every triangle reachable from T across edges without meeting an
