@@ -8,16 +8,8 @@ import time
 
 import numpy as np
 import sdf_lattices as sl
+from timing import best  # scripts/device/timing.py
 
-
-def best(f, n=3):
-    f()
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 mesh = sl.load_mesh(sys.argv[1])

@@ -5,20 +5,11 @@ self-intersection check, the CUDA SDF's construction, and the query, wall time (
 after a warm-up).
     PYTHONPATH=build-gpu/python python3 scripts/device/user-wait-sign.py MESH..."""
 import sys
-import time
 
 import numpy as np
 import sdf_lattices as sl
+from timing import best  # scripts/device/timing.py
 
-
-def best(f, n=3):
-    f()
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 for path in sys.argv[1:]:
