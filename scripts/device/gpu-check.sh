@@ -10,13 +10,7 @@ cd "$(dirname "$0")/../.."
 OUT=${OUT:-$PWD/gpu-out}
 mkdir -p "$OUT"
 PREFIX=$PWD/.gpu-prefix/root/usr
-# Debian packages the lent machine lacks that are too large to carry unpacked (CGAL with Boost's
-# headers, GMP, MPFR) travel as .deb files in .gpu-prefix/debs and are unpacked here once.
-for deb in .gpu-prefix/debs/*.deb; do
-    [ -f "$deb" ] || continue
-    stamp=.gpu-prefix/root/.$(basename "$deb").unpacked
-    [ -f "$stamp" ] || { dpkg -x "$deb" .gpu-prefix/root && touch "$stamp"; }
-done
+scripts/device/unpack-debs  # CGAL, Boost's headers, GMP, MPFR: carried as .deb files
 export LD_LIBRARY_PATH=$PREFIX/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export SDF_DATA_PATH=$PWD/data/meshes
 B=build-gpu

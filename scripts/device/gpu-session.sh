@@ -12,6 +12,7 @@ cd "$(dirname "$0")/../.."
 OUT=${OUT:-$PWD/gpu-out}
 mkdir -p "$OUT"
 PREFIX=$PWD/.gpu-prefix/root/usr
+scripts/device/unpack-debs  # CGAL, Boost's headers, GMP, MPFR: carried as .deb files
 export LD_LIBRARY_PATH=$PREFIX/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export SDF_DATA_PATH=$PWD/data/meshes
 BUILD=${BUILD:-build-gpu}

@@ -24,12 +24,7 @@ PY=${PYTHON:-python3}
 
 if [ "$1" = build ]; then
     PREFIX=$PWD/.gpu-prefix/root/usr
-    # The .deb files of make-gpu-prefix (CGAL, Boost's headers, GMP with libgmp.a, MPFR), once.
-    for deb in .gpu-prefix/debs/*.deb; do
-        [ -f "$deb" ] || continue
-        stamp=.gpu-prefix/root/.$(basename "$deb").unpacked
-        [ -f "$stamp" ] || { dpkg -x "$deb" .gpu-prefix/root && touch "$stamp"; }
-    done
+    scripts/device/unpack-debs  # the .deb files of make-gpu-prefix, once
     B=build-wheel
     options=(-G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PREFIX" -DSDF_SOURCE_COMMIT="${SDF_SOURCE_COMMIT:-}"
              -DSDF_WHEEL=ON -DSDF_BUILD_PEERS=OFF -DSDF_BUILD_TESTS=OFF -DSDF_BUILD_BENCHMARKS=OFF
