@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <utility>
 
@@ -130,6 +131,10 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         return out;
     }
     const size_t n = tris.size(), nv = mesh.vertices().size();
+    if (n > size_t(std::numeric_limits<int>::max() / 4)) {  // corners and edges are numbered in int
+        out.why_off = "more than " + std::to_string(std::numeric_limits<int>::max() / 4) + " triangles";
+        return out;
+    }
     // Triangles in an intersecting pair split the regions beside the surface; the corners
     // of such triangles, of slivers and of edges folded flat, and corners where fans touch,
     // have no single pseudonormal side that can be trusted.
