@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -196,6 +197,36 @@ TEST(SurfaceSides, SliversAreNotVouchedFor) {
     }
 }
 
+TEST(SurfaceSides, TheDefaultSignIsExactBesideSurfacesAnUlpApart) {
+    // A review's case against the table: two boxes one ulp apart (closed, oriented, no
+    // intersecting pair), points inside the upper one. The closest triangle found in rounded
+    // arithmetic may lie across the lower box's top face, whose front winding is 0, so the
+    // table's rule says outside; the default sampler (the ladder) says inside, as the exact
+    // winding number does.
+    auto box = [](Vec3d lo, Vec3d hi) {
+        TriangleMesh m = make_box({1, 1, 1});
+        for (Vec3d& v : m.vertices) v = Vec3d(v.x < 0 ? lo.x : hi.x, v.y < 0 ? lo.y : hi.y, v.z < 0 ? lo.z : hi.z);
+        return m;
+    };
+    const double gap = std::ldexp(1.0, -52);
+    const PreparedMesh m = prepare_mesh(test::concatenated(
+        {box({-100, -100, -15}, {100, 100, 1}), box({-100, -100, 1 + gap}, {100, 100, 16})}, "boxes an ulp apart"));
+    ASSERT_TRUE(m.report().closed());
+    SamplerOptions o;
+    o.sign = SignMode::Winding;
+    o.threads = 2;
+    const auto bound = make_cpu_bvh_sampler(o)->bind(share(m));
+    std::mt19937_64 rng(1);
+    std::uniform_real_distribution<double> xy(-50, 50), z(1.5, 8.5);
+    std::vector<Vec3d> pts;
+    for (int i = 0; i < 300; ++i) pts.push_back({xy(rng), xy(rng), z(rng)});
+    const std::vector<PointSample> got = bound->query(pts);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const long double w = exact_winding_long(m, pts[i]);
+        EXPECT_EQ(got[i].distance < 0, w > 0.5L) << "w " << double(w) << " at " << pts[i].x << " " << pts[i].y << " " << pts[i].z;
+    }
+}
+
 TEST(SurfaceSides, OpenMeshesGetNoTable) {
     TriangleMesh bowl = make_icosphere(2, 1.0);
     bowl.triangles.resize(bowl.triangles.size() - 10);
@@ -212,7 +243,11 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
     SamplerOptions o;
     o.sign = SignMode::Winding;
     o.threads = 2;
+    // The table is an experiment, off unless asked for (sampler_sign.cpp says why).
+    const auto ladder_only = make_cpu_bvh_sampler(o)->bind(share(m));
+    setenv("SDF_WINDING_SURFACE_SIDES", "1", 1);
     const auto bound = make_cpu_bvh_sampler(o)->bind(share(m));
+    unsetenv("SDF_WINDING_SURFACE_SIDES");
     const Lattice lattice = fit_lattice(LatticeType::CC, {28, 24, 24}, m.bounds(), 0.1);
     const SampledField f = bound->sample(lattice);
     ASSERT_TRUE(f.sampler.winding_sign.has_value());
@@ -225,6 +260,10 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
         if (f.distance[size_t(i)] == 0) continue;
         EXPECT_EQ(f.distance[size_t(i)] < 0, ladder.side(lattice.position(i)).inside) << i;
     }
+    const SampledField by_default = ladder_only->sample(lattice);
+    ASSERT_TRUE(by_default.sampler.winding_sign.has_value());
+    EXPECT_EQ(by_default.sampler.winding_sign->surface, 0);
+    EXPECT_EQ(by_default.distance, f.distance);
 }
 
 }  // namespace
