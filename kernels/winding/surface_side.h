@@ -17,6 +17,9 @@
 /// intersecting triangle. So one certified evaluation per such component of the mesh gives
 /// `front_winding`, and then
 ///   w(p) = front_winding[T] + (p behind T),      inside  <=>  w(p) >= 1  (w > 1/2).
+/// Exact in exact arithmetic only: the closest triangle found by rounded searches and the
+/// rounded pseudonormal's side can be wrong beside surfaces an ulp apart or at needle corners,
+/// so the samplers use it only where asked (SDF_WINDING_SURFACE_SIDES=1, docs/winding.md).
 /// The table is built once per mesh (core/winding/surface_sides.h); triangles it cannot vouch
 /// for hold kSurfaceSideUnknown and their points take the ladder (certified_winding.h), as do
 /// points within `min_distance` of the surface, where the ladder's tie rule holds.
