@@ -1,6 +1,8 @@
 #include "core/sampling/sampler_report.h"
 
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace sdf {
 
@@ -128,6 +130,11 @@ WindingSignReport winding_sign_from_json(const nlohmann::json& j) {
     w.direct = k.integer("direct");
     w.ties = k.integer("ties");
     w.surface = k.has("surface") ? k.integer("surface") : 0;  // fields sampled before the surface stage
+    for (const auto& [name, count] : {std::pair<const char*, int64_t>{"surface", w.surface}, {"fast", w.fast},
+                                      {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}})
+        if (count < 0)
+            throw std::runtime_error("sampler.winding_sign." + std::string(name) + ": expected a count >= 0, got " +
+                                     std::to_string(count));
     if (k.integer("points") != w.points())
         throw std::runtime_error("sampler.winding_sign.points: expected surface + fast + refined + direct + ties = " +
                                  std::to_string(w.points()) + ", got " + j.at("points").dump());

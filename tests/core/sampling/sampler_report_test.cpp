@@ -144,6 +144,17 @@ TEST(SamplerReport, WindingSurfaceCounterMergesAndReadsBack) {
     before["winding_sign"].erase("surface");
     before["winding_sign"]["points"] = 4;
     EXPECT_EQ(before.get<SamplerReport>().winding_sign->surface, 0);
+    // A negative count that the total still adds up to is refused, naming the key.
+    nlohmann::json negative = j;
+    negative["winding_sign"]["surface"] = -3;
+    negative["winding_sign"]["points"] = 1;
+    try {
+        (void)negative.get<SamplerReport>();
+        FAIL() << "a negative count was read";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("sampler.winding_sign.surface: expected a count >= 0"), std::string::npos)
+            << e.what();
+    }
 }
 
 /// The certified winding sign's counters (kernels/winding/certified_winding.h): summed by
