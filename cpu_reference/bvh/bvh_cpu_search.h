@@ -123,6 +123,15 @@ public:
     void prepare(const Vec3d* position, const SignedDistanceSample<double>* sample, int count) {
         if (winding_ == nullptr) return;
         const WindingSignOptions& o = winding_->options();
+        if (o.certify && surface_.front_winding == nullptr) {  // no table: every lane takes the ladder
+            WindingSide side[kCpuPacketLanes];
+            certified_kernel_(winding_->view(), position, count, o.accuracy, o.certification, side);
+            for (int k = 0; k < count; ++k) {
+                inside_[k] = side[k].inside;
+                counts_.add(side[k].stage);
+            }
+            return;
+        }
         if (o.certify) {
             Vec3d ladder_position[kCpuPacketLanes];
             int ladder_lane[kCpuPacketLanes];
