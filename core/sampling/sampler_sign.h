@@ -50,7 +50,7 @@ public:
                                        WindingSignCounts& counts) const {
         if (!winding()) return s;
         bool inside = false;
-        if (surface_side(surface_view(), s.triangle, s.distance, inside)) {
+        if (surface_side(surface_view(), winding_->view(), p, s.triangle, s.distance, inside)) {
             counts.add(WindingStage::Surface);
             return with_sign(s, inside);
         }

@@ -79,43 +79,68 @@ std::vector<EdgePair> edge_pairs(size_t vertices, const std::vector<Int3>& tris,
     return pairs;
 }
 
-/// The certified winding number in front of triangle t, when the direct sum decides it: the
-/// sum over every other triangle at t's centroid, less 1/2 (t's own solid angle tends to
-/// -2 pi just in front of it), is an integer to within its bound. The sum runs in fixed
-/// chunks on `threads` threads, each chunk's rounding bounded as certified_winding_direct()
-/// bounds its own, and the chunks added in order with theirs.
+/// The winding number in front of triangle t, when it can be certified: w at a point x in
+/// front of t (the certified direct sum, an integer to within its bound), less what the
+/// triangles crossed between x and t's centroid add (surface_side.h's rule, read from x).
+/// The direct sum runs in fixed chunks on `threads` threads, each chunk's rounding bounded
+/// as certified_winding_direct() bounds its own, and the chunks added in order with theirs.
 bool front_winding_of(const WindingView<double>& v, int t, int threads, int& front) {
     const Int3 tri = v.triangles[t];
-    const Vec3d c = (v.vertices[tri.x] + v.vertices[tri.y] + v.vertices[tri.z]) / 3.0;
+    const Vec3d corner[3] = {v.vertices[tri.x], v.vertices[tri.y], v.vertices[tri.z]};
+    const Vec3d n = cross(corner[1] - corner[0], corner[2] - corner[0]);  // twice the area
+    const double twice_area = length(n);
+    if (!(twice_area > 0)) return false;
+    // A quarter of the triangle's size in front of its centroid: far enough from t that its
+    // own solid angle is well conditioned; other triangles between are counted as crossed.
+    const Vec3d x = (corner[0] + corner[1] + corner[2]) / 3.0 + n * (0.25 / std::sqrt(twice_area));
+    if (decided_sign(orientation_det(corner[0], corner[1], corner[2], x)) >= 0) return false;  // not surely in front
     constexpr int64_t kChunk = 8192;
-    const int64_t n = v.num_triangles, chunks = (n + kChunk - 1) / kChunk;
+    const int64_t count = v.num_triangles, chunks = (count + kChunk - 1) / kChunk;
     std::vector<double> chunk_sum(size_t(chunks), 0.0), chunk_error(size_t(chunks), 0.0);
+    std::vector<int> chunk_change(size_t(chunks), 0);
+    std::vector<uint8_t> chunk_decided(size_t(chunks), 1);
+    Vec3d lo = x, hi = x;  // the segment's box
+    for (const Vec3d& c : corner) {
+        lo = component_min(lo, c);
+        hi = component_max(hi, c);
+    }
     parallel_for(chunks, 1, threads, [&](int64_t k0, int64_t k1) {
         for (int64_t k = k0; k < k1; ++k) {
             double s = 0, e = 0;
-            for (int64_t i = k * kChunk; i < std::min(n, (k + 1) * kChunk); ++i) {
-                if (i == t) continue;
+            int change = 0;
+            bool decided = true;
+            for (int64_t i = k * kChunk; i < std::min(count, (k + 1) * kChunk); ++i) {
                 const Int3 o = v.triangles[i];
+                const Vec3d a = v.vertices[o.x], b = v.vertices[o.y], c = v.vertices[o.z];
                 double err;
-                s += certified_solid_angle(c, v.vertices[o.x], v.vertices[o.y], v.vertices[o.z], err);
+                s += certified_solid_angle(x, a, b, c, err);
                 e += err + kWindingUnitRoundoff * std::fabs(s);
+                if (i == t || !decided) continue;
+                const Vec3d olo = component_min(a, component_min(b, c)), ohi = component_max(a, component_max(b, c));
+                if (olo.x > hi.x || olo.y > hi.y || olo.z > hi.z || ohi.x < lo.x || ohi.y < lo.y || ohi.z < lo.z) continue;
+                decided = add_crossing(x, corner, a, b, c, change);
             }
             chunk_sum[size_t(k)] = s;
             chunk_error[size_t(k)] = e;
+            chunk_change[size_t(k)] = change;
+            chunk_decided[size_t(k)] = decided;
         }
     });
     double s = 0, e = 0;
+    int change = 0;
     for (int64_t k = 0; k < chunks; ++k) {
+        if (!chunk_decided[size_t(k)]) return false;
         s += chunk_sum[size_t(k)];
         e += chunk_error[size_t(k)] + kWindingUnitRoundoff * std::fabs(s);
+        change += chunk_change[size_t(k)];
     }
     CertifiedSum sum;
     add_solid_angles(sum, s, e);
-    const WindingEstimate<double> w = certified_estimate(sum, winding_rounding(v, c), 0);
-    const double x = w.value - 0.5, k = std::nearbyint(x);
+    const WindingEstimate<double> w = certified_estimate(sum, winding_rounding(v, x), 0);
+    const double k = std::nearbyint(w.value);
     const double margin = w.error_bound + 4.0 * kWindingUnitRoundoff * (std::fabs(w.value) + 1.0);
-    if (!(std::fabs(x - k) + margin < 0.5) || std::fabs(k) > 127.0) return false;
-    front = int(k);
+    if (!(std::fabs(w.value - k) + margin < 0.5) || std::fabs(k - change) > 127.0) return false;
+    front = int(k) - change;
     return true;
 }
 
@@ -135,69 +160,24 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         out.why_off = "more than " + std::to_string(std::numeric_limits<int>::max() / 4) + " triangles";
         return out;
     }
-    // Triangles in an intersecting pair split the regions beside the surface; the corners
-    // of such triangles, of slivers and of edges folded flat, and corners where fans touch,
-    // have no single pseudonormal side that can be trusted.
-    std::vector<uint8_t> crossed(n, 0), tainted(nv, 0), doubtful(n, 0);
+    // Triangles in an intersecting pair split the regions beside the surface: they get no
+    // front winding number, and they join no component.
+    std::vector<uint8_t> crossed(n, 0);
     for (const auto& [a, b] : mesh.intersecting_triangles()) crossed[size_t(a)] = crossed[size_t(b)] = 1;
     const std::vector<Vec3d>& x = mesh.vertices();
     std::vector<double> area(n, 0.0);  // twice the area
     parallel_for(int64_t(n), 16384, threads, [&](int64_t t0, int64_t t1) {
         for (int64_t t = t0; t < t1; ++t) {
             const Int3 tri = tris[size_t(t)];
-            const Vec3d a = x[size_t(tri.x)], b = x[size_t(tri.y)], c = x[size_t(tri.z)];
-            area[size_t(t)] = length(cross(b - a, c - a));
-            // A sliver's normal is uncertain in direction by about u L^2 / area: its
-            // pseudonormals (face, edges and corners) do not vouch for a side.
-            const double longest = std::max({length_squared(b - a), length_squared(c - b), length_squared(a - c)});
-            doubtful[size_t(t)] = crossed[size_t(t)] || !(area[size_t(t)] > std::ldexp(longest, -30));
+            area[size_t(t)] = length(cross(x[size_t(tri.y)] - x[size_t(tri.x)], x[size_t(tri.z)] - x[size_t(tri.x)]));
         }
     });
-    // Each vertex's number of corners and one of them, for the walk around it below.
-    std::vector<int> degree(nv, 0), first_corner(nv, -1);
-    for (size_t t = 0; t < n; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int v = tris[t][k];
-            if (doubtful[t]) tainted[size_t(v)] = 1;
-            if (degree[size_t(v)]++ == 0) first_corner[size_t(v)] = int(3 * t) + k;
-        }
-    // The triangle across each triangle's edge k; the uncrossed triangles joined across
-    // their edges are the components, the region in front of one being in front of all.
-    const std::vector<EdgePair> pairs = edge_pairs(nv, tris, threads);
-    std::vector<int> across(3 * n, -1);
+    // Across an edge of two triangles that no other triangle meets, the region in front of
+    // one is the region in front of the other: the uncrossed triangles joined across their
+    // edges are the components.
     UnionFind components(n);
-    const std::vector<Vec3d>& normal = mesh.face_normals();
-    for (const EdgePair& e : pairs) {
-        across[3 * size_t(e.t) + size_t(e.t_edge)] = e.u;
-        across[3 * size_t(e.u) + size_t(e.u_edge)] = e.t;
+    for (const EdgePair& e : edge_pairs(nv, tris, threads))
         if (!crossed[size_t(e.t)] && !crossed[size_t(e.u)]) components.unite(e.t, e.u);
-        // An edge folded flat (opposite normals to within 1e-12) has an edge pseudonormal of
-        // uncertain direction, as a sliver's face normal is.
-        if (dot(normal[size_t(e.t)], normal[size_t(e.u)]) < -1.0 + 1e-12) {
-            tainted[size_t(tris[size_t(e.t)][e.t_edge])] = 1;
-            tainted[size_t(tris[size_t(e.t)][(e.t_edge + 1) % 3])] = 1;
-        }
-    }
-    // The corners around a vertex: from corner k of t (its edge k leaves the vertex) to the
-    // triangle across that edge, whose corner at the vertex leaves it by its other edge. One
-    // cycle through all of the vertex's corners is one fan; a shorter one means fans that
-    // touch there.
-    parallel_for(int64_t(nv), 4096, threads, [&](int64_t v0, int64_t v1) {
-        for (int64_t v = v0; v < v1; ++v) {
-            if (first_corner[size_t(v)] < 0) continue;
-            int t = first_corner[size_t(v)] / 3, k = first_corner[size_t(v)] % 3, steps = 0;
-            do {
-                const int u = across[3 * size_t(t) + size_t(k)];
-                if (u < 0 || ++steps > degree[size_t(v)]) break;
-                const Int3 c = tris[size_t(u)];
-                t = u;
-                k = c.x == int(v) ? 0 : c.y == int(v) ? 1 : 2;
-            } while (3 * t + k != first_corner[size_t(v)]);
-            if (steps != degree[size_t(v)]) tainted[size_t(v)] = 1;
-        }
-    });
-    // Each component's candidates: its safe triangles, largest first (their centroids lie
-    // farthest from the other triangles' planes).
     std::vector<int> root(n), size_of(n, 0);
     for (size_t t = 0; t < n; ++t) {
         root[t] = crossed[t] ? -1 : components.find(int(t));
@@ -209,14 +189,14 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     out.components = int(roots.size());
     std::stable_sort(roots.begin(), roots.end(), [&](int a, int b) { return size_of[size_t(a)] > size_of[size_t(b)]; });
     if (roots.size() > size_t(kSurfaceSideComponents)) roots.resize(size_t(kSurfaceSideComponents));
+    // Each component's candidates: its largest triangles (their points in front lie farthest
+    // from the other triangles).
     constexpr int kCandidates = 3;
-    std::vector<std::vector<int>> candidates(n > 0 ? roots.size() : 0);
+    std::vector<std::vector<int>> candidates(roots.size());
     std::vector<int> slot_of(n, -1);
     for (size_t r = 0; r < roots.size(); ++r) slot_of[size_t(roots[r])] = int(r);
     for (size_t t = 0; t < n; ++t) {
         if (root[t] < 0 || slot_of[size_t(root[t])] < 0) continue;
-        const Int3 tri = tris[t];
-        if (tainted[size_t(tri.x)] || tainted[size_t(tri.y)] || tainted[size_t(tri.z)]) continue;
         std::vector<int>& c = candidates[size_t(slot_of[size_t(root[t])])];
         if (c.size() == size_t(kCandidates) && !(area[t] > area[size_t(c.back())])) continue;
         if (c.size() == size_t(kCandidates)) c.pop_back();
@@ -241,16 +221,14 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     out.front_winding.assign(n, kSurfaceSideUnknown);
     for (size_t t = 0; t < n; ++t) {
         if (root[t] < 0 || slot_of[size_t(root[t])] < 0) continue;
-        const Int3 tri = tris[t];
-        if (tainted[size_t(tri.x)] || tainted[size_t(tri.y)] || tainted[size_t(tri.z)]) continue;
         const int w = front[size_t(slot_of[size_t(root[t])])];
         if (w == int(kSurfaceSideUnknown)) continue;
         out.front_winding[t] = int8_t(w);
         ++out.triangles_known;
     }
     for (int w : front) out.components_decided += w != int(kSurfaceSideUnknown);
-    // Below this distance the pseudonormal's side is within rounding of the surface: the
-    // ladder's tie rule decides there, as it would without the table.
+    // Within this distance of the surface the ladder's tie rule decides, as it would
+    // without the table (a point on the surface has no side).
     out.min_distance = std::ldexp(view.scale, -36);
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;

@@ -1,10 +1,8 @@
 /// @file surface_sides.h
 /// @brief The table of kernels/winding/surface_side.h for one mesh: the winding number in
-/// front of every triangle of a closed, self-intersecting mesh that no intersection comes near,
-/// one certified direct sum per component of such triangles. Built once, when a sampler with
-/// the winding sign is bound to the mesh and the environment asks for it
-/// (SDF_WINDING_SURFACE_SIDES=1): an experiment, off by default, because rounding can defeat
-/// it (core/sampling/sampler_sign.cpp, docs/winding.md).
+/// front of every triangle of a closed mesh that no intersection meets, one certified
+/// evaluation per edge-connected component of such triangles. Built once, when a sampler with
+/// the certified winding sign is bound to the mesh (core/sampling/sampler_sign.cpp).
 #pragma once
 
 #include <cstdint>

@@ -137,7 +137,7 @@ public:
             int ladder_lane[kCpuPacketLanes];
             int ladder = 0;
             for (int k = 0; k < count; ++k) {
-                if (surface_side(surface_, sample[k].triangle, sample[k].distance, inside_[k])) {
+                if (surface_side(surface_, winding_->view(), position[k], sample[k].triangle, sample[k].distance, inside_[k])) {
                     counts_.add(WindingStage::Surface);
                     continue;
                 }

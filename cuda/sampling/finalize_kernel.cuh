@@ -83,7 +83,7 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
     bool winding_inside = false;
     if constexpr (Winding) {
         // The closest triangle's side where the mesh's table vouches for it (surface_side.h).
-        const bool by_surface = n >= 0 && sign.certify && surface_side(sign.surface, n, s.distance, winding_inside);
+        const bool by_surface = n >= 0 && sign.certify && surface_side(sign.surface, sign.view, p, n, s.distance, winding_inside);
         const bool wants = o >= 0 && !by_surface && (n >= 0 || n == kOutsideBandSignPerPoint);
         if constexpr (PerThread) {
             if (by_surface) count_winding_stage(sign, WindingStage::Surface);

@@ -42,7 +42,7 @@ __device__ inline SignedDistanceSample<double> apply_winding_sign(const WindingS
                                                                   const Vec3d& p) {
     if (!w.enabled()) return s;
     bool inside = false;
-    if (w.certify && surface_side(w.surface, s.triangle, s.distance, inside)) {
+    if (w.certify && surface_side(w.surface, w.view, p, s.triangle, s.distance, inside)) {
         count_winding_stage(w, WindingStage::Surface);
         return with_sign(s, inside);
     }

@@ -1,11 +1,13 @@
-// The sides from the closest triangle (kernels/winding/surface_side.h, core/winding/
+// The first stage of the certified sign (kernels/winding/surface_side.h, core/winding/
 // surface_sides.h) against the brute-force exact winding number in long double: on closed
 // meshes that intersect themselves (overlapping spheres, a torus thicker than its hole, the
-// dragon of the data folder when found) and on nested shells, at random points and at points
-// 1e-1 .. 1e-7 of the size from the surface, every side the table decides is the exact side
-// of 1/2; the winding number in front of a sphere's triangles inside the other sphere is 1;
-// open meshes get no table; and the CPU BVH sampler's winding sign, which reads the table
-// first, equals the ladder's side (WindingSign::side) at every point.
+// dragon of the data folder when found), on nested shells, and on the cases that defeat a
+// side read from rounded closest points and pseudonormals (two boxes an ulp apart, a needle
+// corner, slivers, fans touching at a vertex), at random points and at points 1e-1 .. 1e-7 of
+// the size from the surface, every side the stage decides is the exact side of 1/2, whichever
+// triangle it is given (the closest, or any other); open meshes get no table; and the CPU BVH
+// sampler, which reads the table first, gives the ladder's side (WindingSign::side) at every
+// point.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,10 +76,11 @@ struct Checked {
 /// closed mesh: 1/2 is never near).
 Checked check_sides(const PreparedMesh& m, const SurfaceSides& sides, const std::vector<Vec3d>& pts) {
     Checked c;
+    const WindingSign tree(m);
     for (const Vec3d& p : pts) {
         const SignedDistanceSample<double> s = closest_sample(m, p);
         bool inside = false;
-        if (!surface_side(sides.view(), s.triangle, s.distance, inside)) {
+        if (!surface_side(sides.view(), tree.view(), p, s.triangle, s.distance, inside)) {
             ++c.ladder;
             continue;
         }
@@ -152,89 +155,182 @@ TEST(SurfaceSides, TheDragonsSidesAreExactAwayFromItsIntersections) {
     EXPECT_GT(c.decided, 50);
 }
 
-TEST(SurfaceSides, FansThatTouchAtAVertexAreNotVouchedFor) {
+/// Every side decided from a random triangle with a front winding number, not the closest:
+/// the segment to its centroid is long and crosses many triangles, each counted exactly.
+Checked check_any_triangle(const PreparedMesh& m, const SurfaceSides& sides, const std::vector<Vec3d>& pts, unsigned seed) {
+    Checked c;
+    const WindingSign tree(m);
+    std::mt19937_64 rng(seed);
+    for (const Vec3d& p : pts) {
+        const int t = int(rng() % m.triangles().size());
+        bool inside = false;
+        if (!surface_side(sides.view(), tree.view(), p, t, 1e300, inside)) {
+            ++c.ladder;
+            continue;
+        }
+        ++c.decided;
+        const long double w = exact_winding_long(m, p);
+        EXPECT_EQ(inside, w > 0.5L) << m.name() << ": w " << double(w) << " at " << p.x << " " << p.y << " " << p.z
+                                    << " from triangle " << t;
+    }
+    return c;
+}
+
+TEST(SurfaceSides, AnyTriangleGivesTheExactSide) {
+    const TriangleMesh a = make_icosphere(3, 1.0), b = make_icosphere(3, 0.7, {0.9, 0.1, 0.05});
+    TriangleMesh thick = make_torus(0.5, 0.7, 32, 16);
+    thick.name = "thick torus";
+    for (const TriangleMesh& mesh : {test::concatenated({a, b}, "overlapping spheres"), thick}) {
+        const PreparedMesh m = prepare_mesh(mesh);
+        const SurfaceSides sides = build_surface_sides(m, 2);
+        const Checked c = check_any_triangle(m, sides, points_around(m, 400, 17), 5);
+        EXPECT_GT(c.decided, 250) << mesh.name;
+    }
+}
+
+/// Closed box [lo, hi] with outward triangles.
+TriangleMesh box_between(Vec3d lo, Vec3d hi) {
+    TriangleMesh m = make_box({1, 1, 1});
+    for (Vec3d& v : m.vertices) v = Vec3d(v.x < 0 ? lo.x : hi.x, v.y < 0 ? lo.y : hi.y, v.z < 0 ? lo.z : hi.z);
+    return m;
+}
+
+TEST(SurfaceSides, FansThatTouchAtAVertexAndSliversHaveTheExactSide) {
     // Two tetrahedra with one vertex in common (closed, no edge shared by more than two
-    // triangles, no intersection): the common vertex has two fans, so its six triangles are
-    // left to the ladder; the others have the outside in front of them.
-    TriangleMesh m;
-    m.name = "two tetrahedra touching at a vertex";
-    m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
-    m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},   // outward
-                   {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};  // the point reflection, outward
-    const PreparedMesh pm = prepare_mesh(m);
+    // triangles, no intersection): the outside is in front of all eight triangles. No
+    // pseudonormal is read, so the common vertex needs no care.
+    TriangleMesh fans;
+    fans.name = "two tetrahedra touching at a vertex";
+    fans.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+    fans.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},   // outward
+                      {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};  // the point reflection, outward
+    const PreparedMesh pm = prepare_mesh(fans);
     ASSERT_TRUE(pm.report().closed());
     ASSERT_EQ(pm.report().self_intersecting_pairs + pm.report().shell_intersecting_pairs, 0);
     const SurfaceSides sides = build_surface_sides(pm, 2);
     ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
-    for (size_t t = 0; t < pm.triangles().size(); ++t) {
-        const Int3 tri = pm.triangles()[t];
-        const bool at_common = tri.x == 0 || tri.y == 0 || tri.z == 0;
-        EXPECT_EQ(sides.front_winding[t], at_common ? kSurfaceSideUnknown : int8_t(0)) << t;
-    }
-    EXPECT_EQ(sides.triangles_known, 2);
-}
+    for (size_t t = 0; t < pm.triangles().size(); ++t) EXPECT_EQ(sides.front_winding[t], 0) << t;
+    std::vector<Vec3d> near_common;  // around the vertex the two fans share
+    std::mt19937_64 rng(29);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (int i = 0; i < 300; ++i) near_common.push_back(Vec3d(g(rng), g(rng), g(rng)) * std::pow(10.0, -1.0 - i % 6));
+    EXPECT_GT(check_sides(pm, sides, near_common).decided, 250);
+    EXPECT_GT(check_sides(pm, sides, points_around(pm, 200, 31)).decided, 150);
 
-TEST(SurfaceSides, SliversAreNotVouchedFor) {
-    // A tetrahedron whose face a-b-c is split at a point `offset` from the midpoint of edge
-    // a-b: at 1e-13 the triangle a-b-m is a sliver whose normal's direction rounding cannot
-    // fix, and every triangle (each has a corner at a, b or m) is left to the ladder; at 0.2
-    // the same mesh has no sliver and every triangle is vouched for.
+    // A tetrahedron whose face a-b-c is split at a point 1e-13 from the midpoint of edge a-b:
+    // the triangle a-b-m is a sliver whose normal's direction rounding cannot fix.
     const Vec3d a{1, 0, 0}, b{0, 1, 0}, c{0, 0, 1};
     const Vec3d mid = (a + b) * 0.5;
-    for (double offset : {1e-13, 0.2}) {
-        TriangleMesh m;
-        m.name = "tetrahedron with a split face";
-        m.vertices = {{0, 0, 0}, a, b, c, mid + (c - mid) * (offset / length(c - mid))};
-        m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 4}, {2, 3, 4}, {3, 1, 4}};
-        const PreparedMesh pm = prepare_mesh(m);
-        ASSERT_EQ(pm.triangles().size(), 6u) << offset;  // the sliver has an area: it is kept
-        ASSERT_TRUE(pm.report().closed()) << offset;
-        const SurfaceSides sides = build_surface_sides(pm, 1);
-        ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
-        EXPECT_EQ(sides.triangles_known, offset < 1e-6 ? 0 : 6) << offset;
-        const Checked checked = check_sides(pm, sides, points_around(pm, 200, 23));
-        EXPECT_EQ(checked.decided, offset < 1e-6 ? 0 : 200) << offset;
-    }
+    TriangleMesh sliver;
+    sliver.name = "tetrahedron with a sliver";
+    sliver.vertices = {{0, 0, 0}, a, b, c, mid + (c - mid) * (1e-13 / length(c - mid))};
+    sliver.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 4}, {2, 3, 4}, {3, 1, 4}};
+    const PreparedMesh ps = prepare_mesh(sliver);
+    ASSERT_EQ(ps.triangles().size(), 6u);  // the sliver has an area: it is kept
+    const SurfaceSides sliver_sides = build_surface_sides(ps, 1);
+    ASSERT_TRUE(sliver_sides.why_off.empty()) << sliver_sides.why_off;
+    EXPECT_EQ(sliver_sides.triangles_known, 6);
+    std::vector<Vec3d> near_sliver;
+    for (int i = 0; i < 300; ++i) near_sliver.push_back(mid + Vec3d(g(rng), g(rng), g(rng)) * std::pow(10.0, -2.0 - i % 10));
+    const Checked checked = check_sides(ps, sliver_sides, near_sliver);
+    EXPECT_GT(checked.decided, 200);
+    check_sides(ps, sliver_sides, points_around(ps, 200, 23));
+    check_any_triangle(ps, sliver_sides, near_sliver, 37);
 }
 
-TEST(SurfaceSides, TheDefaultSignIsExactBesideSurfacesAnUlpApart) {
-    // A review's case against the table: two boxes one ulp apart (closed, oriented, no
-    // intersecting pair), points inside the upper one. The closest triangle found in rounded
-    // arithmetic may lie across the lower box's top face, whose front winding is 0, so the
-    // table's rule says outside; the default sampler (the ladder) says inside, as the exact
-    // winding number does.
-    auto box = [](Vec3d lo, Vec3d hi) {
-        TriangleMesh m = make_box({1, 1, 1});
-        for (Vec3d& v : m.vertices) v = Vec3d(v.x < 0 ? lo.x : hi.x, v.y < 0 ? lo.y : hi.y, v.z < 0 ? lo.z : hi.z);
-        return m;
-    };
-    const double gap = std::ldexp(1.0, -52);
-    const PreparedMesh m = prepare_mesh(test::concatenated(
-        {box({-100, -100, -15}, {100, 100, 1}), box({-100, -100, 1 + gap}, {100, 100, 16})}, "boxes an ulp apart"));
+TEST(SurfaceSides, ANeedleCornerHasTheExactSide) {
+    // A review's case against pseudonormals: a pyramid whose apex angle is about 1e-6. Its
+    // vertex pseudonormal at the apex is rounded by more than the margin of points near its
+    // normal cone's boundary; the stage reads no pseudonormal.
+    TriangleMesh needle;
+    needle.name = "needle pyramid";
+    const double r = 5e-7;
+    needle.vertices = {{-r, -r, 0}, {r, -r, 0}, {r, r, 0}, {-r, r, 0}, {0, 0, 1}};
+    needle.triangles = {{0, 2, 1}, {0, 3, 2}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    const PreparedMesh m = prepare_mesh(needle);
     ASSERT_TRUE(m.report().closed());
-    SamplerOptions o;
-    o.sign = SignMode::Winding;
-    o.threads = 2;
-    const auto bound = make_cpu_bvh_sampler(o)->bind(share(m));
-    std::mt19937_64 rng(1);
-    std::uniform_real_distribution<double> xy(-50, 50), z(1.5, 8.5);
+    const SurfaceSides sides = build_surface_sides(m, 1);
+    ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
+    EXPECT_EQ(sides.triangles_known, 6);
     std::vector<Vec3d> pts;
-    for (int i = 0; i < 300; ++i) pts.push_back({xy(rng), xy(rng), z(rng)});
-    const std::vector<PointSample> got = bound->query(pts);
-    for (size_t i = 0; i < pts.size(); ++i) {
-        const long double w = exact_winding_long(m, pts[i]);
-        EXPECT_EQ(got[i].distance < 0, w > 0.5L) << "w " << double(w) << " at " << pts[i].x << " " << pts[i].y << " " << pts[i].z;
+    std::mt19937_64 rng(41);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (int i = 0; i < 1000; ++i) {
+        const double sigma = std::pow(10.0, -1.0 - i % 8);
+        pts.push_back(Vec3d(0, 0, 1 - (i % 3) * 0.3) + Vec3d(g(rng) * r * 4, g(rng) * r * 4, g(rng)) * sigma);
+    }
+    const Checked c = check_sides(m, sides, pts);
+    EXPECT_GT(c.decided, 800);
+}
+
+TEST(SurfaceSides, SurfacesAnUlpApartHaveTheExactSide) {
+    // A review's case against a side read from the rounded closest triangle: two boxes one
+    // ulp apart (closed, oriented, no intersecting pair), points inside the upper one. The
+    // closest triangle found in rounded arithmetic may be the lower box's top face, whose
+    // front winding is 0: the segment to its centroid crosses the upper box's bottom face,
+    // which the stage counts. Tilted, the faces are no longer on lattice planes.
+    const double gap = std::ldexp(1.0, -52);
+    const TriangleMesh flat = test::concatenated({box_between({-100, -100, -15}, {100, 100, 1}), box_between({-100, -100, 1 + gap}, {100, 100, 16})},
+                                                 "boxes an ulp apart");
+    // Tilted, a few ulps of the coordinates apart (one ulp of 1 would round away).
+    const double tilted_gap = std::ldexp(1.0, -42);
+    TriangleMesh tilted = test::concatenated({box_between({-100, -100, -15}, {100, 100, 1}), box_between({-100, -100, 1 + tilted_gap}, {100, 100, 16})},
+                                             "tilted boxes a few ulps apart");
+    const double ca = std::cos(0.3), sa = std::sin(0.3);
+    for (Vec3d& v : tilted.vertices) v = Vec3d(ca * v.x - sa * v.z, v.y, sa * v.x + ca * v.z);
+    for (const TriangleMesh& mesh : {flat, tilted}) {
+        const PreparedMesh m = prepare_mesh(mesh);
+        ASSERT_TRUE(m.report().closed()) << mesh.name;
+        const SurfaceSides sides = build_surface_sides(m, 2);
+        ASSERT_TRUE(sides.why_off.empty()) << sides.why_off;
+        std::mt19937_64 rng(1);
+        std::uniform_real_distribution<double> xy(-50, 50), z(-8.5, 8.5), near(-1e-3, 1e-3);
+        std::vector<Vec3d> pts;
+        for (int i = 0; i < 300; ++i) {
+            Vec3d p{xy(rng), xy(rng), i % 2 == 0 ? z(rng) : 1 + near(rng)};
+            if (mesh.name == tilted.name) p = Vec3d(ca * p.x - sa * p.z, p.y, sa * p.x + ca * p.z);
+            pts.push_back(p);
+        }
+        const Checked c = check_sides(m, sides, pts);
+        EXPECT_GT(c.decided, 200) << mesh.name;
+        // The review's failure: points whose closest triangle (rounded) is across the other
+        // surface, so that the crossings change the side.
+        int across = 0;
+        const WindingSign tree(m);
+        for (const Vec3d& p : pts) {
+            const SignedDistanceSample<double> s = closest_sample(m, p);
+            const Int3 ti = m.triangles()[size_t(s.triangle)];
+            const Vec3d t[3] = {m.vertices()[size_t(ti.x)], m.vertices()[size_t(ti.y)], m.vertices()[size_t(ti.z)]};
+            int change = 0;
+            across += segment_winding_change(tree.view(), p, s.triangle, t, change) && change != 0;
+        }
+        if (mesh.name == flat.name) {
+            EXPECT_GT(across, 20);
+        }
+        check_any_triangle(m, sides, pts, 43);
+        if (m.report().self_intersecting_pairs + m.report().shell_intersecting_pairs > 0) continue;
+        // The sampler's default sign, which reads the table first.
+        SamplerOptions o;
+        o.sign = SignMode::Winding;
+        o.threads = 2;
+        const auto bound = make_cpu_bvh_sampler(o)->bind(share(m));
+        const std::vector<PointSample> got = bound->query(pts);
+        for (size_t i = 0; i < pts.size(); ++i) {
+            const long double w = exact_winding_long(m, pts[i]);
+            EXPECT_EQ(got[i].distance < 0, w > 0.5L) << mesh.name << ": w " << double(w) << " at " << pts[i].x << " " << pts[i].y << " " << pts[i].z;
+        }
     }
 }
 
 TEST(SurfaceSides, OpenMeshesGetNoTable) {
     TriangleMesh bowl = make_icosphere(2, 1.0);
     bowl.triangles.resize(bowl.triangles.size() - 10);
-    const SurfaceSides sides = build_surface_sides(prepare_mesh(bowl));
+    const PreparedMesh m = prepare_mesh(bowl);
+    const SurfaceSides sides = build_surface_sides(m);
     EXPECT_FALSE(sides.why_off.empty());
     EXPECT_TRUE(sides.front_winding.empty());
     bool inside = false;
-    EXPECT_FALSE(surface_side(sides.view(), 0, 1.0, inside));
+    EXPECT_FALSE(surface_side(sides.view(), WindingSign(m).view(), {0, 0, 0}, 0, 1.0, inside));
 }
 
 TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
@@ -243,11 +339,10 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
     SamplerOptions o;
     o.sign = SignMode::Winding;
     o.threads = 2;
-    // The table is an experiment, off unless asked for (sampler_sign.cpp says why).
-    const auto ladder_only = make_cpu_bvh_sampler(o)->bind(share(m));
-    setenv("SDF_WINDING_SURFACE_SIDES", "1", 1);
     const auto bound = make_cpu_bvh_sampler(o)->bind(share(m));
-    unsetenv("SDF_WINDING_SURFACE_SIDES");
+    setenv("SDF_WINDING_LADDER_ONLY", "1", 1);  // the baseline: every point on the ladder
+    const auto ladder_only = make_cpu_bvh_sampler(o)->bind(share(m));
+    unsetenv("SDF_WINDING_LADDER_ONLY");
     const Lattice lattice = fit_lattice(LatticeType::CC, {28, 24, 24}, m.bounds(), 0.1);
     const SampledField f = bound->sample(lattice);
     ASSERT_TRUE(f.sampler.winding_sign.has_value());
@@ -260,10 +355,10 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
         if (f.distance[size_t(i)] == 0) continue;
         EXPECT_EQ(f.distance[size_t(i)] < 0, ladder.side(lattice.position(i)).inside) << i;
     }
-    const SampledField by_default = ladder_only->sample(lattice);
-    ASSERT_TRUE(by_default.sampler.winding_sign.has_value());
-    EXPECT_EQ(by_default.sampler.winding_sign->surface, 0);
-    EXPECT_EQ(by_default.distance, f.distance);
+    const SampledField by_ladder = ladder_only->sample(lattice);
+    ASSERT_TRUE(by_ladder.sampler.winding_sign.has_value());
+    EXPECT_EQ(by_ladder.sampler.winding_sign->surface, 0);
+    EXPECT_EQ(by_ladder.distance, f.distance);
 }
 
 }  // namespace
