@@ -37,10 +37,12 @@ SDF_CPU_GPU SDF_INLINE BoundedValue orientation_det(const Vec3d& a, const Vec3d&
     const double permanent = (fabs(bdxcdy) + fabs(cdxbdy)) * fabs(adz) + (fabs(cdxady) + fabs(adxcdy)) * fabs(bdz) +
                              (fabs(adxbdy) + fabs(bdxady)) * fabs(cdz);
     constexpr double eps = 1.1102230246251565404e-16;  // 2^-53
-    r.bound = (7.0 + 56.0 * eps) * eps * permanent;
-    // Products below the normal range lose the relative accuracy the bound assumes, and
-    // overflow loses everything: such a determinant decides nothing.
-    if (!(permanent < 1e300) || (permanent != 0.0 && permanent < 1e-280)) r.bound = INFINITY;
+    // Shewchuk's relative bound, plus what underflow adds: a product below the normal range
+    // is rounded by up to 2^-1075 absolutely (the differences are exact there), which the
+    // outer products multiply by |adz|, |bdz|, |cdz|; the 8 covers the permanent's own
+    // products lost to underflow. Overflow loses everything: no decision.
+    r.bound = (7.0 + 56.0 * eps) * eps * permanent + 0x1p-1071 * (fabs(adz) + fabs(bdz) + fabs(cdz) + 1.0);
+    if (!(permanent < 1e300)) r.bound = INFINITY;
     return r;
 }
 

@@ -93,6 +93,10 @@ SDF_CPU_GPU SDF_INLINE void certified_solid_angle_terms(const Vec3d& p, const Ve
     numerator = dot(a, cross(b, c));
     S = la * lb * lc;
     denominator = S + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    // Below these, squares and products leave the normal range, where rounding is absolute
+    // (a length from a subnormal square can be wrong by 100%) and 128 u S bounds nothing:
+    // the triangle decides nothing (solid_angle_rounding() gives 4 pi for S = inf).
+    if (!(fmin(la, fmin(lb, lc)) > 0x1p-450) || !(S > 0x1p-900)) S = INFINITY;
 }
 
 /// Omega of one triangle seen from p, with the bound on its rounding.
@@ -148,8 +152,9 @@ SDF_CPU_GPU SDF_INLINE void certified_far_term(const WindingMoments<double>& m, 
     const double one_minus_t = 1.0 - t;
     const double series = order >= 2 ? t * t * (3.0 - 2.0 * t) : t * (2.0 - t);
     bound = (mass * series / (one_minus_t * one_minus_t) + rounding) * inverse_four_pi<double>() * (1.0 + 16.0 * u);
-    // The radius's rounding ate the margin (a far-away tiny cluster): no bound.
-    if (!(t < 0.75)) bound = INFINITY;
+    // The radius's rounding ate the margin (a far-away tiny cluster), or the cluster is so
+    // close that the terms' products leave the normal range: no bound.
+    if (!(t < 0.75) || !(d2 > 0x1p-900)) bound = INFINITY;
 }
 
 /// The far-field term of one child with its certified bound; false when q is not far enough

@@ -73,27 +73,23 @@ SDF_CPU_GPU inline bool add_crossing(const Vec3d& p, const Vec3d t[3], const Vec
     return true;
 }
 
-/// Whether the segment from p along `dir` (t in [0, 1]) may meet the float box grown by
-/// `slack`: conservative (the slack covers the rounding of dir and of the slab parameters).
-SDF_CPU_GPU SDF_INLINE bool segment_may_meet_box(const Vec3d& p, const Vec3d& dir, double slack, float lo_x, float hi_x,
-                                                 float lo_y, float hi_y, float lo_z, float hi_z) {
+/// Whether the segment from p along dir = 1 / inv (t in [0, 1]) may meet the box [lo, hi]
+/// grown by `slack`: conservative (the slack covers the rounding of dir, of its inverse and
+/// of the slab parameters, a few ulps of the coordinates). A zero component of dir has an
+/// infinite inverse, whose slab is all or nothing.
+SDF_CPU_GPU SDF_INLINE bool segment_may_meet_box(const Vec3d& p, const Vec3d& inv, double slack, const Vec3d& lo,
+                                                 const Vec3d& hi) {
     double t0 = 0.0, t1 = 1.0;
-    const double lo[3] = {double(lo_x) - slack, double(lo_y) - slack, double(lo_z) - slack};
-    const double hi[3] = {double(hi_x) + slack, double(hi_y) + slack, double(hi_z) + slack};
-    const double o[3] = {p.x, p.y, p.z}, d[3] = {dir.x, dir.y, dir.z};
     for (int k = 0; k < 3; ++k) {
-        if (d[k] == 0.0) {
-            if (o[k] < lo[k] || o[k] > hi[k]) return false;
+        const double a = lo[k] - slack - p[k], b = hi[k] + slack - p[k];
+        if (inv[k] == INFINITY || inv[k] == -INFINITY) {  // parallel to the slab
+            if (a > 0.0 || b < 0.0) return false;
             continue;
         }
-        double a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
-        if (a > b) {
-            const double s = a;
-            a = b;
-            b = s;
-        }
-        t0 = fmax(t0, a);
-        t1 = fmin(t1, b);
+        const double ta = a * inv[k], tb = b * inv[k];
+        const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
+        t0 = near > t0 ? near : t0;
+        t1 = far < t1 ? far : t1;
     }
     return t0 <= t1;
 }
@@ -103,7 +99,7 @@ SDF_CPU_GPU SDF_INLINE bool segment_may_meet_box(const Vec3d& p, const Vec3d& di
 SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, const Vec3d& p, int triangle, const Vec3d t[3],
                                                int& change) {
     const Vec3d y = (t[0] + t[1] + t[2]) / 3.0;  // for the boxes only
-    const Vec3d dir = y - p;
+    const Vec3d dir = y - p, inv(1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z);
     const double scale = fmax(v.scale, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
     const double slack = ldexp(scale, -40);
     change = 0;
@@ -114,7 +110,7 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
         const BvhNode& n = v.nodes[stack[--top]];
         for (int c = 0; c < 2; ++c) {
             if (n.count[c] == 0 && n.ref[c] < 0) continue;  // an empty root child
-            if (!segment_may_meet_box(p, dir, slack, n.min_x[c], n.max_x[c], n.min_y[c], n.max_y[c], n.min_z[c], n.max_z[c]))
+            if (!segment_may_meet_box(p, inv, slack, Vec3d(n.min_x[c], n.min_y[c], n.min_z[c]), Vec3d(n.max_x[c], n.max_y[c], n.max_z[c])))
                 continue;
             if (!bvh_child_is_leaf(n, c)) {
                 SDF_DCHECK(top <= kBvhMaxDepth);
@@ -125,7 +121,10 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
                 const int32_t u = v.triangle_index[slot];
                 if (u == triangle) continue;
                 const Int3 ui = v.triangles[u];
-                if (!add_crossing(p, t, v.vertices[ui.x], v.vertices[ui.y], v.vertices[ui.z], change)) return false;
+                const Vec3d u0 = v.vertices[ui.x], u1 = v.vertices[ui.y], u2 = v.vertices[ui.z];
+                if (!segment_may_meet_box(p, inv, slack, component_min(u0, component_min(u1, u2)), component_max(u0, component_max(u1, u2))))
+                    continue;  // most of a leaf's triangles: the determinants cost more than this
+                if (!add_crossing(p, t, u0, u1, u2, change)) return false;
             }
         }
     }

@@ -322,6 +322,50 @@ TEST(SurfaceSides, SurfacesAnUlpApartHaveTheExactSide) {
     }
 }
 
+TEST(SurfaceSides, UnderflowDecidesNothing) {
+    // A review's cases against the bounds at the bottom of the double range. (1) A
+    // tetrahedron with subnormal x coordinates and a point 2^125 away: the determinant's
+    // subnormal products are rounded absolutely, which the outer products magnify past a
+    // purely relative bound. The stage must not call the point inside (w = 0).
+    TriangleMesh tet;
+    tet.name = "tetrahedron with subnormal coordinates";
+    tet.vertices = {{0x0.00000002d4dfp-1022, 0x1.ec0b126936336p-1, -0x1.dd2f15dd24ee8p-1},
+                    {0x0.00000001234a2p-1022, -0x1.fe29cfa4f3329p-1, 0x1.520fa045bbc02p-1},
+                    {0x0.00000001b6a9fp-1022, -0x1.5306d8417e70ep-2, -0x1.fd64e9e6e5e6ep-2},
+                    {-1.0, -0x1.f45b18f6a0945p-4, -0x1.068bf1b1e8169p-2}};
+    tet.triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
+    const PreparedMesh m = prepare_mesh(tet);
+    const SurfaceSides sides = build_surface_sides(m, 1);
+    const WindingSign tree(m);
+    const Vec3d far_away(0x0.000000023441fp-1022, 0x1.e32a10cad296p-3, -0x1p+125);
+    for (int t = 0; t < 4; ++t) {
+        bool inside = false;
+        if (surface_side(sides.view(), tree.view(), far_away, t, 1e38, inside)) {
+            EXPECT_FALSE(inside) << t;
+        }
+    }
+    // (2) A tetrahedron beside a second one 2^-358 across, placed so that the first's
+    // evaluation point in front of its top face is the origin, next to the tiny one: their
+    // solid angles' products underflow, and a bound of 128 u S (S subnormal) let a wrong sum
+    // fix the front winding number at 1. It is 0, or unknown.
+    Vec3d a(2, -1, 0), b(-1, 2, 0), c(-1, -1, 0);
+    const Vec3d n = cross(b - a, c - a);
+    const double z0 = -(n * (0.25 / std::sqrt(length(n)))).z;
+    a.z = b.z = c.z = z0;
+    TriangleMesh pair;
+    pair.name = "a tetrahedron and a tiny one";
+    pair.vertices = {a, b, c, {0, 0, z0 - 0.5},
+                     {0x1.c8ff0b7579826p-359, -0x1.296fde3ef6e08p-363, 0x1.13fa5a489f64bp-360},
+                     {-0x1.2bc209d1fb8b9p-359, 0x1.f1a55a2129d78p-359, 0x1.07e8da83f6b4bp-360},
+                     {-0x1.091c05da3dba9p-359, -0x1.ab031aa9b0f19p-359, 0x1.1018b7b774b72p-360},
+                     {-0x1.6c2543ef8ca37p-364, -0x1.274f0a8cfa64ap-362, 0x1.22f941c4663b5p-358}};
+    pair.triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}, {4, 6, 5}, {4, 5, 7}, {5, 6, 7}, {6, 4, 7}};
+    const PreparedMesh pm = prepare_mesh(pair);
+    const SurfaceSides pair_sides = build_surface_sides(pm, 1);
+    for (int8_t f : pair_sides.front_winding) EXPECT_TRUE(f == 0 || f == kSurfaceSideUnknown) << int(f);
+    EXPECT_FALSE(WindingSign(pm).side({3, 3, 3}).inside);
+}
+
 TEST(SurfaceSides, OpenMeshesGetNoTable) {
     TriangleMesh bowl = make_icosphere(2, 1.0);
     bowl.triangles.resize(bowl.triangles.size() - 10);
