@@ -176,8 +176,12 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
     // one is the region in front of the other: the uncrossed triangles joined across their
     // edges are the components.
     UnionFind components(n);
-    for (const EdgePair& e : edge_pairs(nv, tris, threads))
+    std::vector<int> across(3 * n, -1);  // the triangle across each triangle's edge k
+    for (const EdgePair& e : edge_pairs(nv, tris, threads)) {
+        across[3 * size_t(e.t) + size_t(e.t_edge)] = e.u;
+        across[3 * size_t(e.u) + size_t(e.u_edge)] = e.t;
         if (!crossed[size_t(e.t)] && !crossed[size_t(e.u)]) components.unite(e.t, e.u);
+    }
     std::vector<int> root(n), size_of(n, 0);
     for (size_t t = 0; t < n; ++t) {
         root[t] = crossed[t] ? -1 : components.find(int(t));
@@ -227,6 +231,27 @@ SurfaceSides build_surface_sides(const PreparedMesh& mesh, int threads) {
         ++out.triangles_known;
     }
     for (int w : front) out.components_decided += w != int(kSurfaceSideUnknown);
+    // Every other triangle's stand-in: the nearest known one across edges (a breadth-first
+    // walk from all known triangles at once, in index order), so that points whose closest
+    // triangle is in an intersecting pair still take the stage; their segment is longer by
+    // a few triangles and crosses the intersecting ones, each counted.
+    out.stand_in.assign(n, -1);
+    std::vector<int> queue;
+    queue.reserve(n);
+    for (size_t t = 0; t < n; ++t)
+        if (out.front_winding[t] != kSurfaceSideUnknown) {
+            out.stand_in[t] = int(t);
+            queue.push_back(int(t));
+        }
+    for (size_t head = 0; head < queue.size(); ++head) {
+        const int t = queue[head];
+        for (int k = 0; k < 3; ++k) {
+            const int u = across[3 * size_t(t) + size_t(k)];
+            if (u < 0 || out.stand_in[size_t(u)] >= 0) continue;
+            out.stand_in[size_t(u)] = out.stand_in[size_t(t)];
+            queue.push_back(u);
+        }
+    }
     // Within this distance of the surface the ladder's tie rule decides, as it would
     // without the table (a point on the surface has no side).
     out.min_distance = std::ldexp(view.scale, -36);

@@ -19,6 +19,9 @@ struct SurfaceSides {
     /// empty when the mesh is not closed and consistently oriented with its intersections
     /// checked (then every point takes the ladder).
     std::vector<int8_t> front_winding;
+    /// Per prepared triangle: itself when it has a front winding number, else the nearest
+    /// triangle across edges that has one, or -1 (SurfaceSideView::stand_in).
+    std::vector<int32_t> stand_in;
     double min_distance = 0;     ///< SurfaceSideView::min_distance
     int components = 0;          ///< edge-connected components of triangles in no intersecting pair
     int components_decided = 0;  ///< those whose front winding number was certified
@@ -27,7 +30,7 @@ struct SurfaceSides {
     std::string why_off;         ///< empty when the table is on
 
     SurfaceSideView view() const {
-        return front_winding.empty() ? SurfaceSideView{} : SurfaceSideView{front_winding.data(), min_distance};
+        return front_winding.empty() ? SurfaceSideView{} : SurfaceSideView{front_winding.data(), stand_in.data(), min_distance};
     }
 };
 

@@ -89,7 +89,8 @@ private:
         const SurfaceSideView surface = sign.surface_view();
         if (surface.front_winding != nullptr) {  // the sides from the closest triangle
             surface_.upload(surface.front_winding, size_t(mesh.num_triangles), stream);
-            view_.surface = {surface_.get(), surface.min_distance};
+            stand_in_.upload(surface.stand_in, size_t(mesh.num_triangles), stream);
+            view_.surface = {surface_.get(), stand_in_.get(), surface.min_distance};
         }
         if (counts_.get() == nullptr) counts_.allocate(kWindingStages);
         CUDA_CHECK(cudaMemsetAsync(counts_.get(), 0, kWindingStages * sizeof(unsigned long long), stream));
@@ -100,6 +101,7 @@ private:
     DeviceBuffer<WindingNode<double>> moments_;
     DeviceBuffer<int32_t> triangle_index_;
     DeviceBuffer<int8_t> surface_;  ///< SurfaceSides::front_winding
+    DeviceBuffer<int32_t> stand_in_;  ///< SurfaceSides::stand_in
     DeviceBuffer<unsigned long long> counts_;  ///< kWindingStages: the current sampling's (scratch)
     WindingSignView view_;
 };

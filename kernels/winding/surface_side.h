@@ -18,8 +18,9 @@
 /// Every term is decided by orientation determinants of the input doubles with rigorous
 /// bounds (kernels/core/filtered_orientation.h); the centroid enters as a sum of three of
 /// them, never as rounded coordinates. Nothing depends on T being the closest triangle: any T
-/// gives the exact w. The closest one (the search's) makes the segment short, so the tree
-/// (the winding BVH's boxes) hands it few candidates. Where any determinant is undecided (p on
+/// gives the exact w. The closest one (the search's; where it is in an intersecting pair, the
+/// nearest triangle across edges that is not, its stand-in) makes the segment short, so the
+/// tree (the winding BVH's boxes) hands it few candidates. Where any determinant is undecided (p on
 /// a triangle's plane, the segment through an edge) the point takes the ladder
 /// (certified_winding.h); so do points within `min_distance` of the surface, where the
 /// ladder's tie rule holds, and points with no triangle.
@@ -39,6 +40,9 @@ constexpr int8_t kSurfaceSideUnknown = INT8_MIN;
 /// Plain pointers to a mesh's table (host or device); no table (front_winding null): off.
 struct SurfaceSideView {
     const int8_t* front_winding = nullptr;  ///< per prepared triangle, or kSurfaceSideUnknown
+    /// Per prepared triangle: the triangle whose centroid the segment runs to (itself when
+    /// its front winding number is known; else the nearest known one across edges), or -1.
+    const int32_t* stand_in = nullptr;
     double min_distance = 0;               ///< |d| at or below this: the ladder decides
 };
 
@@ -132,14 +136,15 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
 }
 
 /// Decides `inside` (w(p) > 1/2, exactly) from triangle `triangle` (the search's closest, at
-/// distance `distance` from p); false when the table cannot: no table, no triangle, one it
-/// has no front winding number for, p within min_distance of the surface, or a determinant
-/// left undecided.
+/// distance `distance` from p) or its stand-in; false when the table cannot: no table, no
+/// triangle, no stand-in, p within min_distance of the surface, or a determinant left
+/// undecided.
 SDF_CPU_GPU inline bool surface_side(const SurfaceSideView& s, const WindingView<double>& v, const Vec3d& p, int triangle,
                                      double distance, bool& inside) {
-    if (s.front_winding == nullptr || triangle < 0) return false;
+    if (s.front_winding == nullptr || triangle < 0 || !(fabs(distance) > s.min_distance)) return false;
+    triangle = s.stand_in[triangle];
+    if (triangle < 0) return false;
     const int8_t front = s.front_winding[triangle];
-    if (front == kSurfaceSideUnknown || !(fabs(distance) > s.min_distance)) return false;
     const Int3 ti = v.triangles[triangle];
     const Vec3d t[3] = {v.vertices[ti.x], v.vertices[ti.y], v.vertices[ti.z]};
     const int behind = decided_sign(orientation_det(t[0], t[1], t[2], p));
