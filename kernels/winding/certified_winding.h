@@ -46,8 +46,8 @@ constexpr double kWindingUnitRoundoff = 1.1102230246251565404e-16;
 constexpr double kWindingPi = 3.14159265358979323846;
 
 /// How a certified side was decided (the manifest's counters: sampler_report.h). Surface:
-/// by the closest triangle's side and the winding number in front of it (surface_side.h),
-/// before the ladder.
+/// by the first stage, a triangle's front winding number and the triangles the segment to
+/// its centroid crosses (surface_side.h), before the ladder.
 enum class WindingStage : uint8_t { Fast = 0, Refined = 1, Direct = 2, Tie = 3, Surface = 4 };
 constexpr int kWindingStages = 5;
 
