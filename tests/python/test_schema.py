@@ -1,6 +1,8 @@
 """The run schema's validator: missing and mistyped keys are errors naming the file and the
 key; strict mode rejects undeclared keys; the schema file uses only keywords it knows."""
+import glob
 import json
+import os
 
 import pytest
 
@@ -34,6 +36,32 @@ def test_every_keyword_of_the_schema_file_is_understood(schema):
                 walk(value, "%s[%d]" % (where, i))
     for part in ("manifest", "metrics", "$defs"):
         walk(schema[part], part)
+
+
+def test_every_schema_file_is_listed_and_every_ref_resolves(schema):
+    # A file under harness/schema/ that "$defs_files" does not list would be ignored unseen.
+    folder = os.path.dirname(run_schema.SCHEMA_PATH)
+    files = run_schema.schema_files()
+    stray = sorted(set(glob.glob(os.path.join(folder, "**", "*.json"), recursive=True)) - set(files))
+    assert not stray, "not listed under \"$defs_files\" of %s: %s" % (run_schema.SCHEMA_NAME, ", ".join(stray))
+    for path in files:
+        with open(path) as f:
+            assert len(f.readlines()) < 600, "%s: over the repository's 600 lines a file" % path
+    refs = []
+
+    def walk(node, where):
+        if isinstance(node, dict):
+            if isinstance(node.get("$ref"), str):
+                refs.append((where, node["$ref"]))
+            for key, value in node.items():
+                walk(value, where + "/" + key)
+        elif isinstance(node, list):
+            for i, value in enumerate(node):
+                walk(value, "%s[%d]" % (where, i))
+    walk(schema, "")
+    assert len(refs) > 40
+    for where, ref in refs:
+        assert ref.startswith("#/$defs/") and ref[len("#/$defs/"):] in schema["$defs"], "%s: $ref %s" % (where, ref)
 
 
 def test_missing_key_names_the_file_and_the_key_path(schema):
