@@ -1,5 +1,5 @@
-"""The run schema (harness/schema/run_schema.json) and a validator for the subset of JSON
-Schema it uses.
+"""The run schema (harness/schema/run_schema.json and the $defs files it lists under
+harness/schema/defs/) and a validator for the subset of JSON Schema it uses.
 
 The schema states, per experiment kind, the keys of metrics.json and the manifest keys the
 report reads, with their types. The report validates every run it reads against it, and
@@ -9,10 +9,13 @@ C++ side and the report cannot drift apart unnoticed.
 
 Keywords understood: type, properties, required, additionalProperties, items, enum, const,
 if/then/else, $ref (to "#/$defs/<name>") and the annotations description, title, $comment,
-$schema, $id, $defs. Any other keyword is an error in the schema file, so that no rule is
+$schema, $id, $defs. Any other keyword is an error in the schema's files, so that no rule is
 silently ignored. Strict mode: an object whose schema lists "properties" and says nothing
 about "additionalProperties" may hold no other key (the report itself reads leniently:
 keys it does not know are ignored).
+
+load_schema() joins the files into one document: the top file's "$defs_files" names the
+$defs files, in order, and is consumed there; every $ref stays "#/$defs/<name>".
 """
 
 import json
@@ -36,7 +39,7 @@ class RunFileError(Exception):
 
 
 class SchemaFileError(Exception):
-    """The schema file itself is malformed (a bug in the repository, not in a run)."""
+    """A file of the run schema is malformed (a bug in the repository, not in a run)."""
 
 
 def _read_json(path, what):

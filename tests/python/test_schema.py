@@ -1,5 +1,8 @@
 """The run schema's validator: missing and mistyped keys are errors naming the file and the
-key; strict mode rejects undeclared keys; the schema file uses only keywords it knows."""
+key; strict mode rejects undeclared keys; the schema's files use only keywords it knows. Its
+loader: the $defs files the top document lists are joined into one document, every file
+under harness/schema/ is listed and every $ref resolves; a name defined twice, a missing or
+malformed file is an error naming the files."""
 import glob
 import json
 import os
