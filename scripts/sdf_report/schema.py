@@ -1,5 +1,5 @@
-"""The run schema (harness/schema/run_schema.json) and a validator for the subset of JSON
-Schema it uses.
+"""The run schema (harness/schema/run_schema.json and the $defs files it lists under
+harness/schema/defs/) and a validator for the subset of JSON Schema it uses.
 
 The schema states, per experiment kind, the keys of metrics.json and the manifest keys the
 report reads, with their types. The report validates every run it reads against it, and
@@ -9,10 +9,13 @@ C++ side and the report cannot drift apart unnoticed.
 
 Keywords understood: type, properties, required, additionalProperties, items, enum, const,
 if/then/else, $ref (to "#/$defs/<name>") and the annotations description, title, $comment,
-$schema, $id, $defs. Any other keyword is an error in the schema file, so that no rule is
+$schema, $id, $defs. Any other keyword is an error in the schema's files, so that no rule is
 silently ignored. Strict mode: an object whose schema lists "properties" and says nothing
 about "additionalProperties" may hold no other key (the report itself reads leniently:
 keys it does not know are ignored).
+
+load_schema() joins the files into one document: the top file's "$defs_files" names the
+$defs files, in order, and is consumed there; every $ref stays "#/$defs/<name>".
 """
 
 import json
@@ -21,6 +24,7 @@ import os
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCHEMA_NAME = "harness/schema/run_schema.json"
 SCHEMA_PATH = os.path.join(REPO, *SCHEMA_NAME.split("/"))
+DEFS_FILES = "$defs_files"  # the top document's list of its $defs files, consumed by load_schema()
 
 _ANNOTATIONS = {"description", "title", "$comment", "$schema", "$id", "$defs"}
 _KEYWORDS = {"type", "properties", "required", "additionalProperties", "items", "enum", "const", "if", "then", "else",
@@ -35,17 +39,73 @@ class RunFileError(Exception):
 
 
 class SchemaFileError(Exception):
-    """The schema file itself is malformed (a bug in the repository, not in a run)."""
+    """A file of the run schema is malformed (a bug in the repository, not in a run)."""
+
+
+def _read_json(path, what):
+    def no_duplicates(pairs):
+        # json.load would keep the last of two equal keys: a def (or rule) silently lost.
+        seen = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise SchemaFileError("%s: key \"%s\" appears twice in one object" % (path, key))
+            seen.add(key)
+        return dict(pairs)
+    try:
+        with open(path) as f:
+            return json.load(f, object_pairs_hook=no_duplicates)
+    except (OSError, ValueError) as e:
+        raise SchemaFileError("%s: cannot read %s: %s" % (path, what, e)) from None
+
+
+def schema_files(path=SCHEMA_PATH):
+    """The files of the run schema: the top document, then the $defs files it lists under
+    "$defs_files" (paths relative to its folder), in that order."""
+    return [path] + [part for part, _ in _defs_parts(_read_json(path, "the run schema"), path)]
+
+
+def _defs_parts(schema, path):
+    """(file, its $defs) per entry of the top document's "$defs_files"."""
+    listed = schema.get(DEFS_FILES, [])
+    if not isinstance(listed, list) or not all(isinstance(name, str) and name for name in listed):
+        raise SchemaFileError("%s: key \"%s\": expected a list of file names (relative to %s)"
+                              % (path, DEFS_FILES, os.path.dirname(path)))
+    parts = []
+    for i, name in enumerate(listed):
+        part_path = os.path.join(os.path.dirname(path), *name.split("/"))
+        if name in listed[:i]:
+            raise SchemaFileError("%s: key \"%s\" lists %s twice" % (path, DEFS_FILES, name))
+        part = _read_json(part_path, "a $defs file of the run schema (listed in %s)" % path)
+        # Only definitions: a rule placed beside them would be dropped unseen.
+        if not isinstance(part, dict) or not isinstance(part.get("$defs"), dict) or set(part) - {"description", "$defs"}:
+            got = _show(sorted(part) if isinstance(part, dict) else part)
+            raise SchemaFileError("%s: expected an object of \"$defs\" (an object of named definitions) and an optional "
+                                  "\"description\", got %s" % (part_path, got))
+        parts.append((part_path, part["$defs"]))
+    return parts
 
 
 def load_schema(path=SCHEMA_PATH):
-    try:
-        with open(path) as f:
-            schema = json.load(f)
-    except (OSError, ValueError) as e:
-        raise SchemaFileError("%s: cannot read the run schema: %s" % (path, e)) from None
-    if not isinstance(schema.get("manifest"), dict) or not isinstance(schema.get("metrics"), dict):
+    """The run schema as one document: the top file's "$defs" joined with those of the files
+    its "$defs_files" lists (that key consumed), so every $ref stays "#/$defs/<name>"."""
+    schema = _read_json(path, "the run schema")
+    if not isinstance(schema, dict) or not isinstance(schema.get("manifest"), dict) \
+            or not isinstance(schema.get("metrics"), dict):
         raise SchemaFileError("%s: expected the keys \"manifest\" and \"metrics\" (by kind)" % path)
+    parts = _defs_parts(schema, path)
+    schema.pop(DEFS_FILES, None)
+    defs = schema.get("$defs", {})
+    if not isinstance(defs, dict):
+        raise SchemaFileError("%s: key \"$defs\": expected an object of named definitions" % path)
+    where = dict.fromkeys(defs, path)
+    for part_path, part_defs in parts:
+        for name, definition in part_defs.items():
+            if name in where:
+                raise SchemaFileError("run schema: $defs \"%s\" is defined in both %s and %s"
+                                      % (name, where[name], part_path))
+            where[name] = part_path
+            defs[name] = definition
+    schema["$defs"] = defs
     return schema
 
 

@@ -1,6 +1,11 @@
 """The run schema's validator: missing and mistyped keys are errors naming the file and the
-key; strict mode rejects undeclared keys; the schema file uses only keywords it knows."""
+key; strict mode rejects undeclared keys; the schema's files use only keywords it knows. Its
+loader: the $defs files the top document lists are joined into one document, every file
+under harness/schema/ is listed and every $ref resolves; a name defined twice, a missing or
+malformed file is an error naming the files."""
+import glob
 import json
+import os
 
 import pytest
 
@@ -34,6 +39,32 @@ def test_every_keyword_of_the_schema_file_is_understood(schema):
                 walk(value, "%s[%d]" % (where, i))
     for part in ("manifest", "metrics", "$defs"):
         walk(schema[part], part)
+
+
+def test_every_schema_file_is_listed_and_every_ref_resolves(schema):
+    # A file under harness/schema/ that "$defs_files" does not list would be ignored unseen.
+    folder = os.path.dirname(run_schema.SCHEMA_PATH)
+    files = run_schema.schema_files()
+    stray = sorted(set(glob.glob(os.path.join(folder, "**", "*.json"), recursive=True)) - set(files))
+    assert not stray, "not listed under \"$defs_files\" of %s: %s" % (run_schema.SCHEMA_NAME, ", ".join(stray))
+    for path in files:
+        with open(path) as f:
+            assert len(f.readlines()) < 600, "%s: over the repository's 600 lines a file" % path
+    refs = []
+
+    def walk(node, where):
+        if isinstance(node, dict):
+            if isinstance(node.get("$ref"), str):
+                refs.append((where, node["$ref"]))
+            for key, value in node.items():
+                walk(value, where + "/" + key)
+        elif isinstance(node, list):
+            for i, value in enumerate(node):
+                walk(value, "%s[%d]" % (where, i))
+    walk(schema, "")
+    assert len(refs) > 40
+    for where, ref in refs:
+        assert ref.startswith("#/$defs/") and ref[len("#/$defs/"):] in schema["$defs"], "%s: $ref %s" % (where, ref)
 
 
 def test_missing_key_names_the_file_and_the_key_path(schema):
@@ -135,3 +166,75 @@ def test_schema_file_errors_are_not_blamed_on_runs(tmp_path):
     with pytest.raises(SchemaFileError) as e:
         run_schema.load_schema(str(bad))
     assert "\"metrics\"" in str(e.value)
+
+
+def write_schema(folder, defs_files, parts, defs=None):
+    """A top document listing `defs_files` (and holding `defs`), and the files of `parts`
+    ({relative name: text}); returns the top document's path."""
+    top = {"manifest": {"$ref": "#/$defs/m"}, "metrics": {"k": {"$ref": "#/$defs/k"}}, "$defs_files": defs_files}
+    if defs is not None:
+        top["$defs"] = defs
+    for name, text in parts.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text(text)
+    (folder / "top.json").write_text(json.dumps(top))
+    return str(folder / "top.json")
+
+
+def test_defs_files_are_joined_into_one_document(tmp_path):
+    path = write_schema(tmp_path, ["defs/a.json", "defs/b.json"], {
+        "defs/a.json": json.dumps({"description": "a",
+                                   "$defs": {"m": {"type": "object", "properties": {"x": {"$ref": "#/$defs/x"}}}}}),
+        "defs/b.json": json.dumps({"$defs": {"k": {"type": "object"}, "x": {"type": "integer"}}})},
+        defs={"top": {"type": "string"}})
+    schema = run_schema.load_schema(path)
+    assert "$defs_files" not in schema
+    assert list(schema["$defs"]) == ["top", "m", "k", "x"]  # files in their listed order
+    assert errors_of({"x": "1"}, schema["manifest"], schema) == ["key 'x': expected integer, got string \"1\""]
+    assert run_schema.schema_files(path) == [path, str(tmp_path / "defs" / "a.json"), str(tmp_path / "defs" / "b.json")]
+
+
+def test_a_def_in_two_files_is_an_error_naming_both(tmp_path):
+    path = write_schema(tmp_path, ["a.json", "b.json"], {"a.json": json.dumps({"$defs": {"m": {}, "k": {}}}),
+                                                         "b.json": json.dumps({"$defs": {"k": {}}})})
+    with pytest.raises(SchemaFileError) as e:
+        run_schema.load_schema(path)
+    assert str(e.value) == "run schema: $defs \"k\" is defined in both %s and %s" % (tmp_path / "a.json",
+                                                                                    tmp_path / "b.json")
+    path = write_schema(tmp_path, ["a.json"], {}, defs={"m": {}})
+    with pytest.raises(SchemaFileError) as e:
+        run_schema.load_schema(path)
+    assert str(e.value) == "run schema: $defs \"m\" is defined in both %s and %s" % (path, tmp_path / "a.json")
+    # Within one file too: json.load alone would keep the second silently.
+    path = write_schema(tmp_path, ["a.json"], {"a.json": '{"$defs": {"m": {}, "k": {}, "m": {"type": "string"}}}'})
+    with pytest.raises(SchemaFileError) as e:
+        run_schema.load_schema(path)
+    assert str(e.value) == "%s: key \"m\" appears twice in one object" % (tmp_path / "a.json")
+
+
+@pytest.mark.parametrize("text, expected", [
+    (None, "cannot read a $defs file of the run schema"),
+    ('{"$defs": {', "cannot read a $defs file of the run schema"),
+    ('[]', "expected an object of \"$defs\""),
+    ('{"$defs": []}', "expected an object of \"$defs\""),
+    ('{"$defs": {}, "k": {"type": "object"}}', "expected an object of \"$defs\" (an object of named definitions) and an "
+                                                "optional \"description\", got [\"$defs\", \"k\"]"),
+])
+def test_a_missing_or_malformed_defs_file_is_an_error_naming_it(tmp_path, text, expected):
+    path = write_schema(tmp_path, ["defs/a.json"], {} if text is None else {"defs/a.json": text})
+    with pytest.raises(SchemaFileError) as e:
+        run_schema.load_schema(path)
+    assert str(e.value).startswith(str(tmp_path / "defs" / "a.json") + ": ")
+    assert expected in str(e.value)
+
+
+@pytest.mark.parametrize("listed, expected", [
+    ("defs/a.json", "key \"$defs_files\": expected a list of file names"),
+    (["a.json", 3], "key \"$defs_files\": expected a list of file names"),
+    (["a.json", "a.json"], "key \"$defs_files\" lists a.json twice"),
+])
+def test_a_malformed_defs_files_list_is_an_error_naming_the_top_file(tmp_path, listed, expected):
+    path = write_schema(tmp_path, listed, {"a.json": json.dumps({"$defs": {"m": {}, "k": {}}})})
+    with pytest.raises(SchemaFileError) as e:
+        run_schema.load_schema(path)
+    assert str(e.value).startswith(path + ": " + expected)
