@@ -23,6 +23,7 @@
 #pragma once
 
 #include "cuda/bvh/bvh_warp_kernel.cuh"
+#include "kernels/bvh/traversal.h"
 
 namespace sdf::cuda {
 
@@ -48,6 +49,41 @@ __device__ SDF_INLINE T brick_gap_d2(const BvhNode& n, int c, const Vec3<T>& lo,
     const T gz = gap(T(n.min_z[c]), T(n.max_z[c]), lo.z, hi.z);
     return gx * gx + gy * gy + gz * gz;
 }
+
+/// The candidates kernel's query for nearest_first_walk(): every leaf within u of the brick
+/// box, whose ranges lane 0 collects for the warp (scanned in rounds of kCandidateRanges).
+/// The radius never shrinks, so the children keep their own order and every stacked subtree
+/// stays open.
+template <typename T, typename Scan>
+struct CandidateQuery {
+    const Vec3<T>& lo;
+    const Vec3<T>& hi;
+    T u;
+    Scan& scan;
+    int32_t* range_first;  ///< this warp's, in shared memory
+    int32_t* range_count;
+    int& ranges;
+    int& triangles;
+    int lane;
+    bool want[2] = {false, false};
+    __device__ SDF_INLINE ChildOrder<NoKey> measure(const BvhNode& n) {
+        want[0] = may_hold_nearer(brick_gap_d2(n, 0, lo, hi), u);
+        want[1] = may_hold_nearer(brick_gap_d2(n, 1, lo, hi), u);
+        return {};
+    }
+    __device__ SDF_INLINE bool enter(const ChildOrder<NoKey>&, int child) const { return want[child]; }
+    __device__ SDF_INLINE void leaf(int32_t first, int32_t count) {
+        if (count <= 0) return;
+        if (lane == 0) {
+            range_first[ranges] = first;
+            range_count[ranges] = count;
+        }
+        triangles += count;
+        if (++ranges == kCandidateRanges) scan();
+    }
+    __device__ SDF_INLINE void node_done() {}
+    __device__ SDF_INLINE bool still_open(const NoKey&) const { return true; }
+};
 
 }  // namespace detail
 
@@ -95,32 +131,10 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_candidates(B
         ranges = 0;
         __syncwarp();
     };
-    int top = 0;
-    int32_t node = 0;
-    while (node >= 0) {
-        const BvhNode n = bvh.nodes[node];
-        int32_t next = -1;
-        for (int ch = 0; ch < 2; ++ch) {
-            if (!may_hold_nearer(detail::brick_gap_d2(n, ch, lo, hi), u)) continue;
-            if (bvh_child_is_leaf(n, ch)) {
-                if (n.count[ch] <= 0) continue;
-                if (lane == 0) {
-                    range_first[w][ranges] = n.ref[ch];
-                    range_count[w][ranges] = n.count[ch];
-                }
-                triangles += n.count[ch];
-                if (++ranges == kCandidateRanges) scan_ranges();
-            } else if (next < 0) {
-                next = n.ref[ch];
-            } else {
-                if (lane == 0) stack_node[w][top] = n.ref[ch];
-                ++top;
-            }
-        }
-        __syncwarp();
-        if (next < 0 && top > 0) next = stack_node[w][--top];
-        node = next;
-    }
+    // Every leaf within u of the brick, in the children's own order.
+    detail::CandidateQuery<T, decltype(scan_ranges)> q{lo, hi, u, scan_ranges, range_first[w], range_count[w], ranges, triangles, lane};
+    detail::WarpStack<NoKey> stack{stack_node[w], nullptr};
+    nearest_first_walk<NoKey>(bvh.nodes, q, stack);
     scan_ranges();
     if (stats && lane == 0) {
         atomicAdd(stats + 0, 1ull);

@@ -14,6 +14,7 @@
 
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/bvh/streamed_certificate.h"
+#include "kernels/bvh/traversal.h"
 #include "cuda/bvh/bvh_kernel.cuh"
 #include "cuda/sampling/certify_kernel.cuh"
 #include "cuda/sampling/finalize_kernel.cuh"
@@ -87,6 +88,72 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
     return count;
 }
 
+namespace detail {
+
+/// nearest_first_walk()'s stack for a warp walking as one: the warp's entries in shared
+/// memory, written by lane 0 and read by every lane after the warp has synchronised; `top` is
+/// warp-uniform. Entries without a key (NoKey) store only the node.
+template <typename Key>
+struct WarpStack {
+    int32_t* node;
+    Key* key;
+    int top = 0;
+    __device__ SDF_INLINE void push(int32_t n, const Key& k) {
+        if (threadIdx.x % 32 == 0) {
+            node[top] = n;
+            if constexpr (!std::is_empty_v<Key>) key[top] = k;
+        }
+        ++top;
+    }
+    __device__ SDF_INLINE bool empty() const { return top == 0; }
+    __device__ SDF_INLINE int32_t pop(Key& k) {
+        --top;
+        if constexpr (!std::is_empty_v<Key>) k = key[top];
+        return node[top];
+    }
+    __device__ SDF_INLINE void begin_pops() { __syncwarp(); }  // lane 0's pushes are seen
+    __device__ SDF_INLINE void end_pops() { __syncwarp(); }    // read before lane 0 writes again
+};
+
+/// warp_search()'s query for nearest_first_walk(): a child is wanted when some lane of the
+/// warp wants it (a vote), ordered and stacked by the warp's nearest point; after a scan the
+/// warp agrees on its largest radius, below which a stacked subtree stays open.
+template <typename T, int K, typename Near>
+struct WarpNearestQuery {
+    const BvhView<T>& bvh;
+    BvhPacket<T, K>& pk;
+    bool valid;
+    Near& policy;
+    T worst;  ///< the warp's largest radius: +inf, or a bounded search's bound
+    bool want[2] = {false, false};
+    bool scanned = false;
+    T mine = T(-1);  ///< the thread's largest radius after a scan
+    __device__ SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
+        T d0, d1;
+        const bool w0 = sdf::detail::child_wanted(n, 0, pk, d0), w1 = sdf::detail::child_wanted(n, 1, pk, d1);
+        want[0] = __any_sync(kFullWarp, w0);
+        want[1] = __any_sync(kFullWarp, w1);
+        ChildOrder<T> c;
+        c.key[0] = warp_min(valid ? d0 : T(INFINITY));  // the nearest point's distance: a bound for all
+        c.key[1] = warp_min(valid ? d1 : T(INFINITY));
+        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        return c;
+    }
+    __device__ SDF_INLINE bool enter(const ChildOrder<T>&, int child) const { return want[child]; }
+    __device__ SDF_INLINE void leaf(int32_t first, int32_t count) {
+        mine = sdf::detail::scan_leaf_packet(bvh, first, count, pk, policy);
+        scanned = true;
+    }
+    __device__ SDF_INLINE void node_done() {
+        if (scanned) worst = warp_max(mine);
+        scanned = false;
+        mine = T(-1);
+    }
+    __device__ SDF_INLINE bool still_open(T key) const { return may_hold_nearer(key, worst); }
+};
+
+}  // namespace detail
+
 /// The warp's shared traversal: completes the nearest triangle of every lane's points,
 /// pruning with each lane's radius (`policy`: plain, or the streamed certificate's widened
 /// one). `stack_node`/`stack_d2` are this warp's kBvhMaxDepth entries in shared memory.
@@ -95,52 +162,9 @@ __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, K>& p
                                        T* stack_d2, Near& policy) {
     T worst = T(-1);  // the lanes' radii: +inf, or a bounded search's bound
     for (int k = 0; k < K; ++k) worst = max(worst, pk.radius[k]);
-    worst = warp_max(valid ? worst : T(-1));
-    int top = 0;  // warp-uniform
-    int32_t node = 0;
-    while (node >= 0) {
-        const BvhNode n = bvh.nodes[node];  // one address for the whole warp
-        T d0, d1;
-        const bool w0 = detail::child_wanted(n, 0, pk, d0), w1 = detail::child_wanted(n, 1, pk, d1);
-        const bool want0 = __any_sync(kFullWarp, w0), want1 = __any_sync(kFullWarp, w1);
-        const T m0 = warp_min(valid ? d0 : T(INFINITY)), m1 = warp_min(valid ? d1 : T(INFINITY));
-        const int near = m1 < m0 ? 1 : 0;
-        const bool want_near = near ? want1 : want0, want_far = near ? want0 : want1;
-        int32_t next = -1;
-        bool scanned = false;
-        T mine = T(-1);  // the thread's largest radius after a scan
-        if (want_near) {
-            if (bvh_child_is_leaf(n, near)) {
-                mine = detail::scan_leaf_packet(bvh, n.ref[near], n.count[near], pk, policy);
-                scanned = true;
-            } else {
-                next = n.ref[near];
-            }
-        }
-        if (want_far) {
-            const int far = 1 - near;
-            if (bvh_child_is_leaf(n, far)) {
-                mine = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk, policy);
-                scanned = true;
-            } else if (next < 0) {
-                next = n.ref[far];
-            } else {
-                if (threadIdx.x % 32 == 0) {
-                    stack_node[top] = n.ref[far];
-                    stack_d2[top] = near ? m0 : m1;  // the nearest point's distance: a bound for all
-                }
-                ++top;
-            }
-        }
-        if (scanned) worst = warp_max(mine);
-        __syncwarp();
-        while (next < 0 && top > 0) {
-            --top;
-            if (may_hold_nearer(stack_d2[top], worst)) next = stack_node[top];
-        }
-        __syncwarp();
-        node = next;
-    }
+    detail::WarpNearestQuery<T, K, Near> q{bvh, pk, valid, policy, warp_max(valid ? worst : T(-1))};
+    detail::WarpStack<T> stack{stack_node, stack_d2};
+    nearest_first_walk<T>(bvh.nodes, q, stack);
 }
 
 /// The narrow band as the search sees it; width 0 = no band, skip_bricks false = every brick

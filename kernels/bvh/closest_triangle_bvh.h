@@ -1,10 +1,10 @@
 /// @file closest_triangle_bvh.h
 /// @brief The exact nearest-triangle query over a BVH, written once for host and device.
 ///
-/// Ordered depth-first traversal with a shrinking radius, the closest-point form of the
-/// nearest-neighbour search of Friedman, Bentley & Finkel, "An Algorithm for Finding Best
-/// Matches in Logarithmic Expected Time" (ACM TOMS 1977) on the node layout of Aila & Laine
-/// (2009): at every node both child boxes are measured, the nearer child is entered first,
+/// Ordered depth-first traversal with a shrinking radius (traversal.h's nearest_first_walk),
+/// the closest-point form of the nearest-neighbour search of Friedman, Bentley & Finkel, "An
+/// Algorithm for Finding Best Matches in Logarithmic Expected Time" (ACM TOMS 1977) on the
+/// node layout of Aila & Laine (2009): at every node both child boxes are measured, the nearer child is entered first,
 /// the farther one is kept on a small fixed stack with its box distance, and an entry is
 /// dropped when it is popped if the best squared distance found so far (the radius) has
 /// shrunk below it. Leaves are scanned with the same branch-free squared_distance() as the
@@ -30,6 +30,7 @@
 
 #include "kernels/bvh/aabb_distance.h"
 #include "kernels/bvh/bvh_view.h"
+#include "kernels/bvh/traversal.h"
 #include "kernels/distance/search_certificate.h"
 
 namespace sdf {
@@ -132,53 +133,45 @@ SDF_CPU_GPU SDF_INLINE void scan_leaf(const BvhView<T>& bvh, int32_t first, int3
     scan_leaf(bvh, first, count, p, best, radius, plain);
 }
 
+namespace detail {
+
+/// closest_triangle_bvh()'s query for nearest_first_walk(): children by their box distance,
+/// the farther one tested against the radius as it stands after the nearer leaf's scan.
+template <typename T, typename Stats, typename Near>
+struct NearestTriangleQuery {
+    const BvhView<T>& bvh;
+    const Vec3<T>& p;
+    BvhHit<T>& best;
+    T& radius;
+    Stats& stats;
+    Near& near;
+    SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
+        stats.visit_node();
+        ChildOrder<T> c;
+        c.key[0] = child_box_distance_squared(n, 0, p);
+        c.key[1] = child_box_distance_squared(n, 1, p);
+        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        return c;
+    }
+    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>& c, int child) const { return may_hold_nearer(c.key[child], radius); }
+    SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
+        stats.test_triangles(count);
+        scan_leaf(bvh, first, count, p, best, radius, near);
+    }
+    SDF_CPU_GPU SDF_INLINE void node_done() {}
+    SDF_CPU_GPU SDF_INLINE bool still_open(T key) const { return may_hold_nearer(key, radius); }
+};
+
+}  // namespace detail
+
 /// Nearest triangle to p, starting from `best` (an empty hit or a seed); every triangle
 /// within the final radius is offered to `near`.
 template <typename T, typename Stats, typename Near>
 SDF_CPU_GPU BvhHit<T> closest_triangle_bvh(const BvhView<T>& bvh, const Vec3<T>& p, BvhHit<T> best, Stats& stats,
                                            Near& near) {
     T radius = bvh.margin.widen(near.radius(best.distance_squared));
-    int32_t stack_node[kBvhMaxDepth];
-    T stack_d2[kBvhMaxDepth];
-    int top = 0;
-    int32_t node = 0;
-    while (node >= 0) {
-        stats.visit_node();
-        const BvhNode n = bvh.nodes[node];
-        const T d0 = child_box_distance_squared(n, 0, p), d1 = child_box_distance_squared(n, 1, p);
-        const int nearer = d1 < d0 ? 1 : 0;
-        const T d_near = nearer ? d1 : d0, d_far = nearer ? d0 : d1;
-        int32_t next = -1;
-        // Nearer child first: scanning a leaf shrinks the radius before the farther test.
-        if (may_hold_nearer(d_near, radius)) {
-            if (bvh_child_is_leaf(n, nearer)) {
-                stats.test_triangles(n.count[nearer]);
-                scan_leaf(bvh, n.ref[nearer], n.count[nearer], p, best, radius, near);
-            } else {
-                next = n.ref[nearer];
-            }
-        }
-        if (may_hold_nearer(d_far, radius)) {
-            const int far = 1 - nearer;
-            if (bvh_child_is_leaf(n, far)) {
-                stats.test_triangles(n.count[far]);
-                scan_leaf(bvh, n.ref[far], n.count[far], p, best, radius, near);
-            } else if (next < 0) {
-                next = n.ref[far];
-            } else {
-                SDF_DCHECK(top < kBvhMaxDepth);
-                stack_node[top] = n.ref[far];
-                stack_d2[top] = d_far;
-                ++top;
-            }
-        }
-        // Pop the next subtree still inside the (shrunken) radius.
-        while (next < 0 && top > 0) {
-            --top;
-            if (may_hold_nearer(stack_d2[top], radius)) next = stack_node[top];
-        }
-        node = next;
-    }
+    detail::NearestTriangleQuery<T, Stats, Near> q{bvh, p, best, radius, stats, near};
+    nearest_first_walk<T>(bvh.nodes, q);
     return best;
 }
 

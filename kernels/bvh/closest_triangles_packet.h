@@ -25,6 +25,7 @@
 #include <type_traits>
 
 #include "kernels/bvh/closest_triangle_bvh.h"
+#include "kernels/bvh/traversal.h"
 
 // Vector compares for the leaf loop's lane mask: host compilers with SSE2 (every x86-64), not
 // the CUDA compiler's passes.
@@ -257,53 +258,46 @@ SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* se
     }
 }
 
+namespace detail {
+
+/// closest_triangles_packet()'s query for nearest_first_walk(): a child is wanted when it is
+/// within some lane's radius (decided for both children on entering the node), ordered and
+/// stacked by its nearest lane's distance, a lower bound for every lane; a stacked subtree
+/// is dropped once that distance is beyond every lane's radius.
+template <typename T, int K, typename Stats, typename Near>
+struct NearestTrianglesPacketQuery {
+    const BvhView<T>& bvh;
+    BvhPacket<T, K>& pk;
+    T& worst;  ///< the largest radius of the packet
+    Stats& stats;
+    Near& near;
+    bool want[2] = {false, false};
+    SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
+        stats.visit_node();
+        ChildOrder<T> c;
+        want[0] = child_wanted(n, 0, pk, c.key[0]);
+        want[1] = child_wanted(n, 1, pk, c.key[1]);
+        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        return c;
+    }
+    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>&, int child) const { return want[child]; }
+    SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
+        stats.test_triangles(count * K);
+        worst = scan_leaf_packet(bvh, first, count, pk, near);
+    }
+    SDF_CPU_GPU SDF_INLINE void node_done() {}
+    SDF_CPU_GPU SDF_INLINE bool still_open(T key) const { return may_hold_nearer(key, worst); }
+};
+
+}  // namespace detail
+
 /// Completes the nearest triangle of every lane of `pk` (seeded or with infinite radii),
 /// offering every triangle within a lane's final radius to `near`.
 template <typename T, int K, typename Stats, typename Near>
 SDF_CPU_GPU void closest_triangles_packet(const BvhView<T>& bvh, BvhPacket<T, K>& pk, Stats& stats, Near& near) {
     T worst = detail::refresh_radii(bvh, pk, near);
-    int32_t stack_node[kBvhMaxDepth];
-    T stack_d2[kBvhMaxDepth];
-    int top = 0;
-    int32_t node = 0;
-    while (node >= 0) {
-        stats.visit_node();
-        const BvhNode n = bvh.nodes[node];
-        T d0, d1;
-        const bool want0 = detail::child_wanted(n, 0, pk, d0), want1 = detail::child_wanted(n, 1, pk, d1);
-        const int nearer = d1 < d0 ? 1 : 0;
-        const bool want_near = nearer ? want1 : want0, want_far = nearer ? want0 : want1;
-        int32_t next = -1;
-        if (want_near) {
-            if (bvh_child_is_leaf(n, nearer)) {
-                stats.test_triangles(n.count[nearer] * K);
-                worst = detail::scan_leaf_packet(bvh, n.ref[nearer], n.count[nearer], pk, near);
-            } else {
-                next = n.ref[nearer];
-            }
-        }
-        if (want_far) {
-            const int far = 1 - nearer;
-            const T d_far = nearer ? d0 : d1;
-            if (bvh_child_is_leaf(n, far)) {
-                stats.test_triangles(n.count[far] * K);
-                worst = detail::scan_leaf_packet(bvh, n.ref[far], n.count[far], pk, near);
-            } else if (next < 0) {
-                next = n.ref[far];
-            } else {
-                SDF_DCHECK(top < kBvhMaxDepth);
-                stack_node[top] = n.ref[far];
-                stack_d2[top] = d_far;  // nearest lane's distance: a lower bound for every lane
-                ++top;
-            }
-        }
-        // A popped subtree is dropped once its nearest lane is beyond every lane's radius.
-        while (next < 0 && top > 0) {
-            --top;
-            if (may_hold_nearer(stack_d2[top], worst)) next = stack_node[top];
-        }
-        node = next;
-    }
+    detail::NearestTrianglesPacketQuery<T, K, Stats, Near> q{bvh, pk, worst, stats, near};
+    nearest_first_walk<T>(bvh.nodes, q);
 }
 
 template <typename T, int K, typename Stats>

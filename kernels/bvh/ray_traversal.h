@@ -1,8 +1,8 @@
 /// @file ray_traversal.h
 /// @brief Closest-hit ray traversal of the triangle BVH (bvh_node.h), written once for host
-/// and device: ordered depth-first traversal with a shrinking t_max on the two-box node
-/// layout of Aila & Laine, "Understanding the Efficiency of Ray Traversal on GPUs" (HPG
-/// 2009). The ray-box test is the slab method with the far distance enlarged by a few ulps
+/// and device: ordered depth-first traversal with a shrinking t_max (traversal.h's
+/// nearest_first_walk) on the two-box node layout of Aila & Laine, "Understanding the
+/// Efficiency of Ray Traversal on GPUs" (HPG 2009). The ray-box test is the slab method with the far distance enlarged by a few ulps
 /// (pbrt-v4's Bounds3::IntersectP, after Ize, "Robust BVH Ray Traversal", JCGT 2013), so a
 /// box is never missed by rounding; triangles are tested by the caller's leaf function,
 /// which keeps the closest hit and shrinks t_max.
@@ -17,6 +17,7 @@
 #pragma once
 
 #include "kernels/bvh/bvh_node.h"
+#include "kernels/bvh/traversal.h"
 #include "kernels/raycast/camera.h"
 
 namespace sdf {
@@ -45,6 +46,35 @@ SDF_CPU_GPU T ray_child_entry(const BvhNode& n, int c, const Ray<T>& ray, const 
     return t0;
 }
 
+namespace detail {
+
+/// closest_hit_bvh()'s query for nearest_first_walk(): children by the ray's entry into their
+/// box (-1: missed), entered while the entry is not beyond the closest hit so far.
+template <typename T, typename LeafFn>
+struct ClosestHitQuery {
+    const Ray<T>& ray;
+    Vec3<T> inv_dir;
+    T& t_max;
+    LeafFn& leaf_fn;
+    SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) const {
+        ChildOrder<T> c;
+        c.key[0] = ray_child_entry(n, 0, ray, inv_dir, t_max);
+        c.key[1] = ray_child_entry(n, 1, ray, inv_dir, t_max);
+        c.nearer = (c.key[1] >= T(0) && (c.key[0] < T(0) || c.key[1] < c.key[0])) ? 1 : 0;
+        return c;
+    }
+    /// The nearer child's entry is within the t_max it was measured with; the farther one's
+    /// is compared with t_max as the nearer leaf left it.
+    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>& c, int child) const { return still_open(c.key[child]); }
+    SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
+        if (count > 0) leaf_fn(first, count, t_max);
+    }
+    SDF_CPU_GPU SDF_INLINE void node_done() {}
+    SDF_CPU_GPU SDF_INLINE bool still_open(T entry) const { return entry >= T(0) && entry <= t_max; }
+};
+
+}  // namespace detail
+
 /// Visits the leaves the ray may hit before t_max, nearer child first; `leaf(first, count,
 /// t_max)` tests the triangles of one leaf and lowers t_max to the closest hit so far.
 template <typename T, typename LeafFn>
@@ -52,43 +82,8 @@ SDF_CPU_GPU void closest_hit_bvh(const BvhNode* nodes, const Ray<T>& ray, T t_ma
     const Vec3<T> inv_dir(ray.direction.x != T(0) ? T(1) / ray.direction.x : T(0),
                           ray.direction.y != T(0) ? T(1) / ray.direction.y : T(0),
                           ray.direction.z != T(0) ? T(1) / ray.direction.z : T(0));
-    int32_t stack_node[kBvhMaxDepth];
-    T stack_t[kBvhMaxDepth];
-    int top = 0;
-    int32_t node = 0;
-    while (node >= 0) {
-        const BvhNode& n = nodes[node];
-        const T e0 = ray_child_entry(n, 0, ray, inv_dir, t_max), e1 = ray_child_entry(n, 1, ray, inv_dir, t_max);
-        const int near = (e1 >= T(0) && (e0 < T(0) || e1 < e0)) ? 1 : 0;
-        const T e_near = near ? e1 : e0, e_far = near ? e0 : e1;
-        int32_t next = -1;
-        if (e_near >= T(0)) {
-            if (bvh_child_is_leaf(n, near)) {
-                if (n.count[near] > 0) leaf(n.ref[near], n.count[near], t_max);
-            } else {
-                next = n.ref[near];
-            }
-        }
-        if (e_far >= T(0) && e_far <= t_max) {
-            const int far = 1 - near;
-            if (bvh_child_is_leaf(n, far)) {
-                if (n.count[far] > 0) leaf(n.ref[far], n.count[far], t_max);
-            } else if (next < 0) {
-                next = n.ref[far];
-            } else {
-                SDF_DCHECK(top < kBvhMaxDepth);
-                stack_node[top] = n.ref[far];
-                stack_t[top] = e_far;
-                ++top;
-            }
-        }
-        // Pop the next subtree the ray still enters before the closest hit
-        while (next < 0 && top > 0) {
-            --top;
-            if (stack_t[top] <= t_max) next = stack_node[top];
-        }
-        node = next;
-    }
+    detail::ClosestHitQuery<T, std::remove_reference_t<LeafFn>> q{ray, inv_dir, t_max, leaf};
+    nearest_first_walk<T>(nodes, q);
 }
 
 }  // namespace sdf
