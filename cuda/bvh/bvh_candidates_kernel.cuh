@@ -65,13 +65,13 @@ struct CandidateQuery {
     int& ranges;
     int& triangles;
     int lane;
-    bool want[2] = {false, false};
-    __device__ SDF_INLINE ChildOrder<NoKey> measure(const BvhNode& n) {
-        want[0] = may_hold_nearer(brick_gap_d2(n, 0, lo, hi), u);
-        want[1] = may_hold_nearer(brick_gap_d2(n, 1, lo, hi), u);
-        return {};
+    __device__ SDF_INLINE ChildOrder<NoKey> measure(const BvhNode& n) const {
+        ChildOrder<NoKey> c;  // child 0 first
+        c.near_wanted = may_hold_nearer(brick_gap_d2(n, 0, lo, hi), u);
+        c.far_wanted = may_hold_nearer(brick_gap_d2(n, 1, lo, hi), u);
+        return c;
     }
-    __device__ SDF_INLINE bool enter(const ChildOrder<NoKey>&, int child) const { return want[child]; }
+    __device__ SDF_INLINE bool enter(const NoKey&) const { return true; }
     __device__ SDF_INLINE void leaf(int32_t first, int32_t count) {
         if (count <= 0) return;
         if (lane == 0) {

@@ -91,23 +91,19 @@ __device__ SDF_INLINE int load_packet(const Layout& layout, int64_t t, int64_t& 
 namespace detail {
 
 /// nearest_first_walk()'s stack for a warp walking as one: the warp's entries in shared
-/// memory, written by lane 0 and read by every lane after the warp has synchronised; `top` is
-/// warp-uniform. Entries without a key (NoKey) store only the node.
+/// memory, written by lane 0 and read by every lane after the warp has synchronised (the
+/// walk's depth is warp-uniform). Entries without a key (NoKey) store only the node.
 template <typename Key>
 struct WarpStack {
     int32_t* node;
     Key* key;
-    int top = 0;
-    __device__ SDF_INLINE void push(int32_t n, const Key& k) {
+    __device__ SDF_INLINE void store(int top, int32_t n, const Key& k) {
         if (threadIdx.x % 32 == 0) {
             node[top] = n;
             if constexpr (!std::is_empty_v<Key>) key[top] = k;
         }
-        ++top;
     }
-    __device__ SDF_INLINE bool empty() const { return top == 0; }
-    __device__ SDF_INLINE int32_t pop(Key& k) {
-        --top;
+    __device__ SDF_INLINE int32_t load(int top, Key& k) const {
         if constexpr (!std::is_empty_v<Key>) k = key[top];
         return node[top];
     }
@@ -125,21 +121,22 @@ struct WarpNearestQuery {
     bool valid;
     Near& policy;
     T worst;  ///< the warp's largest radius: +inf, or a bounded search's bound
-    bool want[2] = {false, false};
     bool scanned = false;
     T mine = T(-1);  ///< the thread's largest radius after a scan
     __device__ SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
         T d0, d1;
         const bool w0 = sdf::detail::child_wanted(n, 0, pk, d0), w1 = sdf::detail::child_wanted(n, 1, pk, d1);
-        want[0] = __any_sync(kFullWarp, w0);
-        want[1] = __any_sync(kFullWarp, w1);
-        ChildOrder<T> c;
-        c.key[0] = warp_min(valid ? d0 : T(INFINITY));  // the nearest point's distance: a bound for all
-        c.key[1] = warp_min(valid ? d1 : T(INFINITY));
-        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        const bool want0 = __any_sync(kFullWarp, w0), want1 = __any_sync(kFullWarp, w1);
+        const T m0 = warp_min(valid ? d0 : T(INFINITY)), m1 = warp_min(valid ? d1 : T(INFINITY));
+        ChildOrder<T> c;  // keys: the nearest point's distance, a bound for all
+        c.nearer = m1 < m0 ? 1 : 0;
+        c.near_key = c.nearer ? m1 : m0;
+        c.far_key = c.nearer ? m0 : m1;
+        c.near_wanted = c.nearer ? want1 : want0;
+        c.far_wanted = c.nearer ? want0 : want1;
         return c;
     }
-    __device__ SDF_INLINE bool enter(const ChildOrder<T>&, int child) const { return want[child]; }
+    __device__ SDF_INLINE bool enter(T) const { return true; }  // the votes decided
     __device__ SDF_INLINE void leaf(int32_t first, int32_t count) {
         mine = sdf::detail::scan_leaf_packet(bvh, first, count, pk, policy);
         scanned = true;

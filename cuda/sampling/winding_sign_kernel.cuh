@@ -8,7 +8,6 @@
 /// points are counted by how they were decided (`counts`, four counters).
 #pragma once
 
-#include "kernels/bvh/traversal.h"
 #include "kernels/winding/certified_winding.h"
 #include "kernels/winding/fast_winding_number.h"
 #include "kernels/winding/surface_side.h"
@@ -67,25 +66,36 @@ __device__ inline double warp_fast_winding_value(const WindingView<double>& v, c
     constexpr unsigned kWarp = 0xffffffffu;
     const unsigned lane_bit = 1u << (threadIdx.x & 31u);
     double value = 0.0;
-    const unsigned lanes = __ballot_sync(kWarp, wants);
-    if (lanes == 0) return value;
-    // A node carries the lanes that opened it; the walk is warp-uniform (the stack, every ballot).
-    depth_first_walk(v.nodes, lanes, [&](int32_t node, const BvhNode& n, int c, unsigned in, unsigned& out) {
-        bool open = false;
-        if ((in & lane_bit) != 0) {
-            double term, bound;
-            if (far_field(v.moments[node].child[c], p, acc, term, bound)) value += term;
-            else open = true;
+    int32_t stack_node[kBvhMaxDepth + 1];
+    unsigned stack_lanes[kBvhMaxDepth + 1];
+    stack_lanes[0] = __ballot_sync(kWarp, wants);
+    if (stack_lanes[0] == 0) return value;
+    stack_node[0] = 0;
+    int top = 1;
+    while (top > 0) {  // warp-uniform: top, the stack and every ballot are the same in all lanes
+        --top;
+        const int32_t node = stack_node[top];
+        const bool active = (stack_lanes[top] & lane_bit) != 0;
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            bool open = false;
+            if (active) {
+                double term, bound;
+                if (far_field(v.moments[node].child[c], p, acc, term, bound)) value += term;
+                else open = true;
+            }
+            const unsigned opened = __ballot_sync(kWarp, open);
+            if (opened == 0) continue;
+            if (bvh_child_is_leaf(n, c)) {
+                if (open) value += leaf_winding_number(v, n.ref[c], n.count[c], p);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack_node[top] = n.ref[c];
+                stack_lanes[top] = opened;
+                ++top;
+            }
         }
-        const unsigned opened = __ballot_sync(kWarp, open);
-        if (opened == 0) return false;
-        if (bvh_child_is_leaf(n, c)) {
-            if (open) value += leaf_winding_number(v, n.ref[c], n.count[c], p);
-            return false;
-        }
-        out = opened;
-        return true;
-    });
+    }
     return value;
 }
 
@@ -99,27 +109,37 @@ __device__ inline WindingEstimate<double> warp_certified_winding(const WindingVi
     const WindingRounding rnd = winding_rounding(v, p);
     CertifiedSum sum;
     int opened = 0;
-    const unsigned lanes = __ballot_sync(kWarp, wants);
-    if (lanes == 0) return certified_estimate(sum, rnd, opened);
-    opened = wants ? 1 : 0;  // the root; every child this lane opens is counted below
-    // Warp-uniform, as in warp_fast_winding_value().
-    depth_first_walk(v.nodes, lanes, [&](int32_t node, const BvhNode& n, int c, unsigned in, unsigned& out) {
-        bool open = false;
-        if ((in & lane_bit) != 0) {
-            double term, bound;
-            if (certified_far_field(v.moments[node].child[c], p, acc, rnd, term, bound)) sum.add(term, bound);
-            else open = true;
+    int32_t stack_node[kBvhMaxDepth + 1];
+    unsigned stack_lanes[kBvhMaxDepth + 1];
+    stack_lanes[0] = __ballot_sync(kWarp, wants);
+    if (stack_lanes[0] == 0) return certified_estimate(sum, rnd, opened);
+    stack_node[0] = 0;
+    int top = 1;
+    while (top > 0) {  // warp-uniform, as in warp_fast_winding_value()
+        --top;
+        const int32_t node = stack_node[top];
+        const bool active = (stack_lanes[top] & lane_bit) != 0;
+        opened += active;
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            bool open = false;
+            if (active) {
+                double term, bound;
+                if (certified_far_field(v.moments[node].child[c], p, acc, rnd, term, bound)) sum.add(term, bound);
+                else open = true;
+            }
+            const unsigned opened_lanes = __ballot_sync(kWarp, open);
+            if (opened_lanes == 0) continue;
+            if (bvh_child_is_leaf(n, c)) {
+                if (open) certified_leaf(sum, v, n.ref[c], n.count[c], p);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack_node[top] = n.ref[c];
+                stack_lanes[top] = opened_lanes;
+                ++top;
+            }
         }
-        const unsigned opened_lanes = __ballot_sync(kWarp, open);
-        if (opened_lanes == 0) return false;
-        if (bvh_child_is_leaf(n, c)) {
-            if (open) certified_leaf(sum, v, n.ref[c], n.count[c], p);
-            return false;
-        }
-        opened += open;
-        out = opened_lanes;
-        return true;
-    });
+    }
     return certified_estimate(sum, rnd, opened);
 }
 

@@ -147,13 +147,14 @@ struct NearestTriangleQuery {
     Near& near;
     SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
         stats.visit_node();
+        const T d0 = child_box_distance_squared(n, 0, p), d1 = child_box_distance_squared(n, 1, p);
         ChildOrder<T> c;
-        c.key[0] = child_box_distance_squared(n, 0, p);
-        c.key[1] = child_box_distance_squared(n, 1, p);
-        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        c.nearer = d1 < d0 ? 1 : 0;
+        c.near_key = c.nearer ? d1 : d0;
+        c.far_key = c.nearer ? d0 : d1;
         return c;
     }
-    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>& c, int child) const { return may_hold_nearer(c.key[child], radius); }
+    SDF_CPU_GPU SDF_INLINE bool enter(T key) const { return may_hold_nearer(key, radius); }
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
         stats.test_triangles(count);
         scan_leaf(bvh, first, count, p, best, radius, near);

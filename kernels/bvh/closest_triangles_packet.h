@@ -271,16 +271,19 @@ struct NearestTrianglesPacketQuery {
     T& worst;  ///< the largest radius of the packet
     Stats& stats;
     Near& near;
-    bool want[2] = {false, false};
     SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
         stats.visit_node();
+        T d0, d1;
+        const bool want0 = child_wanted(n, 0, pk, d0), want1 = child_wanted(n, 1, pk, d1);
         ChildOrder<T> c;
-        want[0] = child_wanted(n, 0, pk, c.key[0]);
-        want[1] = child_wanted(n, 1, pk, c.key[1]);
-        c.nearer = c.key[1] < c.key[0] ? 1 : 0;
+        c.nearer = d1 < d0 ? 1 : 0;
+        c.near_key = c.nearer ? d1 : d0;
+        c.far_key = c.nearer ? d0 : d1;
+        c.near_wanted = c.nearer ? want1 : want0;
+        c.far_wanted = c.nearer ? want0 : want1;
         return c;
     }
-    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>&, int child) const { return want[child]; }
+    SDF_CPU_GPU SDF_INLINE bool enter(T) const { return true; }  // the votes decided
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
         stats.test_triangles(count * K);
         worst = scan_leaf_packet(bvh, first, count, pk, near);

@@ -57,15 +57,16 @@ struct ClosestHitQuery {
     T& t_max;
     LeafFn& leaf_fn;
     SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) const {
+        const T e0 = ray_child_entry(n, 0, ray, inv_dir, t_max), e1 = ray_child_entry(n, 1, ray, inv_dir, t_max);
         ChildOrder<T> c;
-        c.key[0] = ray_child_entry(n, 0, ray, inv_dir, t_max);
-        c.key[1] = ray_child_entry(n, 1, ray, inv_dir, t_max);
-        c.nearer = (c.key[1] >= T(0) && (c.key[0] < T(0) || c.key[1] < c.key[0])) ? 1 : 0;
+        c.nearer = (e1 >= T(0) && (e0 < T(0) || e1 < e0)) ? 1 : 0;
+        c.near_key = c.nearer ? e1 : e0;
+        c.far_key = c.nearer ? e0 : e1;
         return c;
     }
     /// The nearer child's entry is within the t_max it was measured with; the farther one's
     /// is compared with t_max as the nearer leaf left it.
-    SDF_CPU_GPU SDF_INLINE bool enter(const ChildOrder<T>& c, int child) const { return still_open(c.key[child]); }
+    SDF_CPU_GPU SDF_INLINE bool enter(T entry) const { return still_open(entry); }
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
         if (count > 0) leaf_fn(first, count, t_max);
     }

@@ -37,7 +37,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include "kernels/bvh/traversal.h"
 #include "kernels/winding/fast_winding_number.h"
 
 namespace sdf {
@@ -185,20 +184,26 @@ SDF_CPU_GPU inline WindingEstimate<double> certified_winding_number(const Windin
                                                                     const WindingAccuracy<double>& acc) {
     const WindingRounding rnd = winding_rounding(v, q);
     CertifiedSum sum;
-    int opened = 1;  // the root; every opened child is counted below
-    depth_first_walk(v.nodes, NoPayload{}, [&](int32_t node, const BvhNode& n, int c, NoPayload, NoPayload&) {
-        double value, bound;
-        if (certified_far_field(v.moments[node].child[c], q, acc, rnd, value, bound)) {
-            sum.add(value, bound);
-            return false;
-        }
-        if (bvh_child_is_leaf(n, c)) {
-            certified_leaf(sum, v, n.ref[c], n.count[c], q);
-            return false;
-        }
+    int opened = 0;
+    int32_t stack[kBvhMaxDepth + 1];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const int32_t node = stack[--top];
         ++opened;
-        return true;
-    });
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            double value, bound;
+            if (certified_far_field(v.moments[node].child[c], q, acc, rnd, value, bound)) {
+                sum.add(value, bound);
+            } else if (bvh_child_is_leaf(n, c)) {
+                certified_leaf(sum, v, n.ref[c], n.count[c], q);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack[top++] = n.ref[c];
+            }
+        }
+    }
     return certified_estimate(sum, rnd, opened);
 }
 

@@ -9,7 +9,6 @@
 
 #include <cstdint>
 
-#include "kernels/bvh/traversal.h"
 #include "kernels/winding/certified_winding.h"
 
 namespace sdf {
@@ -56,7 +55,8 @@ template <int K, int Order>
 inline void certified_winding_numbers_packet_at(const WindingView<double>& v, const Vec3d* p, const int64_t* lanes,
                                                 const WindingAccuracy<double>& acc, double* value_out, double* bound_out) {
     double px[K], py[K], pz[K], scale[K], value[K], bound[K];
-    PacketLanes<K> wanted;
+    int32_t stack_node[kBvhMaxDepth + 1];
+    int64_t stack_lanes[kBvhMaxDepth + 1][K];
     int64_t any = 0;
     const double n_factor = winding_rounding(v, p[0]).n_factor;  // the mesh's: the same for every lane
     for (int k = 0; k < K; ++k) {
@@ -65,12 +65,18 @@ inline void certified_winding_numbers_packet_at(const WindingView<double>& v, co
         pz[k] = p[k].z;
         scale[k] = winding_rounding(v, p[k]).scale;
         value[k] = bound[k] = 0.0;
-        wanted.lane[k] = lanes[k];
+        stack_lanes[0][k] = lanes[k];
         any |= lanes[k];
     }
-    // A node carries the lanes that opened it.
-    if (any)
-        depth_first_walk(v.nodes, wanted, [&](int32_t node, const BvhNode& n, int c, const PacketLanes<K>& active, PacketLanes<K>& out) {
+    stack_node[0] = 0;
+    int top = any ? 1 : 0;
+    while (top > 0) {
+        --top;
+        const int32_t node = stack_node[top];
+        int64_t active[K];
+        for (int k = 0; k < K; ++k) active[k] = stack_lanes[top][k];
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
             const WindingMoments<double>& m = v.moments[node].child[c];
             const double limit = far_limit(m, acc);
             int64_t add[K], open[K];
@@ -79,8 +85,8 @@ inline void certified_winding_numbers_packet_at(const WindingView<double>& v, co
             for (int k = 0; k < K; ++k) {
                 const Vec3d y = m.center - Vec3d(px[k], py[k], pz[k]);
                 const int64_t far = int64_t(length_squared(y) > limit);
-                add[k] = active.lane[k] & far;
-                open[k] = active.lane[k] & (far ^ 1);
+                add[k] = active[k] & far;
+                open[k] = active[k] & (far ^ 1);
                 any_add |= add[k];
                 any_open |= open[k];
             }
@@ -97,14 +103,17 @@ inline void certified_winding_numbers_packet_at(const WindingView<double>& v, co
                     bound[k] = add[k] ? sum_bound : bound[k];
                 }
             }
-            if (!any_open) return false;
+            if (!any_open) continue;
             if (bvh_child_is_leaf(n, c)) {
                 detail::add_certified_leaf<K>(v, n.ref[c], n.count[c], px, py, pz, open, value, bound);
-                return false;
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack_node[top] = n.ref[c];
+                for (int k = 0; k < K; ++k) stack_lanes[top][k] = open[k];
+                ++top;
             }
-            for (int k = 0; k < K; ++k) out.lane[k] = open[k];
-            return true;
-        });
+        }
+    }
     for (int k = 0; k < K; ++k) {
         const WindingEstimate<double> e = certified_estimate(CertifiedSum{value[k], bound[k]}, WindingRounding{n_factor, scale[k]}, 0);
         value_out[k] = e.value;

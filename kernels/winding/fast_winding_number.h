@@ -27,7 +27,6 @@
 #pragma once
 
 #include "kernels/bvh/bvh_node.h"
-#include "kernels/bvh/traversal.h"
 #include "kernels/winding/solid_angle.h"
 #include "kernels/winding/winding_moments.h"
 
@@ -114,21 +113,26 @@ SDF_CPU_GPU SDF_INLINE T leaf_winding_number(const WindingView<T>& v, int32_t fi
 template <typename T>
 SDF_CPU_GPU WindingEstimate<T> fast_winding_number(const WindingView<T>& v, const Vec3<T>& q, const WindingAccuracy<T>& acc) {
     WindingEstimate<T> est;
-    est.opened = 1;  // the root; every opened child is counted below
-    depth_first_walk(v.nodes, NoPayload{}, [&](int32_t node, const BvhNode& n, int c, NoPayload, NoPayload&) {
-        T value, bound;
-        if (far_field(v.moments[node].child[c], q, acc, value, bound)) {
-            est.value += value;
-            est.error_bound += bound;
-            return false;
-        }
-        if (bvh_child_is_leaf(n, c)) {
-            est.value += leaf_winding_number(v, n.ref[c], n.count[c], q);
-            return false;
-        }
+    int32_t stack[kBvhMaxDepth + 1];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const int32_t node = stack[--top];
         ++est.opened;
-        return true;
-    });
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            T value, bound;
+            if (far_field(v.moments[node].child[c], q, acc, value, bound)) {
+                est.value += value;
+                est.error_bound += bound;
+            } else if (bvh_child_is_leaf(n, c)) {
+                est.value += leaf_winding_number(v, n.ref[c], n.count[c], q);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack[top++] = n.ref[c];
+            }
+        }
+    }
     return est;
 }
 

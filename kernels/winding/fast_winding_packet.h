@@ -18,7 +18,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include "kernels/bvh/traversal.h"
 #include "kernels/winding/fast_winding_number.h"
 
 namespace sdf {
@@ -53,46 +52,57 @@ template <int K, int Order>
 inline void fast_winding_numbers_packet_at(const WindingView<double>& v, const double* px_in, const double* py_in,
                                            const double* pz_in, const WindingAccuracy<double>& acc, double* value_out) {
     double px[K], py[K], pz[K], value[K];
-    PacketLanes<K> all;
+    int32_t stack_node[kBvhMaxDepth + 1];
+    int64_t stack_lanes[kBvhMaxDepth + 1][K];  // the lanes that opened the stacked node
     for (int k = 0; k < K; ++k) {
         px[k] = px_in[k];
         py[k] = py_in[k];
         pz[k] = pz_in[k];
         value[k] = 0.0;
-        all.lane[k] = 1;
+        stack_lanes[0][k] = 1;
     }
-    // A node carries the lanes that opened it.
-    depth_first_walk(v.nodes, all, [&](int32_t node, const BvhNode& n, int c, const PacketLanes<K>& active, PacketLanes<K>& out) {
-        const WindingMoments<double>& m = v.moments[node].child[c];
-        const double limit = far_limit(m, acc);
-        int64_t add[K], open[K];
-        int64_t any_add = 0, any_open = 0;
+    stack_node[0] = 0;
+    int top = 1;
+    while (top > 0) {
+        --top;
+        const int32_t node = stack_node[top];
+        int64_t active[K];
+        for (int k = 0; k < K; ++k) active[k] = stack_lanes[top][k];
+        const BvhNode& n = v.nodes[node];
+        for (int c = 0; c < 2; ++c) {
+            const WindingMoments<double>& m = v.moments[node].child[c];
+            const double limit = far_limit(m, acc);
+            int64_t add[K], open[K];
+            int64_t any_add = 0, any_open = 0;
 #pragma omp simd reduction(| : any_add, any_open)
-        for (int k = 0; k < K; ++k) {
-            const Vec3<double> y = m.center - Vec3<double>(px[k], py[k], pz[k]);
-            const int64_t far = int64_t(length_squared(y) > limit);
-            add[k] = active.lane[k] & far;
-            open[k] = active.lane[k] & (far ^ 1);
-            any_add |= add[k];
-            any_open |= open[k];
-        }
-        if (any_add) {
-#pragma omp simd
             for (int k = 0; k < K; ++k) {
                 const Vec3<double> y = m.center - Vec3<double>(px[k], py[k], pz[k]);
-                const double d = std::sqrt(length_squared(y)), inv_d = 1.0 / d, inv_d3 = inv_d * inv_d * inv_d;
-                const double term = far_field_value(m, y, inv_d, inv_d3, Order);
-                value[k] = add[k] ? value[k] + term : value[k];
+                const int64_t far = int64_t(length_squared(y) > limit);
+                add[k] = active[k] & far;
+                open[k] = active[k] & (far ^ 1);
+                any_add |= add[k];
+                any_open |= open[k];
+            }
+            if (any_add) {
+#pragma omp simd
+                for (int k = 0; k < K; ++k) {
+                    const Vec3<double> y = m.center - Vec3<double>(px[k], py[k], pz[k]);
+                    const double d = std::sqrt(length_squared(y)), inv_d = 1.0 / d, inv_d3 = inv_d * inv_d * inv_d;
+                    const double term = far_field_value(m, y, inv_d, inv_d3, Order);
+                    value[k] = add[k] ? value[k] + term : value[k];
+                }
+            }
+            if (!any_open) continue;
+            if (bvh_child_is_leaf(n, c)) {
+                detail::add_leaf_winding<K>(v, n.ref[c], n.count[c], px, py, pz, open, value);
+            } else {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack_node[top] = n.ref[c];
+                for (int k = 0; k < K; ++k) stack_lanes[top][k] = open[k];
+                ++top;
             }
         }
-        if (!any_open) return false;
-        if (bvh_child_is_leaf(n, c)) {
-            detail::add_leaf_winding<K>(v, n.ref[c], n.count[c], px, py, pz, open, value);
-            return false;
-        }
-        for (int k = 0; k < K; ++k) out.lane[k] = open[k];
-        return true;
-    });
+    }
     for (int k = 0; k < K; ++k) value_out[k] = value[k];
 }
 

@@ -29,7 +29,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include "kernels/bvh/traversal.h"
 #include "kernels/core/filtered_orientation.h"
 #include "kernels/core/vec3.h"
 #include "kernels/winding/fast_winding_number.h"
@@ -108,28 +107,32 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
     const double scale = fmax(v.scale, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
     const double slack = ldexp(scale, -40);
     change = 0;
-    bool decided = true;
-    depth_first_walk(v.nodes, NoPayload{}, [&](int32_t, const BvhNode& n, int c, NoPayload, NoPayload&) {
-        if (!decided) return false;  // the answer is known: the walk runs out
-        if (n.count[c] == 0 && n.ref[c] < 0) return false;  // an empty root child
-        if (!segment_may_meet_box(p, inv, slack, Vec3d(n.min_x[c], n.min_y[c], n.min_z[c]), Vec3d(n.max_x[c], n.max_y[c], n.max_z[c])))
-            return false;
-        if (!bvh_child_is_leaf(n, c)) return true;
-        for (int32_t slot = n.ref[c]; slot < n.ref[c] + n.count[c]; ++slot) {
-            const int32_t u = v.triangle_index[slot];
-            if (u == triangle) continue;
-            const Int3 ui = v.triangles[u];
-            const Vec3d u0 = v.vertices[ui.x], u1 = v.vertices[ui.y], u2 = v.vertices[ui.z];
-            if (!segment_may_meet_box(p, inv, slack, component_min(u0, component_min(u1, u2)), component_max(u0, component_max(u1, u2))))
-                continue;  // most of a leaf's triangles: the determinants cost more than this
-            if (!add_crossing(p, t, u0, u1, u2, change)) {
-                decided = false;
-                return false;
+    int32_t stack[kBvhMaxDepth + 1];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& n = v.nodes[stack[--top]];
+        for (int c = 0; c < 2; ++c) {
+            if (n.count[c] == 0 && n.ref[c] < 0) continue;  // an empty root child
+            if (!segment_may_meet_box(p, inv, slack, Vec3d(n.min_x[c], n.min_y[c], n.min_z[c]), Vec3d(n.max_x[c], n.max_y[c], n.max_z[c])))
+                continue;
+            if (!bvh_child_is_leaf(n, c)) {
+                SDF_DCHECK(top <= kBvhMaxDepth);
+                stack[top++] = n.ref[c];
+                continue;
+            }
+            for (int32_t slot = n.ref[c]; slot < n.ref[c] + n.count[c]; ++slot) {
+                const int32_t u = v.triangle_index[slot];
+                if (u == triangle) continue;
+                const Int3 ui = v.triangles[u];
+                const Vec3d u0 = v.vertices[ui.x], u1 = v.vertices[ui.y], u2 = v.vertices[ui.z];
+                if (!segment_may_meet_box(p, inv, slack, component_min(u0, component_min(u1, u2)), component_max(u0, component_max(u1, u2))))
+                    continue;  // most of a leaf's triangles: the determinants cost more than this
+                if (!add_crossing(p, t, u0, u1, u2, change)) return false;
             }
         }
-        return false;
-    });
-    return decided;
+    }
+    return true;
 }
 
 /// Decides `inside` (w(p) > 1/2, exactly) from triangle `triangle` (the search's closest, at

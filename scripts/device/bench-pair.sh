@@ -1,30 +1,35 @@
 #!/usr/bin/env bash
 # A before/after benchmark round on one machine: the same benchmarks from two build trees,
 # run in the order A B B A per round (so that drift of the machine falls on both sides
-# alike), the medians per benchmark and side in $OUT/bench-pair.txt with B/A.
+# alike; ORDER=AB runs A B), the medians per benchmark and side in $OUT/bench-pair.txt with B/A.
 #   scripts/device/bench-pair.sh BUILD_A BUILD_B [rounds]    (carry: data)
-# Benchmarks: the BVH searches (CPU kernels at 1 and all threads, point queries, every CUDA
-# kernel in float and double, point lists, bands: bench_bvh), the winding-number walks
-# (bench_winding), and sdf-sample's kernel time on dragon-legacy (the winding sign's exact
-# stage and ladder: CPU packets, GPU warps).
+# Benchmarks: the BVH searches (bench_bvh: the CPU's three kernels on all threads with the
+# pseudonormal and the winding sign, the packet kernel on one thread; every CUDA kernel in
+# float, the default warp kernel in double, on 16.8M near-surface points and in a band), the
+# scalar winding-number walks (bench_winding), and sdf-sample's kernel time on dragon-legacy
+# (the winding sign's exact stage and ladder: CPU packets, GPU warps). Each step's start is
+# logged in $OUT/steps.log.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 A=$1 B=$2 ROUNDS=${3:-2}
 OUT=${OUT:-$PWD/bench-out}
 mkdir -p "$OUT"
 export SDF_DATA_PATH=$PWD/data/meshes
-BVH_FILTER=${BVH_FILTER:-'^BM_CpuBvh/(dragon|dragon_legacy)/res:128/threads:0/|^BM_CpuBvh/dragon/res:64/threads:1/|^BM_CpuBvhPointQuery/dragon/gaussian:1/threads:0/|^BM_CudaBvh/dragon/res:(128|256)/|^BM_CudaBvhPoints/dragon/points:16777216/|^BM_CudaBvhBand/dragon/'}
+BVH_FILTER=${BVH_FILTER:-'^BM_CpuBvh/(dragon|dragon_legacy)/res:128/threads:0/|^BM_CpuBvh/dragon/res:64/threads:1/kernel:0|^BM_CudaBvh/dragon/res:128/kernel:[0-4]/double:0|^BM_CudaBvh/dragon/res:(128|256)/kernel:3/double:1|^BM_CudaBvh/dragon/res:256/kernel:3/double:0|^BM_CudaBvhPoints/dragon/points:16777216/gaussian:1/kernel:3|^BM_CudaBvhBand/dragon/res:256/band_spacings:2/kernel:3'}
 WINDING_FILTER=${WINDING_FILTER:-'^BM_WindingFast/64/1/20/2|^BM_WindingCertified/64/1/40/2'}
 
 run_side() {  # side build round
     local side=$1 dir=$2 r=$3
+    echo "$(date +%T) $side $r bench_bvh" >> "$OUT/steps.log"
     "$dir/tests/benchmarks/bench_bvh" --benchmark_filter="$BVH_FILTER" --benchmark_format=json \
         --benchmark_out="$OUT/bvh-$side-$r.json" > /dev/null 2>> "$OUT/stderr-$side.log"
+    echo "$(date +%T) $side $r bench_winding" >> "$OUT/steps.log"
     "$dir/tests/benchmarks/bench_winding" --benchmark_filter="$WINDING_FILTER" --benchmark_format=json \
         --benchmark_out="$OUT/winding-$side-$r.json" > /dev/null 2>> "$OUT/stderr-$side.log"
-    for run in "cpu 128" "cuda 256" "cuda 512"; do
+    for run in "cpu 128" "cuda 256"; do
         set -- $run
         local name="sample-$1-$2-$side-$r"
+        echo "$(date +%T) $side $r sdf-sample $1 $2" >> "$OUT/steps.log"
         "$dir/bin/sdf-sample" dragon-legacy.obj --resolution "$2" --backend "$1" --channels distance --quiet \
             --out "/tmp/$name.json" >> "$OUT/stderr-$side.log" 2>&1
         cp "/tmp/$name.json" "$OUT/$name.json" 2> /dev/null
@@ -34,7 +39,8 @@ run_side() {  # side build round
 
 for r in $(seq "$ROUNDS"); do
     echo "== $(date +%T) round $r"
-    run_side A "$A" "$r"; run_side B "$B" "$r"; run_side B "$B" "$r.2"; run_side A "$A" "$r.2"
+    run_side A "$A" "$r"; run_side B "$B" "$r"
+    [ "${ORDER:-ABBA}" = AB ] || { run_side B "$B" "$r.2"; run_side A "$A" "$r.2"; }
 done
 
 python3 - "$OUT" > "$OUT/bench-pair.txt" <<'EOF'
