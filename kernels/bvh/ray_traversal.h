@@ -64,8 +64,8 @@ struct ClosestHitQuery {
         c.far_key = c.nearer ? e0 : e1;
         return c;
     }
-    /// The nearer child's entry is within the t_max it was measured with; the farther one's
-    /// is compared with t_max as the nearer leaf left it.
+    /// The nearer child's entry is within the t_max it was measured with (a NaN t_max, from a
+    /// zero direction, ends the walk); the farther one's is compared with t_max as left.
     SDF_CPU_GPU SDF_INLINE bool enter(T entry) const { return still_open(entry); }
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {
         if (count > 0) leaf_fn(first, count, t_max);

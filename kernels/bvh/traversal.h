@@ -14,7 +14,7 @@
 ///
 /// The winding numbers' walks (kernels/winding/) open every child their far-field test
 /// rejects, in child order, and keep their own loops: written as one depth-first walk with the
-/// query as a lambda they ran 9-73% slower on the CPU (docs/bvh.md, "One traversal").
+/// query as a lambda they ran 9-17% slower on the CPU (docs/bvh.md, "One traversal").
 #pragma once
 
 #include <cstdint>
