@@ -94,6 +94,7 @@ struct ProbeBall {
     Vec3d centre{};
     double clear = -1;  ///< D - w - margin; < 0: no ball
     bool negative = false;
+    int triangle = -1;  ///< the probe's nearest (prepared-mesh index): the winding table's start
 };
 
 inline bool brick_in_ball(const Brick& br, const ProbeBall& ball) {
@@ -156,7 +157,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
-                    ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0};
+                    ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0, s.triangle};
                     below = ball;
                     ++probes;
                 }
@@ -166,8 +167,10 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 if (skip && band.winding == nullptr && ball.negative)
                     for (int k = 0; k < br.count; ++k) skip = skip && !exact.outside_box(br.position[k]);
                 if (skip) {
+                    // Every point of the ball is more than w from the surface.
                     for (int k = 0; k < br.count; ++k)
-                        emit_outside(br.local[k], (band.winding ? packet_sign.inside(br.position[k]) : ball.negative)
+                        emit_outside(br.local[k], (band.winding ? packet_sign.inside(br.position[k], ball.triangle, band.width)
+                                                                : ball.negative)
                                                       ? kBandSideInside : kBandSideOutside);
                     ++skipped_bricks;
                     skipped_points += br.count;

@@ -170,8 +170,16 @@ public:
         return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p, counts_);
     }
 
-    /// The side of one point outside the packets (a narrow band's skipped brick), counted.
-    bool inside(const Vec3d& p) {
+    /// The side of one point outside the packets (a narrow band's skipped brick), counted:
+    /// by the table from `triangle` (any triangle gives the exact side, surface_side.h; a
+    /// nearby one keeps the segment short), `distance` a lower bound on p's distance to the
+    /// surface; else by the ladder.
+    bool inside(const Vec3d& p, int triangle, double distance) {
+        bool in = false;
+        if (winding_->options().certify && surface_side(surface_, winding_->view(), p, triangle, distance, in)) {
+            counts_.add(WindingStage::Surface);
+            return in;
+        }
         const WindingSide side = winding_->side(p);
         counts_.add(side.stage);
         return side.inside;
