@@ -95,6 +95,8 @@ struct ProbeBall {
     double clear = -1;  ///< D - w - margin; < 0: no ball
     bool negative = false;
     int triangle = -1;  ///< the probe's nearest (prepared-mesh index): the winding table's start
+    double distance = 0;  ///< the probe's |distance| to it
+    int side = -1;        ///< winding sign: the ball's side once known (1 inside, 0 outside)
 };
 
 inline bool brick_in_ball(const Brick& br, const ProbeBall& ball) {
@@ -157,7 +159,7 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
-                    ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0, s.triangle};
+                    ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0, s.triangle, d};
                     below = ball;
                     ++probes;
                 }
@@ -167,9 +169,17 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 if (skip && band.winding == nullptr && ball.negative)
                     for (int k = 0; k < br.count; ++k) skip = skip && !exact.outside_box(br.position[k]);
                 if (skip) {
-                    // Every point of the ball is more than w from the surface.
+                    // No surface within the ball: a closed mesh's winding number is one integer
+                    // there, its centre's (PacketSign::ball_side). Every point of the ball is
+                    // more than w from the surface.
+                    if (band.winding && ball.side < 0) {
+                        bool in = false;
+                        if (packet_sign.ball_side(ball.centre, ball.triangle, ball.distance, in)) ball.side = in ? 1 : 0;
+                    }
+                    if (band.winding && ball.side >= 0) packet_sign.count_surface(br.count);
                     for (int k = 0; k < br.count; ++k)
-                        emit_outside(br.local[k], (band.winding ? packet_sign.inside(br.position[k], ball.triangle, band.width)
+                        emit_outside(br.local[k], (band.winding ? (ball.side >= 0 ? ball.side == 1
+                                                                                  : packet_sign.inside(br.position[k], ball.triangle, band.width))
                                                                 : ball.negative)
                                                       ? kBandSideInside : kBandSideOutside);
                     ++skipped_bricks;

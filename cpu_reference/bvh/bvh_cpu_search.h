@@ -170,6 +170,16 @@ public:
         return winding_ != nullptr ? with_sign(s, inside_[k]) : sign_.apply(s, p, counts_);
     }
 
+    /// The side of a ball without surface around `centre` (a narrow band's probe, `distance`
+    /// from the surface, `triangle` its nearest), uncounted; false where the table cannot
+    /// decide. With a table the mesh is closed, so the winding number is one integer in the
+    /// ball and the centre's side is every point's.
+    bool ball_side(const Vec3d& centre, int triangle, double distance, bool& inside) const {
+        return winding_->options().certify && surface_side(surface_, winding_->view(), centre, triangle, distance, inside);
+    }
+    /// Counts n points whose side the table gave (a ball's).
+    void count_surface(int n) { counts_.add(WindingStage::Surface, n); }
+
     /// The side of one point outside the packets (a narrow band's skipped brick), counted:
     /// by the table from `triangle` (any triangle gives the exact side, surface_side.h; a
     /// nearby one keeps the segment short), `distance` a lower bound on p's distance to the
