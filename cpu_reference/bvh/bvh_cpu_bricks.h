@@ -96,7 +96,7 @@ struct ProbeBall {
     bool negative = false;
     int triangle = -1;  ///< the probe's nearest (prepared-mesh index): the winding table's start
     double distance = 0;  ///< the probe's |distance| to it
-    int side = -1;        ///< winding sign: the ball's side once known (1 inside, 0 outside)
+    int side = -1;        ///< winding sign: the ball's side (1 inside, 0 outside); -1 not asked, -2 undecided
 };
 
 inline bool brick_in_ball(const Brick& br, const ProbeBall& ball) {
@@ -172,9 +172,9 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     // No surface within the ball: a closed mesh's winding number is one integer
                     // there, its centre's (PacketSign::ball_side). Every point of the ball is
                     // more than w from the surface.
-                    if (band.winding && ball.side < 0) {
+                    if (band.winding && ball.side == -1) {
                         bool in = false;
-                        if (packet_sign.ball_side(ball.centre, ball.triangle, ball.distance, in)) ball.side = in ? 1 : 0;
+                        ball.side = packet_sign.ball_side(ball.centre, ball.triangle, ball.distance, in) ? (in ? 1 : 0) : -2;
                     }
                     if (band.winding && ball.side >= 0) packet_sign.count_surface(br.count);
                     for (int k = 0; k < br.count; ++k)

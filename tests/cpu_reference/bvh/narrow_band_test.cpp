@@ -58,6 +58,7 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
         SignMode sign;  ///< what auto resolves to (named, so the tests print no auto warning)
     };
     const std::vector<Case> cases = {{"torus", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), SignMode::Auto},
+                                     {"torus, winding", prepare_mesh(make_torus(1.0, 0.35, 32, 16)), SignMode::Winding},
                                      {"bowl", test::open_bowl(), SignMode::Winding}};
     for (const Case& c : cases) {
         const Lattice cc = fit_lattice(LatticeType::CC, {21, 22, 23}, c.mesh.bounds(), 0.3);
@@ -74,6 +75,13 @@ TEST(NarrowBand, BvhAndBruteForceEqualTheFullFieldBanded) {
                     expect_banded(full_bvh, bvh, w, what + " bvh");
                     EXPECT_EQ(bvh.sampler.band->how, "bricks skipped by the distance bound") << what;
                     EXPECT_GT(bvh.sampler.band->bricks_skipped, 0) << what;
+                    // A closed mesh's skipped bricks take their side from the winding table
+                    // (one evaluation per probe's ball): no point reaches the ladder.
+                    if (c.name == "torus, winding") {
+                        ASSERT_TRUE(bvh.sampler.winding_sign.has_value()) << what;
+                        EXPECT_EQ(bvh.sampler.winding_sign->surface, bvh.sampler.winding_sign->points()) << what;
+                        EXPECT_EQ(bvh.sampler.winding_sign->points(), lattice.num_points()) << what;
+                    }
                     const SampledField brute = make_cpu_brute_force_sampler(options(precision, w, c.sign))->bind(share(c.mesh))->sample(lattice);
                     expect_banded(full_brute, brute, w, what + " brute force");
                     EXPECT_EQ(brute.sampler.band->how, "post-processed") << what;
