@@ -128,13 +128,8 @@ struct WarpNearestQuery {
         const bool w0 = sdf::detail::child_wanted(n, 0, pk, d0), w1 = sdf::detail::child_wanted(n, 1, pk, d1);
         const bool want0 = __any_sync(kFullWarp, w0), want1 = __any_sync(kFullWarp, w1);
         const T m0 = warp_min(valid ? d0 : T(INFINITY)), m1 = warp_min(valid ? d1 : T(INFINITY));
-        ChildOrder<T> c;  // keys: the nearest point's distance, a bound for all
-        c.nearer = m1 < m0 ? 1 : 0;
-        c.near_key = c.nearer ? m1 : m0;
-        c.far_key = c.nearer ? m0 : m1;
-        c.near_wanted = c.nearer ? want1 : want0;
-        c.far_wanted = c.nearer ? want0 : want1;
-        return c;
+        // keys: the warp's nearest point's distance, a bound for all
+        return ChildOrder<T>::ordered(m1 < m0 ? 1 : 0, m0, m1, want0, want1);
     }
     __device__ SDF_INLINE bool enter(T) const { return true; }  // the votes decided
     __device__ SDF_INLINE void leaf(int32_t first, int32_t count) {

@@ -148,11 +148,7 @@ struct NearestTriangleQuery {
     SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
         stats.visit_node();
         const T d0 = child_box_distance_squared(n, 0, p), d1 = child_box_distance_squared(n, 1, p);
-        ChildOrder<T> c;
-        c.nearer = d1 < d0 ? 1 : 0;
-        c.near_key = c.nearer ? d1 : d0;
-        c.far_key = c.nearer ? d0 : d1;
-        return c;
+        return ChildOrder<T>::ordered(d1 < d0 ? 1 : 0, d0, d1);
     }
     SDF_CPU_GPU SDF_INLINE bool enter(T key) const { return may_hold_nearer(key, radius); }
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {

@@ -275,13 +275,7 @@ struct NearestTrianglesPacketQuery {
         stats.visit_node();
         T d0, d1;
         const bool want0 = child_wanted(n, 0, pk, d0), want1 = child_wanted(n, 1, pk, d1);
-        ChildOrder<T> c;
-        c.nearer = d1 < d0 ? 1 : 0;
-        c.near_key = c.nearer ? d1 : d0;
-        c.far_key = c.nearer ? d0 : d1;
-        c.near_wanted = c.nearer ? want1 : want0;
-        c.far_wanted = c.nearer ? want0 : want1;
-        return c;
+        return ChildOrder<T>::ordered(d1 < d0 ? 1 : 0, d0, d1, want0, want1);
     }
     SDF_CPU_GPU SDF_INLINE bool enter(T) const { return true; }  // the votes decided
     SDF_CPU_GPU SDF_INLINE void leaf(int32_t first, int32_t count) {

@@ -58,11 +58,7 @@ struct ClosestHitQuery {
     LeafFn& leaf_fn;
     SDF_CPU_GPU SDF_INLINE ChildOrder<T> measure(const BvhNode& n) const {
         const T e0 = ray_child_entry(n, 0, ray, inv_dir, t_max), e1 = ray_child_entry(n, 1, ray, inv_dir, t_max);
-        ChildOrder<T> c;
-        c.nearer = (e1 >= T(0) && (e0 < T(0) || e1 < e0)) ? 1 : 0;
-        c.near_key = c.nearer ? e1 : e0;
-        c.far_key = c.nearer ? e0 : e1;
-        return c;
+        return ChildOrder<T>::ordered((e1 >= T(0) && (e0 < T(0) || e1 < e0)) ? 1 : 0, e0, e1);
     }
     /// The nearer child's entry is within the t_max it was measured with (a NaN t_max, from a
     /// zero direction, ends the walk); the farther one's is compared with t_max as left.

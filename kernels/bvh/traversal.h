@@ -33,6 +33,18 @@ struct ChildOrder {
     int nearer = 0;
     Key near_key{}, far_key{};
     bool near_wanted = true, far_wanted = true;
+
+    /// Children 0 and 1's keys and votes put in the order `nearer` says.
+    SDF_CPU_GPU SDF_INLINE static ChildOrder ordered(int nearer, const Key& key0, const Key& key1,
+                                                     bool want0 = true, bool want1 = true) {
+        ChildOrder c;
+        c.nearer = nearer;
+        c.near_key = nearer ? key1 : key0;
+        c.far_key = nearer ? key0 : key1;
+        c.near_wanted = nearer ? want1 : want0;
+        c.far_wanted = nearer ? want0 : want1;
+        return c;
+    }
 };
 
 /// For walks whose stacked entries need no key (they are entered whatever happened since).
