@@ -103,10 +103,11 @@ struct WarpStack {
             if constexpr (!std::is_empty_v<Key>) key[top] = k;
         }
     }
-    __device__ SDF_INLINE int32_t load(int top, Key& k) const {
-        if constexpr (!std::is_empty_v<Key>) k = key[top];
-        return node[top];
+    __device__ SDF_INLINE Key key_at(int top) const {
+        if constexpr (std::is_empty_v<Key>) return Key{};
+        else return key[top];
     }
+    __device__ SDF_INLINE int32_t node_at(int top) const { return node[top]; }
     __device__ SDF_INLINE void begin_pops() { __syncwarp(); }  // lane 0's pushes are seen
     __device__ SDF_INLINE void end_pops() { __syncwarp(); }    // read before lane 0 writes again
 };

@@ -26,7 +26,8 @@ struct alignas(64) BvhNode {
 };
 static_assert(sizeof(BvhNode) == 64, "BvhNode must stay one 64-byte line");
 
-SDF_CPU_GPU constexpr bool bvh_child_is_leaf(const BvhNode& n, int c) { return n.count[c] > 0 || n.ref[c] < 0; }
+SDF_CPU_GPU constexpr bool bvh_child_is_leaf(int32_t ref, int32_t count) { return count > 0 || ref < 0; }
+SDF_CPU_GPU constexpr bool bvh_child_is_leaf(const BvhNode& n, int c) { return bvh_child_is_leaf(n.ref[c], n.count[c]); }
 
 /// Deepest node level a builder may produce; the traversal stack holds one entry per level.
 constexpr int kBvhMaxDepth = 64;
