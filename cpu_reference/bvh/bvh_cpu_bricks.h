@@ -145,7 +145,11 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             const bool row_start = b % bricks.x == 0;
             if (row_start)
                 for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k];
-            if (band.enabled()) {
+            // With a search bounded by the band no probe: in the sparse band's blocks (all near
+            // the surface) a probe's full search rarely proved its brick outside, and a bounded
+            // search ends as soon, giving the points beyond it their side by the flood
+            // (dragon, 512^3: 0.77 -> 0.61 s).
+            if (band.enabled() && !(band.bound_squared > 0)) {
                 ProbeBall& below = column_ball[size_t(b % bricks.x)];
                 if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
                 if (!brick_in_ball(br, ball)) {  // probe at the brick's centre
