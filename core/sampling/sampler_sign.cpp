@@ -23,6 +23,13 @@ std::shared_ptr<const SurfaceSides> surface_sides_for(const PreparedMesh& mesh) 
 
 }  // namespace
 
+WindingSignOptions SamplerSign::winding_options() {
+    const char* uncertified = std::getenv("SDF_WINDING_UNCERTIFIED");  // read at binding, not per point
+    WindingSignOptions o;
+    o.certify = !(uncertified != nullptr && std::string(uncertified) == "1");
+    return o;
+}
+
 const SignModeChoice& SamplerSign::prepare_mode(const PreparedMesh& mesh) {
     choice_ = choose_sign_mode(mesh.report(), requested_);
     winding_.reset();

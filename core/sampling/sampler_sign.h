@@ -69,8 +69,11 @@ public:
 
     /// The winding sign every backend uses (WindingSignOptions' default: certified, first
     /// evaluation beta 2, order 2, then certified_winding.h's ladder): every backend and tree
-    /// gives the exact side of 1/2 of the winding number, ties outside.
-    static WindingSignOptions winding_options() { return {}; }
+    /// gives the exact side of 1/2 of the winding number, ties outside. For measurement only,
+    /// SDF_WINDING_UNCERTIFIED=1 turns the certification off (the fast value's side: the
+    /// uncertified kernel the certified one is timed against); the provenance's
+    /// "certified": false and the field cache's key say so.
+    static WindingSignOptions winding_options();
 
     /// The prepared mesh's largest |coordinate| (WindingView::scale, for device views).
     double mesh_scale() const { return mesh_scale_; }

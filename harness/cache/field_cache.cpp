@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/sampling/sampler_sign.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/sampler_spec.h"
 #include "harness/io/field_file.h"
@@ -24,7 +25,7 @@ std::string exact(double v) {
 }  // namespace
 
 nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l, const SamplerOptions& o) {
-    return {{"what", "sampled_field"},
+    nlohmann::json key = {{"what", "sampled_field"},
             {"code_version", kFieldCodeVersion},
             {"mesh_sha256", mesh_sha256},
             {"lattice", {{"type", lattice_type_name(l.type)},
@@ -34,6 +35,9 @@ nlohmann::json field_cache_key(const std::string& mesh_sha256, const Lattice& l,
             // Every option of role Result, from the codec's table (the sign as requested: auto
             // resolves from the mesh, which mesh_sha256 fixes).
             {"sampler", sampler_result_identity(o, l.type)}};
+    // The measurement switch's fields (SamplerSign::winding_options) never pass for certified ones.
+    if (!SamplerSign::winding_options().certify) key["winding_sign"] = "uncertified (SDF_WINDING_UNCERTIFIED=1)";
+    return key;
 }
 
 std::optional<SampledField> FieldCache::load(const nlohmann::json& key) const {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/mesh/sha256.h"
+#include "core/sampling/sampler_sign.h"
 #include "harness/cache/content_cache.h"
 #include "harness/config/json_reader.h"
 #include "harness/config/sampler_spec.h"
@@ -157,6 +158,21 @@ TEST(FieldCacheKey, TheNarrowBandIsPartOfTheKey) {
     SamplerOptions banded;
     banded.band_width = 0.25;
     EXPECT_NE(field_cache_key("abc", l, SamplerOptions{}), field_cache_key("abc", l, banded));
+}
+
+// The uncertified winding sign (SDF_WINDING_UNCERTIFIED=1, a measurement switch) gives other
+// signs: its fields never pass for the certified ones, nor the other way round.
+TEST(FieldCacheKey, TheUncertifiedWindingSignIsPartOfTheKey) {
+    const Lattice l = lattice(LatticeType::CC, {4, 4, 4});
+    const json certified = field_cache_key("abc", l, SamplerOptions{});
+    setenv("SDF_WINDING_UNCERTIFIED", "1", 1);
+    const json uncertified = field_cache_key("abc", l, SamplerOptions{});
+    const bool certify = SamplerSign::winding_options().certify;
+    unsetenv("SDF_WINDING_UNCERTIFIED");
+    EXPECT_FALSE(certify);
+    EXPECT_TRUE(SamplerSign::winding_options().certify);
+    EXPECT_NE(certified, uncertified);
+    EXPECT_EQ(certified, field_cache_key("abc", l, SamplerOptions{}));
 }
 
 TEST_F(Cache, StoreThenLoadIsExactAndNeverReplaces) {
