@@ -166,7 +166,7 @@ LbvhBuild build_lbvh(const BvhBuildInput& mesh, const Bounds3& box, const GpuBvh
         if (lbvh_kept(a, i)) depth = std::max(depth, lbvh_radius_from(a, i));
     });
 
-    bvh.triangle_index = order;
+    bvh.triangle_index.assign(order.begin(), order.end());
     bvh.packed_float.resize(count);
     bvh.packed_double.resize(count);
     for (int s = 0; s < n; ++s) {

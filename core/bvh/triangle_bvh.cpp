@@ -122,7 +122,7 @@ struct TopSplit {
 /// bytes at any thread count (tests/cpu_reference/bvh/sah_build_test.cpp).
 class Builder {
 public:
-    Builder(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& nodes,
+    Builder(DefaultInitVector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& nodes,
             int threads = 1)
         : refs_(refs), o_(o), stats_(stats), nodes_(nodes), threads_(threads) {}
 
@@ -324,15 +324,15 @@ private:
         return mid;
     }
 
-    std::vector<BuildRef>& refs_;
+    DefaultInitVector<BuildRef>& refs_;
     const BvhBuildOptions& o_;
     BvhBuildStats& stats_;
     std::vector<BvhNode>& nodes_;
     int threads_;
 };
 
-std::vector<BuildRef> build_refs(const BvhBuildInput& mesh, int threads) {
-    std::vector<BuildRef> refs(mesh.triangles.size());
+DefaultInitVector<BuildRef> build_refs(const BvhBuildInput& mesh, int threads) {
+    DefaultInitVector<BuildRef> refs(mesh.triangles.size());
     parallel_for(int64_t(refs.size()), 8192, threads, [&](int64_t i0, int64_t i1) {
         for (int64_t i = i0; i < i1; ++i) {
             const Int3 t = mesh.triangles[size_t(i)];
@@ -375,7 +375,7 @@ int32_t splice(const std::vector<BvhNode>& top, int32_t t, std::vector<SubtreeTa
 /// another, each binned on all threads, then its other nodes side by side, one thread each
 /// (they own disjoint ranges of refs). A node of at most `grain` refs becomes a SubtreeTask.
 /// Returns the root's child.
-BuiltChild build_top(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& top,
+BuiltChild build_top(DefaultInitVector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats, std::vector<BvhNode>& top,
                      std::vector<SubtreeTask>& tasks, int grain, int threads) {
     struct Pending {
         int begin, end, depth;
@@ -431,7 +431,7 @@ BuiltChild build_top(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhB
 /// one). On one thread, one recursion; on several, the top of the tree first (build_top)
 /// down to subtrees of about n / (8 threads) refs, those subtrees on all threads, then
 /// spliced in pre-order.
-BuiltChild build_nodes(std::vector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats,
+BuiltChild build_nodes(DefaultInitVector<BuildRef>& refs, const BvhBuildOptions& o, BvhBuildStats& stats,
                        std::vector<BvhNode>& nodes) {
     const int n = int(refs.size());
     const int threads = resolve_thread_count(o.threads);
@@ -519,7 +519,7 @@ TriangleBvh build_triangle_bvh(const BvhBuildInput& mesh, const BvhBuildOptions&
     bvh.float_bound = mesh.search_bound ? *mesh.search_bound
                                        : float_search_bound(mesh.vertices, mesh.triangles, mesh.packed_double, mesh.packed_float);
     const int threads = resolve_thread_count(options.threads);
-    std::vector<BuildRef> refs = build_refs(mesh, threads);
+    DefaultInitVector<BuildRef> refs = build_refs(mesh, threads);
     const int n = int(refs.size());
     bvh.nodes.reserve(size_t(2 * n / std::max(1, options.max_leaf_size) + 1));
     // Nodes are numbered in pre-order, so the root is node 0; a mesh that fits one leaf gets

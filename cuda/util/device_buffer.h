@@ -64,7 +64,8 @@ public:
         const DeviceGuard on(device_);
         CUDA_CHECK(cudaMemcpyAsync(ptr_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream));
     }
-    void upload(const std::vector<T>& host, cudaStream_t stream = 0) { upload(host.data(), host.size(), stream); }
+    template <typename Allocator>
+    void upload(const std::vector<T, Allocator>& host, cudaStream_t stream = 0) { upload(host.data(), host.size(), stream); }
     void download(T* host, size_t count, cudaStream_t stream = 0) const {
         if (count == 0) return;
         const DeviceGuard on(device_);

@@ -43,8 +43,8 @@ const std::vector<Case>& cases() {
     return all;
 }
 
-template <typename V>
-void expect_bytes_equal(const std::vector<V>& a, const std::vector<V>& b, const std::string& what) {
+template <typename V, typename A>
+void expect_bytes_equal(const std::vector<V, A>& a, const std::vector<V, A>& b, const std::string& what) {
     ASSERT_EQ(a.size(), b.size()) << what;
     EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(V))) << what << " differ";
 }
