@@ -66,6 +66,15 @@ echo
 echo "| run | kernel s | transfers s | kernel+transfers s | sampling s | wall s (to disk) | how |"
 echo "|---|---|---|---|---|---|---|"
 } > "$OUT/rows.txt"
+# A lent machine's memory grows as it is first used (about 3 s for each 8 GiB: KINDS.md): the
+# first run of a 1024^3 field paid for it in its transfers (39 s of the one-GPU row's 40 s on
+# 2026-11-29). One untimed run first (WARMUP=0 leaves it out).
+if [ "${WARMUP:-1}" = 1 ]; then
+    config warmup ""
+    log "warm-up run (untimed: the host's memory grows)"
+    rm -rf "$FIELDS" && mkdir -p "$FIELDS"
+    $B/bin/run-experiment "$OUT/warmup.json" --no-cache --quiet --output-root "$FIELDS" > "$OUT/warmup.log" 2>&1
+fi
 for n in 1 2 4; do
     [ "$n" -le "$gpus" ] || { log "$n GPUs: not run ($gpus visible)"; continue; }
     list=$(python3 -c "print(list(range($n)))")
