@@ -34,8 +34,8 @@ double rho_of_slivers(double smallest_sin2) {
 }  // namespace
 
 FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles,
-                                    const std::vector<PackedTriangle<double>>& packed_double,
-                                    const std::vector<PackedTriangle<float>>& packed_float, int threads) {
+                                    const DefaultInitVector<PackedTriangle<double>>& packed_double,
+                                    const DefaultInitVector<PackedTriangle<float>>& packed_float, int threads) {
     // Smallest sin^2 of the triangles each precision searches inside (pack_triangle; sb NaN:
     // edges only). Float-only slivers carry their own bound (sliver_excess). Minima and
     // maxima of non-NaN values: the same whatever the chunks.

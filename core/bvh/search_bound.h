@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include "core/default_init_vector.h"
 #include "kernels/core/vec3.h"
 #include "kernels/distance/packed_triangle.h"
 #include "kernels/distance/search_certificate.h"
@@ -17,7 +18,7 @@ namespace sdf {
 /// |E0| + |E1| and the largest |coordinate|, folded into the bound's constants; the
 /// minima and maxima over chunks on `threads` threads (0 = all) are the one pass's.
 FloatSearchBound float_search_bound(const std::vector<Vec3d>& vertices, const std::vector<Int3>& triangles,
-                                    const std::vector<PackedTriangle<double>>& packed_double,
-                                    const std::vector<PackedTriangle<float>>& packed_float, int threads = 1);
+                                    const DefaultInitVector<PackedTriangle<double>>& packed_double,
+                                    const DefaultInitVector<PackedTriangle<float>>& packed_float, int threads = 1);
 
 }  // namespace sdf

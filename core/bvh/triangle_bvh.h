@@ -61,8 +61,8 @@ public:
 struct BvhBuildInput {
     const std::vector<Vec3d>& vertices;
     const std::vector<Int3>& triangles;
-    const std::vector<PackedTriangle<float>>& packed_float;    ///< one per triangle, in triangle order
-    const std::vector<PackedTriangle<double>>& packed_double;
+    const DefaultInitVector<PackedTriangle<float>>& packed_float;    ///< one per triangle, in triangle order
+    const DefaultInitVector<PackedTriangle<double>>& packed_double;
     const std::string& name;  ///< for messages
     /// The float search's bound of these arrays where the caller has it already (a prepared
     /// mesh makes it once: PreparedMesh::search_bound()); null: the build computes it.

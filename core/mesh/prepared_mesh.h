@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/default_init_vector.h"
 #include "core/mesh/triangle_mesh.h"
 #include "kernels/distance/mesh_view.h"
 #include "kernels/distance/search_certificate.h"
@@ -75,7 +76,7 @@ template <typename T>
 struct MeshBuffers {
     std::vector<Vec3<T>> vertices, face_normals, edge_normals, vertex_normals;
     std::vector<Int3> triangles;
-    std::vector<PackedTriangle<T>> packed;
+    DefaultInitVector<PackedTriangle<T>> packed;  ///< every element written by preparation (no zero fill)
     Vec3<T> box_lo{}, box_hi{};  ///< of `vertices` (as converted to T)
     MeshView<T> view() const;
 };

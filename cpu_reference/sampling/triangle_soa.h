@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "core/default_init_vector.h"
 #include "kernels/distance/packed_triangle.h"
 
 namespace sdf {
@@ -14,7 +15,7 @@ class TriangleSoA {
 public:
     static constexpr int kFields = int(sizeof(PackedTriangle<T>) / sizeof(T));
 
-    explicit TriangleSoA(const std::vector<PackedTriangle<T>>& packed) : size_(int(packed.size())) {
+    explicit TriangleSoA(const DefaultInitVector<PackedTriangle<T>>& packed) : size_(int(packed.size())) {
         for (int f = 0; f < kFields; ++f) fields_[f].resize(packed.size());
         for (size_t i = 0; i < packed.size(); ++i) {
             const T* src = reinterpret_cast<const T*>(&packed[i]);

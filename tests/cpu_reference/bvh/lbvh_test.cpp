@@ -76,7 +76,7 @@ void check_tree(const PreparedMesh& mesh, const TriangleBvh& bvh, int max_leaf, 
 
 /// The double loop over all triangles with the one tie rule (wins_tie): the truth.
 std::pair<int32_t, double> loop_winner(const PreparedMesh& mesh, const Vec3d& p) {
-    const std::vector<PackedTriangle<double>>& packed = mesh.buffers<double>().packed;
+    const auto& packed = mesh.buffers<double>().packed;
     double best = std::numeric_limits<double>::infinity();
     int32_t winner = -1;
     for (size_t t = 0; t < packed.size(); ++t) {

@@ -71,7 +71,7 @@ const PreparedMesh& test_mesh() {
 template <typename T>
 void check_brute_force_at_every_level() {
     const PreparedMesh& mesh = test_mesh();
-    const std::vector<PackedTriangle<T>>& packed = mesh.buffers<T>().packed;
+    const auto& packed = mesh.buffers<T>().packed;
     const TriangleSoA<T> soa(packed);
     const MeshView<T> view = mesh.buffers<T>().view();
     const std::vector<Vec3d> pts = query_points(mesh, 512);
