@@ -11,22 +11,29 @@ std::string auto_sign_text(const PreparedMesh& mesh, const std::string& reason) 
     return "sign auto for mesh '" + mesh.name() + "' (" + mesh.source() + "): " + reason;
 }
 
+/// Whether the environment variable `name` is "1" (the measurement switches below).
+bool switched_on(const char* name) {
+    const char* v = std::getenv(name);
+    return v != nullptr && std::string(v) == "1";
+}
+
 /// The table of sides from the closest triangle (surface_sides.h), the certified sign's first
-/// stage, unless the environment asks for the ladder alone (SDF_WINDING_LADDER_ONLY=1: the
-/// baseline the stage is measured against; the sides are the same, only the cost differs).
+/// stage, where winding_options() asks for it.
 std::shared_ptr<const SurfaceSides> surface_sides_for(const PreparedMesh& mesh) {
     const WindingSignOptions o = SamplerSign::winding_options();
-    const char* ladder_only = std::getenv("SDF_WINDING_LADDER_ONLY");
-    if (!o.certify || !o.surface_sides || (ladder_only != nullptr && std::string(ladder_only) == "1")) return nullptr;
+    if (!o.certify || !o.surface_sides) return nullptr;
     return std::make_shared<const SurfaceSides>(build_surface_sides(mesh));
 }
 
 }  // namespace
 
+/// Two measurement switches, read at binding (not per point): SDF_WINDING_LADDER_ONLY=1 leaves
+/// the table out (the ladder alone: the baseline the table is measured against; the same
+/// sides, only the cost differs), SDF_WINDING_UNCERTIFIED=1 the certification.
 WindingSignOptions SamplerSign::winding_options() {
-    const char* uncertified = std::getenv("SDF_WINDING_UNCERTIFIED");  // read at binding, not per point
     WindingSignOptions o;
-    o.certify = !(uncertified != nullptr && std::string(uncertified) == "1");
+    o.certify = !switched_on("SDF_WINDING_UNCERTIFIED");
+    o.surface_sides = !switched_on("SDF_WINDING_LADDER_ONLY");
     return o;
 }
 

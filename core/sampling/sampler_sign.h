@@ -70,9 +70,10 @@ public:
     /// The winding sign every backend uses (WindingSignOptions' default: certified, first
     /// evaluation beta 2, order 2, then certified_winding.h's ladder): every backend and tree
     /// gives the exact side of 1/2 of the winding number, ties outside. For measurement only,
-    /// SDF_WINDING_UNCERTIFIED=1 turns the certification off (the fast value's side: the
-    /// uncertified kernel the certified one is timed against); the provenance's
-    /// "certified": false and the field cache's key say so.
+    /// SDF_WINDING_LADDER_ONLY=1 leaves the first stage's table out (the same sides), and
+    /// SDF_WINDING_UNCERTIFIED=1 the certification (the fast value's side: the uncertified
+    /// kernel the certified one is timed against; the provenance's "certified": false and
+    /// the field cache's key say so).
     static WindingSignOptions winding_options();
 
     /// The prepared mesh's largest |coordinate| (WindingView::scale, for device views).
