@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "core/lattice/lattice_fitting.h"
@@ -154,6 +155,7 @@ int main(int argc, char** argv) {
     // The command line's values that CLI11 cannot check: exit 2 with what was expected.
     sdf::StreamOptions stream;
     sdf::LatticeSpec spec;
+    sdf::LatticeStorage storage = sdf::LatticeStorage::Dense;
     sdf::SamplerOptions options;
     double band = 0;
     try {
@@ -189,7 +191,10 @@ int main(int argc, char** argv) {
             lattice_json["resolution"] = resolution;
         }
         sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
-        spec = sdf::parse_lattice_spec(lattice_reader);
+        // Only a sparse band's own field file leaves the lattice unwritten: its lattice may be
+        // larger than a dense one (max_lattice_points).
+        storage = sparse && layout == "sparse" ? sdf::LatticeStorage::SparseBand : sdf::LatticeStorage::Dense;
+        spec = sdf::parse_lattice_spec(lattice_reader, storage);
         options = sampler.options({{"progress", false}});
         band = options.band_width;
         // Values the output cannot hold: a band whose +-W the stored type would round to 0 or inf.
@@ -227,17 +232,21 @@ int main(int argc, char** argv) {
             sdf::prepare_mesh(sdf::load_mesh(sdf::mesh_spec_from_argument(mesh_arg), sdf::data_search_path(), ".")));
         const sdf::PreparedMesh& mesh = *shared_mesh;
         for (const std::string& w : mesh.warnings()) std::cerr << "sdf-sample: warning: " << w << "\n";
-        const sdf::Lattice lattice = sdf::build_lattice(spec, mesh.bounds(), margin);
+        const sdf::Lattice lattice = sdf::build_lattice(spec, mesh.bounds(), margin, storage);
         stream.fixed_bytes = sdf::estimate_fixed_bytes(mesh);
         stream.vdb_path = sparse ? "" : vdb_path;  // --sparse: written from the band's blocks below
         stream.vdb_band = band > 0 ? band : 3.0 * lattice.spacing;  // the .vdb export's default band: 3 spacings
-        const sdf::StreamPlan plan = sdf::plan_streamed_sampling(lattice, stream);
-        doing = "sampling " + mesh_arg + " on " + sdf::lattice_notation(lattice) + ", " + std::to_string(plan.points) + " points";
-        planned_bytes = plan.peak_estimate;
+        // The dense field file's slabs; the sparse layout writes none (the band checks its own
+        // memory once its blocks are known: core/sampling/sparse_band_sampler.h).
+        const std::optional<sdf::StreamPlan> plan =
+            layout == "dense" ? std::optional<sdf::StreamPlan>(sdf::plan_streamed_sampling(lattice, stream)) : std::nullopt;
+        doing = "sampling " + mesh_arg + " on " + sdf::lattice_notation(lattice) +
+                (plan ? ", " + std::to_string(plan->points) + " points" : std::string());
+        planned_bytes = plan ? plan->peak_estimate : stream.fixed_bytes;
         // What the run checks before sampling; the dry run checks it too and says so.
         const auto require_runnable = [&] {
-            sdf::require_plan_fits_machine(plan.peak_estimate, stream.memory_budget, "--memory-budget");
-            if (layout == "dense") require_output_space(plan, out_path);  // sparse: known once sampled
+            sdf::require_plan_fits_machine(planned_bytes, stream.memory_budget, "--memory-budget");
+            if (plan) require_output_space(*plan, out_path);  // sparse: known once sampled
         };
         if (dry_run) {
             std::cout << "sampler: " << options.backend << " " << options.method << ", " << sdf::precision_name(options.precision);
@@ -245,7 +254,7 @@ int main(int argc, char** argv) {
             if (layout == "sparse")
                 std::cout << "\nout: " << out_path << ", the sparse band's field file (its size grows with the band)\n";
             else
-                std::cout << "\n" << plan.describe() << "out: " << out_path << "\n";
+                std::cout << "\n" << plan->describe() << "out: " << out_path << "\n";
             if (!vdb_path.empty() && sparse)
                 std::cout << "vdb: " << vdb_path << ", a level set from the sparse band's blocks, points with |d| <= "
                           << band << " active (outside the budget)\n";
@@ -270,7 +279,7 @@ int main(int argc, char** argv) {
         // Temporaries of an interrupted earlier run in the output folder (their process is gone).
         sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
-        if (!quiet) std::cerr << plan.describe();
+        if (!quiet && plan) std::cerr << plan->describe();
         // The front ends' one field source (harness/study/field_source.h), without a cache:
         // its sampler, bound to the mesh, samples the slabs this tool streams to disk.
         sdf::FieldSource source(nullptr, options, "the command line: sampler", sdf::SamplerReach::ThisProcess);

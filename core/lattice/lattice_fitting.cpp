@@ -9,12 +9,12 @@
 
 namespace sdf {
 
-Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin) {
+Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin, LatticeStorage storage) {
     for (int a = 0; a < 3; ++a)
         if (resolution[a] < 2)
             throw std::invalid_argument("lattice resolution must be at least 2 along every axis, got " +
                                         std::to_string(resolution[a]));
-    checked_lattice_points(type, resolution);
+    checked_lattice_points(type, resolution, storage);
     if (bounds.empty()) throw std::invalid_argument("cannot fit a lattice to an empty mesh");
     const Vec3d extent = bounds.extent();
     const double largest = std::max({extent.x, extent.y, extent.z});
@@ -31,7 +31,7 @@ Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, do
     return lattice;
 }
 
-int64_t checked_lattice_points(LatticeType type, Int3 r) {
+int64_t checked_lattice_points(LatticeType type, Int3 r, LatticeStorage storage) {
     const bool bcc = type == LatticeType::BCC;
     const std::string notation = std::to_string(r.x) + "x" + std::to_string(r.y) + "x" +
                                  std::to_string(bcc ? 2 * int64_t(r.z) : int64_t(r.z));
@@ -41,11 +41,15 @@ int64_t checked_lattice_points(LatticeType type, Int3 r) {
     const std::optional<int64_t> primary = checked_mul(r.x, r.y, r.z);
     const std::optional<int64_t> secondary = bcc ? checked_mul(r.x - 1, r.y - 1, r.z - 1) : int64_t(0);
     const std::optional<int64_t> total = primary && secondary ? checked_add(*primary, *secondary) : std::nullopt;
-    if (!total || *total > kMaxLatticePoints)
+    const int64_t most = max_lattice_points(storage);
+    if (!total || *total > most) {
+        const bool dense = storage == LatticeStorage::Dense;
         throw std::invalid_argument("lattice resolution " + notation + " has " +
                                     (total ? std::to_string(*total) : std::string("more than 2^63")) +
-                                    " points, more than the largest lattice sampled (2^36 = " +
-                                    std::to_string(kMaxLatticePoints) + ")");
+                                    " points, more than the largest lattice sampled " +
+                                    (dense ? "densely (2^36 = " : "as a sparse band (2^42 = ") + std::to_string(most) +
+                                    (dense ? "; a sparse narrow band may have up to 2^42)" : ")"));
+    }
     return *total;
 }
 
@@ -69,7 +73,7 @@ int64_t cubic_lattice_points(LatticeType type, int r) {
 
 int cubic_resolution_for_samples(LatticeType type, int64_t samples) {
     int best = 2;
-    for (int r = 2; r < 4096; ++r) {
+    for (int r = 2; r <= 16384; ++r) {  // 16384^3: the largest sparse band's lattice
         if (std::llabs(cubic_lattice_points(type, r) - samples) < std::llabs(cubic_lattice_points(type, best) - samples))
             best = r;
         if (cubic_lattice_points(type, r) > samples) break;

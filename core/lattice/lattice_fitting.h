@@ -14,17 +14,34 @@
 
 namespace sdf {
 
-/// `resolution` is the CC resolution, or for BCC the primary grid (Rx, Ry, Rz).
-Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin);
+/// How a lattice's values are held, which bounds how large it may be.
+enum class LatticeStorage {
+    Dense,       ///< every point (a field, its files, a reconstruction): memory grows with the lattice
+    SparseBand,  ///< only the blocks of a sparse narrow band (core/sampling/sparse_band.h): memory grows with the band
+};
 
-/// The largest lattice any tool samples or reads: 2^36 points (16 bytes each with a gradient
-/// channel: 1 TiB), far beyond any machine's memory but far from int64 overflow.
-constexpr int64_t kMaxLatticePoints = int64_t(1) << 36;
+/// The largest lattice any tool samples or reads as `storage`: dense 2^36 points (16 bytes
+/// each with a gradient channel: 1 TiB, beyond any machine's memory); a sparse band 2^42
+/// (16384^3), whose cost is its band's but whose per-block bitsets (one bit per 8^3 block)
+/// take 1 GiB each there. Both far from int64 overflow.
+constexpr int64_t max_lattice_points(LatticeStorage storage) {
+    switch (storage) {
+    case LatticeStorage::Dense: return int64_t(1) << 36;
+    case LatticeStorage::SparseBand: return int64_t(1) << 42;
+    }
+    return 0;
+}
+constexpr int64_t kMaxLatticePoints = max_lattice_points(LatticeStorage::Dense);
+
+/// `resolution` is the CC resolution, or for BCC the primary grid (Rx, Ry, Rz); its point
+/// count is checked against `storage`'s largest lattice.
+Lattice fit_lattice(LatticeType type, Int3 resolution, const Bounds3& bounds, double margin,
+                    LatticeStorage storage = LatticeStorage::Dense);
 
 /// The number of points of a lattice of `type` with primary resolution `resolution`, in
 /// checked arithmetic; throws std::invalid_argument when a resolution entry is below 1 or the
-/// count exceeds kMaxLatticePoints (an overflowing count included).
-int64_t checked_lattice_points(LatticeType type, Int3 resolution);
+/// count exceeds max_lattice_points(storage) (an overflowing count included).
+int64_t checked_lattice_points(LatticeType type, Int3 resolution, LatticeStorage storage = LatticeStorage::Dense);
 
 /// Thesis notation: "80x80x80" for CC, "Rx x Ry x 2Rz" = "64x64x128" for BCC.
 std::string lattice_notation(const Lattice& lattice);

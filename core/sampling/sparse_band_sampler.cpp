@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/host_memory.h"
+#include "core/lattice/lattice_fitting.h"
 #include "core/parallel/parallel_for.h"
 #include "core/sampling/sampler.h"
 #include "core/sampling/sampler_sign.h"
@@ -32,9 +34,15 @@ public:
     /// time took 0.13-0.16 s of CPU on the dragon, this 0.045 s.
     std::vector<int64_t> set_bits() const {
         std::vector<int64_t> out;
+        out.reserve(size_t(count()));
         for (size_t w = 0; w < bits_.size(); ++w)
             for (uint64_t b = bits_[w]; b != 0; b &= b - 1) out.push_back(int64_t(w) * 64 + __builtin_ctzll(b));
         return out;
+    }
+    int64_t count() const {
+        int64_t n = 0;
+        for (const uint64_t w : bits_) n += __builtin_popcountll(w);
+        return n;
     }
 
 private:
@@ -252,6 +260,12 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     require_search_range(mesh, lattice, plan.precision);
     if (plan.batch_points < kBandBlockPoints)
         throw std::invalid_argument("sparse band: batch_points must be at least " + std::to_string(kBandBlockPoints));
+    // Every size is checked before it is allocated: first the two bitsets of one bit per
+    // block (the active blocks, the inside tiles: 2 x 128 MiB at 8192^3), then, once the
+    // active blocks are known, their channels.
+    const std::string what = "the sparse band of " + lattice_notation(lattice);
+    require_host_bytes(2 * uint64_t((BandLayout(lattice).block_count() + 63) / 64) * sizeof(uint64_t),
+                       what + " (its per-block bitsets)");
     SparseBandField out(lattice, width, plan.precision, plan.channels);
     const BandLayout& layout = out.layout();
     nlohmann::json steps = nlohmann::json::object();
@@ -259,6 +273,13 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     // 1. Active blocks.
     Clock::time_point t = Clock::now();
     const BlockBits active = active_blocks(mesh, layout, width);
+    const int64_t active_count = active.count();
+    const uint64_t point_bytes = sizeof(double) + (plan.channels.gradient ? sizeof(Vec3d) : 0) +
+                                 (plan.channels.closest_triangle ? sizeof(int32_t) : 0);
+    require_host_bytes(uint64_t(active_count) * (kBandBlockPoints * point_bytes + sizeof(BandPointMask) + sizeof(int64_t)),
+                       what + ": " + std::to_string(active_count) + " active blocks of " +
+                           std::to_string(kBandBlockPoints) + " points, " + std::to_string(point_bytes) +
+                           " bytes a point (" + channel_names(plan.channels).dump() + ")");
     out.active = active.set_bits();
     steps["find_blocks_seconds"] = seconds_since(t);
 

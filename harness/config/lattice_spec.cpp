@@ -7,7 +7,7 @@
 
 namespace sdf {
 
-LatticeSpec parse_lattice_spec(JsonReader& r) {
+LatticeSpec parse_lattice_spec(JsonReader& r, LatticeStorage storage) {
     LatticeSpec spec;
     spec.type = lattice_type_named(r.choice("type", lattice_type_names(), lattice_type_name(LatticeType::CC)));
     const bool has_res = r.has("resolution"), has_samples = r.has("samples");
@@ -24,15 +24,16 @@ LatticeSpec parse_lattice_spec(JsonReader& r) {
             spec.resolution = bcc_primary_from_notation(spec.resolution);
         }
         try {
-            checked_lattice_points(spec.type, spec.resolution);
+            checked_lattice_points(spec.type, spec.resolution, storage);
         } catch (const std::invalid_argument& e) {
             r.fail("resolution", e.what());
         }
     } else {
         spec.samples = r.required<int64_t>("samples", "a target number of lattice points");
         if (spec.samples < 8) r.fail("samples", "expected at least 8 points, got " + std::to_string(spec.samples));
-        if (spec.samples > int64_t(1) << 36)
-            r.fail("samples", "expected at most 2^36 points, got " + std::to_string(spec.samples));
+        if (spec.samples > max_lattice_points(storage))
+            r.fail("samples", std::string("expected at most ") + (storage == LatticeStorage::Dense ? "2^36" : "2^42") +
+                                  " points, got " + std::to_string(spec.samples));
     }
     if (r.has("margin")) {
         spec.margin = r.required<double>("margin", "a margin as a fraction of the mesh's largest extent");
@@ -61,8 +62,9 @@ std::string lattice_spec_notation(const LatticeSpec& spec) {
     return std::string(lattice_type_name(spec.type)) + " " + lattice_notation(l);
 }
 
-Lattice build_lattice(const LatticeSpec& spec, const Bounds3& bounds, double default_margin) {
-    return fit_lattice(spec.type, lattice_spec_resolution(spec), bounds, spec.margin >= 0 ? spec.margin : default_margin);
+Lattice build_lattice(const LatticeSpec& spec, const Bounds3& bounds, double default_margin, LatticeStorage storage) {
+    return fit_lattice(spec.type, lattice_spec_resolution(spec), bounds, spec.margin >= 0 ? spec.margin : default_margin,
+                       storage);
 }
 
 std::vector<std::string> lattice_spec_labels(const std::vector<LatticeSpec>& specs, const JsonReader& r,

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/lattice/lattice_fitting.h"
 #include "core/mesh/triangle_mesh.h"
 #include "harness/config/json_reader.h"
 #include "kernels/lattice/lattice.h"
@@ -25,9 +26,11 @@ struct LatticeSpec {
     std::string name;      ///< as written; "" = derived (lattice_spec_labels)
 };
 
-LatticeSpec parse_lattice_spec(JsonReader& r);
-/// The lattice of `spec` around `bounds` (margin as in fit_lattice).
-Lattice build_lattice(const LatticeSpec& spec, const Bounds3& bounds, double default_margin);
+/// Reads a lattice, its size checked against `storage`'s largest lattice (max_lattice_points).
+LatticeSpec parse_lattice_spec(JsonReader& r, LatticeStorage storage = LatticeStorage::Dense);
+/// The lattice of `spec` around `bounds` (margin as in fit_lattice), held as `storage`.
+Lattice build_lattice(const LatticeSpec& spec, const Bounds3& bounds, double default_margin,
+                      LatticeStorage storage = LatticeStorage::Dense);
 // Lattice types by name: lattice_type_name(), lattice_type_named() (kernels/lattice/lattice_kinds.h).
 
 /// The resolution `spec` will have (CC resolution or BCC primary), known without a mesh.

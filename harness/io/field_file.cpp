@@ -85,7 +85,7 @@ nlohmann::json lattice_to_json(const Lattice& l) {
             {"points", l.num_points()}};
 }
 
-Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
+Lattice lattice_from_json(const nlohmann::json& j, const std::string& file, LatticeStorage storage) {
     JsonReader r(j, file, "lattice");
     Lattice l;
     l.type = lattice_type_named(r.choice("type", lattice_type_names(), lattice_type_name(LatticeType::CC)));
@@ -108,7 +108,7 @@ Lattice lattice_from_json(const nlohmann::json& j, const std::string& file) {
     }
     // Checked before any channel size is computed from it (points x components x bytes).
     try {
-        checked_lattice_points(l.type, l.resolution);
+        checked_lattice_points(l.type, l.resolution, storage);
     } catch (const std::invalid_argument& e) {
         r.fail("resolution", e.what());
     }

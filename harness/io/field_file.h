@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/lattice/lattice_fitting.h"
 #include "core/sampling/sampled_field.h"
 #include "harness/io/atomic_file.h"
 
@@ -85,6 +86,7 @@ double export_uint8(const std::string& path, const SampledField& field, Overwrit
 
 /// JSON description of a lattice as stored in headers and manifests.
 nlohmann::json lattice_to_json(const Lattice& lattice);
-Lattice lattice_from_json(const nlohmann::json& j, const std::string& file);
+/// Reads a lattice, its size checked against `storage`'s largest (a sparse band's file may be larger).
+Lattice lattice_from_json(const nlohmann::json& j, const std::string& file, LatticeStorage storage = LatticeStorage::Dense);
 
 }  // namespace sdf

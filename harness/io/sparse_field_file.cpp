@@ -292,7 +292,7 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
     const std::string layout = r.required<std::string>("layout", "\"" + std::string(kSparseBandLayout) + "\"");
     if (layout != kSparseBandLayout)
         r.fail("layout", "expected \"" + std::string(kSparseBandLayout) + "\" (a sparse band's file), got \"" + layout + "\"");
-    const Lattice lattice = lattice_from_json(r.raw("lattice"), header);
+    const Lattice lattice = lattice_from_json(r.raw("lattice"), header, LatticeStorage::SparseBand);
     JsonReader b = r.object("band");
     const double width = b.required<double>("width", "the band's width W > 0, mesh units");
     if (!(width > 0) || !std::isfinite(width)) b.fail("width", "expected a finite band width > 0, got " + b.raw("width").dump());

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/host_memory.h"  // format_bytes, host_memory_available, ...
 #include "kernels/lattice/lattice.h"
 
 namespace sdf {
@@ -32,8 +33,6 @@ constexpr uint64_t kReconstructionBytesPerPoint = 256;
 /// The fixed part: libraries, thread stacks, a mesh of up to a few 100k triangles and its BVH.
 constexpr uint64_t kBaseBytes = 512ull << 20;
 
-/// "1.5 GiB", "512 MiB", "12 KiB", "300 B".
-std::string format_bytes(uint64_t bytes);
 
 /// A size as users write it: a positive number with an optional unit, B, KiB, MiB, GiB, TiB
 /// (powers of 1024; K, M, G, T mean the same) or KB, MB, GB, TB (powers of 1000), any case,
@@ -42,17 +41,6 @@ std::string format_bytes(uint64_t bytes);
 /// no number, a negative, zero or non-finite one, an unknown unit, or a size beyond 2^62 bytes.
 uint64_t parse_byte_size(const std::string& text, const std::string& what);
 
-/// The peak resident memory of this process so far (getrusage), in bytes.
-uint64_t peak_resident_bytes();
-/// The resident memory of this process now (/proc/self/statm), in bytes; 0 when unknown.
-uint64_t current_resident_bytes();
-
-/// Host memory a new allocation can get: $SDF_MEMORY_AVAILABLE (bytes; for tests and to
-/// leave room for other work), else MemAvailable of /proc/meminfo, lowered to what this
-/// process's limits leave (a cgroup's memory limit, `ulimit -v`); 0 when unknown.
-uint64_t host_memory_available();
-/// The machine's physical memory (sysconf); 0 when unknown.
-uint64_t host_memory_physical();
 
 /// Refuses (std::runtime_error naming `what`, the peak, the budget, the memory available and
 /// the machine's) a memory plan whose estimated peak exceeds host_memory_available(): a

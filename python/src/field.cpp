@@ -52,7 +52,7 @@ double number_argument(const py::object& value, const std::string& what) {
 /// The "lattice" object of a config, from sample()'s arguments, parsed by the config's own
 /// parser: the same checks and messages as run-experiment's, key path "sample(): lattice".
 LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::object& resolution, const py::object& samples,
-                                        const py::object& margin) {
+                                        const py::object& margin, LatticeStorage storage = LatticeStorage::Dense) {
     nlohmann::json j = {{"type", type}};
     if (!resolution.is_none()) {
         std::vector<int64_t> r;
@@ -68,7 +68,7 @@ LatticeSpec lattice_spec_from_arguments(const std::string& type, const py::objec
     if (!samples.is_none()) j["samples"] = integer_argument(samples, "samples");
     if (!margin.is_none()) j["margin"] = number_argument(margin, "margin");
     JsonReader reader(j, "sample()", "lattice");
-    LatticeSpec spec = parse_lattice_spec(reader);
+    LatticeSpec spec = parse_lattice_spec(reader, storage);
     reader.finish();
     return spec;
 }
@@ -105,7 +105,7 @@ Bounds3 bounds_argument(const py::object& value) {
 
 /// The lattice of `type` with origin bounds.min and `spacing` whose points cover `bounds`:
 /// ceil(extent / h) + 1 points per axis (the primary grid for BCC).
-Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing) {
+Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing, LatticeStorage storage) {
     Lattice l;
     l.type = type;
     l.origin = bounds.min;
@@ -121,7 +121,7 @@ Lattice lattice_covering(LatticeType type, const Bounds3& bounds, double spacing
         n[k] = std::max(2, int(points));
     }
     l.resolution = {n[0], n[1], n[2]};
-    checked_lattice_points(type, l.resolution);
+    checked_lattice_points(type, l.resolution, storage);
     return l;
 }
 
@@ -135,7 +135,9 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
         throw std::invalid_argument("margin: expected a finite, non-negative fraction of the mesh's largest extent, got " +
                                     number_text(margin));
     const double spacing = a.spacing.is_none() ? 0.0 : number_argument(a.spacing, "spacing");
-    if (!framed) return build_lattice(lattice_spec_from_arguments(a.type, a.resolution, a.samples, py::none()), mesh_bounds, margin);
+    if (!framed)
+        return build_lattice(lattice_spec_from_arguments(a.type, a.resolution, a.samples, py::none(), a.storage), mesh_bounds,
+                             margin, a.storage);
     // A lattice framed by the caller: bounds and spacing or resolution, or origin, spacing
     // and resolution; spacing alone covers the mesh's box grown by the margin.
     if (!a.samples.is_none()) throw std::invalid_argument("samples: not with bounds, spacing or origin (give resolution or spacing)");
@@ -144,7 +146,8 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
     if (!a.spacing.is_none() && !(spacing >= std::numeric_limits<double>::min() && std::isfinite(spacing)))
         throw std::invalid_argument("spacing: expected a finite distance > 0 (and not subnormal), got " + number_text(spacing));
     Int3 resolution{};
-    if (!a.resolution.is_none()) resolution = lattice_spec_from_arguments(a.type, a.resolution, py::none(), py::none()).resolution;
+    if (!a.resolution.is_none())
+        resolution = lattice_spec_from_arguments(a.type, a.resolution, py::none(), py::none(), a.storage).resolution;
     if (!a.origin.is_none()) {
         if (!a.bounds.is_none()) throw std::invalid_argument("origin: not with bounds (the origin is bounds[0])");
         if (a.spacing.is_none() || a.resolution.is_none())
@@ -154,7 +157,7 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
         l.origin = vec3_argument(a.origin, "origin");
         l.spacing = spacing;
         l.resolution = resolution;
-        checked_lattice_points(type, resolution);
+        checked_lattice_points(type, resolution, a.storage);
         return l;
     }
     Bounds3 box;
@@ -168,7 +171,7 @@ Lattice frame_lattice(const LatticeArguments& a, const Bounds3& mesh_bounds) {
     }
     if (a.spacing.is_none() == a.resolution.is_none())
         throw std::invalid_argument("bounds: give exactly one of spacing and resolution");
-    if (!a.spacing.is_none()) return lattice_covering(type, box, spacing);
+    if (!a.spacing.is_none()) return lattice_covering(type, box, spacing, a.storage);
     if (resolution.x < 2 || resolution.y < 2 || resolution.z < 2)
         throw std::invalid_argument("resolution: expected at least 2 points per axis with bounds");
     // The widest axis decides the (isotropic) spacing; the lattice starts at bounds[0].

@@ -137,6 +137,7 @@ private:
 struct LatticeArguments {
     std::string type;  ///< a lattice type's name (kernels/lattice/lattice_kinds.h)
     py::object resolution, samples, margin, bounds, spacing, origin;
+    LatticeStorage storage = LatticeStorage::Dense;  ///< bounds its size: a sparse band's may be larger
 };
 
 /// The lattice of `arguments`: fitted around `mesh_bounds` (resolution or samples, and

@@ -268,7 +268,8 @@ SparseField sample_band(const MeshSdf& sdf, double band, const std::string& latt
         throw std::invalid_argument("band: expected a positive width in mesh units, got " + std::to_string(band));
     if (!(float(band) > 0) || !std::isfinite(float(band)))
         throw std::invalid_argument("band: " + std::to_string(band) + " is not representable in float32 (a .vdb's values)");
-    const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin}, sdf.mesh().bounds());
+    const Lattice l = frame_lattice({lattice, resolution, samples, margin, bounds, spacing, origin, LatticeStorage::SparseBand},
+                                    sdf.mesh().bounds());
     TaskOptions task;
     task.total = kBackgroundItems;
     task.label = "sampling the band of '" + sdf.mesh().name() + "'";

@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
     auto t_prepare = std::chrono::steady_clock::now();
     const auto mesh = std::make_shared<const PreparedMesh>(prepare_mesh(std::move(loaded)));
     const double prepare_s = since(t_prepare);
-    const Lattice lattice = fit_lattice(type, {res, res, res}, mesh->bounds(), 0.1);
+    const bool dense_mode = mode == "dense" || mode == "check";
+    const Lattice lattice = fit_lattice(type, {res, res, res}, mesh->bounds(), 0.1,
+                                        dense_mode ? LatticeStorage::Dense : LatticeStorage::SparseBand);
     const double w = band * lattice.spacing;
     SamplerOptions o;
     o.backend = argc > 6 ? argv[6] : "cpu";

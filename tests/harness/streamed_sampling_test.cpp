@@ -405,6 +405,26 @@ TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
     EXPECT_TRUE(test::Contains(refused.err, "--layout sparse")) << refused.err;
 }
 
+// A sparse band's own field file may have a lattice no dense field may (max_lattice_points):
+// 8192^3 around a sphere that spans a hundred of its spacings runs, and reads back with its
+// lattice; the dense layout of the same lattice is refused before the mesh is loaded.
+TEST(StreamedSampling, SparseLayoutTakesLatticesBeyondTheDenseLimit) {
+    test::ScratchDir dir("sdf_sample_sparse_8192");
+    const std::string exe = test::quote(SDF_SAMPLE_EXE) +
+                            " --backend cpu --quiet shape:sphere --resolution 8192 --margin 50 --band 0.074 --sparse";
+    const test::ShellResult dense = test::run_in(dir.path(), exe + " --out d.json");
+    EXPECT_EQ(dense.code, 2) << dense.err;
+    EXPECT_TRUE(test::Contains(dense.err, "more than the largest lattice sampled densely")) << dense.err;
+    EXPECT_TRUE(test::Contains(dense.err, "a sparse narrow band may have up to 2^42")) << dense.err;
+    const test::ShellResult sparse = test::run_in(dir.path(), exe + " --layout sparse --channels distance --out s.json");
+    ASSERT_EQ(sparse.code, 0) << sparse.err;
+    EXPECT_TRUE(test::Contains(sparse.out, "of 1073741824 blocks of 8^3 active")) << sparse.out;
+    const SparseBandField back = read_sparse_field(dir.at("s.json"));
+    EXPECT_EQ(back.lattice.resolution.x, 8192);
+    EXPECT_EQ(back.lattice.num_points(), int64_t(1) << 39);
+    EXPECT_GT(back.counts().band_points, 10000);
+}
+
 #if SDF_TEST_HAVE_NANOVDB
 // --nvdb beside either field file: the streamed dense file and the sparse layout write the
 // same NanoVDB level set, byte for byte (the sparse layout once returned before writing it).

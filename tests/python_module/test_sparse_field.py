@@ -388,3 +388,18 @@ def test_level_sets_refuse_float64(pair, tmp_path):
         with pytest.raises(ValueError, match=r"stores float32"):
             sparse.write(str(tmp_path / name), dtype="float64")
         assert not (tmp_path / name).exists()
+
+
+def test_a_band_may_have_a_lattice_no_dense_field_may():
+    """8192^3 (2^39 points) is beyond a dense field's limit (2^36) but within a sparse band's
+    (2^42): the band of a box spanning a hundred of its spacings, its points holding the point
+    query's values at their positions, bit for bit."""
+    mesh = sl.Mesh(*box_arrays(), name="box")
+    with pytest.raises(ValueError, match=r"densely.*a sparse narrow band may have up to 2\^42"):
+        sl.sample(mesh, resolution=8192, margin=40.0, backend="cpu")
+    sparse = sl.sample(mesh, resolution=8192, margin=40.0, band=0.02, backend="cpu", threads=2, precision="float")
+    assert sparse.resolution == (8192, 8192, 8192) and sparse.num_points == 8192 ** 3
+    assert sparse.counts["blocks"] == 1024 ** 3 and len(sparse) > 10000
+    exact = sl.query(mesh, sparse.points, backend="cpu", threads=2, precision="float")
+    assert same_bits(sparse.distance, exact.distance)
+    assert same_bits(sparse.triangle, exact.triangle)

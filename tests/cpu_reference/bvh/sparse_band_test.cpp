@@ -11,6 +11,7 @@
 // SDF_DATA_PATH has it), at widths from one spacing up, and switched off below one.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <set>
 #include <stdexcept>
@@ -20,6 +21,8 @@
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/sampling/sparse_band.h"
+#include "core/sampling/narrow_band.h"
+#include "core/sampling/sparse_band_window.h"
 #include "core/winding/winding_sign.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
@@ -473,6 +476,85 @@ TEST(SparseBand, RefusesToDensifyPastTheLimitAndBadWidths) {
     EXPECT_THROW(sparse.densify(1000), std::length_error);
     EXPECT_THROW(bound->sample_band_sparse(lattice, 0.0), std::invalid_argument);
     EXPECT_THROW(bound->sample_band_sparse(lattice, -1.0), std::invalid_argument);
+}
+
+// A sparse band's lattice may be larger than any dense one (max_lattice_points): 8192^3
+// (2^39 points, 2^30 blocks) around a torus that spans about a hundred of its spacings. Its
+// windows densified equal the dense banded sampler's field of the same points byte for byte,
+// near the surface and at the lattice's corner; the band's memory is checked before it is
+// allocated (its bitsets, then its active blocks' channels).
+TEST(SparseBand, LatticesBeyondTheDenseLimitAreSampledWithTheirMemoryChecked) {
+    const PreparedMesh torus = prepare_mesh(make_torus(1.0, 0.35, 32, 16));
+    const Int3 r{8192, 8192, 8192};
+    try {
+        fit_lattice(LatticeType::CC, r, torus.bounds(), 40.0);
+        ADD_FAILURE() << "a dense 8192^3 lattice was not refused";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("a sparse narrow band may have up to 2^42"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(fit_lattice(LatticeType::CC, {16385, 16384, 16384}, torus.bounds(), 40.0, LatticeStorage::SparseBand),
+                 std::invalid_argument);
+    const Lattice lattice = fit_lattice(LatticeType::CC, r, torus.bounds(), 40.0, LatticeStorage::SparseBand);
+    const double w = 2 * lattice.spacing;
+    const auto sparse_sampler = make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(torus));
+    const SparseBandField band = sparse_sampler->sample_band_sparse(lattice, w);
+    const SparseBandCounts c = band.counts();
+    EXPECT_EQ(c.blocks, int64_t(1) << 30);
+    EXPECT_GT(c.band_points, 10000);
+    EXPECT_EQ(c.tiles + c.active_blocks + c.mixed_blocks, c.blocks);
+    // The torus spans the centre's 100 x 100 x 26 points; a window around it, and the corner.
+    // Each point against the point query at its position in the lattice (a window's own
+    // lattice rounds its positions differently): a band point holds the query's bits, any
+    // other point +-W on the query's side, beyond W.
+    int64_t compared = 0, in_band = 0, wrong = 0;
+    for (const LatticeWindow& window : {LatticeWindow{{4096 - 60, 4096 - 60, 4096 - 18}, {120, 120, 36}},
+                                        LatticeWindow{{0, 0, 0}, {9, 9, 9}}}) {
+        ASSERT_TRUE(window.fits(lattice));
+        const SampledField f = densify_window(band, window, true);
+        std::vector<Vec3d> points;
+        for (int k = 0; k < window.resolution.z; ++k)
+            for (int j = 0; j < window.resolution.y; ++j)
+                for (int i = 0; i < window.resolution.x; ++i)
+                    points.push_back(lattice.position_of_coords(  // units of h/2
+                        Int3{2 * (window.first.x + i), 2 * (window.first.y + j), 2 * (window.first.z + k)}));
+        ASSERT_EQ(int64_t(points.size()), f.size());
+        const std::vector<PointSample> q = sparse_sampler->query(points);
+        for (size_t p = 0; p < q.size(); ++p, ++compared) {
+            const bool band_point = f.closest_triangle[p] != kOutsideBandTriangle;
+            in_band += band_point;
+            const bool same = band_point ? f.distance[p] == q[p].distance && f.closest_triangle[p] == q[p].triangle &&
+                                               std::memcmp(&f.gradient[p], &q[p].gradient, sizeof(Vec3d)) == 0
+                                         : outside_band(q[p].distance, w) &&
+                                               f.distance[p] == (std::signbit(q[p].distance) ? -w : w);
+            if (!same && wrong++ < 5)
+                ADD_FAILURE() << "point " << p << " of the window at " << window.first.x << ": " << f.distance[p]
+                              << " against the query's " << q[p].distance;
+        }
+    }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_GT(in_band, 10000);
+    EXPECT_EQ(compared, 120 * 120 * 36 + 9 * 9 * 9);
+    // Memory checked before it is allocated: the two bitsets (2 x 128 MiB), then the channels
+    // of the active blocks of a lattice the torus fills.
+    setenv("SDF_MEMORY_AVAILABLE", "100000000", 1);
+    try {
+        sparse_sampler->sample_band_sparse(lattice, w);
+        ADD_FAILURE() << "100 MB held 256 MiB of bitsets";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("the sparse band of 8192x8192x8192 (its per-block bitsets) needs 256 MiB"),
+                  std::string::npos)
+            << e.what();
+    }
+    setenv("SDF_MEMORY_AVAILABLE", "1000000000", 1);
+    const Lattice filled = fit_lattice(LatticeType::CC, r, torus.bounds(), 0.05, LatticeStorage::SparseBand);
+    try {
+        sparse_sampler->sample_band_sparse(filled, 2 * filled.spacing);
+        ADD_FAILURE() << "1 GB held the active blocks of a torus filling 8192^3";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("active blocks of 512 points, 36 bytes a point"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("available to this process"), std::string::npos) << e.what();
+    }
+    unsetenv("SDF_MEMORY_AVAILABLE");
 }
 
 }  // namespace
