@@ -16,7 +16,9 @@
 // level set from the same blocks (harness/io/sparse_nvdb_file.h; builds with NanoVDB only), and
 // --layout sparse the field file's sparse variant instead of the dense one
 // (harness/io/sparse_field_file.h: the band's blocks, never densified; sdf-eval, sdf-render and
-// Python's read_field read it). A sparse band holds the gradient and the closest triangle only
+// Python's read_field read it); with --vdb or --nvdb, --out may be left out to write the level
+// sets alone (the band's lattice may then be as large as a sparse field file's: up to 2^42
+// points). A sparse band holds the gradient and the closest triangle only
 // when --channels names them: without them, they are neither kept nor downloaded from a GPU
 // (--channels distance: 8.125 bytes a point, not 36.125; the band's points are a bit mask).
 #include <CLI/CLI.hpp>
@@ -25,6 +27,7 @@
 #include "apps/cli_validators.h"
 #include "apps/sampler_cli.h"
 
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -133,7 +136,9 @@ int main(int argc, char** argv) {
     app.add_option("--dtype", dtype, "float32 or float64 for distance and gradient")
         ->check(CLI::IsMember({"float32", "float64"}))
         ->capture_default_str();
-    app.add_option("--out", out_path, "the field file's header, NAME.json (channels NAME.<channel>.raw beside it)")->required();
+    app.add_option("--out", out_path,
+                   "the field file's header, NAME.json (channels NAME.<channel>.raw beside it); required unless --sparse "
+                   "writes only level sets (--vdb, --nvdb)");
     std::string vdb_path;
     app.add_option("--vdb", vdb_path,
                    "also write a narrow-band OpenVDB level set here (FILE.vdb): points with |d| < the band active (--band W, "
@@ -156,13 +161,19 @@ int main(int argc, char** argv) {
     sdf::StreamOptions stream;
     sdf::LatticeSpec spec;
     sdf::LatticeStorage storage = sdf::LatticeStorage::Dense;
+    bool dense_file = true;  // a dense field file at --out
     sdf::SamplerOptions options;
     double band = 0;
     try {
         if (resolution.size() == 2) throw std::invalid_argument("--resolution: expected N or NX NY NZ, got 2 numbers");
         stream.memory_budget = budget_text.empty() ? default_memory_budget() : sdf::parse_byte_size(budget_text, "--memory-budget");
-        if (out_path.size() < 6 || out_path.compare(out_path.size() - 5, 5, ".json") != 0)
+        if (out_path.empty() && !(sparse && (!vdb_path.empty() || !nvdb_path.empty())))
+            throw std::invalid_argument("--out: expected a field file header NAME.json (only --sparse with --vdb or --nvdb "
+                                        "may leave it out, writing the level sets alone)");
+        if (!out_path.empty() && (out_path.size() < 6 || out_path.compare(out_path.size() - 5, 5, ".json") != 0))
             throw std::invalid_argument("--out " + out_path + ": expected a field file header NAME.json");
+        if (out_path.empty() && layout == "sparse")
+            throw std::invalid_argument("--layout sparse: the layout of the field file at --out; give --out NAME.json");
         std::stringstream names(channels_text);
         bool has_distance = false;
         stream.gradient = false;
@@ -191,9 +202,10 @@ int main(int argc, char** argv) {
             lattice_json["resolution"] = resolution;
         }
         sdf::JsonReader lattice_reader(lattice_json, "command line", "--lattice/--resolution");
-        // Only a sparse band's own field file leaves the lattice unwritten: its lattice may be
-        // larger than a dense one (max_lattice_points).
-        storage = sparse && layout == "sparse" ? sdf::LatticeStorage::SparseBand : sdf::LatticeStorage::Dense;
+        // Only a sparse band without a dense field file (its own file, or level sets alone)
+        // leaves the lattice unwritten: its lattice may be larger than a dense one.
+        dense_file = !out_path.empty() && layout == "dense";
+        storage = sparse && !dense_file ? sdf::LatticeStorage::SparseBand : sdf::LatticeStorage::Dense;
         spec = sdf::parse_lattice_spec(lattice_reader, storage);
         options = sampler.options({{"progress", false}});
         band = options.band_width;
@@ -224,7 +236,7 @@ int main(int argc, char** argv) {
 
         // Every target is checked before the mesh is even loaded (and again before sampling).
         if (!dry_run) {
-            sdf::require_writable_target(out_path, stream.write.overwrite);
+            if (!out_path.empty()) sdf::require_writable_target(out_path, stream.write.overwrite);
             if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
             if (!nvdb_path.empty()) sdf::require_writable_target(nvdb_path, stream.write.overwrite);
         }
@@ -239,7 +251,7 @@ int main(int argc, char** argv) {
         // The dense field file's slabs; the sparse layout writes none (the band checks its own
         // memory once its blocks are known: core/sampling/sparse_band_sampler.h).
         const std::optional<sdf::StreamPlan> plan =
-            layout == "dense" ? std::optional<sdf::StreamPlan>(sdf::plan_streamed_sampling(lattice, stream)) : std::nullopt;
+            dense_file ? std::optional<sdf::StreamPlan>(sdf::plan_streamed_sampling(lattice, stream)) : std::nullopt;
         doing = "sampling " + mesh_arg + " on " + sdf::lattice_notation(lattice) +
                 (plan ? ", " + std::to_string(plan->points) + " points" : std::string());
         planned_bytes = plan ? plan->peak_estimate : stream.fixed_bytes;
@@ -253,8 +265,10 @@ int main(int argc, char** argv) {
             if (band > 0) std::cout << ", band " << band << (sparse ? " (sparse: the band's memory is added when sampled)" : "");
             if (layout == "sparse")
                 std::cout << "\nout: " << out_path << ", the sparse band's field file (its size grows with the band)\n";
-            else
+            else if (plan)
                 std::cout << "\n" << plan->describe() << "out: " << out_path << "\n";
+            else
+                std::cout << "\nout: none, the level sets alone\n";
             if (!vdb_path.empty() && sparse)
                 std::cout << "vdb: " << vdb_path << ", a level set from the sparse band's blocks, points with |d| <= "
                           << band << " active (outside the budget)\n";
@@ -265,7 +279,7 @@ int main(int argc, char** argv) {
                 std::cout << "nvdb: " << nvdb_path << ", a NanoVDB level set from the sparse band's blocks, points with |d| <= "
                           << band << " active (outside the budget)\n";
             try {
-                sdf::require_writable_target(out_path, stream.write.overwrite);
+                if (!out_path.empty()) sdf::require_writable_target(out_path, stream.write.overwrite);
                 if (!vdb_path.empty()) sdf::require_writable_target(vdb_path, stream.write.overwrite);
                 if (!nvdb_path.empty()) sdf::require_writable_target(nvdb_path, stream.write.overwrite);
                 require_runnable();
@@ -277,7 +291,8 @@ int main(int argc, char** argv) {
         }
         require_runnable();
         // Temporaries of an interrupted earlier run in the output folder (their process is gone).
-        sdf::remove_stale_staging(fs::absolute(out_path).parent_path().string());
+        for (const std::string& target : {out_path, vdb_path, nvdb_path})
+            if (!target.empty()) sdf::remove_stale_staging(fs::absolute(target).parent_path().string());
         const sdf::MeshProvenance mesh_provenance = sdf::describe_prepared_mesh(mesh);
         if (!quiet && plan) std::cerr << plan->describe();
         // The front ends' one field source (harness/study/field_source.h), without a cache:
@@ -302,9 +317,15 @@ int main(int argc, char** argv) {
                       << " s\n";
         }
         // The level sets written straight from the sparse band's blocks, after either field file.
+        // Seconds of each file written from the band: where an end-to-end run's time goes.
+        const auto since = [](std::chrono::steady_clock::time_point t) {
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        };
+        double vdb_seconds = 0, nvdb_seconds = 0;
         const auto write_level_sets = [&]() -> std::pair<int64_t, int64_t> {
             std::pair<int64_t, int64_t> active{0, 0};
             if (!vdb_path.empty()) {
+                const auto t = std::chrono::steady_clock::now();
                 doing = "writing " + vdb_path + " from the sparse band";
                 sdf::SparseVdbOptions vdb_options;
                 vdb_options.gradient = stream.gradient;
@@ -312,26 +333,42 @@ int main(int argc, char** argv) {
                 vdb_options.closest_triangle = false;
                 vdb_options.overwrite = stream.write.overwrite;
                 active.first = sdf::write_sparse_band_vdb(sparse_slabs->band(), vdb_path, vdb_options).active_voxels;
+                vdb_seconds = since(t);
             }
             if (!nvdb_path.empty()) {
+                const auto t = std::chrono::steady_clock::now();
                 doing = "writing " + nvdb_path + " from the sparse band";
                 active.second = sdf::write_sparse_band_nvdb(sparse_slabs->band(), nvdb_path, stream.write.overwrite).active_voxels;
+                nvdb_seconds = since(t);
             }
             return active;
         };
+        const auto report_level_sets = [&](int64_t vdb_active, int64_t nvdb_active) {
+            if (!vdb_path.empty())
+                std::cout << "wrote " << vdb_path << ": " << vdb_active << " active points (|d| <= " << band << ", "
+                          << vdb_seconds << " s)\n";
+            if (!nvdb_path.empty())
+                std::cout << "wrote " << nvdb_path << ": " << nvdb_active << " active points (|d| <= " << band << ", "
+                          << nvdb_seconds << " s)\n";
+        };
+        if (out_path.empty()) {  // --sparse writing its level sets alone
+            const auto [vdb_active, nvdb_active] = write_level_sets();
+            report_level_sets(vdb_active, nvdb_active);
+            return 0;
+        }
         if (layout == "sparse") {
             doing = "writing the sparse field file " + out_path;
             sdf::SparseFieldWriteOptions file;
             file.dtype = stream.write.dtype;
             file.gradient = stream.gradient;
             file.overwrite = stream.write.overwrite;
+            const auto t = std::chrono::steady_clock::now();
             sdf::write_sparse_field(out_path, sparse_slabs->band(), file);
+            const double field_seconds = since(t);
             const auto [vdb_active, nvdb_active] = write_level_sets();
             std::cout << "wrote " << out_path << ": the sparse band's field file, " << sparse_slabs->band().active.size()
-                      << " active blocks\n";
-            if (!vdb_path.empty()) std::cout << "wrote " << vdb_path << ": " << vdb_active << " active points (|d| <= " << band << ")\n";
-            if (!nvdb_path.empty())
-                std::cout << "wrote " << nvdb_path << ": " << nvdb_active << " active points (|d| <= " << band << ")\n";
+                      << " active blocks (" << field_seconds << " s)\n";
+            report_level_sets(vdb_active, nvdb_active);
             return 0;
         }
         const sdf::StreamResult r = sdf::sample_streamed(sparse_slabs ? *sparse_slabs : bound, options, lattice, stream, mesh_provenance);

@@ -70,6 +70,9 @@ public:
     Int3 point_coords(int64_t id, int local) const { return grid_.point_coords(block_coords(id), local); }
     /// Its lattice storage index, or -1 for padding (beyond the coset's resolution).
     int64_t storage_index(int64_t id, int local) const { return grid_.storage_index(block_coords(id), local); }
+    /// The block's lattice points per axis (BandBlockGrid::block_points): point `local` is one
+    /// iff BandBlockGrid::within(block_points(b), local).
+    Int3 block_points(const BandBlockCoords& b) const { return grid_.block_points(b); }
     /// The block's cell (see the file's comment), in world units.
     void cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const;
 

@@ -1,5 +1,6 @@
 #include "harness/io/sparse_field_file.h"
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +11,7 @@
 
 #include "core/checked_math.h"
 #include "core/lattice/lattice_fitting.h"
+#include "core/parallel/parallel_for.h"
 #include "harness/config/json_reader.h"
 #include "harness/io/field_replacement.h"
 #include "harness/resources/memory_budget.h"
@@ -22,7 +24,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "field files are little
 namespace {
 
 constexpr int kSignWords = kBandBlockPoints / 64;  // words of a mixed block's BandSignMask
-constexpr int64_t kChunk = int64_t(1) << 20;       // elements converted per write or read
+constexpr int64_t kChunk = int64_t(1) << 20;       // elements converted per read
+constexpr int64_t kWriteChunk = int64_t(1) << 22;  // per write: each converted on every core
 
 std::string header_of(const std::string& path) {
     return path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0 ? path : path + ".json";
@@ -50,8 +53,8 @@ void write_channel(FieldReplacement& replacement, size_t i, const SparseChannel&
             std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
             if (!out) throw std::runtime_error(path + ": cannot open " + tmp + " for writing");
             std::vector<char> bytes;
-            for (int64_t first = 0; first < count; first += kChunk) {
-                const int64_t n = std::min(kChunk, count - first);
+            for (int64_t first = 0; first < count; first += kWriteChunk) {
+                const int64_t n = std::min(kWriteChunk, count - first);
                 bytes.resize(size_t(n) * element);
                 fill(first, n, bytes.data());
                 out.write(bytes.data(), std::streamsize(bytes.size()));
@@ -69,21 +72,32 @@ void write_channel(FieldReplacement& replacement, size_t i, const SparseChannel&
     }
 }
 
-/// Stores doubles as float32 or float64, refusing a finite value beyond float32's range.
+/// Stores doubles as float32 or float64, refusing a finite value beyond float32's range (the
+/// first such value, whatever the thread count). Converted on every core: at 8192^3 a band's
+/// distances are 4.2G values.
 void store_reals(const double* values, size_t n, FieldDtype dtype, char* out, const std::string& channel, int64_t first) {
     if (dtype == FieldDtype::Float64) {
         std::memcpy(out, values, n * sizeof(double));
         return;
     }
-    for (size_t i = 0; i < n; ++i) {
-        if (std::abs(values[i]) > double(std::numeric_limits<float>::max()) && std::isfinite(values[i])) {
-            char text[32];
-            std::snprintf(text, sizeof text, "%.6g", values[i]);
-            throw std::range_error(channel + ": value " + text + " (value " + std::to_string(first + int64_t(i)) +
-                                   " of the channel) is beyond float32's range (3.40282e+38); write float64");
+    std::atomic<size_t> beyond{n};  // the first value beyond float32's range
+    parallel_for(int64_t(n), 1 << 16, 0, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+            const double v = values[size_t(i)];
+            if (std::abs(v) > double(std::numeric_limits<float>::max()) && std::isfinite(v)) {
+                for (size_t seen = beyond.load(); size_t(i) < seen && !beyond.compare_exchange_weak(seen, size_t(i));) {
+                }
+                return;
+            }
+            const float f = float(v);
+            std::memcpy(out + size_t(i) * sizeof(float), &f, sizeof(float));
         }
-        const float f = float(values[i]);
-        std::memcpy(out + i * sizeof(float), &f, sizeof(float));
+    });
+    if (const size_t i = beyond.load(); i < n) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", values[i]);
+        throw std::range_error(channel + ": value " + text + " (value " + std::to_string(first + int64_t(i)) +
+                               " of the channel) is beyond float32's range (3.40282e+38); write float64");
     }
 }
 

@@ -4,10 +4,13 @@
 /// placed (write_through_temporary).
 #include "harness/io/sparse_nvdb_file.h"
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
+#include "core/parallel/parallel_for.h"
 #include "harness/io/field_file.h"
 #include "harness/io/volume_grids.h"
 
@@ -64,31 +67,46 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
         grids.back()->setTransform(g.spacing, nanovdb::Vec3d(g.origin.x, g.origin.y, g.origin.z));
         accessors.push_back(grids.back()->getAccessor());
     }
-    // Active blocks: leaves whose band points are active voxels.
+    // Active blocks: leaves whose band points are active voxels. The leaves are made in
+    // order on one thread (the tree's nodes are shared), then filled on every core (each
+    // leaf its own): at 8192^3, 8.2M leaves and 4.2G voxels.
+    std::vector<BuildLeaf*> leaves(band.active.size());
+    std::vector<Int3> extent(band.active.size());
     for (size_t a = 0; a < band.active.size(); ++a) {
         const BandBlockCoords b = layout.block_coords(band.active[a]);
-        BuildLeaf& leaf = touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
-        for (int local = 0; local < kBandBlockPoints; ++local) {
-            if (layout.storage_index(band.active[a], local) < 0) continue;  // padding: background +W
-            const size_t at = a * kBandBlockPoints + size_t(local);
-            const uint32_t offset = leaf_offset(local);
-            const float d = float(band.distance[at]);
-            if (!band.in_band(a, local)) {
-                set_inactive(leaf, offset, d);  // +-W, its side
-                continue;
-            }
-            leaf.setValue(offset, d);  // on
-            ++counts.active_voxels;
-        }
-        ++counts.leaves;
+        leaves[a] = &touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
+        extent[a] = layout.block_points(b);
     }
+    std::atomic<int64_t> active_voxels{0};
+    parallel_for(int64_t(band.active.size()), 1024, 0, [&](int64_t a0, int64_t a1) {
+        int64_t on = 0;
+        for (int64_t a = a0; a < a1; ++a) {
+            BuildLeaf& leaf = *leaves[size_t(a)];
+            const bool whole = BandBlockGrid::whole(extent[size_t(a)]);
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                if (!whole && !BandBlockGrid::within(extent[size_t(a)], local)) continue;  // padding: background +W
+                const size_t at = size_t(a) * kBandBlockPoints + size_t(local);
+                const float d = float(band.distance[at]);
+                if (!band.in_band(size_t(a), local)) {
+                    set_inactive(leaf, leaf_offset(local), d);  // +-W, its side
+                    continue;
+                }
+                leaf.setValue(leaf_offset(local), d);  // on
+                ++on;
+            }
+        }
+        active_voxels += on;
+    });
+    counts.active_voxels += active_voxels.load();
+    counts.leaves += int64_t(band.active.size());
     // Mixed blocks: leaves of inactive voxels, each on its side.
     for (size_t m = 0; m < band.mixed.size(); ++m) {
         const BandBlockCoords b = layout.block_coords(band.mixed[m]);
         BuildLeaf& leaf = touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
         const BandSignMask& inside = band.mixed_inside[m];
+        const Int3 points = layout.block_points(b);
         for (int local = 0; local < kBandBlockPoints; ++local) {
-            if (layout.storage_index(band.mixed[m], local) < 0) continue;
+            if (!BandBlockGrid::within(points, local)) continue;
             if ((inside[size_t(local >> 6)] >> (local & 63)) & 1) set_inactive(leaf, leaf_offset(local), -w);
         }
         ++counts.leaves;

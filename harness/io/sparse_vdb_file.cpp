@@ -3,9 +3,13 @@
 /// the blocks directly, then written to a temporary, synced and placed (write_through_temporary).
 #include "harness/io/sparse_vdb_file.h"
 
+#include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
+#include "core/parallel/parallel_for.h"
 #include "harness/io/field_file.h"
 #include "harness/io/volume_grids.h"
 
@@ -70,46 +74,69 @@ void write_grids(const SparseBandField& band, const std::string& path, const Spa
         if (gradient) cg.gradient = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
         if (options.closest_triangle) cg.triangle = openvdb::Int32Grid::create(kOutsideBandTriangle);
     }
-    // Active blocks: leaves whose band points are active voxels.
+    // Active blocks: leaves whose band points are active voxels. The leaves are made and
+    // added in order on one thread (the trees' nodes are shared), then filled on every core
+    // (each leaf its own). A block's gradient and triangle leaves exist where it has a band
+    // point.
+    struct Leaves {
+        FloatLeaf* distance;
+        Vec3Leaf* gradient;
+        Int32Leaf* triangle;
+        Int3 points;
+    };
+    std::vector<Leaves> leaves(band.active.size());
     for (size_t a = 0; a < band.active.size(); ++a) {
         const BandBlockCoords b = layout.block_coords(band.active[a]);
         CosetGrids& cg = grids[size_t(b.coset)];
         const openvdb::Coord origin = block_origin(b);
-        auto* leaf = new FloatLeaf(origin, w, false);
-        cg.distance->tree().addLeaf(leaf);
-        Vec3Leaf* gleaf = nullptr;
-        Int32Leaf* tleaf = nullptr;
-        for (int local = 0; local < kBandBlockPoints; ++local) {
-            const size_t at = a * kBandBlockPoints + size_t(local);
-            const openvdb::Index offset = leaf_offset(local);
-            if (layout.storage_index(band.active[a], local) < 0) continue;  // padding: background +W
-            const float d = float(band.distance[at]);
-            if (!band.in_band(a, local)) {
-                leaf->setValueOff(offset, d);  // +-W, its side
-                continue;
-            }
-            leaf->setValueOn(offset, d);
-            ++counts.active_voxels;
-            if (gradient) {
-                if (!gleaf) cg.gradient->tree().addLeaf(gleaf = new Vec3Leaf(origin, openvdb::Vec3s(0.0f), false));
-                const Vec3d& n = band.gradient[at];
-                gleaf->setValueOn(offset, openvdb::Vec3s(float(n.x), float(n.y), float(n.z)));
-            }
-            if (cg.triangle) {
-                if (!tleaf) cg.triangle->tree().addLeaf(tleaf = new Int32Leaf(origin, kOutsideBandTriangle, false));
-                tleaf->setValueOn(offset, band.closest_triangle[at]);
+        Leaves& l = leaves[a];
+        l.points = layout.block_points(b);
+        l.distance = new FloatLeaf(origin, w, false);
+        cg.distance->tree().addLeaf(l.distance);
+        const BandPointMask& mask = band.band_mask[a];
+        const bool any = std::any_of(mask.begin(), mask.end(), [](uint64_t word) { return word != 0; });
+        l.gradient = gradient && any ? new Vec3Leaf(origin, openvdb::Vec3s(0.0f), false) : nullptr;
+        l.triangle = cg.triangle && any ? new Int32Leaf(origin, kOutsideBandTriangle, false) : nullptr;
+        if (l.gradient) cg.gradient->tree().addLeaf(l.gradient);
+        if (l.triangle) cg.triangle->tree().addLeaf(l.triangle);
+    }
+    std::atomic<int64_t> active_voxels{0};
+    parallel_for(int64_t(band.active.size()), 1024, 0, [&](int64_t a0, int64_t a1) {
+        int64_t on = 0;
+        for (int64_t a = a0; a < a1; ++a) {
+            const Leaves& l = leaves[size_t(a)];
+            const bool whole = BandBlockGrid::whole(l.points);
+            for (int local = 0; local < kBandBlockPoints; ++local) {
+                if (!whole && !BandBlockGrid::within(l.points, local)) continue;  // padding: background +W
+                const size_t at = size_t(a) * kBandBlockPoints + size_t(local);
+                const openvdb::Index offset = leaf_offset(local);
+                const float d = float(band.distance[at]);
+                if (!band.in_band(size_t(a), local)) {
+                    l.distance->setValueOff(offset, d);  // +-W, its side
+                    continue;
+                }
+                l.distance->setValueOn(offset, d);
+                ++on;
+                if (l.gradient) {
+                    const Vec3d& n = band.gradient[at];
+                    l.gradient->setValueOn(offset, openvdb::Vec3s(float(n.x), float(n.y), float(n.z)));
+                }
+                if (l.triangle) l.triangle->setValueOn(offset, band.closest_triangle[at]);
             }
         }
-        ++counts.leaves;
-    }
+        active_voxels += on;
+    });
+    counts.active_voxels += active_voxels.load();
+    counts.leaves += int64_t(band.active.size());
     // Mixed blocks: leaves of inactive voxels, each on its side.
     for (size_t m = 0; m < band.mixed.size(); ++m) {
         const BandBlockCoords b = layout.block_coords(band.mixed[m]);
         auto* leaf = new FloatLeaf(block_origin(b), w, false);
         grids[size_t(b.coset)].distance->tree().addLeaf(leaf);
         const BandSignMask& inside = band.mixed_inside[m];
+        const Int3 points = layout.block_points(b);
         for (int local = 0; local < kBandBlockPoints; ++local) {
-            if (layout.storage_index(band.mixed[m], local) < 0) continue;
+            if (!BandBlockGrid::within(points, local)) continue;
             if ((inside[size_t(local >> 6)] >> (local & 63)) & 1) leaf->setValueOff(leaf_offset(local), -w);
         }
         ++counts.leaves;

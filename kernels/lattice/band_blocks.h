@@ -87,6 +87,24 @@ struct BandBlockGrid {
         const Int3 f = coset[b.coset].first;
         return {f.x + 2 * p.x, f.y + 2 * p.y, f.z + 2 * p.z};
     }
+    /// The block's lattice points per axis: 8, fewer at the coset's far edges. Point `local`
+    /// is a lattice point iff within(points, local): one test per block instead of one
+    /// storage_index() a point, for the loops that visit every point of many blocks.
+    SDF_CPU_GPU Int3 block_points(const BandBlockCoords& b) const {
+        const Int3 n = coset[b.coset].points;
+        const auto along = [](int total, int block) {
+            const int left = total - block * kBandBlockDim;
+            return left < kBandBlockDim ? left : kBandBlockDim;
+        };
+        return {along(n.x, b.block.x), along(n.y, b.block.y), along(n.z, b.block.z)};
+    }
+    static SDF_CPU_GPU bool whole(const Int3& points) {
+        return points.x == kBandBlockDim && points.y == kBandBlockDim && points.z == kBandBlockDim;
+    }
+    static SDF_CPU_GPU bool within(const Int3& points, int local) {
+        const Int3 o = local_offset(local);
+        return o.x < points.x && o.y < points.y && o.z < points.z;
+    }
     /// Whether the point lies beyond the coset's resolution (padding: no lattice point).
     SDF_CPU_GPU bool padding(const BandBlockCoords& b, int local) const {
         const Int3 p = coset_point(b, local);

@@ -18,13 +18,14 @@ if [ "${1:-}" = build ]; then
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1
 fi
 RESOLUTIONS=${*:-4096 8192}
+BENCH=${BENCH:-1}  # 0: only the end-to-end run
 export SDF_DATA_PATH=$PWD/data/meshes
 export LD_LIBRARY_PATH=$PWD/.gpu-prefix/root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee -a "$OUT/summary.txt"
 echo "host: $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB" | tee -a "$OUT/summary.txt"
 # The numbers a row needs from bench_sparse_band's JSON line and time -v's report.
 row() {
-    /usr/bin/python3 - "$1" "$2" <<'PY' | tee -a "$OUT/summary.txt"
+    python3 - "$1" "$2" <<'PY' | tee -a "$OUT/summary.txt"
 import json, re, sys
 j = json.loads([l for l in open(sys.argv[1]) if l.startswith("{")][-1])
 t = open(sys.argv[2]).read()
@@ -36,6 +37,7 @@ print(f"{j['lattice']} {j['sampler']}: band {j['sparse_wall_s']:.2f} s wall ({j[
 PY
 }
 for res in $RESOLUTIONS; do
+    [ "$BENCH" = 1 ] || break
     for backend in cuda cpu; do
         log "bench_sparse_band sparse-distance dragon.obj $res 3 cc $backend"
         /usr/bin/time -v $B/tests/benchmarks/bench_sparse_band sparse-distance "$MESH" "$res" 3 cc $backend \
@@ -46,23 +48,28 @@ for res in $RESOLUTIONS; do
 done
 # End to end at the largest resolution: 3 spacings of the fitted lattice (margin 0.1).
 res=${RESOLUTIONS##* }
-W=$(/usr/bin/python3 -c "
-import numpy as np
-v = np.array([l.split()[1:4] for l in open('$MESH') if l.startswith('v ')], float)
-print(repr(3 * (v.max(0) - v.min(0)).max() * 1.2 / ($res - 1)))")
+W=$(python3 -c "
+v = [[float(x) for x in l.split()[1:4]] for l in open('$MESH') if l.startswith('v ')]
+extent = max(max(p[a] for p in v) - min(p[a] for p in v) for a in range(3))
+print(repr(3 * extent * 1.2 / ($res - 1)))")
 work=$PWD/huge-band-out
-rm -rf "$work" && mkdir -p "$work"
-log "sdf-sample $MESH --resolution $res --band $W --sparse --layout sparse --channels distance --dtype float32 --nvdb (cuda)"
-/usr/bin/time -v $B/bin/sdf-sample "$MESH" --resolution "$res" --band "$W" --sparse --layout sparse --channels distance \
-    --dtype float32 --backend cuda --quiet --out "$work/band.json" --nvdb "$work/band.nvdb" > "$OUT/sdf-sample.txt" 2> "$OUT/sdf-sample-time.txt"
-echo "exit $?" | tee -a "$OUT/summary.txt"
-cat "$OUT/sdf-sample.txt" | tee -a "$OUT/summary.txt"
-grep -E "Elapsed|Maximum resident|User time|System time" "$OUT/sdf-sample-time.txt" | tee -a "$OUT/summary.txt"
-bytes=$(du -cb "$work" | tail -1 | cut -f1)
-echo "files: $bytes bytes ($(du -sh "$work" | cut -f1))" | tee -a "$OUT/summary.txt"
-rm -rf "$work"
-mkdir -p "$work"
-log "dd of $bytes bytes with fsync (the bytes' own write)"
-dd if=/dev/zero of="$work/dd" bs=64M count=$(( (bytes + 67108863) / 67108864 )) conv=fsync 2>&1 | tail -1 | tee -a "$OUT/summary.txt"
-rm -rf "$work"
+# 1. the .nvdb alone (no field file: sdf-sample's --out left out), against dd of its bytes;
+# 2. the sparse field file (float32) beside it.
+for files in nvdb field+nvdb; do
+    rm -rf "$work" && mkdir -p "$work"
+    out=()
+    [ "$files" = nvdb ] || out=(--layout sparse --dtype float32 --out "$work/band.json")
+    log "sdf-sample $MESH --resolution $res --band $W --sparse --channels distance --nvdb ${out[*]} (cuda)"
+    /usr/bin/time -v $B/bin/sdf-sample "$MESH" --resolution "$res" --band "$W" --sparse --channels distance \
+        --backend cuda --quiet --nvdb "$work/band.nvdb" "${out[@]}" > "$OUT/sdf-sample-$files.txt" 2> "$OUT/sdf-sample-time-$files.txt"
+    echo "exit $?" | tee -a "$OUT/summary.txt"
+    cat "$OUT/sdf-sample-$files.txt" | tee -a "$OUT/summary.txt"
+    grep -E "Elapsed|Maximum resident|User time|System time" "$OUT/sdf-sample-time-$files.txt" | tee -a "$OUT/summary.txt"
+    bytes=$(du -cb "$work" | tail -1 | cut -f1)
+    echo "files: $bytes bytes ($(du -sh "$work" | cut -f1))" | tee -a "$OUT/summary.txt"
+    rm -rf "$work" && mkdir -p "$work"
+    log "dd of $bytes bytes with fsync (the bytes' own write)"
+    dd if=/dev/zero of="$work/dd" bs=64M count=$(( (bytes + 67108863) / 67108864 )) conv=fsync 2>&1 | tail -1 | tee -a "$OUT/summary.txt"
+    rm -rf "$work"
+done
 log "done"

@@ -403,6 +403,15 @@ TEST(StreamedSampling, SparseLayoutReadsBackAsTheDenseBand) {
         test::run_in(dir.path(), exe + " shape:sphere --resolution 8 --band 0.1 --layout sparse --out n.json");
     EXPECT_EQ(refused.code, 2) << refused.err;
     EXPECT_TRUE(test::Contains(refused.err, "--layout sparse")) << refused.err;
+    // --out may be left out only where level sets alone are written from a sparse band.
+    for (const std::string& args : {std::string(" shape:sphere --resolution 8 --band 0.1"),
+                                    std::string(" shape:sphere --resolution 8 --band 0.1 --sparse"),
+                                    std::string(" shape:sphere --resolution 8 --band 0.1 --vdb n.vdb")}) {
+        const test::ShellResult no_out = test::run_in(dir.path(), exe + args);
+        EXPECT_EQ(no_out.code, 2) << args << ": " << no_out.err;
+        EXPECT_TRUE(test::Contains(no_out.err, "--out: expected a field file header NAME.json (only --sparse with --vdb"))
+            << no_out.err;
+    }
 }
 
 // A sparse band's own field file may have a lattice no dense field may (max_lattice_points):
@@ -440,6 +449,11 @@ TEST(StreamedSampling, NvdbIsWrittenBesideEitherFieldFile) {
     const std::string a = test::read_text(dir.at("d.nvdb")), b = test::read_text(dir.at("s.nvdb"));
     EXPECT_EQ(a.substr(0, 8), "NanoVDB2");
     EXPECT_TRUE(a == b) << a.size() << " and " << b.size() << " bytes";
+    // Without --out, the level set alone: the same bytes, and no field file.
+    const test::ShellResult alone = test::run_in(dir.path(), exe + " --nvdb a.nvdb");
+    ASSERT_EQ(alone.code, 0) << alone.err;
+    EXPECT_TRUE(test::read_text(dir.at("a.nvdb")) == a);
+    EXPECT_FALSE(test::Contains(alone.out, ".json")) << alone.out;
 }
 #endif
 
