@@ -40,13 +40,6 @@ nanovdb::Coord block_origin(const BandBlockCoords& b) {
     return nanovdb::Coord(b.block.x * kBandBlockDim, b.block.y * kBandBlockDim, b.block.z * kBandBlockDim);
 }
 
-/// The leaf of the block at `origin`, created (every voxel inactive at the background +W).
-BuildLeaf& touch_leaf(nanovdb::tools::build::ValueAccessor<float>& acc, const nanovdb::Coord& origin, float w) {
-    BuildLeaf* leaf = acc.setValue(origin, w);  // creates the leaf and turns voxel 0 on
-    leaf->mValueMask.setOff(0);
-    return *leaf;
-}
-
 void set_inactive(BuildLeaf& leaf, uint32_t offset, float value) {
     leaf.mValues[offset] = value;
     leaf.mValueMask.setOff(offset);
@@ -59,58 +52,61 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
     if (int(parts.size()) != layout.cosets()) throw std::logic_error(path + ": the band's cosets are not the lattice's grids");
     const float w = float(band.width);
     std::vector<std::unique_ptr<BuildGrid>> grids;
-    std::vector<nanovdb::tools::build::ValueAccessor<float>> accessors;
     for (int c = 0; c < layout.cosets(); ++c) {
         const VolumeGrid& g = parts[size_t(c)];
         grids.push_back(std::make_unique<BuildGrid>(w, g.part.empty() ? "distance" : "distance_" + g.part,
                                                     nanovdb::GridClass::LevelSet));
         grids.back()->setTransform(g.spacing, nanovdb::Vec3d(g.origin.x, g.origin.y, g.origin.z));
-        accessors.push_back(grids.back()->getAccessor());
     }
-    // Active blocks: leaves whose band points are active voxels. The leaves are made in
-    // order on one thread (the tree's nodes are shared), then filled on every core (each
-    // leaf its own): at 8192^3, 8.2M leaves and 4.2G voxels.
-    std::vector<BuildLeaf*> leaves(band.active.size());
-    std::vector<Int3> extent(band.active.size());
-    for (size_t a = 0; a < band.active.size(); ++a) {
-        const BandBlockCoords b = layout.block_coords(band.active[a]);
-        leaves[a] = &touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
-        extent[a] = layout.block_points(b);
-    }
+    // Active blocks: leaves whose band points are active voxels; mixed blocks: leaves of
+    // inactive voxels, each on its side. Each leaf is made (every voxel inactive at the
+    // background +W) and filled on every core, then linked into its grid's tree in block
+    // order on one thread (the tree's nodes are shared), as NanoVDB's own builders do: at
+    // 8192^3, 8.2M leaves, 16 GiB, and 4.2G voxels.
+    const size_t active = band.active.size(), leaf_count = active + band.mixed.size();
+    std::vector<BuildLeaf*> leaves(leaf_count, nullptr);
+    std::vector<int> coset(leaf_count);
     std::atomic<int64_t> active_voxels{0};
-    parallel_for(int64_t(band.active.size()), 1024, 0, [&](int64_t a0, int64_t a1) {
-        int64_t on = 0;
-        for (int64_t a = a0; a < a1; ++a) {
-            BuildLeaf& leaf = *leaves[size_t(a)];
-            const bool whole = BandBlockGrid::whole(extent[size_t(a)]);
-            for (int local = 0; local < kBandBlockPoints; ++local) {
-                if (!whole && !BandBlockGrid::within(extent[size_t(a)], local)) continue;  // padding: background +W
-                const size_t at = size_t(a) * kBandBlockPoints + size_t(local);
-                const float d = float(band.distance[at]);
-                if (!band.in_band(size_t(a), local)) {
-                    set_inactive(leaf, leaf_offset(local), d);  // +-W, its side
+    try {
+        parallel_for(int64_t(leaf_count), 1024, 0, [&](int64_t i0, int64_t i1) {
+            int64_t on = 0;
+            for (int64_t i = i0; i < i1; ++i) {
+                const bool is_active = size_t(i) < active;
+                const int64_t id = is_active ? band.active[size_t(i)] : band.mixed[size_t(i) - active];
+                const BandBlockCoords b = layout.block_coords(id);
+                const Int3 points = layout.block_points(b);
+                const bool whole = BandBlockGrid::whole(points);
+                coset[size_t(i)] = b.coset;
+                BuildLeaf& leaf = *(leaves[size_t(i)] = new BuildLeaf(block_origin(b), w, false));
+                if (!is_active) {
+                    const BandSignMask& inside = band.mixed_inside[size_t(i) - active];
+                    for (int local = 0; local < kBandBlockPoints; ++local)
+                        if ((whole || BandBlockGrid::within(points, local)) && ((inside[size_t(local >> 6)] >> (local & 63)) & 1))
+                            set_inactive(leaf, leaf_offset(local), -w);
                     continue;
                 }
-                leaf.setValue(leaf_offset(local), d);  // on
-                ++on;
+                for (int local = 0; local < kBandBlockPoints; ++local) {
+                    if (!whole && !BandBlockGrid::within(points, local)) continue;  // padding: background +W
+                    const size_t at = size_t(i) * kBandBlockPoints + size_t(local);
+                    const float d = float(band.distance[at]);
+                    if (!band.in_band(size_t(i), local)) {
+                        set_inactive(leaf, leaf_offset(local), d);  // +-W, its side
+                        continue;
+                    }
+                    leaf.setValue(leaf_offset(local), d);  // on
+                    ++on;
+                }
             }
-        }
-        active_voxels += on;
-    });
-    counts.active_voxels += active_voxels.load();
-    counts.leaves += int64_t(band.active.size());
-    // Mixed blocks: leaves of inactive voxels, each on its side.
-    for (size_t m = 0; m < band.mixed.size(); ++m) {
-        const BandBlockCoords b = layout.block_coords(band.mixed[m]);
-        BuildLeaf& leaf = touch_leaf(accessors[size_t(b.coset)], block_origin(b), w);
-        const BandSignMask& inside = band.mixed_inside[m];
-        const Int3 points = layout.block_points(b);
-        for (int local = 0; local < kBandBlockPoints; ++local) {
-            if (!BandBlockGrid::within(points, local)) continue;
-            if ((inside[size_t(local >> 6)] >> (local & 63)) & 1) set_inactive(leaf, leaf_offset(local), -w);
-        }
-        ++counts.leaves;
+            active_voxels += on;
+        });
+        // Linked in block order; addNode takes each leaf (nulls its pointer).
+        for (size_t i = 0; i < leaf_count; ++i) grids[size_t(coset[i])]->tree().root().addNode(leaves[i]);
+    } catch (...) {
+        for (BuildLeaf* leaf : leaves) delete leaf;  // those not yet in a tree
+        throw;
     }
+    counts.active_voxels += active_voxels.load();
+    counts.leaves += int64_t(leaf_count);
     // Inside tiles: -W tiles of one leaf's extent (level 1). The builder makes a missing lower
     // node with the tile's value for all its 4096 tiles, so the node is first made with a +W
     // (background) tile, then that tile set to -W.
@@ -126,7 +122,6 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
         }
     }
     std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
-    accessors.clear();
     for (const std::unique_ptr<BuildGrid>& grid : grids) {
         handles.push_back(nanovdb::tools::createNanoGrid(*grid));
         counts.bytes += int64_t(handles.back().bufferSize());
