@@ -18,7 +18,7 @@ if [ "${1:-}" = build ]; then
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1
 fi
 RESOLUTIONS=${*:-4096 8192}
-BENCH=${BENCH:-1}  # 0: only the end-to-end run
+BENCH=${BENCH:-1}  # 0: only the end-to-end runs (FILES: "nvdb", "field+nvdb" or both)
 export SDF_DATA_PATH=$PWD/data/meshes
 export LD_LIBRARY_PATH=$PWD/.gpu-prefix/root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee -a "$OUT/summary.txt"
@@ -55,7 +55,7 @@ print(repr(3 * extent * 1.2 / ($res - 1)))")
 work=$PWD/huge-band-out
 # 1. the .nvdb alone (no field file: sdf-sample's --out left out), against dd of its bytes;
 # 2. the sparse field file (float32) beside it.
-for files in nvdb field+nvdb; do
+for files in ${FILES:-nvdb field+nvdb}; do
     rm -rf "$work" && mkdir -p "$work"
     out=()
     [ "$files" = nvdb ] || out=(--layout sparse --dtype float32 --out "$work/band.json")
