@@ -69,6 +69,7 @@ nlohmann::json surface_sides_json(const SurfaceSides& s) {
     return {{"used", true},
             {"components", s.components},
             {"components_decided", s.components_decided},
+            {"components_from_outside", s.components_from_outside},
             {"triangles_known", s.triangles_known},
             {"seconds", s.seconds}};
 }

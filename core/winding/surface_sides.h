@@ -25,6 +25,7 @@ struct SurfaceSides {
     double min_distance = 0;     ///< SurfaceSideView::min_distance
     int components = 0;          ///< edge-connected components of triangles in no intersecting pair
     int components_decided = 0;  ///< those whose front winding number was certified
+    int components_from_outside = 0;  ///< of them, read from outside the mesh's box (no sum)
     int64_t triangles_known = 0; ///< triangles with a front winding number
     double seconds = 0;
     std::string why_off;         ///< empty when the table is on
