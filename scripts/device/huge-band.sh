@@ -6,13 +6,8 @@
 # disk) under /usr/bin/time -v, and dd writing as many bytes with fsync (the goal's floor).
 #   carry: .gpu-prefix data        run: scripts/device/huge-band.sh [build] [RES...]
 # Output under $OUT: summary.txt and the logs.
-set -uo pipefail
-cd "$(dirname "$0")/../.."
-OUT=${OUT:-$PWD/gpu-out}
-mkdir -p "$OUT"
-B=build-gpu
+. "$(dirname "$0")/start.sh"
 MESH=${MESH:-$PWD/data/meshes/dragon.obj}
-log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
 if [ "${1:-}" = build ]; then
     shift
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1

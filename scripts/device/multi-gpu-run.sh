@@ -8,16 +8,11 @@
 #   carry: .gpu-prefix data        run: scripts/device/multi-gpu-run.sh [build]
 # Builds with scripts/device/gpu-check.sh's "build" step (into build-gpu) when asked or absent.
 # Output under $OUT: scaling.md (the table), summary.txt and the logs.
-set -uo pipefail
-cd "$(dirname "$0")/../.."
-OUT=${OUT:-$PWD/gpu-out}
-mkdir -p "$OUT"
-B=build-gpu
+. "$(dirname "$0")/start.sh"
 MESH=${MESH:-$PWD/data/meshes/dragon.obj}
 RES=${RES:-1024}
 QUERY_POINTS=${QUERY_POINTS:-16777216}
 FIELDS=${FIELDS:-/tmp/multi-gpu-fields}
-log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
 if [ "${1:-}" = build ] || [ ! -x $B/bin/run-experiment ]; then
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1
 fi

@@ -8,14 +8,9 @@
 #     SDF_WINDING_UNCERTIFIED=1 (the fast value's side: the uncertified kernel), kernel seconds.
 #   carry: .gpu-prefix data        run: scripts/device/query-breakdown.sh [build]
 # Output under $OUT: summary.txt, ncu-kernels.csv and the logs.
-set -uo pipefail
-cd "$(dirname "$0")/../.."
-OUT=${OUT:-$PWD/gpu-out}
-mkdir -p "$OUT"
-B=build-gpu
+. "$(dirname "$0")/start.sh"
 MESH=${MESH:-$PWD/data/meshes/dragon-legacy.obj}
 QUERY_POINTS=${QUERY_POINTS:-1048576}
-log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
 if [ "${1:-}" = build ] || [ ! -x $B/bin/sdf-sample ]; then
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1
 fi
