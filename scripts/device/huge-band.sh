@@ -13,7 +13,7 @@ if [ "${1:-}" = build ]; then
     OUT=$OUT scripts/device/gpu-check.sh build || exit 1
 fi
 RESOLUTIONS=${*:-4096 8192}
-BENCH=${BENCH:-1}  # 0: only the end-to-end runs (FILES: "nvdb", "field+nvdb" or both)
+BENCH=${BENCH:-1}  # 0: only the end-to-end runs (FILES: "nvdb", "field+nvdb" or both; BACKENDS: cuda, cpu or both)
 export SDF_DATA_PATH=$PWD/data/meshes
 export LD_LIBRARY_PATH=$PWD/.gpu-prefix/root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee -a "$OUT/summary.txt"
@@ -33,7 +33,7 @@ PY
 }
 for res in $RESOLUTIONS; do
     [ "$BENCH" = 1 ] || break
-    for backend in cuda cpu; do
+    for backend in ${BACKENDS:-cuda cpu}; do
         log "bench_sparse_band sparse-distance dragon.obj $res 3 cc $backend"
         /usr/bin/time -v $B/tests/benchmarks/bench_sparse_band sparse-distance "$MESH" "$res" 3 cc $backend \
             > "$OUT/bench-$res-$backend.json" 2> "$OUT/time-$res-$backend.txt"
