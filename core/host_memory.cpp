@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -106,6 +107,18 @@ void require_host_bytes(uint64_t bytes, const std::string& what) {
                              format_bytes(available) + " available to this process" +
                              (physical ? " (the machine has " + format_bytes(physical) + ")" : std::string()) +
                              " (SDF_MEMORY_AVAILABLE overrides the figure, in bytes)");
+}
+
+void advise_huge_pages(void* data, uint64_t bytes) {
+#if defined(MADV_HUGEPAGE)
+    constexpr uint64_t kHugePage = uint64_t(2) << 20;
+    const uint64_t begin = (uint64_t(reinterpret_cast<uintptr_t>(data)) + kHugePage - 1) / kHugePage * kHugePage;
+    const uint64_t end = (uint64_t(reinterpret_cast<uintptr_t>(data)) + bytes) / kHugePage * kHugePage;
+    if (end > begin) madvise(reinterpret_cast<void*>(uintptr_t(begin)), size_t(end - begin), MADV_HUGEPAGE);
+#else
+    (void)data;
+    (void)bytes;
+#endif
 }
 
 }  // namespace sdf

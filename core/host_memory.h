@@ -30,4 +30,10 @@ uint64_t host_memory_physical();
 /// the figure is unknown.
 void require_host_bytes(uint64_t bytes, const std::string& what);
 
+/// Asks Linux for transparent huge pages (madvise) on the 2 MiB pages wholly inside
+/// [data, data + bytes), before their first touch: a large buffer filled on every core then
+/// faults one page in 512 (DefaultInitVector does the same for its own arrays). Advice only:
+/// refused or ignored, the pages stay small.
+void advise_huge_pages(void* data, uint64_t bytes);
+
 }  // namespace sdf

@@ -9,9 +9,11 @@
 /// an active block is a leaf whose band points (the band's mask, SparseBandField::band_mask) are
 /// active voxels holding float(d), its other points inactive at +-W and its padding inactive
 /// at +W; a mixed block is a leaf of inactive voxels at +-W; an inside tile is an inactive
-/// tile of one leaf's extent at -W; every other block is the background +W. The grids are
-/// built on the host with NanoVDB's tools/GridBuilder.h and tools/CreateNanoGrid.h and written
-/// with its io::writeGrids (uncompressed). Distance only: no gradient or triangle grids.
+/// tile of one leaf's extent at -W; every other block is the background +W. Each grid is laid
+/// out in place on the host, breadth first, from the band's blocks (sparse_nvdb_grids.h: the
+/// bytes NanoVDB's tools/GridBuilder.h and tools/CreateNanoGrid.h make of the same tree, with
+/// no intermediate tree and no second copy of the leaves) and written with its io::writeGrids
+/// (uncompressed). Distance only: no gradient or triangle grids.
 #pragma once
 
 #include <string>

@@ -4,19 +4,29 @@
 // inside tiles included) and its voxel is active exactly where the point is within the band;
 // the grids are level sets with background W, named as the .vdb's, and each grid's map puts
 // its voxel (i, j, k) at the lattice point's own position. 10,000 random lattice points agree
-// in sign with the field. Built only where NanoVDB's headers are found (cmake/Dependencies.cmake).
+// in sign with the field. The grids, laid out in place from the band's blocks, equal byte for
+// byte what NanoVDB's own builder (tools/GridBuilder.h) and conversion (tools/CreateNanoGrid.h)
+// make of the same tree, and pass NanoVDB's full validator (checksum included). Built only
+// where NanoVDB's headers are found (cmake/Dependencies.cmake).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <random>
 
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/io/IO.h>
+#include <nanovdb/tools/CreateNanoGrid.h>
+#include <nanovdb/tools/GridBuilder.h>
+#include <nanovdb/tools/GridValidator.h>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "cpu_reference/bvh/bvh_cpu.h"
 #include "harness/io/sparse_nvdb_file.h"
+#include "harness/io/sparse_nvdb_grids.h"
+#include "harness/io/volume_grids.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
 
@@ -53,6 +63,55 @@ std::pair<int, nanovdb::Coord> voxel_of(const Lattice& lattice, int64_t index) {
     return {coset, nanovdb::Coord(c.x >> 1, c.y >> 1, c.z >> 1)};
 }
 
+/// NanoVDB's own way to the same grids, the reference: its host builder fed the band's blocks
+/// (a leaf per active or mixed block, a -W tile per inside tile), then its conversion.
+std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> reference_grids(const SparseBandField& band) {
+    using BuildGrid = nanovdb::tools::build::Grid<float>;
+    using BuildLeaf = BuildGrid::Node0;
+    const BandLayout& layout = band.layout();
+    const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
+    const float w = float(band.width);
+    std::vector<std::unique_ptr<BuildGrid>> grids;
+    for (const VolumeGrid& g : parts) {
+        grids.push_back(std::make_unique<BuildGrid>(w, g.part.empty() ? "distance" : "distance_" + g.part, nanovdb::GridClass::LevelSet));
+        grids.back()->setTransform(g.spacing, nanovdb::Vec3d(g.origin.x, g.origin.y, g.origin.z));
+    }
+    const auto origin = [](const BandBlockCoords& b) {
+        return nanovdb::Coord(b.block.x * kBandBlockDim, b.block.y * kBandBlockDim, b.block.z * kBandBlockDim);
+    };
+    const auto offset = [](int local) {
+        const Int3 o = BandLayout::local_offset(local);
+        return uint32_t((o.x << 6) | (o.y << 3) | o.z);
+    };
+    const size_t active = band.active.size();
+    for (size_t i = 0; i < active + band.mixed.size(); ++i) {
+        const int64_t id = i < active ? band.active[i] : band.mixed[i - active];
+        const BandBlockCoords b = layout.block_coords(id);
+        auto* leaf = new BuildLeaf(origin(b), w, false);
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (layout.storage_index(id, local) < 0) continue;  // padding: +W
+            const uint32_t n = offset(local);
+            if (i >= active) {
+                if (mask_bit(band.mixed_inside[i - active], local)) leaf->mValues[n] = -w;
+            } else if (band.in_band(i, local)) {
+                leaf->setValue(n, float(band.distance[i * kBandBlockPoints + size_t(local)]));
+            } else {
+                leaf->mValues[n] = float(band.distance[i * kBandBlockPoints + size_t(local)]);
+            }
+        }
+        grids[size_t(b.coset)]->tree().root().addNode(leaf);
+    }
+    for (int64_t id = 0; id < layout.block_count(); ++id) {
+        if (!band.tile_inside(id) || band.find_active(id) >= 0 || band.find_mixed(id) >= 0) continue;
+        const BandBlockCoords b = layout.block_coords(id);
+        grids[size_t(b.coset)]->tree().root().addTile<1>(origin(b), w, false);  // a new lower node's tiles: +W
+        grids[size_t(b.coset)]->tree().root().addTile<1>(origin(b), -w, false);
+    }
+    std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+    for (const auto& g : grids) handles.push_back(nanovdb::tools::createNanoGrid(*g));
+    return handles;
+}
+
 TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
     // Lattices fine enough for inside tiles (8^3 points inside) and, across the bowl's
     // opening, mixed blocks; a resolution not a multiple of 8 (padding).
@@ -69,7 +128,27 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
         const SampledField dense = band.densify();
         const std::string path = temp_path("band.nvdb");
         fs::remove(path);
+        // In memory: NanoVDB's own builder and conversion give the same bytes, and its full
+        // validator (checksum, node order, offsets) passes.
+        SparseNvdbCounts in_memory;
+        const auto built = sparse_band_nanogrids(band, &in_memory);
+        const auto reference = reference_grids(band);
+        ASSERT_EQ(built.size(), reference.size());
+        for (size_t g = 0; g < built.size(); ++g) {
+            ASSERT_EQ(built[g].bufferSize(), reference[g].bufferSize()) << "grid " << g;
+            const auto* a = static_cast<const unsigned char*>(built[g].data());
+            const auto* b = static_cast<const unsigned char*>(reference[g].data());
+            const auto differ = std::mismatch(a, a + built[g].bufferSize(), b);
+            EXPECT_EQ(differ.first, a + built[g].bufferSize()) << "grid " << g << ": first different byte at " << (differ.first - a)
+                                                              << " of " << built[g].bufferSize();
+            EXPECT_TRUE(nanovdb::tools::isValid(built[g].grid<float>(), nanovdb::CheckMode::Full, true)) << "grid " << g;
+        }
+        EXPECT_GT(in_memory.inside_tiles, 0);
+        EXPECT_EQ(in_memory.inside_tiles, band.counts().inside_tiles);
+
         const SparseNvdbCounts counts = write_sparse_band_nvdb(band, path);
+        EXPECT_EQ(counts.inside_tiles, in_memory.inside_tiles);
+        EXPECT_EQ(counts.leaves, band.counts().active_blocks + band.counts().mixed_blocks);
         ASSERT_TRUE(fs::exists(path));
         EXPECT_EQ(counts.active_voxels, band.counts().band_points);
         if (c.name.find("mixed") != std::string::npos) {
@@ -138,6 +217,70 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
             left += e.path().filename().string().rfind(temporaries, 0) == 0;
         EXPECT_EQ(left, 0);
         fs::remove(path);
+    }
+}
+
+TEST(SparseNvdb, GridsSpanningManyNodesAreLaidOutAsNanoVdbsOwnConversion) {
+    // A synthetic band on lattices long enough for several upper nodes (4096 points per axis)
+    // and many lower nodes (128): random active, mixed and inside blocks, with padding on the
+    // far edges, so that the node order, child offsets and tiles of every level are checked.
+    for (const LatticeType type : {LatticeType::CC, LatticeType::BCC}) {
+        SCOPED_TRACE(type == LatticeType::CC ? "CC" : "BCC");
+        Lattice lattice;
+        lattice.type = type;
+        lattice.origin = {-1.5, 0.25, 3.0};
+        lattice.spacing = 0.001;
+        lattice.resolution = {4100 * 2 + 5, 260, 21};
+        const double w = 3 * lattice.spacing;
+        SparseBandField band(lattice, w, Precision::Double, BandChannels{false, false});
+        std::mt19937_64 rng(11);
+        std::uniform_real_distribution<double> value(-w, w);
+        std::uniform_int_distribution<int> kind(0, 15);
+        const BandLayout& layout = band.layout();
+        for (int64_t id = 0; id < layout.block_count(); ++id) {
+            const int k = kind(rng);
+            if (k == 0) {
+                const int64_t a = band.add_active(id);
+                for (int local = 0; local < kBandBlockPoints; ++local) {
+                    if (layout.storage_index(id, local) < 0) continue;
+                    const double d = value(rng);
+                    if (local % 3 == 0) {
+                        band.distance[size_t(a) * kBandBlockPoints + size_t(local)] = d < 0 ? -w : w;  // outside the band
+                    } else {
+                        band.distance[size_t(a) * kBandBlockPoints + size_t(local)] = d;
+                        set_mask_bit(band.band_mask[size_t(a)], local);
+                    }
+                }
+            } else if (k == 1) {
+                const int64_t m = band.add_mixed(id);
+                for (int local = 0; local < kBandBlockPoints; ++local)
+                    if (layout.storage_index(id, local) >= 0 && value(rng) < 0) set_mask_bit(band.mixed_inside[size_t(m)], local);
+            }
+            if (k >= 1 && k <= 6) band.set_tile_inside(id, true);  // on a mixed block: ignored (it is a leaf)
+        }
+        SparseNvdbCounts counts;
+        const auto built = sparse_band_nanogrids(band, &counts);
+        const auto reference = reference_grids(band);
+        ASSERT_EQ(built.size(), reference.size());
+        uint64_t uppers = 0, lowers = 0;
+        for (size_t g = 0; g < built.size(); ++g) {
+            ASSERT_EQ(built[g].bufferSize(), reference[g].bufferSize()) << "grid " << g;
+            const auto* a = static_cast<const unsigned char*>(built[g].data());
+            const auto* b = static_cast<const unsigned char*>(reference[g].data());
+            const auto differ = std::mismatch(a, a + built[g].bufferSize(), b);
+            EXPECT_EQ(differ.first, a + built[g].bufferSize()) << "grid " << g << ": first different byte at " << (differ.first - a)
+                                                              << " of " << built[g].bufferSize();
+            const nanovdb::NanoGrid<float>* grid = built[g].grid<float>();
+            ASSERT_NE(grid, nullptr);
+            EXPECT_TRUE(nanovdb::tools::isValid(grid, nanovdb::CheckMode::Full, true)) << "grid " << g;
+            uppers += grid->tree().nodeCount(2);
+            lowers += grid->tree().nodeCount(1);
+        }
+        EXPECT_GE(uppers, uint64_t(3 * built.size())) << "the lattice should span several upper nodes";
+        EXPECT_GE(lowers, uint64_t(100));
+        EXPECT_EQ(counts.active_voxels, band.counts().band_points);
+        EXPECT_EQ(counts.inside_tiles, band.counts().inside_tiles);
+        EXPECT_EQ(counts.leaves, band.counts().active_blocks + band.counts().mixed_blocks);
     }
 }
 
