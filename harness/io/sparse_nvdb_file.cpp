@@ -1,16 +1,22 @@
 /// @file sparse_nvdb_file.cpp
-/// @brief The sparse band's NanoVDB writer (sparse_nvdb_file.h, sparse_nvdb_grids.h): each
-/// grid laid out in place, breadth first, straight from the band's blocks (no intermediate
-/// tree, no second copy of the leaves), then written to a temporary, synced and placed
-/// (write_through_temporary).
+/// @brief The sparse band's NanoVDB grids and writer (sparse_nvdb_file.h, sparse_nvdb_grids.h):
+/// each grid laid out breadth first straight from the band's blocks (no intermediate tree),
+/// every node and its statistics on every core; in memory, or streamed to a temporary that is
+/// then synced and placed (write_through_temporary).
 #include "harness/io/sparse_nvdb_file.h"
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <future>
+#include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <vector>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "core/host_memory.h"
 #include "core/parallel/parallel_for.h"
@@ -286,183 +292,226 @@ void fill_leaf(const SparseBandField& band, const BandBlockGrid& blocks, int64_t
     }
 }
 
-}  // namespace
+/// The band's grids planned: every grid's nodes in NanoVDB's breadth-first order and its byte
+/// layout (CreateNanoGrid's, without blind data). A grid is then built in two parts: its top
+/// (grid, tree, root, upper and lower nodes: every byte before its leaves) in one buffer, and
+/// its leaves, a lower node's at a time, wherever the caller puts them (the grid's own buffer,
+/// or a window the writer streams to the file).
+class BandNanoPlan {
+public:
+    struct GridPlan {
+        size_t upper_begin = 0, upper_end = 0, lower_begin = 0, lower_end = 0, leaf_begin = 0, leaf_end = 0;
+        uint64_t tree_at = 0, root_at = 0, upper_at = 0, lower_at = 0, leaf_at = 0, size = 0;
+        std::string name;
+        nanovdb::Map map;
+        uint64_t uppers() const { return upper_end - upper_begin; }
+        uint64_t lowers() const { return lower_end - lower_begin; }
+        uint64_t leaves() const { return leaf_end - leaf_begin; }
+    };
 
-std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> sparse_band_nanogrids(const SparseBandField& band, SparseNvdbCounts* counts_out) {
-    const BandLayout& layout = band.layout();
-    const BandBlockGrid blocks = BandBlockGrid::of(band.lattice);
-    const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
-    if (int(parts.size()) != layout.cosets() || blocks.cosets != layout.cosets())
-        throw std::logic_error("the band's cosets are not the lattice's grids");
-    const float w = float(band.width);
-    const NodeKeys nodes(blocks);
-
-    // The nodes: leaves sorted into NanoVDB's order; the lower nodes of the leaves and of the
-    // inside tiles; their upper nodes.
-    const SortedLeaves leaves = sort_leaves(band, blocks, nodes);
-    std::vector<uint64_t> lowers = inside_tile_lowers(band, blocks, nodes);
-    {
-        std::vector<uint64_t> of_leaves;
-        for (uint64_t k : leaves.keys)
+    explicit BandNanoPlan(const SparseBandField& band)
+        : band_(band), blocks_(BandBlockGrid::of(band.lattice)), nodes_(blocks_), w_(float(band.width)) {
+        const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
+        if (int(parts.size()) != band.layout().cosets() || blocks_.cosets != band.layout().cosets())
+            throw std::logic_error("the band's cosets are not the lattice's grids");
+        // The leaves sorted into NanoVDB's order; the lower nodes of the leaves and of the
+        // inside tiles; their upper nodes.
+        leaves_ = sort_leaves(band, blocks_, nodes_);
+        lowers_ = inside_tile_lowers(band, blocks_, nodes_);
+        std::vector<uint64_t> of_leaves, merged;
+        for (uint64_t k : leaves_.keys)
             if (of_leaves.empty() || of_leaves.back() != k >> kLeafBits) of_leaves.push_back(k >> kLeafBits);
-        std::vector<uint64_t> merged;
-        merged.reserve(lowers.size() + of_leaves.size());
-        std::set_union(lowers.begin(), lowers.end(), of_leaves.begin(), of_leaves.end(), std::back_inserter(merged));
-        lowers.swap(merged);
+        merged.reserve(lowers_.size() + of_leaves.size());
+        std::set_union(lowers_.begin(), lowers_.end(), of_leaves.begin(), of_leaves.end(), std::back_inserter(merged));
+        lowers_.swap(merged);
+        for (uint64_t k : lowers_)
+            if (uppers_.empty() || uppers_.back() != k >> kLowerBits) uppers_.push_back(k >> kLowerBits);
+
+        for (int c = 0; c < blocks_.cosets; ++c) {
+            // This coset's runs of the three sorted node lists.
+            const uint64_t u0 = nodes_.first_upper[c], u1 = nodes_.first_upper[c + 1];
+            const auto range = [](const std::vector<uint64_t>& keys, uint64_t lo, uint64_t hi) {
+                return std::pair<size_t, size_t>(size_t(std::lower_bound(keys.begin(), keys.end(), lo) - keys.begin()),
+                                                 size_t(std::lower_bound(keys.begin(), keys.end(), hi) - keys.begin()));
+            };
+            GridPlan g;
+            std::tie(g.upper_begin, g.upper_end) = range(uppers_, u0, u1);
+            std::tie(g.lower_begin, g.lower_end) = range(lowers_, u0 << kLowerBits, u1 << kLowerBits);
+            std::tie(g.leaf_begin, g.leaf_end) = range(leaves_.keys, u0 << (kLowerBits + kLeafBits), u1 << (kLowerBits + kLeafBits));
+            g.tree_at = Grid::memUsage();
+            g.root_at = g.tree_at + Tree::memUsage();
+            g.upper_at = g.root_at + Root::memUsage(uint32_t(g.uppers()));
+            g.lower_at = g.upper_at + Upper::memUsage() * g.uppers();
+            g.leaf_at = g.lower_at + Lower::memUsage() * g.lowers();
+            g.size = g.leaf_at + Leaf::DataType::memUsage() * g.leaves();
+            const VolumeGrid& part = parts[size_t(c)];
+            g.name = part.part.empty() ? "distance" : "distance_" + part.part;
+            g.map.set(part.spacing, nanovdb::Vec3d(part.origin.x, part.origin.y, part.origin.z), 1.0);  // build::Grid::setTransform's
+            grids_.push_back(g);
+        }
     }
-    std::vector<uint64_t> uppers;
-    for (uint64_t k : lowers)
-        if (uppers.empty() || uppers.back() != k >> kLowerBits) uppers.push_back(k >> kLowerBits);
 
-    SparseNvdbCounts counts;
-    std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
-    for (int c = 0; c < layout.cosets(); ++c) {
-        // This coset's runs of the three sorted node lists.
-        const uint64_t u0 = nodes.first_upper[c], u1 = nodes.first_upper[c + 1];
-        const auto range = [](const std::vector<uint64_t>& keys, uint64_t lo, uint64_t hi) {
-            return std::pair<size_t, size_t>(size_t(std::lower_bound(keys.begin(), keys.end(), lo) - keys.begin()),
-                                             size_t(std::lower_bound(keys.begin(), keys.end(), hi) - keys.begin()));
-        };
-        const auto [upper_begin, upper_end] = range(uppers, u0, u1);
-        const auto [lower_begin, lower_end] = range(lowers, u0 << kLowerBits, u1 << kLowerBits);
-        const auto [leaf_begin, leaf_end] = range(leaves.keys, u0 << (kLowerBits + kLeafBits), u1 << (kLowerBits + kLeafBits));
-        const uint64_t upper_count = upper_end - upper_begin, lower_count = lower_end - lower_begin, leaf_count = leaf_end - leaf_begin;
+    int grids() const { return int(grids_.size()); }
+    const GridPlan& grid(int c) const { return grids_[size_t(c)]; }
+    /// The leaves of lower node n of grid c: [first, last) of the grid's leaves.
+    std::pair<size_t, size_t> leaves_of_lower(int c, size_t n) const {
+        const GridPlan& g = grids_[size_t(c)];
+        const auto [l0, l1] = run_of(leaves_.keys, lowers_[g.lower_begin + n], kLeafBits);
+        return {l0 - g.leaf_begin, l1 - g.leaf_begin};
+    }
 
-        // The breadth-first layout NanoVDB's CreateNanoGrid gives (no blind data).
-        const uint64_t tree_at = Grid::memUsage(), root_at = tree_at + Tree::memUsage();
-        const uint64_t upper_at = root_at + Root::memUsage(uint32_t(upper_count));
-        const uint64_t lower_at = upper_at + Upper::memUsage() * upper_count;
-        const uint64_t leaf_at = lower_at + Lower::memUsage() * lower_count;
-        const uint64_t size = leaf_at + Leaf::DataType::memUsage() * leaf_count;
-        require_host_bytes(size, "the NanoVDB grid of " + std::to_string(leaf_count) + " leaves");
-        nanovdb::HostBuffer buffer = nanovdb::HostBuffer::create(size);
-        char* base = static_cast<char*>(buffer.data());
-        advise_huge_pages(base, size);  // untouched yet: the leaves' fill below is the first touch
-        Leaf* leaf_nodes = reinterpret_cast<Leaf*>(base + leaf_at);
-        Lower* lower_nodes = reinterpret_cast<Lower*>(base + lower_at);
-        Upper* upper_nodes = reinterpret_cast<Upper*>(base + upper_at);
-        Root* root = reinterpret_cast<Root*>(base + root_at);
-
-        // Lower nodes, each with its leaves, on every core (the leaves' fill is the first
-        // touch of most of the grid's memory): +W tiles (the background), -W where a block is
-        // an inside tile, the leaves as children; then, as tools/GridStats.h computes them
-        // (StatsMode::All, in its order: each node's children in offset order), each leaf's
-        // and lower node's active bounding box and statistics.
-        std::vector<NodeStats> lower_stats(lower_count);
-        std::atomic<int64_t> voxels{0}, inside_tiles{0};
-        parallel_for(int64_t(lower_count), 1, 0, [&](int64_t n0, int64_t n1) {
-            int64_t on = 0, inside = 0;
-            for (int64_t n = n0; n < n1; ++n) {
-                const uint64_t key = lowers[lower_begin + size_t(n)];
-                Lower& lower = lower_nodes[n];
-                auto& data = *lower.data();
-                std::memset(static_cast<void*>(&data), 0, Lower::memUsage());
-                const Int3 first = nodes.lower_block(key);
-                data.mBBox[0] = voxel_origin(first);
-                for (uint32_t t = 0; t < Lower::SIZE; ++t) data.mTable[t].value = w;
-                const BandCoset& s = blocks.coset[nodes.coset_of_upper(key >> kLowerBits)];
-                const int nx = std::min(kLeavesPerLower, s.blocks.x - first.x);
-                for (int z = first.z; z < std::min(first.z + kLeavesPerLower, s.blocks.z); ++z)
-                    for (int y = first.y; y < std::min(first.y + kLeavesPerLower, s.blocks.y); ++y) {
-                        const int64_t id = s.first_block + first.x + int64_t(s.blocks.x) * (y + int64_t(s.blocks.y) * z);
-                        for (uint32_t bits = bits_at(band.inside_tiles, id, nx); bits; bits &= bits - 1) {
-                            const uint32_t x = uint32_t(__builtin_ctz(bits));
-                            data.mTable[(x << (2 * Lower::LOG2DIM)) | (uint32_t(y - first.y) << Lower::LOG2DIM) | uint32_t(z - first.z)].value = -w;
-                            ++inside;
-                        }
-                    }
-                NodeStats total;
-                const auto [l0, l1] = run_of(leaves.keys, key, kLeafBits);
-                for (size_t l = l0; l < l1; ++l) {
-                    const uint32_t t = uint32_t(leaves.keys[l] & ((1u << kLeafBits) - 1));
-                    inside -= data.mTable[t].value == -w;  // a leaf, not a tile
-                    data.mChildMask.setOn(t);
-                    Leaf& leaf = leaf_nodes[l - leaf_begin];
-                    data.setChild(t, &leaf);
-                    fill_leaf(band, blocks, leaves.source[l], leaf, on);
-                    total.add(leaf_stats(leaf));
+    /// Lower node n of grid c into `top`, its leaves (leaves_of_lower) filled at `leaves`:
+    /// +W tiles (the background), -W where a block is an inside tile, the leaves as children
+    /// (offsets into the grid's layout, wherever the leaves are now); then, as
+    /// tools/GridStats.h computes them, each leaf's and the node's box and statistics.
+    NodeStats build_lower(int c, size_t n, char* top, Leaf* leaves, int64_t& on, int64_t& inside) const {
+        const GridPlan& g = grids_[size_t(c)];
+        const uint64_t key = lowers_[g.lower_begin + n];
+        const uint64_t node_at = g.lower_at + Lower::memUsage() * n;
+        auto& data = *reinterpret_cast<Lower*>(top + node_at)->data();
+        std::memset(static_cast<void*>(&data), 0, Lower::memUsage());
+        const Int3 first = nodes_.lower_block(key);
+        data.mBBox[0] = voxel_origin(first);
+        for (uint32_t t = 0; t < Lower::SIZE; ++t) data.mTable[t].value = w_;
+        const BandCoset& s = blocks_.coset[c];
+        const int nx = std::min(kLeavesPerLower, s.blocks.x - first.x);
+        for (int z = first.z; z < std::min(first.z + kLeavesPerLower, s.blocks.z); ++z)
+            for (int y = first.y; y < std::min(first.y + kLeavesPerLower, s.blocks.y); ++y) {
+                const int64_t id = s.first_block + first.x + int64_t(s.blocks.x) * (y + int64_t(s.blocks.y) * z);
+                for (uint32_t bits = bits_at(band_.inside_tiles, id, nx); bits; bits &= bits - 1) {
+                    const uint32_t x = uint32_t(__builtin_ctz(bits));
+                    data.mTable[(x << (2 * Lower::LOG2DIM)) | (uint32_t(y - first.y) << Lower::LOG2DIM) | uint32_t(z - first.z)].value = -w_;
+                    ++inside;
                 }
-                set_node_stats(data, total);
-                lower_stats[size_t(n)] = total;
             }
-            voxels += on;
-            inside_tiles += inside;
-        });
+        NodeStats total;
+        const auto [l0, l1] = run_of(leaves_.keys, key, kLeafBits);
+        for (size_t l = l0; l < l1; ++l) {
+            const uint32_t t = uint32_t(leaves_.keys[l] & ((1u << kLeafBits) - 1));
+            inside -= data.mTable[t].value == -w_;  // a leaf, not a tile
+            data.mChildMask.setOn(t);
+            data.mTable[t].child = int64_t(g.leaf_at + Leaf::DataType::memUsage() * (l - g.leaf_begin)) - int64_t(node_at);
+            Leaf& leaf = leaves[l - l0];
+            fill_leaf(band_, blocks_, leaves_.source[l], leaf, on);
+            total.add(leaf_stats(leaf));
+        }
+        set_node_stats(data, total);
+        return total;
+    }
 
-        // Upper nodes: +W tiles and their lower nodes as children.
-        std::vector<NodeStats> upper_stats(upper_count);
-        parallel_for(int64_t(upper_count), 1, 0, [&](int64_t n0, int64_t n1) {
+    /// The rest of grid c's top once its lower nodes are built: the upper nodes (+W tiles,
+    /// the lower nodes as children), the root, the tree and the grid, with GridStats's
+    /// statistics, boxes and flags, and the checksum CreateNanoGrid leaves (CheckMode::Default).
+    void finish(int c, char* top, const std::vector<NodeStats>& lower_stats, int64_t voxels) const {
+        const GridPlan& g = grids_[size_t(c)];
+        std::vector<NodeStats> upper_stats(g.uppers());
+        parallel_for(int64_t(g.uppers()), 1, 0, [&](int64_t n0, int64_t n1) {
             for (int64_t n = n0; n < n1; ++n) {
-                const uint64_t key = uppers[upper_begin + size_t(n)];
-                auto& data = *upper_nodes[n].data();
+                const uint64_t key = uppers_[g.upper_begin + size_t(n)];
+                const uint64_t node_at = g.upper_at + Upper::memUsage() * uint64_t(n);
+                auto& data = *reinterpret_cast<Upper*>(top + node_at)->data();
                 std::memset(static_cast<void*>(&data), 0, Upper::memUsage());
-                data.mBBox[0] = voxel_origin(nodes.upper_block(key));
-                for (uint32_t t = 0; t < Upper::SIZE; ++t) data.mTable[t].value = w;
+                data.mBBox[0] = voxel_origin(nodes_.upper_block(key));
+                for (uint32_t t = 0; t < Upper::SIZE; ++t) data.mTable[t].value = w_;
                 NodeStats total;
-                const auto [l0, l1] = run_of(lowers, key, kLowerBits);
+                const auto [l0, l1] = run_of(lowers_, key, kLowerBits);
                 for (size_t l = l0; l < l1; ++l) {
-                    const uint32_t t = uint32_t(lowers[l] & ((1u << kLowerBits) - 1));
+                    const uint32_t t = uint32_t(lowers_[l] & ((1u << kLowerBits) - 1));
                     data.mChildMask.setOn(t);
-                    data.setChild(t, &lower_nodes[l - lower_begin]);
-                    total.add(lower_stats[l - lower_begin]);
+                    data.mTable[t].child = int64_t(g.lower_at + Lower::memUsage() * (l - g.lower_begin)) - int64_t(node_at);
+                    total.add(lower_stats[l - g.lower_begin]);
                 }
                 set_node_stats(data, total);
                 upper_stats[size_t(n)] = total;
             }
         });
 
-        // The root: one child tile per upper node, in order; the tree; the grid.
-        auto& root_data = *root->data();
-        std::memset(static_cast<void*>(&root_data), 0, Root::memUsage(uint32_t(upper_count)));
-        root_data.mTableSize = uint32_t(upper_count);
-        root_data.mMinimum = root_data.mMaximum = root_data.mBackground = w;
-        root_data.mBBox = nanovdb::CoordBBox();
+        // The root: one child tile per upper node, in order.
+        auto& root = *reinterpret_cast<Root*>(top + g.root_at)->data();
+        std::memset(static_cast<void*>(&root), 0, Root::memUsage(uint32_t(g.uppers())));
+        root.mTableSize = uint32_t(g.uppers());
+        root.mMinimum = root.mMaximum = root.mBackground = w_;
+        root.mBBox = nanovdb::CoordBBox();
         NodeStats total;
-        for (uint64_t n = 0; n < upper_count; ++n) {
-            root_data.tile(uint32_t(n))->setChild(voxel_origin(nodes.upper_block(uppers[upper_begin + n])), &upper_nodes[n], &root_data);
+        for (uint64_t n = 0; n < g.uppers(); ++n) {
+            auto& tile = *root.tile(uint32_t(n));
+            tile.setValue(voxel_origin(nodes_.upper_block(uppers_[g.upper_begin + n])), false, 0.0f);  // the key; then the child
+            tile.child = int64_t(g.upper_at + Upper::memUsage() * n) - int64_t(g.root_at);
             total.add(upper_stats[n]);
         }
-        if (upper_count > 0) {  // else min = max = background, average and deviation 0, an empty box
-            set_stats(root_data, total.stats);
-            root_data.mBBox = total.bbox;
+        if (g.uppers() > 0) {  // else min = max = background, average and deviation 0, an empty box
+            set_stats(root, total.stats);
+            root.mBBox = total.bbox;
         }
-        auto& tree = *reinterpret_cast<Tree*>(base + tree_at)->data();
-        tree.setRoot(root);
-        tree.setFirstNode(upper_count ? &upper_nodes[0] : static_cast<Upper*>(nullptr));
-        tree.setFirstNode(lower_count ? &lower_nodes[0] : static_cast<Lower*>(nullptr));
-        tree.setFirstNode(leaf_count ? &leaf_nodes[0] : static_cast<Leaf*>(nullptr));
-        tree.mNodeCount[0] = uint32_t(leaf_count);
-        tree.mNodeCount[1] = uint32_t(lower_count);
-        tree.mNodeCount[2] = uint32_t(upper_count);
+
+        auto& tree = *reinterpret_cast<Tree*>(top + g.tree_at)->data();
+        const auto offset = [&](uint64_t count, uint64_t at) { return count ? int64_t(at) - int64_t(g.tree_at) : int64_t(0); };
+        tree.mNodeOffset[0] = offset(g.leaves(), g.leaf_at);
+        tree.mNodeOffset[1] = offset(g.lowers(), g.lower_at);
+        tree.mNodeOffset[2] = offset(g.uppers(), g.upper_at);
+        tree.mNodeOffset[3] = int64_t(g.root_at - g.tree_at);
+        tree.mNodeCount[0] = uint32_t(g.leaves());
+        tree.mNodeCount[1] = uint32_t(g.lowers());
+        tree.mNodeCount[2] = uint32_t(g.uppers());
         tree.mTileCount[0] = tree.mTileCount[1] = tree.mTileCount[2] = 0;  // every tile inactive
-        tree.mVoxelCount = uint64_t(voxels.load());
+        tree.mVoxelCount = uint64_t(voxels);
 
-        const VolumeGrid& part = parts[size_t(c)];
-        const std::string name = part.part.empty() ? "distance" : "distance_" + part.part;
-        Grid& grid = *reinterpret_cast<Grid*>(base);
-        nanovdb::Map map;
-        map.set(part.spacing, nanovdb::Vec3d(part.origin.x, part.origin.y, part.origin.z), 1.0);
-        auto& grid_data = *grid.data();
-        grid_data.init({nanovdb::GridFlags::IsBreadthFirst}, size, map, nanovdb::GridType::Float, nanovdb::GridClass::LevelSet);
-        std::memset(grid_data.mGridName, 0, nanovdb::GridData::MaxNameSize);
-        std::strncpy(grid_data.mGridName, name.c_str(), nanovdb::GridData::MaxNameSize - 1);
-        // The grid's world box and flags, as GridStats::process(Grid&).
-        if (root_data.mBBox.empty()) {
-            grid_data.mWorldBBox = nanovdb::Vec3dBBox();
-            grid_data.setBBoxOn(false);
+        Grid& grid = *reinterpret_cast<Grid*>(top);
+        auto& data = *grid.data();
+        data.init({nanovdb::GridFlags::IsBreadthFirst}, g.size, g.map, nanovdb::GridType::Float, nanovdb::GridClass::LevelSet);
+        std::memset(data.mGridName, 0, nanovdb::GridData::MaxNameSize);
+        std::strncpy(data.mGridName, g.name.c_str(), nanovdb::GridData::MaxNameSize - 1);
+        // The world box and flags, as GridStats::process(Grid&).
+        if (root.mBBox.empty()) {
+            data.mWorldBBox = nanovdb::Vec3dBBox();
+            data.setBBoxOn(false);
         } else {
-            grid_data.mWorldBBox = nanovdb::CoordBBox(root_data.mBBox[0], root_data.mBBox[1].offsetBy(1)).transform(grid.map());
-            grid_data.setBBoxOn(true);
+            data.mWorldBBox = nanovdb::CoordBBox(root.mBBox[0], root.mBBox[1].offsetBy(1)).transform(grid.map());
+            data.setBBoxOn(true);
         }
-        grid_data.setMinMaxOn(true);
-        grid_data.setAverageOn(true);
-        grid_data.setStdDeviationOn(true);
-        nanovdb::tools::updateChecksum(&grid, nanovdb::CheckMode::Default);
+        data.setMinMaxOn(true);
+        data.setAverageOn(true);
+        data.setStdDeviationOn(true);
+        nanovdb::tools::updateChecksum(&grid, nanovdb::CheckMode::Default);  // the head: grid and tree
+    }
 
-        counts.leaves += int64_t(leaf_count);
+private:
+    const SparseBandField& band_;
+    BandBlockGrid blocks_;
+    NodeKeys nodes_;
+    float w_;
+    SortedLeaves leaves_;
+    std::vector<uint64_t> lowers_, uppers_;
+    std::vector<GridPlan> grids_;
+};
+
+}  // namespace
+
+std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> sparse_band_nanogrids(const SparseBandField& band, SparseNvdbCounts* counts_out) {
+    const BandNanoPlan plan(band);
+    SparseNvdbCounts counts;
+    std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+    for (int c = 0; c < plan.grids(); ++c) {
+        const BandNanoPlan::GridPlan& g = plan.grid(c);
+        require_host_bytes(g.size, "the NanoVDB grid of " + std::to_string(g.leaves()) + " leaves");
+        nanovdb::HostBuffer buffer = nanovdb::HostBuffer::create(g.size);
+        char* top = static_cast<char*>(buffer.data());
+        advise_huge_pages(top, g.size);  // untouched yet: the leaves' fill is the first touch
+        Leaf* leaves = reinterpret_cast<Leaf*>(top + g.leaf_at);
+        std::vector<NodeStats> lower_stats(g.lowers());
+        std::atomic<int64_t> voxels{0}, inside_tiles{0};
+        parallel_for(int64_t(g.lowers()), 1, 0, [&](int64_t n0, int64_t n1) {
+            int64_t on = 0, inside = 0;
+            for (int64_t n = n0; n < n1; ++n)
+                lower_stats[size_t(n)] = plan.build_lower(c, size_t(n), top, leaves + plan.leaves_of_lower(c, size_t(n)).first, on, inside);
+            voxels += on;
+            inside_tiles += inside;
+        });
+        plan.finish(c, top, lower_stats, voxels.load());
+        counts.leaves += int64_t(g.leaves());
         counts.active_voxels += voxels.load();
         counts.inside_tiles += inside_tiles.load();
-        counts.bytes += int64_t(size);
+        counts.bytes += int64_t(g.size);
         handles.emplace_back(std::move(buffer));
     }
     if (counts_out) *counts_out = counts;
@@ -471,16 +520,109 @@ std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> sparse_band_nanogrids(cons
 
 namespace {
 
-// path: the temporary written; target: the name the messages give.
-void write_grids(const SparseBandField& band, const std::string& path, const std::string& target, SparseNvdbCounts& counts) {
-    const std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles = sparse_band_nanogrids(band, &counts);
-    // NanoVDB's file-name overload neither checks its stream nor reports a short write: a full
-    // disk would be placed as a whole file. Our own stream, checked after closing, does not.
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    if (!os) throw std::runtime_error(target + ": cannot open a file beside it for writing");
-    nanovdb::io::writeGrids(os, handles);
-    os.close();
-    if (!os) throw std::runtime_error(target + ": writing the NanoVDB grids failed (disk full?)");
+void write_at(int fd, const char* data, uint64_t bytes, uint64_t at, const std::string& target) {
+    while (bytes > 0) {
+        const ssize_t n = ::pwrite(fd, data, size_t(std::min<uint64_t>(bytes, uint64_t(1) << 30)), off_t(at));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0)
+            throw std::runtime_error(target + ": writing the NanoVDB grids failed (" + (n < 0 ? std::strerror(errno) : "no progress") + ")");
+        data += n;
+        bytes -= uint64_t(n);
+        at += uint64_t(n);
+    }
+}
+
+/// Leaves a window holds: 128Ki (268 MiB), two windows, one filling while the other is written.
+constexpr uint64_t kWindowLeaves = uint64_t(1) << 17;
+constexpr uint64_t kLeavesOfALower = uint64_t(1) << (3 * Lower::LOG2DIM);  // a window holds at least one lower node's
+
+// path: the temporary written; target: the name the messages give. The file io::writeGrids
+// writes (one segment per grid: its header, metadata and name, then the grid), streamed: the
+// leaves, a window of lower nodes' at a time, are filled on every core while the previous
+// window is written; each grid's top part and segment header last, at their places, once its
+// statistics are known. Host memory: the band, the tops and the two windows.
+void write_grids(const SparseBandField& band, const std::string& path, const std::string& target, uint64_t window_capacity,
+                 SparseNvdbCounts& counts) {
+    const BandNanoPlan plan(band);
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error(target + ": cannot open a file beside it for writing (" + std::strerror(errno) + ")");
+    struct Closer {
+        int fd;
+        ~Closer() {
+            if (fd >= 0) ::close(fd);
+        }
+    } closer{fd};
+    uint64_t file_at = 0;
+    for (int c = 0; c < plan.grids(); ++c) {
+        const BandNanoPlan::GridPlan& g = plan.grid(c);
+        const uint64_t prefix = sizeof(nanovdb::io::FileHeader) + sizeof(nanovdb::io::FileMetaData) + g.name.size() + 1;
+        const uint64_t window_leaves = std::min<uint64_t>(g.leaves(), std::max(window_capacity, kLeavesOfALower));
+        require_host_bytes(g.leaf_at + 2 * window_leaves * Leaf::DataType::memUsage(),
+                           target + ": the NanoVDB grid's nodes and two windows of its " + std::to_string(g.leaves()) + " leaves");
+        nanovdb::HostBuffer top_buffer = nanovdb::HostBuffer::create(g.leaf_at);
+        char* top = static_cast<char*>(top_buffer.data());
+        nanovdb::HostBuffer windows[2];
+        std::future<void> written[2];
+        for (nanovdb::HostBuffer& w : windows) {
+            w = nanovdb::HostBuffer::create(std::max<uint64_t>(window_leaves, 1) * Leaf::DataType::memUsage());
+            advise_huge_pages(w.data(), w.size());
+        }
+        std::vector<NodeStats> lower_stats(g.lowers());
+        std::atomic<int64_t> voxels{0}, inside_tiles{0};
+        int window = 0;
+        for (size_t n0 = 0; n0 < g.lowers();) {
+            // The next lower nodes whose leaves fit the window (a lower node holds at most 4096).
+            const size_t first_leaf = plan.leaves_of_lower(c, n0).first;
+            size_t n1 = n0 + 1;
+            while (n1 < g.lowers() && plan.leaves_of_lower(c, n1).second - first_leaf <= window_leaves) ++n1;
+            if (written[window].valid()) written[window].get();  // its previous write is done
+            Leaf* leaves = static_cast<Leaf*>(windows[window].data());
+            parallel_for(int64_t(n1 - n0), 1, 0, [&](int64_t k0, int64_t k1) {
+                int64_t on = 0, inside = 0;
+                for (int64_t k = k0; k < k1; ++k) {
+                    const size_t n = n0 + size_t(k);
+                    lower_stats[n] = plan.build_lower(c, n, top, leaves + (plan.leaves_of_lower(c, n).first - first_leaf), on, inside);
+                }
+                voxels += on;
+                inside_tiles += inside;
+            });
+            const size_t last_leaf = plan.leaves_of_lower(c, n1 - 1).second;
+            const uint64_t bytes = (last_leaf - first_leaf) * Leaf::DataType::memUsage();
+            const uint64_t at = file_at + prefix + g.leaf_at + first_leaf * Leaf::DataType::memUsage();
+            written[window] = std::async(std::launch::async, [=, &target] {
+                write_at(fd, reinterpret_cast<const char*>(leaves), bytes, at, target);
+            });
+            window ^= 1;
+            n0 = n1;
+        }
+        for (std::future<void>& f : written)
+            if (f.valid()) f.get();
+        plan.finish(c, top, lower_stats, voxels.load());
+
+        // The segment's header and metadata, as io::writeGrid writes them for this grid.
+        const auto& grid_data = *reinterpret_cast<const nanovdb::GridData*>(top);
+        nanovdb::io::Segment segment(nanovdb::io::Codec::NONE);
+        segment.header.gridCount = 1;
+        segment.meta.emplace_back(g.size, nanovdb::io::Codec::NONE, grid_data);
+        segment.meta.back().fileSize = g.size;  // uncompressed
+        std::ostringstream head;
+        segment.write(head);
+        const std::string bytes = head.str();
+        if (bytes.size() != prefix) throw std::logic_error(target + ": unexpected NanoVDB segment header size");
+        write_at(fd, bytes.data(), bytes.size(), file_at, target);
+        write_at(fd, top, g.leaf_at, file_at + prefix, target);
+        file_at += prefix + g.size;
+
+        counts.leaves += int64_t(g.leaves());
+        counts.active_voxels += voxels.load();
+        counts.inside_tiles += inside_tiles.load();
+        counts.bytes += int64_t(g.size);
+    }
+    if (::close(closer.fd) != 0) {
+        closer.fd = -1;
+        throw std::runtime_error(target + ": writing the NanoVDB grids failed (" + std::strerror(errno) + ")");
+    }
+    closer.fd = -1;
 }
 
 }  // namespace
@@ -488,12 +630,17 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
 bool nanovdb_available() { return true; }
 
 SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::string& path, Overwrite overwrite) {
+    return write_sparse_band_nvdb_windows(band, path, overwrite, kWindowLeaves);
+}
+
+SparseNvdbCounts write_sparse_band_nvdb_windows(const SparseBandField& band, const std::string& path, Overwrite overwrite,
+                                                uint64_t window_leaves) {
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
     band.require_channels({false, false}, path + ": the distance grids");  // the arrays match the active blocks
     require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .nvdb stores float32)");
     SparseNvdbCounts counts;
     write_through_temporary(path, overwrite,
-                            [&](const std::string& temporary) { write_grids(band, temporary, path, counts); });
+                            [&](const std::string& temporary) { write_grids(band, temporary, path, window_leaves, counts); });
     return counts;
 }
 

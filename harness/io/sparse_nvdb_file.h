@@ -10,10 +10,14 @@
 /// active voxels holding float(d), its other points inactive at +-W and its padding inactive
 /// at +W; a mixed block is a leaf of inactive voxels at +-W; an inside tile is an inactive
 /// tile of one leaf's extent at -W; every other block is the background +W. Each grid is laid
-/// out in place on the host, breadth first, from the band's blocks (sparse_nvdb_grids.h: the
-/// bytes NanoVDB's tools/GridBuilder.h and tools/CreateNanoGrid.h make of the same tree, with
-/// no intermediate tree and no second copy of the leaves) and written with its io::writeGrids
-/// (uncompressed). Distance only: no gradient or triangle grids.
+/// out on the host, breadth first, from the band's blocks (sparse_nvdb_grids.h: the bytes
+/// NanoVDB's tools/GridBuilder.h and tools/CreateNanoGrid.h make of the same tree) and
+/// streamed: the leaves are filled on every core a window of lower nodes at a time while the
+/// previous window is written, and each grid's nodes above them and its segment header are
+/// written last, once its statistics are known. The file holds the bytes NanoVDB's
+/// io::writeGrids (uncompressed) writes, and the process holds the band, the grids' upper and
+/// lower nodes and two windows (2 x 268 MiB), never a grid's leaves. Distance only: no
+/// gradient or triangle grids.
 #pragma once
 
 #include <string>

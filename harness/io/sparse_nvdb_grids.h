@@ -21,4 +21,10 @@ namespace sdf {
 std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> sparse_band_nanogrids(const SparseBandField& band,
                                                                            SparseNvdbCounts* counts = nullptr);
 
+/// write_sparse_band_nvdb, whose leaves are filled and written a window of lower nodes at a
+/// time, with windows of `window_leaves` leaves (at least one lower node's, 4096): for tests
+/// that stream a small band through many windows.
+SparseNvdbCounts write_sparse_band_nvdb_windows(const SparseBandField& band, const std::string& path, Overwrite overwrite,
+                                                uint64_t window_leaves);
+
 }  // namespace sdf

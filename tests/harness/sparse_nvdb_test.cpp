@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <memory>
 #include <random>
 
@@ -61,6 +63,18 @@ std::pair<int, nanovdb::Coord> voxel_of(const Lattice& lattice, int64_t index) {
     const Int3 c = lattice.coords_of(index);
     const int coset = c.x & 1;
     return {coset, nanovdb::Coord(c.x >> 1, c.y >> 1, c.z >> 1)};
+}
+
+std::string file_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The file NanoVDB's own writer (io::writeGrids) makes of grids in memory.
+std::string nanovdb_file_bytes(const std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>>& handles) {
+    std::ostringstream os;
+    nanovdb::io::writeGrids(os, handles);
+    return os.str();
 }
 
 /// NanoVDB's own way to the same grids, the reference: its host builder fed the band's blocks
@@ -146,8 +160,12 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
         EXPECT_GT(in_memory.inside_tiles, 0);
         EXPECT_EQ(in_memory.inside_tiles, band.counts().inside_tiles);
 
+        // The writer streams the leaves and places each grid's top last: the file is the one
+        // NanoVDB's own writer makes of the grids in memory.
         const SparseNvdbCounts counts = write_sparse_band_nvdb(band, path);
+        EXPECT_TRUE(file_bytes(path) == nanovdb_file_bytes(built)) << "the streamed file differs from io::writeGrids'";
         EXPECT_EQ(counts.inside_tiles, in_memory.inside_tiles);
+        EXPECT_EQ(counts.bytes, in_memory.bytes);
         EXPECT_EQ(counts.leaves, band.counts().active_blocks + band.counts().mixed_blocks);
         ASSERT_TRUE(fs::exists(path));
         EXPECT_EQ(counts.active_voxels, band.counts().band_points);
@@ -281,6 +299,16 @@ TEST(SparseNvdb, GridsSpanningManyNodesAreLaidOutAsNanoVdbsOwnConversion) {
         EXPECT_EQ(counts.active_voxels, band.counts().band_points);
         EXPECT_EQ(counts.inside_tiles, band.counts().inside_tiles);
         EXPECT_EQ(counts.leaves, band.counts().active_blocks + band.counts().mixed_blocks);
+
+        const std::string path = temp_path("many_nodes.nvdb");
+        fs::remove(path);
+        const SparseNvdbCounts written = write_sparse_band_nvdb(band, path);
+        EXPECT_TRUE(file_bytes(path) == nanovdb_file_bytes(built)) << "the streamed file differs from io::writeGrids'";
+        EXPECT_EQ(written.bytes, counts.bytes);
+        // Through many windows (one lower node's 4096 leaves each, at least): the same bytes.
+        write_sparse_band_nvdb_windows(band, path, Overwrite::Allow, 1);
+        EXPECT_TRUE(file_bytes(path) == nanovdb_file_bytes(built)) << "streamed through small windows";
+        fs::remove(path);
     }
 }
 
