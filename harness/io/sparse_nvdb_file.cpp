@@ -532,8 +532,8 @@ void write_at(int fd, const char* data, uint64_t bytes, uint64_t at, const std::
     }
 }
 
-/// Leaves a window holds: 128Ki (268 MiB), two windows, one filling while the other is written.
-constexpr uint64_t kWindowLeaves = uint64_t(1) << 17;
+/// Leaves a window holds: 32Ki (67 MiB), two windows, one filling while the other is written.
+constexpr uint64_t kWindowLeaves = uint64_t(1) << 15;
 constexpr uint64_t kLeavesOfALower = uint64_t(1) << (3 * Lower::LOG2DIM);  // a window holds at least one lower node's
 
 // path: the temporary written; target: the name the messages give. The file io::writeGrids

@@ -16,7 +16,7 @@
 /// previous window is written, and each grid's nodes above them and its segment header are
 /// written last, once its statistics are known. The file holds the bytes NanoVDB's
 /// io::writeGrids (uncompressed) writes, and the process holds the band, the grids' upper and
-/// lower nodes and two windows (2 x 268 MiB), never a grid's leaves. Distance only: no
+/// lower nodes and two windows (2 x 67 MiB), never a grid's leaves. Distance only: no
 /// gradient or triangle grids.
 #pragma once
 
