@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <future>
 #include <sstream>
@@ -314,6 +315,11 @@ public:
         const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
         if (int(parts.size()) != band.layout().cosets() || blocks_.cosets != band.layout().cosets())
             throw std::logic_error("the band's cosets are not the lattice's grids");
+        for (int c = 0; c < blocks_.cosets; ++c)  // NanoVDB's index coordinates are 32-bit (a block's origin is 8 its index)
+            for (int k = 0; k < 3; ++k)
+                if (int64_t(blocks_.coset[c].blocks[k]) * kBandBlockDim > int64_t(INT32_MAX))
+                    throw std::length_error("a NanoVDB grid holds at most 2^31 - 1 voxels per axis; this lattice has " +
+                                            std::to_string(blocks_.coset[c].points[k]) + " points along an axis");
         // The leaves sorted into NanoVDB's order; the lower nodes of the leaves and of the
         // inside tiles; their upper nodes.
         leaves_ = sort_leaves(band, blocks_, nodes_);
@@ -344,6 +350,9 @@ public:
             g.lower_at = g.upper_at + Upper::memUsage() * g.uppers();
             g.leaf_at = g.lower_at + Lower::memUsage() * g.lowers();
             g.size = g.leaf_at + Leaf::DataType::memUsage() * g.leaves();
+            if (g.leaves() > UINT32_MAX || g.lowers() > UINT32_MAX)  // TreeData's node counts are 32-bit
+                throw std::length_error("a NanoVDB grid holds at most 2^32 - 1 nodes of a level; this band has " +
+                                        std::to_string(g.leaves()) + " leaves in one grid");
             const VolumeGrid& part = parts[size_t(c)];
             g.name = part.part.empty() ? "distance" : "distance_" + part.part;
             g.map.set(part.spacing, nanovdb::Vec3d(part.origin.x, part.origin.y, part.origin.z), 1.0);  // build::Grid::setTransform's
