@@ -323,6 +323,8 @@ public:
         // The leaves sorted into NanoVDB's order; the lower nodes of the leaves and of the
         // inside tiles; their upper nodes.
         leaves_ = sort_leaves(band, blocks_, nodes_);
+        if (std::adjacent_find(leaves_.keys.begin(), leaves_.keys.end()) != leaves_.keys.end())
+            throw std::logic_error("a sparse band lists a block twice (active and mixed): a NanoVDB leaf cannot be two");
         lowers_ = inside_tile_lowers(band, blocks_, nodes_);
         std::vector<uint64_t> of_leaves, merged;
         for (uint64_t k : leaves_.keys)
