@@ -126,6 +126,23 @@ std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> reference_grids(const Spar
     return handles;
 }
 
+/// The grids laid out from the band equal NanoVDB's own (reference_grids) byte for byte, and
+/// pass its full validator (checksum, node order, offsets).
+void expect_nanovdbs_own_grids(const std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>>& built,
+                               const std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>>& reference) {
+    ASSERT_EQ(built.size(), reference.size());
+    for (size_t g = 0; g < built.size(); ++g) {
+        ASSERT_EQ(built[g].bufferSize(), reference[g].bufferSize()) << "grid " << g;
+        const auto* a = static_cast<const unsigned char*>(built[g].data());
+        const auto* b = static_cast<const unsigned char*>(reference[g].data());
+        const auto differ = std::mismatch(a, a + built[g].bufferSize(), b);
+        EXPECT_EQ(differ.first, a + built[g].bufferSize()) << "grid " << g << ": first different byte at " << (differ.first - a)
+                                                          << " of " << built[g].bufferSize();
+        ASSERT_NE(built[g].grid<float>(), nullptr);
+        EXPECT_TRUE(nanovdb::tools::isValid(built[g].grid<float>(), nanovdb::CheckMode::Full, true)) << "grid " << g;
+    }
+}
+
 TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
     // Lattices fine enough for inside tiles (8^3 points inside) and, across the bowl's
     // opening, mixed blocks; a resolution not a multiple of 8 (padding).
@@ -142,21 +159,10 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
         const SampledField dense = band.densify();
         const std::string path = temp_path("band.nvdb");
         fs::remove(path);
-        // In memory: NanoVDB's own builder and conversion give the same bytes, and its full
-        // validator (checksum, node order, offsets) passes.
+        // In memory: NanoVDB's own builder and conversion give the same bytes.
         SparseNvdbCounts in_memory;
         const auto built = sparse_band_nanogrids(band, &in_memory);
-        const auto reference = reference_grids(band);
-        ASSERT_EQ(built.size(), reference.size());
-        for (size_t g = 0; g < built.size(); ++g) {
-            ASSERT_EQ(built[g].bufferSize(), reference[g].bufferSize()) << "grid " << g;
-            const auto* a = static_cast<const unsigned char*>(built[g].data());
-            const auto* b = static_cast<const unsigned char*>(reference[g].data());
-            const auto differ = std::mismatch(a, a + built[g].bufferSize(), b);
-            EXPECT_EQ(differ.first, a + built[g].bufferSize()) << "grid " << g << ": first different byte at " << (differ.first - a)
-                                                              << " of " << built[g].bufferSize();
-            EXPECT_TRUE(nanovdb::tools::isValid(built[g].grid<float>(), nanovdb::CheckMode::Full, true)) << "grid " << g;
-        }
+        expect_nanovdbs_own_grids(built, reference_grids(band));
         EXPECT_GT(in_memory.inside_tiles, 0);
         EXPECT_EQ(in_memory.inside_tiles, band.counts().inside_tiles);
 
@@ -278,21 +284,11 @@ TEST(SparseNvdb, GridsSpanningManyNodesAreLaidOutAsNanoVdbsOwnConversion) {
         }
         SparseNvdbCounts counts;
         const auto built = sparse_band_nanogrids(band, &counts);
-        const auto reference = reference_grids(band);
-        ASSERT_EQ(built.size(), reference.size());
+        expect_nanovdbs_own_grids(built, reference_grids(band));
         uint64_t uppers = 0, lowers = 0;
-        for (size_t g = 0; g < built.size(); ++g) {
-            ASSERT_EQ(built[g].bufferSize(), reference[g].bufferSize()) << "grid " << g;
-            const auto* a = static_cast<const unsigned char*>(built[g].data());
-            const auto* b = static_cast<const unsigned char*>(reference[g].data());
-            const auto differ = std::mismatch(a, a + built[g].bufferSize(), b);
-            EXPECT_EQ(differ.first, a + built[g].bufferSize()) << "grid " << g << ": first different byte at " << (differ.first - a)
-                                                              << " of " << built[g].bufferSize();
-            const nanovdb::NanoGrid<float>* grid = built[g].grid<float>();
-            ASSERT_NE(grid, nullptr);
-            EXPECT_TRUE(nanovdb::tools::isValid(grid, nanovdb::CheckMode::Full, true)) << "grid " << g;
-            uppers += grid->tree().nodeCount(2);
-            lowers += grid->tree().nodeCount(1);
+        for (const auto& handle : built) {
+            uppers += handle.grid<float>()->tree().nodeCount(2);
+            lowers += handle.grid<float>()->tree().nodeCount(1);
         }
         EXPECT_GE(uppers, uint64_t(3 * built.size())) << "the lattice should span several upper nodes";
         EXPECT_GE(lowers, uint64_t(100));
