@@ -71,7 +71,7 @@ struct NodeKeys {
                          (b.z + kBlocksPerUpper - 1) / kBlocksPerUpper};
             first_upper[c + 1] = first_upper[c] + uint64_t(uppers[c].x) * uint64_t(uppers[c].y) * uint64_t(uppers[c].z);
         }
-        if (first_upper[cosets] > (uint64_t(1) << kMaxUpperBits))
+        if (first_upper[cosets] >= (uint64_t(1) << kMaxUpperBits))
             throw std::length_error("a NanoVDB grid of " + std::to_string(first_upper[cosets]) + " upper nodes cannot be keyed");
     }
     uint64_t leaf_key(const BandBlockCoords& b) const {
@@ -293,6 +293,31 @@ void fill_leaf(const SparseBandField& band, const BandBlockGrid& blocks, int64_t
     }
 }
 
+/// Refuses (std::invalid_argument naming `what`) a band whose arrays do not match its
+/// blocks and lattice, before any of them is read by block: the writer's input may come
+/// from a file or a caller's own band.
+const SparseBandField& checked_for_nanovdb(const SparseBandField& band, const std::string& what) {
+    if (!(band.width > 0)) throw std::invalid_argument(what + ": a sparse band needs a width W > 0");
+    band.require_channels({false, false}, what);  // the distances and masks match the active blocks
+    require_representable_band(band.width, FieldDtype::Float32, what + ": the band's width (a .nvdb stores float32)");
+    const BandBlockGrid blocks = BandBlockGrid::of(band.lattice);
+    const int64_t count = band.layout().block_count();
+    if (blocks.block_count != count || blocks.cosets != band.layout().cosets())
+        throw std::invalid_argument(what + ": the band's lattice is not the one its blocks were laid out for");
+    if (band.inside_tiles.size() != size_t((count + 63) / 64))
+        throw std::invalid_argument(what + ": the band's tile signs hold " + std::to_string(band.inside_tiles.size()) +
+                                    " words for " + std::to_string(count) + " blocks");
+    if (band.mixed_inside.size() != band.mixed.size())
+        throw std::invalid_argument(what + ": the band's " + std::to_string(band.mixed.size()) + " mixed blocks have " +
+                                    std::to_string(band.mixed_inside.size()) + " sign masks");
+    for (const std::vector<int64_t>* ids : {&band.active, &band.mixed})
+        for (size_t i = 0; i < ids->size(); ++i)
+            if ((*ids)[i] < 0 || (*ids)[i] >= count || (i > 0 && (*ids)[i] <= (*ids)[i - 1]))
+                throw std::invalid_argument(what + ": the band's block ids must ascend within [0, " + std::to_string(count) +
+                                            "); got " + std::to_string((*ids)[i]) + " at " + std::to_string(i));
+    return band;
+}
+
 /// The band's grids planned: every grid's nodes in NanoVDB's breadth-first order and its byte
 /// layout (CreateNanoGrid's, without blind data). A grid is then built in two parts: its top
 /// (grid, tree, root, upper and lower nodes: every byte before its leaves) in one buffer, and
@@ -310,11 +335,13 @@ public:
         uint64_t leaves() const { return leaf_end - leaf_begin; }
     };
 
-    explicit BandNanoPlan(const SparseBandField& band)
-        : band_(band), blocks_(BandBlockGrid::of(band.lattice)), nodes_(blocks_), w_(float(band.width)) {
+    /// `what` names the grids in messages (the file, for the writer).
+    BandNanoPlan(const SparseBandField& band, const std::string& what)
+        : band_(checked_for_nanovdb(band, what)), blocks_(BandBlockGrid::of(band.lattice)), nodes_(blocks_), w_(float(band.width)) {
         const std::vector<VolumeGrid> parts = volume_grids(band.lattice);
-        if (int(parts.size()) != band.layout().cosets() || blocks_.cosets != band.layout().cosets())
-            throw std::logic_error("the band's cosets are not the lattice's grids");
+        if (int(parts.size()) != blocks_.cosets)
+            throw std::invalid_argument(what + ": a BCC lattice with one point along an axis has no secondary grid, and a "
+                                               ".nvdb of it would name one; expected at least 2 points per axis");
         for (int c = 0; c < blocks_.cosets; ++c)  // NanoVDB's index coordinates are 32-bit (a block's origin is 8 its index)
             for (int k = 0; k < 3; ++k)
                 if (int64_t(blocks_.coset[c].blocks[k]) * kBandBlockDim > int64_t(INT32_MAX))
@@ -499,7 +526,7 @@ private:
 }  // namespace
 
 std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> sparse_band_nanogrids(const SparseBandField& band, SparseNvdbCounts* counts_out) {
-    const BandNanoPlan plan(band);
+    const BandNanoPlan plan(band, "the NanoVDB grids");
     SparseNvdbCounts counts;
     std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
     for (int c = 0; c < plan.grids(); ++c) {
@@ -554,8 +581,9 @@ constexpr uint64_t kLeavesOfALower = uint64_t(1) << (3 * Lower::LOG2DIM);  // a 
 // statistics are known. Host memory: the band, the tops and the two windows.
 void write_grids(const SparseBandField& band, const std::string& path, const std::string& target, uint64_t window_capacity,
                  SparseNvdbCounts& counts) {
-    const BandNanoPlan plan(band);
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const BandNanoPlan plan(band, target);
+    // A fresh temporary (write_through_temporary's unique name): never one a link points at.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0) throw std::runtime_error(target + ": cannot open a file beside it for writing (" + std::strerror(errno) + ")");
     struct Closer {
         int fd;
@@ -572,6 +600,8 @@ void write_grids(const SparseBandField& band, const std::string& path, const std
                            target + ": the NanoVDB grid's nodes and two windows of its " + std::to_string(g.leaves()) + " leaves");
         nanovdb::HostBuffer top_buffer = nanovdb::HostBuffer::create(g.leaf_at);
         char* top = static_cast<char*>(top_buffer.data());
+        // The futures after the windows: on an exception their destructors, first, wait for
+        // the writes still reading the windows.
         nanovdb::HostBuffer windows[2];
         std::future<void> written[2];
         for (nanovdb::HostBuffer& w : windows) {
@@ -646,9 +676,7 @@ SparseNvdbCounts write_sparse_band_nvdb(const SparseBandField& band, const std::
 
 SparseNvdbCounts write_sparse_band_nvdb_windows(const SparseBandField& band, const std::string& path, Overwrite overwrite,
                                                 uint64_t window_leaves) {
-    if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
-    band.require_channels({false, false}, path + ": the distance grids");  // the arrays match the active blocks
-    require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .nvdb stores float32)");
+    checked_for_nanovdb(band, path);  // before a temporary is made
     SparseNvdbCounts counts;
     write_through_temporary(path, overwrite,
                             [&](const std::string& temporary) { write_grids(band, temporary, path, window_leaves, counts); });
