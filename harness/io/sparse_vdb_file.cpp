@@ -16,6 +16,8 @@
 #if SDF_HAVE_OPENVDB
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
+
+#include "harness/io/vdb_grid_file.h"
 #endif
 
 namespace sdf {
@@ -168,9 +170,7 @@ void write_grids(const SparseBandField& band, const std::string& path, const Spa
             out.push_back(cg.triangle);
         }
     }
-    openvdb::io::File file(path);
-    file.write(out);
-    file.close();
+    write_vdb_grids(out, path);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "harness/io/vdb_grid_file.h"
 #include "harness/io/volume_grids.h"
 
 namespace sdf {
@@ -104,9 +105,7 @@ void VdbNarrowBandBuilder::write(const std::string& path) {
             grids.push_back(normals);
         }
     }
-    openvdb::io::File file(path);
-    file.write(grids);
-    file.close();
+    write_vdb_grids(grids, path);
 }
 
 void write_vdb_file(const SampledField& field, const std::string& path, double band_in_spacings) {
