@@ -305,6 +305,9 @@ int main(int argc, char** argv) {
             sdf::BandChannels channels;
             channels.gradient = stream.gradient;
             channels.closest_triangle = stream.write.closest_triangle;  // the band's points are its mask either way
+            // Every output of a float32 run stores float32 (the field file, .vdb, .nvdb): the band
+            // holds its distances rounded as they will be written (4 bytes a point, not 8).
+            if (stream.write.dtype == sdf::FieldDtype::Float32) channels.distance_type = sdf::BandDistanceType::Float32;
             sdf::SparseBandField sparse_band = bound.sample_band_sparse(lattice, band, channels);
             sparse_band.mesh = mesh_provenance;
             stream.fixed_bytes += sparse_band.memory_bytes();  // held while the slabs are written

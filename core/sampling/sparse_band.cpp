@@ -32,7 +32,8 @@ void BandLayout::cell_box(int64_t id, Vec3d& lo, Vec3d& hi) const {
 }
 
 SparseBandField::SparseBandField(const Lattice& lattice_in, double width_in, Precision precision_in, BandChannels channels_in)
-    : lattice(lattice_in), width(width_in), precision(precision_in), channels(channels_in), layout_(lattice_in) {
+    : lattice(lattice_in), width(width_in), precision(precision_in), channels(channels_in),
+      distance(channels_in.distance_type), layout_(lattice_in) {
     require_band_width(width, "sparse band width");
     if (!(width > 0)) throw std::invalid_argument("sparse band width: expected a band width > 0, got 0");
     inside_tiles.assign(size_t((layout_.block_count() + 63) / 64), 0);
@@ -89,8 +90,12 @@ void SparseBandField::require_channels(BandChannels wanted, const std::string& w
         throw std::invalid_argument(what + ": the band holds no closest triangle (sampled without the closest_triangle "
                                            "channel, or read from a file without one); ask for it when sampling, or write "
                                            "without it");
+    if (wanted.distance_type == BandDistanceType::Float64 && distance.float32())
+        throw std::invalid_argument(what + ": the band holds its distances in float32 (sampled for float32 outputs only); "
+                                           "sample it with double distances for this");
     const size_t values = active.size() * kBandBlockPoints;
-    if (distance.size() != values || closest_triangle.size() != (channels.closest_triangle ? values : 0) ||
+    if (distance.type() != channels.distance_type || distance.size() != values ||
+        closest_triangle.size() != (channels.closest_triangle ? values : 0) ||
         gradient.size() != (channels.gradient ? values : 0) || band_mask.size() != active.size())
         throw std::invalid_argument(what + ": the band's value arrays (" + std::to_string(distance.size()) + " distances, " +
                                     std::to_string(gradient.size()) + " gradients, " + std::to_string(closest_triangle.size()) +
@@ -119,7 +124,7 @@ SparseBandCounts SparseBandField::counts() const {
 }
 
 size_t SparseBandField::memory_bytes() const {
-    return active.capacity() * sizeof(int64_t) + distance.capacity() * sizeof(double) + gradient.capacity() * sizeof(Vec3d) +
+    return active.capacity() * sizeof(int64_t) + distance.memory_bytes() + gradient.capacity() * sizeof(Vec3d) +
            closest_triangle.capacity() * sizeof(int32_t) + band_mask.capacity() * sizeof(BandPointMask) +
            inside_tiles.capacity() * sizeof(uint64_t) +
            mixed.capacity() * sizeof(int64_t) + mixed_inside.capacity() * sizeof(BandSignMask);
@@ -191,7 +196,7 @@ SampledField SparseBandField::densify_slab(const LatticeSlab& slab, NarrowBandCo
                             band_points += mask_bit(band_mask[size_t(a)], local) ? 1 : 0;
                         } else {  // store_outside_band's values, in the channels held
                             const bool inside = is_mixed ? mask_bit(mixed_inside[size_t(m)], local) : tile_inside(id);
-                            field.distance[size_t(out)] = inside ? -width : width;
+                            field.distance[size_t(out)] = distance.rounded(inside ? -width : width);
                             if (channels.gradient) field.gradient[size_t(out)] = Vec3d(0.0);
                             if (channels.closest_triangle) field.closest_triangle[size_t(out)] = kOutsideBandTriangle;
                         }
@@ -237,7 +242,7 @@ SparseBandField SparseBandField::sparsify(const SampledField& dense, double w, B
                 if (i < 0) continue;
                 const double d = dense.distance[size_t(i)];
                 const bool flagged = dense.closest_triangle[size_t(i)] == kOutsideBandTriangle || outside_band(d, w);
-                out.distance[base + size_t(local)] = flagged ? (std::signbit(d) ? -w : w) : d;
+                out.distance.set(base + size_t(local), flagged ? (std::signbit(d) ? -w : w) : d);
                 if (channels.gradient) out.gradient[base + size_t(local)] = flagged ? Vec3d(0.0) : dense.gradient[size_t(i)];
                 if (channels.closest_triangle)
                     out.closest_triangle[base + size_t(local)] = flagged ? kOutsideBandTriangle : dense.closest_triangle[size_t(i)];

@@ -21,7 +21,8 @@
 /// band membership (counts, level sets' active voxels, the band's cells) reads it there.
 /// The gradient and the closest triangle are held only when asked (BandChannels): a point
 /// costs 8 bytes of distance and 1/8 byte of mask, +24 with the gradient, +4 with the triangle
-/// (36.125 with both, as sampled by default; 8.125 with the distance alone).
+/// (36.125 with both, as sampled by default; 8.125 with the distance alone); a band sampled
+/// for float32 outputs only holds its distances in float32 (band_distances.h: 4 bytes).
 /// Every other block is outside the band: a tile of one sign (bit `inside_tiles`: -W, else
 /// +W), or, where its points' signs differ (the winding sign across a hole, far from any
 /// triangle), a "mixed" block whose signs are stored per point (512 bits).
@@ -39,6 +40,7 @@
 #include <vector>
 
 #include "core/default_init_vector.h"
+#include "core/sampling/band_distances.h"
 #include "core/sampling/narrow_band.h"
 #include "core/sampling/sampled_field.h"
 #include "kernels/lattice/band_blocks.h"
@@ -108,6 +110,9 @@ struct SparseBandCounts {
 struct BandChannels {
     bool gradient = true;          ///< 24 bytes a point
     bool closest_triangle = true;  ///< 4 bytes a point
+    /// The distances' type (band_distances.h): float32 for a band whose outputs all store
+    /// float32 (4 bytes a point instead of 8; values rounded once, as those writers round).
+    BandDistanceType distance_type = BandDistanceType::Float64;
 };
 
 /// A band's channels by name, as reports list them: "distance", then "gradient" and
@@ -129,7 +134,7 @@ struct SparseBandField {
     /// Active block ids, ascending; block a's values are [a * 512, (a + 1) * 512) of each channel.
     /// The value arrays' resize(n) leaves new values unwritten (a block kernel writes them all).
     std::vector<int64_t> active;
-    DefaultInitVector<double> distance;
+    BandDistances distance;      ///< in channels.distance_type
     DefaultInitVector<Vec3d> gradient;
     DefaultInitVector<int32_t> closest_triangle;  ///< in the mesh file's face order; kOutsideBandTriangle outside the band
     /// The band's points, one mask per active block (always held): bit set where |d| <= W
@@ -166,8 +171,9 @@ struct SparseBandField {
     int64_t add_mixed(int64_t id);
 
     /// Throws std::invalid_argument naming `what` when `wanted` asks for a channel the band
-    /// does not hold, or when the arrays of a channel it holds (or band_mask) do not match
-    /// its active blocks.
+    /// does not hold, or for double distances (distance_type Float64) of a band that holds
+    /// float32 ones, or when the arrays of a channel it holds (or band_mask) do not match its
+    /// active blocks.
     void require_channels(BandChannels wanted, const std::string& what) const;
 
     SparseBandCounts counts() const;

@@ -299,7 +299,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     Clock::time_point t = Clock::now();
     const BlockBits active = active_blocks(mesh, layout, width);
     const int64_t active_count = active.count();
-    const uint64_t point_bytes = sizeof(double) + (plan.channels.gradient ? sizeof(Vec3d) : 0) +
+    const uint64_t point_bytes = band_distance_type(plan.channels.distance_type).bytes + (plan.channels.gradient ? sizeof(Vec3d) : 0) +
                                  (plan.channels.closest_triangle ? sizeof(int32_t) : 0);
     require_host_bytes(uint64_t(active_count) * (kBandBlockPoints * point_bytes + sizeof(BandPointMask) + sizeof(int64_t)),
                        what + ": " + std::to_string(active_count) + " active blocks of " +
@@ -332,7 +332,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                 const Int3 p = BandLayout::local_offset(local);
                 if (p.x < r.x && p.y < r.y && p.z < r.z) continue;
                 const size_t v = a * kBandBlockPoints + size_t(local);
-                out.distance[v] = width;
+                out.distance.set(v, width);
                 if (plan.channels.gradient) out.gradient[v] = Vec3d(0.0);
                 if (plan.channels.closest_triangle) out.closest_triangle[v] = kOutsideBandTriangle;
             }
@@ -363,9 +363,9 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
             for (size_t i = 0; i < r.size(); ++i) {
                 const size_t v = slot[i];
                 if (outside_band(r[i].distance, width)) {
-                    out.distance[v] = std::signbit(r[i].distance) ? -width : width;  // store_outside_band's values
+                    out.distance.set(v, std::signbit(r[i].distance) ? -width : width);  // store_outside_band's values
                 } else {
-                    out.distance[v] = r[i].distance;
+                    out.distance.set(v, r[i].distance);
                     if (plan.channels.gradient) out.gradient[v] = r[i].gradient;
                     if (plan.channels.closest_triangle) out.closest_triangle[v] = r[i].triangle;
                     set_mask_bit(out.band_mask[v / kBandBlockPoints], int(v % kBandBlockPoints));
@@ -474,6 +474,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"points_signed_per_point", per_point_points},
                                           {"outside_rule", rule_name},
                                           {"channels", channel_names(plan.channels)},
+                                          {"distance_type", band_distance_type(plan.channels.distance_type).name},
                                           {"boundary_edges", int64_t(boundary_edge_count)},
                                           {"steps", steps},
                                           {"memory_bytes", int64_t(out.memory_bytes())}};

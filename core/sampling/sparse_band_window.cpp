@@ -60,7 +60,7 @@ SampledField densify_window(const SparseBandField& band, const LatticeWindow& wi
                     } else {
                         const bool inside = mixed >= 0 ? (band.mixed_inside[size_t(mixed)][size_t(local >> 6)] >> (local & 63)) & 1
                                                        : band.tile_inside(id);
-                        store_outside_band(field, out, inside, band.width);  // the triangle channel cleared below if not held
+                        store_outside_band(field, out, inside, band.distance.rounded(band.width));  // the triangle channel cleared below if not held
                     }
                 }
     }

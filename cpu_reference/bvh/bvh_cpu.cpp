@@ -147,7 +147,7 @@ private:
                     const bool gradient = out.channels.gradient, triangle = out.channels.closest_triangle;
                     BandPointMask in_band{};  // the block's band points
                     const auto store_outside = [&](size_t v, bool negative) {
-                        out.distance[v] = negative ? -band.width : band.width;
+                        out.distance.set(v, negative ? -band.width : band.width);
                         if (gradient) out.gradient[v] = Vec3d(0.0);
                         if (triangle) out.closest_triangle[v] = kOutsideBandTriangle;
                     };
@@ -158,7 +158,7 @@ private:
                             store_outside(v, std::signbit(s.distance));
                             return;
                         }
-                        out.distance[v] = s.distance;
+                        out.distance.set(v, s.distance);
                         if (gradient) out.gradient[v] = s.gradient;
                         if (triangle) out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
                         set_mask_bit(in_band, int(v - base));
@@ -192,7 +192,7 @@ private:
                     for (int local = 0; local < kBandBlockPoints; ++local) {
                         if (side[size_t(local)] == kBandSideNone)
                             throw std::logic_error("CPU BVH sparse band: a point beyond the band was left without a side");
-                        if (flooded[size_t(local)] && side[size_t(local)] == kBandSideInside) out.distance[base + size_t(local)] = -band.width;
+                        if (flooded[size_t(local)] && side[size_t(local)] == kBandSideInside) out.distance.set(base + size_t(local), -band.width);
                     }
                 }
             });

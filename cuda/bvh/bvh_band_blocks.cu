@@ -171,6 +171,13 @@ __global__ void mark_band_points(const int* triangle, int64_t n, uint32_t* mask)
     if ((threadIdx.x & 31) == 0) mask[i >> 5] = bits;
 }
 
+/// Distances rounded to float32 (float(d), as the band's host type rounds them) for a band
+/// held in float32: half the download and half the host's memory.
+__global__ void round_to_float32(const double* distance, int64_t n, float* out) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) out[i] = float(distance[i]);
+}
+
 size_t device_bytes_in_use() {
     size_t free_bytes = 0, total = 0;
     CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
@@ -204,7 +211,8 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
 
     // Blocks per batch: 80% of free device memory (max_points_per_piece caps it, as a slab's pieces).
     const size_t free_bytes = free_device_memory();
-    const int64_t block_bytes = int64_t(PieceResults::bytes_per_point()) * kBandBlockPoints;
+    const bool float32 = band.distance.float32();  // the download rounds them on the device
+    const int64_t block_bytes = int64_t(PieceResults::bytes_per_point() + (float32 ? sizeof(float) : 0)) * kBandBlockPoints;
     int64_t batch = int64_t(0.8 * double(free_bytes)) / block_bytes;
     if (batch < 1 && options_.max_points_per_piece <= 0)
         throw std::runtime_error("CUDA BVH sampler: " + std::to_string(free_bytes >> 20) +
@@ -214,6 +222,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     batch = std::clamp<int64_t>(batch, 1, blocks);
     PieceResults r(batch * kBandBlockPoints);
     DeviceBuffer<uint32_t> band_mask{size_t(batch) * kBandBlockPoints / 32};  // 64 bytes a block: within the 20% left free
+    DeviceBuffer<float> distance32{float32 ? size_t(batch) * kBandBlockPoints : 0};
     const size_t in_use = device_bytes_in_use();
 
     // As the dense lattice path (run_slab): the same certificate slack, band and finalize.
@@ -268,11 +277,16 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         CUDA_CHECK_LAUNCH("to_source_order");
         mark_band_points<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, band_mask.get());
         CUDA_CHECK_LAUNCH("mark_band_points");
+        if (float32) {
+            round_to_float32<<<blocks_for(n, 256), 256>>>(r.samples.distance.get(), n, distance32.get());
+            CUDA_CHECK_LAUNCH("round_to_float32");
+        }
         flood_stage.end();
         compute.end();
         download.begin();
         const size_t v = (first + size_t(b0)) * kBandBlockPoints;
-        staged_.to_host(r.samples.distance.get(), band.distance.data() + v, size_t(n) * sizeof(double));
+        if (float32) staged_.to_host(distance32.get(), band.distance.values<float>() + v, size_t(n) * sizeof(float));
+        else staged_.to_host(r.samples.distance.get(), band.distance.values<double>() + v, size_t(n) * sizeof(double));
         if (band.channels.gradient)  // else the band holds none: 24 bytes a point stay on the device
             staged_.to_host(r.samples.gradient.get(), band.gradient.data() + v, size_t(n) * sizeof(Vec3d));
         if (band.channels.closest_triangle)  // else 4 bytes a point stay: the mask marks the band's points
@@ -300,6 +314,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"batches", batches},
         {"brick_skip", search.skip_bricks},
         {"bounded_search", bounded},
+        {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
         {"kernel_seconds", compute.seconds()},

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 #include "core/checked_math.h"
 #include "core/lattice/lattice_fitting.h"
@@ -74,12 +75,15 @@ void write_channel(FieldReplacement& replacement, size_t i, const SparseChannel&
 
 /// Stores doubles as float32 or float64, refusing a finite value beyond float32's range (the
 /// first such value, whatever the thread count). Converted on every core: at 8192^3 a band's
-/// distances are 4.2G values.
-void store_reals(const double* values, size_t n, FieldDtype dtype, char* out, const std::string& channel, int64_t first) {
-    if (dtype == FieldDtype::Float64) {
-        std::memcpy(out, values, n * sizeof(double));
+/// distances are 4.2G values. Floats (a band held in float32) are stored as they are, in
+/// float32 only (the caller refused float64 for them).
+template <typename Real>
+void store_reals(const Real* values, size_t n, FieldDtype dtype, char* out, const std::string& channel, int64_t first) {
+    if (sizeof(Real) == (dtype == FieldDtype::Float32 ? sizeof(float) : sizeof(double))) {
+        std::memcpy(out, values, n * sizeof(Real));
         return;
     }
+    if constexpr (std::is_same_v<Real, float>) throw std::logic_error(channel + ": float32 values written as float64");
     std::atomic<size_t> beyond{n};  // the first value beyond float32's range
     parallel_for(int64_t(n), 1 << 16, 0, [&](int64_t i0, int64_t i1) {
         for (int64_t i = i0; i < i1; ++i) {
@@ -140,7 +144,9 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
     require_representable_band(band.width, options.dtype, header + ": the narrow band width");
     const int64_t points = int64_t(band.active.size()) * kBandBlockPoints;
     const bool gradient = options.gradient;
-    band.require_channels({gradient, false}, header + ": the gradient channel");
+    // A band held in float32 is written in float32 only: float64 would claim digits it lacks.
+    band.require_channels({gradient, false, options.dtype == FieldDtype::Float32 ? BandDistanceType::Float32 : BandDistanceType::Float64},
+                          header + ": the gradient channel and the distances' dtype");
     if (band.mixed_inside.size() != band.mixed.size() ||
         band.inside_tiles.size() != size_t((band.layout().block_count() + 63) / 64))
         throw std::invalid_argument(header + ": the sparse band's arrays do not match its " + std::to_string(band.active.size()) +
@@ -169,7 +175,7 @@ void write_sparse_field(const std::string& header_path, const SparseBandField& b
             });
         } else if (name == "distance") {
             write_channel(replacement, i, c, points, [&](int64_t first, int64_t n, char* out) {
-                store_reals(band.distance.data() + first, size_t(n), options.dtype, out, path, first);
+                band.distance.visit([&](const auto* d) { store_reals(d + first, size_t(n), options.dtype, out, path, first); });
             });
         } else if (name == "gradient") {
             write_channel(replacement, i, c, points, [&](int64_t first, int64_t n, char* out) {
@@ -387,7 +393,7 @@ SparseBandField read_sparse_field(const std::string& header_path, const nlohmann
     band.mixed_inside.resize(size_t(mixed));
     read_values(signs, band.mixed_inside.empty() ? nullptr : band.mixed_inside[0].data(), mixed * kSignWords, header);
     band.distance.resize(size_t(points));
-    read_values(dist, band.distance.data(), points, header);
+    read_values(dist, band.distance.values<double>(), points, header);
     // A float32 file holds +-float(W) where its active blocks leave the band; its tiles and
     // mixed blocks read as the same value, so the band densifies to the dense float32 file.
     if (dist.dtype == "float32") band.width = double(float(width));

@@ -253,23 +253,26 @@ void fill_leaf(const SparseBandField& band, const BandBlockGrid& blocks, int64_t
             if ((whole || BandBlockGrid::within(points, local)) && mask_bit(inside, local)) data.mValues[leaf_offset(local)] = -w;
         return;
     }
-    const double* distance = band.distance.data() + size_t(i) * kBandBlockPoints;
-    for (int local = 0; local < kBandBlockPoints; ++local) {
-        if (!whole && !BandBlockGrid::within(points, local)) continue;
-        const uint32_t n = leaf_offset(local);
-        data.mValues[n] = float(distance[local]);  // a band point's value, else +-W, its side
-        if (band.in_band(size_t(i), local)) {
-            data.mValueMask.setOn(n);
-            ++on;
+    band.distance.visit([&](const auto* values) {  // double, or float32 (a band held for float32 outputs)
+        const auto* distance = values + size_t(i) * kBandBlockPoints;
+        for (int local = 0; local < kBandBlockPoints; ++local) {
+            if (!whole && !BandBlockGrid::within(points, local)) continue;
+            const uint32_t n = leaf_offset(local);
+            data.mValues[n] = float(distance[local]);  // a band point's value, else +-W, its side
+            if (band.in_band(size_t(i), local)) {
+                data.mValueMask.setOn(n);
+                ++on;
+            }
         }
-    }
+    });
 }
 
 }  // namespace
 
 void check_band_for_nanovdb(const SparseBandField& band, const std::string& what) {
     if (!(band.width > 0)) throw std::invalid_argument(what + ": a sparse band needs a width W > 0");
-    band.require_channels({false, false}, what);  // the distances and masks match the active blocks
+    // The distances (float32 or double: a .nvdb stores float32) and masks match the active blocks.
+    band.require_channels({false, false, BandDistanceType::Float32}, what);
     require_representable_band(band.width, FieldDtype::Float32, what + ": the band's width (a .nvdb stores float32)");
     const BandBlockGrid blocks = BandBlockGrid::of(band.lattice);
     const int64_t count = band.layout().block_count();

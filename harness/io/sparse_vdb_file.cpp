@@ -180,7 +180,8 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
     namespace fs = std::filesystem;
     if (!(band.width > 0)) throw std::invalid_argument(path + ": a sparse band needs a width W > 0");
     require_representable_band(band.width, FieldDtype::Float32, path + ": the band's width (a .vdb stores float32)");
-    band.require_channels({options.gradient, options.closest_triangle}, path + ": the gradient and closest triangle grids");
+    band.require_channels({options.gradient, options.closest_triangle, BandDistanceType::Float32},  // float32 grids
+                          path + ": the gradient and closest triangle grids");
     if (options.overwrite == Overwrite::Forbid && fs::exists(path))
         throw std::runtime_error(path + ": already exists; refusing to overwrite a field");
     openvdb::initialize();
@@ -193,7 +194,7 @@ SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::st
 #else
 
 SparseVdbCounts write_sparse_band_vdb(const SparseBandField& band, const std::string& path, const SparseVdbOptions& options) {
-    band.require_channels({options.gradient, options.closest_triangle},
+    band.require_channels({options.gradient, options.closest_triangle, BandDistanceType::Float32},
                           path + ": the gradient and closest triangle grids");  // as with OpenVDB: the caller's error first
     throw std::runtime_error(path + ": this build has no OpenVDB support (libopenvdb-dev)");
 }

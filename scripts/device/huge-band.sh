@@ -14,6 +14,7 @@ if [ "${1:-}" = build ]; then
 fi
 RESOLUTIONS=${*:-4096 8192}
 BENCH=${BENCH:-1}  # 0: only the end-to-end runs (FILES: "nvdb", "field+nvdb" or both; BACKENDS: cuda, cpu or both)
+DTYPE=${DTYPE:-float32}  # the end-to-end runs' --dtype: float32 holds the band's distances in float32, float64 in double
 export SDF_DATA_PATH=$PWD/data/meshes
 export LD_LIBRARY_PATH=$PWD/.gpu-prefix/root/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee -a "$OUT/summary.txt"
@@ -49,13 +50,13 @@ extent = max(max(p[a] for p in v) - min(p[a] for p in v) for a in range(3))
 print(repr(3 * extent * 1.2 / ($res - 1)))")
 work=$PWD/huge-band-out
 # 1. the .nvdb alone (no field file: sdf-sample's --out left out), against dd of its bytes;
-# 2. the sparse field file (float32) beside it.
+# 2. the sparse field file ($DTYPE) beside it.
 for files in ${FILES:-nvdb field+nvdb}; do
     rm -rf "$work" && mkdir -p "$work"
     out=()
-    [ "$files" = nvdb ] || out=(--layout sparse --dtype float32 --out "$work/band.json")
-    log "sdf-sample $MESH --resolution $res --band $W --sparse --channels distance --nvdb ${out[*]} (cuda)"
-    /usr/bin/time -v $B/bin/sdf-sample "$MESH" --resolution "$res" --band "$W" --sparse --channels distance \
+    [ "$files" = nvdb ] || out=(--layout sparse --out "$work/band.json")
+    log "sdf-sample $MESH --resolution $res --band $W --sparse --channels distance --dtype $DTYPE --nvdb ${out[*]} (cuda)"
+    /usr/bin/time -v $B/bin/sdf-sample "$MESH" --resolution "$res" --band "$W" --sparse --channels distance --dtype "$DTYPE" \
         --backend cuda --quiet --nvdb "$work/band.nvdb" "${out[@]}" > "$OUT/sdf-sample-$files.txt" 2> "$OUT/sdf-sample-time-$files.txt"
     echo "exit $?" | tee -a "$OUT/summary.txt"
     cat "$OUT/sdf-sample-$files.txt" | tee -a "$OUT/summary.txt"

@@ -42,6 +42,7 @@ template <typename V, typename A>
 bool same_bytes(const std::vector<V, A>& a, const std::vector<V, A>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
 }
+bool same_bytes(const BandDistances& a, const BandDistances& b) { return a.same_bytes(b); }
 
 bool same_field(const SampledField& a, const SampledField& b) {
     return same_bytes(a.distance, b.distance) && same_bytes(a.gradient, b.gradient) &&
@@ -154,6 +155,22 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                         EXPECT_TRUE(same_bytes(sparse.distance, lean.distance)) << which << ": the distance alone";
                         EXPECT_TRUE(same_masks(lean)) << which << ": the distance alone, its mask";
                         EXPECT_EQ(lean.counts().band_points, sparse.counts().band_points) << which;
+                        // Held in float32 (sdf-sample's float32 outputs; rounded on the device): each
+                        // distance the double band's rounded once, padding included; the same mask.
+                        BandChannels f32_channels = lean_channels;
+                        f32_channels.distance_type = BandDistanceType::Float32;
+                        const SparseBandField f32 =
+                            make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(lattice, w, f32_channels);
+                        bool rounded = f32.distance.float32() && f32.distance.size() == sparse.distance.size();
+                        for (size_t i = 0; rounded && i < f32.distance.size(); ++i) {
+                            const float want = float(sparse.distance[i]), got = float(f32.distance[i]);
+                            rounded = std::memcmp(&want, &got, sizeof(float)) == 0;
+                        }
+                        EXPECT_TRUE(rounded) << which << ": float32 distances";
+                        EXPECT_TRUE(same_masks(f32)) << which << ": float32 distances, the mask";
+                        if (run.on_device) {
+                            EXPECT_EQ(f32.sampler.details["band_blocks_on_device"]["distance_type"], "float32") << which;
+                        }
                     }
                 }
                 if (HasFailure()) return;

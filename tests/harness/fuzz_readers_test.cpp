@@ -595,7 +595,7 @@ TEST_F(FuzzReaders, SparseFieldHeadersAndBlockIds) {
         const size_t base = size_t(band.add_active(id)) * kBandBlockPoints;
         for (int local = 0; local < kBandBlockPoints; local += 3) {
             if (band.layout().storage_index(id, local) < 0) continue;  // padding holds +W
-            band.distance[base + size_t(local)] = 0.001 * local - 0.3;  // |d| <= W: a band point
+            band.distance.set(base + size_t(local), 0.001 * local - 0.3);  // |d| <= W: a band point
             band.gradient[base + size_t(local)] = {0, 0, 1};
             band.closest_triangle[base + size_t(local)] = local % 5;
         }
@@ -658,7 +658,7 @@ TEST_F(FuzzReaders, SparseFieldBandPointsMask) {
         const size_t a = size_t(band.add_active(id));
         for (int local = 0; local < kBandBlockPoints; local += 3) {
             if (band.layout().storage_index(id, local) < 0) continue;
-            band.distance[a * kBandBlockPoints + size_t(local)] = 0.001 * local - 0.3;  // |d| <= W: a band point
+            band.distance.set(a * kBandBlockPoints + size_t(local), 0.001 * local - 0.3);  // |d| <= W: a band point
             set_mask_bit(band.band_mask[a], local);
         }
     }

@@ -47,6 +47,7 @@ template <typename V, typename A>
 bool same_bytes(const std::vector<V, A>& a, const std::vector<V, A>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
 }
+bool same_bytes(const BandDistances& a, const BandDistances& b) { return a.same_bytes(b); }
 
 TriangleMesh joined(const std::vector<TriangleMesh>& parts) {
     TriangleMesh m;
@@ -146,6 +147,21 @@ TEST_F(SparseFieldFile, RoundTripAndDensifiedEqualsTheDenseBandFile) {
             const auto a = channel_bytes(at("dense.json")), b = channel_bytes(at("again.json"));
             ASSERT_EQ(a.size(), 3u) << what;
             for (const auto& [name, bytes] : a) EXPECT_TRUE(bytes == b.at(name)) << what << ": channel " << name;
+            // A band held in float32 (sdf-sample's float32 runs): the same float32 file, every
+            // channel's bytes; float64 from it refused, naming the file.
+            BandChannels f32_channels;
+            f32_channels.distance_type = BandDistanceType::Float32;
+            const SparseBandField band_f32 =
+                make_cpu_bvh_sampler(options(0, c.sign))->bind(share(c.mesh))->sample_band_sparse(lattice, w, f32_channels);
+            write_sparse_field(at("f32.json"), band_f32);
+            const auto from_double = channel_bytes(at("b32.json")), from_float = channel_bytes(at("f32.json"));
+            EXPECT_EQ(from_double.size(), from_float.size()) << what;
+            for (const auto& [name, bytes] : from_double) EXPECT_TRUE(bytes == from_float.at(name)) << what << ": channel " << name;
+            const std::string refused = test::error_of([&] { write_sparse_field(at("f64.json"), band_f32, o64); });
+            EXPECT_NE(refused.find("f64.json: the gradient channel and the distances' dtype: the band holds its distances in float32"),
+                      std::string::npos)
+                << refused;
+            EXPECT_FALSE(fs::exists(at("f64.json"))) << what;
             // Without the gradient channel, as `--channels distance,closest_triangle`.
             SparseFieldWriteOptions no_gradient;
             no_gradient.gradient = false;

@@ -177,6 +177,15 @@ TEST(SparseNvdb, EveryLatticePointReadBackByNanoVdbEqualsTheDenseBand) {
         EXPECT_EQ(counts.bytes, in_memory.bytes);
         EXPECT_EQ(counts.leaves, band.counts().active_blocks + band.counts().mixed_blocks);
         ASSERT_TRUE(fs::exists(path));
+        // A band held in float32 (sdf-sample's float32 runs) writes the same file.
+        BandChannels f32_channels;
+        f32_channels.distance_type = BandDistanceType::Float32;
+        const std::string f32_path = temp_path("band-f32.nvdb");
+        fs::remove(f32_path);
+        write_sparse_band_nvdb(
+            make_cpu_bvh_sampler(options(c.sign, 0))->bind(share(c.mesh))->sample_band_sparse(lattice, w, f32_channels), f32_path);
+        EXPECT_TRUE(file_bytes(f32_path) == file_bytes(path)) << "a float32 band's .nvdb differs from the double band's";
+        fs::remove(f32_path);
         EXPECT_EQ(counts.active_voxels, band.counts().band_points);
         if (c.name.find("mixed") != std::string::npos) {
             EXPECT_GT(band.counts().mixed_blocks, 0);
@@ -272,9 +281,9 @@ TEST(SparseNvdb, GridsSpanningManyNodesAreLaidOutAsNanoVdbsOwnConversion) {
                     if (layout.storage_index(id, local) < 0) continue;
                     const double d = value(rng);
                     if (local % 3 == 0) {
-                        band.distance[size_t(a) * kBandBlockPoints + size_t(local)] = d < 0 ? -w : w;  // outside the band
+                        band.distance.set(size_t(a) * kBandBlockPoints + size_t(local), d < 0 ? -w : w);  // outside the band
                     } else {
-                        band.distance[size_t(a) * kBandBlockPoints + size_t(local)] = d;
+                        band.distance.set(size_t(a) * kBandBlockPoints + size_t(local), d);
                         set_mask_bit(band.band_mask[size_t(a)], local);
                     }
                 }
@@ -333,13 +342,13 @@ TEST(SparseNvdb, EmptyAndLeaflessGridsAreNanoVdbsOwn) {
         const int64_t primary_blocks = layout.coset(0).blocks.x * int64_t(layout.coset(0).blocks.y) * layout.coset(0).blocks.z;
         const int64_t a = bands[2].add_active(primary_blocks / 2);  // the primary grid's middle block
         for (int local = 0; local < kBandBlockPoints; local += 3) {
-            bands[2].distance[size_t(a) * kBandBlockPoints + size_t(local)] = 0.25 * w;
+            bands[2].distance.set(size_t(a) * kBandBlockPoints + size_t(local), 0.25 * w);
             set_mask_bit(bands[2].band_mask[size_t(a)], local);
         }
         const int64_t last = bands[3].add_active(primary_blocks - 1);  // padded on every axis
         for (int local = 0; local < kBandBlockPoints; ++local)
             if (layout.storage_index(primary_blocks - 1, local) >= 0) {
-                bands[3].distance[size_t(last) * kBandBlockPoints + size_t(local)] = -0.5 * w;
+                bands[3].distance.set(size_t(last) * kBandBlockPoints + size_t(local), -0.5 * w);
                 set_mask_bit(bands[3].band_mask[size_t(last)], local);
             }
         for (size_t i = 0; i < bands.size(); ++i) {

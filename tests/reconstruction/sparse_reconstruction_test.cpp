@@ -215,14 +215,14 @@ SparseBandField sphere_band(const Lattice& lattice, const Vec3d& c) {
                     const Vec3d x = lattice.position_of_coords(layout.point_coords(id, local)) - c;
                     const double d = length(x) - radius;
                     if (std::abs(d) > w) continue;  // +-W below
-                    band.distance[base + size_t(local)] = d;
+                    band.distance.set(base + size_t(local), d);
                     band.gradient[base + size_t(local)] = x / length(x);
                     band.closest_triangle[base + size_t(local)] = 0;
                 }
                 for (int local = 0; local < kBandBlockPoints; ++local)
                     if (band.closest_triangle[base + size_t(local)] == kOutsideBandTriangle) {
                         const Vec3d x = lattice.position_of_coords(layout.point_coords(id, local)) - c;
-                        band.distance[base + size_t(local)] = length(x) - radius < 0 ? -w : w;
+                        band.distance.set(base + size_t(local), length(x) - radius < 0 ? -w : w);
                     }
             }
     band.mask_from_triangles();  // the band's points, as its triangles mark them

@@ -45,6 +45,7 @@ template <typename V, typename A>
 bool same_bytes(const std::vector<V, A>& a, const std::vector<V, A>& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(V)) == 0);
 }
+bool same_bytes(const BandDistances& a, const BandDistances& b) { return a.same_bytes(b); }
 
 /// The first differing point, for the message.
 std::string first_difference(const SampledField& a, const SampledField& b) {
@@ -266,6 +267,68 @@ TEST(SparseBand, WithoutTheGradientTheSameDistancesAndTriangles) {
     dense.gradient.clear();
     EXPECT_THROW(SparseBandField::sparsify(dense, 2 * lattice.spacing), std::invalid_argument);
     EXPECT_TRUE(SparseBandField::sparsify(dense, 2 * lattice.spacing, slim_channels).gradient.empty());
+}
+
+/// Whether a float32 band's distances are a double band's, each rounded once (float(d)).
+bool rounded_from(const BandDistances& f32, const BandDistances& f64) {
+    if (!f32.float32() || f64.float32() || f32.size() != f64.size()) return false;
+    for (size_t i = 0; i < f32.size(); ++i) {
+        const float want = float(f64[i]), got = float(f32[i]);
+        if (std::memcmp(&want, &got, sizeof(float)) != 0) return false;
+    }
+    return true;
+}
+
+// A band held in float32 (for float32 outputs): every distance the double band's rounded once,
+// everything else (blocks, band points, triangles, gradients, signs) the same bytes, through
+// the brick kernel and the point queries, CC and BCC, both sign rules, both search precisions;
+// densified, the dense band rounded; refused where double distances are asked.
+TEST(SparseBand, Float32DistancesAreTheDoubleBandRoundedOnce) {
+    BandChannels f32_channels;
+    f32_channels.distance_type = BandDistanceType::Float32;
+    for (const Case& c : cases()) {
+        const Lattice cc = fit_lattice(LatticeType::CC, {37, 34, 33}, c.mesh.bounds(), 0.3);
+        const Lattice bcc = fit_lattice(LatticeType::BCC, {27, 25, 24}, c.mesh.bounds(), 0.3);
+        for (const Lattice& lattice : {cc, bcc})
+            for (Precision precision : {Precision::Float, Precision::Double}) {
+                const double w = 2.0 * lattice.spacing;
+                const std::string what = c.name + " " + lattice_notation(lattice) + " " + precision_name(precision);
+                for (int brute = 0; brute < 2; ++brute) {
+                    const auto bound = (brute ? make_cpu_brute_force_sampler(options(precision, 0, c.sign))
+                                              : make_cpu_bvh_sampler(options(precision, 0, c.sign)))
+                                           ->bind(share(c.mesh));
+                    const SparseBandField f64 = bound->sample_band_sparse(lattice, w);
+                    const SparseBandField f32 = bound->sample_band_sparse(lattice, w, f32_channels);
+                    const std::string how = what + (brute ? " brute force" : " bvh");
+                    EXPECT_TRUE(rounded_from(f32.distance, f64.distance)) << how;
+                    EXPECT_TRUE(same_bytes(f32.active, f64.active) && same_bytes(f32.gradient, f64.gradient) &&
+                                same_bytes(f32.closest_triangle, f64.closest_triangle) &&
+                                same_bytes(f32.band_mask, f64.band_mask) && same_bytes(f32.mixed, f64.mixed) &&
+                                same_bytes(f32.mixed_inside, f64.mixed_inside) && same_bytes(f32.inside_tiles, f64.inside_tiles))
+                        << how;
+                    EXPECT_EQ(f64.memory_bytes() - f32.memory_bytes(), f64.distance.size() * sizeof(float)) << how;
+                    // Densified: the dense band, every distance rounded once (the bytes a float32 file holds).
+                    const SampledField dense = f64.densify(), densified = f32.densify();
+                    bool rounded = dense.size() == densified.size();
+                    for (int64_t i = 0; rounded && i < dense.size(); ++i)
+                        rounded = double(float(dense.distance[size_t(i)])) == densified.distance[size_t(i)] &&
+                                  std::signbit(dense.distance[size_t(i)]) == std::signbit(densified.distance[size_t(i)]);
+                    EXPECT_TRUE(rounded) << how;
+                    EXPECT_TRUE(same_bytes(dense.closest_triangle, densified.closest_triangle)) << how;
+                    try {
+                        f32.require_channels(BandChannels{}, "the test's reader");
+                        ADD_FAILURE() << how << ": require_channels gave float32 distances to a reader of doubles";
+                    } catch (const std::invalid_argument& e) {
+                        EXPECT_NE(std::string(e.what()).find("the test's reader: the band holds its distances in float32"),
+                                  std::string::npos)
+                            << e.what();
+                    }
+                    EXPECT_NO_THROW(f32.require_channels(f32_channels, "x")) << how;
+                    EXPECT_NO_THROW(f64.require_channels(f32_channels, "x")) << how;  // a float32 writer takes doubles
+                    if (HasFailure()) return;
+                }
+            }
+    }
 }
 
 /// The band's points by the rule of the dense band (narrow_band.h): the points of each active
