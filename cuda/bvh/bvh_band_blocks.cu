@@ -11,6 +11,7 @@
 // On a solid, the search is bounded by the band (BandSearch::bound_squared): a point beyond
 // it finds no triangle and takes its side from its neighbours (flood_band_sides).
 #include <algorithm>
+#include <climits>
 #include <stdexcept>
 #include <string>
 
@@ -171,6 +172,122 @@ __global__ void mark_band_points(const int* triangle, int64_t n, uint32_t* mask)
     if ((threadIdx.x & 31) == 0) mask[i >> 5] = bits;
 }
 
+/// The triangle sweep (a solid's bounded band, in place of the bounded search): each
+/// triangle visits the lattice points of its box dilated by the bound, and each point keeps the
+/// least Q_d (squared_distance() on PackedTriangle<double> at the point, the quantity the
+/// double search and the float search's certificate rank by) within the bound, ties to the
+/// smaller triangle index (wins_tie): the double search's triangle, whatever the tree, and
+/// none (kOutsideBandFlood, the flood's) where no triangle is within the bound. Two passes: the
+/// least Q_d as an ordered 64-bit key (atomicMin), then the least triangle index among the
+/// triangles at that key. Work grows with the band's points near each triangle, not with a
+/// search per point of every active block (3-6 times the band's points).
+constexpr int kSweepThreads = 128;
+/// Blocks of a triangle's box whose batch indices are kept in shared memory; a larger box
+/// (a triangle many blocks wide) looks each point's block up in the sorted ids instead.
+constexpr int kSweepCachedBlocks = 2048;
+constexpr unsigned long long kSweepNone = ~0ull;
+
+/// A double's order as an unsigned key (negative values below positive ones).
+__device__ SDF_INLINE unsigned long long ordered_key(double q) {
+    const unsigned long long bits = static_cast<unsigned long long>(__double_as_longlong(q));
+    return (bits >> 63) ? ~bits : bits | (1ull << 63);
+}
+
+/// Index of block `id` among the batch's sorted ids, or -1.
+__device__ int64_t batch_index(const BandBlocksPiece& piece, int64_t id) {
+    int64_t lo = 0, hi = piece.blocks;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (piece.ids[mid] < id) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < piece.blocks && piece.ids[lo] == id ? lo : -1;
+}
+
+/// The coset points [p0, p1] (per axis, clamped to the coset) whose positions may lie in
+/// [lo, hi]: one point of margin covers the rounding of the box and of the positions.
+__device__ SDF_INLINE bool coset_range(const Lattice& lattice, const BandCoset& coset, const Vec3d& lo, const Vec3d& hi, Int3& p0,
+                                    Int3& p1) {
+    const double hh = lattice.half_spacing();
+    for (int k = 0; k < 3; ++k) {
+        // Point p of the coset lies at origin + hh (first + 2 p).
+        const double a = floor(((lo[k] - lattice.origin[k]) / hh - coset.first[k]) / 2) - 1;
+        const double b = ceil(((hi[k] - lattice.origin[k]) / hh - coset.first[k]) / 2) + 1;
+        if (!(a <= double(coset.points[k] - 1)) || !(b >= 0)) return false;  // NaN too
+        p0[k] = a < 0 ? 0 : int(a);
+        p1[k] = b > double(coset.points[k] - 1) ? coset.points[k] - 1 : int(b);
+    }
+    return true;
+}
+
+template <int kPass>
+__global__ void __launch_bounds__(kSweepThreads)
+    sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
+                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle) {
+    __shared__ int64_t cached[kSweepCachedBlocks];
+    const double reach = sqrt(bound_squared);
+    for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
+        const PackedTriangle<double> t = packed[s];
+        const int triangle = triangle_index[s];
+        // Its vertices B, B + E0, B + E1 (packed as 2 E0, 2 E1; the index margin covers the rounding).
+        const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
+            v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
+        const Vec3d lo(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
+        const Vec3d hi(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+        for (int c = 0; c < piece.grid.cosets; ++c) {
+            const BandCoset& coset = piece.grid.coset[c];
+            Int3 p0, p1;
+            if (!coset_range(piece.lattice, coset, lo, hi, p0, p1)) continue;  // uniform over the CUDA block
+            const Int3 b0{p0.x >> kBandBlockLog2, p0.y >> kBandBlockLog2, p0.z >> kBandBlockLog2};
+            const Int3 nb{(p1.x >> kBandBlockLog2) - b0.x + 1, (p1.y >> kBandBlockLog2) - b0.y + 1, (p1.z >> kBandBlockLog2) - b0.z + 1};
+            const int64_t box_blocks = int64_t(nb.x) * nb.y * nb.z;
+            const bool use_cache = box_blocks <= kSweepCachedBlocks;
+            if (use_cache) {
+                for (int j = threadIdx.x; j < box_blocks; j += blockDim.x)
+                    cached[j] = batch_index(piece, piece.grid.block_id(c, {b0.x + j % nb.x, b0.y + (j / nb.x) % nb.y, b0.z + j / (nb.x * nb.y)}));
+                __syncthreads();
+            }
+            const Int3 np{p1.x - p0.x + 1, p1.y - p0.y + 1, p1.z - p0.z + 1};
+            const int64_t points = int64_t(np.x) * np.y * np.z;
+            for (int64_t j = threadIdx.x; j < points; j += blockDim.x) {
+                const Int3 p{p0.x + int(j % np.x), p0.y + int((j / np.x) % np.y), p0.z + int(j / (int64_t(np.x) * np.y))};
+                const Int3 pb{p.x >> kBandBlockLog2, p.y >> kBandBlockLog2, p.z >> kBandBlockLog2};
+                const int64_t a = use_cache ? cached[(pb.x - b0.x) + int64_t(nb.x) * ((pb.y - b0.y) + int64_t(nb.y) * (pb.z - b0.z))]
+                                            : batch_index(piece, piece.grid.block_id(c, pb));
+                if (a < 0) continue;  // not an active block of this batch
+                const Vec3d x = piece.lattice.position_of_coords({coset.first.x + 2 * p.x, coset.first.y + 2 * p.y, coset.first.z + 2 * p.z});
+                // Beyond twice the reach from the triangle's plane: beyond the bound, whatever
+                // Q_d's rounding (about 2^-50 |B - P|^2, small against 3 bounds while |B - P|
+                // stays below 2^20 reaches; farther points are not culled).
+                const double dx = t.bx - x.x, dy = t.by - x.y, dz = t.bz - x.z;
+                const double h = t.nx * dx + t.ny * dy + t.nz * dz, f = dx * dx + dy * dy + dz * dz;
+                if (h * h > 4 * bound_squared && f < 0x1p40 * bound_squared) continue;
+                double q = squared_distance(t, x.x, x.y, x.z);
+                if (!(q <= bound_squared)) continue;
+                if (q == 0) q = 0;  // -0 ties +0, as the search's comparison
+                const int64_t i = a * kBandBlockPoints + (p.x & (kBandBlockDim - 1)) +
+                                  kBandBlockDim * ((p.y & (kBandBlockDim - 1)) + kBandBlockDim * (p.z & (kBandBlockDim - 1)));
+                const unsigned long long key = ordered_key(q);
+                if constexpr (kPass == 0) {
+                    if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
+                } else if (key == best_key[i]) {
+                    atomicMin(best_triangle + i, triangle);
+                }
+            }
+            if (use_cache) __syncthreads();  // before the next box overwrites the cache
+        }
+    }
+}
+
+/// Points the sweep left without a triangle: kOutsideBandFlood (their side from the flood),
+/// padding kOutsideBandOutside (as the search leaves it: +W).
+__global__ void finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= piece.size() || best_key[i] != kSweepNone) return;
+    const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[i / kBandBlockPoints]), int(i % kBandBlockPoints));
+    nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
+}
+
 /// Distances rounded to float32 (float(d), as the band's host type rounds them) for a band
 /// held in float32: half the download and half the host's memory.
 __global__ void round_to_float32(const double* distance, int64_t n, float* out) {
@@ -250,16 +367,37 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         const BandBlocksLayout layout{piece};
         compute.begin();
         search_stage.begin();
-        fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
-        CUDA_CHECK_LAUNCH("fill_nearest");
-        const int grid = blocks_for(layout.threads(), kBvhThreads);
-        if (kernel_ == BvhGpuKernel::Warp) {
-            launch_bvh_warp(grid, dev.view, layout, search, fused, r.nearest.get());
+        if (bounded) {
+            // The sweep: the least key per point in the distance array (rewritten by finalize),
+            // the least triangle at it in `nearest`.
+            auto* key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
+            static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
+            CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
+            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
+            CUDA_CHECK_LAUNCH("fill_nearest");
+            const int triangles = dev.view.num_triangles;
+            const int grid = std::max(1, std::min(triangles, 1 << 20));
+            const double bound = double(search.bound_squared);
+            sweep_band_triangles<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece, bound,
+                                                              key, r.nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
+            sweep_band_triangles<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece, bound,
+                                                              key, r.nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
+            finish_sweep<<<blocks_for(n, 256), 256>>>(piece, key, r.nearest.get());
+            CUDA_CHECK_LAUNCH("finish_sweep");
         } else {
-            nearest_triangle_bvh_candidates<T><<<grid, kBvhThreads>>>(dev.view, layout, search, r.nearest.get(), nullptr);
+            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
+            CUDA_CHECK_LAUNCH("fill_nearest");
+            const int grid = blocks_for(layout.threads(), kBvhThreads);
+            if (kernel_ == BvhGpuKernel::Warp) {
+                launch_bvh_warp(grid, dev.view, layout, search, fused, r.nearest.get());
+            } else {
+                nearest_triangle_bvh_candidates<T><<<grid, kBvhThreads>>>(dev.view, layout, search, r.nearest.get(), nullptr);
+            }
+            CUDA_CHECK_LAUNCH("nearest_triangle_bvh (band blocks)");
+            if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         }
-        CUDA_CHECK_LAUNCH("nearest_triangle_bvh (band blocks)");
-        if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         search_stage.end();
         finalize_stage.begin();
         PieceOutputs outputs = r.outputs();
@@ -314,6 +452,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"batches", batches},
         {"brick_skip", search.skip_bricks},
         {"bounded_search", bounded},
+        {"nearest", bounded ? "triangle_sweep" : "search"},
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},

@@ -80,6 +80,14 @@ struct DeviceBvh {
     std::unique_ptr<DeviceLbvh> lbvh;  ///< owns the arrays of `view` when built on the device
 };
 
+/// The double search constants (PackedTriangle<double>) in the tree's slot order, whatever
+/// its type and where it was built: what the double search and the certificate rank by.
+template <typename T>
+const PackedTriangle<double>* packed_double(const DeviceBvh<T>& dev) {
+    if constexpr (std::is_same_v<T, double>) return dev.view.packed;
+    else return dev.lbvh ? dev.lbvh->packed_double.get() : dev.exact.get();
+}
+
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
 template <typename T, typename Piece>
 void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {

@@ -117,7 +117,11 @@ TEST(CudaSparseBand, DensifiedEqualsTheCpuDenseBand) {
                         }
                         EXPECT_GT(sparse.timings.kernel, 0.0) << which;
                         EXPECT_LE(sparse.timings.kernel, sparse.timings.total) << which;
-                        if (precision == Precision::Float) {
+                        // A solid's bounded band takes the triangle sweep (no search, no
+                        // certificate); every other band the certified search.
+                        const bool swept = d["bounded_search"].get<bool>();
+                        EXPECT_EQ(d["nearest"], swept ? "triangle_sweep" : "search") << which;
+                        if (precision == Precision::Float && !swept) {
                             EXPECT_GT(sparse.timings.certified_points, 0) << which;
                         }
                     }
