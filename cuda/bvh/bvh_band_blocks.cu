@@ -8,10 +8,14 @@
 // time: the sampler allocates them without a fill). Padding (points of a block beyond the
 // coset's resolution) is marked "outside, positive side" before the search, so finalize
 // writes it +W, gradient 0, kOutsideBandTriangle: the host's values for padding.
-// On a solid, the search is bounded by the band (BandSearch::bound_squared): a point beyond
-// it finds no triangle and takes its side from its neighbours (flood_band_sides).
+// On a solid (the pseudonormal sign, W >= one spacing) no point is searched: each triangle
+// sweeps the points near it (sweep_band_triangles: the double search's triangle of every point
+// within W, exactly); a point beyond finds no triangle and takes its side from its neighbours
+// (flood_band_sides), a block of such points from its point 0's nearest triangle
+// (sweep_block_origins). Every other band runs the search.
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -91,12 +95,13 @@ __global__ void to_source_order(int* triangle, int64_t n, const int32_t* source_
 /// CUDA block of 512 threads per band block, each point taking a neighbour's side
 /// (kernels/lattice/band_sides.h) until none changes. A block of such points only takes the
 /// side of its point 0, at its nearest triangle in double (that point too lies beyond the
-/// band). counters: points flooded, blocks signed by a search,
+/// band): `block_nearest`'s (the sweep's, sweep_block_origins) where it found one, else every
+/// triangle's. counters: points flooded, blocks signed by a search,
 /// points left without a side (never: the host checks).
 template <typename T>
 __global__ void __launch_bounds__(kBandBlockPoints)
-    flood_band_sides(BvhView<T> bvh, MeshView<double> mesh, BandBlocksPiece piece, const int* nearest, double width,
-                     double* distance, unsigned long long* counters) {
+    flood_band_sides(BvhView<T> bvh, MeshView<double> mesh, BandBlocksPiece piece, const int* nearest, const int* block_nearest,
+                     double width, double* distance, unsigned long long* counters) {
     __shared__ volatile signed char side[kBandBlockPoints];
     const int local = threadIdx.x;
     const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + local;
@@ -108,40 +113,50 @@ __global__ void __launch_bounds__(kBandBlockPoints)
     if (flooded == 0) return;  // uniform over the block
     if (!__syncthreads_or(!flood && !padding)) {
         // Point 0's side (a block's point 0 is never padding) at its nearest triangle in
-        // double over every triangle, the block's threads sharing them (ties: the smaller
-        // index, as closest_triangle_bvh.h's rule): exact where a float search may tie
-        // across a thin part. A block without a point of known side is rare.
+        // double: the sweep's, else over every triangle, the block's threads sharing them
+        // (ties: the smaller index, as closest_triangle_bvh.h's rule): exact where a float
+        // search may tie across a thin part.
         __shared__ double nearest_d[kBandBlockPoints];
         __shared__ int nearest_t[kBandBlockPoints];
         const Vec3d p = piece.position(int64_t(blockIdx.x) * kBandBlockPoints);
-        double best = INFINITY;
-        int best_t = -1;
-        for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
-            const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
-            if (d < best) {
-                best = d;
-                best_t = t;
+        const int swept = block_nearest ? block_nearest[blockIdx.x] : -1;
+        if (swept >= 0 && swept != INT_MAX) {  // uniform over the block
+            if (local == 0) {
+                side[0] = signed_distance_to_triangle(mesh, p, swept).distance < 0 ? kBandSideInside : kBandSideOutside;
+                atomicAdd(counters + 1, 1ull);
             }
-        }
-        nearest_d[local] = best;
-        nearest_t[local] = best_t;
-        __syncthreads();
-        for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
-            if (local < half) {
-                const double d = nearest_d[local + half];
-                const int t = nearest_t[local + half];
-                if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
-                    nearest_d[local] = d;
-                    nearest_t[local] = t;
+            __syncthreads();
+        } else {
+            double best = INFINITY;
+            int best_t = -1;
+            for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
+                const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
+                if (d < best) {
+                    best = d;
+                    best_t = t;
                 }
+            }
+            nearest_d[local] = best;
+            nearest_t[local] = best_t;
+            __syncthreads();
+            for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
+                if (local < half) {
+                    const double d = nearest_d[local + half];
+                    const int t = nearest_t[local + half];
+                    if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
+                        nearest_d[local] = d;
+                        nearest_t[local] = t;
+                    }
+                }
+                __syncthreads();
+            }
+            if (local == 0) {
+                side[0] = signed_distance_to_triangle(mesh, p, nearest_t[0]).distance < 0 ? kBandSideInside : kBandSideOutside;
+                atomicAdd(counters + 1, 1ull);
+                atomicAdd(counters + 3, 1ull);
             }
             __syncthreads();
         }
-        if (local == 0) {
-            side[0] = signed_distance_to_triangle(mesh, p, nearest_t[0]).distance < 0 ? kBandSideInside : kBandSideOutside;
-            atomicAdd(counters + 1, 1ull);
-        }
-        __syncthreads();
     }
     const auto side_of = [&](int j) { return static_cast<signed char>(side[j]); };
     for (;;) {
@@ -249,8 +264,16 @@ __global__ void __launch_bounds__(kSweepThreads)
             }
             const Int3 np{p1.x - p0.x + 1, p1.y - p0.y + 1, p1.z - p0.z + 1};
             const int64_t points = int64_t(np.x) * np.y * np.z;
+            const bool narrow = points < (int64_t(1) << 32);  // 32-bit divisions (a 64-bit one is ~4x dearer)
             for (int64_t j = threadIdx.x; j < points; j += blockDim.x) {
-                const Int3 p{p0.x + int(j % np.x), p0.y + int((j / np.x) % np.y), p0.z + int(j / (int64_t(np.x) * np.y))};
+                Int3 p;
+                if (narrow) {
+                    const uint32_t u = uint32_t(j), row = u / uint32_t(np.x);
+                    p = {p0.x + int(u - row * uint32_t(np.x)), p0.y + int(row % uint32_t(np.y)), p0.z + int(row / uint32_t(np.y))};
+                } else {
+                    const int64_t row = j / np.x;
+                    p = {p0.x + int(j - row * np.x), p0.y + int(row % np.y), p0.z + int(row / np.y)};
+                }
                 const Int3 pb{p.x >> kBandBlockLog2, p.y >> kBandBlockLog2, p.z >> kBandBlockLog2};
                 const int64_t a = use_cache ? cached[(pb.x - b0.x) + int64_t(nb.x) * ((pb.y - b0.y) + int64_t(nb.y) * (pb.z - b0.z))]
                                             : batch_index(piece, piece.grid.block_id(c, pb));
@@ -275,6 +298,59 @@ __global__ void __launch_bounds__(kSweepThreads)
                 }
             }
             if (use_cache) __syncthreads();  // before the next box overwrites the cache
+        }
+    }
+}
+
+/// Blocks whose every lattice point the sweep left without a triangle (their sides all from
+/// the flood): block_nearest INT_MAX (to be found), else -1.
+__global__ void __launch_bounds__(kBandBlockPoints) find_unsigned_blocks(const int* nearest, int* block_nearest) {
+    const bool any = __syncthreads_or(nearest[int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x] >= 0);
+    if (threadIdx.x == 0) block_nearest[blockIdx.x] = any ? -1 : INT_MAX;
+}
+
+/// The nearest triangle in double of point 0 of each such block (flood_band_sides' side for
+/// the block), by the same sweep within a wider bound (W and the block's extent): each
+/// triangle visits the block origins near it. Q_d and the tie rule as sweep_band_triangles.
+template <int kPass>
+__global__ void __launch_bounds__(kSweepThreads)
+    sweep_block_origins(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
+                        BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* block_nearest) {
+    const double reach = sqrt(bound_squared);
+    for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
+        const PackedTriangle<double> t = packed[s];
+        const int triangle = triangle_index[s];
+        const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
+            v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
+        const Vec3d lo(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
+        const Vec3d hi(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+        for (int c = 0; c < piece.grid.cosets; ++c) {
+            const BandCoset& coset = piece.grid.coset[c];
+            Int3 p0, p1;
+            if (!coset_range(piece.lattice, coset, lo, hi, p0, p1)) continue;
+            // The blocks whose point 0 (8 b) lies in [p0, p1].
+            const Int3 b0{(p0.x + kBandBlockDim - 1) >> kBandBlockLog2, (p0.y + kBandBlockDim - 1) >> kBandBlockLog2,
+                          (p0.z + kBandBlockDim - 1) >> kBandBlockLog2};
+            const Int3 nb{(p1.x >> kBandBlockLog2) - b0.x + 1, (p1.y >> kBandBlockLog2) - b0.y + 1, (p1.z >> kBandBlockLog2) - b0.z + 1};
+            if (nb.x <= 0 || nb.y <= 0 || nb.z <= 0) continue;
+            const int64_t count = int64_t(nb.x) * nb.y * nb.z;
+            for (int64_t j = threadIdx.x; j < count; j += blockDim.x) {
+                const int64_t row = j / nb.x;
+                const Int3 pb{b0.x + int(j - row * nb.x), b0.y + int(row % nb.y), b0.z + int(row / nb.y)};
+                const int64_t a = batch_index(piece, piece.grid.block_id(c, pb));
+                if (a < 0 || block_nearest[a] < 0) continue;  // inactive, or signed by its own points
+                const Vec3d x = piece.lattice.position_of_coords(
+                    {coset.first.x + 2 * kBandBlockDim * pb.x, coset.first.y + 2 * kBandBlockDim * pb.y, coset.first.z + 2 * kBandBlockDim * pb.z});
+                double q = squared_distance(t, x.x, x.y, x.z);
+                if (!(q <= bound_squared)) continue;
+                if (q == 0) q = 0;
+                const unsigned long long key = ordered_key(q);
+                if constexpr (kPass == 0) {
+                    if (key < best_key[a]) atomicMin(best_key + a, key);
+                } else if (key == best_key[a]) {
+                    atomicMin(block_nearest + a, triangle);
+                }
+            }
         }
     }
 }
@@ -353,12 +429,23 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
     // (flood_band_sides), the warp kernel (the candidates kernel searches every point).
     const bool bounded = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
+    // The sweep's blocks without a triangle: their point 0's key and nearest triangle (12 bytes a block).
+    DeviceBuffer<unsigned long long> block_key{bounded ? size_t(batch) : 0};
+    DeviceBuffer<int> block_nearest{bounded ? size_t(batch) : 0};
+    // The sweep's bound on Q_d: W with a relative margin of 1e-6 and an absolute one of 2^-30
+    // of the coordinates' scale, far above Q_d's rounding in distance terms (about
+    // u (|B - P| scale + 8 extent^2) / W, |B - P| <= the mesh's extent <= 16384 W), so that
+    // every point the finalize finds within W has its triangle. No sliver reach: Q_d is exact
+    // to that, where the float search ranks slivers by their edges.
+    double sweep_bound = 0;
     if (bounded) {
         const double scale = coordinate + bound.coordinate;
         search.bound_squared = band_search_bound_squared<T>(width, scale, reach);
+        const double r = (width + 0x1p-30 * scale) * (1.0 + 1e-6);
+        sweep_bound = r * r;
     }
-    DeviceBuffer<unsigned long long> flood_counters{3};
-    CUDA_CHECK(cudaMemset(flood_counters.get(), 0, 3 * sizeof(unsigned long long)));
+    DeviceBuffer<unsigned long long> flood_counters{4};
+    CUDA_CHECK(cudaMemset(flood_counters.get(), 0, 4 * sizeof(unsigned long long)));
     reset_certificate(dev);
     int64_t batches = 0;
     for (int64_t b0 = 0; b0 < blocks; b0 += batch, ++batches) {
@@ -377,15 +464,26 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
             CUDA_CHECK_LAUNCH("fill_nearest");
             const int triangles = dev.view.num_triangles;
             const int grid = std::max(1, std::min(triangles, 1 << 20));
-            const double bound = double(search.bound_squared);
-            sweep_band_triangles<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece, bound,
-                                                              key, r.nearest.get());
+            sweep_band_triangles<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
+                                                              sweep_bound, key, r.nearest.get());
             CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
-            sweep_band_triangles<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece, bound,
-                                                              key, r.nearest.get());
+            sweep_band_triangles<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
+                                                              sweep_bound, key, r.nearest.get());
             CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
             finish_sweep<<<blocks_for(n, 256), 256>>>(piece, key, r.nearest.get());
             CUDA_CHECK_LAUNCH("finish_sweep");
+            // The blocks left without a triangle: their point 0's nearest within W and the
+            // block's reach (its far corner 7 sqrt(3) spacings away, 16 taken), for the flood.
+            find_unsigned_blocks<<<int(nb), kBandBlockPoints>>>(r.nearest.get(), block_nearest.get());
+            CUDA_CHECK_LAUNCH("find_unsigned_blocks");
+            CUDA_CHECK(cudaMemset(block_key.get(), 0xff, size_t(nb) * sizeof(unsigned long long)));
+            const double r2 = (std::sqrt(sweep_bound) + 16 * lattice.spacing) * (1.0 + 1e-6);
+            sweep_block_origins<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
+                                                             r2 * r2, block_key.get(), block_nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_block_origins (keys)");
+            sweep_block_origins<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
+                                                             r2 * r2, block_key.get(), block_nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_block_origins (triangles)");
         } else {
             fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
             CUDA_CHECK_LAUNCH("fill_nearest");
@@ -407,7 +505,8 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         finalize_stage.end();
         flood_stage.begin();
         if (bounded) {
-            flood_band_sides<T><<<int(nb), kBandBlockPoints>>>(dev.view, dev.mesh->view(), piece, r.nearest.get(), width,
+            flood_band_sides<T><<<int(nb), kBandBlockPoints>>>(dev.view, dev.mesh->view(), piece, r.nearest.get(),
+                                                               bounded ? block_nearest.get() : nullptr, width,
                                                                r.samples.distance.get(), flood_counters.get());
             CUDA_CHECK_LAUNCH("flood_band_sides");
         }
@@ -432,7 +531,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         staged_.to_host(band_mask.get(), band.band_mask.data() + first + size_t(b0), size_t(nb) * sizeof(BandPointMask));
         download.end();
     }
-    unsigned long long flood[3] = {0, 0, 0};
+    unsigned long long flood[4] = {0, 0, 0, 0};
     CUDA_CHECK(cudaMemcpy(flood, flood_counters.get(), sizeof(flood), cudaMemcpyDeviceToHost));
     if (flood[2] != 0)
         throw std::logic_error("CUDA BVH sparse band: " + std::to_string(flood[2]) +
@@ -456,6 +555,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
+        {"blocks_signed_over_every_triangle", int64_t(flood[3])},
         {"kernel_seconds", compute.seconds()},
         {"stage_seconds", {{"search", search_stage.seconds()}, {"finalize", finalize_stage.seconds()},
                            {"flood_source_order_and_mask", flood_stage.seconds()}}},
