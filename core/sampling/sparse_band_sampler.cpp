@@ -49,7 +49,7 @@ private:
     std::vector<uint64_t> bits_;
 };
 
-/// Step 1: the blocks whose cells meet a triangle's box dilated by W.
+/// Step 1: the blocks whose cells meet a triangle's box dilated by W and the slab within W of its plane.
 BlockBits active_blocks(const PreparedMesh& mesh, const BandLayout& layout, double width) {
     BlockBits bits(layout.block_count());
     const Lattice& lattice = layout.lattice();
@@ -75,9 +75,37 @@ BlockBits active_blocks(const PreparedMesh& mesh, const BandLayout& layout, doub
                 empty = empty || lo[a] > hi[a];
             }
             if (empty) continue;
+            // Of those, the cells that meet the slab within W of the triangle's plane: a
+            // triangle across its box (a diagonal one) leaves most of the box's cells beyond W.
+            // Conservative: the cell's distance to the plane, |n.(centre - V0)| less the cell's
+            // half extent along n, is taken within the dilation plus 1e-4 spacings and 2^-40 of
+            // the magnitudes (the rounding of n and the dot products). A degenerate triangle
+            // (no normal) keeps its box.
+            const Vec3d a = v[size_t(t.x)], e0 = v[size_t(t.y)] - a, e1 = v[size_t(t.z)] - a;
+            const Vec3d normal = cross(e0, e1);
+            const double area2 = length(normal);
+            // The normal's direction is off by about u |E0| |E1| / |E0 x E1| (a sliver's cross
+            // product cancels): that times the cell's distance from V0 is added to the reach;
+            // past 1e-3 rad (an extreme sliver) the box alone decides.
+            const double tilt = 8 * 0x1p-53 * length(e0) * length(e1) / area2 + 8 * 0x1p-53;
+            const bool slab = area2 > 0 && std::isfinite(area2) && tilt < 1e-3;
+            const Vec3d n = slab ? normal / area2 : Vec3d(0.0);
+            const double half = 0.5 * kBandBlockDim * h * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+            const double magnitude = std::abs(a.x) + std::abs(a.y) + std::abs(a.z) + std::abs(o.x) + std::abs(o.y) + std::abs(o.z) +
+                                     3 * kBandBlockDim * h * (double(s.blocks.x) + s.blocks.y + s.blocks.z);
+            const double reach = dilation + half + 1e-4 * h + 0x1p-40 * magnitude;
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) bits.set(layout.block_id(c, {x, y, z}));
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        if (slab) {
+                            const double cell = 0.5 * kBandBlockDim * h;  // the cell's centre, from its first point
+                            const Vec3d centre{o.x + (kBandBlockDim * x) * h + cell, o.y + (kBandBlockDim * y) * h + cell,
+                                               o.z + (kBandBlockDim * z) * h + cell};
+                            const Vec3d from = centre - a;
+                            if (std::abs(dot(n, from)) > reach + tilt * (length(from) + kBandBlockDim * h)) continue;
+                        }
+                        bits.set(layout.block_id(c, {x, y, z}));
+                    }
         }
     }
     return bits;
