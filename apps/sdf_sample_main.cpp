@@ -20,7 +20,8 @@
 // sets alone (the band's lattice may then be as large as a sparse field file's: up to 2^42
 // points). A sparse band holds the gradient and the closest triangle only
 // when --channels names them: without them, they are neither kept nor downloaded from a GPU
-// (--channels distance: 8.125 bytes a point, not 36.125; the band's points are a bit mask).
+// (--channels distance: 8.125 bytes a point, not 36.125; the band's points are a bit mask),
+// and with --dtype float32 (the default) its distances in float32 as written: 4.125 bytes.
 #include <CLI/CLI.hpp>
 
 #include "apps/cli_exit.h"
