@@ -98,6 +98,8 @@ int main(int argc, char** argv) {
         out["sparse"] = sparse.sampler.details["sparse_band"];
         if (sparse.sampler.details.contains("band_blocks_on_device"))  // the GPU's stages, batches and memory
             out["on_device"] = sparse.sampler.details["band_blocks_on_device"];
+        if (sparse.sampler.details.contains("band_blocks_on_host"))  // the CPU's bounded search and flood
+            out["on_host"] = sparse.sampler.details["band_blocks_on_host"];
         if (sparse.sampler.details.contains("band_blocks_on_device"))
             out["band_blocks_on_device"] = sparse.sampler.details["band_blocks_on_device"];
         out["active_blocks"] = int64_t(sparse.active.size());
