@@ -139,10 +139,8 @@ private:
                         const int x = int(i % r.x), y = int((i / r.x) % r.y), z = int(i / (int64_t(r.x) * r.y));
                         return base + size_t(x + kBandBlockDim * (y + kBandBlockDim * z));
                     };
-                    // Each point's side for the flood: padding stays kBandSidePadding.
-                    std::array<signed char, kBandBlockPoints> side;
-                    side.fill(kBandSidePadding);
-                    std::array<bool, kBandBlockPoints> flooded{};  // the points whose side the flood gives
+                    // Each point's side for the flood (padding has none and is never open).
+                    BandSideLayers sides;
                     bool flood = false;
                     const bool gradient = out.channels.gradient, triangle = out.channels.closest_triangle;
                     BandPointMask in_band{};  // the block's band points
@@ -153,7 +151,7 @@ private:
                     };
                     auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
                         const size_t v = slot(i);
-                        side[v - base] = std::signbit(s.distance) ? kBandSideInside : kBandSideOutside;
+                        sides.set(int(v - base), std::signbit(s.distance) ? kBandSideInside : kBandSideOutside);
                         if (outside_band(s.distance, band.width)) {
                             store_outside(v, std::signbit(s.distance));
                             return;
@@ -165,8 +163,7 @@ private:
                     };
                     auto emit_outside = [&](int64_t i, BandSide s) {
                         const size_t v = slot(i);
-                        side[v - base] = s;
-                        flooded[v - base] = s == kBandSideNone;
+                        sides.set(int(v - base), s);
                         flood = flood || s == kBandSideNone;
                         store_outside(v, s == kBandSideInside);
                     };
@@ -177,23 +174,15 @@ private:
                     });
                     out.band_mask[a] = in_band;
                     if (!flood) continue;
-                    if (std::none_of(side.begin(), side.end(), band_side_known)) {  // its point 0 by the double search
-                        side[0] = nearest_side_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside;
+                    if (!sides.any_known()) {  // its point 0 by the double search
+                        sides.set(0, nearest_side_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside);
                         ++searched_blocks;
                     }
-                    for (bool changed = true; changed;) {
-                        changed = false;
-                        for (int local = 0; local < kBandBlockPoints; ++local) {
-                            if (side[size_t(local)] != kBandSideNone) continue;
-                            side[size_t(local)] = neighbour_side([&](int j) { return side[size_t(j)]; }, local);
-                            changed = changed || side[size_t(local)] != kBandSideNone;
-                        }
-                    }
-                    for (int local = 0; local < kBandBlockPoints; ++local) {
-                        if (side[size_t(local)] == kBandSideNone)
-                            throw std::logic_error("CPU BVH sparse band: a point beyond the band was left without a side");
-                        if (flooded[size_t(local)] && side[size_t(local)] == kBandSideInside) out.distance.set(base + size_t(local), -band.width);
-                    }
+                    if (!sides.spread())
+                        throw std::logic_error("CPU BVH sparse band: a point beyond the band was left without one side");
+                    for (int z = 0; z < kBandBlockDim; ++z)
+                        for (uint64_t in = sides.open[z] & sides.inside[z]; in != 0; in &= in - 1)
+                            out.distance.set(base + size_t(64 * z + __builtin_ctzll(in)), -band.width);
                 }
             });
             out.sampler.details["band_blocks_on_host"] = {{"bounded_search", band.bound_squared > 0},

@@ -119,6 +119,8 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
     const MeshView<double> exact = mesh.buffers<double>().view();
     const Certifier<T> certifier(mesh, bvh, largest_lattice_coordinate(lattice));
     const auto closest_triangle = cpu_kernels<T>().closest_triangle;  // the probes': plain, the widest ISA
+    const BvhView<double> exact_view = bvh.view<double>();
+    const auto closest_double = cpu_kernels<double>().closest_triangle;  // the probes' side
     const Int3 r = block.resolution;
     const Int3 bricks{(r.x + kBrickX - 1) / kBrickX, (r.y + kBrickY - 1) / kBrickY, (r.z + kBrickZ - 1) / kBrickZ};
     const int64_t n = int64_t(bricks.x) * bricks.y * bricks.z;
@@ -159,8 +161,14 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                     const Vec3<T> pt(c);
                     const BvhHit<T> hit = closest_triangle(view, pt, seed_hit(view, probe_seed, pt), stats);
                     probe_seed = hit.slot;
-                    // The probe needs only a distance bound, which its margin covers: not certified.
-                    const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[hit.slot]);
+                    // The distance needs only a bound, which the margin covers; the side needs
+                    // the double search's triangle (the points' own): a float near-tie may pick
+                    // a triangle whose pseudonormal puts c on the other side (a sliver's edge an
+                    // ulp beside a sharp edge), and the ball would carry that side.
+                    int32_t slot = hit.slot;
+                    if constexpr (std::is_same_v<T, float>)
+                        slot = closest_double(exact_view, c, seed_hit(exact_view, hit.slot, c), stats).slot;
+                    const SignedDistanceSample<double> s = signed_distance_to_triangle(exact, c, view.triangle_index[slot]);
                     const double d = std::abs(s.distance);
                     const double margin = band.relative_margin * (d + band.coordinate_scale + std::abs(c.x) + std::abs(c.y) + std::abs(c.z));
                     ball = {c, d - band.width - margin - band.sliver_reach, s.distance < 0, s.triangle, d};

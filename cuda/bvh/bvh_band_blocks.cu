@@ -11,8 +11,9 @@
 // On a solid (the pseudonormal sign, W >= one spacing) no point is searched: each triangle
 // sweeps the points near it (sweep_band_triangles: the double search's triangle of every point
 // within W, exactly); a point beyond finds no triangle and takes its side from its neighbours
-// (flood_band_sides), a block of such points from its point 0's nearest triangle
-// (sweep_block_origins). Every other band runs the search.
+// (finish_band_blocks, band_sides.h), a block of such points from its point 0's nearest
+// triangle (sweep_block_origins, else nearest_of_unswept_origins). Every other band runs the
+// search.
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -83,108 +84,157 @@ __global__ void fill_nearest(int* nearest, int64_t n, int code) {
     if (i < n) nearest[i] = code;
 }
 
-/// Prepared-mesh triangle indices to the mesh file's face order, in place.
-__global__ void to_source_order(int* triangle, int64_t n, const int32_t* source_triangle) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const int t = triangle[i];
-    if (t >= 0) triangle[i] = source_triangle[t];
-}
-
-/// The sides of the points a bounded search left without a triangle (kOutsideBandFlood): one
-/// CUDA block of 512 threads per band block, each point taking a neighbour's side
-/// (kernels/lattice/band_sides.h) until none changes. A block of such points only takes the
-/// side of its point 0, at its nearest triangle in double (that point too lies beyond the
-/// band): `block_nearest`'s (the sweep's, sweep_block_origins) where it found one, else every
-/// triangle's. counters: points flooded, blocks signed by a search,
-/// points left without a side (never: the host checks).
-template <typename T>
+/// The nearest triangle in double of point 0 of each block that the origins' sweep left
+/// without one (block_nearest INT_MAX: no triangle within its reach), over every triangle,
+/// the CUDA block's threads sharing them (ties: the smaller index, closest_triangle_bvh.h's
+/// rule): exact where a float search may tie across a thin part. Rare (none to 0.2% of the
+/// blocks): CUDA blocks stride over the band's blocks. counters[3]: blocks signed so.
 __global__ void __launch_bounds__(kBandBlockPoints)
-    flood_band_sides(BvhView<T> bvh, MeshView<double> mesh, BandBlocksPiece piece, const int* nearest, const int* block_nearest,
-                     double width, double* distance, unsigned long long* counters) {
-    __shared__ volatile signed char side[kBandBlockPoints];
+    nearest_of_unswept_origins(MeshView<double> mesh, BandBlocksPiece piece, int* block_nearest, unsigned long long* counters) {
+    __shared__ double nearest_d[kBandBlockPoints];
+    __shared__ int nearest_t[kBandBlockPoints];
     const int local = threadIdx.x;
-    const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + local;
-    const BandBlockCoords b = piece.grid.block_coords(piece.ids[blockIdx.x]);
-    const bool padding = piece.grid.padding(b, local);
-    const bool flood = !padding && nearest[i] == kOutsideBandFlood;
-    side[local] = padding ? kBandSidePadding : flood ? kBandSideNone : signbit(distance[i]) ? kBandSideInside : kBandSideOutside;
-    const int flooded = __syncthreads_count(flood);
-    if (flooded == 0) return;  // uniform over the block
-    if (!__syncthreads_or(!flood && !padding)) {
-        // Point 0's side (a block's point 0 is never padding) at its nearest triangle in
-        // double: the sweep's, else over every triangle, the block's threads sharing them
-        // (ties: the smaller index, as closest_triangle_bvh.h's rule): exact where a float
-        // search may tie across a thin part.
-        __shared__ double nearest_d[kBandBlockPoints];
-        __shared__ int nearest_t[kBandBlockPoints];
-        const Vec3d p = piece.position(int64_t(blockIdx.x) * kBandBlockPoints);
-        const int swept = block_nearest ? block_nearest[blockIdx.x] : -1;
-        if (swept >= 0 && swept != INT_MAX) {  // uniform over the block
-            if (local == 0) {
-                side[0] = signed_distance_to_triangle(mesh, p, swept).distance < 0 ? kBandSideInside : kBandSideOutside;
-                atomicAdd(counters + 1, 1ull);
+    for (int64_t a = blockIdx.x; a < piece.blocks; a += gridDim.x) {
+        if (block_nearest[a] != INT_MAX) continue;  // uniform over the CUDA block
+        const Vec3d p = piece.position(a * kBandBlockPoints);
+        double best = INFINITY;
+        int best_t = -1;
+        for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
+            const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
+            if (d < best) {
+                best = d;
+                best_t = t;
             }
-            __syncthreads();
-        } else {
-            double best = INFINITY;
-            int best_t = -1;
-            for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
-                const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
-                if (d < best) {
-                    best = d;
-                    best_t = t;
+        }
+        nearest_d[local] = best;
+        nearest_t[local] = best_t;
+        __syncthreads();
+        for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
+            if (local < half) {
+                const double d = nearest_d[local + half];
+                const int t = nearest_t[local + half];
+                if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
+                    nearest_d[local] = d;
+                    nearest_t[local] = t;
                 }
-            }
-            nearest_d[local] = best;
-            nearest_t[local] = best_t;
-            __syncthreads();
-            for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
-                if (local < half) {
-                    const double d = nearest_d[local + half];
-                    const int t = nearest_t[local + half];
-                    if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
-                        nearest_d[local] = d;
-                        nearest_t[local] = t;
-                    }
-                }
-                __syncthreads();
-            }
-            if (local == 0) {
-                side[0] = signed_distance_to_triangle(mesh, p, nearest_t[0]).distance < 0 ? kBandSideInside : kBandSideOutside;
-                atomicAdd(counters + 1, 1ull);
-                atomicAdd(counters + 3, 1ull);
             }
             __syncthreads();
         }
-    }
-    const auto side_of = [&](int j) { return static_cast<signed char>(side[j]); };
-    for (;;) {
-        bool changed = false;
-        if (side[local] == kBandSideNone) {
-            const signed char s = neighbour_side(side_of, local);
-            if (s != kBandSideNone) {
-                side[local] = s;
-                changed = true;
-            }
+        if (local == 0) {
+            block_nearest[a] = nearest_t[0];
+            atomicAdd(counters + 3, 1ull);
         }
-        if (!__syncthreads_or(changed)) break;
+        __syncthreads();  // before the next block's reduction overwrites the arrays
     }
-    if (flood) distance[i] = side[local] == kBandSideInside ? -width : width;
-    if (local == 0) atomicAdd(counters + 0, (unsigned long long)flooded);
-    if (flood && side[local] == kBandSideNone) atomicAdd(counters + 2, 1ull);
 }
 
-/// The band's points of a batch's blocks as their masks (SparseBandField::band_mask): bit
-/// `local` of a block set where its point's triangle is not kOutsideBandTriangle (padding's
-/// is). One thread per point, one ballot per warp: the warp's 32 points are 32-bit half
-/// i / 32 of the masks' 64-bit words (little-endian, as the host reads them). n is a whole
-/// number of blocks, so a warp is wholly in or out.
-__global__ void mark_band_points(const int* triangle, int64_t n, uint32_t* mask) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i - (threadIdx.x & 31) >= n) return;
-    const unsigned bits = __ballot_sync(0xffffffffu, i < n && triangle[i] != kOutsideBandTriangle);
-    if ((threadIdx.x & 31) == 0) mask[i >> 5] = bits;
+/// The side of each block whose points all lie beyond the band (block_nearest >= 0: point
+/// 0's nearest triangle, from the sweep or over every triangle), as its point 0's at that
+/// triangle; kBandSideNone for the others (their points give the sides). counters[1]:
+/// blocks signed by a nearest triangle.
+__global__ void sides_of_unsigned_blocks(MeshView<double> mesh, BandBlocksPiece piece, const int* block_nearest,
+                                         signed char* block_side, unsigned long long* counters) {
+    const int64_t a = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (a >= piece.blocks) return;
+    const int t = block_nearest[a];
+    signed char side = kBandSideNone;
+    if (t >= 0) {
+        const Vec3d p = piece.position(a * kBandBlockPoints);
+        side = signed_distance_to_triangle(mesh, p, t).distance < 0 ? kBandSideInside : kBandSideOutside;
+        atomicAdd(counters + 1, 1ull);
+    }
+    block_side[a] = side;
+}
+
+/// The last pass over a batch's blocks after finalize, a warp per block, 16 points a lane
+/// (point 32 j + lane at step j: coalesced): the closest triangles to the mesh file's face
+/// order, the band's points as the block's mask (SparseBandField::band_mask: bit `local` set
+/// where the triangle is not kOutsideBandTriangle; step j's ballot is the mask's 32-bit half j,
+/// little-endian, as the host reads it), the distances rounded to float32 where the band holds
+/// them so (float(d), as the host type rounds them: half the download), and with kSpread the
+/// sides of the points the sweep left without a triangle (kOutsideBandFlood): band_sides.h's
+/// layers, lane s * 8 + z holding side s's layer z (bits 32 (j & 1) + lane of layer j / 2 at
+/// step j), spread a step at a time with the layers below and above shuffled in; a block of
+/// such points starts from `block_side`. counters[0]: points spread to; counters[2]: points
+/// left without one side (never: the host checks).
+constexpr int kFinishThreads = 256;
+constexpr int kFinishBlocksPerCudaBlock = kFinishThreads / 32;
+
+template <bool kSpread>
+__global__ void __launch_bounds__(kFinishThreads)
+    finish_band_blocks(BandBlocksPiece piece, const int* nearest, const signed char* block_side, double width, double* distance,
+                       float* distance32, int* triangle, const int32_t* source_triangle, uint32_t* mask,
+                       unsigned long long* counters) {
+    constexpr int kSteps = kBandBlockPoints / 32;
+    const int lane = threadIdx.x & 31;
+    const int64_t a = int64_t(blockIdx.x) * kFinishBlocksPerCudaBlock + threadIdx.x / 32;
+    if (a >= piece.blocks) return;  // the whole warp
+    const int64_t base = a * kBandBlockPoints;
+    const Int3 points = piece.grid.block_points(piece.grid.block_coords(piece.ids[a]));
+    const int z = lane & (kBandBlockDim - 1);
+    const bool inside_lane = lane < kBandBlockDim, layer_lane = lane < 2 * kBandBlockDim;
+    uint64_t layer = 0, open = 0;  // side (lane / 8)'s layer z, and layer z's open points
+    int flooded = 0;               // the block's open points (uniform)
+    double d[kSteps];
+#pragma unroll
+    for (int j = 0; j < kSteps; ++j) {
+        const int64_t i = base + 32 * j + lane;
+        const int t = triangle[i];
+        const unsigned in_band = __ballot_sync(kFullWarp, t != kOutsideBandTriangle);
+        if (lane == 0) mask[a * kSteps + j] = in_band;
+        if (t >= 0) triangle[i] = source_triangle[t];
+        if (kSpread || distance32 != nullptr) d[j] = distance[i];
+        if constexpr (kSpread) {
+            const int local = 32 * j + lane;
+            const bool real = BandBlockGrid::within(points, local);
+            const bool flood = real && nearest[i] == kOutsideBandFlood;
+            const bool negative = signbit(d[j]);
+            const unsigned in = __ballot_sync(kFullWarp, real && !flood && negative);
+            const unsigned out = __ballot_sync(kFullWarp, real && !flood && !negative);
+            const unsigned fl = __ballot_sync(kFullWarp, flood);
+            flooded += __popc(fl);
+            if ((j >> 1) == z) {
+                const int shift = 32 * (j & 1);
+                if (layer_lane) layer |= uint64_t(inside_lane ? in : out) << shift;
+                open |= uint64_t(fl) << shift;
+            }
+        }
+    }
+    if constexpr (kSpread) {
+        if (!layer_lane) open = 0;
+        if (flooded > 0) {
+            if (!__any_sync(kFullWarp, layer != 0) && z == 0 && layer_lane)  // no point with its own side: point 0's
+                layer = block_side[a] == (inside_lane ? kBandSideInside : kBandSideOutside) ? 1 : 0;
+            for (;;) {
+                const uint64_t below = __shfl_sync(kFullWarp, layer, z > 0 ? lane - 1 : lane);
+                const uint64_t above = __shfl_sync(kFullWarp, layer, z + 1 < kBandBlockDim ? lane + 1 : lane);
+                const uint64_t reached = band_layer_step(layer, z > 0 ? below : 0, z + 1 < kBandBlockDim ? above : 0) & open & ~layer;
+                layer |= reached;
+                if (!__any_sync(kFullWarp, reached != 0)) break;
+            }
+            const uint64_t other = __shfl_xor_sync(kFullWarp, layer, kBandBlockDim);  // the other side's layer z
+            const uint64_t wrong = (open & ~(layer | other)) | (layer & other);
+            int unsided = inside_lane ? __popcll(wrong) : 0;
+            for (int o = 16; o > 0; o >>= 1) unsided += __shfl_xor_sync(kFullWarp, unsided, o);
+#pragma unroll
+            for (int j = 0; j < kSteps; ++j) {
+                const uint64_t in = __shfl_sync(kFullWarp, layer, j >> 1), fl = __shfl_sync(kFullWarp, open, j >> 1);
+                const int bit = 32 * (j & 1) + lane;
+                if ((fl >> bit) & 1) {
+                    d[j] = ((in >> bit) & 1) ? -width : width;
+                    if (distance32 == nullptr) distance[base + 32 * j + lane] = d[j];
+                }
+            }
+            if (lane == 0) {
+                atomicAdd(counters + 0, (unsigned long long)flooded);
+                if (unsided > 0) atomicAdd(counters + 2, (unsigned long long)unsided);
+            }
+        }
+    }
+    if (distance32 != nullptr) {
+#pragma unroll
+        for (int j = 0; j < kSteps; ++j) distance32[base + 32 * j + lane] = float(d[j]);
+    }
 }
 
 /// The triangle sweep (a solid's bounded band, in place of the bounded search): each
@@ -235,6 +285,27 @@ __device__ SDF_INLINE bool coset_range(const Lattice& lattice, const BandCoset& 
     return true;
 }
 
+/// A triangle's box dilated by `reach`, from its vertices B, B + E0, B + E1 (packed as 2 E0,
+/// 2 E1; coset_range's margin of a point covers the rounding).
+__device__ SDF_INLINE void dilated_box(const PackedTriangle<double>& t, double reach, Vec3d& lo, Vec3d& hi) {
+    const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
+        v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
+    lo = Vec3d(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
+    hi = Vec3d(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+}
+
+/// Whether point x lies beyond the bound from the triangle by its plane alone, before Q_d is
+/// evaluated: the distance h from the plane is a lower bound of the distance, and what the
+/// doubles lose stays below 2^-40 |B - x|^2 (h's, through the unit normal's direction: about
+/// 200 u off for a triangle that is not a sliver, a few u for a sliver's accurate normal; Q_d's,
+/// about 2^-47 |B - x|^2), so a point culled here has Q_d above the bound too. A normal of
+/// zero (h = 0) or NaN culls nothing.
+__device__ SDF_INLINE bool beyond_plane(const PackedTriangle<double>& t, const Vec3d& x, double bound_squared) {
+    const double dx = t.bx - x.x, dy = t.by - x.y, dz = t.bz - x.z;
+    const double h = t.nx * dx + t.ny * dy + t.nz * dz, f = dx * dx + dy * dy + dz * dz;
+    return h * h > 1.01 * bound_squared + 0x1p-40 * f;
+}
+
 template <int kPass>
 __global__ void __launch_bounds__(kSweepThreads)
     sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
@@ -244,11 +315,8 @@ __global__ void __launch_bounds__(kSweepThreads)
     for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
         const PackedTriangle<double> t = packed[s];
         const int triangle = triangle_index[s];
-        // Its vertices B, B + E0, B + E1 (packed as 2 E0, 2 E1; the index margin covers the rounding).
-        const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
-            v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
-        const Vec3d lo(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
-        const Vec3d hi(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+        Vec3d lo, hi;
+        dilated_box(t, reach, lo, hi);
         for (int c = 0; c < piece.grid.cosets; ++c) {
             const BandCoset& coset = piece.grid.coset[c];
             Int3 p0, p1;
@@ -279,12 +347,7 @@ __global__ void __launch_bounds__(kSweepThreads)
                                             : batch_index(piece, piece.grid.block_id(c, pb));
                 if (a < 0) continue;  // not an active block of this batch
                 const Vec3d x = piece.lattice.position_of_coords({coset.first.x + 2 * p.x, coset.first.y + 2 * p.y, coset.first.z + 2 * p.z});
-                // Beyond twice the reach from the triangle's plane: beyond the bound, whatever
-                // Q_d's rounding (about 2^-50 |B - P|^2, small against 3 bounds while |B - P|
-                // stays below 2^20 reaches; farther points are not culled).
-                const double dx = t.bx - x.x, dy = t.by - x.y, dz = t.bz - x.z;
-                const double h = t.nx * dx + t.ny * dy + t.nz * dz, f = dx * dx + dy * dy + dz * dz;
-                if (h * h > 4 * bound_squared && f < 0x1p40 * bound_squared) continue;
+                if (beyond_plane(t, x, bound_squared)) continue;  // the triangle's slab: most of its box
                 double q = squared_distance(t, x.x, x.y, x.z);
                 if (!(q <= bound_squared)) continue;
                 if (q == 0) q = 0;  // -0 ties +0, as the search's comparison
@@ -309,8 +372,8 @@ __global__ void __launch_bounds__(kBandBlockPoints) find_unsigned_blocks(const i
     if (threadIdx.x == 0) block_nearest[blockIdx.x] = any ? -1 : INT_MAX;
 }
 
-/// The nearest triangle in double of point 0 of each such block (flood_band_sides' side for
-/// the block), by the same sweep within a wider bound (W and the block's extent): each
+/// The nearest triangle in double of point 0 of each such block (the block's side,
+/// sides_of_unsigned_blocks), by the same sweep within a wider bound (W and the block's extent): each
 /// triangle visits the block origins near it. Q_d and the tie rule as sweep_band_triangles.
 template <int kPass>
 __global__ void __launch_bounds__(kSweepThreads)
@@ -320,10 +383,8 @@ __global__ void __launch_bounds__(kSweepThreads)
     for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
         const PackedTriangle<double> t = packed[s];
         const int triangle = triangle_index[s];
-        const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
-            v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
-        const Vec3d lo(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
-        const Vec3d hi(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+        Vec3d lo, hi;
+        dilated_box(t, reach, lo, hi);
         for (int c = 0; c < piece.grid.cosets; ++c) {
             const BandCoset& coset = piece.grid.coset[c];
             Int3 p0, p1;
@@ -341,6 +402,7 @@ __global__ void __launch_bounds__(kSweepThreads)
                 if (a < 0 || block_nearest[a] < 0) continue;  // inactive, or signed by its own points
                 const Vec3d x = piece.lattice.position_of_coords(
                     {coset.first.x + 2 * kBandBlockDim * pb.x, coset.first.y + 2 * kBandBlockDim * pb.y, coset.first.z + 2 * kBandBlockDim * pb.z});
+                if (beyond_plane(t, x, bound_squared)) continue;
                 double q = squared_distance(t, x.x, x.y, x.z);
                 if (!(q <= bound_squared)) continue;
                 if (q == 0) q = 0;
@@ -362,13 +424,6 @@ __global__ void finish_sweep(BandBlocksPiece piece, const unsigned long long* be
     if (i >= piece.size() || best_key[i] != kSweepNone) return;
     const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[i / kBandBlockPoints]), int(i % kBandBlockPoints));
     nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
-}
-
-/// Distances rounded to float32 (float(d), as the band's host type rounds them) for a band
-/// held in float32: half the download and half the host's memory.
-__global__ void round_to_float32(const double* distance, int64_t n, float* out) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i < n) out[i] = float(distance[i]);
 }
 
 size_t device_bytes_in_use() {
@@ -396,7 +451,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     require_search_range(mesh(), lattice, options_.precision);
     const int64_t blocks = int64_t(last - first);
     EventTimer upload, compute, download;
-    EventTimer search_stage, finalize_stage, flood_stage;  // compute's parts
+    EventTimer search_stage, finalize_stage, sides_stage;  // compute's parts
     DeviceBuffer<int64_t> ids{size_t(blocks)};
     upload.begin();
     ids.upload(band.active.data() + first, size_t(blocks));
@@ -424,23 +479,23 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     const bool winding = dev.winding.view().enabled();
     const FloatSearchBound& bound = mesh().search_bound();
     const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
-    BandSearch search{width, dev.mesh->view(), winding, winding || solid(), reach};
-    // The bounded search and the flood where the sides of points beyond W can be taken from
+    BandSearch search{width, dev.mesh->view(), winding, winding || solid(), reach, double_view(dev, bound)};
+    // The sweep and the spread of sides where the sides of points beyond W can be taken from
     // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
-    // (flood_band_sides), the warp kernel (the candidates kernel searches every point).
-    const bool bounded = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
-    // The sweep's blocks without a triangle: their point 0's key and nearest triangle (12 bytes a block).
-    DeviceBuffer<unsigned long long> block_key{bounded ? size_t(batch) : 0};
-    DeviceBuffer<int> block_nearest{bounded ? size_t(batch) : 0};
+    // (band_sides.h), the warp kernel (the candidates kernel searches every point).
+    const bool swept = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
+    // The sweep's blocks without a triangle: their point 0's key, nearest triangle and side (13 bytes a block).
+    DeviceBuffer<unsigned long long> block_key{swept ? size_t(batch) : 0};
+    DeviceBuffer<int> block_nearest{swept ? size_t(batch) : 0};
+    DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
     // The sweep's bound on Q_d: W with a relative margin of 1e-6 and an absolute one of 2^-30
     // of the coordinates' scale, far above Q_d's rounding in distance terms (about
     // u (|B - P| scale + 8 extent^2) / W, |B - P| <= the mesh's extent <= 16384 W), so that
     // every point the finalize finds within W has its triangle. No sliver reach: Q_d is exact
     // to that, where the float search ranks slivers by their edges.
     double sweep_bound = 0;
-    if (bounded) {
+    if (swept) {
         const double scale = coordinate + bound.coordinate;
-        search.bound_squared = band_search_bound_squared<T>(width, scale, reach);
         const double r = (width + 0x1p-30 * scale) * (1.0 + 1e-6);
         sweep_bound = r * r;
     }
@@ -454,7 +509,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         const BandBlocksLayout layout{piece};
         compute.begin();
         search_stage.begin();
-        if (bounded) {
+        if (swept) {
             // The sweep: the least key per point in the distance array (rewritten by finalize),
             // the least triangle at it in `nearest`.
             auto* key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
@@ -503,22 +558,25 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, outputs);
         CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
         finalize_stage.end();
-        flood_stage.begin();
-        if (bounded) {
-            flood_band_sides<T><<<int(nb), kBandBlockPoints>>>(dev.view, dev.mesh->view(), piece, r.nearest.get(),
-                                                               bounded ? block_nearest.get() : nullptr, width,
-                                                               r.samples.distance.get(), flood_counters.get());
-            CUDA_CHECK_LAUNCH("flood_band_sides");
+        sides_stage.begin();
+        if (swept) {
+            const int strides = int(std::min<int64_t>(nb, 1024));  // a few per multiprocessor: most exit at once
+            nearest_of_unswept_origins<<<strides, kBandBlockPoints>>>(dev.mesh->view(), piece, block_nearest.get(),
+                                                                      flood_counters.get());
+            CUDA_CHECK_LAUNCH("nearest_of_unswept_origins");
+            sides_of_unsigned_blocks<<<blocks_for(nb, 256), 256>>>(dev.mesh->view(), piece, block_nearest.get(), block_side.get(),
+                                                                   flood_counters.get());
+            CUDA_CHECK_LAUNCH("sides_of_unsigned_blocks");
         }
-        to_source_order<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, dev.source_triangle.get());
-        CUDA_CHECK_LAUNCH("to_source_order");
-        mark_band_points<<<blocks_for(n, 256), 256>>>(r.samples.triangle.get(), n, band_mask.get());
-        CUDA_CHECK_LAUNCH("mark_band_points");
-        if (float32) {
-            round_to_float32<<<blocks_for(n, 256), 256>>>(r.samples.distance.get(), n, distance32.get());
-            CUDA_CHECK_LAUNCH("round_to_float32");
-        }
-        flood_stage.end();
+        const auto finish = [&](auto spread) {
+            finish_band_blocks<decltype(spread)::value><<<blocks_for(nb, kFinishBlocksPerCudaBlock), kFinishThreads>>>(
+                piece, r.nearest.get(), block_side.get(), width, r.samples.distance.get(), float32 ? distance32.get() : nullptr,
+                r.samples.triangle.get(), dev.source_triangle.get(), band_mask.get(), flood_counters.get());
+        };
+        if (swept) finish(std::true_type{});
+        else finish(std::false_type{});
+        CUDA_CHECK_LAUNCH("finish_band_blocks");
+        sides_stage.end();
         compute.end();
         download.begin();
         const size_t v = (first + size_t(b0)) * kBandBlockPoints;
@@ -550,15 +608,15 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"blocks_per_batch", batch},
         {"batches", batches},
         {"brick_skip", search.skip_bricks},
-        {"bounded_search", bounded},
-        {"nearest", bounded ? "triangle_sweep" : "search"},
+        {"bounded_search", swept},
+        {"nearest", swept ? "triangle_sweep" : "search"},
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
         {"blocks_signed_over_every_triangle", int64_t(flood[3])},
         {"kernel_seconds", compute.seconds()},
         {"stage_seconds", {{"search", search_stage.seconds()}, {"finalize", finalize_stage.seconds()},
-                           {"flood_source_order_and_mask", flood_stage.seconds()}}},
+                           {"sides_source_order_and_mask", sides_stage.seconds()}}},
         {"upload_seconds", upload.seconds()},
         {"download_seconds", download.seconds()},
         {"device_bytes_in_use", int64_t(in_use)},  // after the batch's buffers: the conversion's peak (pool included)

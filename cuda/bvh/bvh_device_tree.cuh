@@ -88,6 +88,19 @@ const PackedTriangle<double>* packed_double(const DeviceBvh<T>& dev) {
     else return dev.lbvh ? dev.lbvh->packed_double.get() : dev.exact.get();
 }
 
+/// The double search's view of the tree: its nodes and slots with the double constants, and
+/// the double search's pruning margin (the float bound's), as certify_kernel.cuh's.
+template <typename T>
+BvhView<double> double_view(const DeviceBvh<T>& dev, const FloatSearchBound& bound) {
+    if constexpr (std::is_same_v<T, double>) {
+        return dev.view;
+    } else {
+        BvhView<double> v{dev.view.nodes, packed_double(dev), dev.view.triangle_index, dev.view.num_nodes, dev.view.num_triangles};
+        v.margin = double_prune_margin(bound);
+        return v;
+    }
+}
+
 /// Certifies a float search's `nearest` (certify_kernel.cuh); double searches are the reference.
 template <typename T, typename Piece>
 void certify(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, int* nearest) {

@@ -39,7 +39,7 @@ BandSearch BoundCudaBvh::band_search(const DeviceBvh<T>& dev) const {
     const bool winding = dev.winding.view().enabled();
     const FloatSearchBound& bound = mesh().search_bound();
     const double reach = std::is_same_v<T, float> ? bound.sliver_reach_float : bound.sliver_reach_double;
-    return {options_.band_width, dev.mesh->view(), winding, winding || solid(), reach};
+    return {options_.band_width, dev.mesh->view(), winding, winding || solid(), reach, double_view(dev, bound)};
 }
 
 template <typename T>

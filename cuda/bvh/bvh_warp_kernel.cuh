@@ -174,30 +174,15 @@ struct BandSearch {
     /// How much farther than the true nearest the search's nearest may be, through slivers
     /// ranked by their edges (FloatSearchBound::sliver_reach_*): lowers the centre's bound.
     double sliver_reach = 0;
-    /// A bounded search (0: none): each point starts with this squared radius instead of
-    /// +inf, so a point farther than the band from every triangle ends with no triangle
-    /// (kOutsideBandFlood) after visiting only the nodes within the bound. The bound exceeds
-    /// (W + the float error + sliver_reach)^2, so every point within W still finds its
-    /// nearest: the same one, as a search started at +inf keeps every triangle within the
-    /// bound (streamed_certificate.h: the double winner stays within the radius). Set only
-    /// where the sides of such points can be taken from their neighbours (band_sides.h:
-    /// band_search_bound_squared).
-    double bound_squared = 0;
+    /// The double search's tree (the same nodes and slots with the double constants), for a
+    /// float search: a skipped brick takes the side at its centre's double-search triangle.
+    BvhView<double> exact{};
 };
 
-/// Starts every real lane of a bounded search (band.bound_squared > 0) at the bound: no
-/// triangle yet, and the radius a best of the bound would have (the certificate's widening,
-/// or the plain search's margin, as refresh_radii sets it), so that every triangle the
-/// unbounded search could rank below the bound is still reached.
-template <typename T, int K, typename Near>
-__device__ SDF_INLINE void bound_lanes(const BvhView<T>& bvh, BvhPacket<T, K>& pk, int count, const BandSearch& band,
-                                       const Near& policy) {
-    if (!(band.bound_squared > 0) || count == 0) return;
-    const T b = T(band.bound_squared);
-    for (int k = 0; k < K; ++k) {
-        pk.best_q[k] = b;
-        pk.radius[k] = Near::kStreams ? policy.radius(b) : bvh.margin.widen(policy.radius(b));
-    }
+/// The double search's triangle slot at p, seeded with a float search's `seed` slot: the
+/// point queries' reference. Out of line: the warp kernels' registers stay their search's.
+static __device__ __noinline__ int32_t double_search_slot(const BvhView<double>& exact, Vec3d p, int32_t seed) {
+    return closest_triangle_bvh(exact, p, seed_hit(exact, seed, p)).slot;
 }
 
 /// The box of the warp's real points (uniform across the warp); lo > hi when it has none.
@@ -235,7 +220,12 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
     const double slack = 64.0 * double(std::numeric_limits<T>::epsilon()) * (scale + dc + r) + 1e-300;
     if (!(dc - r - slack - band.sliver_reach > band.width)) return 0;
     if (band.winding_sign) return kOutsideBandSignPerPoint;
-    const SignedDistanceSample<double> s = signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[seed.slot]);
+    // The side needs the double search's triangle (the points' own): a float near-tie may pick
+    // a triangle whose pseudonormal puts c on the other side (a sliver's edge a float ulp
+    // beside a sharp edge), and every point of the brick would carry that side.
+    int32_t slot = seed.slot;
+    if constexpr (std::is_same_v<T, float>) slot = double_search_slot(band.exact, Vec3d(c), seed.slot);
+    const SignedDistanceSample<double> s = signed_distance_to_triangle(band.mesh, Vec3d(c), bvh.triangle_index[slot]);
     return s.distance < 0 ? kOutsideBandInside : kOutsideBandOutside;
 }
 
@@ -267,10 +257,6 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
 #pragma unroll
         for (int k = 0; k < K; ++k) {
             if (k >= count) continue;
-            if (pk.best_slot[k] < 0) {  // a bounded search found nothing within its bound
-                nearest[first + k] = kOutsideBandFlood;
-                continue;
-            }
             bool r = false;
             nearest[first + k] = policy.finish(bvh, k, pk, r);
             reranked += unsigned(r);
@@ -280,7 +266,7 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
         warp_add(cert.counters + 1, reranked);
     } else {
         for (int k = 0; k < count; ++k)
-            nearest[first + k] = pk.best_slot[k] < 0 ? int(kOutsideBandFlood) : bvh.triangle_index[pk.best_slot[k]];
+            nearest[first + k] = bvh.triangle_index[pk.best_slot[k]];
     }
 }
 
@@ -313,12 +299,10 @@ __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
     }
     if constexpr (kCertified) {
         StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
-        bound_lanes(bvh, pk, count, band, policy);
         warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
         write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
     } else {
         PacketPlainNear policy;
-        bound_lanes(bvh, pk, count, band, policy);
         warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
         write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
     }

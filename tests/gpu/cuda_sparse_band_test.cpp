@@ -5,12 +5,14 @@
 // and self-intersecting spheres; CC and BCC, float and double; bunny-open where
 // SDF_DATA_PATH has it. The CUDA BVH's warp and candidates kernels sample the active blocks
 // in device memory (also in batches of a few blocks); its brick kernel and the brute force
-// through point queries. On solids the warp kernel's search is bounded by the band and the
-// points beyond it take their sides from their neighbours (the flood): checked on solids
-// whose triangles' boxes reach far from them (an icosahedron: whole blocks without a band
-// point), the torus and the dragon, at widths from one spacing up, and off below one.
+// through point queries. On solids the warp kernel sweeps the triangles instead of searching
+// and the points beyond the band take their sides from their neighbours (the flood): checked
+// on solids whose triangles' boxes reach far from them (an icosahedron: whole blocks without a
+// band point), the torus and the dragon, at widths from one spacing up, and off below one; and
+// on a tetrahedron of slivers with exact ties (SliversAndTies...).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 
 #include <nlohmann/json.hpp>
@@ -232,6 +234,48 @@ TEST(CudaSparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
         }
     EXPECT_GT(flooded, 0);
     EXPECT_GT(searched_blocks, 0) << "no block was all beyond the band: the search for its side went untested";
+}
+
+// Slivers of every kind (down to those searched by their edges alone), within a float ulp of
+// the tetrahedron's sharp edges, and exact ties at their shared vertices and edges: the
+// triangle sweep (W >= one spacing), the search with its brick skip (W below: each skipped
+// brick's side from its centre's double-search triangle) and the dense band, against the CPU's
+// dense band byte for byte and the exact winding number's sides.
+TEST(CudaSparseBand, SliversAndTiesEqualTheCpuDenseBand) {
+    int64_t flooded = 0;
+    for (const Vec3d& offset : {Vec3d{0, 0, 0}, Vec3d{1e4, -2500.5, 1234.25}}) {
+        const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron(offset));
+        ASSERT_EQ(choose_sign_mode(fan.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << "the fanned tetrahedron is a solid";
+        for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
+            for (Precision precision : {Precision::Float, Precision::Double})
+                for (double spacings : {0.9, 1.0, 3.0}) {
+                    const Lattice lattice = test::lattice_through_the_fan(type, offset);
+                    const double w = spacings * lattice.spacing;
+                    const std::string what = "fanned tetrahedron offset " + std::to_string(offset.x) + " " +
+                                             lattice_notation(lattice) + " " + precision_name(precision) + " W = " +
+                                             std::to_string(spacings) + " h";
+                    const SampledField cpu = make_sampler(options("cpu", "bvh", precision, w, SignMode::Auto))->bind(share(fan))->sample(lattice);
+                    const SampledField winding =
+                        make_sampler(options("cpu", "bvh", precision, w, SignMode::Winding))->bind(share(fan))->sample(lattice);
+                    int64_t wrong = 0;
+                    for (size_t i = 0; i < cpu.distance.size(); ++i)
+                        wrong += std::abs(winding.distance[i]) > 1e-6 && std::signbit(winding.distance[i]) != std::signbit(cpu.distance[i]);
+                    EXPECT_EQ(wrong, 0) << what << ": the CPU's signs off the winding number's";
+                    SamplerOptions dense_options = options("cuda", "bvh", precision, w, SignMode::Auto);
+                    dense_options.kernel = "warp";
+                    const SampledField gpu_dense = make_sampler(dense_options)->bind(share(fan))->sample(lattice);
+                    EXPECT_TRUE(same_field(cpu, gpu_dense)) << what << ": the dense bands differ";
+                    SamplerOptions o = options("cuda", "bvh", precision, 0, SignMode::Auto);
+                    o.kernel = "warp";
+                    const SparseBandField sparse = make_sampler(o)->bind(share(fan))->sample_band_sparse(lattice, w);
+                    const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+                    EXPECT_EQ(d["nearest"], spacings >= 1.0 ? "triangle_sweep" : "search") << what;
+                    flooded += d["points_flooded"].get<int64_t>();
+                    EXPECT_TRUE(same_field(cpu, sparse.densify())) << what << ": the sparse band";
+                    if (HasFailure()) return;
+                }
+    }
+    EXPECT_GT(flooded, 0);
 }
 
 }  // namespace

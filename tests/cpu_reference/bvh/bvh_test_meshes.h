@@ -165,6 +165,47 @@ inline Lattice lattice_cutting_the_box(LatticeType type) {
     return lattice;
 }
 
+/// A closed solid of slivers, down to those searched by their edges alone (kRobustSliverSin2):
+/// a tetrahedron A B C D whose edge A B is split at the parameters k / 64 and, towards A, at
+/// 2^-30 .. 2^-7, its two faces on that edge fans from C and from D over the split points
+/// (angles at C and D down to about 2^-31). The slivers' edges from C and D lie within a float
+/// ulp of the sharp edges A C and A D, where a float search's near-tie picks a sliver whose
+/// pseudonormal puts a point beside that edge on the wrong side (the double search does not:
+/// 2^-30 is far above its rounding). A lies at `offset`, B = A + (1, 0, 0): without an offset
+/// the split points are exactly collinear and lattice_through_the_fan's points fall on them and
+/// on A B (exact ties between the fans' triangles); with a large one the points nearest A round
+/// onto A and their triangles are dropped.
+inline TriangleMesh fanned_tetrahedron(const Vec3d& offset = {0, 0, 0}) {
+    std::vector<double> t{0.0};
+    for (int e = 30; e >= 7; --e) t.push_back(std::ldexp(1.0, -e));
+    for (int k = 1; k <= 64; ++k) t.push_back(k / 64.0);
+    TriangleMesh m;
+    m.name = "fanned-tetrahedron";
+    m.source = "shape:fanned-tetrahedron";
+    for (double s : t) m.vertices.push_back(offset + Vec3d{s, 0, 0});
+    const int n = int(t.size()), c = n, d = n + 1;
+    m.vertices.push_back(offset + Vec3d{0.3, 0.9, 0.2});
+    m.vertices.push_back(offset + Vec3d{0.45, 0.25, -0.8});
+    for (int k = 0; k + 1 < n; ++k) {
+        m.triangles.push_back({k, k + 1, c});  // face A B C
+        m.triangles.push_back({k + 1, k, d});  // face A D B
+    }
+    m.triangles.push_back({0, c, d});      // A C D
+    m.triangles.push_back({n - 1, d, c});  // B D C
+    return m;
+}
+
+/// A lattice of spacing 1/32 over fanned_tetrahedron(offset), its points on A B at k / 32 (CC,
+/// and BCC's primary grid) when the offset is 0.
+inline Lattice lattice_through_the_fan(LatticeType type, const Vec3d& offset = {0, 0, 0}) {
+    Lattice lattice;
+    lattice.type = type;
+    lattice.spacing = 1.0 / 32;
+    lattice.resolution = {49, 46, 47};
+    lattice.origin = offset + Vec3d{-0.25, -0.25, -1.0};
+    return lattice;
+}
+
 /// Every BVH test mesh, prepared once; bunny and dragon only when the data path has them.
 inline const std::vector<NamedMesh>& bvh_test_meshes() {
     static const std::vector<NamedMesh> meshes = [] {
