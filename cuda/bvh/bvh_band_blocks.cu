@@ -11,9 +11,8 @@
 // On a solid (the pseudonormal sign, W >= one spacing) no point is searched: each triangle
 // sweeps the points near it (sweep_band_triangles: the double search's triangle of every point
 // within W, exactly); a point beyond finds no triangle and takes its side from its neighbours
-// (finish_band_blocks, band_sides.h), a block of such points from its point 0's nearest
-// triangle (sweep_block_origins, else nearest_of_unswept_origins). Every other band runs the
-// search.
+// (finish_band_blocks, band_sides.h), a block of such points from its point 0's double-search
+// triangle. Every other band runs the search.
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -84,66 +83,12 @@ __global__ void fill_nearest(int* nearest, int64_t n, int code) {
     if (i < n) nearest[i] = code;
 }
 
-/// The nearest triangle in double of point 0 of each block that the origins' sweep left
-/// without one (block_nearest INT_MAX: no triangle within its reach), over every triangle,
-/// the CUDA block's threads sharing them (ties: the smaller index, closest_triangle_bvh.h's
-/// rule): exact where a float search may tie across a thin part. Rare (none to 0.2% of the
-/// blocks): CUDA blocks stride over the band's blocks. counters[3]: blocks signed so.
-__global__ void __launch_bounds__(kBandBlockPoints)
-    nearest_of_unswept_origins(MeshView<double> mesh, BandBlocksPiece piece, int* block_nearest, unsigned long long* counters) {
-    __shared__ double nearest_d[kBandBlockPoints];
-    __shared__ int nearest_t[kBandBlockPoints];
-    const int local = threadIdx.x;
-    for (int64_t a = blockIdx.x; a < piece.blocks; a += gridDim.x) {
-        if (block_nearest[a] != INT_MAX) continue;  // uniform over the CUDA block
-        const Vec3d p = piece.position(a * kBandBlockPoints);
-        double best = INFINITY;
-        int best_t = -1;
-        for (int t = local; t < mesh.num_triangles; t += kBandBlockPoints) {
-            const double d = fabs(signed_distance_to_triangle(mesh, p, t).distance);
-            if (d < best) {
-                best = d;
-                best_t = t;
-            }
-        }
-        nearest_d[local] = best;
-        nearest_t[local] = best_t;
-        __syncthreads();
-        for (int half = kBandBlockPoints / 2; half > 0; half /= 2) {
-            if (local < half) {
-                const double d = nearest_d[local + half];
-                const int t = nearest_t[local + half];
-                if (t >= 0 && (d < nearest_d[local] || (d == nearest_d[local] && (nearest_t[local] < 0 || t < nearest_t[local])))) {
-                    nearest_d[local] = d;
-                    nearest_t[local] = t;
-                }
-            }
-            __syncthreads();
-        }
-        if (local == 0) {
-            block_nearest[a] = nearest_t[0];
-            atomicAdd(counters + 3, 1ull);
-        }
-        __syncthreads();  // before the next block's reduction overwrites the arrays
-    }
-}
-
-/// The side of each block whose points all lie beyond the band (block_nearest >= 0: point
-/// 0's nearest triangle, from the sweep or over every triangle), as its point 0's at that
-/// triangle; kBandSideNone for the others (their points give the sides). counters[1]:
-/// blocks signed by a nearest triangle.
-__global__ void sides_of_unsigned_blocks(MeshView<double> mesh, BandBlocksPiece piece, const int* block_nearest,
-                                         signed char* block_side, unsigned long long* counters) {
-    const int64_t a = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (a >= piece.blocks) return;
-    const int t = block_nearest[a];
-    signed char side = kBandSideNone;
-    if (t >= 0) {
-        const Vec3d p = piece.position(a * kBandBlockPoints);
-        side = signed_distance_to_triangle(mesh, p, t).distance < 0 ? kBandSideInside : kBandSideOutside;
-        atomicAdd(counters + 1, 1ull);
-    }
-    block_side[a] = side;
+/// Whether point p is inside by the pseudonormal sign at its double-search triangle (the
+/// points' reference, exact where a float search may tie across a thin part): the side of a
+/// block whose points all lie beyond the band.
+__device__ SDF_INLINE bool inside_by_double_search(const BvhView<double>& exact, const MeshView<double>& mesh, Vec3d p) {
+    const int32_t slot = double_search_slot(exact, p, -1);
+    return signed_distance_to_triangle(mesh, p, exact.triangle_index[slot]).distance < 0;
 }
 
 /// The last pass over a batch's blocks after finalize, a warp per block, 16 points a lane
@@ -155,15 +100,16 @@ __global__ void sides_of_unsigned_blocks(MeshView<double> mesh, BandBlocksPiece 
 /// sides of the points the sweep left without a triangle (kOutsideBandFlood): band_sides.h's
 /// layers, lane s * 8 + z holding side s's layer z (bits 32 (j & 1) + lane of layer j / 2 at
 /// step j), spread a step at a time with the layers below and above shuffled in; a block of
-/// such points starts from `block_side`. counters[0]: points spread to; counters[2]: points
-/// left without one side (never: the host checks).
+/// such points starts from its point 0's side (`block_side`: sides_of_unsigned_blocks).
+/// counters[0]: points spread to; counters[2]: points left without one side (never: the host
+/// checks).
 constexpr int kFinishThreads = 256;
 constexpr int kFinishBlocksPerCudaBlock = kFinishThreads / 32;
 
 template <bool kSpread>
 __global__ void __launch_bounds__(kFinishThreads)
     finish_band_blocks(BandBlocksPiece piece, const int* nearest, const signed char* block_side, double width, double* distance,
-                       float* distance32, int* triangle, const int32_t* source_triangle, uint32_t* mask,
+                       float* distance32, Vec3d* gradient, int* triangle, const int32_t* source_triangle, uint32_t* mask,
                        unsigned long long* counters) {
     constexpr int kSteps = kBandBlockPoints / 32;
     const int lane = threadIdx.x & 31;
@@ -179,16 +125,21 @@ __global__ void __launch_bounds__(kFinishThreads)
 #pragma unroll
     for (int j = 0; j < kSteps; ++j) {
         const int64_t i = base + 32 * j + lane;
-        const int t = triangle[i];
+        // An open point's outputs are this pass's (finalize leaves them): outside the band.
+        const bool flood = kSpread && nearest[i] == kOutsideBandFlood;
+        const int t = flood ? kOutsideBandTriangle : triangle[i];
         const unsigned in_band = __ballot_sync(kFullWarp, t != kOutsideBandTriangle);
         if (lane == 0) mask[a * kSteps + j] = in_band;
         if (t >= 0) triangle[i] = source_triangle[t];
-        if (kSpread || distance32 != nullptr) d[j] = distance[i];
+        if (flood) {
+            triangle[i] = kOutsideBandTriangle;
+            if (gradient) gradient[i] = Vec3d(0.0);
+        }
+        d[j] = flood || !(kSpread || distance32 != nullptr) ? width : distance[i];  // an open point's: spread below
         if constexpr (kSpread) {
             const int local = 32 * j + lane;
-            const bool real = BandBlockGrid::within(points, local);
-            const bool flood = real && nearest[i] == kOutsideBandFlood;
-            const bool negative = signbit(d[j]);
+            const bool real = BandBlockGrid::within(points, local);  // padding: never open (finish_sweep)
+            const bool negative = !flood && signbit(d[j]);
             const unsigned in = __ballot_sync(kFullWarp, real && !flood && negative);
             const unsigned out = __ballot_sync(kFullWarp, real && !flood && !negative);
             const unsigned fl = __ballot_sync(kFullWarp, flood);
@@ -307,7 +258,7 @@ __device__ SDF_INLINE bool beyond_plane(const PackedTriangle<double>& t, const V
 }
 
 template <int kPass>
-__global__ void __launch_bounds__(kSweepThreads)
+__global__ void __launch_bounds__(kSweepThreads, 6)
     sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
                          BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle) {
     __shared__ int64_t cached[kSweepCachedBlocks];
@@ -330,34 +281,57 @@ __global__ void __launch_bounds__(kSweepThreads)
                     cached[j] = batch_index(piece, piece.grid.block_id(c, {b0.x + j % nb.x, b0.y + (j / nb.x) % nb.y, b0.z + j / (nb.x * nb.y)}));
                 __syncthreads();
             }
-            const Int3 np{p1.x - p0.x + 1, p1.y - p0.y + 1, p1.z - p0.z + 1};
-            const int64_t points = int64_t(np.x) * np.y * np.z;
-            const bool narrow = points < (int64_t(1) << 32);  // 32-bit divisions (a 64-bit one is ~4x dearer)
-            for (int64_t j = threadIdx.x; j < points; j += blockDim.x) {
-                Int3 p;
-                if (narrow) {
-                    const uint32_t u = uint32_t(j), row = u / uint32_t(np.x);
-                    p = {p0.x + int(u - row * uint32_t(np.x)), p0.y + int(row % uint32_t(np.y)), p0.z + int(row / uint32_t(np.y))};
-                } else {
-                    const int64_t row = j / np.x;
-                    p = {p0.x + int(j - row * np.x), p0.y + int(row % np.y), p0.z + int(row / np.y)};
+            // Columns along the normal's largest axis, each walked only where it crosses the
+            // slab |h| <= R (h linear along it; R bounds beyond_plane's threshold over the
+            // box, one point of margin for the rounding): most of a large triangle's box lies
+            // beyond its slab. beyond_plane still decides each point, so the range only has to
+            // hold every point it keeps. A normal of zero or NaN walks whole columns.
+            const Vec3d n(t.nx, t.ny, t.nz);
+            const int ax = fabs(n.x) >= fabs(n.y) && fabs(n.x) >= fabs(n.z) ? 0 : fabs(n.y) >= fabs(n.z) ? 1 : 2;
+            const int au = ax == 0 ? 1 : 0, av = ax == 2 ? 1 : 2;
+            const double hh = piece.lattice.half_spacing();
+            const Vec3d span = hi - lo;
+            const double slab = sqrt(1.01 * bound_squared + 0x1p-40 * length_squared(span) * 4);  // R
+            const double n_ax = n[ax];
+            const bool sloped = fabs(n_ax) >= 0.5;  // a unit normal's largest component is >= 1/sqrt(3)
+            const Int3 r0 = p0, r1 = p1;  // read only (a write through Int3::operator[] would put them in local memory)
+            const int nu = r1[au] - r0[au] + 1;
+            const int64_t columns = int64_t(nu) * (r1[av] - r0[av] + 1);
+            const Int3 step{ax == 0, ax == 1, ax == 2};
+            for (int64_t j = threadIdx.x; j < columns; j += blockDim.x) {
+                const int u = r0[au] + int(j % nu), v = r0[av] + int(j / nu);
+                int first = r0[ax], last = r1[ax];
+                if (sloped) {
+                    // h = n . (B - x) = k - n_ax x_ax, with x_ax = origin + hh (first + 2 p_ax).
+                    const double xu = piece.lattice.origin[au] + hh * double(coset.first[au] + 2 * u);
+                    const double xv = piece.lattice.origin[av] + hh * double(coset.first[av] + 2 * v);
+                    const double k = n.x * t.bx + n.y * t.by + n.z * t.bz - n[au] * xu - n[av] * xv;
+                    const double e0 = (k - slab) / n_ax, e1 = (k + slab) / n_ax;  // x_ax's ends, either order
+                    const double c0 = ((fmin(e0, e1) - piece.lattice.origin[ax]) / hh - coset.first[ax]) / 2;
+                    const double c1 = ((fmax(e0, e1) - piece.lattice.origin[ax]) / hh - coset.first[ax]) / 2;
+                    if (c0 - 1 > double(first)) first = c0 - 1 > double(last) ? last + 1 : int(floor(c0)) - 1;
+                    if (c1 + 1 < double(last)) last = c1 + 1 < double(first) ? first - 1 : int(ceil(c1)) + 1;
                 }
-                const Int3 pb{p.x >> kBandBlockLog2, p.y >> kBandBlockLog2, p.z >> kBandBlockLog2};
-                const int64_t a = use_cache ? cached[(pb.x - b0.x) + int64_t(nb.x) * ((pb.y - b0.y) + int64_t(nb.y) * (pb.z - b0.z))]
-                                            : batch_index(piece, piece.grid.block_id(c, pb));
-                if (a < 0) continue;  // not an active block of this batch
-                const Vec3d x = piece.lattice.position_of_coords({coset.first.x + 2 * p.x, coset.first.y + 2 * p.y, coset.first.z + 2 * p.z});
-                if (beyond_plane(t, x, bound_squared)) continue;  // the triangle's slab: most of its box
-                double q = squared_distance(t, x.x, x.y, x.z);
-                if (!(q <= bound_squared)) continue;
-                if (q == 0) q = 0;  // -0 ties +0, as the search's comparison
-                const int64_t i = a * kBandBlockPoints + (p.x & (kBandBlockDim - 1)) +
-                                  kBandBlockDim * ((p.y & (kBandBlockDim - 1)) + kBandBlockDim * (p.z & (kBandBlockDim - 1)));
-                const unsigned long long key = ordered_key(q);
-                if constexpr (kPass == 0) {
-                    if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
-                } else if (key == best_key[i]) {
-                    atomicMin(best_triangle + i, triangle);
+                Int3 p{ax == 0 ? first : u, ax == 0 ? u : ax == 1 ? first : v, ax == 2 ? first : v};
+                for (int along = first; along <= last; ++along, p.x += step.x, p.y += step.y, p.z += step.z) {
+                    const Int3 pb{p.x >> kBandBlockLog2, p.y >> kBandBlockLog2, p.z >> kBandBlockLog2};
+                    const int64_t a = use_cache ? cached[(pb.x - b0.x) + int64_t(nb.x) * ((pb.y - b0.y) + int64_t(nb.y) * (pb.z - b0.z))]
+                                                : batch_index(piece, piece.grid.block_id(c, pb));
+                    if (a < 0) continue;  // not an active block of this batch
+                    const Vec3d x =
+                        piece.lattice.position_of_coords({coset.first.x + 2 * p.x, coset.first.y + 2 * p.y, coset.first.z + 2 * p.z});
+                    if (beyond_plane(t, x, bound_squared)) continue;
+                    double q = squared_distance(t, x.x, x.y, x.z);
+                    if (!(q <= bound_squared)) continue;
+                    if (q == 0) q = 0;  // -0 ties +0, as the search's comparison
+                    const int64_t i = a * kBandBlockPoints + (p.x & (kBandBlockDim - 1)) +
+                                      kBandBlockDim * ((p.y & (kBandBlockDim - 1)) + kBandBlockDim * (p.z & (kBandBlockDim - 1)));
+                    const unsigned long long key = ordered_key(q);
+                    if constexpr (kPass == 0) {
+                        if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
+                    } else if (key == best_key[i]) {
+                        atomicMin(best_triangle + i, triangle);
+                    }
                 }
             }
             if (use_cache) __syncthreads();  // before the next box overwrites the cache
@@ -365,65 +339,35 @@ __global__ void __launch_bounds__(kSweepThreads)
     }
 }
 
-/// Blocks whose every lattice point the sweep left without a triangle (their sides all from
-/// the flood): block_nearest INT_MAX (to be found), else -1.
-__global__ void __launch_bounds__(kBandBlockPoints) find_unsigned_blocks(const int* nearest, int* block_nearest) {
-    const bool any = __syncthreads_or(nearest[int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x] >= 0);
-    if (threadIdx.x == 0) block_nearest[blockIdx.x] = any ? -1 : INT_MAX;
-}
-
-/// The nearest triangle in double of point 0 of each such block (the block's side,
-/// sides_of_unsigned_blocks), by the same sweep within a wider bound (W and the block's extent): each
-/// triangle visits the block origins near it. Q_d and the tie rule as sweep_band_triangles.
-template <int kPass>
-__global__ void __launch_bounds__(kSweepThreads)
-    sweep_block_origins(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
-                        BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* block_nearest) {
-    const double reach = sqrt(bound_squared);
-    for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
-        const PackedTriangle<double> t = packed[s];
-        const int triangle = triangle_index[s];
-        Vec3d lo, hi;
-        dilated_box(t, reach, lo, hi);
-        for (int c = 0; c < piece.grid.cosets; ++c) {
-            const BandCoset& coset = piece.grid.coset[c];
-            Int3 p0, p1;
-            if (!coset_range(piece.lattice, coset, lo, hi, p0, p1)) continue;
-            // The blocks whose point 0 (8 b) lies in [p0, p1].
-            const Int3 b0{(p0.x + kBandBlockDim - 1) >> kBandBlockLog2, (p0.y + kBandBlockDim - 1) >> kBandBlockLog2,
-                          (p0.z + kBandBlockDim - 1) >> kBandBlockLog2};
-            const Int3 nb{(p1.x >> kBandBlockLog2) - b0.x + 1, (p1.y >> kBandBlockLog2) - b0.y + 1, (p1.z >> kBandBlockLog2) - b0.z + 1};
-            if (nb.x <= 0 || nb.y <= 0 || nb.z <= 0) continue;
-            const int64_t count = int64_t(nb.x) * nb.y * nb.z;
-            for (int64_t j = threadIdx.x; j < count; j += blockDim.x) {
-                const int64_t row = j / nb.x;
-                const Int3 pb{b0.x + int(j - row * nb.x), b0.y + int(row % nb.y), b0.z + int(row / nb.y)};
-                const int64_t a = batch_index(piece, piece.grid.block_id(c, pb));
-                if (a < 0 || block_nearest[a] < 0) continue;  // inactive, or signed by its own points
-                const Vec3d x = piece.lattice.position_of_coords(
-                    {coset.first.x + 2 * kBandBlockDim * pb.x, coset.first.y + 2 * kBandBlockDim * pb.y, coset.first.z + 2 * kBandBlockDim * pb.z});
-                if (beyond_plane(t, x, bound_squared)) continue;
-                double q = squared_distance(t, x.x, x.y, x.z);
-                if (!(q <= bound_squared)) continue;
-                if (q == 0) q = 0;
-                const unsigned long long key = ordered_key(q);
-                if constexpr (kPass == 0) {
-                    if (key < best_key[a]) atomicMin(best_key + a, key);
-                } else if (key == best_key[a]) {
-                    atomicMin(block_nearest + a, triangle);
-                }
-            }
-        }
+/// Points the sweep left without a triangle: kOutsideBandFlood (their side from their
+/// neighbours), padding kOutsideBandOutside (as the search leaves it: +W); a CUDA block per
+/// band block, which is listed in `unsigned_blocks` (count in `unsigned_count`) when none of
+/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks).
+__global__ void __launch_bounds__(kBandBlockPoints)
+    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest, int32_t* unsigned_blocks,
+                 unsigned int* unsigned_count) {
+    const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x;
+    const bool swept = best_key[i] != kSweepNone;
+    if (!swept) {
+        const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[blockIdx.x]), int(threadIdx.x));
+        nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
     }
+    if (!__syncthreads_or(swept) && threadIdx.x == 0) unsigned_blocks[atomicAdd(unsigned_count, 1u)] = int32_t(blockIdx.x);
 }
 
-/// Points the sweep left without a triangle: kOutsideBandFlood (their side from the flood),
-/// padding kOutsideBandOutside (as the search leaves it: +W).
-__global__ void finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= piece.size() || best_key[i] != kSweepNone) return;
-    const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[i / kBandBlockPoints]), int(i % kBandBlockPoints));
-    nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
+/// The side of each listed block (no point with a triangle: every point beyond the band), as
+/// its point 0's by the double search (inside_by_double_search), a thread per block, striding
+/// over the list (its length is on the device). counters[1]: blocks signed so.
+__global__ void sides_of_unsigned_blocks(BvhView<double> exact, MeshView<double> mesh, BandBlocksPiece piece,
+                                         const int32_t* unsigned_blocks, const unsigned int* unsigned_count, signed char* block_side,
+                                         unsigned long long* counters) {
+    const unsigned count = *unsigned_count;
+    for (unsigned k = blockIdx.x * blockDim.x + threadIdx.x; k < count; k += gridDim.x * blockDim.x) {
+        const int32_t a = unsigned_blocks[k];
+        block_side[a] = inside_by_double_search(exact, mesh, piece.position(int64_t(a) * kBandBlockPoints)) ? kBandSideInside
+                                                                                                            : kBandSideOutside;
+        atomicAdd(counters + 1, 1ull);
+    }
 }
 
 size_t device_bytes_in_use() {
@@ -484,15 +428,15 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
     // (band_sides.h), the warp kernel (the candidates kernel searches every point).
     const bool swept = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
-    // The sweep's blocks without a triangle: their point 0's key, nearest triangle and side (13 bytes a block).
-    DeviceBuffer<unsigned long long> block_key{swept ? size_t(batch) : 0};
-    DeviceBuffer<int> block_nearest{swept ? size_t(batch) : 0};
-    DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
     // The sweep's bound on Q_d: W with a relative margin of 1e-6 and an absolute one of 2^-30
     // of the coordinates' scale, far above Q_d's rounding in distance terms (about
     // u (|B - P| scale + 8 extent^2) / W, |B - P| <= the mesh's extent <= 16384 W), so that
     // every point the finalize finds within W has its triangle. No sliver reach: Q_d is exact
     // to that, where the float search ranks slivers by their edges.
+    // The blocks the sweep leaves without a triangle: their list and sides (5 bytes a block).
+    DeviceBuffer<int32_t> unsigned_blocks{swept ? size_t(batch) : 0};
+    DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
+    DeviceBuffer<unsigned int> unsigned_count{1};
     double sweep_bound = 0;
     if (swept) {
         const double scale = coordinate + bound.coordinate;
@@ -525,20 +469,13 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
             sweep_band_triangles<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
                                                               sweep_bound, key, r.nearest.get());
             CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
-            finish_sweep<<<blocks_for(n, 256), 256>>>(piece, key, r.nearest.get());
+            CUDA_CHECK(cudaMemset(unsigned_count.get(), 0, sizeof(unsigned int)));
+            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
             CUDA_CHECK_LAUNCH("finish_sweep");
-            // The blocks left without a triangle: their point 0's nearest within W and the
-            // block's reach (its far corner 7 sqrt(3) spacings away, 16 taken), for the flood.
-            find_unsigned_blocks<<<int(nb), kBandBlockPoints>>>(r.nearest.get(), block_nearest.get());
-            CUDA_CHECK_LAUNCH("find_unsigned_blocks");
-            CUDA_CHECK(cudaMemset(block_key.get(), 0xff, size_t(nb) * sizeof(unsigned long long)));
-            const double r2 = (std::sqrt(sweep_bound) + 16 * lattice.spacing) * (1.0 + 1e-6);
-            sweep_block_origins<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
-                                                             r2 * r2, block_key.get(), block_nearest.get());
-            CUDA_CHECK_LAUNCH("sweep_block_origins (keys)");
-            sweep_block_origins<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
-                                                             r2 * r2, block_key.get(), block_nearest.get());
-            CUDA_CHECK_LAUNCH("sweep_block_origins (triangles)");
+            sides_of_unsigned_blocks<<<std::max<int64_t>(1, std::min<int64_t>(blocks_for(nb, 128), 1024)), 128>>>(
+                search.exact, dev.mesh->view(), piece, unsigned_blocks.get(), unsigned_count.get(), block_side.get(),
+                flood_counters.get());
+            CUDA_CHECK_LAUNCH("sides_of_unsigned_blocks");
         } else {
             fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
             CUDA_CHECK_LAUNCH("fill_nearest");
@@ -555,23 +492,15 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         finalize_stage.begin();
         PieceOutputs outputs = r.outputs();
         if (!band.channels.gradient) outputs.gradient = nullptr;  // not written: 24 of a point's 36 bytes
+        outputs.output_index = nullptr;  // block-major: point i is slot i
         launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, outputs);
         CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
         finalize_stage.end();
         sides_stage.begin();
-        if (swept) {
-            const int strides = int(std::min<int64_t>(nb, 1024));  // a few per multiprocessor: most exit at once
-            nearest_of_unswept_origins<<<strides, kBandBlockPoints>>>(dev.mesh->view(), piece, block_nearest.get(),
-                                                                      flood_counters.get());
-            CUDA_CHECK_LAUNCH("nearest_of_unswept_origins");
-            sides_of_unsigned_blocks<<<blocks_for(nb, 256), 256>>>(dev.mesh->view(), piece, block_nearest.get(), block_side.get(),
-                                                                   flood_counters.get());
-            CUDA_CHECK_LAUNCH("sides_of_unsigned_blocks");
-        }
         const auto finish = [&](auto spread) {
             finish_band_blocks<decltype(spread)::value><<<blocks_for(nb, kFinishBlocksPerCudaBlock), kFinishThreads>>>(
                 piece, r.nearest.get(), block_side.get(), width, r.samples.distance.get(), float32 ? distance32.get() : nullptr,
-                r.samples.triangle.get(), dev.source_triangle.get(), band_mask.get(), flood_counters.get());
+                outputs.gradient, r.samples.triangle.get(), dev.source_triangle.get(), band_mask.get(), flood_counters.get());
         };
         if (swept) finish(std::true_type{});
         else finish(std::false_type{});
@@ -593,7 +522,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     CUDA_CHECK(cudaMemcpy(flood, flood_counters.get(), sizeof(flood), cudaMemcpyDeviceToHost));
     if (flood[2] != 0)
         throw std::logic_error("CUDA BVH sparse band: " + std::to_string(flood[2]) +
-                               " points beyond the band were left without a side by the flood");
+                               " points beyond the band were left without one side by the spread of sides");
     CertificateCounters certificate;
     read_certificate(dev, certificate);
     band.timings.upload += upload.seconds();
@@ -613,7 +542,6 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
-        {"blocks_signed_over_every_triangle", int64_t(flood[3])},
         {"kernel_seconds", compute.seconds()},
         {"stage_seconds", {{"search", search_stage.seconds()}, {"finalize", finalize_stage.seconds()},
                            {"sides_source_order_and_mask", sides_stage.seconds()}}},

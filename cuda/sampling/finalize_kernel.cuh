@@ -22,9 +22,9 @@ enum NearestOutsideBand : int {
     kOutsideBandOutside = -2,        ///< positive side
     kOutsideBandInside = -3,         ///< negative side
     kOutsideBandSignPerPoint = -4,   ///< the winding number decides, point by point
-    /// No triangle within the bounded search's radius: outside the band, its side taken
-    /// from a neighbour after finalize (the sparse band's flood, cuda/bvh/bvh_band_blocks.cu);
-    /// finalize writes +W meanwhile.
+    /// No triangle within the sweep's bound: outside the band, its side taken from its
+    /// neighbours after finalize, which leaves its outputs to that pass (the sparse band's
+    /// finish_band_blocks, cuda/bvh/bvh_band_blocks.cu).
     kOutsideBandFlood = -5,
 };
 
@@ -33,7 +33,7 @@ struct PieceOutputs {
     double* distance;
     Vec3d* gradient;        ///< null: not wanted (a sparse band without its gradient channel)
     int* triangle;
-    int64_t* output_index;  ///< -1: padding or discarded
+    int64_t* output_index;  ///< -1: padding or discarded; null: not wanted (a sparse band's block-major arrays)
 };
 
 /// Writes sample i, or the band's value when it lies outside a narrow band (width > 0).
@@ -75,9 +75,9 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     const bool in_piece = i < piece.size();
     const int64_t o = !in_piece || piece.block_local(i) < 0 ? -1 : piece.output_index(i);
-    if (in_piece) out.output_index[i] = o;
-    const Vec3d p = o >= 0 ? piece.position(i) : Vec3d(0.0);
+    if (in_piece && out.output_index) out.output_index[i] = o;
     const int n = o >= 0 ? nearest[i] : -1;
+    const Vec3d p = o >= 0 && (n >= 0 || Winding) ? piece.position(i) : Vec3d(0.0);
     SignedDistanceSample<double> s;
     if (n >= 0) s = signed_distance_to_triangle(mesh, p, n);
     bool winding_inside = false;
@@ -96,7 +96,7 @@ __global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpW
             winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside);
         }
     }
-    if (o < 0) return;
+    if (o < 0 || n == kOutsideBandFlood) return;
     if (n >= 0) {
         if constexpr (Winding) s = with_sign(s, winding_inside);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
