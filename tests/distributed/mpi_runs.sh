@@ -130,6 +130,10 @@ if [ "$case_name" = gpu ]; then
     # Issue 36: two GPUs, as ranks and as one process's devices, give one GPU's files byte for
     # byte, each rank on its own device. Skipped (77) below two visible GPUs.
     gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU' || true)
+    if [ -n "${CUDA_VISIBLE_DEVICES+set}" ]; then  # nvidia-smi lists every GPU; CUDA sees only these
+        visible=$(printf '%s\n' "$CUDA_VISIBLE_DEVICES" | tr ',' '\n' | grep -c . || true)
+        if [ "$visible" -lt "${gpus:-0}" ]; then gpus=$visible; fi
+    fi
     [ "${gpus:-0}" -ge 2 ] || { echo "$gpus GPU(s) visible, this test needs 2: skipped"; exit 77; }
     sed -e 's/"backend": "cpu"/"backend": "cuda"/' -e 's/\[11, 9, 13\]/[96, 96, 96]/' -e 's/\[8, 7, 18\]/[64, 64, 128]/' \
         "$work/mpi_fields.json" > "$work/gpu.json"
