@@ -58,7 +58,6 @@ struct BandSideLayers {
         for (int z = 0; z < kBandBlockDim; ++z) any |= inside[z] | outside[z];
         return any != 0;
     }
-    SDF_CPU_GPU bool inside_at(int local) const { return (inside[layer_of(local)] & bit_of(local)) != 0; }
     /// Spreads both sides into the open points until neither grows; false when an open point
     /// is left without a side or both reach one (never, by the argument above).
     SDF_CPU_GPU bool spread() {

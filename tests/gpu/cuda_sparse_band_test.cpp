@@ -243,38 +243,23 @@ TEST(CudaSparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
 // dense band byte for byte and the exact winding number's sides.
 TEST(CudaSparseBand, SliversAndTiesEqualTheCpuDenseBand) {
     int64_t flooded = 0;
-    for (const Vec3d& offset : {Vec3d{0, 0, 0}, Vec3d{1e4, -2500.5, 1234.25}}) {
-        const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron(offset));
-        ASSERT_EQ(choose_sign_mode(fan.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << "the fanned tetrahedron is a solid";
-        for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
-            for (Precision precision : {Precision::Float, Precision::Double})
-                for (double spacings : {0.9, 1.0, 3.0}) {
-                    const Lattice lattice = test::lattice_through_the_fan(type, offset);
-                    const double w = spacings * lattice.spacing;
-                    const std::string what = "fanned tetrahedron offset " + std::to_string(offset.x) + " " +
-                                             lattice_notation(lattice) + " " + precision_name(precision) + " W = " +
-                                             std::to_string(spacings) + " h";
-                    const SampledField cpu = make_sampler(options("cpu", "bvh", precision, w, SignMode::Auto))->bind(share(fan))->sample(lattice);
-                    const SampledField winding =
-                        make_sampler(options("cpu", "bvh", precision, w, SignMode::Winding))->bind(share(fan))->sample(lattice);
-                    int64_t wrong = 0;
-                    for (size_t i = 0; i < cpu.distance.size(); ++i)
-                        wrong += std::abs(winding.distance[i]) > 1e-6 && std::signbit(winding.distance[i]) != std::signbit(cpu.distance[i]);
-                    EXPECT_EQ(wrong, 0) << what << ": the CPU's signs off the winding number's";
-                    SamplerOptions dense_options = options("cuda", "bvh", precision, w, SignMode::Auto);
-                    dense_options.kernel = "warp";
-                    const SampledField gpu_dense = make_sampler(dense_options)->bind(share(fan))->sample(lattice);
-                    EXPECT_TRUE(same_field(cpu, gpu_dense)) << what << ": the dense bands differ";
-                    SamplerOptions o = options("cuda", "bvh", precision, 0, SignMode::Auto);
-                    o.kernel = "warp";
-                    const SparseBandField sparse = make_sampler(o)->bind(share(fan))->sample_band_sparse(lattice, w);
-                    const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
-                    EXPECT_EQ(d["nearest"], spacings >= 1.0 ? "triangle_sweep" : "search") << what;
-                    flooded += d["points_flooded"].get<int64_t>();
-                    EXPECT_TRUE(same_field(cpu, sparse.densify())) << what << ": the sparse band";
-                    if (HasFailure()) return;
-                }
-    }
+    test::for_each_fan_case({0.9, 1.0, 3.0}, [&](const test::FanCase& c) {
+        const SampledField cpu = make_sampler(options("cpu", "bvh", c.precision, c.width, SignMode::Auto))->bind(share(c.mesh))->sample(c.lattice);
+        const SampledField winding =
+            make_sampler(options("cpu", "bvh", c.precision, c.width, SignMode::Winding))->bind(share(c.mesh))->sample(c.lattice);
+        EXPECT_EQ(test::sides_off_the_winding_number(cpu, winding), 0) << c.name << ": the CPU's signs off the winding number's";
+        SamplerOptions dense_options = options("cuda", "bvh", c.precision, c.width, SignMode::Auto);
+        dense_options.kernel = "warp";
+        const SampledField gpu_dense = make_sampler(dense_options)->bind(share(c.mesh))->sample(c.lattice);
+        EXPECT_TRUE(same_field(cpu, gpu_dense)) << c.name << ": the dense bands differ";
+        SamplerOptions o = options("cuda", "bvh", c.precision, 0, SignMode::Auto);
+        o.kernel = "warp";
+        const SparseBandField sparse = make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(c.lattice, c.width);
+        const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+        EXPECT_EQ(d["nearest"], c.spacings >= 1.0 ? "triangle_sweep" : "search") << c.name;
+        flooded += d["points_flooded"].get<int64_t>();
+        EXPECT_TRUE(same_field(cpu, sparse.densify())) << c.name << ": the sparse band";
+    });
     EXPECT_GT(flooded, 0);
 }
 

@@ -19,11 +19,13 @@
 #include <tuple>
 #include <vector>
 
+#include "core/lattice/lattice_fitting.h"
 #include "core/mesh/load_mesh.h"
 #include "core/mesh/load_obj.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/sampling/sampler.h"
+#include "core/winding/winding_sign.h"
 #include "kernels/distance/closest_point_on_triangle.h"
 
 namespace sdf::test {
@@ -204,6 +206,46 @@ inline Lattice lattice_through_the_fan(LatticeType type, const Vec3d& offset = {
     lattice.resolution = {49, 46, 47};
     lattice.origin = offset + Vec3d{-0.25, -0.25, -1.0};
     return lattice;
+}
+
+/// One case of the sliver tests (CPU and GPU): fanned_tetrahedron, lattice_through_the_fan,
+/// a precision and a band width.
+struct FanCase {
+    const PreparedMesh& mesh;
+    Lattice lattice;
+    Precision precision;
+    double spacings;  ///< the band's width in spacings
+    double width;     ///< and in mesh units
+    std::string name;  ///< for messages
+};
+
+/// Calls check(FanCase) for fanned_tetrahedron without and with an offset of 10^4 (a solid,
+/// asserted), CC and BCC, float and double, and each width in `spacings`; stops at a failure.
+template <typename Check>
+void for_each_fan_case(const std::vector<double>& spacings, Check check) {
+    for (const Vec3d& offset : {Vec3d{0, 0, 0}, Vec3d{1e4, -2500.5, 1234.25}}) {
+        const PreparedMesh fan = prepare_mesh(fanned_tetrahedron(offset));
+        ASSERT_EQ(choose_sign_mode(fan.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << "the fanned tetrahedron is a solid";
+        for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
+            for (Precision precision : {Precision::Float, Precision::Double})
+                for (double s : spacings) {
+                    const Lattice lattice = lattice_through_the_fan(type, offset);
+                    check(FanCase{fan, lattice, precision, s, s * lattice.spacing,
+                                  "fanned tetrahedron offset " + std::to_string(offset.x) + " " + lattice_notation(lattice) + " " +
+                                      precision_name(precision) + " W = " + std::to_string(s) + " h"});
+                    if (::testing::Test::HasFailure()) return;
+                }
+    }
+}
+
+/// The points whose side in `field` is not the exact winding number's (`winding`, the same
+/// lattice) off the surface: |d| > 1e-6 (on it, where distances round to 1e-16 .. 1e-9 through
+/// the slivers, either side is right).
+inline int64_t sides_off_the_winding_number(const SampledField& field, const SampledField& winding) {
+    int64_t wrong = 0;
+    for (size_t i = 0; i < field.distance.size(); ++i)
+        wrong += std::abs(winding.distance[i]) > 1e-6 && std::signbit(winding.distance[i]) != std::signbit(field.distance[i]);
+    return wrong;
 }
 
 /// Every BVH test mesh, prepared once; bunny and dragon only when the data path has them.

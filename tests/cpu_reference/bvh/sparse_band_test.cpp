@@ -8,7 +8,8 @@
 // search is bounded by the band and the points beyond it take their sides from their
 // neighbours (kernels/lattice/band_sides.h): checked where whole blocks lie beyond the band
 // (an icosahedron's triangle boxes reach far from it), on the torus and the dragon (where
-// SDF_DATA_PATH has it), at widths from one spacing up, and switched off below one.
+// SDF_DATA_PATH has it), at widths from one spacing up, and switched off below one; and on a
+// tetrahedron of slivers with exact ties, every side off the surface the winding number's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -501,34 +502,16 @@ TEST(SparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
 // points on the fans' shared vertices and edges, where several triangles are equally near.
 TEST(SparseBand, SliversAndTiesEqualTheDenseBand) {
     int64_t flooded = 0;
-    for (const Vec3d& offset : {Vec3d{0, 0, 0}, Vec3d{1e4, -2500.5, 1234.25}}) {
-        const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron(offset));
-        ASSERT_EQ(choose_sign_mode(fan.report(), SignMode::Auto).mode, SignMode::Pseudonormal) << "the fanned tetrahedron is a solid";
-        for (LatticeType type : {LatticeType::CC, LatticeType::BCC})
-            for (Precision precision : {Precision::Float, Precision::Double})
-                for (double spacings : {1.0, 3.0}) {
-                    const Lattice lattice = test::lattice_through_the_fan(type, offset);
-                    const double w = spacings * lattice.spacing;
-                    const std::string what = "fanned tetrahedron offset " + std::to_string(offset.x) + " " +
-                                             lattice_notation(lattice) + " " + precision_name(precision) + " W = " +
-                                             std::to_string(spacings) + " h";
-                    const SampledField dense = make_cpu_bvh_sampler(options(precision, w, SignMode::Auto))->bind(share(fan))->sample(lattice);
-                    // Independent truth: the exact winding number's side at every point off the
-                    // surface (points on it, whose distances round to 1e-16 .. 1e-9 through the
-                    // slivers, have either side).
-                    const SampledField winding =
-                        make_cpu_bvh_sampler(options(precision, w, SignMode::Winding))->bind(share(fan))->sample(lattice);
-                    int64_t wrong = 0;
-                    for (size_t i = 0; i < dense.distance.size(); ++i)
-                        wrong += std::abs(winding.distance[i]) > 1e-6 && std::signbit(winding.distance[i]) != std::signbit(dense.distance[i]);
-                    EXPECT_EQ(wrong, 0) << what << ": signs off the winding number's";
-                    const SparseBandField sparse =
-                        make_cpu_bvh_sampler(options(precision, 0, SignMode::Auto))->bind(share(fan))->sample_band_sparse(lattice, w);
-                    flooded += sparse.sampler.details["band_blocks_on_host"]["points_flooded"].get<int64_t>();
-                    expect_same_field(dense, sparse.densify(), what);
-                    if (HasFailure()) return;
-                }
-    }
+    test::for_each_fan_case({1.0, 3.0}, [&](const test::FanCase& c) {
+        const SampledField dense = make_cpu_bvh_sampler(options(c.precision, c.width, SignMode::Auto))->bind(share(c.mesh))->sample(c.lattice);
+        const SampledField winding =
+            make_cpu_bvh_sampler(options(c.precision, c.width, SignMode::Winding))->bind(share(c.mesh))->sample(c.lattice);
+        EXPECT_EQ(test::sides_off_the_winding_number(dense, winding), 0) << c.name << ": signs off the winding number's";
+        const SparseBandField sparse =
+            make_cpu_bvh_sampler(options(c.precision, 0, SignMode::Auto))->bind(share(c.mesh))->sample_band_sparse(c.lattice, c.width);
+        flooded += sparse.sampler.details["band_blocks_on_host"]["points_flooded"].get<int64_t>();
+        expect_same_field(dense, sparse.densify(), c.name);
+    });
     EXPECT_GT(flooded, 0);
 }
 
