@@ -178,8 +178,15 @@ private:
                         sides.set(0, nearest_side_inside(lattice.position_of_coords(block.first)) ? kBandSideInside : kBandSideOutside);
                         ++searched_blocks;
                     }
-                    if (!sides.spread())
-                        throw std::logic_error("CPU BVH sparse band: a point beyond the band was left without one side");
+                    if (!sides.spread()) {  // neighbours beyond the band on opposite sides
+                        const Vec3d p = lattice.position_of_coords(block.first);
+                        throw std::runtime_error(
+                            "CPU BVH sparse band: " + mesh().name() + ": points beyond the band in the block at (" +
+                            std::to_string(p.x) + ", " + std::to_string(p.y) + ", " + std::to_string(p.z) +
+                            ") have neighbours on both sides by the pseudonormal sign, which is not consistent there "
+                            "(slivers within the search's rounding of a sharp edge?); sample this mesh with the winding "
+                            "sign (--sign winding, sampler \"sign\": \"winding\")");
+                    }
                     for (int z = 0; z < kBandBlockDim; ++z)
                         for (uint64_t in = sides.open[z] & sides.inside[z]; in != 0; in &= in - 1)
                             out.distance.set(base + size_t(64 * z + __builtin_ctzll(in)), -band.width);

@@ -101,8 +101,8 @@ __device__ SDF_INLINE bool inside_by_double_search(const BvhView<double>& exact,
 /// layers, lane s * 8 + z holding side s's layer z (bits 32 (j & 1) + lane of layer j / 2 at
 /// step j), spread a step at a time with the layers below and above shuffled in; a block of
 /// such points starts from its point 0's side (`block_side`: sides_of_unsigned_blocks).
-/// counters[0]: points spread to; counters[2]: points left without one side (never: the host
-/// checks).
+/// counters[0]: points spread to; counters[2]: points left without one side (reached by both:
+/// pseudonormal sides that disagree, which the host refuses).
 constexpr int kFinishThreads = 256;
 constexpr int kFinishBlocksPerCudaBlock = kFinishThreads / 32;
 
@@ -520,9 +520,11 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     }
     unsigned long long flood[4] = {0, 0, 0, 0};
     CUDA_CHECK(cudaMemcpy(flood, flood_counters.get(), sizeof(flood), cudaMemcpyDeviceToHost));
-    if (flood[2] != 0)
-        throw std::logic_error("CUDA BVH sparse band: " + std::to_string(flood[2]) +
-                               " points beyond the band were left without one side by the spread of sides");
+    if (flood[2] != 0)  // neighbours beyond the band on opposite sides
+        throw std::runtime_error("CUDA BVH sparse band: " + mesh().name() + ": " + std::to_string(flood[2]) +
+                                 " points beyond the band have neighbours on both sides by the pseudonormal sign, which "
+                                 "is not consistent there (slivers within the search's rounding of a sharp edge?); "
+                                 "sample this mesh with the winding sign (--sign winding, sampler \"sign\": \"winding\")");
     CertificateCounters certificate;
     read_certificate(dev, certificate);
     band.timings.upload += upload.seconds();

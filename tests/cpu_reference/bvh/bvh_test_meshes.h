@@ -176,10 +176,11 @@ inline Lattice lattice_cutting_the_box(LatticeType type) {
 /// 2^-30 is far above its rounding). A lies at `offset`, B = A + (1, 0, 0): without an offset
 /// the split points are exactly collinear and lattice_through_the_fan's points fall on them and
 /// on A B (exact ties between the fans' triangles); with a large one the points nearest A round
-/// onto A and their triangles are dropped.
-inline TriangleMesh fanned_tetrahedron(const Vec3d& offset = {0, 0, 0}) {
+/// onto A and their triangles are dropped. `finest` 45 puts slivers within the double search's
+/// rounding of A C, where the pseudonormal sign itself fails (docs/large-lattices.md).
+inline TriangleMesh fanned_tetrahedron(const Vec3d& offset = {0, 0, 0}, int finest = 30) {
     std::vector<double> t{0.0};
-    for (int e = 30; e >= 7; --e) t.push_back(std::ldexp(1.0, -e));
+    for (int e = finest; e >= 7; --e) t.push_back(std::ldexp(1.0, -e));
     for (int k = 1; k <= 64; ++k) t.push_back(k / 64.0);
     TriangleMesh m;
     m.name = "fanned-tetrahedron";

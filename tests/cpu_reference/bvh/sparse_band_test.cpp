@@ -515,6 +515,25 @@ TEST(SparseBand, SliversAndTiesEqualTheDenseBand) {
     EXPECT_GT(flooded, 0);
 }
 
+// With slivers within the double search's rounding of a sharp edge (the fan down to 2^-45) the
+// pseudonormal sign itself is not consistent: beyond the band neighbours disagree, and the sparse
+// band refuses the mesh, naming the winding sign, which samples it exactly.
+TEST(SparseBand, InconsistentPseudonormalSidesAreRefused) {
+    const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron({0, 0, 0}, 45));
+    const Lattice lattice = test::lattice_through_the_fan(LatticeType::BCC);  // a block of its secondary grid disagrees
+    const double w = 3 * lattice.spacing;
+    try {
+        make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(fan))->sample_band_sparse(lattice, w);
+        ADD_FAILURE() << "a sparse band with disagreeing pseudonormal sides was not refused";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("--sign winding"), std::string::npos) << e.what();
+    }
+    const SampledField dense = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding))->bind(share(fan))->sample(lattice);
+    const SparseBandField sparse =
+        make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding))->bind(share(fan))->sample_band_sparse(lattice, w);
+    expect_same_field(dense, sparse.densify(), "the fan down to 2^-45 with the winding sign");
+}
+
 // Across the bowl's opening the winding number passes 1/2 far from any triangle: there the
 // sides are stored per point, and they are the dense path's.
 TEST(SparseBand, HolesGiveMixedBlocksWithTheDenseSides) {
