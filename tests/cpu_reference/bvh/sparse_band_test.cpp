@@ -66,6 +66,17 @@ void expect_same_field(const SampledField& dense, const SampledField& densified,
     EXPECT_TRUE(same) << what << ": " << (same ? "" : first_difference(dense, densified));
 }
 
+/// Expects `call` to throw an E whose message holds `text`; `unrefused` is the failure's message.
+template <typename E, typename Call>
+void expect_refused(const Call& call, const std::string& text, const std::string& unrefused) {
+    try {
+        call();
+        ADD_FAILURE() << unrefused;
+    } catch (const E& e) {
+        EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+}
+
 TriangleMesh joined(const std::vector<TriangleMesh>& parts, const std::string& name) {
     TriangleMesh m;
     m.name = name;
@@ -317,14 +328,9 @@ TEST(SparseBand, Float32DistancesAreTheDoubleBandRoundedOnce) {
                                   std::signbit(dense.distance[size_t(i)]) == std::signbit(densified.distance[size_t(i)]);
                     EXPECT_TRUE(rounded) << how;
                     EXPECT_TRUE(same_bytes(dense.closest_triangle, densified.closest_triangle)) << how;
-                    try {
-                        f32.require_channels(BandChannels{}, "the test's reader");
-                        ADD_FAILURE() << how << ": require_channels gave float32 distances to a reader of doubles";
-                    } catch (const std::invalid_argument& e) {
-                        EXPECT_NE(std::string(e.what()).find("the test's reader: the band holds its distances in float32"),
-                                  std::string::npos)
-                            << e.what();
-                    }
+                    expect_refused<std::invalid_argument>([&] { f32.require_channels(BandChannels{}, "the test's reader"); },
+                                                          "the test's reader: the band holds its distances in float32",
+                                                          how + ": require_channels gave float32 distances to a reader of doubles");
                     EXPECT_NO_THROW(f32.require_channels(f32_channels, "x")) << how;
                     EXPECT_NO_THROW(f64.require_channels(f32_channels, "x")) << how;  // a float32 writer takes doubles
                     if (HasFailure()) return;
@@ -425,14 +431,9 @@ TEST(SparseBand, WithoutTheClosestTriangleTheSameValuesAndBandPoints) {
                 // Asking it for triangles is refused, naming the caller's what.
                 BandChannels wanted = channels;
                 wanted.closest_triangle = true;
-                try {
-                    lean.require_channels(wanted, "the test's writer");
-                    ADD_FAILURE() << what << ": require_channels accepted a missing closest triangle";
-                } catch (const std::invalid_argument& e) {
-                    EXPECT_NE(std::string(e.what()).find("the test's writer: the band holds no closest triangle"),
-                              std::string::npos)
-                        << e.what();
-                }
+                expect_refused<std::invalid_argument>([&] { lean.require_channels(wanted, "the test's writer"); },
+                                                      "the test's writer: the band holds no closest triangle",
+                                                      what + ": require_channels accepted a missing closest triangle");
                 EXPECT_NO_THROW(lean.require_channels(channels, "x")) << what;
             }
             if (HasFailure()) return;
@@ -522,12 +523,9 @@ TEST(SparseBand, InconsistentPseudonormalSidesAreRefused) {
     const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron({0, 0, 0}, 45));
     const Lattice lattice = test::lattice_through_the_fan(LatticeType::BCC);  // a block of its secondary grid disagrees
     const double w = 3 * lattice.spacing;
-    try {
-        make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(fan))->sample_band_sparse(lattice, w);
-        ADD_FAILURE() << "a sparse band with disagreeing pseudonormal sides was not refused";
-    } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("--sign winding"), std::string::npos) << e.what();
-    }
+    expect_refused<std::runtime_error>(
+        [&] { make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Auto))->bind(share(fan))->sample_band_sparse(lattice, w); },
+        "--sign winding", "a sparse band with disagreeing pseudonormal sides was not refused");
     const SampledField dense = make_cpu_bvh_sampler(options(Precision::Float, w, SignMode::Winding))->bind(share(fan))->sample(lattice);
     const SparseBandField sparse =
         make_cpu_bvh_sampler(options(Precision::Float, 0, SignMode::Winding))->bind(share(fan))->sample_band_sparse(lattice, w);
