@@ -14,6 +14,7 @@
 #include "cpu_reference/bvh/bvh_cpu_bricks.h"
 #include "cpu_reference/bvh/bvh_cpu_points.h"
 #include "cpu_reference/bvh/bvh_cpu_search.h"
+#include "cpu_reference/bvh/bvh_cpu_sweep.h"
 
 namespace sdf {
 namespace {
@@ -68,7 +69,7 @@ private:
                 if (outside_band(s.distance, w)) store_outside_band(field, out, std::signbit(s.distance), w);
                 else store_sample(field, out, mesh(), s.distance, s.gradient, s.triangle);
             };
-            auto emit_outside = [&](int64_t i, BandSide side) {  // band_.bound_squared is 0: a side always
+            auto emit_outside = [&](int64_t i, BandSide side) {  // a probe's ball: a side always
                 const int64_t out = block.output_index(lattice, i);
                 if (out >= 0) store_outside_band(field, out, side == kBandSideInside, w);
             };
@@ -102,12 +103,13 @@ private:
         return field;
     }
 
-    /// A sparse band's active blocks through the dense path's brick kernel (with its brick
-    /// skip), each block of 8^3 points one GridBlock: the same values as the dense band's,
-    /// every lattice point's channels written (the arrays come unwritten; padding is the
-    /// sampler's), the gradient only when the band holds it. On a solid with a band at least
-    /// a spacing wide the search is bounded by the band, and the points beyond it take their
-    /// sides from their neighbours (band_sides.h).
+    /// A sparse band's active blocks, each block of 8^3 points one GridBlock: the same values
+    /// as the dense band's, every lattice point's channels written (the arrays come unwritten;
+    /// padding is the sampler's), the gradient only when the band holds it. On a solid with a
+    /// band at least a spacing wide the triangles sweep each block (bvh_cpu_sweep.h: the double
+    /// search's triangle of every point within the band) and the points beyond it take their
+    /// sides from their neighbours (band_sides.h); every other band runs the dense path's
+    /// brick kernel with its brick skip.
     BandBlockKernel band_block_kernel(double width) const override {
         if (kernel_ != BvhKernel::Brick) return {};
         const BandSkip skip = band_skip(width);
@@ -115,18 +117,19 @@ private:
         return [this, skip](SparseBandField& out, size_t first, size_t last) {
             const BandLayout& layout = out.layout();
             const Lattice& lattice = out.lattice;
-            BandSkip band = skip;
-            if (band.probe_sign && band.winding == nullptr && band.width >= lattice.spacing) {
-                const double scale = band.coordinate_scale + largest_lattice_coordinate(lattice);
-                band.bound_squared = float_search() ? band_search_bound_squared<float>(band.width, scale, band.sliver_reach)
-                                                    : band_search_bound_squared<double>(band.width, scale, band.sliver_reach);
-            }
+            const BandSkip& band = skip;
+            // The sweep where the sides beyond the band come from the neighbours (band_sides.h).
+            const bool swept = band.probe_sign && band.winding == nullptr && band.width >= lattice.spacing;
+            const double scale = band.coordinate_scale + largest_lattice_coordinate(lattice);
+            const double sweep_bound = band_sweep_bound_squared(band.width, scale);
             CertificateCounters certificate;
             SharedWindingCounts winding;  // a sparse band's report has no winding counters (as queries)
             QueryCounters counters(certificate, winding);
             BandCounters band_counters;
-            std::atomic<int64_t> searched_blocks{0};
+            std::atomic<int64_t> searched_blocks{0}, flooded{0};
             parallel_for(int64_t(last - first), 8, options_.threads, [&](int64_t begin, int64_t end) {
+                SweepScratch scratch;
+                int64_t beyond = 0;
                 for (size_t a = first + size_t(begin); a < first + size_t(end); ++a) {
                     const BandBlockCoords b = layout.block_coords(out.active[a]);
                     const BandCoset& coset = layout.coset(b.coset);
@@ -135,9 +138,9 @@ private:
                                  std::min(kBandBlockDim, coset.points.z - p0.z)};
                     const GridBlock block{{coset.first.x + 2 * p0.x, coset.first.y + 2 * p0.y, coset.first.z + 2 * p0.z}, 2, r, 0, false};
                     const size_t base = a * kBandBlockPoints;
-                    const auto slot = [&](int64_t i) {
+                    const auto local_of = [&](int64_t i) {  // GridBlock's index to the block's
                         const int x = int(i % r.x), y = int((i / r.x) % r.y), z = int(i / (int64_t(r.x) * r.y));
-                        return base + size_t(x + kBandBlockDim * (y + kBandBlockDim * z));
+                        return x + kBandBlockDim * (y + kBandBlockDim * z);
                     };
                     // Each point's side for the flood (padding has none and is never open).
                     BandSideLayers sides;
@@ -149,9 +152,10 @@ private:
                         if (gradient) out.gradient[v] = Vec3d(0.0);
                         if (triangle) out.closest_triangle[v] = kOutsideBandTriangle;
                     };
-                    auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
-                        const size_t v = slot(i);
-                        sides.set(int(v - base), std::signbit(s.distance) ? kBandSideInside : kBandSideOutside);
+                    // By block-local index (x + 8 y + 64 z).
+                    auto emit_at = [&](int local, const SignedDistanceSample<double>& s) {
+                        const size_t v = base + size_t(local);
+                        sides.set(local, std::signbit(s.distance) ? kBandSideInside : kBandSideOutside);
                         if (outside_band(s.distance, band.width)) {
                             store_outside(v, std::signbit(s.distance));
                             return;
@@ -159,19 +163,24 @@ private:
                         out.distance.set(v, s.distance);
                         if (gradient) out.gradient[v] = s.gradient;
                         if (triangle) out.closest_triangle[v] = s.triangle < 0 ? s.triangle : mesh().source_triangle()[size_t(s.triangle)];
-                        set_mask_bit(in_band, int(v - base));
+                        set_mask_bit(in_band, local);
                     };
-                    auto emit_outside = [&](int64_t i, BandSide s) {
-                        const size_t v = slot(i);
-                        sides.set(int(v - base), s);
+                    auto outside_at = [&](int local, BandSide s) {
+                        sides.set(local, s);
                         flood = flood || s == kBandSideNone;
-                        store_outside(v, s == kBandSideInside);
+                        store_outside(base + size_t(local), s == kBandSideInside);
                     };
-                    with_precision(options_.precision, [&](auto zero) {
-                        using T = decltype(zero);
-                        evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters, emit,
-                                           emit_outside);
-                    });
+                    if (swept) {
+                        beyond += sweep_block(mesh(), *bvh_, lattice, block, sweep_bound, scale, scratch, emit_at, outside_at);
+                    } else {
+                        auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) { emit_at(local_of(i), s); };
+                        auto emit_outside = [&](int64_t i, BandSide s) { outside_at(local_of(i), s); };
+                        with_precision(options_.precision, [&](auto zero) {
+                            using T = decltype(zero);
+                            evaluate_bricks<T>(mesh(), *bvh_, sign_, lattice, block, 1, false, band, counters, band_counters,
+                                               emit, emit_outside);
+                        });
+                    }
                     out.band_mask[a] = in_band;
                     if (!flood) continue;
                     if (!sides.any_known()) {  // its point 0 by the double search
@@ -191,9 +200,11 @@ private:
                         for (uint64_t in = sides.open[z] & sides.inside[z]; in != 0; in &= in - 1)
                             out.distance.set(base + size_t(64 * z + __builtin_ctzll(in)), -band.width);
                 }
+                flooded += beyond;
             });
-            out.sampler.details["band_blocks_on_host"] = {{"bounded_search", band.bound_squared > 0},
-                                                          {"points_flooded", band_counters.points_beyond_bound.load()},
+            out.sampler.details["band_blocks_on_host"] = {{"bounded_search", swept},
+                                                          {"nearest", swept ? "triangle_sweep" : "search"},
+                                                          {"points_flooded", flooded.load()},
                                                           {"blocks_signed_by_a_search", searched_blocks.load()}};
         };
     }

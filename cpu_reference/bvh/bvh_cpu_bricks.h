@@ -76,17 +76,11 @@ struct BandSkip {
     /// The search's nearest triangle may be a sliver's neighbour up to this much farther than
     /// the true nearest (FloatSearchBound::sliver_reach_*): the probe's D is lowered by it.
     double sliver_reach = 0;
-    /// A search bounded by the band (0: none; band_sides.h, band_search_bound_squared): a
-    /// point that finds no triangle within the bound lies beyond the band and is handed to
-    /// emit_outside with kBandSideNone, its side to be taken from its neighbours. Set only
-    /// by the sparse band's block kernel, where every point's neighbours are at hand.
-    double bound_squared = 0;
     bool enabled() const { return width > 0 && (probe_sign || winding != nullptr); }
 };
 
 struct BandCounters {
     std::atomic<int64_t> probes{0}, bricks_skipped{0}, points_skipped{0};
-    std::atomic<int64_t> points_beyond_bound{0};  ///< a bounded search found no triangle
 };
 
 /// The ball of the last probe of a chunk: points within `clear` of `centre` are outside the band.
@@ -109,8 +103,7 @@ inline bool brick_in_ball(const Brick& br, const ProbeBall& ball) {
 /// Evaluates every point of `block` brick by brick (closest_triangles_packet.h); each lane
 /// is seeded with the triangle of the same lane of the previous brick along x. With a band,
 /// a brick that a probe proves outside it is handed to emit_outside(local, side) point by
-/// point without a search (side: kBandSideInside or kBandSideOutside), and with a bounded
-/// search a point without a triangle within the bound as kBandSideNone.
+/// point without a search (side: kBandSideInside or kBandSideOutside).
 template <typename T, typename EmitFn, typename OutsideFn>
 void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const SamplerSign& sign, const Lattice& lattice, const GridBlock& block,
                      int threads, bool progress, const BandSkip& band, QueryCounters& counters, BandCounters& band_counters,
@@ -140,18 +133,14 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         std::vector<ProbeBall> column_ball(band.enabled() ? size_t(bricks.x) : 0);
         std::vector<int32_t> below(size_t(bricks.x) * kBrick, -1);  // each column's winners in the row before
         PacketSign packet_sign(sign);
-        int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0, beyond_bound = 0;
+        int64_t done = 0, probes = 0, skipped_bricks = 0, skipped_points = 0;
         for (int64_t b = begin; b < end; ++b) {
             const Brick br = brick_points(lattice, block, bricks, b);
             done += br.count;
             const bool row_start = b % bricks.x == 0;
             if (row_start)
                 for (int k = 0; k < kBrick; ++k) seed[k] = row_seed[k];
-            // With a search bounded by the band no probe: in the sparse band's blocks (all near
-            // the surface) a probe's full search rarely proved its brick outside, and a bounded
-            // search ends as soon, giving the points beyond it their side by the flood
-            // (dragon, 512^3: 0.77 -> 0.61 s).
-            if (band.enabled() && !(band.bound_squared > 0)) {
+            if (band.enabled()) {
                 ProbeBall& below = column_ball[size_t(b % bricks.x)];
                 if (!brick_in_ball(br, ball) && brick_in_ball(br, below)) ball = below;
                 if (!brick_in_ball(br, ball)) {  // probe at the brick's centre
@@ -208,29 +197,13 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             seed_packet(view, seed, pk);
             int32_t* column_below = &below[size_t(b % bricks.x) * kBrick];
             improve_seeds_from_below(view, column_below, pk);
-            if (band.bound_squared > 0) {  // a seed beyond the bound gives way to it (the search widens the radius)
-                const T bound = T(band.bound_squared);
-                for (int k = 0; k < kBrick; ++k)
-                    if (!(pk.best_q[k] <= bound)) {
-                        pk.best_q[k] = pk.radius[k] = bound;
-                        pk.best_slot[k] = pk.best_triangle[k] = -1;
-                    }
-            }
             int32_t slot[kBrick];
             search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
             for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
-            SignedDistanceSample<double> sample[kBrick];  // triangle -1 beyond the bound
-            for (int k = 0; k < br.count; ++k)
-                if (slot[k] >= 0) sample[k] = signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]);
+            SignedDistanceSample<double> sample[kBrick];
+            for (int k = 0; k < br.count; ++k) sample[k] = signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]);
             packet_sign.prepare(br.position, sample, br.count);
-            for (int k = 0; k < br.count; ++k) {
-                if (slot[k] < 0) {  // beyond the bound
-                    emit_outside(br.local[k], kBandSideNone);
-                    ++beyond_bound;
-                    continue;
-                }
-                emit(br.local[k], packet_sign.apply(sample[k], k, br.position[k]));
-            }
+            for (int k = 0; k < br.count; ++k) emit(br.local[k], packet_sign.apply(sample[k], k, br.position[k]));
             // The next brick's lanes start from this brick's last column in x, (1 to 4
             // spacings away rather than 4): a tighter first radius.
             for (int k = 0; k < kBrick; ++k) seed[k] = pk.best_slot[k - k % kBrickX + kBrickX - 1];
@@ -244,7 +217,6 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         band_counters.probes += probes;
         band_counters.bricks_skipped += skipped_bricks;
         band_counters.points_skipped += skipped_points;
-        band_counters.points_beyond_bound += beyond_bound;
         reporter.advance(done);
     });
 }

@@ -3,8 +3,8 @@
 ///
 /// The loops (the vectorised and the Eberly brute force, the BVH point and packet
 /// traversals of kernels/bvh, in their plain and certified forms, the certified search's
-/// re-ranking in double, the packet of fast winding numbers and the packet of certified
-/// winding sides) are compiled once per ISA level by cpu_kernels_isa.cpp into a
+/// re-ranking in double, the packet of fast winding numbers, the packet of certified
+/// winding sides and the sparse band's block sweep) are compiled once per ISA level by cpu_kernels_isa.cpp into a
 /// CpuKernelSet of function pointers; the samplers call them through cpu_kernels<T>() and
 /// certified_cpu_kernels(), which use the set chosen once per process: the widest level this
 /// CPU supports, or the one the environment variable SDF_CPU_ISA (v2, v3, v4) forces. Every
@@ -23,6 +23,7 @@
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/distance/search_certificate.h"
 #include "kernels/distance/signed_distance.h"
+#include "kernels/lattice/band_sweep.h"
 #include "kernels/winding/certified_winding_packet.h"
 #include "kernels/winding/fast_winding_packet.h"
 
@@ -101,6 +102,11 @@ using CertifiedWindingPacketFn = void (*)(const WindingView<double>& v, const Ve
                                           const WindingAccuracy<double>& acc, const WindingCertification& cert,
                                           WindingSide* side);
 
+/// sweep_band_block() (band_sweep.h): a sparse band block's nearest triangles within a bound.
+using SweepBandBlockFn = void (*)(const PackedTriangle<double>* packed, const int32_t* triangle_index, const int32_t* slots,
+                                  int count, const BandSweepBlock& block, double bound_squared, double* best_q,
+                                  int32_t* best_triangle);
+
 struct CpuKernelSet {
     const char* isa;  ///< "x86-64-v4", or the build's -march value in a single-target build
     CpuKernels<float> float_kernels;
@@ -108,6 +114,7 @@ struct CpuKernelSet {
     CpuCertifiedKernels certified;
     WindingPacketFn winding_numbers_packet;
     CertifiedWindingPacketFn winding_sides_packet;
+    SweepBandBlockFn sweep_band_block;
 
     template <typename T>
     const CpuKernels<T>& get() const {

@@ -64,7 +64,8 @@ constexpr CpuCertifiedKernels certified_kernels() {
 
 constexpr CpuKernelSet kSet{SDF_CPU_KERNEL_ISA, kernels_of<float>(), kernels_of<double>(), certified_kernels(),
                             &Flattened<&fast_winding_numbers_packet<kCpuPacketLanes>>::call,
-                            &Flattened<&certified_winding_sides_packet<kCpuPacketLanes>>::call};
+                            &Flattened<&certified_winding_sides_packet<kCpuPacketLanes>>::call,
+                            &Flattened<&sweep_band_block>::call};
 
 }  // namespace
 

@@ -17,7 +17,6 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 
 #include "kernels/lattice/band_blocks.h"
 
@@ -77,20 +76,5 @@ struct BandSideLayers {
         return wrong == 0;
     }
 };
-
-/// The squared radius a search bounded by the band starts with (its points find no triangle
-/// when they lie beyond the band, and then take their sides from their neighbours): a
-/// triangle whose T distance from a point is at least its root lies farther than `width`
-/// from it. The allowance is 256 epsilon of the magnitudes (the float search is exact relative
-/// to them; wider than the GPU brick skip's 64 epsilon and, in float, the CPU probes' relative
-/// 1e-5 of W alone) plus the sliver reach (how much farther than the true nearest a search's
-/// nearest may be, FloatSearchBound::sliver_reach_*). `scale` bounds every |coordinate| of the
-/// points and of the mesh.
-template <typename T>
-inline double band_search_bound_squared(double width, double scale, double sliver_reach) {
-    const double e = 256.0 * double(std::numeric_limits<T>::epsilon());
-    const double r = (width + sliver_reach + e * scale) / (1.0 - e) * (1.0 + 1e-6);
-    return r * r;
-}
 
 }  // namespace sdf

@@ -7,7 +7,8 @@
 // same winners, Q bits and candidates at every level as the templates compiled here, and their
 // re-ranking gives the double brute force's triangle; the certified samplers at the chosen
 // level equal the double brute force in distance, gradient and triangle (CTest runs this at
-// SDF_CPU_ISA=v2, v3 and the widest level). Levels this CPU lacks are skipped; a build for one
+// SDF_CPU_ISA=v2, v3 and the widest level), and the sparse band's block sweep keeps the
+// scalar loop's triangle at every point. Levels this CPU lacks are skipped; a build for one
 // target (SDF_CPU_TARGET other than portable) has no levels and skips.
 #include <gtest/gtest.h>
 
@@ -24,6 +25,9 @@
 #include "cpu_reference/dispatch/cpu_kernels.h"
 #include "cpu_reference/sampling/brute_force_cpu.h"
 #include "core/winding/winding_sign.h"
+#include "core/lattice/lattice_fitting.h"
+#include "kernels/lattice/band_sweep.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
 
 namespace sdf {
@@ -504,6 +508,86 @@ TEST(CpuIsa, RerankEqualsTheScalarReRanking) {
     }
     EXPECT_GT(reranked, cases / 2);
     EXPECT_GT(changed, cases / 4) << "the double search should overrule the float winner often here";
+}
+
+/// The dispatched band sweep (band_sweep.h: a block's rows against its candidate triangles,
+/// vectorised, with its culls) keeps at each point of a block the triangle that a scalar loop
+/// over every triangle keeps (the least squared_distance() within the bound, the lower index on
+/// ties), and its Q bits, at every level: the fanned tetrahedron (slivers down to 2^-30 wide,
+/// lattice points on their shared edge: exact ties) and the icosphere, blocks cut by the
+/// lattice's end (padding never won), candidates in a shuffled order, and a bound that leaves
+/// some points without a triangle.
+TEST(CpuIsa, BandSweepEqualsTheScalarLoopAtEveryLevel) {
+    if (requested_level_missing()) GTEST_SKIP() << "SDF_CPU_ISA names a level this CPU lacks";
+    std::vector<const CpuKernelSet*> sets = runnable_sets();
+    sets.push_back(&active_cpu_kernels());
+    const PreparedMesh fan = prepare_mesh(test::fanned_tetrahedron());
+    std::mt19937_64 rng(11);
+    int64_t points = 0, found = 0, ties = 0;
+    for (const PreparedMesh* mesh : {&fan, &test_mesh()}) {
+        const TriangleBvh bvh = build_triangle_bvh(*mesh);
+        const BvhView<double> exact = bvh.view<double>();
+        const Lattice lattice = mesh == &fan ? test::lattice_through_the_fan(LatticeType::CC)
+                                             : fit_lattice(LatticeType::CC, {20, 19, 21}, mesh->bounds(), 0.2);
+        const double bound = std::pow(2.5 * lattice.spacing, 2);
+        std::vector<int32_t> slots(size_t(exact.num_triangles));
+        for (int32_t s = 0; s < exact.num_triangles; ++s) slots[size_t(s)] = s;
+        for (int bz = 0; bz * kBandBlockDim < lattice.resolution.z; ++bz)
+            for (int by = 0; by * kBandBlockDim < lattice.resolution.y; ++by)
+                for (int bx = 0; bx * kBandBlockDim < lattice.resolution.x; ++bx) {
+                    const Int3 p0{bx * kBandBlockDim, by * kBandBlockDim, bz * kBandBlockDim};
+                    BandSweepBlock block;
+                    block.points = {std::min(kBandBlockDim, lattice.resolution.x - p0.x),
+                                    std::min(kBandBlockDim, lattice.resolution.y - p0.y),
+                                    std::min(kBandBlockDim, lattice.resolution.z - p0.z)};
+                    block.margin = lattice.half_spacing();
+                    block.rounding = 1e-12;
+                    for (int k = 0; k < kBandBlockDim; ++k) {
+                        const Vec3d p = lattice.position_of_coords({2 * (p0.x + k), 2 * (p0.y + k), 2 * (p0.z + k)});
+                        block.x[k] = p.x;
+                        block.y[k] = p.y;
+                        block.z[k] = p.z;
+                    }
+                    std::shuffle(slots.begin(), slots.end(), rng);
+                    std::vector<double> want_q(kBandBlockPoints, -1.0);  // padding: -1 (a Q may round below 0)
+                    std::vector<int32_t> want(kBandBlockPoints, -1);
+                    std::vector<bool> real(kBandBlockPoints, false);
+                    for (int i = 0; i < kBandBlockPoints; ++i) {
+                        const int x = i % kBandBlockDim, y = (i / kBandBlockDim) % kBandBlockDim, z = i / (kBandBlockDim * kBandBlockDim);
+                        if (x >= block.points.x || y >= block.points.y || z >= block.points.z) continue;  // padding
+                        real[size_t(i)] = true;
+                        want_q[size_t(i)] = bound;
+                        for (int32_t s = 0; s < exact.num_triangles; ++s) {
+                            const double q = squared_distance(exact.packed[s], block.x[x], block.y[y], block.z[z]);
+                            const int32_t t = exact.triangle_index[s];
+                            if (q < want_q[size_t(i)] || (q == want_q[size_t(i)] && wins_tie(t, want[size_t(i)]))) {
+                                ties += q == want_q[size_t(i)] && want[size_t(i)] >= 0;
+                                want_q[size_t(i)] = q;
+                                want[size_t(i)] = t;
+                            }
+                        }
+                        ++points;
+                        found += want[size_t(i)] >= 0;
+                    }
+                    for (const CpuKernelSet* set : sets) {
+                        std::vector<double> q(kBandBlockPoints);
+                        std::vector<int32_t> t(kBandBlockPoints, -1);
+                        for (int i = 0; i < kBandBlockPoints; ++i) q[size_t(i)] = real[size_t(i)] ? bound : -1.0;
+                        set->sweep_band_block(exact.packed, exact.triangle_index, slots.data(), int(slots.size()), block, bound,
+                                              q.data(), t.data());
+                        for (int i = 0; i < kBandBlockPoints; ++i) {
+                            ASSERT_EQ(t[size_t(i)], want[size_t(i)]) << set->isa << " " << mesh->name() << " block " << bx << " "
+                                                                     << by << " " << bz << " point " << i;
+                            if (want[size_t(i)] >= 0) {
+                                ASSERT_TRUE(same_bits(q[size_t(i)], want_q[size_t(i)])) << set->isa << " point " << i;
+                            }
+                        }
+                    }
+                }
+    }
+    EXPECT_GT(found, points / 10);
+    EXPECT_LT(found, points);
+    EXPECT_GT(ties, 0) << "points on the fan's shared edge tie";
 }
 
 TEST(CpuIsa, ParsesLevelNames) {
