@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -30,6 +31,7 @@
 #include "cuda/util/device_guard.h"
 #include "kernels/lattice/band_blocks.h"
 #include "kernels/lattice/band_sides.h"
+#include "kernels/lattice/band_sweep.h"
 
 namespace sdf::cuda {
 namespace {
@@ -188,15 +190,21 @@ __global__ void __launch_bounds__(kFinishThreads)
     }
 }
 
-/// The triangle sweep (a solid's bounded band, in place of the bounded search): each
-/// triangle visits the lattice points of its box dilated by the bound, and each point keeps the
-/// least Q_d (squared_distance() on PackedTriangle<double> at the point, the quantity the
-/// double search and the float search's certificate rank by) within the bound, ties to the
-/// smaller triangle index (wins_tie): the double search's triangle, whatever the tree, and
-/// none (kOutsideBandFlood, the flood's) where no triangle is within the bound. Two passes: the
-/// least Q_d as an ordered 64-bit key (atomicMin), then the least triangle index among the
-/// triangles at that key. Work grows with the band's points near each triangle, not with a
-/// search per point of every active block (3-6 times the band's points).
+/// The triangle sweep (kernels/lattice/band_sweep.h; a solid's bounded band, in place of the
+/// bounded search): each triangle walks the columns of its box dilated by the bound, each point
+/// keeps the least (Q_d, triangle index) within the bound, and a point left without one is
+/// kOutsideBandFlood (the flood's). Where the kernel is compiled for sm_90 or later one pass
+/// keeps the pair by a 16-byte compare-and-swap (kSweepPairs); before, two passes: the least
+/// Q_d as an ordered 64-bit key (atomicMin), then the least triangle index among the triangles
+/// at that key. Work grows with the band's points near each triangle, not with a search per
+/// point of every active block (3-6 times the band's points).
+enum SweepPass : int { kSweepKeys = 0, kSweepTriangles = 1, kSweepPairs = 2 };
+
+/// A point's best (key, triangle) for the one-pass sweep: 16 bytes, compared and swapped at once.
+struct alignas(16) SweepPair {
+    unsigned long long key;
+    unsigned long long triangle;  ///< a triangle index (>= 0); ~0 none
+};
 constexpr int kSweepThreads = 128;
 /// Blocks of a triangle's box whose batch indices are kept in shared memory; a larger box
 /// (a triangle many blocks wide) looks each point's block up in the sorted ids instead.
@@ -236,31 +244,33 @@ __device__ SDF_INLINE bool coset_range(const Lattice& lattice, const BandCoset& 
     return true;
 }
 
-/// A triangle's box dilated by `reach`, from its vertices B, B + E0, B + E1 (packed as 2 E0,
-/// 2 E1; coset_range's margin of a point covers the rounding).
-__device__ SDF_INLINE void dilated_box(const PackedTriangle<double>& t, double reach, Vec3d& lo, Vec3d& hi) {
-    const Vec3d b(t.bx, t.by, t.bz), v1(t.bx + 0.5 * t.e0x, t.by + 0.5 * t.e0y, t.bz + 0.5 * t.e0z),
-        v2(t.bx + 0.5 * t.e1x, t.by + 0.5 * t.e1y, t.bz + 0.5 * t.e1z);
-    lo = Vec3d(fmin(b.x, fmin(v1.x, v2.x)) - reach, fmin(b.y, fmin(v1.y, v2.y)) - reach, fmin(b.z, fmin(v1.z, v2.z)) - reach);
-    hi = Vec3d(fmax(b.x, fmax(v1.x, v2.x)) + reach, fmax(b.y, fmax(v1.y, v2.y)) + reach, fmax(b.z, fmax(v1.z, v2.z)) + reach);
+/// Offers (key, triangle) to a point's pair: it replaces the pair where it is less, key first.
+/// The key is read alone first (an 8-byte read is whole; keys only fall, so one above it never
+/// wins); the triangle read beside it may belong to another pair, so on a key tie the pair is
+/// read whole, by a compare-and-swap that changes nothing, before the loop decides.
+__device__ SDF_INLINE void offer_pair(SweepPair* cell, unsigned long long key, int triangle) {
+#if __CUDA_ARCH__ >= 900
+    const unsigned long long seen = cell->key;
+    if (key > seen) return;
+    const SweepPair ours{key, static_cast<unsigned long long>(triangle)};
+    SweepPair expected{seen, cell->triangle};
+    if (key == seen) expected = atomicCAS(cell, expected, expected);
+    while (ours.key < expected.key || (ours.key == expected.key && ours.triangle < expected.triangle)) {
+        const SweepPair old = atomicCAS(cell, expected, ours);
+        if (old.key == expected.key && old.triangle == expected.triangle) return;
+        expected = old;
+    }
+#else
+    (void)cell, (void)key, (void)triangle;
+    __trap();  // never launched: the host runs the two passes where the kernel is older than sm_90
+#endif
 }
 
-/// Whether point x lies beyond the bound from the triangle by its plane alone, before Q_d is
-/// evaluated: the distance h from the plane is a lower bound of the distance, and what the
-/// doubles lose stays below 2^-40 |B - x|^2 (h's, through the unit normal's direction: about
-/// 200 u off for a triangle that is not a sliver, a few u for a sliver's accurate normal; Q_d's,
-/// about 2^-47 |B - x|^2), so a point culled here has Q_d above the bound too. A normal of
-/// zero (h = 0) or NaN culls nothing.
-__device__ SDF_INLINE bool beyond_plane(const PackedTriangle<double>& t, const Vec3d& x, double bound_squared) {
-    const double dx = t.bx - x.x, dy = t.by - x.y, dz = t.bz - x.z;
-    const double h = t.nx * dx + t.ny * dy + t.nz * dz, f = dx * dx + dy * dy + dz * dz;
-    return h * h > 1.01 * bound_squared + 0x1p-40 * f;
-}
-
-template <int kPass>
+template <SweepPass kPass>
 __global__ void __launch_bounds__(kSweepThreads, 6)
     sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
-                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle) {
+                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle,
+                         SweepPair* best_pair) {
     __shared__ int64_t cached[kSweepCachedBlocks];
     const double reach = sqrt(bound_squared);
     for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
@@ -291,7 +301,7 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
             const int au = ax == 0 ? 1 : 0, av = ax == 2 ? 1 : 2;
             const double hh = piece.lattice.half_spacing();
             const Vec3d span = hi - lo;
-            const double slab = sqrt(1.01 * bound_squared + 0x1p-40 * length_squared(span) * 4);  // R
+            const double slab = sweep_slab_half_width(bound_squared, span);  // R
             const double n_ax = n[ax];
             const bool sloped = fabs(n_ax) >= 0.5;  // a unit normal's largest component is >= 1/sqrt(3)
             const Int3 r0 = p0, r1 = p1;  // read only (a write through Int3::operator[] would put them in local memory)
@@ -327,7 +337,9 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
                     const int64_t i = a * kBandBlockPoints + (p.x & (kBandBlockDim - 1)) +
                                       kBandBlockDim * ((p.y & (kBandBlockDim - 1)) + kBandBlockDim * (p.z & (kBandBlockDim - 1)));
                     const unsigned long long key = ordered_key(q);
-                    if constexpr (kPass == 0) {
+                    if constexpr (kPass == kSweepPairs) {
+                        offer_pair(best_pair + i, key, triangle);
+                    } else if constexpr (kPass == kSweepKeys) {
                         if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
                     } else if (key == best_key[i]) {
                         atomicMin(best_triangle + i, triangle);
@@ -342,12 +354,16 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
 /// Points the sweep left without a triangle: kOutsideBandFlood (their side from their
 /// neighbours), padding kOutsideBandOutside (as the search leaves it: +W); a CUDA block per
 /// band block, which is listed in `unsigned_blocks` (count in `unsigned_count`) when none of
-/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks).
+/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks). After
+/// the one-pass sweep (`best_pair`) the others' triangles go to `nearest` here.
 __global__ void __launch_bounds__(kBandBlockPoints)
-    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest, int32_t* unsigned_blocks,
-                 unsigned int* unsigned_count) {
+    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, const SweepPair* best_pair, int* nearest,
+                 int32_t* unsigned_blocks, unsigned int* unsigned_count) {
     const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x;
-    const bool swept = best_key[i] != kSweepNone;
+    SweepPair pair{kSweepNone, kSweepNone};
+    if (best_pair) pair = best_pair[i];
+    const bool swept = (best_pair ? pair.key : best_key[i]) != kSweepNone;
+    if (swept && best_pair) nearest[i] = int(pair.triangle);
     if (!swept) {
         const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[blockIdx.x]), int(threadIdx.x));
         nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
@@ -368,6 +384,19 @@ __global__ void sides_of_unsigned_blocks(BvhView<double> exact, MeshView<double>
                                                                                                             : kBandSideOutside;
         atomicAdd(counters + 1, 1ull);
     }
+}
+
+/// Whether the one-pass sweep runs on this device: its kernel was compiled for sm_90 or later
+/// (the 16-byte compare-and-swap; a PTX JIT from an older virtual architecture has none), and
+/// SDF_CUDA_SWEEP_PASSES (1 or 2; tests and benchmarks compare the two) does not ask for two.
+bool sweep_pairs_compiled() {
+    cudaFuncAttributes attributes{};
+    CUDA_CHECK(cudaFuncGetAttributes(&attributes, sweep_band_triangles<kSweepPairs>));
+    const char* passes = std::getenv("SDF_CUDA_SWEEP_PASSES");
+    const std::string asked = passes ? passes : "";
+    if (!asked.empty() && asked != "1" && asked != "2")
+        throw std::runtime_error("environment variable SDF_CUDA_SWEEP_PASSES: '" + asked + "' is not 1 or 2");
+    return attributes.ptxVersion >= 90 && asked != "2";
 }
 
 size_t device_bytes_in_use() {
@@ -428,21 +457,12 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
     // (band_sides.h), the warp kernel (the candidates kernel searches every point).
     const bool swept = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
-    // The sweep's bound on Q_d: W with a relative margin of 1e-6 and an absolute one of 2^-30
-    // of the coordinates' scale, far above Q_d's rounding in distance terms (about
-    // u (|B - P| scale + 8 extent^2) / W, |B - P| <= the mesh's extent <= 16384 W), so that
-    // every point the finalize finds within W has its triangle. No sliver reach: Q_d is exact
-    // to that, where the float search ranks slivers by their edges.
     // The blocks the sweep leaves without a triangle: their list and sides (5 bytes a block).
     DeviceBuffer<int32_t> unsigned_blocks{swept ? size_t(batch) : 0};
     DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
     DeviceBuffer<unsigned int> unsigned_count{1};
-    double sweep_bound = 0;
-    if (swept) {
-        const double scale = coordinate + bound.coordinate;
-        const double r = (width + 0x1p-30 * scale) * (1.0 + 1e-6);
-        sweep_bound = r * r;
-    }
+    const double sweep_bound = swept ? band_sweep_bound_squared(width, coordinate + bound.coordinate) : 0.0;
+    const bool one_pass_sweep = swept && sweep_pairs_compiled();
     DeviceBuffer<unsigned long long> flood_counters{4};
     CUDA_CHECK(cudaMemset(flood_counters.get(), 0, 4 * sizeof(unsigned long long)));
     reset_certificate(dev);
@@ -454,23 +474,35 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         compute.begin();
         search_stage.begin();
         if (swept) {
-            // The sweep: the least key per point in the distance array (rewritten by finalize),
-            // the least triangle at it in `nearest`.
-            auto* key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
-            static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
-            CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
-            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
-            CUDA_CHECK_LAUNCH("fill_nearest");
             const int triangles = dev.view.num_triangles;
             const int grid = std::max(1, std::min(triangles, 1 << 20));
-            sweep_band_triangles<0><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
-                                                              sweep_bound, key, r.nearest.get());
-            CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
-            sweep_band_triangles<1><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles, piece,
-                                                              sweep_bound, key, r.nearest.get());
-            CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
+            unsigned long long* key = nullptr;
+            SweepPair* pair = nullptr;
+            if (one_pass_sweep) {
+                // The pairs in the gradient array (24 bytes a point, rewritten by finalize).
+                pair = reinterpret_cast<SweepPair*>(r.samples.gradient.get());
+                static_assert(sizeof(SweepPair) <= sizeof(Vec3d), "a pair per point in the gradient array");
+                CUDA_CHECK(cudaMemset(pair, 0xff, size_t(n) * sizeof(SweepPair)));
+                sweep_band_triangles<kSweepPairs><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
+                                                                             triangles, piece, sweep_bound, nullptr, nullptr, pair);
+                CUDA_CHECK_LAUNCH("sweep_band_triangles (pairs)");
+            } else {
+                // The least key per point in the distance array (rewritten by finalize), the
+                // least triangle at it in `nearest`.
+                key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
+                static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
+                CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
+                fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
+                CUDA_CHECK_LAUNCH("fill_nearest");
+                sweep_band_triangles<kSweepKeys><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
+                                                                            triangles, piece, sweep_bound, key, r.nearest.get(), nullptr);
+                CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
+                sweep_band_triangles<kSweepTriangles><<<grid, kSweepThreads>>>(
+                    packed_double(dev), dev.view.triangle_index, triangles, piece, sweep_bound, key, r.nearest.get(), nullptr);
+                CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
+            }
             CUDA_CHECK(cudaMemset(unsigned_count.get(), 0, sizeof(unsigned int)));
-            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
+            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, pair, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
             CUDA_CHECK_LAUNCH("finish_sweep");
             sides_of_unsigned_blocks<<<std::max<int64_t>(1, std::min<int64_t>(blocks_for(nb, 128), 1024)), 128>>>(
                 search.exact, dev.mesh->view(), piece, unsigned_blocks.get(), unsigned_count.get(), block_side.get(),
@@ -541,6 +573,7 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"brick_skip", search.skip_bricks},
         {"bounded_search", swept},
         {"nearest", swept ? "triangle_sweep" : "search"},
+        {"sweep_passes", swept ? (one_pass_sweep ? 1 : 2) : 0},
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},
