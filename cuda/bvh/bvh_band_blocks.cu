@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -193,19 +192,18 @@ __global__ void __launch_bounds__(kFinishThreads)
 /// The triangle sweep (kernels/lattice/band_sweep.h; a solid's bounded band, in place of the
 /// bounded search): each triangle walks the columns of its box dilated by the bound, each point
 /// keeps the least (Q_d, triangle index) within the bound, and a point left without one is
-/// kOutsideBandFlood (the flood's). Where the kernel is compiled for sm_90 or later one pass
-/// keeps the pair by a 16-byte compare-and-swap (kSweepPairs); before, two passes: the least
-/// Q_d as an ordered 64-bit key (atomicMin), then the least triangle index among the triangles
-/// at that key. Work grows with the band's points near each triangle, not with a search per
-/// point of every active block (3-6 times the band's points).
-enum SweepPass : int { kSweepKeys = 0, kSweepTriangles = 1, kSweepPairs = 2 };
-
-/// A point's best (key, triangle) for the one-pass sweep: 16 bytes, compared and swapped at once.
-struct alignas(16) SweepPair {
-    unsigned long long key;
-    unsigned long long triangle;  ///< a triangle index (>= 0); ~0 none
-};
+/// kOutsideBandFlood (the flood's). Two passes: the least Q_d as an ordered 64-bit key
+/// (atomicMin), then the least triangle index among the triangles at that key. (One pass by
+/// sm_90's 16-byte compare-and-swap of key and index was twice as slow: a compare-and-swap
+/// waits for its answer, where an atomicMin whose result is unused is a reduction that does
+/// not; docs/large-lattices.md.) Work grows with the band's points near each triangle, not with
+/// a search per point of every active block (3-6 times the band's points).
+enum SweepPass : int { kSweepKeys = 0, kSweepTriangles = 1 };
 constexpr int kSweepThreads = 128;
+/// Blocks per SM of the band's finalize (launch_finalize_samples): capped at 64 registers it
+/// took 6.5 ms at 4096^3 and 25.6 ms at 8192^3 on an H200, where it took 11.8 and 46.0 ms at
+/// its own 100 (2 blocks) and 8.2 and 32.0 ms at 3 blocks.
+constexpr int kBandFinalizeMinBlocks = 4;
 /// Blocks of a triangle's box whose batch indices are kept in shared memory; a larger box
 /// (a triangle many blocks wide) looks each point's block up in the sorted ids instead.
 constexpr int kSweepCachedBlocks = 2048;
@@ -244,33 +242,10 @@ __device__ SDF_INLINE bool coset_range(const Lattice& lattice, const BandCoset& 
     return true;
 }
 
-/// Offers (key, triangle) to a point's pair: it replaces the pair where it is less, key first.
-/// The key is read alone first (an 8-byte read is whole; keys only fall, so one above it never
-/// wins); the triangle read beside it may belong to another pair, so on a key tie the pair is
-/// read whole, by a compare-and-swap that changes nothing, before the loop decides.
-__device__ SDF_INLINE void offer_pair(SweepPair* cell, unsigned long long key, int triangle) {
-#if __CUDA_ARCH__ >= 900
-    const unsigned long long seen = cell->key;
-    if (key > seen) return;
-    const SweepPair ours{key, static_cast<unsigned long long>(triangle)};
-    SweepPair expected{seen, cell->triangle};
-    if (key == seen) expected = atomicCAS(cell, expected, expected);
-    while (ours.key < expected.key || (ours.key == expected.key && ours.triangle < expected.triangle)) {
-        const SweepPair old = atomicCAS(cell, expected, ours);
-        if (old.key == expected.key && old.triangle == expected.triangle) return;
-        expected = old;
-    }
-#else
-    (void)cell, (void)key, (void)triangle;
-    __trap();  // never launched: the host runs the two passes where the kernel is older than sm_90
-#endif
-}
-
 template <SweepPass kPass>
 __global__ void __launch_bounds__(kSweepThreads, 6)
     sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
-                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle,
-                         SweepPair* best_pair) {
+                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle) {
     __shared__ int64_t cached[kSweepCachedBlocks];
     const double reach = sqrt(bound_squared);
     for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
@@ -337,9 +312,7 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
                     const int64_t i = a * kBandBlockPoints + (p.x & (kBandBlockDim - 1)) +
                                       kBandBlockDim * ((p.y & (kBandBlockDim - 1)) + kBandBlockDim * (p.z & (kBandBlockDim - 1)));
                     const unsigned long long key = ordered_key(q);
-                    if constexpr (kPass == kSweepPairs) {
-                        offer_pair(best_pair + i, key, triangle);
-                    } else if constexpr (kPass == kSweepKeys) {
+                    if constexpr (kPass == kSweepKeys) {
                         if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
                     } else if (key == best_key[i]) {
                         atomicMin(best_triangle + i, triangle);
@@ -354,16 +327,12 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
 /// Points the sweep left without a triangle: kOutsideBandFlood (their side from their
 /// neighbours), padding kOutsideBandOutside (as the search leaves it: +W); a CUDA block per
 /// band block, which is listed in `unsigned_blocks` (count in `unsigned_count`) when none of
-/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks). After
-/// the one-pass sweep (`best_pair`) the others' triangles go to `nearest` here.
+/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks).
 __global__ void __launch_bounds__(kBandBlockPoints)
-    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, const SweepPair* best_pair, int* nearest,
-                 int32_t* unsigned_blocks, unsigned int* unsigned_count) {
+    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest, int32_t* unsigned_blocks,
+                 unsigned int* unsigned_count) {
     const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x;
-    SweepPair pair{kSweepNone, kSweepNone};
-    if (best_pair) pair = best_pair[i];
-    const bool swept = (best_pair ? pair.key : best_key[i]) != kSweepNone;
-    if (swept && best_pair) nearest[i] = int(pair.triangle);
+    const bool swept = best_key[i] != kSweepNone;
     if (!swept) {
         const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[blockIdx.x]), int(threadIdx.x));
         nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
@@ -384,19 +353,6 @@ __global__ void sides_of_unsigned_blocks(BvhView<double> exact, MeshView<double>
                                                                                                             : kBandSideOutside;
         atomicAdd(counters + 1, 1ull);
     }
-}
-
-/// Whether the one-pass sweep runs on this device: its kernel was compiled for sm_90 or later
-/// (the 16-byte compare-and-swap; a PTX JIT from an older virtual architecture has none), and
-/// SDF_CUDA_SWEEP_PASSES (1 or 2; tests and benchmarks compare the two) does not ask for two.
-bool sweep_pairs_compiled() {
-    cudaFuncAttributes attributes{};
-    CUDA_CHECK(cudaFuncGetAttributes(&attributes, sweep_band_triangles<kSweepPairs>));
-    const char* passes = std::getenv("SDF_CUDA_SWEEP_PASSES");
-    const std::string asked = passes ? passes : "";
-    if (!asked.empty() && asked != "1" && asked != "2")
-        throw std::runtime_error("environment variable SDF_CUDA_SWEEP_PASSES: '" + asked + "' is not 1 or 2");
-    return attributes.ptxVersion >= 90 && asked != "2";
 }
 
 size_t device_bytes_in_use() {
@@ -462,7 +418,6 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
     DeviceBuffer<unsigned int> unsigned_count{1};
     const double sweep_bound = swept ? band_sweep_bound_squared(width, coordinate + bound.coordinate) : 0.0;
-    const bool one_pass_sweep = swept && sweep_pairs_compiled();
     DeviceBuffer<unsigned long long> flood_counters{4};
     CUDA_CHECK(cudaMemset(flood_counters.get(), 0, 4 * sizeof(unsigned long long)));
     reset_certificate(dev);
@@ -476,33 +431,21 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         if (swept) {
             const int triangles = dev.view.num_triangles;
             const int grid = std::max(1, std::min(triangles, 1 << 20));
-            unsigned long long* key = nullptr;
-            SweepPair* pair = nullptr;
-            if (one_pass_sweep) {
-                // The pairs in the gradient array (24 bytes a point, rewritten by finalize).
-                pair = reinterpret_cast<SweepPair*>(r.samples.gradient.get());
-                static_assert(sizeof(SweepPair) <= sizeof(Vec3d), "a pair per point in the gradient array");
-                CUDA_CHECK(cudaMemset(pair, 0xff, size_t(n) * sizeof(SweepPair)));
-                sweep_band_triangles<kSweepPairs><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
-                                                                             triangles, piece, sweep_bound, nullptr, nullptr, pair);
-                CUDA_CHECK_LAUNCH("sweep_band_triangles (pairs)");
-            } else {
-                // The least key per point in the distance array (rewritten by finalize), the
-                // least triangle at it in `nearest`.
-                key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
-                static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
-                CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
-                fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
-                CUDA_CHECK_LAUNCH("fill_nearest");
-                sweep_band_triangles<kSweepKeys><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
-                                                                            triangles, piece, sweep_bound, key, r.nearest.get(), nullptr);
-                CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
-                sweep_band_triangles<kSweepTriangles><<<grid, kSweepThreads>>>(
-                    packed_double(dev), dev.view.triangle_index, triangles, piece, sweep_bound, key, r.nearest.get(), nullptr);
-                CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
-            }
+            // The least key per point in the distance array (rewritten by finalize), the least
+            // triangle at it in `nearest`.
+            auto* key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
+            static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
+            CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
+            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
+            CUDA_CHECK_LAUNCH("fill_nearest");
+            sweep_band_triangles<kSweepKeys><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles,
+                                                                        piece, sweep_bound, key, r.nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
+            sweep_band_triangles<kSweepTriangles><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
+                                                                             triangles, piece, sweep_bound, key, r.nearest.get());
+            CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
             CUDA_CHECK(cudaMemset(unsigned_count.get(), 0, sizeof(unsigned int)));
-            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, pair, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
+            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
             CUDA_CHECK_LAUNCH("finish_sweep");
             sides_of_unsigned_blocks<<<std::max<int64_t>(1, std::min<int64_t>(blocks_for(nb, 128), 1024)), 128>>>(
                 search.exact, dev.mesh->view(), piece, unsigned_blocks.get(), unsigned_count.get(), block_side.get(),
@@ -525,7 +468,8 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         PieceOutputs outputs = r.outputs();
         if (!band.channels.gradient) outputs.gradient = nullptr;  // not written: 24 of a point's 36 bytes
         outputs.output_index = nullptr;  // block-major: point i is slot i
-        launch_finalize_samples(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width, outputs);
+        launch_finalize_samples<kBandFinalizeMinBlocks>(n, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), width,
+                                                        outputs);
         CUDA_CHECK_LAUNCH("finalize_samples (band blocks)");
         finalize_stage.end();
         sides_stage.begin();
@@ -573,7 +517,6 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         {"brick_skip", search.skip_bricks},
         {"bounded_search", swept},
         {"nearest", swept ? "triangle_sweep" : "search"},
-        {"sweep_passes", swept ? (one_pass_sweep ? 1 : 2) : 0},
         {"distance_type", band_distance_type(band.distance.type()).name},
         {"points_flooded", int64_t(flood[0])},
         {"blocks_signed_by_a_search", int64_t(flood[1])},

@@ -68,8 +68,8 @@ constexpr int kWarpWindingMinBlocks = 4;
 /// The winding sides are found per warp (warp_winding_inside: every thread of the block,
 /// in the piece or not, reaches that call; blocks are whole warps), or with `PerThread` by
 /// each thread alone (the same bits: the measurement baseline, SDF_CUDA_WINDING_PER_THREAD).
-template <typename Piece, bool Winding, bool PerThread = false>
-__global__ void __launch_bounds__(kFinalizeBlock, Winding && !PerThread ? kWarpWindingMinBlocks : 1)
+template <typename Piece, bool Winding, bool PerThread = false, int MinBlocks = (Winding && !PerThread ? kWarpWindingMinBlocks : 1)>
+__global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
     finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
                      PieceOutputs out) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -119,12 +119,16 @@ inline bool winding_per_thread() {
 }
 
 /// Launches finalize_samples with or without the winding sign, as `sign` says, over the
-/// piece's `count` points in blocks of kFinalizeBlock.
-template <typename Piece>
+/// piece's `count` points in blocks of kFinalizeBlock. Without it, compiled for
+/// `PlainMinBlocks` blocks per SM: the sparse band asks for 4 (64 registers where it takes 100
+/// uncapped, 2 blocks): its finalize is latency-bound, and ran 1.8x faster so on an H200
+/// (docs/large-lattices.md); the other callers keep the uncapped kernel, not measured so.
+template <int PlainMinBlocks = 1, typename Piece>
 void launch_finalize_samples(int64_t count, MeshView<double> mesh, const Piece& piece, const int* nearest,
                              const WindingSignView& sign, double band_width, PieceOutputs out) {
     const int blocks = int((count + kFinalizeBlock - 1) / kFinalizeBlock), threads = kFinalizeBlock;
-    if (!sign.enabled()) finalize_samples<Piece, false><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+    if (!sign.enabled())
+        finalize_samples<Piece, false, false, PlainMinBlocks><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
     else if (winding_per_thread()) finalize_samples<Piece, true, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
     else finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
 }

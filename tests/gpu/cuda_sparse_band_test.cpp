@@ -9,12 +9,10 @@
 // and the points beyond the band take their sides from their neighbours (the flood): checked
 // on solids whose triangles' boxes reach far from them (an icosahedron: whole blocks without a
 // band point), the torus and the dragon, at widths from one spacing up, and off below one; and
-// on a tetrahedron of slivers with exact ties (SliversAndTies...), the sweep in one pass (sm_90
-// and later) and in the two passes of older GPUs (SDF_CUDA_SWEEP_PASSES=2).
+// on a tetrahedron of slivers with exact ties (SliversAndTies...).
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 
 #include <nlohmann/json.hpp>
@@ -24,7 +22,6 @@
 #include "core/mesh/shapes/procedural_shapes.h"
 #include "core/sampling/sparse_band.h"
 #include "core/winding/winding_sign.h"
-#include "cuda/util/cuda_device.h"
 #include "harness/sampling/sampler_table.h"
 #include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 #include "tests/test_util/shared_mesh.h"
@@ -246,7 +243,6 @@ TEST(CudaSparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
 // dense band byte for byte and the exact winding number's sides.
 TEST(CudaSparseBand, SliversAndTiesEqualTheCpuDenseBand) {
     int64_t flooded = 0;
-    bool one_pass_seen = false;
     test::for_each_fan_case({0.9, 1.0, 3.0}, [&](const test::FanCase& c) {
         const SampledField cpu = make_sampler(options("cpu", "bvh", c.precision, c.width, SignMode::Auto))->bind(share(c.mesh))->sample(c.lattice);
         const SampledField winding =
@@ -258,28 +254,13 @@ TEST(CudaSparseBand, SliversAndTiesEqualTheCpuDenseBand) {
         EXPECT_TRUE(same_field(cpu, gpu_dense)) << c.name << ": the dense bands differ";
         SamplerOptions o = options("cuda", "bvh", c.precision, 0, SignMode::Auto);
         o.kernel = "warp";
-        // The sweep in one pass (16-byte compare-and-swap, where compiled for sm_90 or later)
-        // and in the two passes of older GPUs, forced.
-        for (const char* passes : {"", "2"}) {
-            ::setenv("SDF_CUDA_SWEEP_PASSES", passes, 1);
-            const SparseBandField sparse = make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(c.lattice, c.width);
-            ::unsetenv("SDF_CUDA_SWEEP_PASSES");
-            const std::string which = c.name + " SDF_CUDA_SWEEP_PASSES='" + passes + "'";
-            const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
-            EXPECT_EQ(d["nearest"], c.spacings >= 1.0 ? "triangle_sweep" : "search") << which;
-            const int swept_passes = d["sweep_passes"].get<int>();
-            if (c.spacings < 1.0) EXPECT_EQ(swept_passes, 0) << which;
-            else if (*passes != '\0') EXPECT_EQ(swept_passes, 2) << which;
-            else one_pass_seen = one_pass_seen || swept_passes == 1;
-            flooded += d["points_flooded"].get<int64_t>();
-            EXPECT_TRUE(same_field(cpu, sparse.densify())) << which << ": the sparse band";
-        }
+        const SparseBandField sparse = make_sampler(o)->bind(share(c.mesh))->sample_band_sparse(c.lattice, c.width);
+        const nlohmann::json& d = sparse.sampler.details["band_blocks_on_device"];
+        EXPECT_EQ(d["nearest"], c.spacings >= 1.0 ? "triangle_sweep" : "search") << c.name;
+        flooded += d["points_flooded"].get<int64_t>();
+        EXPECT_TRUE(same_field(cpu, sparse.densify())) << c.name << ": the sparse band";
     });
     EXPECT_GT(flooded, 0);
-    const std::string capability = cuda::describe_device(0)["compute_capability"].get<std::string>();
-    if (std::stoi(capability) >= 9) {
-        EXPECT_TRUE(one_pass_seen) << "compute capability " << capability << ": the one-pass sweep should run (a build without sm_90 code?)";
-    }
 }
 
 }  // namespace
