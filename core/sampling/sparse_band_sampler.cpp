@@ -156,6 +156,124 @@ struct Cell {
     Int3 lo, hi;  ///< block range [lo, hi)
 };
 
+/// The sides of the outside's uniform cells from their neighbours, where the band is at least a
+/// coset spacing wide: a point of an inactive block lies farther than W from the surface, so it
+/// and its neighbour h away lie farther than W - h >= 0 from it along the step between them,
+/// on one side (band_sides.h's argument), and the sign is the side of the solid or of the
+/// closed mesh's winding number. A cell takes the side of the point next to one of its own
+/// across a face: an active block's (the sign of the band's value there) or a signed cell's.
+/// Sweeps over the cells still unsigned, forward and backward in turn, until one signs none
+/// (a cell signed early in a sweep signs the cells after it). A neighbour that is a whole
+/// first cell (16^3 blocks, OutsideClassifier's) is looked at once per row of the face.
+class CellFlood {
+public:
+    static constexpr int kFirst = 16;  ///< blocks per axis of OutsideClassifier's first cells
+
+    CellFlood(const BandLayout& layout, const BlockBits& active, const std::vector<Cell>& cells, const SparseBandField& band)
+        : layout_(layout), active_(active), cells_(cells), band_(band), side_(cells.size(), -1), signed_(layout.block_count()),
+          inside_(layout.block_count()) {
+        int64_t n = 0;
+        for (int c = 0; c < layout.cosets(); ++c) {
+            const Int3 b = layout.coset(c).blocks;
+            first_offset_.push_back(n);
+            first_grid_.push_back({(b.x + kFirst - 1) / kFirst, (b.y + kFirst - 1) / kFirst, (b.z + kFirst - 1) / kFirst});
+            n += int64_t(first_grid_.back().x) * first_grid_.back().y * first_grid_.back().z;
+        }
+        whole_.assign(size_t(n), -1);
+        for (size_t k = 0; k < cells.size(); ++k)
+            if (is_first_cell(cells[k])) whole_[size_t(first_of(cells[k].coset, cells[k].lo))] = int64_t(k);
+    }
+
+    /// side(k): 1 inside, 0 outside, -1 left to a query.
+    void run() {
+        std::vector<size_t> open(cells_.size());
+        for (size_t k = 0; k < open.size(); ++k) open[k] = k;
+        for (bool forward = true; !open.empty(); forward = !forward) {
+            std::vector<size_t> left;
+            for (size_t n = 0; n < open.size(); ++n) {
+                const size_t k = open[forward ? n : open.size() - 1 - n];
+                const int side = side_beside(cells_[k]);
+                if (side < 0) {
+                    left.push_back(k);
+                    continue;
+                }
+                side_[k] = static_cast<signed char>(side);
+                const Cell& c = cells_[k];
+                if (!is_first_cell(c))
+                    for (int z = c.lo.z; z < c.hi.z; ++z)
+                        for (int y = c.lo.y; y < c.hi.y; ++y)
+                            for (int x = c.lo.x; x < c.hi.x; ++x) {
+                                const int64_t id = layout_.block_id(c.coset, {x, y, z});
+                                signed_.set(id);
+                                if (side == 1) inside_.set(id);
+                            }
+            }
+            if (left.size() == open.size()) break;
+            if (!forward) std::reverse(left.begin(), left.end());
+            open.swap(left);
+        }
+    }
+
+    int side(size_t k) const { return side_[k]; }
+
+private:
+    int64_t first_of(int coset, const Int3& block) const {
+        const Int3 g = first_grid_[size_t(coset)];
+        return first_offset_[size_t(coset)] + block.x / kFirst + int64_t(g.x) * (block.y / kFirst + int64_t(g.y) * (block.z / kFirst));
+    }
+    bool is_first_cell(const Cell& c) const {
+        const Int3 n = layout_.coset(c.coset).blocks;
+        for (int a = 0; a < 3; ++a)
+            if (c.lo[a] % kFirst != 0 || c.hi[a] != std::min(c.lo[a] + kFirst, n[a])) return false;
+        return true;
+    }
+
+    /// The side of cell c from a neighbour across one of its faces, or -1. The points are real:
+    /// the neighbour's is its block's first along the axis (beyond the high face) or its last
+    /// (below the low face, where its block is not the coset's last), the cell's likewise, and
+    /// every other coordinate is its block's first.
+    int side_beside(const Cell& c) const {
+        const Int3 blocks = layout_.coset(c.coset).blocks;
+        for (int axis = 0; axis < 3; ++axis)
+            for (const bool high : {false, true}) {
+                if (high ? c.hi[axis] >= blocks[axis] : c.lo[axis] == 0) continue;
+                const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+                for (int j = c.lo[v]; j < c.hi[v]; ++j)
+                    for (int i = c.lo[u]; i < c.hi[u]; ++i) {
+                        Int3 b{};
+                        b[axis] = high ? c.hi[axis] : c.lo[axis] - 1;
+                        b[u] = i;
+                        b[v] = j;
+                        const int64_t whole = whole_[size_t(first_of(c.coset, b))];
+                        if (whole >= 0) {
+                            if (side_[size_t(whole)] >= 0) return side_[size_t(whole)];
+                            i = std::min(c.hi[u], (i / kFirst + 1) * kFirst) - 1;  // the rest of that first cell in this row
+                            continue;
+                        }
+                        const int64_t id = layout_.block_id(c.coset, b);
+                        if (signed_.get(id)) return inside_.get(id) ? 1 : 0;
+                        if (!active_.get(id)) continue;
+                        Int3 local{0, 0, 0};
+                        local[axis] = high ? 0 : kBandBlockDim - 1;
+                        const size_t index = size_t(band_.find_active(id)) * kBandBlockPoints +
+                                             size_t(local.x + kBandBlockDim * (local.y + kBandBlockDim * local.z));
+                        return std::signbit(band_.distance[index]) ? 1 : 0;
+                    }
+            }
+        return -1;
+    }
+
+    const BandLayout& layout_;
+    const BlockBits& active_;
+    const std::vector<Cell>& cells_;
+    const SparseBandField& band_;
+    std::vector<signed char> side_;
+    BlockBits signed_, inside_;          ///< the blocks of signed cells that are not whole first cells, and their sides
+    std::vector<int64_t> first_offset_;  ///< each coset's first first cell
+    std::vector<Int3> first_grid_;       ///< each coset's first cells per axis
+    std::vector<int64_t> whole_;         ///< each first cell that is one uniform cell: its index, else -1
+};
+
 class OutsideClassifier {
 public:
     OutsideClassifier(const BandLayout& layout, const BlockBits& active, OutsideRule rule, const WindingSign* winding,
@@ -423,19 +541,36 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     const size_t boundary_edge_count = edges.size();
     OutsideClassifier classify(layout, active, rule, winding.get(), mesh, std::move(edges));
     classify.run(plan.threads);
-    // One query per uniform cell, at its first block's first point.
-    std::vector<Vec3d> reps;
-    reps.reserve(classify.uniform.size());
-    for (const Cell& c : classify.uniform)
-        reps.push_back(lattice.position_of_coords(layout.point_coords(layout.block_id(c.coset, c.lo), 0)));
-    query_in_batches(sampler, reps, plan.batch_points, out.timings, [&](size_t first, const std::vector<PointSample>& r) {
-        for (size_t i = 0; i < r.size(); ++i) {
-            const Cell& c = classify.uniform[first + i];
-            if (!std::signbit(r[i].distance)) continue;  // tiles start outside
-            for (int z = c.lo.z; z < c.hi.z; ++z)
-                for (int y = c.lo.y; y < c.hi.y; ++y)
-                    for (int x = c.lo.x; x < c.hi.x; ++x) out.set_tile_inside(layout.block_id(c.coset, {x, y, z}), true);
+    const auto sign_cell = [&](const Cell& c, bool inside) {
+        if (!inside) return;  // tiles start outside
+        for (int z = c.lo.z; z < c.hi.z; ++z)
+            for (int y = c.lo.y; y < c.hi.y; ++y)
+                for (int x = c.lo.x; x < c.hi.x; ++x) out.set_tile_inside(layout.block_id(c.coset, {x, y, z}), true);
+    };
+    // The uniform cells' sides from their neighbours (CellFlood), where the band is at least a
+    // coset spacing wide and the sign is uniform off the surface; the others are queried, one
+    // point each, at their first block's first point.
+    std::vector<const Cell*> queried;
+    int64_t cells_beside_the_band = 0;
+    if (rule == OutsideRule::Uniform && width >= lattice.spacing) {
+        CellFlood flood(layout, active, classify.uniform, out);
+        flood.run();
+        for (size_t k = 0; k < classify.uniform.size(); ++k) {
+            if (flood.side(k) < 0) {
+                queried.push_back(&classify.uniform[k]);
+                continue;
+            }
+            sign_cell(classify.uniform[k], flood.side(k) == 1);
+            ++cells_beside_the_band;
         }
+    } else {
+        for (const Cell& c : classify.uniform) queried.push_back(&c);
+    }
+    std::vector<Vec3d> reps;
+    reps.reserve(queried.size());
+    for (const Cell* c : queried) reps.push_back(lattice.position_of_coords(layout.point_coords(layout.block_id(c->coset, c->lo), 0)));
+    query_in_batches(sampler, reps, plan.batch_points, out.timings, [&](size_t first, const std::vector<PointSample>& r) {
+        for (size_t i = 0; i < r.size(); ++i) sign_cell(*queried[first + i], std::signbit(r[i].distance));
     });
     // Blocks not proven uniform: every point's side, batch by batch; a block whose sides all
     // agree becomes a tile.
@@ -497,6 +632,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
                                           {"tiles", counts.tiles},
                                           {"inside_tiles", counts.inside_tiles},
                                           {"uniform_cells", int64_t(classify.uniform.size())},
+                                          {"uniform_cells_beside_the_band", cells_beside_the_band},
                                           {"cells_refused_by_evaluation", classify.refused_by_evaluation},
                                           {"cells_refused_by_gradient", classify.refused_by_gradient},
                                           {"points_signed_per_point", per_point_points},

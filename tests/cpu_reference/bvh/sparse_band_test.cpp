@@ -453,7 +453,7 @@ TEST(SparseBand, WithoutTheClosestTriangleTheSameValuesAndBandPoints) {
     EXPECT_GT(padding, 0) << "no active block reached the lattice's far edges";
 }
 
-TEST(SparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
+TEST(SparseBand, SweepAndFloodEqualTheDenseBand) {
     const std::vector<test::BandSolid> cases = test::band_solids(1.0);
     int64_t flooded = 0, searched_blocks = 0;
     for (const test::BandSolid& c : cases) {
@@ -472,8 +472,16 @@ TEST(SparseBand, BoundedSearchAndFloodEqualTheDenseBand) {
                     ASSERT_TRUE(sparse.sampler.details.contains("band_blocks_on_host")) << what;
                     const nlohmann::json& d = sparse.sampler.details["band_blocks_on_host"];
                     EXPECT_EQ(d["bounded_search"].get<bool>(), spacings >= 1.0) << what;
+                    EXPECT_EQ(d["nearest"], spacings >= 1.0 ? "triangle_sweep" : "search") << what;
                     if (spacings >= 1.0) {
                         EXPECT_GT(d["points_flooded"].get<int64_t>(), 0) << what;
+                    }
+                    // The outside's cells signed from their neighbours (no query) from one spacing up.
+                    const nlohmann::json& cells = sparse.sampler.details["sparse_band"];
+                    if (spacings >= 1.0) {
+                        EXPECT_EQ(cells["uniform_cells_beside_the_band"], cells["uniform_cells"]) << what;
+                    } else {
+                        EXPECT_EQ(cells["uniform_cells_beside_the_band"].get<int64_t>(), 0) << what;
                     }
                     flooded += d["points_flooded"].get<int64_t>();
                     searched_blocks += d["blocks_signed_by_a_search"].get<int64_t>();
