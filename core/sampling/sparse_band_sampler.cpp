@@ -1,9 +1,12 @@
 #include "core/sampling/sparse_band_sampler.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -156,6 +159,25 @@ struct Cell {
     Int3 lo, hi;  ///< block range [lo, hi)
 };
 
+/// A bit per block, set and read by several threads at once (GCC's atomic built-ins on plain
+/// words; relaxed unless asked: a reader that sees a bit sees it set for good). The words come
+/// from calloc, whose large blocks are zero pages until written: at 8192^3 the two arrays of
+/// the flood below span 268 MB, of which it touches the few pages near the band.
+class AtomicBlockBits {
+public:
+    explicit AtomicBlockBits(int64_t n) : bits_(static_cast<uint64_t*>(std::calloc(size_t((n + 63) / 64) + 1, sizeof(uint64_t)))) {
+        if (!bits_) throw std::bad_alloc();
+    }
+    bool get(int64_t i, int order = __ATOMIC_RELAXED) const { return (__atomic_load_n(&bits_.get()[i >> 6], order) >> (i & 63)) & 1; }
+    void set(int64_t i, int order = __ATOMIC_RELAXED) { __atomic_fetch_or(&bits_.get()[i >> 6], uint64_t(1) << (i & 63), order); }
+
+private:
+    struct Free {
+        void operator()(uint64_t* p) const { std::free(p); }
+    };
+    std::unique_ptr<uint64_t[], Free> bits_;
+};
+
 /// The sides of the outside's uniform cells from their neighbours, where the band is at least a
 /// coset spacing wide: a point of an inactive block lies farther than W from the surface, so it
 /// and its neighbour h away lie farther than W - h >= 0 from it along the step between them,
@@ -163,15 +185,19 @@ struct Cell {
 /// closed mesh's winding number. A cell takes the side of the point next to one of its own
 /// across a face: an active block's (the sign of the band's value there) or a signed cell's.
 /// Sweeps over the cells still unsigned, forward and backward in turn, until one signs none
-/// (a cell signed early in a sweep signs the cells after it). A neighbour that is a whole
-/// first cell (16^3 blocks, OutsideClassifier's) is looked at once per row of the face.
+/// (a cell signed early in a sweep signs the cells after it), each sweep's cells in chunks on
+/// every thread: a side once set never changes and every side set is the cell's own, so which
+/// thread sets it first does not matter, and the cells left unsigned (none reaches them) are
+/// the same whatever the order. A neighbour that is a whole first cell (16^3 blocks,
+/// OutsideClassifier's) is looked at once per row of the face.
 class CellFlood {
 public:
     static constexpr int kFirst = 16;  ///< blocks per axis of OutsideClassifier's first cells
 
     CellFlood(const BandLayout& layout, const BlockBits& active, const std::vector<Cell>& cells, const SparseBandField& band)
-        : layout_(layout), active_(active), cells_(cells), band_(band), side_(cells.size(), -1), signed_(layout.block_count()),
+        : layout_(layout), active_(active), cells_(cells), band_(band), side_(cells.size()), signed_(layout.block_count()),
           inside_(layout.block_count()) {
+        for (auto& s : side_) s.store(-1, std::memory_order_relaxed);
         int64_t n = 0;
         for (int c = 0; c < layout.cosets(); ++c) {
             const Int3 b = layout.coset(c).blocks;
@@ -185,36 +211,43 @@ public:
     }
 
     /// side(k): 1 inside, 0 outside, -1 left to a query.
-    void run() {
+    void run(int threads) {
         std::vector<size_t> open(cells_.size());
         for (size_t k = 0; k < open.size(); ++k) open[k] = k;
+        constexpr int64_t kChunk = 4096;
         for (bool forward = true; !open.empty(); forward = !forward) {
-            std::vector<size_t> left;
-            for (size_t n = 0; n < open.size(); ++n) {
-                const size_t k = open[forward ? n : open.size() - 1 - n];
-                const int side = side_beside(cells_[k]);
-                if (side < 0) {
-                    left.push_back(k);
-                    continue;
+            const int64_t n = int64_t(open.size());
+            std::vector<char> still(open.size(), 0);
+            parallel_for(n, kChunk, threads, [&](int64_t begin, int64_t end) {
+                for (int64_t m = begin; m < end; ++m) {
+                    const size_t i = size_t(forward ? m : n - 1 - m);
+                    const size_t k = open[i];
+                    const int side = side_beside(cells_[k]);
+                    if (side < 0) {
+                        still[i] = 1;
+                        continue;
+                    }
+                    const Cell& c = cells_[k];
+                    if (!is_first_cell(c))  // the side bit before the release that publishes it
+                        for (int z = c.lo.z; z < c.hi.z; ++z)
+                            for (int y = c.lo.y; y < c.hi.y; ++y)
+                                for (int x = c.lo.x; x < c.hi.x; ++x) {
+                                    const int64_t id = layout_.block_id(c.coset, {x, y, z});
+                                    if (side == 1) inside_.set(id);
+                                    signed_.set(id, __ATOMIC_RELEASE);
+                                }
+                    side_[k].store(static_cast<signed char>(side), std::memory_order_relaxed);
                 }
-                side_[k] = static_cast<signed char>(side);
-                const Cell& c = cells_[k];
-                if (!is_first_cell(c))
-                    for (int z = c.lo.z; z < c.hi.z; ++z)
-                        for (int y = c.lo.y; y < c.hi.y; ++y)
-                            for (int x = c.lo.x; x < c.hi.x; ++x) {
-                                const int64_t id = layout_.block_id(c.coset, {x, y, z});
-                                signed_.set(id);
-                                if (side == 1) inside_.set(id);
-                            }
-            }
+            });
+            std::vector<size_t> left;
+            for (size_t i = 0; i < open.size(); ++i)
+                if (still[i]) left.push_back(open[i]);
             if (left.size() == open.size()) break;
-            if (!forward) std::reverse(left.begin(), left.end());
             open.swap(left);
         }
     }
 
-    int side(size_t k) const { return side_[k]; }
+    int side(size_t k) const { return side_[k].load(std::memory_order_relaxed); }
 
 private:
     int64_t first_of(int coset, const Int3& block) const {
@@ -246,12 +279,13 @@ private:
                         b[v] = j;
                         const int64_t whole = whole_[size_t(first_of(c.coset, b))];
                         if (whole >= 0) {
-                            if (side_[size_t(whole)] >= 0) return side_[size_t(whole)];
+                            const int side = side_[size_t(whole)].load(std::memory_order_relaxed);
+                            if (side >= 0) return side;
                             i = std::min(c.hi[u], (i / kFirst + 1) * kFirst) - 1;  // the rest of that first cell in this row
                             continue;
                         }
                         const int64_t id = layout_.block_id(c.coset, b);
-                        if (signed_.get(id)) return inside_.get(id) ? 1 : 0;
+                        if (signed_.get(id, __ATOMIC_ACQUIRE)) return inside_.get(id) ? 1 : 0;
                         if (!active_.get(id)) continue;
                         Int3 local{0, 0, 0};
                         local[axis] = high ? 0 : kBandBlockDim - 1;
@@ -267,8 +301,8 @@ private:
     const BlockBits& active_;
     const std::vector<Cell>& cells_;
     const SparseBandField& band_;
-    std::vector<signed char> side_;
-    BlockBits signed_, inside_;          ///< the blocks of signed cells that are not whole first cells, and their sides
+    std::vector<std::atomic<signed char>> side_;
+    AtomicBlockBits signed_, inside_;    ///< the blocks of signed cells that are not whole first cells, and their sides
     std::vector<int64_t> first_offset_;  ///< each coset's first first cell
     std::vector<Int3> first_grid_;       ///< each coset's first cells per axis
     std::vector<int64_t> whole_;         ///< each first cell that is one uniform cell: its index, else -1
@@ -554,7 +588,7 @@ SparseBandField sample_sparse_band(const BoundSampler& sampler, const Lattice& l
     int64_t cells_beside_the_band = 0;
     if (rule == OutsideRule::Uniform && width >= lattice.spacing) {
         CellFlood flood(layout, active, classify.uniform, out);
-        flood.run();
+        flood.run(plan.threads);
         for (size_t k = 0; k < classify.uniform.size(); ++k) {
             if (flood.side(k) < 0) {
                 queried.push_back(&classify.uniform[k]);
