@@ -14,7 +14,6 @@
 // (finish_band_blocks, band_sides.h), a block of such points from its point 0's double-search
 // triangle. Every other band runs the search.
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -126,7 +125,8 @@ __global__ void __launch_bounds__(kFinishThreads)
 #pragma unroll
     for (int j = 0; j < kSteps; ++j) {
         const int64_t i = base + 32 * j + lane;
-        // An open point's outputs are this pass's (finalize leaves them): outside the band.
+        // An open point's outputs are this pass's (finalize leaves them): outside the band;
+        // padding the sweep did not reach (never, being beyond the coset) likewise, +W.
         const bool flood = kSpread && nearest[i] == kOutsideBandFlood;
         const int t = flood ? kOutsideBandTriangle : triangle[i];
         const unsigned in_band = __ballot_sync(kFullWarp, t != kOutsideBandTriangle);
@@ -139,11 +139,12 @@ __global__ void __launch_bounds__(kFinishThreads)
         d[j] = flood || !(kSpread || distance32 != nullptr) ? width : distance[i];  // an open point's: spread below
         if constexpr (kSpread) {
             const int local = 32 * j + lane;
-            const bool real = BandBlockGrid::within(points, local);  // padding: never open (finish_sweep)
+            const bool real = BandBlockGrid::within(points, local);  // padding: never open
+            if (flood && !real && distance32 == nullptr) distance[i] = width;
             const bool negative = !flood && signbit(d[j]);
             const unsigned in = __ballot_sync(kFullWarp, real && !flood && negative);
             const unsigned out = __ballot_sync(kFullWarp, real && !flood && !negative);
-            const unsigned fl = __ballot_sync(kFullWarp, flood);
+            const unsigned fl = __ballot_sync(kFullWarp, real && flood);
             flooded += __popc(fl);
             if ((j >> 1) == z) {
                 const int shift = 32 * (j & 1);
@@ -207,7 +208,6 @@ constexpr int kBandFinalizeMinBlocks = 4;
 /// Blocks of a triangle's box whose batch indices are kept in shared memory; a larger box
 /// (a triangle many blocks wide) looks each point's block up in the sorted ids instead.
 constexpr int kSweepCachedBlocks = 2048;
-constexpr unsigned long long kSweepNone = ~0ull;
 
 /// A double's order as an unsigned key (negative values below positive ones).
 __device__ SDF_INLINE unsigned long long ordered_key(double q) {
@@ -245,7 +245,8 @@ __device__ SDF_INLINE bool coset_range(const Lattice& lattice, const BandCoset& 
 template <SweepPass kPass>
 __global__ void __launch_bounds__(kSweepThreads, 6)
     sweep_band_triangles(const PackedTriangle<double>* packed, const int32_t* triangle_index, int triangles,
-                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle) {
+                         BandBlocksPiece piece, double bound_squared, unsigned long long* best_key, int* best_triangle,
+                         unsigned char* block_reached) {
     __shared__ int64_t cached[kSweepCachedBlocks];
     const double reach = sqrt(bound_squared);
     for (int s = blockIdx.x; s < triangles; s += gridDim.x) {
@@ -316,6 +317,7 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
                         if (key < best_key[i]) atomicMin(best_key + i, key);  // a stale read only costs an atomic
                     } else if (key == best_key[i]) {
                         atomicMin(best_triangle + i, triangle);
+                        block_reached[a] = 1;  // every writer writes 1
                     }
                 }
             }
@@ -324,20 +326,15 @@ __global__ void __launch_bounds__(kSweepThreads, 6)
     }
 }
 
-/// Points the sweep left without a triangle: kOutsideBandFlood (their side from their
-/// neighbours), padding kOutsideBandOutside (as the search leaves it: +W); a CUDA block per
-/// band block, which is listed in `unsigned_blocks` (count in `unsigned_count`) when none of
-/// its points has a triangle: its side is then its point 0's (sides_of_unsigned_blocks).
-__global__ void __launch_bounds__(kBandBlockPoints)
-    finish_sweep(BandBlocksPiece piece, const unsigned long long* best_key, int* nearest, int32_t* unsigned_blocks,
-                 unsigned int* unsigned_count) {
-    const int64_t i = int64_t(blockIdx.x) * kBandBlockPoints + threadIdx.x;
-    const bool swept = best_key[i] != kSweepNone;
-    if (!swept) {
-        const bool padding = piece.grid.padding(piece.grid.block_coords(piece.ids[blockIdx.x]), int(threadIdx.x));
-        nearest[i] = padding ? kOutsideBandOutside : kOutsideBandFlood;
-    }
-    if (!__syncthreads_or(swept) && threadIdx.x == 0) unsigned_blocks[atomicAdd(unsigned_count, 1u)] = int32_t(blockIdx.x);
+/// The blocks no triangle reached (none of their points within the sweep's bound: every point
+/// beyond the band), listed in `unsigned_blocks` (count in `unsigned_count`): each takes its
+/// point 0's side (sides_of_unsigned_blocks). A thread per block. (The points the sweep left
+/// without a triangle keep kOutsideBandFlood from the fill, padding included: finalize leaves
+/// them to finish_band_blocks.)
+__global__ void list_unreached_blocks(const unsigned char* block_reached, int64_t blocks, int32_t* unsigned_blocks,
+                                      unsigned int* unsigned_count) {
+    const int64_t a = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (a < blocks && !block_reached[a]) unsigned_blocks[atomicAdd(unsigned_count, 1u)] = int32_t(a);
 }
 
 /// The side of each listed block (no point with a triangle: every point beyond the band), as
@@ -413,9 +410,10 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
     // their neighbours: a solid's pseudonormal sign, a band at least one coset spacing wide
     // (band_sides.h), the warp kernel (the candidates kernel searches every point).
     const bool swept = kernel_ == BvhGpuKernel::Warp && !winding && solid() && width >= lattice.spacing;
-    // The blocks the sweep leaves without a triangle: their list and sides (5 bytes a block).
+    // The blocks the sweep leaves without a triangle: their list, sides and marks (6 bytes a block).
     DeviceBuffer<int32_t> unsigned_blocks{swept ? size_t(batch) : 0};
     DeviceBuffer<signed char> block_side{swept ? size_t(batch) : 0};
+    DeviceBuffer<unsigned char> block_reached{swept ? size_t(batch) : 0};
     DeviceBuffer<unsigned int> unsigned_count{1};
     const double sweep_bound = swept ? band_sweep_bound_squared(width, coordinate + bound.coordinate) : 0.0;
     DeviceBuffer<unsigned long long> flood_counters{4};
@@ -435,18 +433,19 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
             // triangle at it in `nearest`.
             auto* key = reinterpret_cast<unsigned long long*>(r.samples.distance.get());
             static_assert(sizeof(double) == sizeof(unsigned long long), "a key per point in the distance array");
-            CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));
-            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, INT_MAX);
+            CUDA_CHECK(cudaMemset(key, 0xff, size_t(n) * sizeof(unsigned long long)));  // all ones: above every key
+            fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandFlood);
             CUDA_CHECK_LAUNCH("fill_nearest");
+            CUDA_CHECK(cudaMemset(block_reached.get(), 0, size_t(nb)));
             sweep_band_triangles<kSweepKeys><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index, triangles,
-                                                                        piece, sweep_bound, key, r.nearest.get());
+                                                                        piece, sweep_bound, key, r.nearest.get(), nullptr);
             CUDA_CHECK_LAUNCH("sweep_band_triangles (keys)");
-            sweep_band_triangles<kSweepTriangles><<<grid, kSweepThreads>>>(packed_double(dev), dev.view.triangle_index,
-                                                                             triangles, piece, sweep_bound, key, r.nearest.get());
+            sweep_band_triangles<kSweepTriangles><<<grid, kSweepThreads>>>(
+                packed_double(dev), dev.view.triangle_index, triangles, piece, sweep_bound, key, r.nearest.get(), block_reached.get());
             CUDA_CHECK_LAUNCH("sweep_band_triangles (triangles)");
             CUDA_CHECK(cudaMemset(unsigned_count.get(), 0, sizeof(unsigned int)));
-            finish_sweep<<<int(nb), kBandBlockPoints>>>(piece, key, r.nearest.get(), unsigned_blocks.get(), unsigned_count.get());
-            CUDA_CHECK_LAUNCH("finish_sweep");
+            list_unreached_blocks<<<blocks_for(nb, 256), 256>>>(block_reached.get(), nb, unsigned_blocks.get(), unsigned_count.get());
+            CUDA_CHECK_LAUNCH("list_unreached_blocks");
             sides_of_unsigned_blocks<<<std::max<int64_t>(1, std::min<int64_t>(blocks_for(nb, 128), 1024)), 128>>>(
                 search.exact, dev.mesh->view(), piece, unsigned_blocks.get(), unsigned_count.get(), block_side.get(),
                 flood_counters.get());

@@ -24,8 +24,9 @@ enum NearestOutsideBand : int {
     kOutsideBandSignPerPoint = -4,   ///< the winding number decides, point by point
     /// No triangle within the sweep's bound: outside the band, its side taken from its
     /// neighbours after finalize, which leaves its outputs to that pass (the sparse band's
-    /// finish_band_blocks, cuda/bvh/bvh_band_blocks.cu).
-    kOutsideBandFlood = -5,
+    /// finish_band_blocks, cuda/bvh/bvh_band_blocks.cu). INT_MAX: what the sweep's atomicMin
+    /// over the triangle indices starts from, so a point no triangle reaches keeps it.
+    kOutsideBandFlood = 0x7fffffff,
 };
 
 /// Per-piece results, downloaded and scattered into the field by the host.
@@ -76,7 +77,9 @@ __global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
     const bool in_piece = i < piece.size();
     const int64_t o = !in_piece || piece.block_local(i) < 0 ? -1 : piece.output_index(i);
     if (in_piece && out.output_index) out.output_index[i] = o;
-    const int n = o >= 0 ? nearest[i] : -1;
+    const int n_read = o >= 0 ? nearest[i] : -1;
+    const bool flood = n_read == kOutsideBandFlood;
+    const int n = flood ? -1 : n_read;  // a triangle where >= 0
     const Vec3d p = o >= 0 && (n >= 0 || Winding) ? piece.position(i) : Vec3d(0.0);
     SignedDistanceSample<double> s;
     if (n >= 0) s = signed_distance_to_triangle(mesh, p, n);
@@ -96,7 +99,7 @@ __global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
             winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside);
         }
     }
-    if (o < 0 || n == kOutsideBandFlood) return;
+    if (o < 0 || flood) return;
     if (n >= 0) {
         if constexpr (Winding) s = with_sign(s, winding_inside);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
