@@ -46,6 +46,7 @@ nlohmann::json mesh_report_to_json(const MeshReport& r) {
             {"boundary_edges", r.boundary_edges},
             {"nonmanifold_edges", r.nonmanifold_edges},
             {"inconsistent_edges", r.inconsistent_edges},
+            {"slivers_within_rounding", r.slivers_within_rounding},
             {"components", r.components},
             {"signed_volume", r.signed_volume},
             {"flipped", r.flipped},

@@ -1,6 +1,7 @@
 #include "core/mesh/prepared_mesh.h"
 
 #include <algorithm>
+#include <atomic>
 #include <future>
 #include <cmath>
 #include <numeric>
@@ -14,6 +15,7 @@
 #include "core/mesh/vertex_welding.h"
 #include "core/parallel/parallel_for.h"
 #include "core/parallel/task_monitor.h"
+#include "kernels/distance/accurate_cross.h"
 
 namespace sdf {
 namespace {
@@ -188,6 +190,27 @@ std::vector<uint8_t> degenerate_triangles(const std::vector<Int3>& triangles, co
     return degenerate;
 }
 
+/// Triangles whose height over their longest edge (the accurate cross product's length over
+/// it) is below kRoundingSliverHeight of the mesh's largest extent.
+int count_slivers_within_rounding(const std::vector<Vec3d>& v, const std::vector<Int3>& triangles, const Bounds3& bounds,
+                                  int threads) {
+    if (triangles.empty()) return 0;
+    const Vec3d e = bounds.extent();
+    const double limit = kRoundingSliverHeight * std::max({e.x, e.y, e.z});
+    std::atomic<int> count{0};
+    parallel_for(int64_t(triangles.size()), 8192, threads, [&](int64_t i0, int64_t i1) {
+        int n = 0;
+        for (int64_t i = i0; i < i1; ++i) {
+            const Int3 t = triangles[size_t(i)];
+            const Vec3d &a = v[size_t(t.x)], &b = v[size_t(t.y)], &c = v[size_t(t.z)];
+            const double longest = std::sqrt(std::max({length_squared(b - a), length_squared(c - b), length_squared(a - c)}));
+            n += length(accurate_triangle_cross(a, b, c)) < limit * longest ? 1 : 0;
+        }
+        count += n;
+    });
+    return count.load();
+}
+
 }  // namespace
 
 bool PreparedMesh::Topology::orient(PreparedMesh& out, const MeshPreparationOptions& options) {
@@ -247,6 +270,7 @@ void PreparedMesh::Topology::make_geometry(PreparedMesh& out, const EdgeUses& ed
                 length_squared(n) > 0 ? n : out.face_normals_[size_t(uses[u].triangle)];
     });
     out.bounds_ = triangle_bounds(out.vertices_, out.triangles_);
+    rep.slivers_within_rounding = count_slivers_within_rounding(out.vertices_, out.triangles_, out.bounds_, threads);
     {
         // The two precisions' buffers at once, each pass on every thread.
         std::future<std::shared_ptr<MeshBuffers<float>>> floats =
@@ -447,6 +471,9 @@ std::string MeshReport::sign_unreliable_reason() const {
     if (!intersections_checked) return "self-intersections were not checked";
     if (self_intersecting_pairs > 0)
         return "the mesh intersects itself (" + std::to_string(self_intersecting_pairs) + " triangle pairs)";
+    if (slivers_within_rounding > 0)
+        return "the mesh has " + std::to_string(slivers_within_rounding) +
+               " slivers thinner than the nearest-triangle search's rounding (their nearest edge is not decided)";
     return "";
 }
 
@@ -470,6 +497,10 @@ std::vector<std::string> PreparedMesh::warnings() const {
         w.push_back(who + " intersects itself: " + std::to_string(report_.self_intersecting_pairs) +
                     " triangle pairs cross within a shell; pseudonormal signs are wrong in the regions they enclose "
                     "twice (use the winding-number sign).");
+    if (report_.slivers_within_rounding > 0)
+        w.push_back(who + " has " + std::to_string(report_.slivers_within_rounding) +
+                    " slivers thinner than the nearest-triangle search's rounding; pseudonormal signs may take a "
+                    "neighbouring edge's side beside them (auto uses the winding-number sign).");
     if (report_.overlapping_shells > 0)
         w.push_back(who + " has " + std::to_string(report_.overlapping_shells) + " pairs of overlapping shells (" +
                     std::to_string(report_.shell_intersecting_pairs) +

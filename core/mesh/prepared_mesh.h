@@ -42,6 +42,16 @@ struct MeshPreparationOptions {
     bool keep_topology = false;
 };
 
+/// A triangle's height over its longest edge (2 area / longest edge) below this fraction of the
+/// mesh's largest extent E makes it a sliver within the search's rounding
+/// (MeshReport::slivers_within_rounding). The double search's squared distances are exact to
+/// about 2^-47 E^2 (away from the coordinates' own rounding), a distance to about 2^-47 E^2 / d
+/// at d from the surface: at 2^-15 E (half a spacing of a sparse band's 16384 points per axis)
+/// that is 2^-32 E. A rule measured, not proven: the fanned tetrahedron
+/// (tests/cpu_reference/bvh/bvh_test_meshes.h) kept every side with slivers down to 2^-30 E,
+/// also 10^4 from the origin, and lost one with slivers of 2^-45 E.
+inline constexpr double kRoundingSliverHeight = 0x1p-32;
+
 /// What preparation found; printed in summaries and stored in field headers.
 struct MeshReport {
     int input_vertices = 0;
@@ -59,13 +69,17 @@ struct MeshReport {
     int self_intersecting_pairs = 0;     ///< intersecting triangle pairs within one shell
     int shell_intersecting_pairs = 0;    ///< intersecting triangle pairs from two shells
     int overlapping_shells = 0;          ///< pairs of shells that intersect
+    /// Triangles thinner than kRoundingSliverHeight of the mesh's extent: two of their edges lie
+    /// within the nearest-triangle search's rounding of each other for points near them, so
+    /// the nearest feature, and with it the pseudonormal, is not decided there.
+    int slivers_within_rounding = 0;
     PolygonStats polygons;               ///< what triangulating the input's polygon faces found
     bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
     bool consistently_oriented() const { return inconsistent_edges == 0; }
     /// Why pseudonormal signs are not trustworthy everywhere, "" when they are: the first of
     /// open, non-manifold, inconsistently oriented, several shells, intersections unchecked,
-    /// self-intersecting. The one rule behind sign_reliable() and `auto`'s sign
-    /// (choose_sign_mode), so that the two never disagree.
+    /// self-intersecting, slivers within the search's rounding. The one rule behind
+    /// sign_reliable() and `auto`'s sign (choose_sign_mode), so that the two never disagree.
     std::string sign_unreliable_reason() const;
     /// True when signs from pseudonormals are trustworthy everywhere: `auto` keeps them.
     bool sign_reliable() const { return sign_unreliable_reason().empty(); }

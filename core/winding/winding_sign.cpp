@@ -35,7 +35,8 @@ SignModeChoice choose_sign_mode(const MeshReport& r, SignMode requested) {
     if (!why.empty())
         return {SignMode::Winding, why + ": pseudonormal signs are not reliable there; using the winding number"};
     return {SignMode::Pseudonormal,
-            "closed, manifold, consistently oriented, one shell, no self-intersections: pseudonormal signs are exact"};
+            "closed, manifold, consistently oriented, one shell, no self-intersections, no slivers within the search's "
+            "rounding: pseudonormal signs are exact"};
 }
 
 WindingSign::WindingSign(const PreparedMesh& mesh, const WindingSignOptions& options)

@@ -221,6 +221,7 @@ check_intersections looks for intersecting triangle pairs (costs about a BVH bui
             d["self_intersecting_pairs"] = r.self_intersecting_pairs;
             d["shell_intersecting_pairs"] = r.shell_intersecting_pairs;
             d["overlapping_shells"] = r.overlapping_shells;
+            d["slivers_within_rounding"] = r.slivers_within_rounding;
             d["closed"] = r.closed();
             d["consistently_oriented"] = r.consistently_oriented();
             d["sign_reliable"] = r.sign_reliable();

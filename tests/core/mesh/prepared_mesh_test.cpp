@@ -15,6 +15,7 @@
 
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
+#include "tests/cpu_reference/bvh/bvh_test_meshes.h"
 
 namespace sdf {
 namespace {
@@ -165,6 +166,27 @@ TEST(PreparedMesh, DropsDegenerateTrianglesAndMapsTheRestToTheirSource) {
                       mesh.vertices[size_t(mesh.triangles[size_t(m.source_triangle()[i])][k])]);
     EXPECT_TRUE(m.report().sign_reliable());
     EXPECT_TRUE(any_warning_contains(m, "degenerate"));
+}
+
+// Slivers thinner than the search's rounding (kRoundingSliverHeight of the extent) make the
+// pseudonormal sign unreliable, so `auto` takes the winding sign: the fanned tetrahedron's
+// fan down to 2^-45 (a point beside its sharp edge got the wrong side) has them, down to
+// 2^-30 (every side right, also 10^4 from the origin) it does not.
+TEST(PreparedMesh, SliversWithinTheSearchsRoundingMakeTheSignUnreliable) {
+    for (const Vec3d offset : {Vec3d{0, 0, 0}, Vec3d{1e4, 1e4, 1e4}}) {
+        const PreparedMesh thin = prepare_mesh(test::fanned_tetrahedron(offset, 45));
+        EXPECT_GT(thin.report().slivers_within_rounding, 0) << offset.x;
+        EXPECT_FALSE(thin.report().sign_reliable()) << offset.x;
+        EXPECT_NE(thin.report().sign_unreliable_reason().find("slivers thinner than"), std::string::npos);
+        EXPECT_TRUE(any_warning_contains(thin, "slivers thinner than the nearest-triangle search's rounding"));
+    }
+    for (const Vec3d offset : {Vec3d{0, 0, 0}, Vec3d{1e4, 1e4, 1e4}}) {
+        const PreparedMesh fan30 = prepare_mesh(test::fanned_tetrahedron(offset, 30));
+        EXPECT_EQ(fan30.report().slivers_within_rounding, 0) << offset.x;
+        EXPECT_TRUE(fan30.report().sign_reliable()) << fan30.report().sign_unreliable_reason();
+    }
+    EXPECT_EQ(prepare_mesh(test::make_sliver_sphere()).report().slivers_within_rounding, 0);
+    EXPECT_EQ(prepare_mesh(make_icosphere(3)).report().slivers_within_rounding, 0);
 }
 
 TEST(PreparedMesh, OpenBoxReportsItsBoundaryAndWarns) {
