@@ -157,7 +157,8 @@ inline void sweep_band_block(const PackedTriangle<double>* packed, const int32_t
             const double bz = detail::outside_interval(block.z[z], lo.z, hi.z);
             for (int y = y0; y <= y1; ++y) {
                 const int r = y + kBandBlockDim * z;
-                const double threshold = 1.01 * worst[r] + allowance;
+                // A Q_d may round below 0 on the surface: 1% of |worst| above worst, either sign.
+                const double threshold = worst[r] + 0.01 * std::abs(worst[r]) + allowance;
                 const double by = detail::outside_interval(block.y[y], lo.y, hi.y);
                 if (bx * bx + by * by + bz * bz > threshold) continue;  // the box
                 const double hyz = t.ny * (t.by - block.y[y]) + t.nz * (t.bz - block.z[z]);
