@@ -53,7 +53,7 @@ void BackendSampler::finish_slab(SampledField& field, SlabRun& run, std::optiona
     field.sampler.search_certificate = certificate_provenance(float_search(), run.certified, run.certificate);
     if (sign_.winding()) {
         const WindingSignCounts c = run.winding.load();
-        field.sampler.winding_sign = WindingSignReport{c.fast, c.refined, c.direct, c.ties, c.surface};
+        field.sampler.winding_sign = WindingSignReport{c.fast, c.refined, c.direct, c.ties, c.surface, c.nearest};
     }
     if (w > 0) {
         BandReport report = narrow_band_provenance(

@@ -25,7 +25,7 @@ void merge_certificate(CertificateReport& into, const CertificateReport& part) {
 }
 
 nlohmann::json winding_sign_to_json(const WindingSignReport& w) {
-    return {{"points", w.points()}, {"surface", w.surface}, {"fast", w.fast},
+    return {{"points", w.points()}, {"nearest", w.nearest}, {"surface", w.surface}, {"fast", w.fast},
             {"refined", w.refined},  {"direct", w.direct},   {"ties", w.ties}};
 }
 
@@ -130,13 +130,14 @@ WindingSignReport winding_sign_from_json(const nlohmann::json& j) {
     w.direct = k.integer("direct");
     w.ties = k.integer("ties");
     w.surface = k.has("surface") ? k.integer("surface") : 0;  // fields sampled before the surface stage
-    for (const auto& [name, count] : {std::pair<const char*, int64_t>{"surface", w.surface}, {"fast", w.fast},
+    w.nearest = k.has("nearest") ? k.integer("nearest") : 0;  // ... and before the sole nearest triangle's
+    for (const auto& [name, count] : {std::pair<const char*, int64_t>{"nearest", w.nearest}, {"surface", w.surface}, {"fast", w.fast},
                                       {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}})
         if (count < 0)
             throw std::runtime_error("sampler.winding_sign." + std::string(name) + ": expected a count >= 0, got " +
                                      std::to_string(count));
     if (k.integer("points") != w.points())
-        throw std::runtime_error("sampler.winding_sign.points: expected surface + fast + refined + direct + ties = " +
+        throw std::runtime_error("sampler.winding_sign.points: expected nearest + surface + fast + refined + direct + ties = " +
                                  std::to_string(w.points()) + ", got " + j.at("points").dump());
     return w;
 }
@@ -160,6 +161,7 @@ void SamplerReport::merge(const SamplerReport& part) {
         winding_sign->direct += part.winding_sign->direct;
         winding_sign->ties += part.winding_sign->ties;
         winding_sign->surface += part.winding_sign->surface;
+        winding_sign->nearest += part.winding_sign->nearest;
     } else if (part.winding_sign) {
         winding_sign = part.winding_sign;
     }

@@ -49,11 +49,11 @@ struct CertificateReport {
 
 /// The certified winding sign (kernels/winding/certified_winding.h): points signed by the
 /// winding number, by how their side was decided: by the closest triangle's side
-/// (surface_side.h), by the fast evaluation's bound, by a stricter opening rule, by the
-/// direct sum, or a tie (outside).
+/// (surface_side.h: after a walk, or from the sole nearest triangle alone), by the fast
+/// evaluation's bound, by a stricter opening rule, by the direct sum, or a tie (outside).
 struct WindingSignReport {
-    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0;
-    int64_t points() const { return fast + refined + direct + ties + surface; }
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0, nearest = 0;
+    int64_t points() const { return fast + refined + direct + ties + surface + nearest; }
 };
 
 struct SamplerReport {

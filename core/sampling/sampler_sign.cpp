@@ -27,13 +27,16 @@ std::shared_ptr<const SurfaceSides> surface_sides_for(const PreparedMesh& mesh) 
 
 }  // namespace
 
-/// Two measurement switches, read at binding (not per point): SDF_WINDING_LADDER_ONLY=1 leaves
+/// Three measurement switches, read at binding (not per point): SDF_WINDING_LADDER_ONLY=1 leaves
 /// the table out (the ladder alone: the baseline the table is measured against; the same
-/// sides, only the cost differs), SDF_WINDING_UNCERTIFIED=1 the certification.
+/// sides, only the cost differs), SDF_WINDING_WALK_ONLY=1 the side from the nearest
+/// triangles alone (every table side walks the tree), SDF_WINDING_UNCERTIFIED=1 the
+/// certification.
 WindingSignOptions SamplerSign::winding_options() {
     WindingSignOptions o;
     o.certify = !switched_on("SDF_WINDING_UNCERTIFIED");
     o.surface_sides = !switched_on("SDF_WINDING_LADDER_ONLY");
+    o.nearest_sides = !switched_on("SDF_WINDING_WALK_ONLY");
     return o;
 }
 

@@ -45,11 +45,17 @@ public:
     const WindingSign* winding_sign() const { return winding_.get(); }
 
     /// `s` (evaluated at p) with the winding number's certified side in winding mode, the
-    /// point counted in `counts` by how its side was decided; unchanged otherwise.
-    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p,
-                                       WindingSignCounts& counts) const {
+    /// point counted in `counts` by how its side was decided; unchanged otherwise. `near`:
+    /// the certified search's candidates at p (nearest_side, surface_side.h), if known.
+    SignedDistanceSample<double> apply(const SignedDistanceSample<double>& s, const Vec3d& p, WindingSignCounts& counts,
+                                       const NearTriangles& near = {}) const {
         if (!winding()) return s;
         bool inside = false;
+        if (winding_->options().nearest_sides &&
+            nearest_side(surface_view(), winding_->view(), p, s.triangle, s.distance, s.closest_point, near, inside)) {
+            counts.add(WindingStage::Nearest);
+            return with_sign(s, inside);
+        }
         if (surface_side(surface_view(), winding_->view(), p, s.triangle, s.distance, inside)) {
             counts.add(WindingStage::Surface);
             return with_sign(s, inside);

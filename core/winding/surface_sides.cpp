@@ -118,7 +118,7 @@ bool front_winding_of(const WindingView<double>& v, int t, int threads, int& fro
                 if (i == t || !decided) continue;
                 const Vec3d olo = component_min(a, component_min(b, c)), ohi = component_max(a, component_max(b, c));
                 if (olo.x > hi.x || olo.y > hi.y || olo.z > hi.z || ohi.x < lo.x || ohi.y < lo.y || ohi.z < lo.z) continue;
-                decided = add_crossing(x, corner, a, b, c, change);
+                decided = add_crossing(x, corner, InteriorPoint{}, a, b, c, change);
             }
             chunk_sum[size_t(k)] = s;
             chunk_error[size_t(k)] = e;
@@ -184,7 +184,7 @@ bool front_winding_from_outside(const WindingView<double>& v, const Bounds3& box
                 const Vec3d a = v.vertices[o.x], b = v.vertices[o.y], c = v.vertices[o.z];
                 const Vec3d olo = component_min(a, component_min(b, c)), ohi = component_max(a, component_max(b, c));
                 if (olo.x > hi.x || olo.y > hi.y || olo.z > hi.z || ohi.x < lo.x || ohi.y < lo.y || ohi.z < lo.z) continue;
-                decided = add_crossing(x, corner, a, b, c, change);
+                decided = add_crossing(x, corner, InteriorPoint{}, a, b, c, change);
             }
             chunk_change[size_t(k)] = change;
             chunk_decided[size_t(k)] = decided;

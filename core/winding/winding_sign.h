@@ -37,11 +37,15 @@ struct WindingSignOptions {
     /// exact side, without the far field's refinements near the surface). Off: every point
     /// takes the ladder (its tests).
     bool surface_sides = true;
+    /// With the table: first the side from the search's nearest triangles alone, where the
+    /// search is certified (nearest_side, surface_side.h: no walk of the tree). Off: the
+    /// walk (its measurements).
+    bool nearest_sides = true;
 };
 
 /// Points signed, by how their side was decided (certified_winding.h's ladder).
 struct WindingSignCounts {
-    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0;
+    int64_t fast = 0, refined = 0, direct = 0, ties = 0, surface = 0, nearest = 0;
     void add(WindingStage stage, int64_t n = 1) {
         switch (stage) {
         case WindingStage::Fast: fast += n; break;
@@ -49,22 +53,25 @@ struct WindingSignCounts {
         case WindingStage::Direct: direct += n; break;
         case WindingStage::Tie: ties += n; break;
         case WindingStage::Surface: surface += n; break;
+        case WindingStage::Nearest: nearest += n; break;
         }
     }
-    int64_t points() const { return fast + refined + direct + ties + surface; }
+    int64_t points() const { return fast + refined + direct + ties + surface + nearest; }
     WindingSignCounts& operator+=(const WindingSignCounts& o) {
         fast += o.fast;
         refined += o.refined;
         direct += o.direct;
         ties += o.ties;
         surface += o.surface;
+        nearest += o.nearest;
         return *this;
     }
     WindingSignCounts operator-(const WindingSignCounts& o) const {
-        return {fast - o.fast, refined - o.refined, direct - o.direct, ties - o.ties, surface - o.surface};
+        return {fast - o.fast, refined - o.refined, direct - o.direct, ties - o.ties, surface - o.surface, nearest - o.nearest};
     }
     bool operator==(const WindingSignCounts& o) const {
-        return fast == o.fast && refined == o.refined && direct == o.direct && ties == o.ties && surface == o.surface;
+        return fast == o.fast && refined == o.refined && direct == o.direct && ties == o.ties && surface == o.surface &&
+               nearest == o.nearest;
     }
 };
 
@@ -78,11 +85,12 @@ struct SharedWindingCounts {
         n[int(WindingStage::Direct)] += c.direct;
         n[int(WindingStage::Tie)] += c.ties;
         n[int(WindingStage::Surface)] += c.surface;
+        n[int(WindingStage::Nearest)] += c.nearest;
     }
     WindingSignCounts load() const {
         return {n[int(WindingStage::Fast)].load(), n[int(WindingStage::Refined)].load(),
                 n[int(WindingStage::Direct)].load(), n[int(WindingStage::Tie)].load(),
-                n[int(WindingStage::Surface)].load()};
+                n[int(WindingStage::Surface)].load(), n[int(WindingStage::Nearest)].load()};
     }
 };
 

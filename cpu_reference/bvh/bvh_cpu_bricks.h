@@ -198,11 +198,12 @@ void evaluate_bricks(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
             int32_t* column_below = &below[size_t(b % bricks.x) * kBrick];
             improve_seeds_from_below(view, column_below, pk);
             int32_t slot[kBrick];
-            search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot);
+            LaneNear near[kBrick];
+            search_packet(view, certifier, br.position, br.count, pk, stats, certified, slot, near);
             for (int k = 0; k < kBrick; ++k) column_below[k] = pk.best_slot[k];
             SignedDistanceSample<double> sample[kBrick];
             for (int k = 0; k < br.count; ++k) sample[k] = signed_distance_to_triangle(exact, br.position[k], view.triangle_index[slot[k]]);
-            packet_sign.prepare(br.position, sample, br.count);
+            packet_sign.prepare(br.position, sample, near, br.count);
             for (int k = 0; k < br.count; ++k) emit(br.local[k], packet_sign.apply(sample[k], k, br.position[k]));
             // The next brick's lanes start from this brick's last column in x, (1 to 4
             // spacings away rather than 4): a tighter first radius.

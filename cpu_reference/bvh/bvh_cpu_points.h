@@ -57,10 +57,11 @@ void evaluate_point_packets(const PreparedMesh& mesh, const TriangleBvh& bvh, co
             }
             seed_packet(view, seed, pk);
             int32_t slot[kPointPacket];
-            search_packet(view, certifier, position, count, pk, stats, certified, slot);
+            LaneNear near[kPointPacket];
+            search_packet(view, certifier, position, count, pk, stats, certified, slot, near);
             SignedDistanceSample<double> sample[kPointPacket];
             for (int k = 0; k < count; ++k) sample[k] = signed_distance_to_triangle(exact, position[k], view.triangle_index[slot[k]]);
-            packet_sign.prepare(position, sample, count);
+            packet_sign.prepare(position, sample, near, count);
             for (int k = 0; k < count; ++k) emit(int64_t(order[size_t(first + k)]), packet_sign.apply(sample[k], k, position[k]));
             for (int k = 0; k < kPointPacket; ++k) seed[k] = pk.best_slot[k];
             done += count;

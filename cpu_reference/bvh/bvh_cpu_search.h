@@ -53,6 +53,16 @@ struct LocalCertificate {
     }
 };
 
+/// A point's candidates for the winding sign's nearest_side() (surface_side.h), from
+/// Certifier::certify: the triangles the certified search could not rule out, and the squared
+/// distance every other triangle exceeds. count 0: unknown (double searches, overflows).
+struct LaneNear {
+    int32_t triangle[kCpuNearCandidates + 1];
+    int count = 0;
+    double beyond_squared = 0;
+    NearTriangles view() const { return {triangle, count, beyond_squared}; }
+};
+
 /// The certified float search's context (search_certificate.h): the slack of every point of
 /// the run, the double constants for re-ranking and the kernels of the widest ISA the CPU
 /// has (cpu_kernels.h). `T` double: the search is the reference.
@@ -81,12 +91,25 @@ struct Certifier {
     }
 
     /// The double search's winner (BVH slot) at p from the float search's winner and its
-    /// candidates; counts what it took.
+    /// candidates; counts what it took. `lane` receives the candidates' triangles and a
+    /// squared distance X that every other triangle exceeds in exact arithmetic: a triangle
+    /// U with Q(U) <= X has Q_f(U) - x <= Q(U) + E <= X + E <= radius (search_certificate.h;
+    /// radius >= q + 2E with q the float winner's Q, so X = q + 0.49 (radius - q) leaves room
+    /// for E, and X is kept within q + 2E, where the bound on M holds), so it is a candidate.
     int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
-                    const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters) const {
-        Rerank r = kernels.rerank(exact.packed, view.triangle_index, p, winner, slack.radius(best_q), near.slot, near.q,
-                                  near.count, near.dropped);
-        if (r.overflow) {
+                    const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters, LaneNear& lane) const {
+        const float radius = slack.radius(best_q);
+        Rerank r = kernels.rerank(exact.packed, view.triangle_index, p, winner, radius, near.slot, near.q, near.count,
+                                  near.dropped);
+        lane.count = 0;
+        if (!r.overflow) {
+            lane.triangle[lane.count++] = view.triangle_index[winner];
+            for (int i = 0; i < near.count; ++i)
+                if (near.slot[i] != winner && near.q[i] <= radius) lane.triangle[lane.count++] = view.triangle_index[near.slot[i]];
+            const double q = double(best_q), m = double(slack.k1) * std::sqrt(q > 0 ? q : 0.0) + double(slack.k2);
+            const double e = (double(slack.rho) * m + 2.0 * double(slack.d0)) * m + double(slack.c0);
+            lane.beyond_squared = q + std::fmin(0.49 * (double(radius) - q), 1.9 * e);
+        } else {  // more candidates than kept (a vertex of many triangles): the lane knows none
             AllNear all{slack, {}, {}};
             const Vec3f pt(p);
             BvhStats uncounted;
@@ -119,8 +142,8 @@ public:
 
     /// Evaluates the sides of the packet's points `position`, whose samples (pseudonormal
     /// sign; triangle -1 where there is none) are `sample`: the first `count` lanes are
-    /// points (counted), the others spare.
-    void prepare(const Vec3d* position, const SignedDistanceSample<double>* sample, int count) {
+    /// points (counted), the others spare. `near[k]`: lane k's candidates (Certifier::certify).
+    void prepare(const Vec3d* position, const SignedDistanceSample<double>* sample, const LaneNear* near, int count) {
         if (winding_ == nullptr) return;
         const WindingSignOptions& o = winding_->options();
         if (o.certify && surface_.front_winding == nullptr) {  // no table: every lane takes the ladder
@@ -137,6 +160,11 @@ public:
             int ladder_lane[kCpuPacketLanes];
             int ladder = 0;
             for (int k = 0; k < count; ++k) {
+                if (o.nearest_sides && nearest_side(surface_, winding_->view(), position[k], sample[k].triangle, sample[k].distance,
+                                                    sample[k].closest_point, near[k].view(), inside_[k])) {
+                    counts_.add(WindingStage::Nearest);
+                    continue;
+                }
                 if (surface_side(surface_, winding_->view(), position[k], sample[k].triangle, sample[k].distance, inside_[k])) {
                     counts_.add(WindingStage::Surface);
                     continue;
@@ -229,6 +257,7 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
         int32_t previous = -1;
         for (int64_t i = begin; i < end; ++i) {
             const Vec3d p = pos(i);
+            LaneNear lane;
             const Vec3<T> pt(p);
             const BvhHit<T> seed = seeded ? seed_hit(view, previous, pt) : BvhHit<T>{};
             int32_t slot;
@@ -237,11 +266,11 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
                 const BvhHit<float> hit = certifier.kernels.closest_triangle(view, pt, seed, stats, near);
                 previous = hit.slot;  // the float winner seeds best (its Q is the float search's)
                 certifier.prefetch(near.near);
-                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified);
+                slot = certifier.certify(view, p, hit.slot, hit.distance_squared, near.near, certified, lane);
             } else {
                 slot = previous = closest_triangle(view, pt, seed, stats).slot;
             }
-            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p, signed_points));
+            emit(i, sign.apply(signed_distance_to_triangle(exact, p, view.triangle_index[slot]), p, signed_points, lane.view()));
         }
         certified.add_to(counters.certificate);
         counters.winding.add(signed_points);
@@ -252,21 +281,28 @@ void evaluate_points(const PreparedMesh& mesh, const TriangleBvh& bvh, const Sam
 }
 
 /// One packet search (closest_triangles_packet.h): `slot` receives the winner of each of the
-/// first `count` lanes, certified for float (`position`: the lanes' exact points).
+/// first `count` lanes, certified for float (`position`: the lanes' exact points), and `near`
+/// the lane's candidates (Certifier::certify; none for double, whose search has no
+/// certificate).
 template <typename T>
 void search_packet(const BvhView<T>& view, const Certifier<T>& certifier, const Vec3d* position, int count,
-                   BvhPacket<T, kCpuPacketLanes>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot) {
+                   BvhPacket<T, kCpuPacketLanes>& pk, BvhStats& stats, LocalCertificate& counters, int32_t* slot, LaneNear* lanes) {
     if constexpr (Certifier<T>::kActive) {
         CpuPacketCertifiedNear near;
         near.slack = certifier.slack;
         certifier.kernels.closest_triangles_packet(view, pk, stats, near);
         for (int k = 0; k < count; ++k) certifier.prefetch(near.near[k]);
-        for (int k = 0; k < count; ++k)  // a lane of a bounded search may have found nothing (-1)
+        for (int k = 0; k < count; ++k) {  // a lane of a bounded search may have found nothing (-1)
+            lanes[k].count = 0;
             slot[k] = pk.best_slot[k] < 0 ? -1
-                                          : certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters);
+                                          : certifier.certify(view, position[k], pk.best_slot[k], pk.best_q[k], near.near[k], counters, lanes[k]);
+        }
     } else {
         cpu_kernels<T>().closest_triangles_packet(view, pk, stats);
-        for (int k = 0; k < count; ++k) slot[k] = pk.best_slot[k];
+        for (int k = 0; k < count; ++k) {
+            slot[k] = pk.best_slot[k];
+            lanes[k].count = 0;
+        }
     }
 }
 

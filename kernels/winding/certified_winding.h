@@ -47,9 +47,11 @@ constexpr double kWindingPi = 3.14159265358979323846;
 
 /// How a certified side was decided (the manifest's counters: sampler_report.h). Surface:
 /// by the first stage, a triangle's front winding number and the triangles the segment to
-/// its centroid crosses (surface_side.h), before the ladder.
-enum class WindingStage : uint8_t { Fast = 0, Refined = 1, Direct = 2, Tie = 3, Surface = 4 };
-constexpr int kWindingStages = 5;
+/// its centroid crosses (surface_side.h), before the ladder; Nearest: by the point's nearest
+/// triangles alone, those a certified search could not rule out, with no walk of the tree
+/// (nearest_side, surface_side.h).
+enum class WindingStage : uint8_t { Fast = 0, Refined = 1, Direct = 2, Tie = 3, Surface = 4, Nearest = 5 };
+constexpr int kWindingStages = 6;
 
 struct WindingSide {
     bool inside = false;

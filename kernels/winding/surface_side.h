@@ -23,7 +23,8 @@
 /// tree (the winding BVH's boxes) hands it few candidates. Where any determinant is undecided (p on
 /// a triangle's plane, the segment through an edge) the point takes the ladder
 /// (certified_winding.h); so do points within `min_distance` of the surface, where the
-/// ladder's tie rule holds, and points with no triangle.
+/// ladder's tie rule holds, and points with no triangle. Where a certified search hands on
+/// its candidates, nearest_side() decides first from them alone, with no walk of the tree.
 #pragma once
 
 #include <cmath>
@@ -46,28 +47,72 @@ struct SurfaceSideView {
     double min_distance = 0;               ///< |d| at or below this: the ladder decides
 };
 
-/// The sign of det(a, b, c, y) for T's centroid y = (t0 + t1 + t2) / 3 (the sum of three).
-SDF_CPU_GPU SDF_INLINE int centroid_orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d t[3]) {
-    return decided_sign(bounded_sum(orientation_det(a, b, c, t[0]), orientation_det(a, b, c, t[1]), orientation_det(a, b, c, t[2])));
+/// A point y of T's open interior as positive integer weights of its corners,
+/// y = (k0 t0 + k1 t1 + k2 t2) / (k0 + k1 + k2): the centroid (1, 1, 1), or a point near p's
+/// closest point (nearest_side). y enters the determinants, which are affine in each point,
+/// as the weighted sum of three, never as rounded coordinates.
+struct InteriorPoint {
+    double k[3] = {1.0, 1.0, 1.0};
+};
+
+/// k0 a + k1 b + k2 c with its rounding (three products, two additions) added to the bound.
+SDF_CPU_GPU SDF_INLINE BoundedValue weighted_sum(const InteriorPoint& y, const BoundedValue& a, const BoundedValue& b,
+                                                 const BoundedValue& c) {
+    constexpr double eps = 1.1102230246251565404e-16;
+    const double ka = y.k[0] * a.value, kb = y.k[1] * b.value, kc = y.k[2] * c.value;
+    BoundedValue r;
+    r.value = (ka + kb) + kc;
+    r.bound = (y.k[0] * a.bound + y.k[1] * b.bound + y.k[2] * c.bound + 3.0 * eps * (fabs(ka) + fabs(kb) + fabs(kc))) * (1.0 + 8.0 * eps);
+    return r;
 }
 
-/// The sign of det(p, y, a, b) for T's centroid y: which side of the line p y the edge a b
-/// passes.
-SDF_CPU_GPU SDF_INLINE int line_orientation(const Vec3d& p, const Vec3d t[3], const Vec3d& a, const Vec3d& b) {
-    return decided_sign(bounded_sum(orientation_det(p, t[0], a, b), orientation_det(p, t[1], a, b), orientation_det(p, t[2], a, b)));
+/// The sign of det(a, b, c, y) for y in T (the weighted sum of three).
+SDF_CPU_GPU SDF_INLINE int interior_orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d t[3], const InteriorPoint& y) {
+    return decided_sign(weighted_sum(y, orientation_det(a, b, c, t[0]), orientation_det(a, b, c, t[1]), orientation_det(a, b, c, t[2])));
+}
+
+/// The sign of det(p, y, a, b) for y in T: which side of the line p y the edge a b passes.
+SDF_CPU_GPU SDF_INLINE int line_orientation(const Vec3d& p, const Vec3d t[3], const InteriorPoint& y, const Vec3d& a, const Vec3d& b) {
+    return decided_sign(weighted_sum(y, orientation_det(p, t[0], a, b), orientation_det(p, t[1], a, b), orientation_det(p, t[2], a, b)));
+}
+
+/// A point y of T's interior known by rounded coordinates `at` within `radius` of it: one
+/// determinant with y's rounding added to its bound (at most the determinant's gradient in
+/// y, bounded by a product of lengths, times the radius) instead of a sum of three. Every
+/// sign decided so holds for every point of the ball, y among them.
+struct RoundedInteriorPoint {
+    Vec3d at;
+    double radius = 0;
+};
+
+/// |d det(a, b, c, y) / dy| = |(b - a) x (c - a)| <= |b - a| |c - a|, rounded up.
+SDF_CPU_GPU SDF_INLINE int interior_orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d*,
+                                                const RoundedInteriorPoint& y) {
+    BoundedValue d = orientation_det(a, b, c, y.at);
+    d.bound += length(b - a) * length(c - a) * y.radius * (1.0 + 0x1p-40);
+    return decided_sign(d);
+}
+
+/// |d det(p, y, a, b) / dy| = |(p - b) x (a - b)| <= |p - b| |a - b|, rounded up.
+SDF_CPU_GPU SDF_INLINE int line_orientation(const Vec3d& p, const Vec3d*, const RoundedInteriorPoint& y, const Vec3d& a,
+                                            const Vec3d& b) {
+    BoundedValue d = orientation_det(p, y.at, a, b);
+    d.bound += length(p - b) * length(a - b) * y.radius * (1.0 + 0x1p-40);
+    return decided_sign(d);
 }
 
 /// Adds to `change` what crossing triangle u (corners u0 u1 u2, not T) on the way from p to
-/// T's centroid adds to w(p) - w(beside T): +1 when p is behind u, -1 in front, 0 when the
-/// segment misses it. False when the determinants do not decide it. T's interior meets no
-/// other triangle, so the centroid lies on no u.
-SDF_CPU_GPU inline bool add_crossing(const Vec3d& p, const Vec3d t[3], const Vec3d& u0, const Vec3d& u1, const Vec3d& u2,
-                                     int& change) {
+/// the point y of T's interior adds to w(p) - w(beside T): +1 when p is behind u, -1 in
+/// front, 0 when the segment misses it. False when the determinants do not decide it. T's
+/// interior meets no other triangle, so y lies on no u.
+template <typename Y>
+SDF_CPU_GPU inline bool add_crossing(const Vec3d& p, const Vec3d t[3], const Y& y, const Vec3d& u0, const Vec3d& u1,
+                                     const Vec3d& u2, int& change) {
     const int side_p = decided_sign(orientation_det(u0, u1, u2, p));
-    const int side_y = centroid_orientation(u0, u1, u2, t);
+    const int side_y = interior_orientation(u0, u1, u2, t, y);
     if (side_p != 0 && side_p == side_y) return true;  // both strictly on one side of u's plane
     // The line p y meets the closed triangle u iff it passes its three edges on one side.
-    const int e0 = line_orientation(p, t, u0, u1), e1 = line_orientation(p, t, u1, u2), e2 = line_orientation(p, t, u2, u0);
+    const int e0 = line_orientation(p, t, y, u0, u1), e1 = line_orientation(p, t, y, u1, u2), e2 = line_orientation(p, t, y, u2, u0);
     const bool positive = e0 > 0 || e1 > 0 || e2 > 0, negative = e0 < 0 || e1 < 0 || e2 < 0;
     if (positive && negative) return true;  // the line misses u
     // A crossing through u's interior, or a case the determinants leave open (an edge, a
@@ -128,10 +173,118 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
                 const Vec3d u0 = v.vertices[ui.x], u1 = v.vertices[ui.y], u2 = v.vertices[ui.z];
                 if (!segment_may_meet_box(p, inv, slack, component_min(u0, component_min(u1, u2)), component_max(u0, component_max(u1, u2))))
                     continue;  // most of a leaf's triangles: the determinants cost more than this
-                if (!add_crossing(p, t, u0, u1, u2, change)) return false;
+                if (!add_crossing(p, t, InteriorPoint{}, u0, u1, u2, change)) return false;
             }
         }
     }
+    return true;
+}
+
+/// n . ((b - a) x (p - a)) for T's normal n = (t1 - t0) x (t2 - t0) and its edge a b, with a
+/// bound on its rounding: positive when p lies on T's inner side of the plane through the
+/// edge along n. Each of n and the cross product rounds a difference, a product and a
+/// difference (4 roundings of their terms' magnitudes), the dot product 3 more on products
+/// of them: at most gamma_11 of the same sum taken in magnitudes (Higham's bound), 16 u here
+/// with its own rounding; products lost to underflow add at most 2^-1074 each, times the
+/// other factor's size.
+SDF_CPU_GPU SDF_INLINE BoundedValue edge_prism_det(const Vec3d t[3], const Vec3d& a, const Vec3d& b, const Vec3d& p) {
+    const Vec3d e0 = t[1] - t[0], e1 = t[2] - t[0], ab = b - a, ap = p - a;
+    const Vec3d n = cross(e0, e1), g = cross(ab, ap);
+    auto magnitude_cross = [](const Vec3d& u, const Vec3d& w) {
+        return Vec3d(fabs(u.y * w.z) + fabs(u.z * w.y), fabs(u.z * w.x) + fabs(u.x * w.z), fabs(u.x * w.y) + fabs(u.y * w.x));
+    };
+    const Vec3d nm = magnitude_cross(e0, e1), gm = magnitude_cross(ab, ap);
+    const double permanent = nm.x * gm.x + nm.y * gm.y + nm.z * gm.z;
+    constexpr double eps = 1.1102230246251565404e-16;  // 2^-53
+    BoundedValue r;
+    r.value = n.x * g.x + n.y * g.y + n.z * g.z;
+    r.bound = 16.0 * eps * permanent + 0x1p-1070 * (1.0 + nm.x + nm.y + nm.z + gm.x + gm.y + gm.z);
+    if (!(permanent < 1e300)) r.bound = INFINITY;
+    return r;
+}
+
+/// Whether p's orthogonal projection onto T's plane lies strictly inside T, decided exactly
+/// (false where the bounds do not decide it): then T's closest point to p is in T's open
+/// interior, and p - (that point) is along T's normal.
+SDF_CPU_GPU SDF_INLINE bool projects_inside(const Vec3d t[3], const Vec3d& p) {
+    return decided_sign(edge_prism_det(t, t[0], t[1], p)) > 0 && decided_sign(edge_prism_det(t, t[1], t[2], p)) > 0 &&
+           decided_sign(edge_prism_det(t, t[2], t[0], p)) > 0;
+}
+
+/// What a certified search knows beside its winner (search_certificate.h): the triangles it
+/// could not rule out as nearer p than its winner (its candidates, the winner among them),
+/// and a squared distance that every other triangle surely exceeds in exact arithmetic.
+/// count 0: nothing known.
+struct NearTriangles {
+    const int32_t* triangle = nullptr;
+    int count = 0;
+    double beyond_squared = 0;
+};
+
+/// Weights of a point of T's open interior within about 2^-20 of T's size from `closest` (a
+/// point of T, rounded), in units of 2^-20; false for a degenerate T.
+SDF_CPU_GPU SDF_INLINE bool interior_point_near(const Vec3d t[3], const Vec3d& closest, InteriorPoint& y) {
+    constexpr double kUnits = 1048576.0;  // 2^20
+    const Vec3d e0 = t[1] - t[0], e1 = t[2] - t[0], c = closest - t[0];
+    const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(c, e0), d21 = dot(c, e1);
+    const double denominator = d00 * d11 - d01 * d01;
+    if (!(denominator > 0) || !(denominator < INFINITY)) return false;
+    const double b1 = (d11 * d20 - d01 * d21) / denominator, b2 = (d00 * d21 - d01 * d20) / denominator;
+    const double k1 = fmin(fmax(nearbyint(b1 * kUnits), 1.0), kUnits - 2.0);
+    const double k2 = fmin(fmax(nearbyint(b2 * kUnits), 1.0), kUnits - 1.0 - k1);
+    if (!(k1 >= 1.0) || !(k2 >= 1.0)) return false;  // NaN
+    y.k[0] = kUnits - k1 - k2;
+    y.k[1] = k1;
+    y.k[2] = k2;
+    return true;
+}
+
+/// The side of p from its nearest triangles alone, with no walk of the tree. T (`triangle`, a
+/// search's winner, at `distance` from p, its closest point `closest`) must have a known
+/// front winding number (its interior meets no other triangle).
+///  - T the only candidate and p projecting inside T: let q be T's closest point to p; the
+///    segment (p, q] meets no other triangle (one through a point x of it would lie at most
+///    |p - x| <= |p - q| from p, nearer than T or as near; at q it would meet T's interior),
+///    and beside T's interior on p's side w is one value: w(p) = front_winding[T] +
+///    (p behind T).
+///  - Otherwise a point y of T's interior next to `closest`: where |p - y| (rounded up) is
+///    below sqrt(beyond_squared), every triangle that meets the segment p y lies nearer p
+///    than that, so it is a candidate: the walk's formula (file comment) over the candidates
+///    alone, with y for the centroid.
+/// False where any of that is not decided: the caller then asks surface_side().
+SDF_CPU_GPU inline bool nearest_side(const SurfaceSideView& s, const WindingView<double>& v, const Vec3d& p, int triangle,
+                                     double distance, const Vec3d& closest, const NearTriangles& near, bool& inside) {
+    if (s.front_winding == nullptr || triangle < 0 || near.count <= 0 || !(fabs(distance) > s.min_distance)) return false;
+    const int8_t front = s.front_winding[triangle];
+    if (front == kSurfaceSideUnknown) return false;
+    const Int3 ti = v.triangles[triangle];
+    const Vec3d t[3] = {v.vertices[ti.x], v.vertices[ti.y], v.vertices[ti.z]};
+    const int behind = decided_sign(orientation_det(t[0], t[1], t[2], p));
+    if (behind == 0) return false;
+    const int beside = int(front) + (behind > 0 ? 1 : 0);
+    if (near.count == 1 && projects_inside(t, p)) {
+        inside = beside >= 1;
+        return true;
+    }
+    InteriorPoint y;
+    if (!interior_point_near(t, closest, y)) return false;
+    // y's rounded coordinates: each off by at most 3 u of the largest |coordinate| of T
+    // (three products, two sums; the division by a power of two exact), so |y - yr| <= 2^-50
+    // of it; |p - y| rounded up from |p - yr| (a few u of itself) by that.
+    const double units = y.k[0] + y.k[1] + y.k[2];
+    const RoundedInteriorPoint yr{(t[0] * y.k[0] + t[1] * y.k[1] + t[2] * y.k[2]) / units,
+                                  0x1p-50 * fmax(fmax(fmax(fabs(t[0].x), fabs(t[0].y)), fmax(fabs(t[0].z), fabs(t[1].x))),
+                                                 fmax(fmax(fabs(t[1].y), fabs(t[1].z)), fmax(fmax(fabs(t[2].x), fabs(t[2].y)), fabs(t[2].z))))};
+    const double reach = length(p - yr.at) * (1.0 + 0x1p-44) + yr.radius;
+    if (!(reach * reach * (1.0 + 0x1p-44) < near.beyond_squared)) return false;
+    int change = 0;
+    for (int i = 0; i < near.count; ++i) {
+        const int32_t u = near.triangle[i];
+        if (u == triangle) continue;
+        const Int3 ui = v.triangles[u];
+        if (!add_crossing(p, t, yr, v.vertices[ui.x], v.vertices[ui.y], v.vertices[ui.z], change)) return false;
+    }
+    inside = beside + change >= 1;
     return true;
 }
 

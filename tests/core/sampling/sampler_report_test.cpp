@@ -157,6 +157,30 @@ TEST(SamplerReport, WindingSurfaceCounterMergesAndReadsBack) {
     }
 }
 
+/// The nearest triangles' counter (nearest_side, kernels/winding/surface_side.h)
+/// likewise: summed, written, read back, absent (before it) read as 0, in the total.
+TEST(SamplerReport, WindingNearestCounterMergesAndReadsBack) {
+    SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
+    a.winding_sign = WindingSignReport{2, 1, 0, 0, 17, 80};
+    b.winding_sign = WindingSignReport{0, 0, 0, 1, 9, 40};
+    SamplerReport whole;
+    whole.merge(a);
+    whole.merge(b);
+    ASSERT_TRUE(whole.winding_sign.has_value());
+    EXPECT_EQ(whole.winding_sign->nearest, 120);
+    EXPECT_EQ(whole.winding_sign->points(), 150);
+    const nlohmann::json j = whole;
+    EXPECT_EQ(j.at("winding_sign").at("nearest"), 120);
+    EXPECT_EQ(j.get<SamplerReport>().winding_sign->nearest, 120);
+    nlohmann::json before = j;
+    before["winding_sign"].erase("nearest");
+    before["winding_sign"]["points"] = 30;
+    EXPECT_EQ(before.get<SamplerReport>().winding_sign->nearest, 0);
+    nlohmann::json wrong = j;
+    wrong["winding_sign"]["points"] = 30;  // the total without the nearest stage
+    EXPECT_THROW((void)wrong.get<SamplerReport>(), std::runtime_error);
+}
+
 /// The certified winding sign's counters (kernels/winding/certified_winding.h): summed by
 /// merge, written with their total, read back, and a total that does not add up is refused.
 TEST(SamplerReport, WindingSignCountersMergeAndRoundTrip) {

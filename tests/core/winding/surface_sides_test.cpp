@@ -7,7 +7,8 @@
 // the size from the surface, every side the stage decides is the exact side of 1/2, whichever
 // triangle it is given (the closest, or any other); open meshes get no table; and the CPU BVH
 // sampler, which reads the table first, gives the ladder's side (WindingSign::side) at every
-// point.
+// point. From the nearest triangles alone (those a certified search cannot rule out), with no
+// walk of the tree, the side is the exact side too.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -32,17 +33,26 @@
 namespace sdf {
 namespace {
 
-/// The closest triangle by brute force and its pseudonormal-signed sample.
-SignedDistanceSample<double> closest_sample(const PreparedMesh& m, const Vec3d& p) {
+/// The closest triangle by brute force and its pseudonormal-signed sample; `near` (if given)
+/// receives every triangle within `reach` of p's distance.
+SignedDistanceSample<double> closest_sample(const PreparedMesh& m, const Vec3d& p, double reach = 0,
+                                            std::vector<int32_t>* near = nullptr) {
     const MeshView<double> view = m.buffers<double>().view();
     SignedDistanceSample<double> best;
     double best_d = 1e300;
+    std::vector<double> d(m.triangles().size());
     for (int t = 0; t < int(m.triangles().size()); ++t) {
         const SignedDistanceSample<double> s = signed_distance_to_triangle(view, p, t);
-        if (std::abs(s.distance) < best_d) {
-            best_d = std::abs(s.distance);
+        d[size_t(t)] = std::abs(s.distance);
+        if (d[size_t(t)] < best_d) {
+            best_d = d[size_t(t)];
             best = s;
         }
+    }
+    if (near != nullptr) {
+        near->assign(1, best.triangle);
+        for (int t = 0; t < int(d.size()); ++t)
+            if (t != best.triangle && d[size_t(t)] <= best_d + reach) near->push_back(t);
     }
     return best;
 }
@@ -69,17 +79,35 @@ std::vector<Vec3d> points_around(const PreparedMesh& m, int count, unsigned seed
 }
 
 struct Checked {
-    int decided = 0, ladder = 0;
+    int decided = 0, ladder = 0, nearest = 0;
 };
 
 /// Every side the table decides is the exact side (the points' exact w is an integer on a
-/// closed mesh: 1/2 is never near).
+/// closed mesh: 1/2 is never near); so is every side nearest_side() decides from the
+/// triangles within 10^-9 and 10^-4 of the size beyond the closest (the brute force's
+/// promise, as a certified search's candidates make it: every other triangle lies farther
+/// than half that margin beyond, far more than the rounding).
 Checked check_sides(const PreparedMesh& m, const SurfaceSides& sides, const std::vector<Vec3d>& pts) {
     Checked c;
     const WindingSign tree(m);
+    const double diagonal = m.bounds().diagonal();
     for (const Vec3d& p : pts) {
-        const SignedDistanceSample<double> s = closest_sample(m, p);
         bool inside = false;
+        for (const double margin : {1e-9, 1e-4}) {
+            const double reach = margin * (length(p) + diagonal);
+            std::vector<int32_t> near;
+            const SignedDistanceSample<double> s = closest_sample(m, p, reach, &near);
+            const double beyond = std::abs(s.distance) + reach / 2;
+            if (!nearest_side(sides.view(), tree.view(), p, s.triangle, s.distance, s.closest_point,
+                              NearTriangles{near.data(), int(near.size()), beyond * beyond}, inside))
+                continue;
+            ++c.nearest;
+            const long double w = exact_winding_long(m, p);
+            EXPECT_EQ(inside, w > 0.5L) << m.name() << " (nearest, " << near.size() << " candidates within " << margin
+                                        << "): w " << double(w) << " at " << p.x << " " << p.y << " " << p.z
+                                        << " (distance " << s.distance << ", triangle " << s.triangle << ")";
+        }
+        const SignedDistanceSample<double> s = closest_sample(m, p);
         if (!surface_side(sides.view(), tree.view(), p, s.triangle, s.distance, inside)) {
             ++c.ladder;
             continue;
@@ -91,6 +119,67 @@ Checked check_sides(const PreparedMesh& m, const SurfaceSides& sides, const std:
                                     << " (distance " << s.distance << ", triangle " << s.triangle << ")";
     }
     return c;
+}
+
+/// projects_inside() against exact integer arithmetic: triangles and points on an integer
+/// grid (every determinant an exact 64-bit integer: coordinates below 2^12, products below
+/// 2^56), points on and beside the planes through
+/// the edges along the normal. Whenever it says inside, every exact determinant is positive;
+/// a point on such a plane (determinant 0) is never inside.
+TEST(SurfaceSides, ProjectionInsideATriangleIsDecidedExactly) {
+    std::mt19937_64 rng(7);
+    std::uniform_int_distribution<int64_t> coord(-2048, 2048), offset(-2, 2);
+    auto exact_det = [](const int64_t t[3][3], int a, int b, const int64_t p[3]) {
+        int64_t e0[3], e1[3], ab[3], ap[3];
+        for (int k = 0; k < 3; ++k) {
+            e0[k] = t[1][k] - t[0][k];
+            e1[k] = t[2][k] - t[0][k];
+            ab[k] = t[b][k] - t[a][k];
+            ap[k] = p[k] - t[a][k];
+        }
+        const int64_t n[3] = {int64_t(e0[1]) * e1[2] - int64_t(e0[2]) * e1[1], int64_t(e0[2]) * e1[0] - int64_t(e0[0]) * e1[2],
+                               int64_t(e0[0]) * e1[1] - int64_t(e0[1]) * e1[0]};
+        const int64_t g[3] = {int64_t(ab[1]) * ap[2] - int64_t(ab[2]) * ap[1], int64_t(ab[2]) * ap[0] - int64_t(ab[0]) * ap[2],
+                               int64_t(ab[0]) * ap[1] - int64_t(ab[1]) * ap[0]};
+        return n[0] * g[0] + n[1] * g[1] + n[2] * g[2];
+    };
+    int inside = 0, on_plane = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        int64_t t[3][3], p[3];
+        for (auto& c : t)
+            for (int64_t& x : c) x = coord(rng);
+        // A point near a random edge (the edge's midpoint, moved a little), anywhere near, or
+        // on the planes through a corner along the normal (a small triangle's corner plus or
+        // minus its integer normal: two determinants exactly 0).
+        const int e = int(rng() % 3);
+        if (trial % 4 == 3) {
+            for (auto& c : t)
+                for (int64_t& x : c) x /= 128;
+            const int64_t e0[3] = {t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+            const int64_t e1[3] = {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+            const int64_t n[3] = {e0[1] * e1[2] - e0[2] * e1[1], e0[2] * e1[0] - e0[0] * e1[2], e0[0] * e1[1] - e0[1] * e1[0]};
+            const int64_t r = trial % 8 == 3 ? 1 : -1;
+            for (int k = 0; k < 3; ++k) p[k] = t[e][k] + r * n[k];
+        } else {
+            for (int k = 0; k < 3; ++k)
+                p[k] = trial % 2 == 0 ? (t[e][k] + t[(e + 1) % 3][k]) / 2 + offset(rng) : (t[0][k] + t[1][k] + t[2][k]) / 3 + coord(rng) / 8;
+        }
+        const Vec3d tv[3] = {Vec3d(double(t[0][0]), double(t[0][1]), double(t[0][2])), Vec3d(double(t[1][0]), double(t[1][1]), double(t[1][2])),
+                             Vec3d(double(t[2][0]), double(t[2][1]), double(t[2][2]))};
+        const Vec3d pv{double(p[0]), double(p[1]), double(p[2])};
+        const int64_t d0 = exact_det(t, 0, 1, p), d1 = exact_det(t, 1, 2, p), d2 = exact_det(t, 2, 0, p);
+        const bool got = projects_inside(tv, pv);
+        if (got) {
+            ++inside;
+            EXPECT_TRUE(d0 > 0 && d1 > 0 && d2 > 0) << "trial " << trial;
+        }
+        if (d0 == 0 || d1 == 0 || d2 == 0) {
+            ++on_plane;
+            EXPECT_FALSE(got) << "trial " << trial;
+        }
+    }
+    EXPECT_GT(inside, 2000);
+    EXPECT_GT(on_plane, 4000);
 }
 
 TEST(SurfaceSides, OverlappingSpheresHaveTheExactSideAndFrontWindingOneInsideTheOther) {
@@ -156,6 +245,7 @@ TEST(SurfaceSides, ThickTorusAndNestedShellsHaveTheExactSide) {
         EXPECT_GT(sides.components_decided, 0) << mesh.name;
         const Checked c = check_sides(m, sides, points_around(m, 600, 5));
         EXPECT_GT(c.decided, 300) << mesh.name;
+        EXPECT_GT(c.nearest, 400) << mesh.name;
     }
     // The inner shell lies inside the outer one: 1 in front of it, 2 behind it.
     const PreparedMesh m = prepare_mesh(nested);
@@ -175,6 +265,7 @@ TEST(SurfaceSides, TheDragonsSidesAreExactAwayFromItsIntersections) {
     EXPECT_GT(sides.triangles_known, int64_t(m.triangles().size()) * 99 / 100);
     const Checked c = check_sides(m, sides, points_around(m, 60, 11));
     EXPECT_GT(c.decided, 50);
+    EXPECT_GT(c.nearest, 40);
 }
 
 /// Every side decided from a random triangle with a front winding number, not the closest:
@@ -409,13 +500,18 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
     setenv("SDF_WINDING_LADDER_ONLY", "1", 1);  // the baseline: every point on the ladder
     const auto ladder_only = make_cpu_bvh_sampler(o)->bind(share(m));
     unsetenv("SDF_WINDING_LADDER_ONLY");
+    setenv("SDF_WINDING_WALK_ONLY", "1", 1);  // every table side by the walk of the tree
+    const auto walk_only = make_cpu_bvh_sampler(o)->bind(share(m));
+    unsetenv("SDF_WINDING_WALK_ONLY");
     const Lattice lattice = fit_lattice(LatticeType::CC, {28, 24, 24}, m.bounds(), 0.1);
     const SampledField f = bound->sample(lattice);
     ASSERT_TRUE(f.sampler.winding_sign.has_value());
     const WindingSignReport& counts = *f.sampler.winding_sign;
     EXPECT_EQ(counts.points(), lattice.num_points());
-    // Beside the intersections too (stand-ins): the ladder only where a determinant is undecided.
-    EXPECT_GT(counts.surface, lattice.num_points() * 99 / 100);
+    // Beside the intersections too (stand-ins): the ladder only where a determinant is
+    // undecided. Most points take their sole nearest triangle's side with no walk.
+    EXPECT_GT(counts.surface + counts.nearest, lattice.num_points() * 99 / 100);
+    EXPECT_GT(counts.nearest, lattice.num_points() / 4);
     const WindingSign ladder(m);
     for (int64_t i = 0; i < lattice.num_points(); ++i) {
         if (f.distance[size_t(i)] == 0) continue;
@@ -424,7 +520,12 @@ TEST(SurfaceSides, TheSamplersSideIsTheLaddersAtEveryPoint) {
     const SampledField by_ladder = ladder_only->sample(lattice);
     ASSERT_TRUE(by_ladder.sampler.winding_sign.has_value());
     EXPECT_EQ(by_ladder.sampler.winding_sign->surface, 0);
+    EXPECT_EQ(by_ladder.sampler.winding_sign->nearest, 0);
     EXPECT_EQ(by_ladder.distance, f.distance);
+    const SampledField by_walk = walk_only->sample(lattice);
+    ASSERT_TRUE(by_walk.sampler.winding_sign.has_value());
+    EXPECT_EQ(by_walk.sampler.winding_sign->nearest, 0);
+    EXPECT_EQ(by_walk.distance, f.distance);
 }
 
 }  // namespace
