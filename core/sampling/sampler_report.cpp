@@ -1,5 +1,6 @@
 #include "core/sampling/sampler_report.h"
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -130,12 +131,18 @@ WindingSignReport winding_sign_from_json(const nlohmann::json& j) {
     w.direct = k.integer("direct");
     w.ties = k.integer("ties");
     w.surface = k.has("surface") ? k.integer("surface") : 0;  // fields sampled before the surface stage
-    w.nearest = k.has("nearest") ? k.integer("nearest") : 0;  // ... and before the sole nearest triangle's
+    w.nearest = k.has("nearest") ? k.integer("nearest") : 0;  // ... and before the nearest triangles'
+    int64_t total = 0;  // the counts' sum, which must not overflow (points() adds them)
     for (const auto& [name, count] : {std::pair<const char*, int64_t>{"nearest", w.nearest}, {"surface", w.surface}, {"fast", w.fast},
-                                      {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}})
+                                      {"refined", w.refined}, {"direct", w.direct}, {"ties", w.ties}}) {
         if (count < 0)
             throw std::runtime_error("sampler.winding_sign." + std::string(name) + ": expected a count >= 0, got " +
                                      std::to_string(count));
+        if (count > std::numeric_limits<int64_t>::max() - total)
+            throw std::runtime_error("sampler.winding_sign." + std::string(name) + ": expected counts whose sum fits in 64 bits, got " +
+                                     std::to_string(count) + " after " + std::to_string(total));
+        total += count;
+    }
     if (k.integer("points") != w.points())
         throw std::runtime_error("sampler.winding_sign.points: expected nearest + surface + fast + refined + direct + ties = " +
                                  std::to_string(w.points()) + ", got " + j.at("points").dump());

@@ -4,6 +4,10 @@
 // same record; a wrong type names its key.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <limits>
+#include <string>
+
 #include "core/mesh/mesh_provenance.h"
 #include "core/mesh/prepared_mesh.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -125,60 +129,61 @@ TEST(MeshProvenance, OneRecordReadBackWholeAndTheEarlierShortOneIntoItsReport) {
     EXPECT_THROW((void)nlohmann::json({{"name", "x"}, {"vertices", "many"}}).get<MeshProvenance>(), std::runtime_error);
 }
 
-/// The surface stage's counter (kernels/winding/surface_side.h) is summed over slabs and ranks
-/// like the others, and a field written before it (no "surface") reads as 0.
-TEST(SamplerReport, WindingSurfaceCounterMergesAndReadsBack) {
+/// One stage counter of the winding sign (`key`, the member `count`) over two parts of 100 and
+/// 50 points: summed over slabs and ranks like the others, written, read back, a field
+/// written before the stage (no key) read as 0, a negative count that the total still adds up
+/// to refused naming the key, and a total without the stage refused.
+void expect_stage_counter(const std::string& key, int64_t WindingSignReport::*count, const WindingSignReport& a_counts,
+                          const WindingSignReport& b_counts) {
     SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
-    a.winding_sign = WindingSignReport{2, 1, 0, 0, 97};
-    b.winding_sign = WindingSignReport{0, 0, 0, 1, 49};
+    a.winding_sign = a_counts;
+    b.winding_sign = b_counts;
     SamplerReport whole;
     whole.merge(a);
     whole.merge(b);
     ASSERT_TRUE(whole.winding_sign.has_value());
-    EXPECT_EQ(whole.winding_sign->surface, 146);
-    EXPECT_EQ(whole.winding_sign->points(), 150);
+    const int64_t sum = a_counts.*count + b_counts.*count;
+    EXPECT_EQ((*whole.winding_sign).*count, sum) << key;
+    EXPECT_EQ(whole.winding_sign->points(), 150) << key;
     const nlohmann::json j = whole;
-    EXPECT_EQ(j.at("winding_sign").at("surface"), 146);
-    EXPECT_EQ(j.get<SamplerReport>().winding_sign->surface, 146);
+    EXPECT_EQ(j.at("winding_sign").at(key), sum) << key;
+    EXPECT_EQ((*j.get<SamplerReport>().winding_sign).*count, sum) << key;
     nlohmann::json before = j;
-    before["winding_sign"].erase("surface");
-    before["winding_sign"]["points"] = 4;
-    EXPECT_EQ(before.get<SamplerReport>().winding_sign->surface, 0);
-    // A negative count that the total still adds up to is refused, naming the key.
+    before["winding_sign"].erase(key);
+    before["winding_sign"]["points"] = 150 - sum;
+    EXPECT_EQ((*before.get<SamplerReport>().winding_sign).*count, 0) << key;
+    nlohmann::json wrong = j;
+    wrong["winding_sign"]["points"] = 150 - sum;  // the total without the stage
+    EXPECT_THROW((void)wrong.get<SamplerReport>(), std::runtime_error) << key;
     nlohmann::json negative = j;
-    negative["winding_sign"]["surface"] = -3;
-    negative["winding_sign"]["points"] = 1;
+    negative["winding_sign"][key] = -3;
+    negative["winding_sign"]["points"] = 150 - sum - 3;
     try {
         (void)negative.get<SamplerReport>();
-        FAIL() << "a negative count was read";
+        ADD_FAILURE() << "a negative count was read: " << key;
     } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("sampler.winding_sign.surface: expected a count >= 0"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("sampler.winding_sign." + key + ": expected a count >= 0"), std::string::npos)
             << e.what();
     }
 }
 
-/// The nearest triangles' counter (nearest_side, kernels/winding/surface_side.h)
-/// likewise: summed, written, read back, absent (before it) read as 0, in the total.
-TEST(SamplerReport, WindingNearestCounterMergesAndReadsBack) {
-    SamplerReport a = part(100, 40, 10, true), b = part(50, 20, 4, true);
-    a.winding_sign = WindingSignReport{2, 1, 0, 0, 17, 80};
-    b.winding_sign = WindingSignReport{0, 0, 0, 1, 9, 40};
-    SamplerReport whole;
-    whole.merge(a);
-    whole.merge(b);
-    ASSERT_TRUE(whole.winding_sign.has_value());
-    EXPECT_EQ(whole.winding_sign->nearest, 120);
-    EXPECT_EQ(whole.winding_sign->points(), 150);
-    const nlohmann::json j = whole;
-    EXPECT_EQ(j.at("winding_sign").at("nearest"), 120);
-    EXPECT_EQ(j.get<SamplerReport>().winding_sign->nearest, 120);
-    nlohmann::json before = j;
-    before["winding_sign"].erase("nearest");
-    before["winding_sign"]["points"] = 30;
-    EXPECT_EQ(before.get<SamplerReport>().winding_sign->nearest, 0);
-    nlohmann::json wrong = j;
-    wrong["winding_sign"]["points"] = 30;  // the total without the nearest stage
-    EXPECT_THROW((void)wrong.get<SamplerReport>(), std::runtime_error);
+/// The surface stage's counter (the walk, kernels/winding/surface_side.h) and the nearest
+/// triangles' (nearest_side), each absent in fields written before it.
+TEST(SamplerReport, WindingSurfaceAndNearestCountersMergeAndReadBack) {
+    expect_stage_counter("surface", &WindingSignReport::surface, WindingSignReport{2, 1, 0, 0, 97}, WindingSignReport{0, 0, 0, 1, 49});
+    expect_stage_counter("nearest", &WindingSignReport::nearest, WindingSignReport{2, 1, 0, 0, 17, 80},
+                         WindingSignReport{0, 0, 0, 1, 9, 40});
+    // Counts whose sum would overflow (points() adds them) are refused before it is taken.
+    SamplerReport r = part(100, 40, 10, true);
+    r.winding_sign = WindingSignReport{0, 0, 0, 0, 1, 99};
+    nlohmann::json huge = r;
+    huge["winding_sign"]["nearest"] = std::numeric_limits<int64_t>::max();
+    try {
+        (void)huge.get<SamplerReport>();
+        ADD_FAILURE() << "counts that overflow were read";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("sum fits in 64 bits"), std::string::npos) << e.what();
+    }
 }
 
 /// The certified winding sign's counters (kernels/winding/certified_winding.h): summed by
