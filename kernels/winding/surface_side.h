@@ -85,19 +85,22 @@ struct RoundedInteriorPoint {
     double radius = 0;
 };
 
-/// |d det(a, b, c, y) / dy| = |(b - a) x (c - a)| <= |b - a| |c - a|, rounded up.
+/// |v|_1 >= |v|, no square root.
+SDF_CPU_GPU SDF_INLINE double l1_norm(const Vec3d& v) { return fabs(v.x) + fabs(v.y) + fabs(v.z); }
+
+/// |d det(a, b, c, y) / dy| = |(b - a) x (c - a)| <= |b - a|_1 |c - a|_1, rounded up.
 SDF_CPU_GPU SDF_INLINE int interior_orientation(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d*,
                                                 const RoundedInteriorPoint& y) {
     BoundedValue d = orientation_det(a, b, c, y.at);
-    d.bound += length(b - a) * length(c - a) * y.radius * (1.0 + 0x1p-40);
+    d.bound += l1_norm(b - a) * l1_norm(c - a) * y.radius * (1.0 + 0x1p-40);
     return decided_sign(d);
 }
 
-/// |d det(p, y, a, b) / dy| = |(p - b) x (a - b)| <= |p - b| |a - b|, rounded up.
+/// |d det(p, y, a, b) / dy| = |(p - b) x (a - b)| <= |p - b|_1 |a - b|_1, rounded up.
 SDF_CPU_GPU SDF_INLINE int line_orientation(const Vec3d& p, const Vec3d*, const RoundedInteriorPoint& y, const Vec3d& a,
                                             const Vec3d& b) {
     BoundedValue d = orientation_det(p, y.at, a, b);
-    d.bound += length(p - b) * length(a - b) * y.radius * (1.0 + 0x1p-40);
+    d.bound += l1_norm(p - b) * l1_norm(a - b) * y.radius * (1.0 + 0x1p-40);
     return decided_sign(d);
 }
 
@@ -108,11 +111,15 @@ SDF_CPU_GPU SDF_INLINE int line_orientation(const Vec3d& p, const Vec3d*, const 
 template <typename Y>
 SDF_CPU_GPU inline bool add_crossing(const Vec3d& p, const Vec3d t[3], const Y& y, const Vec3d& u0, const Vec3d& u1,
                                      const Vec3d& u2, int& change) {
+    // The segment p y crosses u iff the line p y passes its three edges on one side and p
+    // and y lie on opposite sides of u's plane; the cheapest refutations first (two edges
+    // on opposite sides miss u, whatever the third; then the plane).
+    const int e0 = line_orientation(p, t, y, u0, u1), e1 = line_orientation(p, t, y, u1, u2);
+    if (e0 * e1 < 0) return true;
     const int side_p = decided_sign(orientation_det(u0, u1, u2, p));
     const int side_y = interior_orientation(u0, u1, u2, t, y);
     if (side_p != 0 && side_p == side_y) return true;  // both strictly on one side of u's plane
-    // The line p y meets the closed triangle u iff it passes its three edges on one side.
-    const int e0 = line_orientation(p, t, y, u0, u1), e1 = line_orientation(p, t, y, u1, u2), e2 = line_orientation(p, t, y, u2, u0);
+    const int e2 = line_orientation(p, t, y, u2, u0);
     const bool positive = e0 > 0 || e1 > 0 || e2 > 0, negative = e0 < 0 || e1 < 0 || e2 < 0;
     if (positive && negative) return true;  // the line misses u
     // A crossing through u's interior, or a case the determinants leave open (an edge, a
