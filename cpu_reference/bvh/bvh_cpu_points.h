@@ -17,7 +17,7 @@ constexpr int kPointPacket = kBrick;
 /// Morton order of arbitrary points: the indices of `points` sorted by the Morton key of
 /// their cell in the points' bounding box (2^10 cells per axis: finer cells change nothing
 /// for packets of 16), ties in input order. An LSD radix sort over the 30 key bits (four
-/// 8-bit passes), stable, so the order is deterministic.
+/// 8-bit passes) on `threads` threads, stable, so the order is deterministic.
 std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads);
 
 /// Evaluates arbitrary points as Morton-ordered packets: the points are sorted by Morton key,
