@@ -11,7 +11,8 @@
 ///                      point's triangle (an exact upper bound on its distance);
 ///   kernel "unseeded": the same without seeds;
 ///   kernel "warp":     the warp's 128 points share one traversal (bvh_warp_kernel.cuh).
-/// Point lists take one thread per point.
+/// Point lists are sorted into Morton order and take the warp or the candidates kernel
+/// (bvh_point_query.cu).
 #pragma once
 
 #include "kernels/bvh/closest_triangle_bvh.h"
@@ -78,16 +79,6 @@ __global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_slab(BvhView
             nearest[first + k] = bvh.triangle_index[hit.slot];
         }
     }
-}
-
-/// Nearest triangle of every point of a point list, one thread per point.
-template <typename T>
-__global__ void __launch_bounds__(kBvhThreads) nearest_triangle_bvh_points(BvhView<T> bvh, PointListPiece piece,
-                                                                            int* nearest) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= piece.size()) return;
-    const BvhHit<T> hit = closest_triangle_bvh(bvh, Vec3<T>(piece.position(i)));
-    nearest[i] = bvh.triangle_index[hit.slot];
 }
 
 }  // namespace sdf::cuda
