@@ -10,6 +10,7 @@ import os
 import subprocess
 import sys
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -239,7 +240,16 @@ def test_query_argument_errors():
 def test_query_releases_the_gil():
     """A second Python thread keeps running while a query computes."""
     sphere = sl.load_mesh("shape:sphere")
-    p = random_points(20000, seed=1)
+    # A query long enough for the ticker's 1 ms waits on any machine (20,000 points took
+    # 3 ms on a fast host): with the GIL held it would see none of them.
+    n = 20000
+    while True:
+        p = random_points(n, seed=1)
+        start = time.perf_counter()
+        sl.query(sphere, p, method="brute_force", threads=1)
+        if time.perf_counter() - start >= 0.05 or n >= 2_000_000:
+            break
+        n *= 4
     ticks = []
     done = threading.Event()
 
