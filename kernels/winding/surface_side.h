@@ -193,7 +193,7 @@ SDF_CPU_GPU inline bool segment_winding_change(const WindingView<double>& v, con
 /// difference (4 roundings of their terms' magnitudes), the dot product 3 more on products
 /// of them: at most gamma_11 of the same sum taken in magnitudes (Higham's bound), 16 u here
 /// with its own rounding; products lost to underflow add at most 2^-1074 each, times the
-/// other factor's size.
+/// other factor's size (2^-1070 of the sum, taken as kUnderflowAllowance).
 SDF_CPU_GPU SDF_INLINE BoundedValue edge_prism_det(const Vec3d t[3], const Vec3d& a, const Vec3d& b, const Vec3d& p) {
     const Vec3d e0 = t[1] - t[0], e1 = t[2] - t[0], ab = b - a, ap = p - a;
     const Vec3d n = cross(e0, e1), g = cross(ab, ap);
@@ -205,7 +205,7 @@ SDF_CPU_GPU SDF_INLINE BoundedValue edge_prism_det(const Vec3d t[3], const Vec3d
     constexpr double eps = 1.1102230246251565404e-16;  // 2^-53
     BoundedValue r;
     r.value = n.x * g.x + n.y * g.y + n.z * g.z;
-    r.bound = 16.0 * eps * permanent + 0x1p-1070 * (1.0 + nm.x + nm.y + nm.z + gm.x + gm.y + gm.z);
+    r.bound = 16.0 * eps * permanent + kUnderflowAllowance * (1.0 + nm.x + nm.y + nm.z + gm.x + gm.y + gm.z);
     if (!(permanent < 1e300)) r.bound = INFINITY;
     return r;
 }
