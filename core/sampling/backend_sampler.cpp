@@ -83,7 +83,7 @@ SparseBandField BackendSampler::sample_band_sparse(const Lattice& lattice, doubl
 
 std::vector<PointSample> BackendSampler::query(const std::vector<Vec3d>& points, SamplingTimings* timings) const {
     const auto start = std::chrono::steady_clock::now();
-    require_search_range(mesh(), points, options_.precision);
+    require_search_range(mesh(), points, options_.precision, options_.threads);
     SamplingTimings t;
     CertificateCounters certificate;
     std::vector<PointSample> out = points.empty() ? std::vector<PointSample>() : query_points(points, t, certificate);

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/mesh/prepared_mesh.h"
+#include "core/parallel/parallel_for.h"
 #include "core/sampling/sampled_field.h"
 #include "core/sampling/sampler.h"
 #include "core/sampling/sampler_sign.h"
@@ -44,6 +45,23 @@ inline void store_sample(SampledField& field, int64_t out, const PreparedMesh& m
 /// The result of one query point; `triangle` indexes `mesh`'s prepared triangles.
 inline PointSample point_sample(const PreparedMesh& mesh, double distance, const Vec3d& gradient, int32_t triangle) {
     return {distance, gradient, triangle < 0 ? triangle : mesh.source_triangle()[size_t(triangle)]};
+}
+
+/// `n` unset query results (distance 0, triangle -1) to be filled on `threads` threads
+/// (0: all cores). The vector's storage is first touched a page at a time on every thread,
+/// then written once (40 bytes a point) on this one: a million-point query's 10,000 page
+/// faults were 20-25 ms on the calling thread, more than its Morton sort on 16.
+inline std::vector<PointSample> unfilled_point_samples(size_t n, int threads) {
+    std::vector<PointSample> out;
+    out.reserve(n);
+    constexpr size_t kPage = 4096;
+    unsigned char* storage = reinterpret_cast<unsigned char*>(out.data());
+    const size_t bytes = n * sizeof(PointSample), pages = (bytes + kPage - 1) / kPage;
+    parallel_for(int64_t(pages), 256, threads, [&](int64_t begin, int64_t end) {
+        for (int64_t page = begin; page < end; ++page) storage[size_t(page) * kPage] = 0;
+    });
+    out.resize(n);
+    return out;
 }
 
 /// Scatters a batch of results (per point: distance, gradient, triangle, output_index) into

@@ -35,8 +35,9 @@ double smallest_search_extent(Precision precision);
 /// Throws std::invalid_argument unless the mesh and the lattice's points are in range.
 void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Precision precision);
 /// Throws std::invalid_argument unless the mesh and every point are in range (and finite),
-/// naming the first point that is not.
-void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision);
+/// naming the first point that is not; the points are scanned on `threads` threads (0: all).
+void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision,
+                          int threads = 1);
 /// Throws std::invalid_argument unless the mesh is in range.
 void require_search_range(const PreparedMesh& mesh, Precision precision);
 /// Throws std::invalid_argument naming query point `index` (0-based) unless p is finite and in range.

@@ -108,7 +108,7 @@ public:
 private:
     std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
                                           CertificateCounters& certificate) const override {
-        std::vector<PointSample> out(points.size());
+        std::vector<PointSample> out = unfilled_point_samples(points.size(), options_.threads);
         const double coordinate = largest_coordinate(points, options_.threads);
         SharedWindingCounts unreported;  // a query has no report
         with_precision(options_.precision, [&](auto zero) {
