@@ -179,6 +179,27 @@ TEST(MeshSdf, HostArraysEqualTheQueryBitForBit) {
     }
 }
 
+TEST(MeshSdf, ALongListNamesItsFirstBadPointOnAnyThreadCount) {
+    // Bad rows in different chunks of the threaded range check: the first is named.
+    std::vector<Vec3d> points(300000, Vec3d(0.1, 0.2, 0.3));
+    points[250000].y = std::nan("");
+    points[140000].z = 1e300;
+    points[140001].x = INFINITY;
+    for (int threads : {1, 2, 7}) {
+        SamplerOptions o = cpu("bvh", SignMode::Auto);
+        o.threads = threads;
+        const MeshSdf bound(torus(), o);
+        try {
+            bound.query(points);
+            ADD_FAILURE() << "bad points were accepted on " << threads << " threads";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("query points: row 140000 has a coordinate of magnitude 1e+300"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+}
+
 TEST(TaskMonitor, AStopRequestEndsParallelForBetweenChunks) {
     TaskMonitor monitor;
     ScopedTaskMonitor scope(&monitor);
