@@ -9,19 +9,27 @@
 namespace sdf {
 FloatSearchBound float_search_bound(const PreparedMesh& mesh) { return mesh.search_bound(); }
 
-double largest_coordinate(const std::vector<Vec3d>& points, int threads) {
-    constexpr int64_t kChunk = 1 << 18;
-    const int64_t n = int64_t(points.size()), chunks = (n + kChunk - 1) / kChunk;
+namespace {
+
+template <typename Points>
+double largest_of(const Points& points, int threads) {
+    constexpr int64_t kChunk = 1 << 16;
+    const int64_t n = point_count(points), chunks = (n + kChunk - 1) / kChunk;
     std::vector<double> largest(size_t(std::max<int64_t>(chunks, 1)), 0.0);
     parallel_for(chunks, 1, chunks > 1 ? threads : 1, [&](int64_t c0, int64_t c1) {
         for (int64_t c = c0; c < c1; ++c) {
             double m = 0;
-            for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) m = std::max(m, largest_coordinate(points[size_t(i)]));
+            for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) m = std::max(m, largest_coordinate(point_at(points, i)));
             largest[size_t(c)] = m;
         }
     });
     return *std::max_element(largest.begin(), largest.end());
 }
+
+}  // namespace
+
+double largest_coordinate(const std::vector<Vec3d>& points, int threads) { return largest_of(points, threads); }
+double largest_coordinate(const HostPoints& points, int threads) { return largest_of(points, threads); }
 
 CertificateReport certificate_provenance(bool float_search, bool certified, const CertificateCounters& counters) {
     CertificateReport c;

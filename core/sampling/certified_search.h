@@ -12,6 +12,7 @@
 
 #include "core/bvh/search_bound.h"
 #include "core/mesh/prepared_mesh.h"
+#include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
 #include "kernels/distance/search_certificate.h"
 
@@ -28,6 +29,7 @@ inline double largest_coordinate(const Vec3d& p) { return std::max({std::abs(p.x
 /// Largest |coordinate| of the points, on `threads` threads (0: all) for a long list (a maximum
 /// is the same whichever thread finds it).
 double largest_coordinate(const std::vector<Vec3d>& points, int threads = 0);
+double largest_coordinate(const HostPoints& points, int threads = 0);
 
 /// Largest |coordinate| of a lattice's points.
 inline double largest_lattice_coordinate(const Lattice& lattice) {

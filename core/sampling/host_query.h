@@ -2,9 +2,10 @@
 /// @brief Point queries on the caller's host arrays: points read where they are (float32 or
 /// float64, any strides, e.g. a NumPy array's buffer) and results written into the caller's
 /// columns in input order, so that a front end allocates its outputs once and converts
-/// nothing. Samplers that run on a GPU stream both through pinned buffers; every other
-/// sampler gathers the points and answers with Sampler::query(). The numbers equal query()'s
-/// on the same points bit for bit.
+/// nothing. Samplers that run on a GPU stream both through pinned buffers; the CPU BVH
+/// sampler reads the points and writes the columns in place (point_count/point_at below);
+/// every other sampler gathers the points and answers with Sampler::query(). The numbers
+/// equal query()'s on the same points bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +41,13 @@ struct HostPoints {
     bool contiguous() const { return row_stride == 3 && column_stride == 1; }
     size_t bytes() const { return size_t(count) * 3 * (float32 ? sizeof(float) : sizeof(double)); }
 };
+
+/// A point list as the CPU queries read it, whether the caller's arrays or a vector: how many
+/// points and point i (in double), so one search serves both.
+inline int64_t point_count(const std::vector<Vec3d>& points) { return int64_t(points.size()); }
+inline Vec3d point_at(const std::vector<Vec3d>& points, int64_t i) { return points[size_t(i)]; }
+inline int64_t point_count(const HostPoints& points) { return points.count; }
+inline Vec3d point_at(const HostPoints& points, int64_t i) { return points[i]; }
 
 /// Where a host query's results go, in input order; a null pointer skips that output.
 struct HostQueryResults {

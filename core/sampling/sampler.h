@@ -90,7 +90,7 @@ public:
     /// Samples points in the caller's host arrays, writing the results into its columns in
     /// input order (core/sampling/host_query.h): query()'s numbers, with no conversion by the
     /// caller. This default gathers the points and calls query(); GPU samplers stream the
-    /// caller's bytes through pinned buffers instead. Throws std::invalid_argument for a
+    /// caller's bytes through pinned buffers instead, the CPU BVH reads them in place. Throws std::invalid_argument for a
     /// point that is not finite (naming its row) or out of the search's range.
     virtual void query_host(const HostPoints& points, const HostQueryResults& results,
                             SamplingTimings* timings = nullptr) const {

@@ -73,17 +73,20 @@ void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Prec
     require_point_in_range(lattice.domain_max() + h, precision, which);
 }
 
-void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision, int threads) {
+namespace {
+
+template <typename Points>
+void require_points_in_range(const PreparedMesh& mesh, const Points& points, Precision precision, int threads) {
     require_mesh_in_range(mesh, precision);
     // The first bad row of each chunk, then the first of those: the same row on any thread count.
     constexpr int64_t kChunk = 1 << 16;
-    const int64_t n = int64_t(points.size()), chunks = (n + kChunk - 1) / kChunk;
+    const int64_t n = point_count(points), chunks = (n + kChunk - 1) / kChunk;
     const double limit = largest_search_coordinate(precision);
     std::vector<int64_t> first_bad(size_t(chunks), n);
     parallel_for(chunks, 1, threads, [&](int64_t c0, int64_t c1) {
         for (int64_t c = c0; c < c1; ++c)
             for (int64_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
-                const Vec3d& p = points[size_t(i)];
+                const Vec3d p = point_at(points, i);
                 if (!std::isfinite(p.x + p.y + p.z) || largest_magnitude(p) > limit) {
                     first_bad[size_t(c)] = i;
                     break;
@@ -91,7 +94,17 @@ void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& po
             }
     });
     for (const int64_t i : first_bad)
-        if (i < n) require_point_in_range(points[size_t(i)], precision, "query points: row " + std::to_string(i));
+        if (i < n) require_point_in_range(point_at(points, i), precision, "query points: row " + std::to_string(i));
+}
+
+}  // namespace
+
+void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision, int threads) {
+    require_points_in_range(mesh, points, precision, threads);
+}
+
+void require_search_range(const PreparedMesh& mesh, const HostPoints& points, Precision precision, int threads) {
+    require_points_in_range(mesh, points, precision, threads);
 }
 
 void require_search_range(const PreparedMesh& mesh, Precision precision) { require_mesh_in_range(mesh, precision); }

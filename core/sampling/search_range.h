@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/mesh/prepared_mesh.h"
+#include "core/sampling/host_query.h"
 #include "core/sampling/sampled_field.h"
 
 namespace sdf {
@@ -38,6 +39,7 @@ void require_search_range(const PreparedMesh& mesh, const Lattice& lattice, Prec
 /// naming the first point that is not; the points are scanned on `threads` threads (0: all).
 void require_search_range(const PreparedMesh& mesh, const std::vector<Vec3d>& points, Precision precision,
                           int threads = 1);
+void require_search_range(const PreparedMesh& mesh, const HostPoints& points, Precision precision, int threads = 1);
 /// Throws std::invalid_argument unless the mesh is in range.
 void require_search_range(const PreparedMesh& mesh, Precision precision);
 /// Throws std::invalid_argument naming query point `index` (0-based) unless p is finite and in range.

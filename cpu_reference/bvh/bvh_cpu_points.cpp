@@ -14,8 +14,11 @@ namespace sdf::cpu_bvh {
 /// the digits of fixed chunks of the items, and each chunk scatters its items to the offsets
 /// that the counts give it in order: a stable pass, so the order does not depend on the
 /// threads (the words are distinct, so there is one sorted order).
-std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads) {
-    const int64_t n = int64_t(points.size());
+namespace {
+
+template <typename Points>
+std::vector<uint32_t> morton_order_of(const Points& points, int threads) {
+    const int64_t n = point_count(points);
     if (n == 0) return {};
     constexpr int64_t kChunk = 1 << 16;
     const int64_t chunks = (n + kChunk - 1) / kChunk;
@@ -23,16 +26,17 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
     std::vector<Vec3d> chunk_lo(static_cast<size_t>(chunks)), chunk_hi(static_cast<size_t>(chunks));
     parallel_for(chunks, 1, threads, [&](int64_t c0, int64_t c1) {
         for (int64_t c = c0; c < c1; ++c) {
-            Vec3d lo = points[size_t(c * kChunk)], hi = lo;
+            Vec3d lo = point_at(points, c * kChunk), hi = lo;
             for (int64_t i = c * kChunk; i < chunk_end(c); ++i) {
-                lo = component_min(lo, points[size_t(i)]);
-                hi = component_max(hi, points[size_t(i)]);
+                const Vec3d p = point_at(points, i);
+                lo = component_min(lo, p);
+                hi = component_max(hi, p);
             }
             chunk_lo[size_t(c)] = lo;
             chunk_hi[size_t(c)] = hi;
         }
     });
-    Vec3d lo = points[0], hi = points[0];
+    Vec3d lo = chunk_lo[0], hi = chunk_hi[0];
     for (int64_t c = 0; c < chunks; ++c) {
         lo = component_min(lo, chunk_lo[size_t(c)]);
         hi = component_max(hi, chunk_hi[size_t(c)]);
@@ -44,7 +48,7 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
     std::unique_ptr<uint64_t[]> items(new uint64_t[size_t(n)]), scratch(new uint64_t[size_t(n)]);
     parallel_for(chunks, 1, threads, [&](int64_t c0, int64_t c1) {
         for (int64_t i = c0 * kChunk; i < chunk_end(c1 - 1); ++i) {
-            const Vec3d& p = points[size_t(i)];
+            const Vec3d p = point_at(points, i);
             const uint64_t key = morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_extent) >> 33;
             items[size_t(i)] = key << 32 | uint64_t(i);
         }
@@ -83,5 +87,10 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads
     });
     return order;
 }
+
+}  // namespace
+
+std::vector<uint32_t> morton_order(const std::vector<Vec3d>& points, int threads) { return morton_order_of(points, threads); }
+std::vector<uint32_t> morton_order(const HostPoints& points, int threads) { return morton_order_of(points, threads); }
 
 }  // namespace sdf::cpu_bvh

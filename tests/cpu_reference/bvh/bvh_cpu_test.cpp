@@ -164,8 +164,16 @@ TEST(CpuBvh, MortonOrderIsTheSortedOrderOnEveryThreadCount) {
     std::sort(keyed.begin(), keyed.end());
     std::vector<uint32_t> want(points.size());
     for (size_t i = 0; i < keyed.size(); ++i) want[i] = keyed[i].second;
-    for (int threads : {1, 2, 7}) EXPECT_EQ(cpu_bvh::morton_order(points, threads), want) << threads << " threads";
-    EXPECT_TRUE(cpu_bvh::morton_order({}, 2).empty());
+    // The same points as the caller's arrays: every other column of an N x 6 array.
+    std::vector<double> columns(6 * points.size(), -7.0);
+    for (size_t i = 0; i < points.size(); ++i)
+        for (int k = 0; k < 3; ++k) columns[6 * i + 2 * size_t(k)] = points[i][k];
+    const HostPoints strided{columns.data(), false, int64_t(points.size()), 6, 2};
+    for (int threads : {1, 2, 7}) {
+        EXPECT_EQ(cpu_bvh::morton_order(points, threads), want) << threads << " threads";
+        EXPECT_EQ(cpu_bvh::morton_order(strided, threads), want) << threads << " threads, strided";
+    }
+    EXPECT_TRUE(cpu_bvh::morton_order(std::vector<Vec3d>{}, 2).empty());
 }
 
 TEST(CpuBvh, BccDoubleResolutionStrategyAndThreadCountsGiveTheSameField) {
