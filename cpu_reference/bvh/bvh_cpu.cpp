@@ -75,17 +75,17 @@ private:
         SharedWindingCounts unreported;  // a query has no report
         QueryCounters counters(certificate, unreported);
         const double coordinate = largest_coordinate(points, options_.threads);
-        const std::vector<int>& source = mesh().source_triangle();
         with_precision(options_.precision, [&](auto zero) {
             using T = decltype(zero);
             auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
-                if (results.distance) results.distance[i] = s.distance;
+                const PointSample r = point_sample(mesh(), s.distance, s.gradient, s.triangle);
+                if (results.distance) results.distance[i] = r.distance;
                 if (results.gradient) {
-                    results.gradient[3 * i] = s.gradient.x;
-                    results.gradient[3 * i + 1] = s.gradient.y;
-                    results.gradient[3 * i + 2] = s.gradient.z;
+                    results.gradient[3 * i] = r.gradient.x;
+                    results.gradient[3 * i + 1] = r.gradient.y;
+                    results.gradient[3 * i + 2] = r.gradient.z;
                 }
-                if (results.triangle) results.triangle[i] = s.triangle < 0 ? s.triangle : source[size_t(s.triangle)];
+                if (results.triangle) results.triangle[i] = r.triangle;
             };
             evaluate_point_packets<T>(mesh(), *bvh_, sign_, points, options_.threads, options_.progress, coordinate, counters, emit);
         });
