@@ -39,18 +39,19 @@ std::vector<Vec3d> gather_points(const HostPoints& points, const std::string& ar
     return out;
 }
 
+void store_result(const HostQueryResults& r, int64_t i, const PointSample& s) {
+    if (r.distance) r.distance[i] = s.distance;
+    if (r.gradient) {
+        r.gradient[3 * i] = s.gradient.x;
+        r.gradient[3 * i + 1] = s.gradient.y;
+        r.gradient[3 * i + 2] = s.gradient.z;
+    }
+    if (r.triangle) r.triangle[i] = s.triangle;
+}
+
 void scatter_samples(const std::vector<PointSample>& samples, const HostQueryResults& r, int threads) {
     parallel_for(int64_t(samples.size()), kRowsPerTask, threads, [&](int64_t b, int64_t e) {
-        for (int64_t i = b; i < e; ++i) {
-            const PointSample& s = samples[size_t(i)];
-            if (r.distance) r.distance[i] = s.distance;
-            if (r.gradient) {
-                r.gradient[3 * i] = s.gradient.x;
-                r.gradient[3 * i + 1] = s.gradient.y;
-                r.gradient[3 * i + 2] = s.gradient.z;
-            }
-            if (r.triangle) r.triangle[i] = s.triangle;
-        }
+        for (int64_t i = b; i < e; ++i) store_result(r, i, samples[size_t(i)]);
     });
 }
 

@@ -56,6 +56,9 @@ struct HostQueryResults {
     int32_t* triangle = nullptr;  ///< N, in the mesh file's face order
 };
 
+/// Writes result `s` of point i into the columns `r` asks for.
+void store_result(const HostQueryResults& r, int64_t i, const PointSample& s);
+
 /// Throws std::invalid_argument naming `argument` and the first row (0-based, as NumPy
 /// counts) that is not three finite numbers. Checked on `threads` threads (0: all).
 void require_finite_points(const HostPoints& points, const std::string& argument, int threads);

@@ -37,23 +37,40 @@ private:
     /// triangle; "brick" sorts them into Morton-ordered packets (evaluate_point_packets).
     bool seeded() const { return kernel_ != BvhKernel::Unseeded; }
 
-    std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
-                                          CertificateCounters& certificate) const override {
-        std::vector<PointSample> out = unfilled_point_samples(points.size(), options_.threads);
+    /// Kernel "brick"'s query of `points` (a vector or the caller's arrays) in Morton-ordered
+    /// packets, each result to `store(i, sample)`. 32-bit indices in the sort.
+    template <typename Points, typename Store>
+    void query_packets(const Points& points, CertificateCounters& certificate, Store store) const {
         SharedWindingCounts unreported;  // a query has no report
         QueryCounters counters(certificate, unreported);
         const double coordinate = largest_coordinate(points, options_.threads);
         with_precision(options_.precision, [&](auto zero) {
             using T = decltype(zero);
-            auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
-                out[size_t(i)] = point_sample(mesh(), s.distance, s.gradient, s.triangle);
-            };
-            if (kernel_ == BvhKernel::Brick && points.size() < (size_t(1) << 32))  // 32-bit indices in the sort
-                evaluate_point_packets<T>(mesh(), *bvh_, sign_, points, options_.threads, options_.progress, coordinate,
-                                          counters, emit);
-            else
-                evaluate_points<T>(mesh(), *bvh_, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()),
-                                   coordinate, counters, [&](int64_t i) { return points[size_t(i)]; }, emit);
+            evaluate_point_packets<T>(mesh(), *bvh_, sign_, points, options_.threads, options_.progress, coordinate, counters,
+                                      [&](int64_t i, const SignedDistanceSample<double>& s) {
+                                          store(i, point_sample(mesh(), s.distance, s.gradient, s.triangle));
+                                      });
+        });
+    }
+    bool packets_for(int64_t count) const { return kernel_ == BvhKernel::Brick && count < (int64_t(1) << 32); }
+
+    std::vector<PointSample> query_points(const std::vector<Vec3d>& points, SamplingTimings&,
+                                          CertificateCounters& certificate) const override {
+        std::vector<PointSample> out = unfilled_point_samples(points.size(), options_.threads);
+        if (packets_for(int64_t(points.size()))) {
+            query_packets(points, certificate, [&](int64_t i, const PointSample& r) { out[size_t(i)] = r; });
+            return out;
+        }
+        SharedWindingCounts unreported;  // a query has no report
+        QueryCounters counters(certificate, unreported);
+        const double coordinate = largest_coordinate(points, options_.threads);
+        with_precision(options_.precision, [&](auto zero) {
+            using T = decltype(zero);
+            evaluate_points<T>(mesh(), *bvh_, sign_, seeded(), options_.threads, options_.progress, int64_t(points.size()),
+                               coordinate, counters, [&](int64_t i) { return points[size_t(i)]; },
+                               [&](int64_t i, const SignedDistanceSample<double>& s) {
+                                   out[size_t(i)] = point_sample(mesh(), s.distance, s.gradient, s.triangle);
+                               });
         });
         return out;
     }
@@ -63,7 +80,7 @@ private:
     /// scatter (for a million points 64 MB written on the calling thread before). The bits of
     /// query() on the same points.
     void query_host(const HostPoints& points, const HostQueryResults& results, SamplingTimings* timings) const override {
-        if (kernel_ != BvhKernel::Brick || points.count >= (int64_t(1) << 32)) {  // 32-bit indices in the sort
+        if (!packets_for(points.count)) {
             BackendSampler::query_host(points, results, timings);
             return;
         }
@@ -72,23 +89,7 @@ private:
         require_finite_points(points, "points", options_.threads);
         require_search_range(mesh(), points, options_.precision, options_.threads);
         CertificateCounters certificate;
-        SharedWindingCounts unreported;  // a query has no report
-        QueryCounters counters(certificate, unreported);
-        const double coordinate = largest_coordinate(points, options_.threads);
-        with_precision(options_.precision, [&](auto zero) {
-            using T = decltype(zero);
-            auto emit = [&](int64_t i, const SignedDistanceSample<double>& s) {
-                const PointSample r = point_sample(mesh(), s.distance, s.gradient, s.triangle);
-                if (results.distance) results.distance[i] = r.distance;
-                if (results.gradient) {
-                    results.gradient[3 * i] = r.gradient.x;
-                    results.gradient[3 * i + 1] = r.gradient.y;
-                    results.gradient[3 * i + 2] = r.gradient.z;
-                }
-                if (results.triangle) results.triangle[i] = r.triangle;
-            };
-            evaluate_point_packets<T>(mesh(), *bvh_, sign_, points, options_.threads, options_.progress, coordinate, counters, emit);
-        });
+        query_packets(points, certificate, [&](int64_t i, const PointSample& r) { store_result(results, i, r); });
         if (timings) {
             SamplingTimings t;
             record_certificate(t, certificate);
