@@ -44,9 +44,9 @@ SDF_CPU_GPU SDF_INLINE BoundedValue orientation_det(const Vec3d& a, const Vec3d&
     // Shewchuk's relative bound, plus what underflow adds: a product below the normal range
     // is rounded by up to 2^-1075 absolutely (the differences are exact there), which the
     // outer products multiply by |adz|, |bdz|, |cdz|; 2^-1071 covers that and the
-    // permanent's own products lost to underflow. Taken as 2^-1021, the least normal factor
-    // whose product stays normal: a subnormal product costs an x86 core a microcode assist,
-    // which was 40% of nearest_side()'s time. Overflow loses everything: no decision.
+    // permanent's own products lost to underflow. Taken as 2^-1021, a normal factor whose
+    // product with a sum >= 1 stays normal: a subnormal product costs an x86 core a microcode
+    // assist, which was 40% of nearest_side()'s time. Overflow loses everything: no decision.
     r.bound = (7.0 + 56.0 * eps) * eps * permanent + kUnderflowAllowance * (fabs(adz) + fabs(bdz) + fabs(cdz) + 1.0);
     if (!(permanent < 1e300)) r.bound = INFINITY;
     return r;
