@@ -10,6 +10,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "core/lattice/lattice_fitting.h"
 #include "core/mesh/shapes/procedural_shapes.h"
@@ -142,8 +143,11 @@ TEST(MeshSdf, HostArraysEqualTheQueryBitForBit) {
             as_float[i][k] = double(rows32[3 * i + k]);
             padded64[5 * i + 2 * k] = points[i][k];  // every other column of an N x 5 array
         }
-    for (bool unsigned_distance : {false, true}) {
-        const MeshSdf bound(torus(), cpu("bvh", SignMode::Auto), unsigned_distance);
+    // The pseudonormal (auto on the torus) and the winding sign (the nearest triangles' side,
+    // the packets' certified search): the CPU BVH reads the arrays in place for both.
+    const std::pair<SignMode, bool> modes[] = {{SignMode::Auto, false}, {SignMode::Auto, true}, {SignMode::Winding, false}};
+    for (const auto& [sign, unsigned_distance] : modes) {
+        const MeshSdf bound(torus(), cpu("bvh", sign), unsigned_distance);
         const std::vector<PointSample> ref = bound.query(points), ref_float = bound.query(as_float);
         struct Case { HostPoints points; const std::vector<PointSample>* truth; };
         for (const Case& c : {Case{{rows32.data(), true, int64_t(n), 3, 1}, &ref_float}, Case{{padded64.data(), false, int64_t(n), 5, 2}, &ref}}) {
