@@ -9,13 +9,13 @@
 
 namespace sdf::cpu_bvh {
 
+namespace {
+
 /// The points' order by Morton key (ties by index): a least-significant-digit radix sort of
 /// (key << 32 | index), 4 passes of 8 bits, every step on `threads` threads. Each pass counts
 /// the digits of fixed chunks of the items, and each chunk scatters its items to the offsets
 /// that the counts give it in order: a stable pass, so the order does not depend on the
 /// threads (the words are distinct, so there is one sorted order).
-namespace {
-
 template <typename Points>
 std::vector<uint32_t> morton_order_of(const Points& points, int threads) {
     const int64_t n = point_count(points);
