@@ -116,6 +116,13 @@ StreamedCertify streamed_certify(const DeviceBvh<T>& dev, BvhGpuKernel kernel, d
     return {};
 }
 
+/// The listed certificate's re-rank of a warp search's float winners (certify_kernel.cuh).
+template <typename T, typename Piece>
+void rerank_lists(const DeviceBvh<T>& dev, const Piece& piece, double point_coordinate, const NearLists& lists, int* nearest,
+                  const NearestSideInputs& sides) {
+    if constexpr (std::is_same_v<T, float>) dev.certifier->rerank_lists(piece, point_coordinate, lists, nearest, sides);
+}
+
 /// Zeroes the certifier's counters.
 template <typename T>
 void reset_certificate(const DeviceBvh<T>& dev) {

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <future>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -54,6 +55,30 @@ int list_points_per_thread(int64_t n, int sms) {
     if (n / (32 * 2) >= 2 * resident_warps) return 2;
     return 1;
 }
+
+/// Whether the point lists' certified search lists its candidates for a re-rank after the
+/// walk (and the winding sign's nearest_side) instead of streaming them in double during it.
+/// SDF_LIST_CERTIFY=streamed keeps the streamed form, for measurement.
+bool list_certificate_candidates() {
+    static const bool streamed = [] {
+        const char* e = std::getenv("SDF_LIST_CERTIFY");
+        return e != nullptr && std::strcmp(e, "streamed") == 0;
+    }();
+    return !streamed;
+}
+
+/// Device arrays of NearLists for `n` points, and of the sides nearest_side() finds from
+/// them where `sides` (the certified winding sign with its table of sides).
+struct NearListBuffers {
+    DeviceBuffer<int32_t> slot, count;
+    DeviceBuffer<float> q, best_q;
+    DeviceBuffer<int8_t> side;
+    NearListBuffers(int64_t n, bool sides)
+        : slot{size_t(n) * kNearListSlots}, count{size_t(n)}, q{size_t(n) * kNearListSlots}, best_q{size_t(n)} {
+        if (sides) side.allocate(size_t(n));
+    }
+    NearLists view() { return {slot.get(), q.get(), count.get(), best_q.get()}; }
+};
 
 /// The current device's multiprocessors.
 int multiprocessors() {
@@ -291,14 +316,22 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
     PieceResults r(step);  // reused by every piece
     const int run = list_points_per_thread(step, multiprocessors());
+    const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
+    const WindingSignView sign = dev.winding.view();
+    const bool sides = sign.enabled() && sign.certify && sign.surface.front_winding != nullptr &&
+                       SamplerSign::winding_options().nearest_sides;
+    std::optional<NearListBuffers> lists;
+    if (fused.exact != nullptr && kernel_ == BvhGpuKernel::Warp && list_certificate_candidates()) lists.emplace(step, sides);
+    const NearLists near_lists = lists ? lists->view() : NearLists{};
+    const NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
     for (int64_t begin = 0; begin < n; begin += step) {
         compute.begin();
         if (begin == 0) sort.run(mesh(), device_points, sorted_points.get(), order.get());
         const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
         const PointListPiece list{sorted_points.get(), begin, piece.count};
-        const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
         const auto warp = [&](auto layout) {
-            launch_bvh_warp(blocks_for(layout.threads(), kBvhThreads), dev.view, layout, BandSearch{}, fused, r.nearest.get());
+            launch_bvh_warp(blocks_for(layout.threads(), kBvhThreads), dev.view, layout, BandSearch{}, fused, r.nearest.get(),
+                            near_lists);
         };
         if (kernel_ == BvhGpuKernel::Candidates) {
             const ListLayout layout{list};
@@ -313,8 +346,9 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
-        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), dev.winding.view(), options_.band_width,
-                                r.outputs());
+        if (near_lists.enabled()) rerank_lists(dev, piece, coordinate, near_lists, r.nearest.get(), side_inputs);
+        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), sign, options_.band_width, r.outputs(),
+                                side_inputs.side);
         CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
         store(r, piece.count);
         compute.end();

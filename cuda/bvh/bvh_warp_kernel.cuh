@@ -60,6 +60,7 @@ struct SlabLayout {
 template <int K>
 struct ListRuns {
     static constexpr int kPoints = K;
+    static constexpr bool kListsCandidates = true;  ///< the certificate may list (lists_candidates)
     PointListPiece piece;
     SDF_CPU_GPU int64_t threads() const { return (piece.size() + K - 1) / K; }
     SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
@@ -71,6 +72,13 @@ struct ListRuns {
     SDF_CPU_GPU Vec3d position(int64_t i) const { return piece.position(i); }
 };
 using ListLayout = ListRuns<kRunPoints>;
+
+/// Whether a layout's certified search may list its candidates (NearLists): point lists say
+/// so (ListRuns::kListsCandidates); lattices and the band's blocks always stream.
+template <typename Layout, typename = void>
+struct lists_candidates : std::false_type {};
+template <typename Layout>
+struct lists_candidates<Layout, std::void_t<decltype(Layout::kListsCandidates)>> : std::bool_constant<Layout::kListsCandidates> {};
 
 /// Loads thread t's points into a packet; lanes without points get best = -1, so they never
 /// want a box or a triangle and never hold the warp back.
@@ -245,14 +253,24 @@ struct RunPoint {
 
 template <typename Layout>
 using StreamedRun = StreamedCertifiedNear<float, Layout::kPoints, RunPoint<Layout>>;
+template <typename Layout>
+using ListedRun = ListedCertifiedNear<float, Layout::kPoints, RunPoint<Layout>>;
 
 /// Writes the nearest triangle of the thread's `count` points: the plain search's, or with
 /// the certificate fused (kCertified, float only) the double search's, counting the points
-/// and those that needed double evaluations (every lane of the warp must call this).
-template <bool kCertified, typename T, int K, typename Near>
+/// and those that needed double evaluations (every lane of the warp must call this); with
+/// the listed certificate the float winner, which rerank_near_lists() replaces and counts.
+template <bool kCertified, bool kListed = false, typename T, int K, typename Near>
 __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<T, K>& pk, Near& policy, int64_t first,
                                          int count, const StreamedCertify& cert, int* nearest) {
-    if constexpr (kCertified) {
+    if constexpr (kListed) {
+#pragma unroll
+        for (int k = 0; k < K; ++k) {
+            bool unused = false;
+            const int32_t winner = policy.finish(bvh, k, pk, unused);
+            if (k < count) nearest[first + k] = winner;
+        }
+    } else if constexpr (kCertified) {
         unsigned reranked = 0, found = 0;
 #pragma unroll
         for (int k = 0; k < K; ++k) {
@@ -272,10 +290,12 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
 
 /// The warp search of a lattice slab or a sorted point list; kCertified (float only) fuses
 /// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
-/// the double search's triangles without the separate certify pass.
-template <typename T, typename Layout, bool kCertified>
+/// the double search's triangles without the separate certify pass; kListed leaves each
+/// point's candidates in `lists` for rerank_near_lists() instead of streaming them in double.
+template <typename T, typename Layout, bool kCertified, bool kListed = false>
 __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
-    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest) {
+    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest,
+                              NearLists lists = {}) {
     constexpr int kWarps = kBvhThreads / 32;
     __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
     __shared__ T stack_d2[kWarps][kBvhMaxDepth];
@@ -297,7 +317,11 @@ __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
             return;
         }
     }
-    if constexpr (kCertified) {
+    if constexpr (kListed) {
+        ListedRun<Layout> policy(cert.slack, RunPoint<Layout>{layout, first, count}, lists, first, count);
+        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        write_nearest<true, true>(bvh, pk, policy, first, count, cert, nearest);
+    } else if constexpr (kCertified) {
         StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
         warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
         write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
@@ -308,11 +332,19 @@ __global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
     }
 }
 
-/// Launches the warp search, with the certificate fused when `cert` holds one (float).
+/// Launches the warp search, with the certificate fused when `cert` holds one (float): its
+/// candidates listed in `lists` where given (rerank_near_lists() then finishes it),
+/// otherwise streamed.
 template <typename T, typename Layout>
 void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
-                     const StreamedCertify& cert, int* nearest) {
+                     const StreamedCertify& cert, int* nearest, const NearLists& lists = {}) {
     if constexpr (std::is_same_v<T, float>) {
+        if constexpr (lists_candidates<Layout>::value) {
+            if (cert.exact && lists.enabled()) {
+                nearest_triangle_bvh_warp<T, Layout, true, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, lists);
+                return;
+            }
+        }
         if (cert.exact) {
             nearest_triangle_bvh_warp<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
             return;

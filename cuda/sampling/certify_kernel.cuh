@@ -23,6 +23,9 @@
 #include "cuda/util/device_buffer.h"
 #include "cuda/sampling/launch_util.cuh"
 #include "kernels/bvh/closest_triangle_bvh.h"
+#include "kernels/bvh/streamed_certificate.h"
+#include "kernels/distance/signed_distance.h"
+#include "kernels/winding/surface_side.h"
 
 namespace sdf::cuda {
 
@@ -61,23 +64,19 @@ __device__ inline void warp_count(unsigned long long* counter, bool flag) {
     if ((threadIdx.x % 32) == unsigned(__ffs(active) - 1) && votes != 0) atomicAdd(counter, (unsigned long long)__popc(votes));
 }
 
-/// At most 72 registers (seven blocks of 128 threads an SM): ptxas chose 78 for the three
-/// walks below, one block fewer, where 72 costs 16 bytes of spills.
-template <typename Piece>
-__global__ void __launch_bounds__(128, 7) certify_nearest(CertifyView v, Piece piece, int* nearest) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= piece.size()) return;
-    const int n = nearest[i];
-    if (n < 0) return;  // outside the band: no triangle
-    const Vec3d p = piece.position(i);
+/// The double search's triangle at p from a float winner `triangle` (prepared-mesh index):
+/// a certified float search seeded with it, keeping kNearCandidates and then, where more
+/// lie within the bound, kWideCandidates; beyond that the double search seeded with it.
+/// `reranked`: double evaluations were needed; `full`: more than kNearCandidates.
+__device__ inline int32_t certified_triangle(const CertifyView& v, const Vec3d& p, int32_t triangle, bool& reranked, bool& full) {
     const Vec3f pt(p);
     NoBvhStats none;
     CertifiedNear<float> near{v.slack, {}};
-    const BvhHit<float> hit = closest_triangle_bvh(v.bvh, pt, seed_hit(v.bvh, v.slot_of[n], pt), none, near);
+    const BvhHit<float> hit = closest_triangle_bvh(v.bvh, pt, seed_hit(v.bvh, v.slot_of[triangle], pt), none, near);
     auto index_of = [&](int32_t s) { return v.bvh.triangle_index[s]; };
     Rerank r = rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, hit.slot, v.slack.radius(hit.distance_squared),
                                 near.near);
-    const bool full = r.overflow;
+    full = r.overflow;
     if (r.overflow) {
         CertifiedNear<float, kWideCandidates> wide{v.slack, {}};
         const BvhHit<float> again = closest_triangle_bvh(v.bvh, pt, hit, none, wide);
@@ -86,10 +85,70 @@ __global__ void __launch_bounds__(128, 7) certify_nearest(CertifyView v, Piece p
         if (r.overflow) r.slot = closest_triangle_bvh(v.exact, p, seed_hit(v.exact, hit.slot, p)).slot;
         r.reranked = true;
     }
-    nearest[i] = v.bvh.triangle_index[r.slot];
+    reranked = r.reranked;
+    return v.bvh.triangle_index[r.slot];
+}
+
+/// At most 72 registers (seven blocks of 128 threads an SM): ptxas chose 78 for the three
+/// walks below, one block fewer, where 72 costs 16 bytes of spills.
+template <typename Piece>
+__global__ void __launch_bounds__(128, 7) certify_nearest(CertifyView v, Piece piece, int* nearest) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= piece.size()) return;
+    const int n = nearest[i];
+    if (n < 0) return;  // outside the band: no triangle
+    bool reranked = false, full = false;
+    nearest[i] = certified_triangle(v, piece.position(i), n, reranked, full);
     warp_count(v.counters + 0, true);
-    warp_count(v.counters + 1, r.reranked);
+    warp_count(v.counters + 1, reranked);
     warp_count(v.counters + 2, full);
+}
+
+/// What nearest_side() needs beside a point's candidates: the mesh, the certified winding
+/// sign's table and tree. `side` receives per point 1 (inside), 0 (outside) or -1 (not
+/// decided from the candidates); null: not asked (no table, another sign).
+struct NearestSideInputs {
+    MeshView<double> mesh{};
+    SurfaceSideView surface{};
+    WindingView<double> winding{};
+    int8_t* side = nullptr;
+};
+
+/// The listed certificate's second half (kernels/bvh/streamed_certificate.h): every point's
+/// float winner `nearest` replaced by the double search's triangle from its list, and, where
+/// asked, the point's side from those candidates alone (nearest_side(), surface_side.h),
+/// which saves the finalize its walk. One thread per point, no walk but an overflowed list's
+/// double search (an overflowed list takes certify_nearest's seeded search); apart from the
+/// finalize, whose registers are capped for its winding walk.
+template <typename Piece>
+__global__ void __launch_bounds__(128)
+    rerank_near_lists(CertifyView v, Piece piece, NearLists lists, int* nearest, NearestSideInputs sides) {
+    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= piece.size()) return;
+    const int n = nearest[i];
+    if (n < 0) return;  // outside the band: no triangle
+    const Vec3d p = piece.position(i);
+    bool reranked = false, overflow = false;
+    const auto full_search = [&](const Vec3d& x) {  // the separate pass's certificate, as certify_nearest's
+        bool unused = false;
+        return certified_triangle(v, x, n, unused, unused);
+    };
+    const int32_t t = rerank_near_list(lists, i, v.slack, v.exact.packed, v.bvh.triangle_index, p, n, full_search, reranked, overflow);
+    nearest[i] = t;
+    if (sides.side != nullptr) {
+        int8_t side = -1;
+        const int32_t count = lists.count[i];
+        if (count > 0) {
+            const SignedDistanceSample<double> s = signed_distance_to_triangle(sides.mesh, p, t);
+            const NearTriangles near{lists.slot + i * kNearListSlots, count, beyond_candidates_squared(v.slack, lists.best_q[i])};
+            bool inside = false;
+            if (nearest_side(sides.surface, sides.winding, p, t, s.distance, s.closest_point, near, inside)) side = inside ? 1 : 0;
+        }
+        sides.side[i] = side;
+    }
+    warp_count(v.counters + 0, true);
+    warp_count(v.counters + 1, reranked);
+    warp_count(v.counters + 2, overflow);
 }
 
 /// Host side: the float BVH, the double constants in BVH order, the slot of every triangle
@@ -128,17 +187,22 @@ public:
     /// the double search's triangles, for points of largest |coordinate| `point_coordinate`.
     template <typename Piece>
     void certify(const Piece& piece, double point_coordinate, int* nearest) const {
-        CertifyView v;
-        v.bvh = {arrays_.nodes, arrays_.packed, arrays_.triangle_index, num_nodes_, num_triangles_};
-        v.exact = {arrays_.nodes, arrays_.exact, arrays_.triangle_index, num_nodes_, num_triangles_};
-        v.exact.margin = double_prune_margin(bound_);  // the full double search equals the brute force
-        v.slot_of = arrays_.slot_of;
-        v.slack = make_search_slack(bound_, point_coordinate);
-        v.counters = counters_.get();
         const int64_t n = piece.size();
         if (n == 0) return;
-        certify_nearest<<<blocks_for(n, 128), 128>>>(v, piece, nearest);
+        certify_nearest<<<blocks_for(n, 128), 128>>>(view(point_coordinate), piece, nearest);
         CUDA_CHECK_LAUNCH("certify_nearest");
+    }
+
+    /// Replaces `nearest` (the float winners of a listed warp search, streamed(point_coordinate)
+    /// its certificate) with the double search's triangles from `lists`, and finds the sides
+    /// `sides` asks for.
+    template <typename Piece>
+    void rerank_lists(const Piece& piece, double point_coordinate, const NearLists& lists, int* nearest,
+                      const NearestSideInputs& sides) const {
+        const int64_t n = piece.size();
+        if (n == 0) return;
+        rerank_near_lists<<<blocks_for(n, 128), 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        CUDA_CHECK_LAUNCH("rerank_near_lists");
     }
 
     /// The fused certificate for points of largest |coordinate| `point_coordinate`; not
@@ -165,6 +229,17 @@ public:
     }
 
 private:
+    CertifyView view(double point_coordinate) const {
+        CertifyView v;
+        v.bvh = {arrays_.nodes, arrays_.packed, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact = {arrays_.nodes, arrays_.exact, arrays_.triangle_index, num_nodes_, num_triangles_};
+        v.exact.margin = double_prune_margin(bound_);  // the full double search equals the brute force
+        v.slot_of = arrays_.slot_of;
+        v.slack = make_search_slack(bound_, point_coordinate);
+        v.counters = counters_.get();
+        return v;
+    }
+
     /// The arrays the kernel reads: the buffers below, or another owner's.
     struct Arrays {
         const BvhNode* nodes = nullptr;

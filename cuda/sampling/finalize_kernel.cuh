@@ -72,7 +72,7 @@ constexpr int kWarpWindingMinBlocks = 4;
 template <typename Piece, bool Winding, bool PerThread = false, int MinBlocks = (Winding && !PerThread ? kWarpWindingMinBlocks : 1)>
 __global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
     finalize_samples(MeshView<double> mesh, Piece piece, const int* nearest, WindingSignView sign, double band_width,
-                     PieceOutputs out) {
+                     PieceOutputs out, const int8_t* nearest_sides) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     const bool in_piece = i < piece.size();
     const int64_t o = !in_piece || piece.block_local(i) < 0 ? -1 : piece.output_index(i);
@@ -85,18 +85,25 @@ __global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
     if (n >= 0) s = signed_distance_to_triangle(mesh, p, n);
     bool winding_inside = false;
     if constexpr (Winding) {
-        // The closest triangle's side where the mesh's table vouches for it (surface_side.h).
-        const bool by_surface = n >= 0 && sign.certify && surface_side(sign.surface, sign.view, p, n, s.distance, winding_inside);
+        // The closest triangle's side where the mesh's table vouches for it (surface_side.h):
+        // from the search's candidates alone where the re-rank found it (`nearest_sides`,
+        // rerank_near_lists()), else by a walk.
+        const int8_t listed_side = nearest_sides != nullptr && n >= 0 ? nearest_sides[i] : int8_t(-1);
+        const bool by_nearest = listed_side >= 0;
+        if (by_nearest) winding_inside = listed_side == 1;
+        const bool by_surface =
+            by_nearest || (n >= 0 && sign.certify && surface_side(sign.surface, sign.view, p, n, s.distance, winding_inside));
+        const WindingStage decided_by = by_nearest ? WindingStage::Nearest : WindingStage::Surface;
         const bool wants = o >= 0 && !by_surface && (n >= 0 || n == kOutsideBandSignPerPoint);
         if constexpr (PerThread) {
-            if (by_surface) count_winding_stage(sign, WindingStage::Surface);
+            if (by_surface) count_winding_stage(sign, decided_by);
             if (wants) {
                 const WindingSide side = winding_side(sign, p);
                 count_winding_stage(sign, side.stage);
                 winding_inside = side.inside;
             }
         } else {
-            winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside);
+            winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside, decided_by);
         }
     }
     if (o < 0 || flood) return;
@@ -122,18 +129,20 @@ inline bool winding_per_thread() {
 }
 
 /// Launches finalize_samples with or without the winding sign, as `sign` says, over the
-/// piece's `count` points in blocks of kFinalizeBlock. Without it, compiled for
+/// piece's `count` points in blocks of kFinalizeBlock; `nearest_sides` (or null): the sides
+/// rerank_near_lists() found from the search's candidates (1 inside, 0 outside, -1 not). Without it, compiled for
 /// `PlainMinBlocks` blocks per SM: the sparse band asks for 4 (64 registers where it takes 100
 /// uncapped, 2 blocks): its finalize is latency-bound, and ran 1.8x faster so on an H200
 /// (docs/large-lattices.md); the other callers keep the uncapped kernel, not measured so.
 template <int PlainMinBlocks = 1, typename Piece>
 void launch_finalize_samples(int64_t count, MeshView<double> mesh, const Piece& piece, const int* nearest,
-                             const WindingSignView& sign, double band_width, PieceOutputs out) {
+                             const WindingSignView& sign, double band_width, PieceOutputs out, const int8_t* nearest_sides = nullptr) {
     const int blocks = int((count + kFinalizeBlock - 1) / kFinalizeBlock), threads = kFinalizeBlock;
     if (!sign.enabled())
-        finalize_samples<Piece, false, false, PlainMinBlocks><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
-    else if (winding_per_thread()) finalize_samples<Piece, true, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
-    else finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out);
+        finalize_samples<Piece, false, false, PlainMinBlocks><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out, nearest_sides);
+    else if (winding_per_thread())
+        finalize_samples<Piece, true, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out, nearest_sides);
+    else finalize_samples<Piece, true><<<blocks, threads>>>(mesh, piece, nearest, sign, band_width, out, nearest_sides);
 }
 
 }  // namespace sdf::cuda

@@ -306,11 +306,10 @@ TEST(CudaBvh, CertifiedFloatEqualsDoubleBruteForceOnAdversarialCases) {
                         (long long)timings.full_double_points);
             EXPECT_EQ(bad, 0) << c.mesh.name << " " << kernel;
             EXPECT_EQ(timings.certified_points, int64_t(c.points.size())) << c.mesh.name << " " << kernel;
-            // warp fuses the certificate (kernels/bvh/streamed_certificate.h): no point ever
-            // needs the full double search.
-            if (id == cuda::BvhGpuKernel::Warp) {
-                EXPECT_EQ(timings.full_double_points, 0) << c.mesh.name << " " << kernel;
-            }
+            // warp fuses the certificate (kernels/bvh/streamed_certificate.h), listing each
+            // point's candidates: only a list that outgrows kNearListSlots (a fan of exact ties)
+            // takes the separate pass's search, which re-ranks too.
+            EXPECT_LE(timings.full_double_points, timings.reranked_points) << c.mesh.name << " " << kernel;
         }
         if (c.mesh.name != "cube" && c.mesh.name != "fan_plate") continue;
         Lattice lattice;
