@@ -74,6 +74,7 @@ class QueryResult:
     sign: str
     sampler: str
     timings_seconds: Dict[str, float]
+    search_certificate: Dict[str, int]  # points, reranked, full_double
     devices: Dict[str, Any]       # count, used, split, min_points_per_device, why_not | why_fewer
     def __len__(self) -> int: ...
 

@@ -315,6 +315,15 @@ void bind_query(py::module_& m) {
             return d;
         }, "The query's timings, seconds: total (the sampler's whole call), and on the GPU kernel (device time of the "
            "sort, search and sign), upload and download (the transfers); 0 where the sampler does not measure them (the CPU's, CUDA brute force).")
+        .def_property_readonly("search_certificate", [](const QueryResult& r) {
+            py::dict d;
+            d["points"] = r.timings.certified_points;
+            d["reranked"] = r.timings.reranked_points;
+            d["full_double"] = r.timings.full_double_points;
+            return d;
+        }, "The certified float search's counts (GPU float queries; zero elsewhere): points certified, those re-ranked "
+           "in double (several candidates within the float error bound, a vertex's fan of exact ties for most), and "
+           "those sent to the full double search.")
         .def_property_readonly("devices", [](const QueryResult& r) {
             // plan_device_split depends only on the count, the devices and the threshold, all
             // fixed when the SDF was made: this is the plan the query's sampler followed.
