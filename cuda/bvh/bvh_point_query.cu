@@ -73,6 +73,8 @@ struct NearListBuffers {
     DeviceBuffer<int32_t> slot, count;
     DeviceBuffer<float> q, best_q;
     DeviceBuffer<int8_t> side;
+    /// Bytes per point: the slots and their Q, the count, the winner's Q, the side.
+    static constexpr size_t kBytesPerPoint = kNearListSlots * (sizeof(int32_t) + sizeof(float)) + 2 * 4 + 1;
     NearListBuffers(int64_t n, bool sides)
         : slot{size_t(n) * kNearListSlots}, count{size_t(n)}, q{size_t(n) * kNearListSlots}, best_q{size_t(n)} {
         if (sides) side.allocate(size_t(n));
@@ -320,8 +322,12 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     const WindingSignView sign = dev.winding.view();
     const bool sides = sign.enabled() && sign.certify && sign.surface.front_winding != nullptr &&
                        SamplerSign::winding_options().nearest_sides;
+    // The lists where a quarter of the device's free memory holds them (73 bytes a point);
+    // otherwise the streamed certificate, which needs none (the same results).
     std::optional<NearListBuffers> lists;
-    if (fused.exact != nullptr && kernel_ == BvhGpuKernel::Warp && list_certificate_candidates()) lists.emplace(step, sides);
+    if (fused.exact != nullptr && kernel_ == BvhGpuKernel::Warp && list_certificate_candidates() &&
+        size_t(step) * NearListBuffers::kBytesPerPoint <= free_device_memory() / 4)
+        lists.emplace(step, sides);
     const NearLists near_lists = lists ? lists->view() : NearLists{};
     const NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
     for (int64_t begin = 0; begin < n; begin += step) {
