@@ -241,6 +241,16 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
 /// uncapped), which measured 7-11% faster on an H100 (docs/gpu-notes.md).
 constexpr int kFusedMinBlocks = 4;
 
+/// Blocks per SM the listed form of a `Layout` is compiled for: with one or two points a
+/// thread (sparser lists, fewer warps than the GPU holds many times over) 6, at 80 registers
+/// with 200-400 bytes of spills: 1M points 4.50 -> 4.22 ms near the surface, 4.38 -> 3.93 ms
+/// uniform on an H200; with four (16.8M points) kFusedMinBlocks, where 6 took 29.5 -> 32.1 ms
+/// (docs/gpu-notes.md).
+template <typename Layout>
+constexpr int listed_min_blocks() {
+    return Layout::kPoints <= 2 ? 6 : kFusedMinBlocks;
+}
+
 /// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
 /// load_packet), for the streamed certificate's double evaluations.
 template <typename Layout>
@@ -292,8 +302,8 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
 /// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
 /// the double search's triangles without the separate certify pass; kListed leaves each
 /// point's candidates in `lists` for rerank_near_lists() instead of streaming them in double.
-template <typename T, typename Layout, bool kCertified, bool kListed = false>
-__global__ void __launch_bounds__(kBvhThreads, kCertified ? kFusedMinBlocks : 1)
+template <typename T, typename Layout, bool kCertified, bool kListed = false, int kMinBlocks = kCertified ? kFusedMinBlocks : 1>
+__global__ void __launch_bounds__(kBvhThreads, kMinBlocks)
     nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest,
                               NearLists lists = {}) {
     constexpr int kWarps = kBvhThreads / 32;
@@ -341,7 +351,8 @@ void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, co
     if constexpr (std::is_same_v<T, float>) {
         if constexpr (lists_candidates<Layout>::value) {
             if (cert.exact && lists.enabled()) {
-                nearest_triangle_bvh_warp<T, Layout, true, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, lists);
+                nearest_triangle_bvh_warp<T, Layout, true, true, listed_min_blocks<Layout>()>
+                    <<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, lists);
                 return;
             }
         }

@@ -89,6 +89,13 @@ __device__ inline int32_t certified_triangle(const CertifyView& v, const Vec3d& 
     return v.bvh.triangle_index[r.slot];
 }
 
+/// certified_triangle() out of line, for rerank_near_lists: its candidate arrays and walks
+/// are for the 0.4-0.9% of lists that overflow, not for every point's path.
+static __device__ __noinline__ int32_t overflowed_list_triangle(const CertifyView& v, Vec3d p, int32_t triangle) {
+    bool reranked = false, full = false;
+    return certified_triangle(v, p, triangle, reranked, full);
+}
+
 /// At most 72 registers (seven blocks of 128 threads an SM): ptxas chose 78 for the three
 /// walks below, one block fewer, where 72 costs 16 bytes of spills.
 template <typename Piece>
@@ -129,10 +136,7 @@ __global__ void __launch_bounds__(128)
     if (n < 0) return;  // outside the band: no triangle
     const Vec3d p = piece.position(i);
     bool reranked = false, overflow = false;
-    const auto full_search = [&](const Vec3d& x) {  // the separate pass's certificate, as certify_nearest's
-        bool unused = false;
-        return certified_triangle(v, x, n, unused, unused);
-    };
+    const auto full_search = [&](const Vec3d& x) { return overflowed_list_triangle(v, x, n); };
     const int32_t t = rerank_near_list(lists, i, v.slack, v.exact.packed, v.bvh.triangle_index, p, n, full_search, reranked, overflow);
     nearest[i] = t;
     if (sides.side != nullptr) {
@@ -201,6 +205,7 @@ public:
                       const NearestSideInputs& sides) const {
         const int64_t n = piece.size();
         if (n == 0) return;
+        // Capped at 80 registers (6 blocks an SM) it measured the same (H200, docs/gpu-notes.md).
         rerank_near_lists<<<blocks_for(n, 128), 128>>>(view(point_coordinate), piece, lists, nearest, sides);
         CUDA_CHECK_LAUNCH("rerank_near_lists");
     }
