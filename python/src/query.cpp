@@ -321,9 +321,9 @@ void bind_query(py::module_& m) {
             d["reranked"] = r.timings.reranked_points;
             d["full_double"] = r.timings.full_double_points;
             return d;
-        }, "The certified float search's counts (GPU float queries; zero elsewhere): points certified, those re-ranked "
-           "in double (several candidates within the float error bound, a vertex's fan of exact ties for most), and "
-           "those sent to the full double search.")
+        }, "The certified float search's counts (precision 'float', the default; zero for 'double', the reference): "
+           "points certified, those re-ranked in double (several candidates within the float error bound, a vertex's "
+           "fan of exact ties for most), and those sent to a further search (more candidates than a list holds).")
         .def_property_readonly("devices", [](const QueryResult& r) {
             // plan_device_split depends only on the count, the devices and the threshold, all
             // fixed when the SDF was made: this is the plan the query's sampler followed.

@@ -212,6 +212,20 @@ def test_query_timings_on_the_cpu():
     assert t["total"] > 0 and t["kernel"] == 0 and t["upload"] == 0 and t["download"] == 0
 
 
+@pytest.mark.parametrize("backend", ["cpu", "cuda"])
+def test_query_counts_its_certified_search(backend):
+    """A float query counts every point certified, those re-ranked in double (a torus point's
+    nearest vertex or edge is shared: exact ties) and none sent further; the double search is
+    the reference and counts nothing."""
+    if backend == "cuda" and not sl.cuda_available():
+        pytest.skip("no CUDA backend or GPU")
+    mesh, p = sl.load_mesh("shape:torus"), random_points(3000, -1.6, 1.6, seed=17)
+    c = sl.query(mesh, p, backend=backend, precision="float").search_certificate
+    assert set(c) == {"points", "reranked", "full_double"}
+    assert c["points"] == len(p) and 0 < c["reranked"] <= len(p) and 0 <= c["full_double"] <= c["reranked"]
+    assert sl.query(mesh, p, backend=backend, precision="double").search_certificate == {"points": 0, "reranked": 0, "full_double": 0}
+
+
 def test_sdf_query_text_and_npy_agree_and_float32_points_are_read(tmp_path):
     p = random_points(200, seed=5)
     rows = npy_query(tmp_path, "shape:box", p, "--precision", "double")
