@@ -143,6 +143,19 @@ TEST(CertifiedSearch, ErrorBoundHoldsForEveryPair) {
 }
 
 
+/// A float packet of the K points point_of(k), nothing found yet.
+template <int K, typename PointOf>
+BvhPacket<float, K> unsearched_packet(const PointOf& point_of) {
+    BvhPacket<float, K> pk;
+    for (int k = 0; k < K; ++k) {
+        const Vec3f p(point_of(k));
+        pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
+        pk.best_q[k] = pk.radius[k] = std::numeric_limits<float>::infinity();
+        pk.best_slot[k] = pk.best_triangle[k] = -1;
+    }
+    return pk;
+}
+
 /// The certificate fused into a packet search (kernels/bvh/streamed_certificate.h, the GPU
 /// warp kernel's form) on the CPU: packets of 4 consecutive case points, and
 /// the same points 4 copies to a packet (every lane ties with the others). Every lane's
@@ -166,13 +179,7 @@ TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
                 size_t index[K];
                 for (int k = 0; k < K; ++k) index[k] = std::min(first + size_t(k * stride), c.points.size() - 1);
                 const auto point_of = [&](int k) { return c.points[index[k]]; };
-                BvhPacket<float, K> pk;
-                for (int k = 0; k < K; ++k) {
-                    const Vec3f p(point_of(k));
-                    pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
-                    pk.best_q[k] = pk.radius[k] = std::numeric_limits<float>::infinity();
-                    pk.best_slot[k] = pk.best_triangle[k] = -1;
-                }
+                BvhPacket<float, K> pk = unsearched_packet<K>(point_of);
                 StreamedCertifiedNear<float, K, decltype(point_of)> near(slack, bvh.packed_double.data(), point_of);
                 NoBvhStats none;
                 closest_triangles_packet(view, pk, none, near);
@@ -223,13 +230,7 @@ TEST(CertifiedSearch, ListedPacketEqualsDoubleBruteForce) {
                 size_t index[K];
                 for (int k = 0; k < K; ++k) index[k] = std::min(first + size_t(k * stride), c.points.size() - 1);
                 const auto point_of = [&](int k) { return c.points[index[k]]; };
-                BvhPacket<float, K> pk;
-                for (int k = 0; k < K; ++k) {
-                    const Vec3f p(point_of(k));
-                    pk.x[k] = p.x; pk.y[k] = p.y; pk.z[k] = p.z;
-                    pk.best_q[k] = pk.radius[k] = std::numeric_limits<float>::infinity();
-                    pk.best_slot[k] = pk.best_triangle[k] = -1;
-                }
+                BvhPacket<float, K> pk = unsearched_packet<K>(point_of);
                 ListedCertifiedNear<float, K, decltype(point_of)> near(slack, point_of, lists, 0, K);
                 NoBvhStats none;
                 closest_triangles_packet(view, pk, none, near);
