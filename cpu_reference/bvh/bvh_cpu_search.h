@@ -92,10 +92,8 @@ struct Certifier {
 
     /// The double search's winner (BVH slot) at p from the float search's winner and its
     /// candidates; counts what it took. `lane` receives the candidates' triangles and a
-    /// squared distance X that every other triangle exceeds in exact arithmetic: a triangle
-    /// U with Q(U) <= X has Q_f(U) - x <= Q(U) + E <= X + E <= radius (search_certificate.h;
-    /// radius >= q + 2E with q the float winner's Q, so X = q + 0.49 (radius - q) leaves room
-    /// for E, and X is kept within q + 2E, where the bound on M holds), so it is a candidate.
+    /// squared distance X that every other triangle exceeds in exact arithmetic
+    /// (beyond_candidates_squared, search_certificate.h).
     int32_t certify(const BvhView<float>& view, const Vec3d& p, int32_t winner, float best_q,
                     const NearCandidates<float, kCpuNearCandidates>& near, LocalCertificate& counters, LaneNear& lane) const {
         const float radius = slack.radius(best_q);
@@ -106,9 +104,7 @@ struct Certifier {
             lane.triangle[lane.count++] = view.triangle_index[winner];
             for (int i = 0; i < near.count; ++i)
                 if (near.slot[i] != winner && near.q[i] <= radius) lane.triangle[lane.count++] = view.triangle_index[near.slot[i]];
-            const double q = double(best_q), m = double(slack.k1) * std::sqrt(q > 0 ? q : 0.0) + double(slack.k2);
-            const double e = (double(slack.rho) * m + 2.0 * double(slack.d0)) * m + double(slack.c0);
-            lane.beyond_squared = q + std::fmin(0.49 * (double(radius) - q), 1.9 * e);
+            lane.beyond_squared = beyond_candidates_squared(slack, best_q);
         } else {  // more candidates than kept (a vertex of many triangles): the lane knows none
             AllNear all{slack, {}, {}};
             const Vec3f pt(p);

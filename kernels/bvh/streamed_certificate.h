@@ -29,7 +29,7 @@
 /// a pass of its own, so the walk carries no double state, and leaves them to the winding
 /// sign's nearest_side(). The same argument holds: every triangle whose ranked Q is within R
 /// was met within the radius of its time, and is in the list or deferred at the end; a list
-/// that outgrows kNearListSlots sends its point to the full double search.
+/// that outgrows kNearListSlots sends its point to the separate pass's seeded certified search.
 #pragma once
 
 #include "kernels/bvh/closest_triangles_packet.h"
@@ -203,7 +203,8 @@ struct StreamedCertifiedNear : DeferredCertifiedNear<T, K, PointOf, FoldInDouble
 };
 
 /// Candidates a listed certificate keeps per point; a point offered more (a vertex of that
-/// many triangles within the bound) takes the full double search.
+/// many triangles within the bound) takes the separate pass's seeded certified search
+/// (certify_kernel.cuh, counted as full_double).
 constexpr int kNearListSlots = 8;
 
 /// Per point of a search (index i), what the listed certificate leaves for the re-rank
@@ -325,20 +326,10 @@ SDF_CPU_GPU inline int32_t rerank_near_list(const NearLists& lists, int64_t i, c
         }
         slot[c] = triangle;
     }
+    SDF_DCHECK(live != 1 || slot[0] == winner);  // one live candidate: the float winner itself
     lists.count[i] = live;
     return best_triangle;
 }
 
-/// nearest_side()'s bound from a certified search's float winner Q `best_q`: a squared
-/// distance X that every triangle outside the candidates exceeds in exact arithmetic. A
-/// triangle U with Q(U) <= X has Q_f(U) - x <= Q(U) + E <= X + E <= radius
-/// (search_certificate.h; radius >= q + 2E, so X = q + 0.49 (radius - q) leaves room for E,
-/// and X is kept within q + 2E, where the bound on M holds), so it is a candidate.
-SDF_CPU_GPU inline double beyond_candidates_squared(const SearchSlack<float>& slack, float best_q) {
-    const float radius = slack.radius(best_q);
-    const double q = double(best_q), m = double(slack.k1) * sqrt(q > 0 ? q : 0.0) + double(slack.k2);
-    const double e = (double(slack.rho) * m + 2.0 * double(slack.d0)) * m + double(slack.c0);
-    return q + fmin(0.49 * (double(radius) - q), 1.9 * e);
-}
 
 }  // namespace sdf

@@ -134,6 +134,19 @@ struct SearchSlack {
     }
 };
 
+/// nearest_side()'s bound (kernels/winding/surface_side.h) from a certified search's float
+/// winner Q `best_q`: a squared distance X that every triangle outside the candidates
+/// exceeds in exact arithmetic. A
+/// triangle U with Q(U) <= X has Q_f(U) - x <= Q(U) + E <= X + E <= radius
+/// (the file comment; radius >= q + 2E, so X = q + 0.49 (radius - q) leaves room for E,
+/// and X is kept within q + 2E, where the bound on M holds), so it is a candidate.
+SDF_CPU_GPU inline double beyond_candidates_squared(const SearchSlack<float>& slack, float best_q) {
+    const float radius = slack.radius(best_q);
+    const double q = double(best_q), m = double(slack.k1) * std::sqrt(q > 0 ? q : 0.0) + double(slack.k2);
+    const double e = (double(slack.rho) * m + 2.0 * double(slack.d0)) * m + double(slack.c0);
+    return q + std::fmin(0.49 * (double(radius) - q), 1.9 * e);
+}
+
 /// The slack of a float search at points of largest |coordinate| `point_coordinate`.
 inline SearchSlack<float> make_search_slack(const FloatSearchBound& b, double point_coordinate) {
     SearchSlack<float> s;
