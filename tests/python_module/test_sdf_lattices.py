@@ -226,6 +226,26 @@ def test_query_counts_its_certified_search(backend):
     assert sl.query(mesh, p, backend=backend, precision="double").search_certificate == {"points": 0, "reranked": 0, "full_double": 0}
 
 
+@pytest.mark.parametrize("backend", ["cpu", "cuda"])
+def test_winding_sides_from_the_nearest_triangles_equal_the_walks(backend, monkeypatch):
+    """The certified winding sign's side from a float search's candidates alone (nearest_side:
+    the CPU's packets, the GPU's re-rank of its listed candidates) is the side the walk to the
+    closest triangle gives (SDF_WINDING_WALK_ONLY=1), at every point near the surface, where a
+    vertex's fan of exact ties makes several candidates the rule."""
+    if backend == "cuda" and not sl.cuda_available():
+        pytest.skip("no CUDA backend or GPU")
+    mesh = sl.load_mesh("shape:torus")
+    v = np.asarray(mesh.vertices)
+    rng = np.random.default_rng(23)
+    p = v[rng.integers(0, len(v), 20000)] + rng.normal(0, 0.02, (20000, 3))
+    listed = sl.SDF(mesh, backend=backend, sign="winding").query(p)
+    monkeypatch.setenv("SDF_WINDING_WALK_ONLY", "1")
+    walked = sl.SDF(mesh, backend=backend, sign="winding").query(p)
+    assert same_bits(listed.distance, walked.distance)
+    assert np.array_equal(listed.triangle, walked.triangle)
+    assert 0.2 < np.mean(listed.distance < 0) < 0.8
+
+
 def test_sdf_query_text_and_npy_agree_and_float32_points_are_read(tmp_path):
     p = random_points(200, seed=5)
     rows = npy_query(tmp_path, "shape:box", p, "--precision", "double")
