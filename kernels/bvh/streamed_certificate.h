@@ -291,9 +291,10 @@ struct ListedCertifiedNear : DeferredCertifiedNear<T, K, PointOf, NearListAppend
 /// Point i's double search triangle from its list (NearListAppend) and its float winner
 /// `winner` (prepared-mesh index): the live candidates (ranked Q within the final radius)
 /// re-ranked in double at the exact point p, ties to the smaller index, as
-/// rerank_in_double(); an overflowed list takes `full_search(p)` (the double search seeded
-/// with the winner, a triangle index). Leaves the live candidates' triangles in the list for
-/// nearest_side(). `reranked`: more than one live candidate, or the full search.
+/// rerank_in_double(); an overflowed list takes `full_search(p)` (any search that returns the
+/// double search's triangle index: on the GPU the separate pass's, seeded with the winner).
+/// Leaves the live candidates' triangles in the list for nearest_side(). `reranked`: more
+/// than one live candidate, or an overflow.
 template <typename FullSearch>
 SDF_CPU_GPU inline int32_t rerank_near_list(const NearLists& lists, int64_t i, const SearchSlack<float>& slack,
                                             const PackedTriangle<double>* exact, const int32_t* triangle_index,
