@@ -453,11 +453,10 @@ void BoundCudaBvh::band_blocks_as(SparseBandField& band, size_t first, size_t la
         } else {
             fill_nearest<<<blocks_for(n, 256), 256>>>(r.nearest.get(), n, kOutsideBandOutside);
             CUDA_CHECK_LAUNCH("fill_nearest");
-            const int grid = blocks_for(layout.threads(), kBvhThreads);
             if (kernel_ == BvhGpuKernel::Warp) {
-                launch_bvh_warp(grid, dev.view, layout, search, fused, r.nearest.get());
+                launch_bvh_warp(dev.view, layout, search, fused, r.nearest.get(), {}, warp_queue());
             } else {
-                nearest_triangle_bvh_candidates<T><<<grid, kBvhThreads>>>(dev.view, layout, search, r.nearest.get(), nullptr);
+                nearest_triangle_bvh_candidates<T><<<blocks_for(layout.threads(), kBvhThreads), kBvhThreads>>>(dev.view, layout, search, r.nearest.get(), nullptr);
             }
             CUDA_CHECK_LAUNCH("nearest_triangle_bvh (band blocks)");
             if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());

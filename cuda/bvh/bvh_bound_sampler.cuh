@@ -111,6 +111,10 @@ private:
     void search_points(const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n, double coordinate,
                        EventTimer& compute, CertificateCounters& certificate, Store store) const;
 
+    /// The warp searches' batch counter; null (one batch a warp) under SDF_WARP_QUEUE=off,
+    /// for measurement.
+    unsigned long long* warp_queue() const;
+
     BvhGpuKernel kernel_;
     std::unique_ptr<DeviceBvh<float>> tree_float_;    ///< precision float
     std::unique_ptr<DeviceBvh<double>> tree_double_;  ///< precision double
@@ -119,6 +123,7 @@ private:
 
     mutable std::mutex mutex_;    ///< one call at a time: the scratch below and the certificate's counters
     mutable DeviceBuffer<unsigned long long> candidate_stats_;
+    mutable DeviceBuffer<unsigned long long> warp_queue_;  ///< the warp searches' batch counter (WarpBatches)
     mutable StagedCopy staged_;   ///< query_host()'s pinned buffers
     mutable DeviceBuffer<char> host_query_points_;
     mutable DeviceBuffer<double> host_query_distance_, host_query_gradient_;

@@ -1,6 +1,8 @@
 // The CUDA BVH sampler's binding: the tree built on the device (bvh_build "device" or
 // "auto", with either sign) or on the host and uploaded, with the winding sign's
 // moments and the float search's certificate beside it (bvh_device_tree.cuh).
+#include <cstdlib>
+#include <cstring>
 #include <future>
 #include <string>
 
@@ -18,6 +20,15 @@ BoundCudaBvh::BoundCudaBvh(std::shared_ptr<const PreparedMesh> mesh, const Sampl
         if (!build_on_device<T>()) upload_host_tree<T>();
     });
     if (kernel_ == BvhGpuKernel::Candidates) candidate_stats_.allocate(4);
+    if (kernel_ == BvhGpuKernel::Warp) warp_queue_.allocate(1);
+}
+
+unsigned long long* BoundCudaBvh::warp_queue() const {
+    static const bool off = [] {
+        const char* e = std::getenv("SDF_WARP_QUEUE");
+        return e != nullptr && std::strcmp(e, "off") == 0;
+    }();
+    return off ? nullptr : warp_queue_.get();
 }
 
 /// A tree built on the host (the mesh's own, PreparedMesh::bvh()) goes up with the double

@@ -38,11 +38,11 @@ __global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t
     if (i < n) sorted[i] = points[order[i]];
 }
 /// Points per thread of the warp search over `n` listed points on a GPU of `sms`
-/// multiprocessors: 4, the lattice's, where the list fills the GPU's resident warps many
-/// times over; fewer for sparser lists, whose 128-point warps leave the GPU to a few long,
-/// divergent traversals. Measured on an H200 (docs/gpu-notes.md): 1M points 6.1 -> 5.6 ms
-/// uniform, 6.9 -> 6.1 ms near the surface at 2; 16.8M points fastest at 4.
-/// SDF_LIST_RUN (1, 2 or 4) overrides the rule, for measurement.
+/// multiprocessors: 2 where the list fills the GPU's resident warps 32 times over at 2, else
+/// 1. With the resident warps taking batches from a counter (WarpBatches), measured on an H200
+/// (docs/gpu-notes.md): 1M points near the surface 3.47 ms at 1, 4.04 at 2, 5.43 at 4; 16.8M
+/// points 26.6, 25.4, 28.8 ms (uniform 32.9, 30.8, 34.0). SDF_LIST_RUN (1, 2 or 4) overrides
+/// the rule, for measurement.
 int list_points_per_thread(int64_t n, int sms) {
     static const int forced = [] {
         const char* e = std::getenv("SDF_LIST_RUN");
@@ -51,9 +51,7 @@ int list_points_per_thread(int64_t n, int sms) {
     }();
     if (forced) return forced;
     const int64_t resident_warps = int64_t(sms) * kFusedMinBlocks * (kBvhThreads / 32);
-    if (n / (32 * 4) >= 16 * resident_warps) return 4;
-    if (n / (32 * 2) >= 2 * resident_warps) return 2;
-    return 1;
+    return n / (32 * 2) >= 32 * resident_warps ? 2 : 1;
 }
 
 /// Whether the point lists' certified search lists its candidates for a re-rank after the
@@ -67,19 +65,31 @@ bool list_certificate_candidates() {
     return !streamed;
 }
 
+/// Entries of each point's NearLists: kNearListSlots, or SDF_NEAR_LIST_SLOTS (2 to 64), for
+/// measurement.
+int near_list_slots() {
+    static const int slots = [] {
+        const char* e = std::getenv("SDF_NEAR_LIST_SLOTS");
+        const int v = e ? std::atoi(e) : 0;
+        return v >= 2 && v <= 64 ? v : kNearListSlots;
+    }();
+    return slots;
+}
+
 /// Device arrays of NearLists for `n` points, and of the sides nearest_side() finds from
 /// them where `sides` (the certified winding sign with its table of sides).
 struct NearListBuffers {
+    int slots;
     DeviceBuffer<int32_t> slot, count;
     DeviceBuffer<float> q, best_q;
     DeviceBuffer<int8_t> side;
     /// Bytes per point: the slots and their Q, the count, the winner's Q, the side.
-    static constexpr size_t kBytesPerPoint = kNearListSlots * (sizeof(int32_t) + sizeof(float)) + 2 * 4 + 1;
-    NearListBuffers(int64_t n, bool sides)
-        : slot{size_t(n) * kNearListSlots}, count{size_t(n)}, q{size_t(n) * kNearListSlots}, best_q{size_t(n)} {
+    static size_t bytes_per_point(int slots) { return size_t(slots) * (sizeof(int32_t) + sizeof(float)) + 2 * 4 + 1; }
+    NearListBuffers(int64_t n, int entries, bool sides)
+        : slots(entries), slot{size_t(n) * size_t(entries)}, count{size_t(n)}, q{size_t(n) * size_t(entries)}, best_q{size_t(n)} {
         if (sides) side.allocate(size_t(n));
     }
-    NearLists view() { return {slot.get(), q.get(), count.get(), best_q.get()}; }
+    NearLists view() { return {slot.get(), q.get(), count.get(), best_q.get(), slots}; }
 };
 
 /// The current device's multiprocessors.
@@ -322,12 +332,12 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     const WindingSignView sign = dev.winding.view();
     const bool sides = sign.enabled() && sign.certify && sign.surface.front_winding != nullptr &&
                        SamplerSign::winding_options().nearest_sides;
-    // The lists where a quarter of the device's free memory holds them (73 bytes a point);
+    // The lists where a quarter of the device's free memory holds them (137 bytes a point);
     // otherwise the streamed certificate, which needs none (the same results).
     std::optional<NearListBuffers> lists;
     if (fused.exact != nullptr && kernel_ == BvhGpuKernel::Warp && list_certificate_candidates() &&
-        size_t(step) * NearListBuffers::kBytesPerPoint <= free_device_memory() / 4)
-        lists.emplace(step, sides);
+        size_t(step) * NearListBuffers::bytes_per_point(near_list_slots()) <= free_device_memory() / 4)
+        lists.emplace(step, near_list_slots(), sides);
     const NearLists near_lists = lists ? lists->view() : NearLists{};
     const NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
     for (int64_t begin = 0; begin < n; begin += step) {
@@ -336,8 +346,7 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
         const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
         const PointListPiece list{sorted_points.get(), begin, piece.count};
         const auto warp = [&](auto layout) {
-            launch_bvh_warp(blocks_for(layout.threads(), kBvhThreads), dev.view, layout, BandSearch{}, fused, r.nearest.get(),
-                            near_lists);
+            launch_bvh_warp(dev.view, layout, BandSearch{}, fused, r.nearest.get(), near_lists, warp_queue());
         };
         if (kernel_ == BvhGpuKernel::Candidates) {
             const ListLayout layout{list};

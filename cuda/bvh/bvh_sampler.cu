@@ -58,7 +58,7 @@ void BoundCudaBvh::launch_slab(const DeviceBvh<T>& dev, const GridRangePiece& pi
             nearest_triangle_bvh_slab<T, BvhGpuKernel::Unseeded><<<blocks, kBvhThreads>>>(view, piece, slab, nearest);
             break;
         case BvhGpuKernel::Warp:
-            launch_bvh_warp(blocks, view, SlabLayout{piece, slab}, band_search(dev), cert, nearest);
+            launch_bvh_warp(view, SlabLayout{piece, slab}, band_search(dev), cert, nearest, {}, warp_queue());
             break;
         case BvhGpuKernel::Candidates:
             nearest_triangle_bvh_candidates<T><<<blocks, kBvhThreads>>>(view, SlabLayout{piece, slab}, band_search(dev),

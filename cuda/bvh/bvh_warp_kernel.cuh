@@ -10,7 +10,9 @@
 /// its own exact minimum (up to ties). Leaves are scanned by every thread for its 4 points.
 #pragma once
 
+#include <algorithm>
 #include <type_traits>
+#include <utility>
 
 #include "kernels/bvh/closest_triangles_packet.h"
 #include "kernels/bvh/streamed_certificate.h"
@@ -24,16 +26,41 @@ namespace sdf::cuda {
 
 constexpr unsigned kFullWarp = 0xffffffffu;
 
+namespace detail {
+
+/// A float's bits as an int whose signed order is the float's (a negative float's magnitude
+/// bits flipped; the map is its own inverse), so a float min or max over the warp is one
+/// integer reduction (redux.sync) instead of five dependent shuffles.
+__device__ SDF_INLINE int ordered_bits(float v) {
+    const int i = __float_as_int(v);
+    return i ^ ((i >> 31) & 0x7fffffff);
+}
+__device__ SDF_INLINE float from_ordered_bits(int i) { return __int_as_float(i ^ ((i >> 31) & 0x7fffffff)); }
+
+}  // namespace detail
+
 template <typename T>
 __device__ SDF_INLINE T warp_min(T v) {
-    for (int o = 16; o > 0; o >>= 1) v = min(v, __shfl_xor_sync(kFullWarp, v, o));
-    return v;
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
+    if constexpr (std::is_same_v<T, float>) return detail::from_ordered_bits(__reduce_min_sync(kFullWarp, detail::ordered_bits(v)));
+    else
+#endif
+    {
+        for (int o = 16; o > 0; o >>= 1) v = min(v, __shfl_xor_sync(kFullWarp, v, o));
+        return v;
+    }
 }
 
 template <typename T>
 __device__ SDF_INLINE T warp_max(T v) {
-    for (int o = 16; o > 0; o >>= 1) v = max(v, __shfl_xor_sync(kFullWarp, v, o));
-    return v;
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
+    if constexpr (std::is_same_v<T, float>) return detail::from_ordered_bits(__reduce_max_sync(kFullWarp, detail::ordered_bits(v)));
+    else
+#endif
+    {
+        for (int o = 16; o > 0; o >>= 1) v = max(v, __shfl_xor_sync(kFullWarp, v, o));
+        return v;
+    }
 }
 
 /// Where a warp's points come from: thread t owns `count` consecutive piece-local ids from
@@ -298,21 +325,33 @@ __device__ SDF_INLINE void write_nearest(const BvhView<T>& bvh, const BvhPacket<
     }
 }
 
-/// The warp search of a lattice slab or a sorted point list; kCertified (float only) fuses
-/// the certified search (kernels/bvh/streamed_certificate.h) into it, so `nearest` receives
-/// the double search's triangles without the separate certify pass; kListed leaves each
-/// point's candidates in `lists` for rerank_near_lists() instead of streaming them in double.
-template <typename T, typename Layout, bool kCertified, bool kListed = false, int kMinBlocks = kCertified ? kFusedMinBlocks : 1>
-__global__ void __launch_bounds__(kBvhThreads, kMinBlocks)
-    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest,
-                              NearLists lists = {}) {
-    constexpr int kWarps = kBvhThreads / 32;
-    __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
-    __shared__ T stack_d2[kWarps][kBvhMaxDepth];
-    const int w = threadIdx.x / 32;
+/// Where each warp of a search takes its batches of 32 threads from: without a counter the
+/// grid's warps take one batch each (warp w, batch w); with one, a grid of resident warps
+/// takes batch after batch from it (persistent threads, Aila & Laine 2009), so a warp whose
+/// batch ends early does not idle until the slowest warp of its block ends.
+struct WarpBatches {
+    unsigned long long* next = nullptr;  ///< the next batch to take, zeroed before the launch
+    int64_t count = 0;                   ///< batches: the layout's threads / 32, rounded up
 
-    // Every thread stays to the end: the votes and shuffles need the whole warp.
-    const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    /// The grid's warp `grid_warp`'s first batch (`first`) or its next (every lane calls
+    /// it): `count` or more when none is left.
+    __device__ SDF_INLINE int64_t take(int64_t grid_warp, bool first) const {
+        if (next == nullptr) return first ? grid_warp : count;
+        unsigned long long b = 0;
+        if (threadIdx.x % 32 == 0) b = atomicAdd(next, 1ull);
+        return int64_t(__shfl_sync(kFullWarp, b, 0));
+    }
+};
+
+/// One batch of the warp search (thread t of the layout in this lane); kCertified (float
+/// only) fuses the certified search (kernels/bvh/streamed_certificate.h), so `nearest`
+/// receives the double search's triangles without the separate certify pass; kListed leaves
+/// each point's candidates in `lists` for rerank_near_lists() instead of streaming them in
+/// double.
+template <typename T, typename Layout, bool kCertified, bool kListed>
+__device__ SDF_INLINE void warp_search_batch(const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
+                                             const StreamedCertify& cert, int* nearest, const NearLists& lists, int64_t t,
+                                             int32_t* stack_node, T* stack_d2) {
     int64_t first = 0;
     BvhPacket<T, Layout::kPoints> pk;
     const int count = load_packet<T>(layout, t, first, pk);
@@ -329,39 +368,79 @@ __global__ void __launch_bounds__(kBvhThreads, kMinBlocks)
     }
     if constexpr (kListed) {
         ListedRun<Layout> policy(cert.slack, RunPoint<Layout>{layout, first, count}, lists, first, count);
-        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
         write_nearest<true, true>(bvh, pk, policy, first, count, cert, nearest);
     } else if constexpr (kCertified) {
         StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
-        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
         write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
     } else {
         PacketPlainNear policy;
-        warp_search(bvh, pk, count > 0, stack_node[w], stack_d2[w], policy);
+        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
         write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
     }
 }
 
+/// The warp search of a lattice slab or a sorted point list, batch by batch (WarpBatches).
+template <typename T, typename Layout, bool kCertified, bool kListed = false, int kMinBlocks = kCertified ? kFusedMinBlocks : 1>
+__global__ void __launch_bounds__(kBvhThreads, kMinBlocks)
+    nearest_triangle_bvh_warp(BvhView<T> bvh, Layout layout, BandSearch band, StreamedCertify cert, int* nearest,
+                              NearLists lists, WarpBatches batches) {
+    constexpr int kWarps = kBvhThreads / 32;
+    __shared__ int32_t stack_node[kWarps][kBvhMaxDepth];
+    __shared__ T stack_d2[kWarps][kBvhMaxDepth];
+    const int w = threadIdx.x / 32;
+    const int64_t grid_warp = (int64_t(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+    // Every lane stays to the end of each batch: the votes and shuffles need the whole warp.
+    for (int64_t b = batches.take(grid_warp, true); b < batches.count; b = batches.take(grid_warp, false))
+        warp_search_batch<T, Layout, kCertified, kListed>(bvh, layout, band, cert, nearest, lists,
+                                                          b * 32 + threadIdx.x % 32, stack_node[w], stack_d2[w]);
+}
+
+/// The grid of a warp search over `layout`: one warp a batch, or with `queue` (a device
+/// counter) only the warps the GPU holds at once, taking batches from it.
+template <typename Kernel, typename Layout>
+std::pair<int, WarpBatches> warp_grid(Kernel kernel, const Layout& layout, unsigned long long* queue) {
+    WarpBatches batches{nullptr, (layout.threads() + 31) / 32};
+    int blocks = blocks_for(layout.threads(), kBvhThreads);
+    if (queue != nullptr) {
+        int device = 0, sms = 1, per_sm = 1;
+        CUDA_CHECK(cudaGetDevice(&device));
+        CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+        CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, kernel, kBvhThreads, 0));
+        if (int64_t(blocks) > int64_t(sms) * per_sm) {  // fewer: one batch each, no counter
+            blocks = sms * std::max(per_sm, 1);
+            CUDA_CHECK(cudaMemsetAsync(queue, 0, sizeof *queue));
+            batches.next = queue;
+        }
+    }
+    return {blocks, batches};
+}
+
 /// Launches the warp search, with the certificate fused when `cert` holds one (float): its
 /// candidates listed in `lists` where given (rerank_near_lists() then finishes it),
-/// otherwise streamed.
+/// otherwise streamed. `queue` (a device counter, or null): resident warps take the
+/// batches from it (WarpBatches).
 template <typename T, typename Layout>
-void launch_bvh_warp(int blocks, const BvhView<T>& bvh, const Layout& layout, const BandSearch& band,
-                     const StreamedCertify& cert, int* nearest, const NearLists& lists = {}) {
+void launch_bvh_warp(const BvhView<T>& bvh, const Layout& layout, const BandSearch& band, const StreamedCertify& cert,
+                     int* nearest, const NearLists& lists = {}, unsigned long long* queue = nullptr) {
+    const auto launch = [&](auto kernel) {
+        const auto [blocks, batches] = warp_grid(kernel, layout, queue);
+        kernel<<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, lists, batches);
+    };
     if constexpr (std::is_same_v<T, float>) {
         if constexpr (lists_candidates<Layout>::value) {
             if (cert.exact && lists.enabled()) {
-                nearest_triangle_bvh_warp<T, Layout, true, true, listed_min_blocks<Layout>()>
-                    <<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest, lists);
+                launch(nearest_triangle_bvh_warp<T, Layout, true, true, listed_min_blocks<Layout>()>);
                 return;
             }
         }
         if (cert.exact) {
-            nearest_triangle_bvh_warp<T, Layout, true><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
+            launch(nearest_triangle_bvh_warp<T, Layout, true>);
             return;
         }
     }
-    nearest_triangle_bvh_warp<T, Layout, false><<<blocks, kBvhThreads>>>(bvh, layout, band, cert, nearest);
+    launch(nearest_triangle_bvh_warp<T, Layout, false>);
 }
 
 }  // namespace sdf::cuda

@@ -64,36 +64,50 @@ __device__ inline void warp_count(unsigned long long* counter, bool flag) {
     if ((threadIdx.x % 32) == unsigned(__ffs(active) - 1) && votes != 0) atomicAdd(counter, (unsigned long long)__popc(votes));
 }
 
+/// A certified float search at p seeded with `seed`, keeping N candidates, re-ranked in
+/// double (r.overflow: more than N within the bound); `hit` receives the float winner.
+template <int N>
+__device__ inline Rerank certified_candidates(const CertifyView& v, const Vec3d& p, const BvhHit<float>& seed, BvhHit<float>& hit) {
+    const Vec3f pt(p);
+    NoBvhStats none;
+    CertifiedNear<float, N> near{v.slack, {}};
+    hit = closest_triangle_bvh(v.bvh, pt, seed, none, near);
+    auto index_of = [&](int32_t s) { return v.bvh.triangle_index[s]; };
+    return rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, hit.slot, v.slack.radius(hit.distance_squared), near.near);
+}
+
+/// The double search's triangle at p from `seed` (a float winner's hit) where more than
+/// kNearCandidates lie within the bound: kWideCandidates kept, and beyond that the double
+/// search seeded with it.
+__device__ inline int32_t wide_certified_slot(const CertifyView& v, const Vec3d& p, const BvhHit<float>& seed) {
+    BvhHit<float> hit;
+    const Rerank r = certified_candidates<kWideCandidates>(v, p, seed, hit);
+    return r.overflow ? closest_triangle_bvh(v.exact, p, seed_hit(v.exact, seed.slot, p)).slot : r.slot;
+}
+
 /// The double search's triangle at p from a float winner `triangle` (prepared-mesh index):
 /// a certified float search seeded with it, keeping kNearCandidates and then, where more
 /// lie within the bound, kWideCandidates; beyond that the double search seeded with it.
 /// `reranked`: double evaluations were needed; `full`: more than kNearCandidates.
 __device__ inline int32_t certified_triangle(const CertifyView& v, const Vec3d& p, int32_t triangle, bool& reranked, bool& full) {
     const Vec3f pt(p);
-    NoBvhStats none;
-    CertifiedNear<float> near{v.slack, {}};
-    const BvhHit<float> hit = closest_triangle_bvh(v.bvh, pt, seed_hit(v.bvh, v.slot_of[triangle], pt), none, near);
-    auto index_of = [&](int32_t s) { return v.bvh.triangle_index[s]; };
-    Rerank r = rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, hit.slot, v.slack.radius(hit.distance_squared),
-                                near.near);
+    const BvhHit<float> seed = seed_hit(v.bvh, v.slot_of[triangle], pt);
+    BvhHit<float> hit;
+    Rerank r = certified_candidates<kNearCandidates>(v, p, seed, hit);
     full = r.overflow;
     if (r.overflow) {
-        CertifiedNear<float, kWideCandidates> wide{v.slack, {}};
-        const BvhHit<float> again = closest_triangle_bvh(v.bvh, pt, hit, none, wide);
-        r = rerank_in_double(v.exact.packed, index_of, p.x, p.y, p.z, again.slot, v.slack.radius(again.distance_squared),
-                             wide.near);
-        if (r.overflow) r.slot = closest_triangle_bvh(v.exact, p, seed_hit(v.exact, hit.slot, p)).slot;
+        r.slot = wide_certified_slot(v, p, hit);
         r.reranked = true;
     }
     reranked = r.reranked;
     return v.bvh.triangle_index[r.slot];
 }
 
-/// certified_triangle() out of line, for rerank_near_lists: its candidate arrays and walks
-/// are for the 0.4-0.9% of lists that overflow, not for every point's path.
+/// The double search's triangle at p for an overflowed list (more than its slots within the
+/// bound): the wide search at once. Out of line: its candidate arrays and walks are for
+/// the 0.4-0.9% of lists that overflow, not for every point's path.
 static __device__ __noinline__ int32_t overflowed_list_triangle(const CertifyView& v, Vec3d p, int32_t triangle) {
-    bool reranked = false, full = false;
-    return certified_triangle(v, p, triangle, reranked, full);
+    return v.bvh.triangle_index[wide_certified_slot(v, p, seed_hit(v.bvh, v.slot_of[triangle], Vec3f(p)))];
 }
 
 /// At most 72 registers (seven blocks of 128 threads an SM): ptxas chose 78 for the three
@@ -144,7 +158,7 @@ __global__ void __launch_bounds__(128)
         const int32_t count = lists.count[i];
         if (count > 0) {
             const SignedDistanceSample<double> s = signed_distance_to_triangle(sides.mesh, p, t);
-            const NearTriangles near{lists.slot + i * kNearListSlots, count, beyond_candidates_squared(v.slack, lists.best_q[i])};
+            const NearTriangles near{lists.slot + i * lists.slots, count, beyond_candidates_squared(v.slack, lists.best_q[i])};
             bool inside = false;
             if (nearest_side(sides.surface, sides.winding, p, t, s.distance, s.closest_point, near, inside)) side = inside ? 1 : 0;
         }

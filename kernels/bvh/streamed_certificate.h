@@ -28,8 +28,10 @@
 /// deferred ones; rerank_near_list() then re-ranks the list's triangles within R in double in
 /// a pass of its own, so the walk carries no double state, and leaves them to the winding
 /// sign's nearest_side(). The same argument holds: every triangle whose ranked Q is within R
-/// was met within the radius of its time, and is in the list or deferred at the end; a list
-/// that outgrows kNearListSlots sends its point to the separate pass's seeded certified search.
+/// was met within the radius of its time, and is in the list or deferred at the end (a full
+/// list drops only entries beyond the radius of their time, or, remembering the smallest Q
+/// it dropped, its largest); a list that had to drop one within R sends its point to the
+/// separate pass's seeded certified search.
 #pragma once
 
 #include "kernels/bvh/closest_triangles_packet.h"
@@ -202,14 +204,14 @@ struct StreamedCertifiedNear : DeferredCertifiedNear<T, K, PointOf, FoldInDouble
         : DeferredCertifiedNear<T, K, PointOf, FoldInDouble<K>>(s, p, FoldInDouble<K>(e)) {}
 };
 
-/// Candidates a listed certificate keeps per point; a point offered more (a vertex of that
-/// many triangles within the bound) takes the separate pass's seeded certified search
+/// Candidates a listed certificate keeps per point by default (NearLists::slots); a point
+/// with more within its final radius (a vertex of that many triangles within the bound) takes the separate pass's seeded certified search
 /// (certify_kernel.cuh, counted as full_double).
-constexpr int kNearListSlots = 8;
+constexpr int kNearListSlots = 16;
 
 /// Per point of a search (index i), what the listed certificate leaves for the re-rank
-/// (rerank_near_list): up to kNearListSlots candidates (BVH slots, ranked float Q) at
-/// [i * kNearListSlots, ...), how many were offered (more than kNearListSlots: overflow),
+/// (rerank_near_list): up to `slots` candidates (BVH slots, ranked float Q) at
+/// [i * slots, ...), how many it holds (slots + 1: overflowed),
 /// and the float winner's Q. After the re-rank `slot` holds the live candidates' triangle
 /// indices (the winner among them) and `count` their number (0: unknown, an overflow):
 /// nearest_side()'s NearTriangles.
@@ -218,45 +220,68 @@ struct NearLists {
     float* q = nullptr;
     int32_t* count = nullptr;
     float* best_q = nullptr;
+    int slots = kNearListSlots;  ///< entries per point
     SDF_CPU_GPU bool enabled() const { return slot != nullptr; }
 };
 
 /// The fused certificate's spill to memory: lane k (point row + k, a real point where k <
 /// real) appends the candidates that find both deferred slots live to its list, and at the
 /// end its live deferred ones; the double work is left to rerank_near_list, off the walk.
+///
+/// A full list first drops the entries beyond the lane's current radius (stale: the radius
+/// only shrinks, so they lie beyond the final one too). Still full, it keeps the `slots`
+/// smallest ranked Q of the list and the new entry and remembers the smallest Q it dropped:
+/// the list overflows only where that one lies within the final radius (more than `slots`
+/// candidates at the end, a vertex of that many triangles), not where
+/// the radius was still large when the list filled (a point far from the surface).
 template <int K>
 struct NearListAppend {
     NearLists lists;
     int64_t row = 0;  ///< the list of lane 0's point
     int real = 0;     ///< lanes [0, real) hold points; the others repeat lane 0's
     int32_t listed[K];
+    float dropped[K];  ///< the smallest ranked Q dropped from a full list (+inf: none)
 
     SDF_CPU_GPU NearListAppend(const NearLists& l, int64_t first, int count) : lists(l), row(first), real(count) {
-        for (int k = 0; k < K; ++k) listed[k] = 0;
+        for (int k = 0; k < K; ++k) {
+            listed[k] = 0;
+            dropped[k] = INFINITY;
+        }
     }
 
-    /// Appends to lane k's list; a full list first drops the entries beyond `radius` (the
-    /// lane's current one: stale since the radius shrank), and still full, it overflows.
+    /// Appends to lane k's list, `radius` the lane's current one.
     SDF_CPU_GPU SDF_INLINE void append(int k, int32_t slot, float q, float radius) {
         SDF_UNROLL_LANES
         for (int l = 0; l < K; ++l) {
             if (l != k) continue;
-            int32_t* slots = lists.slot + (row + l) * kNearListSlots;
-            float* qs = lists.q + (row + l) * kNearListSlots;
-            if (listed[l] == kNearListSlots) {  // this thread's own writes: read back in order
-                int kept = 0;
-                for (int c = 0; c < kNearListSlots; ++c)
-                    if (qs[c] <= radius) {
-                        slots[kept] = slots[c];
-                        qs[kept++] = qs[c];
-                    }
-                listed[l] = kept;
-            }
-            if (listed[l] < kNearListSlots) {
+            const int full = lists.slots;
+            int32_t* slots = lists.slot + (row + l) * full;
+            float* qs = lists.q + (row + l) * full;
+            if (listed[l] < full) {
                 slots[listed[l]] = slot;
-                qs[listed[l]] = q;
+                qs[listed[l]++] = q;
+                continue;
             }
-            if (listed[l] <= kNearListSlots) ++listed[l];  // kNearListSlots + 1: overflowed, for good
+            // Full: this thread's own writes, read back in order.
+            int kept = 0, largest = 0;
+            for (int c = 0; c < full; ++c)
+                if (qs[c] <= radius) {
+                    slots[kept] = slots[c];
+                    qs[kept] = qs[c];
+                    if (qs[kept] > qs[largest]) largest = kept;
+                    ++kept;
+                }
+            if (kept < full) {
+                slots[kept] = slot;
+                qs[kept++] = q;
+            } else if (q < qs[largest]) {
+                dropped[l] = fminf(dropped[l], qs[largest]);
+                slots[largest] = slot;
+                qs[largest] = q;
+            } else {
+                dropped[l] = fminf(dropped[l], q);
+            }
+            listed[l] = kept;
         }
     }
 
@@ -265,17 +290,23 @@ struct NearListAppend {
         if (k < real) append(k, slot, float(q), float(radius));
     }
 
+    /// Writes lane k's count (lists.slots + 1: overflowed) and winner's Q.
     template <typename Bvh, typename PointOf, typename T, int D>
     SDF_CPU_GPU SDF_INLINE int32_t finish(const Bvh&, const PointOf&, int k, const BvhPacket<T, K>& pk,
                                           const int32_t (&slot)[D], const T (&q)[D], unsigned live, bool& reranked) {
         reranked = false;
         if (k >= real) return pk.best_triangle[k];
+        const float radius = float(pk.radius[k]);
         for (int d = 0; d < D; ++d)
-            if (live >> d & 1u) append(k, slot[d], float(q[d]), float(pk.radius[k]));
+            if (live >> d & 1u) append(k, slot[d], float(q[d]), radius);
         int32_t n = 0;
+        float lost = INFINITY;
         SDF_UNROLL_LANES
-        for (int l = 0; l < K; ++l) n = l == k ? listed[l] : n;
-        lists.count[row + k] = n;
+        for (int l = 0; l < K; ++l) {
+            n = l == k ? listed[l] : n;
+            lost = l == k ? dropped[l] : lost;
+        }
+        lists.count[row + k] = lost <= radius ? lists.slots + 1 : n;
         lists.best_q[row + k] = float(pk.best_q[k]);
         return pk.best_triangle[k];
     }
@@ -301,14 +332,14 @@ SDF_CPU_GPU inline int32_t rerank_near_list(const NearLists& lists, int64_t i, c
                                             const Vec3d& p, int32_t winner, FullSearch full_search, bool& reranked,
                                             bool& overflow) {
     const int32_t offered = lists.count[i];
-    overflow = offered > kNearListSlots;
+    overflow = offered > lists.slots;
     reranked = overflow;
     if (overflow) {
         lists.count[i] = 0;
         return full_search(p);
     }
-    int32_t* slot = lists.slot + i * kNearListSlots;
-    const float* q = lists.q + i * kNearListSlots;
+    int32_t* slot = lists.slot + i * lists.slots;
+    const float* q = lists.q + i * lists.slots;
     const float r = slack.radius(lists.best_q[i]);
     int live = 0;
     for (int c = 0; c < offered; ++c)
