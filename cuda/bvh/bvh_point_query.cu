@@ -33,9 +33,13 @@ __global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv
     identity[i] = i;
 }
 
-__global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t n, Vec3d* sorted) {
+/// sorted[i] = the point at input position order[i]; with `rank`, rank[order[i]] = i too.
+__global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t n, Vec3d* sorted, int32_t* rank) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i < n) sorted[i] = points[order[i]];
+    if (i >= n) return;
+    const int64_t o = order[i];
+    sorted[i] = points[o];
+    if (rank != nullptr) rank[o] = int32_t(i);
 }
 /// Points per thread of the warp search over `n` listed points on a GPU of `sms`
 /// multiprocessors: 2 where the list fills the GPU's resident warps 32 times over at 2, else
@@ -121,8 +125,9 @@ struct MortonSort {
                                                    identity.get(), n, kSortBeginBit, kSortEndBit));
         temp.allocate(temp_bytes);
     }
-    /// `sorted` receives the points in key order, `order` their input positions.
-    void run(const PreparedMesh& mesh, const Vec3d* points, Vec3d* sorted, int64_t* order) {
+    /// `sorted` receives the points in key order, `order` their input positions and `rank`
+    /// (or null) the inverse: each input position's place in key order.
+    void run(const PreparedMesh& mesh, const Vec3d* points, Vec3d* sorted, int64_t* order, int32_t* rank) {
         const Bounds3& box = mesh.bounds();
         const Vec3d extent = box.extent();
         const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
@@ -130,7 +135,7 @@ struct MortonSort {
         CUDA_CHECK_LAUNCH("morton_keys");
         CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
                                                    n, kSortBeginBit, kSortEndBit));
-        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted);
+        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted, rank);
         CUDA_CHECK_LAUNCH("gather_points");
     }
 };
@@ -242,8 +247,9 @@ std::vector<PointSample> BoundCudaBvh::query_as(const std::vector<Vec3d>& points
     upload.end();
     DeviceBuffer<PointSample> device_out{size_t(n)};
     const double coordinate = largest_coordinate(points);
-    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
-        store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(), device_out.get());
+    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate,
+                     [&](const PieceResults& r, int64_t count, const ResultOrder& order) {
+        store_point_samples<<<blocks_for(count, 256), 256>>>(r.outputs(), count, order, dev.source_triangle.get(), device_out.get());
         CUDA_CHECK_LAUNCH("store_point_samples");
     });
     // The results are in input order on the device already: one copy, no host scatter.
@@ -272,8 +278,9 @@ void BoundCudaBvh::query_device_as(const DevicePoints& points, const DeviceQuery
     DeviceBuffer<Vec3d> device_points{size_t(n)};
     const double coordinate = read_points(points, device_points.get());
     CertificateCounters certificate;
-    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate, [&](const PieceResults& r, int64_t count) {
-        store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs(), count, dev.source_triangle.get(), results);
+    search_points<T>(dev, device_points.get(), n, coordinate, compute, certificate,
+                     [&](const PieceResults& r, int64_t count, const ResultOrder& order) {
+        store_point_columns<<<blocks_for(count, 256), 256>>>(r.outputs(), count, order, dev.source_triangle.get(), results);
         CUDA_CHECK_LAUNCH("store_point_columns");
     });
     CUDA_CHECK(cudaStreamSynchronize(0));
@@ -314,8 +321,9 @@ double BoundCudaBvh::read_points(const DevicePoints& points, Vec3d* out) const {
 }
 
 /// Morton sort, warp (or candidates) search and finalize of n device points, piece by
-/// piece; `store(results, count)` takes each piece's results to their input positions, and
-/// `certificate` the float search's certificate counters.
+/// piece; `store(results, count, order)` takes each piece's results to their input positions
+/// (ResultOrder: gathered where the list is one piece), and `certificate` the float search's
+/// certificate counters.
 template <typename T, typename Store>
 void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_points, int64_t n, double coordinate,
                                  EventTimer& compute, CertificateCounters& certificate, Store store) const {
@@ -326,6 +334,10 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     MortonSort sort(n);
     int64_t step = n;
     if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
+    // One piece of fewer than 2^31 points: its results gathered into input order.
+    const bool gather = step == n && n <= int64_t(INT32_MAX);
+    DeviceBuffer<int32_t> rank{gather ? size_t(n) : 0};
+    const ResultOrder result_order{rank.get()};
     PieceResults r(step);  // reused by every piece
     const int run = list_points_per_thread(step, multiprocessors());
     const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
@@ -342,7 +354,7 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     const NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
     for (int64_t begin = 0; begin < n; begin += step) {
         compute.begin();
-        if (begin == 0) sort.run(mesh(), device_points, sorted_points.get(), order.get());
+        if (begin == 0) sort.run(mesh(), device_points, sorted_points.get(), order.get(), rank.get());
         const SortedPointListPiece piece{sorted_points.get(), order.get(), begin, std::min(step, n - begin)};
         const PointListPiece list{sorted_points.get(), begin, piece.count};
         const auto warp = [&](auto layout) {
@@ -362,10 +374,12 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         if (near_lists.enabled()) rerank_lists(dev, piece, coordinate, near_lists, r.nearest.get(), side_inputs);
-        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), sign, options_.band_width, r.outputs(),
+        PieceOutputs outputs = r.outputs();
+        if (result_order.rank != nullptr) outputs.output_index = nullptr;  // the store gathers by rank
+        launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), sign, options_.band_width, outputs,
                                 side_inputs.side);
         CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");
-        store(r, piece.count);
+        store(r, piece.count, result_order);
         compute.end();
     }
     read_certificate(dev, certificate);

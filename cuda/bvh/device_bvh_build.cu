@@ -162,13 +162,24 @@ __global__ void lbvh_refit(LbvhArrays a) {
 /// counters: [0] depth, [1] leaves, [2] largest leaf.
 __global__ void lbvh_radius(LbvhArrays a, int* counters) {
     const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= a.n - 1 || !lbvh_kept(a, i)) return;
-    atomicMax(&counters[0], lbvh_radius_from(a, i));
-    for (int c = 0; c < 2; ++c) {
-        const int count = lbvh_child_count(a, i, c);
-        if (count > a.max_leaf) continue;
-        atomicAdd(&counters[1], 1);
-        atomicMax(&counters[2], count);
+    int depth = 0, leaves = 0, largest = 0;
+    if (i < a.n - 1 && lbvh_kept(a, i)) {
+        depth = lbvh_radius_from(a, i);
+        for (int c = 0; c < 2; ++c) {
+            const int count = lbvh_child_count(a, i, c);
+            if (count > a.max_leaf) continue;
+            ++leaves;
+            largest = max(largest, count);
+        }
+    }
+    // One atomic per warp and counter: the node's own would serialise on three addresses.
+    depth = __reduce_max_sync(0xffffffffu, depth);
+    leaves = __reduce_add_sync(0xffffffffu, leaves);
+    largest = __reduce_max_sync(0xffffffffu, largest);
+    if (threadIdx.x % 32 == 0 && leaves > 0) {
+        atomicMax(&counters[0], depth);
+        atomicAdd(&counters[1], leaves);
+        atomicMax(&counters[2], largest);
     }
 }
 
@@ -176,22 +187,25 @@ __global__ void lbvh_radius(LbvhArrays a, int* counters) {
 /// here in another order, so equal to rounding).
 __global__ void lbvh_sah(const BvhNode* nodes, int num_nodes, double node_cost, double* sum) {
     const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= num_nodes) return;
     auto area = [](const BvhNode& n, int c) {
         const double ex = double(n.max_x[c]) - n.min_x[c], ey = double(n.max_y[c]) - n.min_y[c],
                      ez = double(n.max_z[c]) - n.min_z[c];
         return ex < 0 ? 0.0 : 2.0 * (ex * ey + ey * ez + ez * ex);
     };
-    const BvhNode& root = nodes[0];
-    double lo[3] = {fmin(root.min_x[0], root.min_x[1]), fmin(root.min_y[0], root.min_y[1]), fmin(root.min_z[0], root.min_z[1])};
-    double hi[3] = {fmax(root.max_x[0], root.max_x[1]), fmax(root.max_y[0], root.max_y[1]), fmax(root.max_z[0], root.max_z[1])};
-    const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
-    const double root_area = fmax(2.0 * (ex * ey + ey * ez + ez * ex), 1e-300);
-    const BvhNode& n = nodes[i];
-    double cost = i == 0 ? node_cost : 0.0;
-    for (int c = 0; c < 2; ++c)
-        cost += area(n, c) / root_area * (n.count[c] > 0 ? double(n.count[c]) : (n.ref[c] > 0 ? node_cost : 0.0));
-    atomicAdd(sum, cost);
+    double cost = 0.0;
+    if (i < num_nodes) {
+        const BvhNode& root = nodes[0];
+        double lo[3] = {fmin(root.min_x[0], root.min_x[1]), fmin(root.min_y[0], root.min_y[1]), fmin(root.min_z[0], root.min_z[1])};
+        double hi[3] = {fmax(root.max_x[0], root.max_x[1]), fmax(root.max_y[0], root.max_y[1]), fmax(root.max_z[0], root.max_z[1])};
+        const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
+        const double root_area = fmax(2.0 * (ex * ey + ey * ez + ez * ex), 1e-300);
+        const BvhNode& n = nodes[i];
+        cost = i == 0 ? node_cost : 0.0;
+        for (int c = 0; c < 2; ++c)
+            cost += area(n, c) / root_area * (n.count[c] > 0 ? double(n.count[c]) : (n.ref[c] > 0 ? node_cost : 0.0));
+    }
+    for (int o = 16; o > 0; o >>= 1) cost += __shfl_xor_sync(0xffffffffu, cost, o);  // one atomic per warp
+    if (threadIdx.x % 32 == 0 && cost != 0.0) atomicAdd(sum, cost);
 }
 
 /// The packed constants of the triangle in slot s, made here (pack_triangle() computes them

@@ -50,18 +50,6 @@ __global__ void store_piece(PieceOutputs piece, int64_t n, StoredChannels<F> out
     if (t == kOutsideBandTriangle) atomicAdd(out.outside_band_count, 1ull);
 }
 
-/// Moves point-list results [0, n) to their input positions (output_index) as PointSample
-/// records, triangles in the mesh file's face order: the host then copies them as they are.
-template <typename Sample>
-__global__ void store_point_samples(PieceOutputs piece, int64_t n, const int32_t* source_triangle, Sample* out) {
-    const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const int64_t o = piece.output_index[i];
-    if (o < 0) return;
-    const int t = piece.triangle[i];
-    out[o] = Sample{piece.distance[i], piece.gradient[i], t < 0 ? t : source_triangle[t]};
-}
-
 /// The device and pinned host buffers of stored slabs. Host buffers are handed out as shared
 /// pointers and taken again only when nobody else holds them (the writer of an earlier slab
 /// may still be copying from one), so two of them alternate while slabs stream to disk.

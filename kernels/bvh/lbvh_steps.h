@@ -99,6 +99,10 @@ SDF_CPU_GPU SDF_INLINE uint32_t lbvh_atomic_add(uint32_t* p, uint32_t v) {
 /// *p = max(*p, v) for v >= 0 (non-negative doubles order as their bit patterns).
 SDF_CPU_GPU SDF_INLINE void lbvh_atomic_max(double* p, double v) {
 #if SDF_IS_GPU_CODE
+    // The value only grows, so a stale read is at most it: skipping the atomic where v does
+    // not exceed it loses nothing, and spares the top nodes, which every leaf below them
+    // raises, most of their serialised atomics.
+    if (!(v > *p)) return;
     atomicMax(reinterpret_cast<unsigned long long*>(p), static_cast<unsigned long long>(__double_as_longlong(v)));
 #else
     if (v > *p) *p = v;
