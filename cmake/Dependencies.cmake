@@ -167,9 +167,10 @@ if(NOT SDF_ENABLE_CUDA STREQUAL "OFF")
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
       # Every current NVIDIA GPU: machine code for Turing (75: T4, RTX 20xx), Ampere (80: A100;
       # 86: A10, RTX 30xx), Ada (89: L4, L40, RTX 40xx) and Hopper (90: H100, H200), and PTX of
-      # 90 that the driver compiles for newer GPUs (Blackwell) on first use. The code uses no
-      # architecture-specific instruction, so every entry runs the same kernels. One
-      # architecture builds faster: -DCMAKE_CUDA_ARCHITECTURES=90 (or native).
+      # 90 that the driver compiles for newer GPUs (Blackwell) on first use. Warp reductions
+      # take redux.sync from sm_80 on and shuffles before (cuda/util/warp_reduce.cuh), with
+      # the same bits; nothing else is architecture-specific. One architecture builds
+      # faster: -DCMAKE_CUDA_ARCHITECTURES=90 (or native).
       set(CMAKE_CUDA_ARCHITECTURES "75-real;80-real;86-real;89-real;90-real;90-virtual"
           CACHE STRING "CUDA architectures: machine code for sm_75 to sm_90, PTX for newer GPUs")
     endif()

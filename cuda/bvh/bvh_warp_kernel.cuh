@@ -20,48 +20,10 @@
 #include "cuda/bvh/bvh_kernel.cuh"
 #include "cuda/sampling/certify_kernel.cuh"
 #include "cuda/sampling/finalize_kernel.cuh"
+#include "cuda/util/warp_reduce.cuh"
 #include "kernels/distance/signed_distance.h"
 
 namespace sdf::cuda {
-
-constexpr unsigned kFullWarp = 0xffffffffu;
-
-namespace detail {
-
-/// A float's bits as an int whose signed order is the float's (a negative float's magnitude
-/// bits flipped; the map is its own inverse), so a float min or max over the warp is one
-/// integer reduction (redux.sync) instead of five dependent shuffles.
-__device__ SDF_INLINE int ordered_bits(float v) {
-    const int i = __float_as_int(v);
-    return i ^ ((i >> 31) & 0x7fffffff);
-}
-__device__ SDF_INLINE float from_ordered_bits(int i) { return __int_as_float(i ^ ((i >> 31) & 0x7fffffff)); }
-
-}  // namespace detail
-
-template <typename T>
-__device__ SDF_INLINE T warp_min(T v) {
-#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
-    if constexpr (std::is_same_v<T, float>) return detail::from_ordered_bits(__reduce_min_sync(kFullWarp, detail::ordered_bits(v)));
-    else
-#endif
-    {
-        for (int o = 16; o > 0; o >>= 1) v = min(v, __shfl_xor_sync(kFullWarp, v, o));
-        return v;
-    }
-}
-
-template <typename T>
-__device__ SDF_INLINE T warp_max(T v) {
-#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 800
-    if constexpr (std::is_same_v<T, float>) return detail::from_ordered_bits(__reduce_max_sync(kFullWarp, detail::ordered_bits(v)));
-    else
-#endif
-    {
-        for (int o = 16; o > 0; o >>= 1) v = max(v, __shfl_xor_sync(kFullWarp, v, o));
-        return v;
-    }
-}
 
 /// Where a warp's points come from: thread t owns `count` consecutive piece-local ids from
 /// `first` (count 0: none). A lattice slab gives every warp an 8 x 4 x 4 brick (SlabGeometry);

@@ -10,6 +10,7 @@
 #include <cub/device/device_scan.cuh>
 
 #include "cuda/util/cuda_check.h"
+#include "cuda/util/warp_reduce.cuh"
 #include "kernels/bvh/lbvh_steps.h"
 #include "kernels/distance/packed_triangle.h"
 
@@ -173,9 +174,9 @@ __global__ void lbvh_radius(LbvhArrays a, int* counters) {
         }
     }
     // One atomic per warp and counter: the node's own would serialise on three addresses.
-    depth = __reduce_max_sync(0xffffffffu, depth);
-    leaves = __reduce_add_sync(0xffffffffu, leaves);
-    largest = __reduce_max_sync(0xffffffffu, largest);
+    depth = warp_max(depth);
+    leaves = warp_sum(leaves);
+    largest = warp_max(largest);
     if (threadIdx.x % 32 == 0 && leaves > 0) {
         atomicMax(&counters[0], depth);
         atomicAdd(&counters[1], leaves);
@@ -204,7 +205,7 @@ __global__ void lbvh_sah(const BvhNode* nodes, int num_nodes, double node_cost, 
         for (int c = 0; c < 2; ++c)
             cost += area(n, c) / root_area * (n.count[c] > 0 ? double(n.count[c]) : (n.ref[c] > 0 ? node_cost : 0.0));
     }
-    for (int o = 16; o > 0; o >>= 1) cost += __shfl_xor_sync(0xffffffffu, cost, o);  // one atomic per warp
+    cost = warp_sum(cost);  // one atomic per warp
     if (threadIdx.x % 32 == 0 && cost != 0.0) atomicAdd(sum, cost);
 }
 
