@@ -2,7 +2,9 @@
 /// @brief Minimum, maximum and sum over the 32 lanes of a warp (every lane must call them):
 /// one redux.sync where the GPU has it (sm_80 and later) for 32-bit integers and for floats
 /// (through bits that order as signed integers), five dependent shuffles otherwise (sm_75,
-/// doubles, other types).
+/// doubles, other types). Float values must not be NaN: the bits order a NaN beyond the
+/// infinities where min()/max() ignore it (the searches' values never are: their points
+/// are checked finite).
 #pragma once
 
 #include <type_traits>
