@@ -205,8 +205,9 @@ struct StreamedCertifiedNear : DeferredCertifiedNear<T, K, PointOf, FoldInDouble
 };
 
 /// Candidates a listed certificate keeps per point by default (NearLists::slots); a point
-/// with more within its final radius (a vertex of that many triangles within the bound) takes the separate pass's seeded certified search
-/// (certify_kernel.cuh, counted as full_double).
+/// with more within its final radius (a vertex of that many triangles within the bound)
+/// takes the separate pass's wide certified search (certify_kernel.cuh, counted as
+/// full_double).
 constexpr int kNearListSlots = 16;
 
 /// Per point of a search (index i), what the listed certificate leaves for the re-rank
