@@ -68,10 +68,8 @@ void ploc_tree(const LbvhArrays& a, int radius, Elements& elements) {
         const int kept = exclusive_sum(p.keeps, keep_scan.data(), p.m);
         if (merged < 1) throw std::logic_error("GPU BVH build: a PLOC iteration merged nothing");
         elements.each(p.m, [&](int i) {
-            if (p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[size_t(i)]));
-        });
-        elements.each(p.m, [&](int i) {
-            if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[size_t(i)]);
+            if (p.keeps[i])
+                ploc_merge_compact(a, p, q, i, p.merges[i] != 0, a.n - 2 - (next_id + merge_scan[size_t(i)]), keep_scan[size_t(i)]);
         });
         next_id += merged;
         std::swap(p.code, q.code);

@@ -2,12 +2,15 @@
 // CUB's radix sort and prefix sum between them (docs/bvh.md, "Build on the GPU").
 #include "cuda/bvh/device_bvh_build.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
 #include <cub/block/block_scan.cuh>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 
 #include "cuda/util/cuda_check.h"
 #include "cuda/util/warp_reduce.cuh"
@@ -49,78 +52,104 @@ __global__ void ploc_nearest_kernel(PlocArrays p) {
     if (i < p.m) ploc_nearest(p, i);
 }
 
-__global__ void ploc_flags_kernel(PlocArrays p) {
-    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i < p.m) ploc_flags(p, i);
-}
+/// Cluster i's flags (ploc_flags_of) packed for one scan of both: merges in the high 32
+/// bits, keeps in the low.
+struct PackedPlocFlags {
+    PlocArrays p;
+    __device__ int64_t operator()(int i) const {
+        int merges = 0, keeps = 0;
+        ploc_flags_of(p, i, merges, keeps);
+        return int64_t(merges) << 32 | keeps;
+    }
+};
 
-__global__ void ploc_merge_kernel(LbvhArrays a, PlocArrays p, const int32_t* merge_scan, int next_id) {
-    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i < p.m && p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
-}
-
-/// Copies the survivors; the last thread also writes the iteration's totals (merges, survivors).
-__global__ void ploc_compact_kernel(PlocArrays p, PlocArrays q, const int32_t* merge_scan, const int32_t* keep_scan,
-                                    int32_t* totals) {
+/// Merges and compacts in one pass from p into q (`scan`: the packed flags' exclusive sum);
+/// the last thread also writes the iteration's totals (merges, survivors).
+__global__ void ploc_merge_compact_kernel(LbvhArrays a, PlocArrays p, PlocArrays q, const int64_t* scan, int next_id,
+                                          int32_t* totals) {
     const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= p.m) return;
-    if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+    int merges = 0, keeps = 0;
+    ploc_flags_of(p, i, merges, keeps);
+    const int merged_before = int(scan[i] >> 32), kept_before = int(scan[i] & 0xffffffff);
+    if (keeps) ploc_merge_compact(a, p, q, i, merges != 0, a.n - 2 - (next_id + merged_before), kept_before);
     if (i == p.m - 1) {
-        totals[0] = merge_scan[i] + p.merges[i];
-        totals[1] = keep_scan[i] + p.keeps[i];
+        totals[0] = merged_before + merges;
+        totals[1] = kept_before + keeps;
     }
 }
 
-/// PLOC's last iterations, once at most GpuBvhBuildOptions::ploc_tail_clusters are left: one
-/// block runs them all, the steps of the launches above in the same order (so the same tree),
-/// where the launches and a read-back per iteration would cost some 40 us each for little work.
+/// PLOC's last iterations, once at most ploc_tail_capacity() clusters are left: one block
+/// runs them all with the clusters in shared memory, the steps of the launches above in the
+/// same order (so the same tree), where the launches and a read-back per iteration would
+/// cost some 40 us each for little work. Each thread owns the clusters threadIdx.x + k *
+/// kPlocTailThreads, k < kPlocTailChunks, and keeps their flags and scans in registers.
 constexpr int kPlocTailThreads = 1024;
-constexpr int kPlocTailMaxClusters = 1 << 15;  ///< the scan packs two counts of at most this in an int
+constexpr int kPlocTailChunks = 6;
+constexpr int kPlocTailMaxClusters = kPlocTailThreads * kPlocTailChunks;
+/// Shared memory per cluster: its box, code, count and nearest neighbour.
+constexpr size_t kPlocTailClusterBytes = 6 * sizeof(float) + 3 * sizeof(int32_t);
 
-/// p: this iteration's clusters (p.m of them), q: the other cluster arrays; `status` becomes 1
-/// where an iteration merged nothing (lbvh_steps.h rules it out; checked, not assumed).
-__global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays a, PlocArrays p, PlocArrays q,
-                                                                       int32_t* merge_scan, int32_t* keep_scan, int next_id,
-                                                                       int32_t* status) {
+/// g: this iteration's clusters in global memory (g.m of them); `status` becomes 1 where an
+/// iteration merged nothing (lbvh_steps.h rules it out; checked, not assumed).
+__global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays a, PlocArrays g, int next_id, int32_t* status) {
     using Scan = cub::BlockScan<int, kPlocTailThreads>;
     __shared__ typename Scan::TempStorage scan_storage;
-    for (int m = p.m; m > 1;) {
-        p.m = m;
-        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_nearest(p, i);
+    extern __shared__ float tail_shared[];
+    const int capacity = g.m;
+    PlocArrays s = g;
+    s.box = tail_shared;
+    s.code = reinterpret_cast<int32_t*>(tail_shared + 6 * capacity);
+    s.count = s.code + capacity;
+    s.nearest = s.count + capacity;
+    s.merges = s.keeps = nullptr;  // in registers
+    const int t = int(threadIdx.x);
+    for (int i = t; i < capacity; i += kPlocTailThreads) ploc_store(s, i, ploc_cluster(g, i));
+    __syncthreads();
+    for (int m = capacity; m > 1;) {
+        s.m = m;
+        for (int i = t; i < m; i += kPlocTailThreads) ploc_nearest(s, i);
         __syncthreads();
-        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads) ploc_flags(p, i);
-        __syncthreads();
-        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m <= 2^15) low.
-        int merges = 0, keeps = 0;
-        for (int base = 0; base < m; base += kPlocTailThreads) {
-            const int i = base + int(threadIdx.x);
-            const int both = i < m ? (p.merges[i] << 16) | p.keeps[i] : 0;
-            int before = 0, chunk = 0;
-            Scan(scan_storage).ExclusiveSum(both, before, chunk);
-            if (i < m) {
-                merge_scan[i] = merges + (before >> 16);
-                keep_scan[i] = keeps + (before & 0xffff);
-            }
-            merges += chunk >> 16;
-            keeps += chunk & 0xffff;
+        // Both exclusive sums in one scan: merges in the high 16 bits, keeps (<= m < 2^16) low.
+        int flags[kPlocTailChunks], before[kPlocTailChunks];
+        int running = 0;
+#pragma unroll
+        for (int k = 0; k < kPlocTailChunks; ++k) {
+            flags[k] = before[k] = 0;
+            if (k * kPlocTailThreads >= m) continue;  // the same in every thread
+            const int i = k * kPlocTailThreads + t;
+            int merges = 0, keeps = 0;
+            if (i < m) ploc_flags_of(s, i, merges, keeps);
+            flags[k] = merges << 16 | keeps;
+            int chunk = 0;
+            Scan(scan_storage).ExclusiveSum(flags[k], before[k], chunk);
+            before[k] += running;
+            running += chunk;
             __syncthreads();  // scan_storage is reused
         }
+        const int merges = running >> 16;
         if (merges < 1) {  // the same in every thread: the block leaves together
-            if (threadIdx.x == 0) *status = 1;
+            if (t == 0) *status = 1;
             return;
         }
-        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
-            if (p.merges[i]) ploc_merge(a, p, i, a.n - 2 - (next_id + merge_scan[i]));
-        __syncthreads();
-        for (int i = int(threadIdx.x); i < m; i += kPlocTailThreads)
-            if (p.keeps[i]) ploc_compact(p, q, i, keep_scan[i]);
+        // In place, chunk by chunk: a survivor moves to its place among the survivors
+        // (<= its own), after every thread of the chunk has read its cluster (and a merge
+        // its neighbour, later in order). Later chunks' clusters lie beyond every place this
+        // chunk writes.
+#pragma unroll
+        for (int k = 0; k < kPlocTailChunks; ++k) {
+            if (k * kPlocTailThreads >= m) continue;
+            const int i = k * kPlocTailThreads + t;
+            const bool survives = (flags[k] & 0xffff) != 0;
+            PlocCluster c;
+            if (survives)
+                c = (flags[k] >> 16) != 0 ? ploc_merged(a, s, i, a.n - 2 - (next_id + (before[k] >> 16))) : ploc_cluster(s, i);
+            __syncthreads();
+            if (survives) ploc_store(s, before[k] & 0xffff, c);
+        }
         __syncthreads();
         next_id += merges;
-        m = keeps;
-        // The survivors are in q's cluster arrays now (nearest, merges and keeps are shared).
-        const PlocArrays was = p;
-        p.code = q.code, p.box = q.box, p.count = q.count;
-        q.code = was.code, q.box = was.box, q.count = was.count;
+        m = running & 0xffff;
     }
 }
 
@@ -231,35 +260,49 @@ void check_launch(const char* what) {
 
 }  // namespace
 
-/// PLOC's iterations (lbvh_steps.h): one launch per step, CUB scans between them, the
-/// iteration's totals read back to know how many clusters are left; the last iterations in
-/// one block (ploc_tail_kernel).
+/// The clusters ploc_tail_kernel can hold on the current device (its shared memory per
+/// block): kPlocTailMaxClusters on an H200, about 1,800 on sm_75.
+static int ploc_tail_capacity() {
+    int device = 0, optin = 0;
+    CUDA_CHECK(cudaGetDevice(&device));
+    CUDA_CHECK(cudaDeviceGetAttribute(&optin, cudaDevAttrMaxSharedMemoryPerBlockOptin, device));
+    cudaFuncAttributes attributes{};
+    CUDA_CHECK(cudaFuncGetAttributes(&attributes, ploc_tail_kernel));
+    const int64_t room = int64_t(optin) - int64_t(attributes.sharedSizeBytes);
+    return int(std::max<int64_t>(0, std::min<int64_t>(kPlocTailMaxClusters, room / int64_t(kPlocTailClusterBytes))));
+}
+
+/// PLOC's iterations (lbvh_steps.h): per iteration the nearest neighbours, one CUB scan of
+/// both flags and one merge-and-compact pass, the iteration's totals read back to know how
+/// many clusters are left; the last iterations in one block (ploc_tail_kernel), from at most
+/// `tail_clusters` (or what the device's shared memory holds).
 static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, DeviceBuffer<unsigned char>& temp) {
     const size_t n = size_t(a.n);
     DeviceBuffer<int32_t> code[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
     DeviceBuffer<int32_t> count[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
     DeviceBuffer<float> box[2] = {DeviceBuffer<float>(6 * n), DeviceBuffer<float>(6 * n)};
-    DeviceBuffer<int32_t> nearest(n), merges(n), keeps(n), merge_scan(n), keep_scan(n), totals(2);
-    size_t scan_bytes = 0;
-    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, merges.get(), merge_scan.get(), a.n));
-    if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
-    int cur = 0, m = a.n, next_id = 0;
+    DeviceBuffer<int32_t> nearest(n), totals(2);
+    DeviceBuffer<int64_t> scan(n);
     auto arrays = [&](int k, int clusters) {
-        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), merges.get(), keeps.get()};
+        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), nullptr, nullptr};
     };
+    auto flags = [](const PlocArrays& p) {
+        return thrust::make_transform_iterator(thrust::make_counting_iterator(0), PackedPlocFlags{p});
+    };
+    size_t scan_bytes = 0;
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags(arrays(0, a.n)), scan.get(), a.n));
+    if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
+    const int tail = std::min(tail_clusters, ploc_tail_capacity());
+    int cur = 0, m = a.n, next_id = 0;
     ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
     check_launch("ploc init");
-    while (m > 1 && m > tail_clusters) {
+    while (m > 1 && m > tail) {
         const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
         ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
-        ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p);
         check_launch("ploc nearest");
         size_t bytes = temp.size();
-        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, merges.get(), merge_scan.get(), m));
-        bytes = temp.size();
-        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, keeps.get(), keep_scan.get(), m));
-        ploc_merge_kernel<<<blocks_for(m), kThreads>>>(a, p, merge_scan.get(), next_id);
-        ploc_compact_kernel<<<blocks_for(m), kThreads>>>(p, q, merge_scan.get(), keep_scan.get(), totals.get());
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, flags(p), scan.get(), m));
+        ploc_merge_compact_kernel<<<blocks_for(m), kThreads>>>(a, p, q, scan.get(), next_id, totals.get());
         check_launch("ploc merge");
         int32_t t[2] = {0, 0};
         CUDA_CHECK(cudaMemcpy(t, totals.get(), sizeof(t), cudaMemcpyDeviceToHost));
@@ -269,9 +312,10 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
         cur = 1 - cur;
     }
     if (m > 1) {
+        const size_t shared = size_t(m) * kPlocTailClusterBytes;
+        CUDA_CHECK(cudaFuncSetAttribute(ploc_tail_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)));
         CUDA_CHECK(cudaMemsetAsync(totals.get(), 0, sizeof(int32_t)));
-        ploc_tail_kernel<<<1, kPlocTailThreads>>>(a, arrays(cur, m), arrays(1 - cur, 0), merge_scan.get(), keep_scan.get(),
-                                                  next_id, totals.get());
+        ploc_tail_kernel<<<1, kPlocTailThreads, shared>>>(a, arrays(cur, m), next_id, totals.get());
         check_launch("ploc tail");
         int32_t status = 0;
         CUDA_CHECK(cudaMemcpy(&status, totals.get(), sizeof(status), cudaMemcpyDeviceToHost));

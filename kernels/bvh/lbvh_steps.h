@@ -265,16 +265,39 @@ SDF_CPU_GPU SDF_INLINE void ploc_nearest(const PlocArrays& p, int i) {
 
 /// Whether cluster i starts a merge (mutual nearest neighbours, i the first), and whether it
 /// survives the iteration (it is not the second of a merge).
-SDF_CPU_GPU SDF_INLINE void ploc_flags(const PlocArrays& p, int i) {
+SDF_CPU_GPU SDF_INLINE void ploc_flags_of(const PlocArrays& p, int i, int& merges, int& keeps) {
     const int j = p.nearest[i];
     const bool mutual = j >= 0 && p.nearest[j] == i;
-    p.merges[i] = mutual && i < j ? 1 : 0;
-    p.keeps[i] = mutual && i > j ? 0 : 1;
+    merges = mutual && i < j ? 1 : 0;
+    keeps = mutual && i > j ? 0 : 1;
+}
+SDF_CPU_GPU SDF_INLINE void ploc_flags(const PlocArrays& p, int i) { ploc_flags_of(p, i, p.merges[i], p.keeps[i]); }
+
+/// One cluster's entries in PlocArrays.
+struct PlocCluster {
+    float box[6];
+    int32_t code;
+    int32_t count;
+};
+
+SDF_CPU_GPU SDF_INLINE PlocCluster ploc_cluster(const PlocArrays& p, int i) {
+    PlocCluster c;
+    for (int k = 0; k < 6; ++k) c.box[k] = p.box[6 * i + k];
+    c.code = p.code[i];
+    c.count = p.count[i];
+    return c;
+}
+
+SDF_CPU_GPU SDF_INLINE void ploc_store(const PlocArrays& p, int i, const PlocCluster& c) {
+    for (int k = 0; k < 6; ++k) p.box[6 * i + k] = c.box[k];
+    p.code[i] = c.code;
+    p.count[i] = c.count;
 }
 
 /// Merges cluster i with its nearest neighbour into internal node `id` (ids count down from
-/// n - 2, so the last merge, the root, is node 0).
-SDF_CPU_GPU SDF_INLINE void ploc_merge(const LbvhArrays& a, const PlocArrays& p, int i, int id) {
+/// n - 2, so the last merge, the root, is node 0): writes the node, returns the merged
+/// cluster (the caller stores it where the next iteration finds it).
+SDF_CPU_GPU SDF_INLINE PlocCluster ploc_merged(const LbvhArrays& a, const PlocArrays& p, int i, int id) {
     const int j = p.nearest[i];
     const int32_t l = p.code[i], r = p.code[j];
     a.left[id] = l;
@@ -283,20 +306,23 @@ SDF_CPU_GPU SDF_INLINE void ploc_merge(const LbvhArrays& a, const PlocArrays& p,
     else a.parent[l] = id;
     if (lbvh_is_leaf(r)) a.leaf_parent[~r] = id;
     else a.parent[r] = id;
-    a.count[id] = p.count[i] + p.count[j];
+    PlocCluster c;
+    c.count = p.count[i] + p.count[j];
+    a.count[id] = c.count;
     for (int x = 0; x < 3; ++x) {
-        p.box[6 * i + x] = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
-        p.box[6 * i + 3 + x] = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
+        c.box[x] = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
+        c.box[3 + x] = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
     }
-    p.code[i] = id;
-    p.count[i] = a.count[id];
+    c.code = id;
+    return c;
 }
 
-/// Copies surviving cluster i to position `to` of the next iteration's arrays.
-SDF_CPU_GPU SDF_INLINE void ploc_compact(const PlocArrays& from, const PlocArrays& to_arrays, int i, int to) {
-    to_arrays.code[to] = from.code[i];
-    to_arrays.count[to] = from.count[i];
-    for (int k = 0; k < 6; ++k) to_arrays.box[6 * to + k] = from.box[6 * i + k];
+/// Surviving cluster i of `from` (merged into node `id` where it starts a merge) stored at
+/// position `to` of the next iteration's arrays `next` (never `from`'s: a merge reads its
+/// neighbour there).
+SDF_CPU_GPU SDF_INLINE void ploc_merge_compact(const LbvhArrays& a, const PlocArrays& from, const PlocArrays& next, int i,
+                                               bool merges, int id, int to) {
+    ploc_store(next, to, merges ? ploc_merged(a, from, i, id) : ploc_cluster(from, i));
 }
 
 SDF_CPU_GPU SDF_INLINE int lbvh_code_count(const LbvhArrays& a, int32_t code) { return lbvh_is_leaf(code) ? 1 : a.count[code]; }
@@ -494,13 +520,15 @@ SDF_CPU_GPU SDF_INLINE int lbvh_radius_from(const LbvhArrays& a, int i) {
             const int p = a.parent[node];
             WindingMoments<double>& m = a.moments[a.kept_index[p]].child[lbvh_side(a, node)];
             const Vec3d centre = m.center;
-            double r = 0;
+            // The largest squared distance, then one root: the square root is monotone and
+            // correctly rounded, so this is the largest length() to the bit.
+            double r2 = 0;
             for (int slot = first; slot < first + count; ++slot)
                 for (int k = 0; k < 3; ++k) {
-                    const double d = length(lbvh_corner(a, slot, k) - centre);
-                    r = r < d ? d : r;
+                    const double d2 = length_squared(lbvh_corner(a, slot, k) - centre);
+                    r2 = r2 < d2 ? d2 : r2;
                 }
-            lbvh_atomic_max(&m.radius, r * (1.0 + 1e-12));
+            lbvh_atomic_max(&m.radius, std::sqrt(r2) * (1.0 + 1e-12));
         }
     }
     return depth;
