@@ -498,7 +498,7 @@ BENCHMARK_CAPTURE(BM_CudaBvhBand, dragon, std::string("dragon.obj"))
 BENCHMARK_CAPTURE(BM_CudaBvhBuild, bunny, std::string("bunny.obj"))->Args({0, 0})->Args({1, 4096})->ArgNames({"device", "tail"})
     ->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CudaBvhBuild, dragon, std::string("dragon.obj"))
-    ->Args({0, 0})->Args({1, 0})->Args({1, 2048})->Args({1, 4096})->Args({1, 8192})->Args({1, 16384})
+    ->Args({0, 0})->Args({1, 0})->Args({1, 2048})->Args({1, 4096})->Args({1, 6144})
     ->ArgNames({"device", "tail"})->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CudaBvhFirstQuery, dragon, std::string("dragon.obj"))
     ->Arg(0)->Arg(1)->ArgName("device_tree")->UseManualTime()->Unit(benchmark::kMillisecond);
