@@ -9,8 +9,6 @@
 #include <cub/block/block_scan.cuh>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/iterator/transform_iterator.h>
 
 #include "cuda/util/cuda_check.h"
 #include "cuda/util/warp_reduce.cuh"
@@ -53,15 +51,15 @@ __global__ void ploc_nearest_kernel(PlocArrays p) {
 }
 
 /// Cluster i's flags (ploc_flags_of) packed for one scan of both: merges in the high 32
-/// bits, keeps in the low.
-struct PackedPlocFlags {
-    PlocArrays p;
-    __device__ int64_t operator()(int i) const {
-        int merges = 0, keeps = 0;
-        ploc_flags_of(p, i, merges, keeps);
-        return int64_t(merges) << 32 | keeps;
-    }
-};
+/// bits, keeps in the low. Written out, not computed in the scan's input iterator: there
+/// its two dependent loads per element made the scan 11-13 us at any size (H200).
+__global__ void ploc_flags_kernel(PlocArrays p, int64_t* flags) {
+    const int i = int(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= p.m) return;
+    int merges = 0, keeps = 0;
+    ploc_flags_of(p, i, merges, keeps);
+    flags[i] = int64_t(merges) << 32 | keeps;
+}
 
 /// Merges and compacts in one pass from p into q (`scan`: the packed flags' exclusive sum);
 /// the last thread also writes the iteration's totals (merges, survivors).
@@ -272,8 +270,8 @@ static int ploc_tail_capacity() {
     return int(std::max<int64_t>(0, std::min<int64_t>(kPlocTailMaxClusters, room / int64_t(kPlocTailClusterBytes))));
 }
 
-/// PLOC's iterations (lbvh_steps.h): per iteration the nearest neighbours, one CUB scan of
-/// both flags and one merge-and-compact pass, the iteration's totals read back to know how
+/// PLOC's iterations (lbvh_steps.h): per iteration the nearest neighbours, their flags, one
+/// CUB scan of both and one merge-and-compact pass, the iteration's totals read back to know how
 /// many clusters are left; the last iterations in one block (ploc_tail_kernel), from at most
 /// `tail_clusters` (or what the device's shared memory holds).
 static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, DeviceBuffer<unsigned char>& temp) {
@@ -282,15 +280,12 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
     DeviceBuffer<int32_t> count[2] = {DeviceBuffer<int32_t>(n), DeviceBuffer<int32_t>(n)};
     DeviceBuffer<float> box[2] = {DeviceBuffer<float>(6 * n), DeviceBuffer<float>(6 * n)};
     DeviceBuffer<int32_t> nearest(n), totals(2);
-    DeviceBuffer<int64_t> scan(n);
+    DeviceBuffer<int64_t> flags(n), scan(n);
     auto arrays = [&](int k, int clusters) {
         return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), nullptr, nullptr};
     };
-    auto flags = [](const PlocArrays& p) {
-        return thrust::make_transform_iterator(thrust::make_counting_iterator(0), PackedPlocFlags{p});
-    };
     size_t scan_bytes = 0;
-    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags(arrays(0, a.n)), scan.get(), a.n));
+    CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags.get(), scan.get(), a.n));
     if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
     const int tail = std::min(tail_clusters, ploc_tail_capacity());
     int cur = 0, m = a.n, next_id = 0;
@@ -299,9 +294,10 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
     while (m > 1 && m > tail) {
         const PlocArrays p = arrays(cur, m), q = arrays(1 - cur, 0);
         ploc_nearest_kernel<<<blocks_for(m), kThreads>>>(p);
+        ploc_flags_kernel<<<blocks_for(m), kThreads>>>(p, flags.get());
         check_launch("ploc nearest");
         size_t bytes = temp.size();
-        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, flags(p), scan.get(), m));
+        CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), bytes, flags.get(), scan.get(), m));
         ploc_merge_compact_kernel<<<blocks_for(m), kThreads>>>(a, p, q, scan.get(), next_id, totals.get());
         check_launch("ploc merge");
         int32_t t[2] = {0, 0};
