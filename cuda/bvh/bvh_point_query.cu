@@ -25,22 +25,36 @@
 namespace sdf::cuda {
 namespace {
 
-__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, uint64_t* keys, int64_t* identity) {
+/// The bits of the 63-bit Morton key the point lists are sorted by: the top 10 of each axis
+/// (1024^3 cells of the mesh's box; points of one cell keep their input order). The order
+/// only groups neighbours into warps, and 30 bits take CUB 4 radix passes where 63 take 8:
+/// the query's kernels 2% faster at 1M and 16.8M points on an H200, the same bits
+/// (docs/gpu-notes.md).
+constexpr int kSortBeginBit = 33, kSortBits = 63 - kSortBeginBit;
+
+/// The sort key of each point (the top kSortBits of its Morton key) and its position.
+template <typename Key, typename Index>
+__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, Key* keys, Index* identity) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const Vec3d p = points[i];
-    keys[i] = morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side);
-    identity[i] = i;
+    keys[i] = Key(morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side) >> kSortBeginBit);
+    identity[i] = Index(i);
 }
 
-/// sorted[i] = the point at input position order[i]; with `rank`, rank[order[i]] = i too.
-__global__ void gather_points(const Vec3d* points, const int64_t* order, int64_t n, Vec3d* sorted, int32_t* rank) {
+/// sorted[i] = the point at input position order[i]; where asked, order[i] widened into
+/// `wide_order`, and rank[order[i]] = i (the ranks' scatter).
+template <typename Index>
+__global__ void gather_points(const Vec3d* points, const Index* order, int64_t n, Vec3d* sorted, int64_t* wide_order,
+                              int32_t* rank) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const int64_t o = order[i];
     sorted[i] = points[o];
+    if (wide_order != nullptr) wide_order[i] = o;
     if (rank != nullptr) rank[o] = int32_t(i);
 }
+
 /// Points per thread of the warp search over `n` listed points on a GPU of `sms`
 /// multiprocessors: 2 where the list fills the GPU's resident warps 32 times over at 2, else
 /// 1. With the resident warps taking batches from a counter (WarpBatches), measured on an H200
@@ -104,39 +118,93 @@ int multiprocessors() {
     return sms;
 }
 
-/// The bits of the 63-bit Morton key the point lists are sorted by: the top 10 of each axis
-/// (1024^3 cells of the mesh's box; points of one cell keep their input order). The order
-/// only groups neighbours into warps, and 30 bits take CUB 4 radix passes where 63 take 8:
-/// the query's kernels 2% faster at 1M and 16.8M points on an H200, the same bits
-/// (docs/gpu-notes.md).
-constexpr int kSortBeginBit = 33, kSortEndBit = 63;
+/// Whether the ranks (each input position's place in sorted order) come from a second
+/// radix sort (of the sorted order, by position) rather than a scatter: for lists of at
+/// least kRankSortPoints points, where the scatter's 4-byte writes miss the L2 cache.
+/// SDF_RANK_BY=scatter or sort overrides the rule, for measurement.
+constexpr int64_t kRankSortPoints = int64_t(1) << 22;
+bool ranks_by_sort(int64_t n) {
+    static const int forced = [] {
+        const char* e = std::getenv("SDF_RANK_BY");
+        return e == nullptr ? 0 : std::strcmp(e, "sort") == 0 ? 1 : std::strcmp(e, "scatter") == 0 ? 2 : 0;
+    }();
+    return forced ? forced == 1 : n >= kRankSortPoints;
+}
+
+/// The least b with 2^b >= n: the bits that hold every value below n.
+int bits_below(int64_t n) {
+    int b = 1;
+    while (b < 63 && (int64_t(1) << b) < n) ++b;
+    return b;
+}
 
 /// Sorts points by their Morton keys in the mesh's (cubic) box; the buffers (keys, CUB's
-/// temporary storage) are allocated by the constructor.
+/// temporary storage) are allocated by the constructor. Lists of at most INT32_MAX points
+/// sort 32-bit keys and positions (half the bytes a pass moves); longer ones 64-bit.
 struct MortonSort {
     int64_t n;
-    DeviceBuffer<uint64_t> keys, keys_sorted;
-    DeviceBuffer<int64_t> identity;
+    bool narrow;  ///< 32-bit keys and positions
+    DeviceBuffer<uint32_t> keys32, keys32_sorted;
+    DeviceBuffer<int32_t> identity32, order32;
+    DeviceBuffer<uint64_t> keys64, keys64_sorted;
+    DeviceBuffer<int64_t> identity64;
     DeviceBuffer<unsigned char> temp;
     size_t temp_bytes = 0;
 
-    explicit MortonSort(int64_t count) : n(count), keys{size_t(count)}, keys_sorted{size_t(count)}, identity{size_t(count)} {
-        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.get(), keys_sorted.get(), identity.get(),
-                                                   identity.get(), n, kSortBeginBit, kSortEndBit));
+    explicit MortonSort(int64_t count) : n(count), narrow(count <= int64_t(INT32_MAX)) {
+        if (narrow) {
+            keys32.allocate(size_t(n));
+            keys32_sorted.allocate(size_t(n));
+            identity32.allocate(size_t(n));
+            order32.allocate(size_t(n));
+            size_t by_key = 0, by_position = 0;
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_key, keys32.get(), keys32_sorted.get(), identity32.get(),
+                                                       order32.get(), n, 0, kSortBits));
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_position, keys32.get(), keys32_sorted.get(),
+                                                       identity32.get(), order32.get(), n, 0, bits_below(n)));
+            temp_bytes = std::max(by_key, by_position);
+        } else {
+            keys64.allocate(size_t(n));
+            keys64_sorted.allocate(size_t(n));
+            identity64.allocate(size_t(n));
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys64.get(), keys64_sorted.get(),
+                                                       identity64.get(), identity64.get(), n, 0, kSortBits));
+        }
         temp.allocate(temp_bytes);
     }
-    /// `sorted` receives the points in key order, `order` their input positions and `rank`
-    /// (or null) the inverse: each input position's place in key order.
+
+    /// `sorted` receives the points in key order, `order` (or null) their input positions
+    /// and `rank` (or null; narrow lists only) the inverse: each input position's place in
+    /// key order.
     void run(const PreparedMesh& mesh, const Vec3d* points, Vec3d* sorted, int64_t* order, int32_t* rank) {
         const Bounds3& box = mesh.bounds();
         const Vec3d extent = box.extent();
         const double side = std::max({extent.x, extent.y, extent.z, 1e-300});
-        morton_keys<<<blocks_for(n, 256), 256>>>(points, n, box.min, 1.0 / side, keys.get(), identity.get());
+        const int blocks = blocks_for(n, 256);
+        if (!narrow) {
+            if (order == nullptr || rank != nullptr) throw std::logic_error("MortonSort: a list this long sorts into `order` only");
+            morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys64.get(), identity64.get());
+            CUDA_CHECK_LAUNCH("morton_keys");
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys64.get(), keys64_sorted.get(),
+                                                       identity64.get(), order, n, 0, kSortBits));
+            gather_points<<<blocks, 256>>>(points, order, n, sorted, static_cast<int64_t*>(nullptr), nullptr);
+            CUDA_CHECK_LAUNCH("gather_points");
+            return;
+        }
+        morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys32.get(), identity32.get());
         CUDA_CHECK_LAUNCH("morton_keys");
-        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys.get(), keys_sorted.get(), identity.get(), order,
-                                                   n, kSortBeginBit, kSortEndBit));
-        gather_points<<<blocks_for(n, 256), 256>>>(points, order, n, sorted, rank);
+        size_t bytes = temp_bytes;
+        CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, keys32.get(), keys32_sorted.get(), identity32.get(),
+                                                   order32.get(), n, 0, kSortBits));
+        const bool rank_by_sort = rank != nullptr && ranks_by_sort(n);
+        gather_points<<<blocks, 256>>>(points, order32.get(), n, sorted, order, rank_by_sort ? nullptr : rank);
         CUDA_CHECK_LAUNCH("gather_points");
+        if (rank_by_sort) {
+            // Sorting the positions (a permutation of 0..n-1) carries each sorted place along.
+            bytes = temp_bytes;
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, reinterpret_cast<const uint32_t*>(order32.get()),
+                                                       keys32_sorted.get(), identity32.get(), rank, n, 0, bits_below(n)));
+        }
     }
 };
 
@@ -330,13 +398,14 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     reset_certificate(dev);
     // Every device buffer is allocated before the timed work (allocation is not search).
     DeviceBuffer<Vec3d> sorted_points{size_t(n)};
-    DeviceBuffer<int64_t> order{size_t(n)};
     MortonSort sort(n);
     int64_t step = n;
     if (options_.max_points_per_piece > 0) step = std::min(step, options_.max_points_per_piece);
-    // One piece of fewer than 2^31 points: its results gathered into input order.
+    // One piece of fewer than 2^31 points: its results gathered into input order by rank;
+    // pieces scatter theirs by input position (`order`).
     const bool gather = step == n && n <= int64_t(INT32_MAX);
     DeviceBuffer<int32_t> rank{gather ? size_t(n) : 0};
+    DeviceBuffer<int64_t> order{gather ? 0 : size_t(n)};
     const ResultOrder result_order{rank.get()};
     PieceResults r(step);  // reused by every piece
     const int run = list_points_per_thread(step, multiprocessors());
@@ -351,7 +420,14 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
         size_t(step) * NearListBuffers::bytes_per_point(near_list_slots()) <= free_device_memory() / 4)
         lists.emplace(step, near_list_slots(), sides);
     const NearLists near_lists = lists ? lists->view() : NearLists{};
-    const NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
+    // Every piece's results in r's arrays, in sorted order; the store gathers them by rank
+    // or scatters them by output_index.
+    PieceOutputs outputs = r.outputs();
+    if (result_order.rank != nullptr) outputs.output_index = nullptr;
+    NearestSideInputs side_inputs{dev.mesh->view(), sign.surface, sign.view, lists ? lists->side.get() : nullptr};
+    side_inputs.out = outputs;
+    side_inputs.band_width = options_.band_width;
+    if (sign.counts != nullptr) side_inputs.nearest_count = sign.counts + int(WindingStage::Nearest);
     for (int64_t begin = 0; begin < n; begin += step) {
         compute.begin();
         if (begin == 0) sort.run(mesh(), device_points, sorted_points.get(), order.get(), rank.get());
@@ -374,8 +450,6 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());
         if (near_lists.enabled()) rerank_lists(dev, piece, coordinate, near_lists, r.nearest.get(), side_inputs);
-        PieceOutputs outputs = r.outputs();
-        if (result_order.rank != nullptr) outputs.output_index = nullptr;  // the store gathers by rank
         launch_finalize_samples(piece.count, dev.mesh->view(), piece, r.nearest.get(), sign, options_.band_width, outputs,
                                 side_inputs.side);
         CUDA_CHECK_LAUNCH("finalize_samples (bvh points)");

@@ -21,6 +21,7 @@
 #include "core/sampling/certified_search.h"
 #include "cuda/util/cuda_check.h"
 #include "cuda/util/device_buffer.h"
+#include "cuda/sampling/finalize_kernel.cuh"
 #include "cuda/sampling/launch_util.cuh"
 #include "kernels/bvh/closest_triangle_bvh.h"
 #include "kernels/bvh/streamed_certificate.h"
@@ -125,22 +126,28 @@ __global__ void __launch_bounds__(128, 7) certify_nearest(CertifyView v, Piece p
     warp_count(v.counters + 2, full);
 }
 
-/// What nearest_side() needs beside a point's candidates: the mesh, the certified winding
-/// sign's table and tree. `side` receives per point 1 (inside), 0 (outside) or -1 (not
-/// decided from the candidates); null: not asked (no table, another sign).
+/// What nearest_side() needs beside a point's candidates (the mesh, the certified winding
+/// sign's table and tree), and where a decided point's sample goes: `side` receives per
+/// point kNearestSideStored (decided, its sample stored in `out` as finalize_samples()
+/// would, with `band_width`, and counted in `nearest_count`) or kNearestSideOpen (the
+/// finalize decides); null: not asked (no table, another sign).
 struct NearestSideInputs {
     MeshView<double> mesh{};
     SurfaceSideView surface{};
     WindingView<double> winding{};
     int8_t* side = nullptr;
+    PieceOutputs out{};
+    double band_width = 0;
+    unsigned long long* nearest_count = nullptr;  ///< the winding sign's WindingStage::Nearest counter, or null
 };
 
 /// The listed certificate's second half (kernels/bvh/streamed_certificate.h): every point's
 /// float winner `nearest` replaced by the double search's triangle from its list, and, where
-/// asked, the point's side from those candidates alone (nearest_side(), surface_side.h),
-/// which saves the finalize its walk. One thread per point, no walk but an overflowed list's
-/// double search (an overflowed list takes certify_nearest's seeded search); apart from the
-/// finalize, whose registers are capped for its winding walk.
+/// asked, the point's side from those candidates alone (nearest_side(), surface_side.h) and
+/// then its sample, which saves the finalize its walk and its closest point. One thread per
+/// point, no walk but an overflowed list's double search (an overflowed list takes
+/// certify_nearest's seeded search); apart from the finalize, whose registers are capped for
+/// its winding walk.
 template <typename Piece>
 __global__ void __launch_bounds__(128)
     rerank_near_lists(CertifyView v, Piece piece, NearLists lists, int* nearest, NearestSideInputs sides) {
@@ -154,15 +161,17 @@ __global__ void __launch_bounds__(128)
     const int32_t t = rerank_near_list(lists, i, v.slack, v.exact.packed, v.bvh.triangle_index, p, n, full_search, reranked, overflow);
     nearest[i] = t;
     if (sides.side != nullptr) {
-        int8_t side = -1;
+        bool stored = false;
         const int32_t count = lists.count[i];
         if (count > 0) {
             const SignedDistanceSample<double> s = signed_distance_to_triangle(sides.mesh, p, t);
             const NearTriangles near{lists.slot + i * lists.slots, count, beyond_candidates_squared(v.slack, lists.best_q[i])};
             bool inside = false;
-            if (nearest_side(sides.surface, sides.winding, p, t, s.distance, s.closest_point, near, inside)) side = inside ? 1 : 0;
+            stored = nearest_side(sides.surface, sides.winding, p, t, s.distance, s.closest_point, near, inside);
+            if (stored) store_sample(sides.out, i, with_sign(s, inside), sides.band_width);
         }
-        sides.side[i] = side;
+        sides.side[i] = stored ? kNearestSideStored : kNearestSideOpen;
+        if (sides.nearest_count != nullptr) warp_count(sides.nearest_count, stored);
     }
     warp_count(v.counters + 0, true);
     warp_count(v.counters + 1, reranked);

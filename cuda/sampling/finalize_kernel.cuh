@@ -50,6 +50,11 @@ __device__ inline void store_sample(const PieceOutputs& out, int64_t i, const Si
     out.triangle[i] = s.triangle;
 }
 
+/// Per point of a listed search, what the re-rank (rerank_near_lists(),
+/// certify_kernel.cuh) did with its side: decided from the search's candidates and the
+/// sample stored, or left to the finalize.
+enum NearestSide : int8_t { kNearestSideOpen = 0, kNearestSideStored = 1 };
+
 /// The block size of every finalize launch (launch_finalize_samples), which __launch_bounds__ needs.
 constexpr int kFinalizeBlock = 256;
 
@@ -80,33 +85,30 @@ __global__ void __launch_bounds__(kFinalizeBlock, MinBlocks)
     const int n_read = o >= 0 ? nearest[i] : -1;
     const bool flood = n_read == kOutsideBandFlood;
     const int n = flood ? -1 : n_read;  // a triangle where >= 0
-    const Vec3d p = o >= 0 && (n >= 0 || Winding) ? piece.position(i) : Vec3d(0.0);
+    // The re-rank stored the sample where the search's candidates decided its side
+    // (`nearest_sides`, rerank_near_lists(), which counted it): nothing is left to do.
+    const bool stored = Winding && nearest_sides != nullptr && n >= 0 && nearest_sides[i] == kNearestSideStored;
+    const Vec3d p = o >= 0 && !stored && (n >= 0 || Winding) ? piece.position(i) : Vec3d(0.0);
     SignedDistanceSample<double> s;
-    if (n >= 0) s = signed_distance_to_triangle(mesh, p, n);
+    if (n >= 0 && !stored) s = signed_distance_to_triangle(mesh, p, n);
     bool winding_inside = false;
     if constexpr (Winding) {
-        // The closest triangle's side where the mesh's table vouches for it (surface_side.h):
-        // from the search's candidates alone where the re-rank found it (`nearest_sides`,
-        // rerank_near_lists()), else by a walk.
-        const int8_t listed_side = nearest_sides != nullptr && n >= 0 ? nearest_sides[i] : int8_t(-1);
-        const bool by_nearest = listed_side >= 0;
-        if (by_nearest) winding_inside = listed_side == 1;
-        const bool by_surface =
-            by_nearest || (n >= 0 && sign.certify && surface_side(sign.surface, sign.view, p, n, s.distance, winding_inside));
-        const WindingStage decided_by = by_nearest ? WindingStage::Nearest : WindingStage::Surface;
-        const bool wants = o >= 0 && !by_surface && (n >= 0 || n == kOutsideBandSignPerPoint);
+        // The closest triangle's side where the mesh's table vouches for it (surface_side.h).
+        const bool by_surface = !stored && n >= 0 && sign.certify &&
+                                surface_side(sign.surface, sign.view, p, n, s.distance, winding_inside);
+        const bool wants = o >= 0 && !stored && !by_surface && (n >= 0 || n == kOutsideBandSignPerPoint);
         if constexpr (PerThread) {
-            if (by_surface) count_winding_stage(sign, decided_by);
+            if (by_surface) count_winding_stage(sign, WindingStage::Surface);
             if (wants) {
                 const WindingSide side = winding_side(sign, p);
                 count_winding_stage(sign, side.stage);
                 winding_inside = side.inside;
             }
         } else {
-            winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside, decided_by);
+            winding_inside = warp_winding_inside(sign, p, wants, by_surface, winding_inside);
         }
     }
-    if (o < 0 || flood) return;
+    if (o < 0 || flood || stored) return;
     if (n >= 0) {
         if constexpr (Winding) s = with_sign(s, winding_inside);  // apply_winding_sign()'s side
         store_sample(out, i, s, band_width);
@@ -129,8 +131,8 @@ inline bool winding_per_thread() {
 }
 
 /// Launches finalize_samples with or without the winding sign, as `sign` says, over the
-/// piece's `count` points in blocks of kFinalizeBlock; `nearest_sides` (or null): the sides
-/// rerank_near_lists() found from the search's candidates (1 inside, 0 outside, -1 not). Without it, compiled for
+/// piece's `count` points in blocks of kFinalizeBlock; `nearest_sides` (or null): what
+/// rerank_near_lists() did with each point's side (NearestSide). Without it, compiled for
 /// `PlainMinBlocks` blocks per SM: the sparse band asks for 4 (64 registers where it takes 100
 /// uncapped, 2 blocks): its finalize is latency-bound, and ran 1.8x faster so on an H200
 /// (docs/large-lattices.md); the other callers keep the uncapped kernel, not measured so.

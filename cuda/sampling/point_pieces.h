@@ -74,14 +74,14 @@ struct PointListPiece {
 /// whose result goes back to the input position original[begin + i].
 struct SortedPointListPiece {
     const Vec3d* sorted = nullptr;
-    const int64_t* original = nullptr;
+    const int64_t* original = nullptr;  ///< null: results gathered by rank (ResultOrder), not scattered
     int64_t begin = 0;
     int64_t count = 0;
 
     SDF_CPU_GPU int64_t size() const { return count; }
     SDF_CPU_GPU int64_t block_local(int64_t i) const { return begin + i; }
     SDF_CPU_GPU Vec3d position(int64_t i) const { return sorted[begin + i]; }
-    SDF_CPU_GPU int64_t output_index(int64_t i) const { return original[begin + i]; }
+    SDF_CPU_GPU int64_t output_index(int64_t i) const { return original ? original[begin + i] : begin + i; }
 };
 
 }  // namespace sdf::cuda
