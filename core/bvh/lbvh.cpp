@@ -57,8 +57,8 @@ void ploc_tree(const LbvhArrays& a, int radius, Elements& elements) {
     const size_t n = size_t(a.n);
     std::vector<int32_t> code(n), count(n), nearest(n), merges(n), keeps(n), code2(n), count2(n), merge_scan(n), keep_scan(n);
     std::vector<float> box(6 * n), box2(6 * n);
-    PlocArrays p{a.n, radius, code.data(), box.data(), count.data(), nearest.data(), merges.data(), keeps.data()};
-    PlocArrays q{0, radius, code2.data(), box2.data(), count2.data(), nearest.data(), merges.data(), keeps.data()};
+    PlocArrays p{a.n, radius, code.data(), box.data(), count.data(), nearest.data(), merges.data(), keeps.data(), a.n};
+    PlocArrays q{0, radius, code2.data(), box2.data(), count2.data(), nearest.data(), merges.data(), keeps.data(), a.n};
     elements.each(a.n, [&](int i) { ploc_leaf_cluster(a, p, i); });
     int next_id = 0;  // merges so far; node id = n - 2 - merge number
     while (p.m > 1) {

@@ -97,6 +97,7 @@ __global__ void __launch_bounds__(kPlocTailThreads) ploc_tail_kernel(LbvhArrays 
     const int capacity = g.m;
     PlocArrays s = g;
     s.box = tail_shared;
+    s.stride = capacity;
     s.code = reinterpret_cast<int32_t*>(tail_shared + 6 * capacity);
     s.count = s.code + capacity;
     s.nearest = s.count + capacity;
@@ -282,7 +283,7 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
     DeviceBuffer<int32_t> nearest(n), totals(2);
     DeviceBuffer<int64_t> flags(n), scan(n);
     auto arrays = [&](int k, int clusters) {
-        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), nullptr, nullptr};
+        return PlocArrays{clusters, radius, code[k].get(), box[k].get(), count[k].get(), nearest.get(), nullptr, nullptr, a.n};
     };
     size_t scan_bytes = 0;
     CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags.get(), scan.get(), a.n));

@@ -208,12 +208,18 @@ struct PlocArrays {
     int m = 0;                 ///< clusters this iteration
     int radius = 16;           ///< positions searched on each side
     int32_t* code = nullptr;   ///< child code of each cluster (lbvh_is_leaf)
-    float* box = nullptr;      ///< 6 per cluster: min x y z, max x y z
+    float* box = nullptr;      ///< 6 arrays of `stride` (ploc_box): min x y z, max x y z
     int32_t* count = nullptr;  ///< triangles in each cluster
     int32_t* nearest = nullptr;
     int32_t* merges = nullptr;  ///< 1 where the cluster merges with its (later) nearest neighbour
     int32_t* keeps = nullptr;   ///< 1 where the cluster survives the iteration (merged or not)
+    int stride = 0;             ///< clusters each box array holds
 };
+
+/// Coordinate k of cluster i's box (0-2 min, 3-5 max). One array per coordinate, so the
+/// threads of a warp, which take consecutive clusters, read consecutive words (in shared
+/// memory a box of six words per cluster made each read six-way bank conflicted).
+SDF_CPU_GPU SDF_INLINE float& ploc_box(const PlocArrays& p, int i, int k) { return p.box[size_t(k) * size_t(p.stride) + size_t(i)]; }
 
 /// Cluster i of the first iteration: the leaf of sorted position i, its box rounded outward.
 SDF_CPU_GPU SDF_INLINE void ploc_leaf_cluster(const LbvhArrays& a, const PlocArrays& p, int i) {
@@ -225,8 +231,8 @@ SDF_CPU_GPU SDF_INLINE void ploc_leaf_cluster(const LbvhArrays& a, const PlocArr
             lo = v[k][x] < lo ? v[k][x] : lo;
             hi = v[k][x] > hi ? v[k][x] : hi;
         }
-        p.box[6 * i + x] = float_below(lo);
-        p.box[6 * i + 3 + x] = float_above(hi);
+        ploc_box(p, i, x) = float_below(lo);
+        ploc_box(p, i, 3 + x) = float_above(hi);
     }
     p.code[i] = ~i;
     p.count[i] = 1;
@@ -236,8 +242,8 @@ SDF_CPU_GPU SDF_INLINE void ploc_leaf_cluster(const LbvhArrays& a, const PlocArr
 SDF_CPU_GPU SDF_INLINE float ploc_merged_area(const PlocArrays& p, int i, int j) {
     float e[3];
     for (int x = 0; x < 3; ++x) {
-        const float lo = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
-        const float hi = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
+        const float lo = ploc_box(p, i, x) < ploc_box(p, j, x) ? ploc_box(p, i, x) : ploc_box(p, j, x);
+        const float hi = ploc_box(p, i, 3 + x) > ploc_box(p, j, 3 + x) ? ploc_box(p, i, 3 + x) : ploc_box(p, j, 3 + x);
         e[x] = hi - lo;
     }
     return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
@@ -282,14 +288,14 @@ struct PlocCluster {
 
 SDF_CPU_GPU SDF_INLINE PlocCluster ploc_cluster(const PlocArrays& p, int i) {
     PlocCluster c;
-    for (int k = 0; k < 6; ++k) c.box[k] = p.box[6 * i + k];
+    for (int k = 0; k < 6; ++k) c.box[k] = ploc_box(p, i, k);
     c.code = p.code[i];
     c.count = p.count[i];
     return c;
 }
 
 SDF_CPU_GPU SDF_INLINE void ploc_store(const PlocArrays& p, int i, const PlocCluster& c) {
-    for (int k = 0; k < 6; ++k) p.box[6 * i + k] = c.box[k];
+    for (int k = 0; k < 6; ++k) ploc_box(p, i, k) = c.box[k];
     p.code[i] = c.code;
     p.count[i] = c.count;
 }
@@ -310,8 +316,8 @@ SDF_CPU_GPU SDF_INLINE PlocCluster ploc_merged(const LbvhArrays& a, const PlocAr
     c.count = p.count[i] + p.count[j];
     a.count[id] = c.count;
     for (int x = 0; x < 3; ++x) {
-        c.box[x] = p.box[6 * i + x] < p.box[6 * j + x] ? p.box[6 * i + x] : p.box[6 * j + x];
-        c.box[3 + x] = p.box[6 * i + 3 + x] > p.box[6 * j + 3 + x] ? p.box[6 * i + 3 + x] : p.box[6 * j + 3 + x];
+        c.box[x] = ploc_box(p, i, x) < ploc_box(p, j, x) ? ploc_box(p, i, x) : ploc_box(p, j, x);
+        c.box[3 + x] = ploc_box(p, i, 3 + x) > ploc_box(p, j, 3 + x) ? ploc_box(p, i, 3 + x) : ploc_box(p, j, 3 + x);
     }
     c.code = id;
     return c;
