@@ -107,7 +107,7 @@ struct NearListBuffers {
         : slots(entries), slot{size_t(n) * size_t(entries)}, count{size_t(n)}, q{size_t(n) * size_t(entries)}, best_q{size_t(n)} {
         if (sides) side.allocate(size_t(n));
     }
-    NearLists view() { return {slot.get(), q.get(), count.get(), best_q.get(), slots}; }
+    NearLists view() { return {slot.get(), q.get(), count.get(), best_q.get(), slots, int64_t(count.size())}; }
 };
 
 /// The current device's multiprocessors.

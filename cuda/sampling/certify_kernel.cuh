@@ -165,7 +165,7 @@ __global__ void __launch_bounds__(128)
         const int32_t count = lists.count[i];
         if (count > 0) {
             const SignedDistanceSample<double> s = signed_distance_to_triangle(sides.mesh, p, t);
-            const NearTriangles near{lists.slot + i * lists.slots, count, beyond_candidates_squared(v.slack, lists.best_q[i])};
+            const NearTriangles near{lists.slot + i, count, beyond_candidates_squared(v.slack, lists.best_q[i]), lists.rows};
             bool inside = false;
             stored = nearest_side(sides.surface, sides.winding, p, t, s.distance, s.closest_point, near, inside);
             if (stored) store_sample(sides.out, i, with_sign(s, inside), sides.band_width);

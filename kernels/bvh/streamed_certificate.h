@@ -210,18 +210,19 @@ struct StreamedCertifiedNear : DeferredCertifiedNear<T, K, PointOf, FoldInDouble
 /// full_double).
 constexpr int kNearListSlots = 16;
 
-/// Per point of a search (index i), what the listed certificate leaves for the re-rank
-/// (rerank_near_list): up to `slots` candidates (BVH slots, ranked float Q) at
-/// [i * slots, ...), how many it holds (slots + 1: overflowed),
-/// and the float winner's Q. After the re-rank `slot` holds the live candidates' triangle
-/// indices (the winner among them) and `count` their number (0: unknown, an overflow):
-/// nearest_side()'s NearTriangles.
+/// Per point of a search (index i < rows), what the listed certificate leaves for the
+/// re-rank (rerank_near_list): up to `slots` candidates (BVH slots, ranked float Q), entry
+/// c at [c * rows + i] (so a warp's consecutive points read and write consecutive words),
+/// how many it holds (slots + 1: overflowed), and the float winner's Q. After the re-rank
+/// `slot` holds the live candidates' triangle indices (the winner among them) and `count`
+/// their number (0: unknown, an overflow): nearest_side()'s NearTriangles.
 struct NearLists {
     int32_t* slot = nullptr;
     float* q = nullptr;
     int32_t* count = nullptr;
     float* best_q = nullptr;
     int slots = kNearListSlots;  ///< entries per point
+    int64_t rows = 0;            ///< points the arrays hold: the stride between a point's entries
     SDF_CPU_GPU bool enabled() const { return slot != nullptr; }
 };
 
@@ -256,29 +257,36 @@ struct NearListAppend {
         for (int l = 0; l < K; ++l) {
             if (l != k) continue;
             const int full = lists.slots;
-            int32_t* slots = lists.slot + (row + l) * full;
-            float* qs = lists.q + (row + l) * full;
+            const int64_t stride = lists.rows;
+            int32_t* slots = lists.slot + (row + l);
+            float* qs = lists.q + (row + l);
             if (listed[l] < full) {
-                slots[listed[l]] = slot;
-                qs[listed[l]++] = q;
+                slots[listed[l] * stride] = slot;
+                qs[listed[l]++ * stride] = q;
                 continue;
             }
             // Full: this thread's own writes, read back in order.
             int kept = 0, largest = 0;
-            for (int c = 0; c < full; ++c)
-                if (qs[c] <= radius) {
-                    slots[kept] = slots[c];
-                    qs[kept] = qs[c];
-                    if (qs[kept] > qs[largest]) largest = kept;
+            float largest_q = 0;
+            for (int c = 0; c < full; ++c) {
+                const float qc = qs[c * stride];
+                if (qc <= radius) {
+                    slots[kept * stride] = slots[c * stride];
+                    qs[kept * stride] = qc;
+                    if (kept == 0 || qc > largest_q) {
+                        largest = kept;
+                        largest_q = qc;
+                    }
                     ++kept;
                 }
+            }
             if (kept < full) {
-                slots[kept] = slot;
-                qs[kept++] = q;
-            } else if (q < qs[largest]) {
-                dropped[l] = fminf(dropped[l], qs[largest]);
-                slots[largest] = slot;
-                qs[largest] = q;
+                slots[kept * stride] = slot;
+                qs[kept++ * stride] = q;
+            } else if (q < largest_q) {
+                dropped[l] = fminf(dropped[l], largest_q);
+                slots[largest * stride] = slot;
+                qs[largest * stride] = q;
             } else {
                 dropped[l] = fminf(dropped[l], q);
             }
@@ -339,25 +347,27 @@ SDF_CPU_GPU inline int32_t rerank_near_list(const NearLists& lists, int64_t i, c
         lists.count[i] = 0;
         return full_search(p);
     }
-    int32_t* slot = lists.slot + i * lists.slots;
-    const float* q = lists.q + i * lists.slots;
+    const int64_t stride = lists.rows;
+    int32_t* slot = lists.slot + i;
+    const float* q = lists.q + i;
     const float r = slack.radius(lists.best_q[i]);
     int live = 0;
     for (int c = 0; c < offered; ++c)
-        if (q[c] <= r) slot[live++] = slot[c];
+        if (q[c * stride] <= r) slot[live++ * stride] = slot[c * stride];
     reranked = live > 1;
     double best = 0;
     int32_t best_triangle = winner;
     for (int c = 0; c < live; ++c) {
-        const int32_t triangle = triangle_index[slot[c]];
+        const int32_t s = slot[c * stride];
+        const int32_t triangle = triangle_index[s];
         if (reranked) {
-            const double d = squared_distance(exact[slot[c]], p.x, p.y, p.z);
+            const double d = squared_distance(exact[s], p.x, p.y, p.z);
             if (c == 0 || d < best || (d == best && triangle < best_triangle)) {
                 best = d;
                 best_triangle = triangle;
             }
         }
-        slot[c] = triangle;
+        slot[c * stride] = triangle;
     }
     SDF_DCHECK(live != 1 || slot[0] == winner);  // one live candidate: the float winner itself
     lists.count[i] = live;

@@ -223,9 +223,10 @@ SDF_CPU_GPU SDF_INLINE bool projects_inside(const Vec3d t[3], const Vec3d& p) {
 /// and a squared distance that every other triangle surely exceeds in exact arithmetic.
 /// count 0: nothing known.
 struct NearTriangles {
-    const int32_t* triangle = nullptr;
+    const int32_t* triangle = nullptr;  ///< candidate k at triangle[k * stride]
     int count = 0;
     double beyond_squared = 0;
+    int64_t stride = 1;
 };
 
 /// Weights of a point of T's open interior within about 2^-20 of T's size from `closest` (a
@@ -286,7 +287,7 @@ SDF_CPU_GPU inline bool nearest_side(const SurfaceSideView& s, const WindingView
     if (!(reach * reach * (1.0 + 0x1p-44) < near.beyond_squared)) return false;
     int change = 0;
     for (int i = 0; i < near.count; ++i) {
-        const int32_t u = near.triangle[i];
+        const int32_t u = near.triangle[i * near.stride];
         if (u == triangle) continue;
         const Int3 ui = v.triangles[u];
         if (!add_crossing(p, t, yr, v.vertices[ui.x], v.vertices[ui.y], v.vertices[ui.z], change)) return false;

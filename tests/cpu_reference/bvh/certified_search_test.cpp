@@ -228,7 +228,7 @@ void check_listed_packets(int slots) {
         std::vector<float> qs(size_t(K * slots));
         int32_t counts[K];
         float best[K];
-        const NearLists lists{list_slots.data(), qs.data(), counts, best, slots};
+        const NearLists lists{list_slots.data(), qs.data(), counts, best, slots, K};
         const auto full_search = [&](const Vec3d& p) { return exact.triangle_index[closest_triangle_bvh(exact, p).slot]; };
         int64_t bad = 0, missing = 0;
         for (const int stride : {1, 0}) {
@@ -260,8 +260,9 @@ void check_listed_packets(int slots) {
                     EXPECT_GT(beyond, double(best[k]));
                     for (size_t s = 0; s < bvh.packed_double.size(); ++s) {
                         if (!(squared_distance(bvh.packed_double[s], p.x, p.y, p.z) <= 0.5 * (double(best[k]) + beyond))) continue;
-                        const int32_t* list = list_slots.data() + k * slots;
-                        missing += std::find(list, list + counts[k], view.triangle_index[s]) == list + counts[k];
+                        bool listed = false;
+                        for (int c = 0; c < counts[k]; ++c) listed |= list_slots[size_t(c * K + k)] == view.triangle_index[s];
+                        missing += !listed;
                     }
                 }
             }
