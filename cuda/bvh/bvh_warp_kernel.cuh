@@ -11,6 +11,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdlib>
 #include <type_traits>
 #include <utility>
 
@@ -393,6 +394,16 @@ void launch_bvh_warp(const BvhView<T>& bvh, const Layout& layout, const BandSear
     if constexpr (std::is_same_v<T, float>) {
         if constexpr (lists_candidates<Layout>::value) {
             if (cert.exact && lists.enabled()) {
+                if constexpr (Layout::kPoints == 1) {
+                    // SDF_LIST_MIN_BLOCKS=7 or 8: one point a lane compiled for more blocks an SM
+                    // (fewer registers), for measurement.
+                    static const int forced = [] {
+                        const char* e = std::getenv("SDF_LIST_MIN_BLOCKS");
+                        return e ? std::atoi(e) : 0;
+                    }();
+                    if (forced == 7) return launch(nearest_triangle_bvh_warp<T, Layout, true, true, 7>);
+                    if (forced == 8) return launch(nearest_triangle_bvh_warp<T, Layout, true, true, 8>);
+                }
                 launch(nearest_triangle_bvh_warp<T, Layout, true, true, listed_min_blocks<Layout>()>);
                 return;
             }

@@ -15,6 +15,7 @@
 /// double brute force up to the rounding of its box distances (8 ulps in double).
 #pragma once
 
+#include <cstdlib>
 #include <vector>
 
 #include "core/bvh/triangle_bvh.h"
@@ -148,8 +149,8 @@ struct NearestSideInputs {
 /// point, no walk but an overflowed list's double search (an overflowed list takes
 /// certify_nearest's seeded search); apart from the finalize, whose registers are capped for
 /// its winding walk.
-template <typename Piece>
-__global__ void __launch_bounds__(128)
+template <typename Piece, int kMinBlocks = 1>
+__global__ void __launch_bounds__(128, kMinBlocks)
     rerank_near_lists(CertifyView v, Piece piece, NearLists lists, int* nearest, NearestSideInputs sides) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= piece.size()) return;
@@ -229,7 +230,15 @@ public:
         const int64_t n = piece.size();
         if (n == 0) return;
         // Capped at 80 registers (6 blocks an SM) it measured the same (H200, docs/gpu-notes.md).
-        rerank_near_lists<<<blocks_for(n, 128), 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        // SDF_RERANK_MIN_BLOCKS=6 or 8 caps it so, for measurement.
+        static const int forced = [] {
+            const char* e = std::getenv("SDF_RERANK_MIN_BLOCKS");
+            return e ? std::atoi(e) : 0;
+        }();
+        const int blocks = blocks_for(n, 128);
+        if (forced == 6) rerank_near_lists<Piece, 6><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        else if (forced == 8) rerank_near_lists<Piece, 8><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        else rerank_near_lists<<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
         CUDA_CHECK_LAUNCH("rerank_near_lists");
     }
 
