@@ -30,15 +30,26 @@ namespace {
 /// only groups neighbours into warps, and 30 bits take CUB 4 radix passes where 63 take 8:
 /// the query's kernels 2% faster at 1M and 16.8M points on an H200, the same bits
 /// (docs/gpu-notes.md).
-constexpr int kSortBeginBit = 33, kSortBits = 63 - kSortBeginBit;
+constexpr int kSortBits = 30;
 
-/// The sort key of each point (the top kSortBits of its Morton key) and its position.
+/// kSortBits, or SDF_SORT_BITS (24 or 27: 8 or 9 bits an axis, 3 or 4 radix passes), for
+/// measurement.
+int sort_bits() {
+    static const int bits = [] {
+        const char* e = std::getenv("SDF_SORT_BITS");
+        const int v = e ? std::atoi(e) : 0;
+        return v == 24 || v == 27 ? v : kSortBits;
+    }();
+    return bits;
+}
+
+/// The sort key of each point (the top `bits` of its 63-bit Morton key) and its position.
 template <typename Key, typename Index>
-__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, Key* keys, Index* identity) {
+__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, int bits, Key* keys, Index* identity) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const Vec3d p = points[i];
-    keys[i] = Key(morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side) >> kSortBeginBit);
+    keys[i] = Key(morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side) >> (63 - bits));
     identity[i] = Index(i);
 }
 
@@ -159,7 +170,7 @@ struct MortonSort {
             order32.allocate(size_t(n));
             size_t by_key = 0, by_position = 0;
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_key, keys32.get(), keys32_sorted.get(), identity32.get(),
-                                                       order32.get(), n, 0, kSortBits));
+                                                       order32.get(), n, 0, sort_bits()));
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_position, keys32.get(), keys32_sorted.get(),
                                                        identity32.get(), order32.get(), n, 0, bits_below(n)));
             temp_bytes = std::max(by_key, by_position);
@@ -168,7 +179,7 @@ struct MortonSort {
             keys64_sorted.allocate(size_t(n));
             identity64.allocate(size_t(n));
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys64.get(), keys64_sorted.get(),
-                                                       identity64.get(), identity64.get(), n, 0, kSortBits));
+                                                       identity64.get(), identity64.get(), n, 0, sort_bits()));
         }
         temp.allocate(temp_bytes);
     }
@@ -183,19 +194,19 @@ struct MortonSort {
         const int blocks = blocks_for(n, 256);
         if (!narrow) {
             if (order == nullptr || rank != nullptr) throw std::logic_error("MortonSort: a list this long sorts into `order` only");
-            morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys64.get(), identity64.get());
+            morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, sort_bits(), keys64.get(), identity64.get());
             CUDA_CHECK_LAUNCH("morton_keys");
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys64.get(), keys64_sorted.get(),
-                                                       identity64.get(), order, n, 0, kSortBits));
+                                                       identity64.get(), order, n, 0, sort_bits()));
             gather_points<<<blocks, 256>>>(points, order, n, sorted, static_cast<int64_t*>(nullptr), nullptr);
             CUDA_CHECK_LAUNCH("gather_points");
             return;
         }
-        morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys32.get(), identity32.get());
+        morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, sort_bits(), keys32.get(), identity32.get());
         CUDA_CHECK_LAUNCH("morton_keys");
         size_t bytes = temp_bytes;
         CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, keys32.get(), keys32_sorted.get(), identity32.get(),
-                                                   order32.get(), n, 0, kSortBits));
+                                                   order32.get(), n, 0, sort_bits()));
         const bool rank_by_sort = rank != nullptr && ranks_by_sort(n);
         gather_points<<<blocks, 256>>>(points, order32.get(), n, sorted, order, rank_by_sort ? nullptr : rank);
         CUDA_CHECK_LAUNCH("gather_points");

@@ -231,14 +231,15 @@ __device__ SDF_INLINE int brick_band_code(const BvhView<T>& bvh, const BvhPacket
 /// uncapped), which measured 7-11% faster on an H100 (docs/gpu-notes.md).
 constexpr int kFusedMinBlocks = 4;
 
-/// Blocks per SM the listed form of a `Layout` is compiled for: with one or two points a
-/// thread (sparser lists, fewer warps than the GPU holds many times over) 6, at 80 registers
-/// with 200-400 bytes of spills: 1M points 4.50 -> 4.22 ms near the surface, 4.38 -> 3.93 ms
-/// uniform on an H200; with four (16.8M points) kFusedMinBlocks, where 6 took 29.5 -> 32.1 ms
-/// (docs/gpu-notes.md).
+/// Blocks per SM the listed form of a `Layout` is compiled for: with one point a thread
+/// (lists below some 4M points, taken by resident warps) 8, at 64 registers: 1M points
+/// 3.01 -> 2.93 ms near the surface, 2.85 -> 2.74 ms uniform on an H200 (7: 2.98, 2.81);
+/// with two 6, at 80 registers with 200-400 bytes of spills: 1M points 4.50 -> 4.22 ms near
+/// the surface, 4.38 -> 3.93 ms uniform (before the resident warps); with four (16.8M
+/// points) kFusedMinBlocks, where 6 took 29.5 -> 32.1 ms (docs/gpu-notes.md).
 template <typename Layout>
 constexpr int listed_min_blocks() {
-    return Layout::kPoints <= 2 ? 6 : kFusedMinBlocks;
+    return Layout::kPoints == 1 ? 8 : Layout::kPoints == 2 ? 6 : kFusedMinBlocks;
 }
 
 /// Lane k's exact point (a run's lanes beyond its count repeat its first point, as in
@@ -395,14 +396,13 @@ void launch_bvh_warp(const BvhView<T>& bvh, const Layout& layout, const BandSear
         if constexpr (lists_candidates<Layout>::value) {
             if (cert.exact && lists.enabled()) {
                 if constexpr (Layout::kPoints == 1) {
-                    // SDF_LIST_MIN_BLOCKS=7 or 8: one point a lane compiled for more blocks an SM
-                    // (fewer registers), for measurement.
-                    static const int forced = [] {
+                    // SDF_LIST_MIN_BLOCKS=6: one point a lane at 6 blocks an SM, as before, for
+                    // measurement.
+                    static const bool six = [] {
                         const char* e = std::getenv("SDF_LIST_MIN_BLOCKS");
-                        return e ? std::atoi(e) : 0;
+                        return e != nullptr && std::atoi(e) == 6;
                     }();
-                    if (forced == 7) return launch(nearest_triangle_bvh_warp<T, Layout, true, true, 7>);
-                    if (forced == 8) return launch(nearest_triangle_bvh_warp<T, Layout, true, true, 8>);
+                    if (six) return launch(nearest_triangle_bvh_warp<T, Layout, true, true, 6>);
                 }
                 launch(nearest_triangle_bvh_warp<T, Layout, true, true, listed_min_blocks<Layout>()>);
                 return;

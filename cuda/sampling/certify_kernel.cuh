@@ -229,16 +229,18 @@ public:
                       const NearestSideInputs& sides) const {
         const int64_t n = piece.size();
         if (n == 0) return;
-        // Capped at 80 registers (6 blocks an SM) it measured the same (H200, docs/gpu-notes.md).
-        // SDF_RERANK_MIN_BLOCKS=6 or 8 caps it so, for measurement.
+        // Capped at 80 registers (6 blocks an SM; 96 uncapped, since it stores the samples it
+        // decides): 1M points near the surface 3.01 -> 2.94 ms, 16.8M 19.5 -> 18.4 ms on an
+        // H200 (8 blocks: 3.00, 18.3 ms; docs/gpu-notes.md). SDF_RERANK_MIN_BLOCKS=1 or 8
+        // compiles it so, for measurement.
         static const int forced = [] {
             const char* e = std::getenv("SDF_RERANK_MIN_BLOCKS");
             return e ? std::atoi(e) : 0;
         }();
         const int blocks = blocks_for(n, 128);
-        if (forced == 6) rerank_near_lists<Piece, 6><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        if (forced == 1) rerank_near_lists<Piece, 1><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
         else if (forced == 8) rerank_near_lists<Piece, 8><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
-        else rerank_near_lists<<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
+        else rerank_near_lists<Piece, 6><<<blocks, 128>>>(view(point_coordinate), piece, lists, nearest, sides);
         CUDA_CHECK_LAUNCH("rerank_near_lists");
     }
 
