@@ -29,27 +29,17 @@ namespace {
 /// (1024^3 cells of the mesh's box; points of one cell keep their input order). The order
 /// only groups neighbours into warps, and 30 bits take CUB 4 radix passes where 63 take 8:
 /// the query's kernels 2% faster at 1M and 16.8M points on an H200, the same bits
-/// (docs/gpu-notes.md).
+/// (docs/gpu-notes.md); 24 and 27 bits (3 or 4 passes of 32-bit keys) measured the same
+/// as 30 at both sizes.
 constexpr int kSortBits = 30;
 
-/// kSortBits, or SDF_SORT_BITS (24 or 27: 8 or 9 bits an axis, 3 or 4 radix passes), for
-/// measurement.
-int sort_bits() {
-    static const int bits = [] {
-        const char* e = std::getenv("SDF_SORT_BITS");
-        const int v = e ? std::atoi(e) : 0;
-        return v == 24 || v == 27 ? v : kSortBits;
-    }();
-    return bits;
-}
-
-/// The sort key of each point (the top `bits` of its 63-bit Morton key) and its position.
+/// The sort key of each point (the top kSortBits of its 63-bit Morton key) and its position.
 template <typename Key, typename Index>
-__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, int bits, Key* keys, Index* identity) {
+__global__ void morton_keys(const Vec3d* points, int64_t n, Vec3d lo, double inv_side, Key* keys, Index* identity) {
     const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const Vec3d p = points[i];
-    keys[i] = Key(morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side) >> (63 - bits));
+    keys[i] = Key(morton_key_of_point(p.x, p.y, p.z, lo.x, lo.y, lo.z, inv_side) >> (63 - kSortBits));
     identity[i] = Index(i);
 }
 
@@ -131,8 +121,9 @@ int multiprocessors() {
 
 /// Whether the ranks (each input position's place in sorted order) come from a second
 /// radix sort (of the sorted order, by position) rather than a scatter: for lists of at
-/// least kRankSortPoints points, where the scatter's 4-byte writes miss the L2 cache.
-/// SDF_RANK_BY=scatter or sort overrides the rule, for measurement.
+/// least kRankSortPoints points, where the scatter's 4-byte writes miss the L2 cache. On an
+/// H200, 16.8M points near the surface: 18.46 ms by sort, 19.24 by scatter; 1M: 3.00 and
+/// 2.97 (docs/gpu-notes.md). SDF_RANK_BY=scatter or sort overrides the rule, for measurement.
 constexpr int64_t kRankSortPoints = int64_t(1) << 22;
 bool ranks_by_sort(int64_t n) {
     static const int forced = [] {
@@ -170,7 +161,7 @@ struct MortonSort {
             order32.allocate(size_t(n));
             size_t by_key = 0, by_position = 0;
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_key, keys32.get(), keys32_sorted.get(), identity32.get(),
-                                                       order32.get(), n, 0, sort_bits()));
+                                                       order32.get(), n, 0, kSortBits));
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, by_position, keys32.get(), keys32_sorted.get(),
                                                        identity32.get(), order32.get(), n, 0, bits_below(n)));
             temp_bytes = std::max(by_key, by_position);
@@ -179,7 +170,7 @@ struct MortonSort {
             keys64_sorted.allocate(size_t(n));
             identity64.allocate(size_t(n));
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys64.get(), keys64_sorted.get(),
-                                                       identity64.get(), identity64.get(), n, 0, sort_bits()));
+                                                       identity64.get(), identity64.get(), n, 0, kSortBits));
         }
         temp.allocate(temp_bytes);
     }
@@ -194,19 +185,19 @@ struct MortonSort {
         const int blocks = blocks_for(n, 256);
         if (!narrow) {
             if (order == nullptr || rank != nullptr) throw std::logic_error("MortonSort: a list this long sorts into `order` only");
-            morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, sort_bits(), keys64.get(), identity64.get());
+            morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys64.get(), identity64.get());
             CUDA_CHECK_LAUNCH("morton_keys");
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys64.get(), keys64_sorted.get(),
-                                                       identity64.get(), order, n, 0, sort_bits()));
+                                                       identity64.get(), order, n, 0, kSortBits));
             gather_points<<<blocks, 256>>>(points, order, n, sorted, static_cast<int64_t*>(nullptr), nullptr);
             CUDA_CHECK_LAUNCH("gather_points");
             return;
         }
-        morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, sort_bits(), keys32.get(), identity32.get());
+        morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys32.get(), identity32.get());
         CUDA_CHECK_LAUNCH("morton_keys");
         size_t bytes = temp_bytes;
         CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, keys32.get(), keys32_sorted.get(), identity32.get(),
-                                                   order32.get(), n, 0, sort_bits()));
+                                                   order32.get(), n, 0, kSortBits));
         const bool rank_by_sort = rank != nullptr && ranks_by_sort(n);
         gather_points<<<blocks, 256>>>(points, order32.get(), n, sorted, order, rank_by_sort ? nullptr : rank);
         CUDA_CHECK_LAUNCH("gather_points");
