@@ -35,10 +35,11 @@ struct GpuBvhBuildOptions {
     GpuBvhBuilder builder = GpuBvhBuilder::Ploc;
     int max_leaf = 4;         ///< leaves hold at most this many triangles
     int ploc_radius = 16;     ///< PLOC's search radius (positions on each side)
-    /// Device only: once at most this many clusters are left (at most 6144, and at most
-    /// what the device's shared memory per block holds: 36 bytes a cluster), one block runs
-    /// PLOC's remaining iterations (0: a launch sequence per iteration to the end). The tree
-    /// is the same.
+    /// Device only: once at most this many clusters are left, one block runs PLOC's
+    /// remaining iterations in shared memory (0: a launch sequence per iteration to the
+    /// end); more than the block holds (6144 clusters, or fewer where the device's shared
+    /// memory per block is smaller: cuda/bvh/device_bvh_build.cu) start where it can. The
+    /// tree is the same.
     int ploc_tail_clusters = 4096;
     /// Host emulation only: 0 runs every step's elements in order; otherwise in an order
     /// shuffled by this seed, as a GPU may schedule them (the result must not change).

@@ -187,7 +187,8 @@ struct MortonSort {
             if (order == nullptr || rank != nullptr) throw std::logic_error("MortonSort: a list this long sorts into `order` only");
             morton_keys<<<blocks, 256>>>(points, n, box.min, 1.0 / side, keys64.get(), identity64.get());
             CUDA_CHECK_LAUNCH("morton_keys");
-            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), temp_bytes, keys64.get(), keys64_sorted.get(),
+            size_t bytes = temp_bytes;
+            CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, keys64.get(), keys64_sorted.get(),
                                                        identity64.get(), order, n, 0, kSortBits));
             gather_points<<<blocks, 256>>>(points, order, n, sorted, static_cast<int64_t*>(nullptr), nullptr);
             CUDA_CHECK_LAUNCH("gather_points");
@@ -202,7 +203,8 @@ struct MortonSort {
         gather_points<<<blocks, 256>>>(points, order32.get(), n, sorted, order, rank_by_sort ? nullptr : rank);
         CUDA_CHECK_LAUNCH("gather_points");
         if (rank_by_sort) {
-            // Sorting the positions (a permutation of 0..n-1) carries each sorted place along.
+            // Sorting the positions (a permutation of 0..n-1) carries each sorted place along;
+            // identity32 still holds 0..n-1 (CUB's pointer form leaves its inputs as they are).
             bytes = temp_bytes;
             CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.get(), bytes, reinterpret_cast<const uint32_t*>(order32.get()),
                                                        keys32_sorted.get(), identity32.get(), rank, n, 0, bits_below(n)));

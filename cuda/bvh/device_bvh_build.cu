@@ -260,7 +260,7 @@ void check_launch(const char* what) {
 }  // namespace
 
 /// The clusters ploc_tail_kernel can hold on the current device (its shared memory per
-/// block): kPlocTailMaxClusters on an H200, about 1,800 on sm_75.
+/// block): kPlocTailMaxClusters on an H200, about 1,700 on sm_75.
 static int ploc_tail_capacity() {
     int device = 0, optin = 0;
     CUDA_CHECK(cudaGetDevice(&device));
@@ -288,7 +288,8 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
     size_t scan_bytes = 0;
     CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, flags.get(), scan.get(), a.n));
     if (scan_bytes > temp.size()) temp.allocate(scan_bytes);
-    const int tail = std::min(tail_clusters, ploc_tail_capacity());
+    const int capacity = ploc_tail_capacity();
+    const int tail = std::min(tail_clusters, capacity);
     int cur = 0, m = a.n, next_id = 0;
     ploc_init<<<blocks_for(a.n), kThreads>>>(a, arrays(0, m));
     check_launch("ploc init");
@@ -310,7 +311,11 @@ static void ploc_on_device(const LbvhArrays& a, int radius, int tail_clusters, D
     }
     if (m > 1) {
         const size_t shared = size_t(m) * kPlocTailClusterBytes;
-        CUDA_CHECK(cudaFuncSetAttribute(ploc_tail_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)));
+        // The kernel's limit is the device's whole capacity, the same for every build: a
+        // limit of this build's size could be lowered by another thread's build before
+        // this launch.
+        CUDA_CHECK(cudaFuncSetAttribute(ploc_tail_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                        int(size_t(capacity) * kPlocTailClusterBytes)));
         CUDA_CHECK(cudaMemsetAsync(totals.get(), 0, sizeof(int32_t)));
         ploc_tail_kernel<<<1, kPlocTailThreads, shared>>>(a, arrays(cur, m), next_id, totals.get());
         check_launch("ploc tail");
@@ -361,9 +366,9 @@ std::unique_ptr<DeviceLbvh> build_lbvh_on_device(const PreparedMesh& mesh, const
     const int n = int(mesh.triangles().size());
     if (options.max_leaf < 1 || options.ploc_radius < 1)
         throw std::invalid_argument("CUDA BVH build: max_leaf and ploc_radius must be >= 1");
-    if (options.ploc_tail_clusters < 0 || options.ploc_tail_clusters > kPlocTailMaxClusters)
-        throw std::invalid_argument("CUDA BVH build: ploc_tail_clusters must be in 0.." + std::to_string(kPlocTailMaxClusters) +
-                                    ", got " + std::to_string(options.ploc_tail_clusters));
+    if (options.ploc_tail_clusters < 0)
+        throw std::invalid_argument("CUDA BVH build: ploc_tail_clusters must be >= 0, got " +
+                                    std::to_string(options.ploc_tail_clusters));
     if (n <= options.max_leaf) return nullptr;
     const auto start = std::chrono::steady_clock::now();
     EventTimer timer;

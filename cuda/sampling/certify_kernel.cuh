@@ -129,9 +129,10 @@ __global__ void __launch_bounds__(128, 7) certify_nearest(CertifyView v, Piece p
 
 /// What nearest_side() needs beside a point's candidates (the mesh, the certified winding
 /// sign's table and tree), and where a decided point's sample goes: `side` receives per
-/// point kNearestSideStored (decided, its sample stored in `out` as finalize_samples()
-/// would, with `band_width`, and counted in `nearest_count`) or kNearestSideOpen (the
-/// finalize decides); null: not asked (no table, another sign).
+/// point with a triangle kNearestSideStored (decided, its sample stored in `out` as
+/// finalize_samples() would, with `band_width`, and counted in `nearest_count`) or
+/// kNearestSideOpen (the finalize decides); points without one (outside the band) are not
+/// written, nor read. Null: not asked (no table, another sign).
 struct NearestSideInputs {
     MeshView<double> mesh{};
     SurfaceSideView surface{};

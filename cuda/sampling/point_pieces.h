@@ -71,7 +71,8 @@ struct PointListPiece {
 };
 
 /// Points sorted on the device (e.g. into Morton order): position i of the sorted list,
-/// whose result goes back to the input position original[begin + i].
+/// whose result goes back to the input position original[begin + i] (scattered), or by its
+/// rank (gathered, ResultOrder; original null).
 struct SortedPointListPiece {
     const Vec3d* sorted = nullptr;
     const int64_t* original = nullptr;  ///< null: results gathered by rank (ResultOrder), not scattered

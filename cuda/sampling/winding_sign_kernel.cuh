@@ -145,9 +145,8 @@ __device__ inline WindingEstimate<double> warp_certified_winding(const WindingVi
 
 /// The side of every lane's point (WindingSign::side's bits) with the warp's traversal for the
 /// first evaluation; the lanes it does not decide refine alone (certified_winding_refine).
-/// A lane whose side its closest triangle gave (`by_surface`, surface_side.h: by a walk, or
-/// from the search's candidates, `surface_stage`) passes it in `surface_inside` with wants =
-/// false. Counts the warp's points by stage, one atomic per stage and warp. Every lane must
+/// A lane whose side its closest triangle gave (`by_surface`, surface_side.h, counted as
+/// `surface_stage`) passes it in `surface_inside` with wants = false. Counts the warp's points by stage, one atomic per stage and warp. Every lane must
 /// call it.
 __device__ inline bool warp_winding_inside(const WindingSignView& w, const Vec3d& p, bool wants, bool by_surface = false,
                                            bool surface_inside = false, WindingStage surface_stage = WindingStage::Surface) {

@@ -324,8 +324,9 @@ SDF_CPU_GPU SDF_INLINE PlocCluster ploc_merged(const LbvhArrays& a, const PlocAr
 }
 
 /// Surviving cluster i of `from` (merged into node `id` where it starts a merge) stored at
-/// position `to` of the next iteration's arrays `next` (never `from`'s: a merge reads its
-/// neighbour there).
+/// position `to` of the next iteration's arrays `next`: other arrays than `from`'s, since a
+/// merge reads its neighbour there (the device's tail compacts in place instead, with a
+/// barrier between its reads and writes).
 SDF_CPU_GPU SDF_INLINE void ploc_merge_compact(const LbvhArrays& a, const PlocArrays& from, const PlocArrays& next, int i,
                                                bool merges, int id, int to) {
     ploc_store(next, to, merges ? ploc_merged(a, from, i, id) : ploc_cluster(from, i));

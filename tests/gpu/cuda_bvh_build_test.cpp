@@ -54,10 +54,13 @@ TEST(CudaBvhBuild, DeviceBuildEqualsTheHostEmulationBitForBit) {
         const PreparedMesh& mesh = *c.mesh;
         if (mesh.triangles().size() <= 4) continue;
         const cuda::DeviceMesh<double> dmesh(mesh.buffers<double>());
-        // PLOC three times: its last iterations in one block from the default cluster count,
-        // from 100 clusters, and never (a launch sequence per iteration): the same bytes.
+        // PLOC four times: its last iterations in one block from the default cluster count,
+        // from 6144 (the dragon's tail then starts at 5,370 clusters: all six chunks a
+        // thread), from 100 clusters, and never (a launch sequence per iteration): the same
+        // bytes.
         for (const auto& [builder, tail] : {std::pair{GpuBvhBuilder::Ploc, GpuBvhBuildOptions{}.ploc_tail_clusters},
-                                            std::pair{GpuBvhBuilder::Ploc, 100}, std::pair{GpuBvhBuilder::Ploc, 0},
+                                            std::pair{GpuBvhBuilder::Ploc, 6144}, std::pair{GpuBvhBuilder::Ploc, 100},
+                                            std::pair{GpuBvhBuilder::Ploc, 0},
                                             std::pair{GpuBvhBuilder::Lbvh, 0}}) {
         GpuBvhBuildOptions o;
         o.builder = builder;
