@@ -23,6 +23,28 @@ BoundCudaBvh::BoundCudaBvh(std::shared_ptr<const PreparedMesh> mesh, const Sampl
     if (kernel_ == BvhGpuKernel::Warp) warp_queue_.allocate(1);
 }
 
+namespace {
+
+/// The device tree's build options: the defaults, or for measurement SDF_GPU_BVH_MAX_LEAF
+/// (1 to 16) and SDF_GPU_PLOC_RADIUS (1 to 64). The field does not depend on the tree; its
+/// speed does.
+GpuBvhBuildOptions device_build_options() {
+    static const GpuBvhBuildOptions options = [] {
+        GpuBvhBuildOptions o;
+        const auto knob = [](const char* name, int lo, int hi, int fallback) {
+            const char* e = std::getenv(name);
+            const int v = e ? std::atoi(e) : 0;
+            return v >= lo && v <= hi ? v : fallback;
+        };
+        o.max_leaf = knob("SDF_GPU_BVH_MAX_LEAF", 1, 16, o.max_leaf);
+        o.ploc_radius = knob("SDF_GPU_PLOC_RADIUS", 1, 64, o.ploc_radius);
+        return o;
+    }();
+    return options;
+}
+
+}  // namespace
+
 unsigned long long* BoundCudaBvh::warp_queue() const {
     static const bool off = [] {
         const char* e = std::getenv("SDF_WARP_QUEUE");
@@ -75,7 +97,8 @@ bool BoundCudaBvh::build_on_device() {
     // host thread, another stream) made the build 1.5-2 ms slower and the first call no
     // faster (H100, docs/gpu-notes.md).
     auto dmesh = std::make_unique<DeviceMesh<double>>(mesh().buffers<double>());
-    std::unique_ptr<DeviceLbvh> lbvh = build_lbvh_on_device(mesh(), dmesh->view().vertices, dmesh->view().triangles);
+    const GpuBvhBuildOptions build = device_build_options();
+    std::unique_ptr<DeviceLbvh> lbvh = build_lbvh_on_device(mesh(), dmesh->view().vertices, dmesh->view().triangles, build);
     if (!lbvh || !lbvh->within_depth) {
         bvh_stats_["device_build_skipped"] = lbvh ? "the device tree is deeper than kBvhMaxDepth = " + std::to_string(kBvhMaxDepth) +
                                                         " (depth " + std::to_string(lbvh->stats.depth) + ")"
@@ -85,7 +108,9 @@ bool BoundCudaBvh::build_on_device() {
     sign_.prepare_mode(mesh());
     bvh_stats_ = lbvh->stats.to_json();
     bvh_stats_["built_on"] = "device";
-    bvh_stats_["builder"] = gpu_bvh_builder_name(GpuBvhBuildOptions{}.builder);
+    bvh_stats_["builder"] = gpu_bvh_builder_name(build.builder);
+    bvh_stats_["max_leaf"] = build.max_leaf;
+    bvh_stats_["ploc_radius"] = build.ploc_radius;
     bvh_stats_["device_seconds"] = lbvh->device_seconds;
     sign_.set_external_moments(lbvh->device_seconds, "device");
     auto dev = std::make_unique<DeviceBvh<T>>(std::move(lbvh), std::move(dmesh), mesh(), sign_);
