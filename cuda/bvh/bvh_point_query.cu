@@ -73,6 +73,16 @@ int list_points_per_thread(int64_t n, int sms) {
     return n / (32 * 2) >= 32 * resident_warps ? 2 : 1;
 }
 
+/// Whether each lane's search of a point list is seeded by its own descent
+/// (ListRuns::seeded); SDF_LIST_SEED=off walks unseeded, for measurement.
+bool list_seeded() {
+    static const bool off = [] {
+        const char* e = std::getenv("SDF_LIST_SEED");
+        return e != nullptr && std::strcmp(e, "off") == 0;
+    }();
+    return !off;
+}
+
 /// Whether the point lists' certified search lists its candidates for a re-rank after the
 /// walk (and the winding sign's nearest_side) instead of streaming them in double during it.
 /// SDF_LIST_CERTIFY=streamed keeps the streamed form, for measurement.
@@ -413,6 +423,7 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
     const ResultOrder result_order{rank.get()};
     PieceResults r(step);  // reused by every piece
     const int run = list_points_per_thread(step, multiprocessors());
+    const bool seeded = list_seeded();
     const StreamedCertify fused = streamed_certify(dev, kernel_, coordinate);
     const WindingSignView sign = dev.winding.view();
     const bool sides = sign.enabled() && sign.certify && sign.surface.front_winding != nullptr &&
@@ -445,11 +456,11 @@ void BoundCudaBvh::search_points(const DeviceBvh<T>& dev, const Vec3d* device_po
             nearest_triangle_bvh_candidates<T><<<blocks_for(layout.threads(), kBvhThreads), kBvhThreads>>>(
                 dev.view, layout, BandSearch{}, r.nearest.get(), nullptr);
         } else if (run == 1) {
-            warp(ListRuns<1>{list});
+            warp(ListRuns<1>{list, seeded});
         } else if (run == 2) {
-            warp(ListRuns<2>{list});
+            warp(ListRuns<2>{list, seeded});
         } else {
-            warp(ListLayout{list});
+            warp(ListLayout{list, seeded});
         }
         CUDA_CHECK_LAUNCH("nearest_triangle_bvh (sorted points)");
         if (!fused.exact) certify(dev, piece, coordinate, r.nearest.get());

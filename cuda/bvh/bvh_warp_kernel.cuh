@@ -52,6 +52,13 @@ struct ListRuns {
     static constexpr int kPoints = K;
     static constexpr bool kListsCandidates = true;  ///< the certificate may list (lists_candidates)
     PointListPiece piece;
+    /// Each lane's search seeded by its own root-to-leaf descent (seed_by_descent) before
+    /// the warp's walk. Morton order keeps most batches compact, but where the list is
+    /// sparse (points far off the surface, a jump of the curve) 32 consecutive points can lie
+    /// across the mesh; unseeded, the lanes far from where the shared walk went first kept
+    /// radii of that size, and the warp walked the union of those searches: one batch of a
+    /// 1M-point list outlasted all the others by 0.9 ms (docs/gpu-notes.md).
+    bool seeded = true;
     SDF_CPU_GPU int64_t threads() const { return (piece.size() + K - 1) / K; }
     SDF_CPU_GPU int points_of(int64_t t, int64_t& first) const {
         first = t * K;
@@ -197,6 +204,17 @@ __device__ SDF_INLINE void warp_brick_box(const BvhPacket<T, K>& pk, int count, 
     hi = Vec3<T>(warp_max(hi.x), warp_max(hi.y), warp_max(hi.z));
 }
 
+/// One batch's walk (every lane of the warp calls it): the warp's shared walk
+/// (warp_search), for a seeded point list (ListRuns::seeded) after each lane's own descent.
+template <typename T, typename Layout, typename Near>
+__device__ SDF_INLINE void walk_batch(const BvhView<T>& bvh, const Layout& layout, BvhPacket<T, Layout::kPoints>& pk,
+                                      int count, int32_t* stack_node, T* stack_d2, Near& policy) {
+    if constexpr (lists_candidates<Layout>::value) {
+        if (layout.seeded) seed_by_descent(bvh, pk, policy);
+    }
+    warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
+}
+
 /// Narrow band: by 1-Lipschitz continuity every point p of the brick has |d(p)| >= |d(c)| -
 /// |p - c| for the box's centre c; when that bound (less a rounding allowance relative to the
 /// coordinates: the float search is exact relative to them) exceeds the band's width, the
@@ -332,15 +350,15 @@ __device__ SDF_INLINE void warp_search_batch(const BvhView<T>& bvh, const Layout
     }
     if constexpr (kListed) {
         ListedRun<Layout> policy(cert.slack, RunPoint<Layout>{layout, first, count}, lists, first, count);
-        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
+        walk_batch(bvh, layout, pk, count, stack_node, stack_d2, policy);
         write_nearest<true, true>(bvh, pk, policy, first, count, cert, nearest);
     } else if constexpr (kCertified) {
         StreamedRun<Layout> policy(cert.slack, cert.exact, RunPoint<Layout>{layout, first, count});
-        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
+        walk_batch(bvh, layout, pk, count, stack_node, stack_d2, policy);
         write_nearest<true>(bvh, pk, policy, first, count, cert, nearest);
     } else {
         PacketPlainNear policy;
-        warp_search(bvh, pk, count > 0, stack_node, stack_d2, policy);
+        walk_batch(bvh, layout, pk, count, stack_node, stack_d2, policy);
         write_nearest<false>(bvh, pk, policy, first, count, cert, nearest);
     }
 }

@@ -258,6 +258,48 @@ SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* se
     }
 }
 
+/// Seeds every lane of `pk` that has a point (best_q >= 0) with the nearest triangle of the
+/// leaf its own greedy descent reaches (at each node the child whose box is nearer to the
+/// lane's point): one root-to-leaf path per lane, after which a packet or warp walk starts
+/// with every radius finite and near its final value, so no lane's search depends on where
+/// the other lanes' searches lead first. The seed is a best like any other: its leaf lies
+/// within the radius, so the walk scans it again and a certified policy offers it then.
+template <typename T, int K, typename Near>
+SDF_CPU_GPU SDF_INLINE void seed_by_descent(const BvhView<T>& bvh, BvhPacket<T, K>& pk, const Near& near) {
+    for (int k = 0; k < K; ++k) {
+        if (!(pk.best_q[k] >= T(0))) continue;  // no point in this lane
+        const T x = pk.x[k], y = pk.y[k], z = pk.z[k];
+        int32_t node = 0, first = 0, count = 0;
+        for (;;) {
+            const BvhNode n = bvh.nodes[node];
+            T d[2];
+            for (int c = 0; c < 2; ++c) {
+                const T gx = axis_gap(T(n.min_x[c]), T(n.max_x[c]), x), gy = axis_gap(T(n.min_y[c]), T(n.max_y[c]), y);
+                const T gz = axis_gap(T(n.min_z[c]), T(n.max_z[c]), z);
+                d[c] = gx * gx + gy * gy + gz * gz;
+            }
+            const bool second = d[1] < d[0];  // an empty child's inverted box is +inf away
+            const int32_t ref = second ? n.ref[1] : n.ref[0];
+            count = second ? n.count[1] : n.count[0];
+            if (bvh_child_is_leaf(ref, count)) {
+                first = ref;
+                break;
+            }
+            node = ref;
+        }
+        for (int32_t j = first; j < first + count; ++j) {
+            const T q = squared_distance(bvh.packed[j], x, y, z);
+            const int32_t triangle = bvh.triangle_index[j];
+            if (q < pk.best_q[k] || (q == pk.best_q[k] && wins_tie(triangle, pk.best_triangle[k]))) {
+                pk.best_q[k] = q;
+                pk.best_slot[k] = j;
+                pk.best_triangle[k] = triangle;
+            }
+        }
+        pk.radius[k] = bvh.margin.widen(near.radius(pk.best_q[k]));
+    }
+}
+
 namespace detail {
 
 /// closest_triangles_packet()'s query for nearest_first_walk(): a child is wanted when it is

@@ -162,7 +162,9 @@ BvhPacket<float, K> unsearched_packet(const PointOf& point_of) {
 /// the same points 4 copies to a packet (every lane ties with the others). Every lane's
 /// triangle is the double brute force's; the fan plate's centre vertex (dozens of triangles
 /// tied exactly) overflows the two deferred candidates, so the streamed double re-rank runs.
-TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
+/// `seeded`: each lane first takes the nearest triangle of its own descent (seed_by_descent,
+/// the GPU point lists' seeds), which the walk must still offer as a candidate.
+void check_streamed_packets(bool seeded) {
     constexpr int K = 4;
     int64_t streamed_lanes = 0, single_lanes = 0;
     for (const AdversarialCase& c : adversarial_cases(2026, 1500)) {
@@ -182,6 +184,7 @@ TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
                 const auto point_of = [&](int k) { return c.points[index[k]]; };
                 BvhPacket<float, K> pk = unsearched_packet<K>(point_of);
                 StreamedCertifiedNear<float, K, decltype(point_of)> near(slack, bvh.packed_double.data(), point_of);
+                if (seeded) seed_by_descent(view, pk, near);
                 NoBvhStats none;
                 closest_triangles_packet(view, pk, none, near);
                 for (int k = 0; k < K; ++k) {
@@ -197,11 +200,13 @@ TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
         }
         EXPECT_EQ(bad, 0) << c.mesh.name;
     }
-    std::printf("streamed packets: %lld lanes streamed, %lld certified without double work\n", (long long)streamed_lanes,
-                (long long)single_lanes);
+    std::printf("streamed packets%s: %lld lanes streamed, %lld certified without double work\n", seeded ? ", seeded" : "",
+                (long long)streamed_lanes, (long long)single_lanes);
     EXPECT_GT(streamed_lanes, 0);
     EXPECT_GT(single_lanes, 0);
 }
+
+TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) { check_streamed_packets(false); }
 
 /// The listed form (NearListAppend, the GPU point lists'): the same packets, each lane's
 /// candidates written to its list and re-ranked after the search (rerank_near_list). Every
@@ -210,8 +215,8 @@ TEST(CertifiedSearch, StreamedPacketEqualsDoubleBruteForce) {
 /// than the float winner is among the live candidates nearest_side() receives. With lists of
 /// two entries (`slots`) nearly every lane fills its list: the entries a full list drops
 /// (beyond the radius of their time, or its largest, remembered) must never lose a candidate
-/// of a lane that does not overflow.
-void check_listed_packets(int slots) {
+/// of a lane that does not overflow. `seeded` as check_streamed_packets().
+void check_listed_packets(int slots, bool seeded = false) {
     constexpr int K = 4;
     int64_t listed_lanes = 0, single_lanes = 0, overflows = 0;
     for (const AdversarialCase& c : adversarial_cases(2026, 1500)) {
@@ -238,6 +243,7 @@ void check_listed_packets(int slots) {
                 const auto point_of = [&](int k) { return c.points[index[k]]; };
                 BvhPacket<float, K> pk = unsearched_packet<K>(point_of);
                 ListedCertifiedNear<float, K, decltype(point_of)> near(slack, point_of, lists, 0, K);
+                if (seeded) seed_by_descent(view, pk, near);
                 NoBvhStats none;
                 closest_triangles_packet(view, pk, none, near);
                 for (int k = 0; k < K; ++k) {
@@ -270,8 +276,8 @@ void check_listed_packets(int slots) {
         EXPECT_EQ(bad, 0) << c.mesh.name;
         EXPECT_EQ(missing, 0) << c.mesh.name;
     }
-    std::printf("listed packets, %d entries: %lld lanes with several live candidates, %lld certified without double work, "
-                "%lld overflows\n", slots, (long long)listed_lanes, (long long)single_lanes, (long long)overflows);
+    std::printf("listed packets, %d entries%s: %lld lanes with several live candidates, %lld certified without double work, "
+                "%lld overflows\n", slots, seeded ? ", seeded" : "", (long long)listed_lanes, (long long)single_lanes, (long long)overflows);
     EXPECT_GT(listed_lanes, 0);
     EXPECT_GT(single_lanes, 0);
     EXPECT_GT(overflows, 0);
@@ -279,6 +285,14 @@ void check_listed_packets(int slots) {
 
 TEST(CertifiedSearch, ListedPacketEqualsDoubleBruteForce) { check_listed_packets(kNearListSlots); }
 TEST(CertifiedSearch, ShortListsDropOnlyWhatTheyRemember) { check_listed_packets(2); }
+
+/// The GPU point lists seed every lane by its own descent before the walk: the seed is a best
+/// like any other, and every candidate still reaches the list (or the streamed re-rank).
+TEST(CertifiedSearch, SeededPacketsEqualDoubleBruteForce) {
+    check_streamed_packets(true);
+    check_listed_packets(kNearListSlots, true);
+    check_listed_packets(2, true);
+}
 
 /// Lattices take the same path with bricks (packets) and per-point seeds: a lattice hugging
 /// the cube's top face 1e-4 above it, and the fan plate's whole box.
