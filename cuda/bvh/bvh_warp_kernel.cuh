@@ -126,7 +126,7 @@ struct WarpNearestQuery {
     BvhPacket<T, K>& pk;
     bool valid;
     Near& policy;
-    T worst;  ///< the warp's largest radius: +inf, or a bounded search's bound
+    T worst;  ///< the warp's largest radius: +inf, a seeded lane's, or a bounded search's bound
     bool scanned = false;
     T mine = T(-1);  ///< the thread's largest radius after a scan
     __device__ SDF_INLINE ChildOrder<T> measure(const BvhNode& n) {
@@ -158,7 +158,7 @@ struct WarpNearestQuery {
 template <typename T, int K, typename Near>
 __device__ SDF_INLINE void warp_search(const BvhView<T>& bvh, BvhPacket<T, K>& pk, bool valid, int32_t* stack_node,
                                        T* stack_d2, Near& policy) {
-    T worst = T(-1);  // the lanes' radii: +inf, or a bounded search's bound
+    T worst = T(-1);  // the lanes' radii as they are (+inf, seeded, or a bounded search's bound)
     for (int k = 0; k < K; ++k) worst = max(worst, pk.radius[k]);
     detail::WarpNearestQuery<T, K, Near> q{bvh, pk, valid, policy, warp_max(valid ? worst : T(-1))};
     detail::WarpStack<T> stack{stack_node, stack_d2};

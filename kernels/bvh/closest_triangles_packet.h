@@ -261,9 +261,12 @@ SDF_CPU_GPU SDF_INLINE void seed_packet(const BvhView<T>& bvh, const int32_t* se
 /// Seeds every lane of `pk` that has a point (best_q >= 0) with the nearest triangle of the
 /// leaf its own greedy descent reaches (at each node the child whose box is nearer to the
 /// lane's point): one root-to-leaf path per lane, after which a packet or warp walk starts
-/// with every radius finite and near its final value, so no lane's search depends on where
-/// the other lanes' searches lead first. The seed is a best like any other: its leaf lies
-/// within the radius, so the walk scans it again and a certified policy offers it then.
+/// with its radius near its final value, so no lane's search depends on where the other
+/// lanes' searches lead first. The radius is set through `near`, as the walk that follows
+/// takes the lanes' radii as they are (warp_search does not refresh them). The seed is a best
+/// like any other: under a certified policy its leaf lies within the radius (the bound that
+/// brings the walk to the double search's triangle), so the walk scans it again and offers
+/// it then; the plain search may prune it, and keeps it as its best.
 template <typename T, int K, typename Near>
 SDF_CPU_GPU SDF_INLINE void seed_by_descent(const BvhView<T>& bvh, BvhPacket<T, K>& pk, const Near& near) {
     for (int k = 0; k < K; ++k) {

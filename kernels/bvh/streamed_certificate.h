@@ -15,8 +15,10 @@
 ///     double Q folded into the lane's running double minimum;
 /// and at the end the deferred ones within R are evaluated and folded in too. A lane that
 /// streamed nothing and ends with one deferred candidate within R has only the float winner
-/// (which is always offered: its ranked Q is at most its Q, at most radius(Q)): that is t*,
-/// certified without any double work. Extra double evaluations of triangles beyond R (a
+/// (which is always offered: its ranked Q is at most its Q, at most radius(Q); a seeded best,
+/// seed_by_descent, is offered when the walk meets it again, as its leaf is within the
+/// certified radius by the same bound that brings the walk to t*): that is t*, certified
+/// without any double work. Extra double evaluations of triangles beyond R (a
 /// streamed one the radius later passed) never change the argmin: t* is in the set.
 ///
 /// Compared with the separate certify pass (cuda/sampling/certify_kernel.cuh): no second traversal,
